@@ -1,0 +1,39 @@
+// build/terrain: the engine's command-line tool.
+#include <cstdio>
+#include <exception>
+#include <vector>
+
+#include "render/app/commands.h"
+#include "sim/error.h"
+
+int main(int argc, char** argv) {
+    CLI::App app{"terrain: a dynamic terrain engine (erosion, waves, global illumination on height fields)"};
+    app.require_subcommand(1);
+    app.set_help_all_flag("--help-all", "Print help for every subcommand");
+    std::vector<std::pair<CLI::App*, terrain::app::Runner>> commands;
+    auto add = [&](terrain::app::Runner (*f)(CLI::App&)) {
+        const std::size_t before = app.get_subcommands({}).size();
+        terrain::app::Runner r = f(app);
+        auto subs = app.get_subcommands({});
+        if (subs.size() > before) commands.emplace_back(subs.back(), std::move(r));
+    };
+    add(&terrain::app::addSimCommand);
+    add(&terrain::app::addGiCommand);
+    add(&terrain::app::addDemoCommand);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    }
+    try {
+        for (auto& [sub, run] : commands)
+            if (sub->parsed()) return run();
+    } catch (const terrain::Error& e) {
+        std::fprintf(stderr, "terrain: error: %s\n", e.what());
+        return 1;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "terrain: error: %s\n", e.what());
+        return 1;
+    }
+    return 1;
+}

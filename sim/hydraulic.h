@@ -1,0 +1,48 @@
+#pragma once
+// Hydraulic erosion with the virtual-pipe model of Mei, Decaudin & Hu 2007
+// ("Fast Hydraulic Erosion Simulation and Visualization on GPU"), with a
+// conservative (flux-form) sediment transport instead of the paper's
+// semi-Lagrangian step, which creates and destroys sediment.
+//
+// One step, each pass a gather over cells (no pass reads what it writes):
+//   1. rain (+ optional water sources)
+//   2. outflow fluxes through four pipes, scaled so depth never goes negative
+//   3. water update from the net volume change, velocity field
+//   4. sediment capacity C = Kc * max(sin(tilt), minTilt) * |v| * depthFactor;
+//      dissolve soil (then bedrock, scaled by bedrockHardness) or deposit
+//   5. sediment transport in flux form with the step-2 fluxes (exact mass
+//      balance: what leaves one cell enters its neighbour)
+//   6. evaporation
+#include "sim/terrain.h"
+
+namespace terrain {
+
+struct HydraulicSettings {
+    float gravity = 9.81f;          // m/s^2
+    float pipeArea = 1.0f;          // pipe cross-section, in units of cellSize^2 (scaled by cellSize^2)
+    float rainRate = 2.0e-5f;       // m/s of water added everywhere (0 = no rain)
+    float capacity = 1.0f;          // Kc, sediment capacity constant
+    float dissolve = 0.5f;          // Ks, 1/s fraction of the capacity deficit dissolved per second
+    float deposit = 1.0f;           // Kd, 1/s fraction of the excess deposited per second
+    float evaporation = 0.015f;     // Ke, 1/s fraction of water evaporated per second
+    float minTilt = 0.05f;          // lower bound on sin(tilt) in the capacity, so flat cells still erode a little
+    float bedrockHardness = 0.3f;   // Ks multiplier for bedrock once the soil is gone (0..1)
+    float maxErosionDepth = 10.0f;  // m, water depth beyond which capacity stops growing (depth limiter)
+    bool closedBoundary = true;     // true: no flux leaves the domain
+};
+
+/// Per-run scratch buffers (explicit state, reused across ticks).
+struct HydraulicScratch {
+    Grid a, b;  // temporaries sized nx x ny on first use
+};
+
+/// The largest stable time step (s) for the pipe model on this terrain:
+/// the flux update is explicit, so dt <= cellSize / sqrt(g * maxDepth) style
+/// limits apply (documented in the implementation).
+float hydraulicMaxDt(const TerrainState& s, const HydraulicSettings& settings);
+
+/// Advances water, fluxes, velocity, soil, bedrock and suspended sediment by dt.
+/// Requires the layers water, sediment and pipes.
+void hydraulicStep(TerrainState& s, const HydraulicSettings& settings, float dt, HydraulicScratch& scratch);
+
+}  // namespace terrain

@@ -1,0 +1,72 @@
+#pragma once
+// The only place that includes TBB. Parallel loops hand the body a chunk
+// [begin, end) (pbrt style). Reductions are deterministic: the range is cut
+// into fixed chunks that do not depend on the thread count, each chunk is
+// reduced serially, and the partial results are combined in chunk order, so
+// the result is bit-identical for any number of threads.
+#include <algorithm>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+namespace terrain {
+
+/// Calls fn(begin, end) over chunks of [begin, end), in parallel.
+/// Bodies must write only data owned by their indices (gather, never scatter).
+template <class Fn>
+void parallelFor(int begin, int end, int grain, Fn&& fn) {
+    if (end <= begin) return;
+    grain = std::max(grain, 1);
+    if (end - begin <= grain) {
+        fn(begin, end);
+        return;
+    }
+    tbb::parallel_for(tbb::blocked_range<int>(begin, end, grain),
+                      [&](const tbb::blocked_range<int>& r) { fn(r.begin(), r.end()); });
+}
+
+/// Rows [0, ny) in parallel, with a grain that keeps chunks around 16k cells.
+template <class Fn>
+void parallelForRows(int ny, int nx, Fn&& fn) {
+    const int grain = std::max(1, 16384 / std::max(nx, 1));
+    parallelFor(0, ny, grain, std::forward<Fn>(fn));
+}
+
+/// Deterministic reduction over [begin, end) with chunks of fixed size.
+/// map(b, e) -> T reduces one chunk serially; combine(T, T) -> T folds the
+/// partial results in chunk order.
+template <class T, class Map, class Combine>
+T deterministicReduce(int begin, int end, int chunk, T init, Map&& map, Combine&& combine) {
+    if (end <= begin) return init;
+    chunk = std::max(chunk, 1);
+    const int nChunks = (end - begin + chunk - 1) / chunk;
+    std::vector<T> partial(static_cast<std::size_t>(nChunks), init);
+    tbb::parallel_for(tbb::blocked_range<int>(0, nChunks, 1), [&](const tbb::blocked_range<int>& r) {
+        for (int c = r.begin(); c < r.end(); ++c) {
+            const int b = begin + c * chunk;
+            const int e = std::min(end, b + chunk);
+            partial[static_cast<std::size_t>(c)] = map(b, e);
+        }
+    });
+    T acc = init;
+    for (const T& p : partial) acc = combine(acc, p);
+    return acc;
+}
+
+/// Runs fn with exactly `threads` worker threads (0 = all hardware threads).
+/// Only mains, tests and benchmarks call this (GUIDE 2).
+template <class Fn>
+auto withThreads(int threads, Fn&& fn) -> decltype(fn()) {
+    if (threads <= 0) return fn();
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+    tbb::task_arena arena(threads);
+    return arena.execute([&] { return fn(); });
+}
+
+}  // namespace terrain
