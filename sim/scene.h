@@ -1,0 +1,117 @@
+#pragma once
+// Scenes: what a terrain is made of, which simulators run on it, and the
+// fixed time step. A scene runs only the stages it declares (model only what
+// a scene needs): no water layers without water, no erosion without erosion.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "sim/generators.h"
+#include "sim/hydraulic.h"
+#include "sim/terrain.h"
+#include "sim/thermal.h"
+#include "sim/waves.h"
+
+namespace terrain {
+
+/// Where the initial ground comes from.
+struct TerrainSource {
+    enum class Kind { Noise, Shape, Dem };
+    Kind kind = Kind::Noise;
+    NoiseSettings noise;
+    ShapeSettings shape;
+    std::string demFile;       // .png (16-bit greyscale) or .vdb
+    float demZScale = 1.0f;    // m per 16-bit step (PNG only)
+    float demZOffset = 0.0f;   // m (PNG only)
+    float demCellSize = 0.0f;  // m; 0 = from the .vdb, required for a .png
+    bool demResample = true;   // resample the DEM to the scene size keeping its extent
+};
+
+struct SceneSettings {
+    std::string name = "erosion";
+    int nx = 256;
+    int ny = 256;
+    float cellSize = 10.0f;  // m
+    std::uint64_t seed = 1;
+    TerrainSource terrain;
+    float soilDepth = 0.0f;    // m of loose material laid on the generated ground
+    bool hasWaterLevel = false;
+    float waterLevel = 0.0f;   // m: fill water up to this surface level at start
+
+    bool hydraulic = false;
+    bool thermal = false;
+    bool waves = false;
+    HydraulicSettings hydraulicSettings;
+    ThermalSettings thermalSettings;
+    WaveSettings waveSettings;
+
+    float dt = 0.0f;      // s; 0 = the default, derived from the CFL limits
+    int changeTile = 32;  // cells per side of a change-tracking tile
+};
+
+/// The built-in scenes: "erosion", "waves", "dem". size is the grid side
+/// (nx = ny = size). dem uses demFile, or the Mont Blanc DEM in shared/data.
+SceneSettings builtinScene(const std::string& name, int size, std::uint64_t seed);
+
+/// Names of the built-in scenes.
+std::vector<std::string> builtinSceneNames();
+
+/// Reads a TOML scene file; it may start from a built-in (`base = "erosion"`)
+/// and set anything a built-in sets. Unknown keys are errors.
+SceneSettings loadSceneFile(const std::string& file);
+
+/// A built-in name, or a path to a .toml scene file.
+SceneSettings resolveScene(const std::string& nameOrFile, int size, std::uint64_t seed);
+
+/// What changed in the last tick, for later stages (GI rebuilds only dirty tiles).
+struct ChangeReport {
+    int tileSize = 32;
+    int tilesX = 0;
+    int tilesY = 0;
+    std::vector<std::uint8_t> dirty;  // tilesX * tilesY, 1 = the ground changed in the tile
+    float maxGroundChange = 0.0f;     // m, largest |d(bedrock + soil)| this tick
+    float maxWaterChange = 0.0f;      // m, largest |d water| this tick (0 without water)
+    int dirtyCount = 0;
+};
+
+/// A running simulation: the terrain state and the fixed-step tick.
+class Simulation {
+public:
+    explicit Simulation(const SceneSettings& settings);
+
+    /// Advances one fixed time step (sub-stepped when the state's current
+    /// stability limit drops below it) and updates the change report.
+    void tick();
+
+    const TerrainState& state() const { return state_; }
+    TerrainState& state() { return state_; }
+    const SceneSettings& settings() const { return settings_; }
+    const ChangeReport& changes() const { return changes_; }
+    float dt() const { return dt_; }
+    /// The CFL-derived limit at start, and whether the requested dt was clamped to it.
+    float dtLimit() const { return dtLimit_; }
+    bool dtClamped() const { return dtClamped_; }
+    int lastSubsteps() const { return lastSubsteps_; }
+
+private:
+    float stableDt() const;
+    void updateChanges();
+
+    SceneSettings settings_;
+    TerrainState state_;
+    HydraulicScratch hydraulicScratch_;
+    ThermalScratch thermalScratch_;
+    WaveScratch waveScratch_;
+    Grid prevGround_, prevWater_;
+    std::vector<float> tileGround_, tileWater_;  // per-tile max |dh| of the last tick
+    ChangeReport changes_;
+    float dt_ = 0.0f;
+    float dtLimit_ = 0.0f;
+    bool dtClamped_ = false;
+    int lastSubsteps_ = 1;
+};
+
+/// Builds the initial ground for a scene (exposed for tests and tools).
+void buildInitialTerrain(const SceneSettings& s, TerrainState& state);
+
+}  // namespace terrain

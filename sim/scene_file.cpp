@@ -1,0 +1,284 @@
+// TOML scene files (toml++). A scene file may start from a built-in scene
+// and set anything a built-in sets; unknown keys and wrong types are errors,
+// so a typo never silently does nothing.
+//
+//   name = "my-bay"
+//   base = "waves"            # optional: start from a built-in
+//   size = 300                # or [nx, ny]
+//   cell_size = 1.5           # m
+//   seed = 7
+//   dt = 0.0                  # s, 0 = derived from the CFL limits
+//   change_tile = 32
+//   soil_depth = 2.0          # m
+//   water_level = 0.0         # m, fill water up to this level
+//   [terrain]  kind = "noise" | "shape" | "dem", plus the generator's keys
+//   [hydraulic] enabled = true, ...   [thermal] ...   [waves] ...
+//   [waves.swell] ...   [[waves.drops]] ...
+#include <toml++/toml.h>
+
+#include <cmath>
+#include <filesystem>
+#include <set>
+
+#include "sim/error.h"
+#include "sim/scene.h"
+
+namespace terrain {
+namespace {
+
+// Reads keys from one TOML table, remembering which were used.
+class TableReader {
+public:
+    TableReader(const toml::table& t, std::string file, std::string path)
+        : t_(t), file_(std::move(file)), path_(std::move(path)) {}
+
+    void num(const char* key, float& out) {
+        if (const toml::node* n = get(key)) {
+            if (auto v = n->value<double>()) out = static_cast<float>(*v);
+            else fail(key, "a number");
+            if (!std::isfinite(out)) fail(key, "a finite number");
+        }
+    }
+    void num(const char* key, double& out) {
+        if (const toml::node* n = get(key)) {
+            if (auto v = n->value<double>()) out = *v;
+            else fail(key, "a number");
+        }
+    }
+    void integer(const char* key, int& out) {
+        if (const toml::node* n = get(key)) {
+            if (auto v = n->value<std::int64_t>()) out = static_cast<int>(*v);
+            else fail(key, "an integer");
+        }
+    }
+    void flag(const char* key, bool& out) {
+        if (const toml::node* n = get(key)) {
+            if (auto v = n->value<bool>()) out = *v;
+            else fail(key, "true or false");
+        }
+    }
+    void text(const char* key, std::string& out) {
+        if (const toml::node* n = get(key)) {
+            if (auto v = n->value<std::string>()) out = *v;
+            else fail(key, "a string");
+        }
+    }
+    const toml::node* get(const char* key) {
+        used_.insert(key);
+        return t_.get(key);
+    }
+    const toml::table* table(const char* key) {
+        if (const toml::node* n = get(key)) {
+            if (const toml::table* tt = n->as_table()) return tt;
+            fail(key, "a table");
+        }
+        return nullptr;
+    }
+    [[noreturn]] void fail(const std::string& key, const std::string& expected) const {
+        throw IoError(file_, "'" + path_ + key + "' must be " + expected);
+    }
+    void finish() const {
+        for (auto&& [k, v] : t_) {
+            (void)v;
+            if (!used_.count(std::string(k.str())))
+                throw IoError(file_, "unknown key '" + path_ + std::string(k.str()) + "'");
+        }
+    }
+    const std::string& file() const { return file_; }
+
+private:
+    const toml::table& t_;
+    std::string file_;
+    std::string path_;
+    std::set<std::string> used_;
+};
+
+int parseEdge(const std::string& file, const std::string& e) {
+    if (e == "-x") return 0;
+    if (e == "+x") return 1;
+    if (e == "-y") return 2;
+    if (e == "+y") return 3;
+    throw IoError(file, "'waves.swell.edge' must be one of -x, +x, -y, +y (got '" + e + "')");
+}
+
+void readTerrain(TableReader& r, const toml::table& t, SceneSettings& s) {
+    TableReader tr(t, r.file(), "terrain.");
+    std::string kind;
+    tr.text("kind", kind);
+    if (!kind.empty()) {
+        if (kind == "noise") s.terrain.kind = TerrainSource::Kind::Noise;
+        else if (kind == "shape") s.terrain.kind = TerrainSource::Kind::Shape;
+        else if (kind == "dem") s.terrain.kind = TerrainSource::Kind::Dem;
+        else tr.fail("kind", "\"noise\", \"shape\" or \"dem\"");
+    }
+    NoiseSettings& n = s.terrain.noise;
+    tr.num("amplitude", n.amplitude);
+    tr.num("wavelength", n.wavelength);
+    tr.integer("octaves", n.octaves);
+    tr.num("lacunarity", n.lacunarity);
+    tr.num("gain", n.gain);
+    tr.flag("ridged", n.ridged);
+    tr.num("offset", n.offset);
+    ShapeSettings& sh = s.terrain.shape;
+    std::string shape;
+    tr.text("shape", shape);
+    if (!shape.empty()) {
+        try {
+            sh.shape = parseShape(shape);
+        } catch (const InputError& e) {
+            throw IoError(r.file(), std::string("terrain.shape: ") + e.what());
+        }
+    }
+    tr.num("base", sh.base);
+    tr.num("height", sh.height);
+    tr.num("radius", sh.radius);
+    tr.num("ridge_wavelength", sh.wavelength);
+    tr.num("angle", sh.angleDeg);
+    std::string file;
+    tr.text("file", file);
+    if (!file.empty()) {
+        // relative paths are relative to the scene file
+        std::filesystem::path p(file);
+        if (p.is_relative()) p = std::filesystem::path(r.file()).parent_path() / p;
+        s.terrain.demFile = p.string();
+    }
+    tr.num("z_scale", s.terrain.demZScale);
+    tr.num("z_offset", s.terrain.demZOffset);
+    tr.num("cell_size", s.terrain.demCellSize);
+    tr.flag("resample", s.terrain.demResample);
+    tr.finish();
+}
+
+void readHydraulic(const std::string& file, const toml::table& t, SceneSettings& s) {
+    TableReader r(t, file, "hydraulic.");
+    HydraulicSettings& h = s.hydraulicSettings;
+    r.flag("enabled", s.hydraulic);
+    r.num("gravity", h.gravity);
+    r.num("pipe_area", h.pipeArea);
+    r.num("rain_rate", h.rainRate);
+    r.num("capacity", h.capacity);
+    r.num("dissolve", h.dissolve);
+    r.num("deposit", h.deposit);
+    r.num("evaporation", h.evaporation);
+    r.num("min_tilt", h.minTilt);
+    r.num("bedrock_hardness", h.bedrockHardness);
+    r.num("max_erosion_depth", h.maxErosionDepth);
+    r.flag("closed_boundary", h.closedBoundary);
+    r.finish();
+}
+
+void readThermal(const std::string& file, const toml::table& t, SceneSettings& s) {
+    TableReader r(t, file, "thermal.");
+    r.flag("enabled", s.thermal);
+    r.num("talus_deg", s.thermalSettings.talusAngleDeg);
+    r.num("rate", s.thermalSettings.rate);
+    r.flag("erode_bedrock", s.thermalSettings.erodeBedrock);
+    r.finish();
+}
+
+void readWaves(const std::string& file, const toml::table& t, SceneSettings& s) {
+    TableReader r(t, file, "waves.");
+    WaveSettings& w = s.waveSettings;
+    r.flag("enabled", s.waves);
+    r.num("gravity", w.gravity);
+    r.num("courant", w.courant);
+    r.num("dry_depth", w.dryDepth);
+    r.num("friction", w.friction);
+    r.flag("advection", w.advection);
+    if (const toml::table* sw = r.table("swell")) {
+        TableReader q(*sw, file, "waves.swell.");
+        w.swell.enabled = true;
+        q.flag("enabled", w.swell.enabled);
+        std::string edge;
+        q.text("edge", edge);
+        if (!edge.empty()) w.swell.edge = parseEdge(file, edge);
+        q.num("amplitude", w.swell.amplitude);
+        q.num("period", w.swell.period);
+        q.finish();
+    }
+    if (const toml::node* d = r.get("drops")) {
+        const toml::array* arr = d->as_array();
+        if (!arr) r.fail("drops", "an array of tables ([[waves.drops]])");
+        w.drops.clear();
+        for (const toml::node& item : *arr) {
+            const toml::table* dt = item.as_table();
+            if (!dt) r.fail("drops", "an array of tables ([[waves.drops]])");
+            TableReader q(*dt, file, "waves.drops.");
+            WaveDrop drop;
+            q.num("time", drop.time);
+            q.num("x", drop.x);
+            q.num("y", drop.y);
+            q.num("radius", drop.radius);
+            q.num("height", drop.height);
+            q.finish();
+            w.drops.push_back(drop);
+        }
+    }
+    r.finish();
+}
+
+}  // namespace
+
+SceneSettings loadSceneFile(const std::string& file) {
+    if (!std::filesystem::exists(file)) throw IoError(file, "cannot open: no such file");
+    toml::table root;
+    try {
+        root = toml::parse_file(file);
+    } catch (const toml::parse_error& e) {
+        const auto& b = e.source().begin;
+        throw IoError(file, "TOML syntax error at line " + std::to_string(b.line) + ", column " +
+                                std::to_string(b.column) + ": " + std::string(e.description()));
+    }
+    TableReader r(root, file, "");
+    std::string base;
+    r.text("base", base);
+    int nx = 256, ny = 256;
+    if (const toml::node* sz = r.get("size")) {
+        if (auto v = sz->value<std::int64_t>()) nx = ny = static_cast<int>(*v);
+        else if (const toml::array* a = sz->as_array(); a && a->size() == 2 && a->get(0)->is_integer() &&
+                                                       a->get(1)->is_integer()) {
+            nx = static_cast<int>(*a->get(0)->value<std::int64_t>());
+            ny = static_cast<int>(*a->get(1)->value<std::int64_t>());
+        } else {
+            r.fail("size", "an integer or [nx, ny]");
+        }
+    }
+    SceneSettings s;
+    if (!base.empty()) {
+        try {
+            s = builtinScene(base, std::max(nx, ny), 1);
+        } catch (const InputError& e) {
+            throw IoError(file, std::string("base: ") + e.what());
+        }
+    } else {
+        s.terrain.kind = TerrainSource::Kind::Noise;
+    }
+    s.nx = nx;
+    s.ny = ny;
+    s.name = std::filesystem::path(file).stem().string();
+    r.text("name", s.name);
+    r.num("cell_size", s.cellSize);
+    int seed = static_cast<int>(s.seed);
+    r.integer("seed", seed);
+    s.seed = static_cast<std::uint64_t>(seed);
+    r.num("dt", s.dt);
+    r.integer("change_tile", s.changeTile);
+    r.num("soil_depth", s.soilDepth);
+    if (r.get("water_level")) {
+        s.hasWaterLevel = true;
+        r.num("water_level", s.waterLevel);
+    }
+    if (const toml::table* t = r.table("terrain")) readTerrain(r, *t, s);
+    if (const toml::table* t = r.table("hydraulic")) readHydraulic(file, *t, s);
+    if (const toml::table* t = r.table("thermal")) readThermal(file, *t, s);
+    if (const toml::table* t = r.table("waves")) readWaves(file, *t, s);
+    r.finish();
+    try {
+        checkDimensions(s.nx, s.ny, s.cellSize);
+    } catch (const InputError& e) {
+        throw IoError(file, e.what());
+    }
+    return s;
+}
+
+}  // namespace terrain
