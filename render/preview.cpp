@@ -61,8 +61,24 @@ void shadePreview(const TerrainState& s, const PreviewSettings& p, std::vector<s
                 if (water) {
                     const float d = s.water(x, y);
                     if (d > 1e-3f) {
+                        // The water surface, lit by its own normal (exaggerated so small
+                        // waves show) with a Fresnel-like sky sheen.
+                        auto eta = [&](int xx, int yy) {
+                            xx = std::clamp(xx, 0, nx - 1);
+                            yy = std::clamp(yy, 0, ny - 1);
+                            const float w = s.water(xx, yy);
+                            return w > 1e-3f ? s.ground(xx, yy) + w : s.ground(x, y) + d;
+                        };
+                        const float k = 8.0f * inv2h;
+                        const float ex = (eta(x + 1, y) - eta(x - 1, y)) * k;
+                        const float ey = (eta(x, y + 1) - eta(x, y - 1)) * k;
+                        const float wi = 1.0f / std::sqrt(ex * ex + ey * ey + 1.0f);
+                        const float ws = std::max(0.0f, (-ex * sx - ey * sy + sz) * wi);
                         const float a = 1.0f - std::exp(-d / 1.5f);
-                        c = lerp(c, {0.03f, 0.12f, 0.25f}, 0.25f + 0.7f * a);
+                        const Rgb deep{0.02f * (0.4f + ws), 0.10f * (0.4f + ws), 0.22f * (0.4f + ws)};
+                        c = lerp(c, deep, 0.3f + 0.65f * a);
+                        const float sheen = std::pow(1.0f - wi, 2.0f) * 2.0f + 0.25f * std::pow(ws, 40.0f);
+                        c = {c.r + sheen * 0.6f, c.g + sheen * 0.7f, c.b + sheen * 0.8f};
                     }
                 }
                 std::uint8_t* o = rgb.data() + (static_cast<std::size_t>(y) * nx + x) * 3;

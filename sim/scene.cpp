@@ -77,9 +77,11 @@ SceneSettings builtinScene(const std::string& name, int size, std::uint64_t seed
         s.cellSize = extent / static_cast<float>(size);
         s.terrain.kind = TerrainSource::Kind::Noise;
         s.terrain.noise.amplitude = 6.0f;
-        s.terrain.noise.wavelength = 160.0f;
+        s.terrain.noise.wavelength = 140.0f;
         s.terrain.noise.octaves = 5;
         s.terrain.noise.offset = -3.0f;
+        s.terrain.rampStart = -8.0f;
+        s.terrain.rampEnd = 4.0f;
         s.hasWaterLevel = true;
         s.waterLevel = 0.0f;
         s.waves = true;
@@ -159,6 +161,12 @@ void buildInitialTerrain(const SceneSettings& s, TerrainState& state) {
             }
             break;
         }
+    }
+    if (s.terrain.rampStart != 0.0f || s.terrain.rampEnd != 0.0f) {
+        const float denom = nx > 1 ? static_cast<float>(nx - 1) : 1.0f;
+        for (int y = 0; y < ny; ++y)
+            for (int x = 0; x < nx; ++x)
+                ground(x, y) += s.terrain.rampStart + (s.terrain.rampEnd - s.terrain.rampStart) * static_cast<float>(x) / denom;
     }
     state.allocate(nx, ny, cellSize, layers);
     state.bedrock.v = ground.v;

@@ -25,6 +25,8 @@ struct TerrainSource {
     float demZOffset = 0.0f;   // m (PNG only)
     float demCellSize = 0.0f;  // m; 0 = from the .vdb, required for a .png
     bool demResample = true;   // resample the DEM to the scene size keeping its extent
+    float rampStart = 0.0f;    // m added at x = 0, going linearly to
+    float rampEnd = 0.0f;      // m added at the last column (a tilted coast)
 };
 
 struct SceneSettings {

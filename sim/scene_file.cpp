@@ -146,6 +146,8 @@ void readTerrain(TableReader& r, const toml::table& t, SceneSettings& s) {
     tr.num("z_offset", s.terrain.demZOffset);
     tr.num("cell_size", s.terrain.demCellSize);
     tr.flag("resample", s.terrain.demResample);
+    tr.num("ramp_start", s.terrain.rampStart);
+    tr.num("ramp_end", s.terrain.rampEnd);
     tr.finish();
 }
 

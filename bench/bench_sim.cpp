@@ -1,0 +1,139 @@
+// Simulation benchmark: ticks/s and cell-updates/s of the erosion and waves
+// scenes at 256^2, 512^2, 1024^2 with 1 and 2 threads, median of several runs.
+// Two figures per case: the kernels alone (hydraulic + thermal, or waves, one
+// step at the scene's dt) and the whole Simulation::tick (plus the stability
+// check and change tracking).
+//
+//   build/bench_sim [--runs 7] [--ticks 20] [--out bench/results]
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <sys/utsname.h>
+#include <thread>
+#include <vector>
+
+#include "sim/parallel.h"
+#include "sim/scene.h"
+
+using namespace terrain;
+
+namespace {
+double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+std::string cpuName() {
+    std::ifstream f("/proc/cpuinfo");
+    std::string line;
+    while (std::getline(f, line))
+        if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
+    return "unknown CPU";
+}
+
+struct Row {
+    std::string scene;
+    int size, threads;
+    double kernelMs, tickMs;
+};
+}  // namespace
+
+int main(int argc, char** argv) {
+    int runs = 7, ticks = 20;
+    std::string outDir = "bench/results";
+    for (int i = 1; i < argc; ++i) {
+        if (!std::strcmp(argv[i], "--runs") && i + 1 < argc) runs = std::atoi(argv[++i]);
+        else if (!std::strcmp(argv[i], "--ticks") && i + 1 < argc) ticks = std::atoi(argv[++i]);
+        else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) outDir = argv[++i];
+        else {
+            std::fprintf(stderr, "usage: bench_sim [--runs N] [--ticks T] [--out DIR]\n");
+            return 2;
+        }
+    }
+    std::vector<Row> rows;
+    for (const char* scene : {"erosion", "waves"})
+        for (int size : {256, 512, 1024})
+            for (int threads : {1, 2}) {
+                Row r{scene, size, threads, 0, 0};
+                withThreads(threads, [&] {
+                    SceneSettings s = builtinScene(scene, size, 1);
+                    Simulation sim(s);
+                    // warm up: let water spread so the timing is of a running scene
+                    for (int t = 0; t < 10; ++t) sim.tick();
+                    std::vector<double> kernel, tick;
+                    HydraulicScratch hs;
+                    ThermalScratch ts;
+                    WaveScratch ws;
+                    TerrainState copy = sim.state();
+                    for (int run = 0; run < runs; ++run) {
+                        double t0 = now();
+                        for (int t = 0; t < ticks; ++t) {
+                            if (s.waves) waveStep(copy, s.waveSettings, sim.dt(), ws);
+                            if (s.hydraulic) hydraulicStep(copy, s.hydraulicSettings, sim.dt(), hs);
+                            if (s.thermal) thermalStep(copy, s.thermalSettings, sim.dt(), ts);
+                        }
+                        kernel.push_back((now() - t0) / ticks);
+                        t0 = now();
+                        for (int t = 0; t < ticks; ++t) sim.tick();
+                        tick.push_back((now() - t0) / ticks);
+                    }
+                    r.kernelMs = 1e3 * median(kernel);
+                    r.tickMs = 1e3 * median(tick);
+                });
+                std::printf("%-8s %5d^2 %d thread(s): kernels %8.2f ms  tick %8.2f ms  (%.1f Mcell/s)\n", scene, size,
+                            threads, r.kernelMs, r.tickMs, 1e-3 * size * size / r.tickMs);
+                std::fflush(stdout);
+                rows.push_back(r);
+            }
+
+    utsname u{};
+    uname(&u);
+    std::ostringstream md, csv;
+    md << "# Simulation benchmark\n\n"
+       << "Machine: " << cpuName() << ", " << std::thread::hardware_concurrency() << " hardware threads, " << u.sysname
+       << " " << u.release << ". Release build (-O3, baseline x86-64, no fast-math).\n\n"
+       << "Command: `build/bench_sim --runs " << runs << " --ticks " << ticks << "`. Each figure is the median of "
+       << runs << " runs of " << ticks << " ticks, after 10 warm-up ticks. *kernels*: the scene's simulation steps "
+       << "alone (erosion: hydraulic + thermal; waves: shallow water); *tick*: `Simulation::tick` "
+       << "(kernels + stability check + change tracking).\n\n"
+       << "| scene | size | threads | kernels ms/tick | tick ms/tick | ticks/s | Mcell-updates/s |\n"
+       << "|---|---|---|---|---|---|---|\n";
+    csv << "scene,size,threads,kernel_ms,tick_ms,ticks_per_s,mcell_updates_per_s\n";
+    char buf[256];
+    for (const Row& r : rows) {
+        const double tps = 1e3 / r.tickMs;
+        const double mcells = tps * r.size * r.size * 1e-6;
+        std::snprintf(buf, sizeof buf, "| %s | %d² | %d | %.2f | %.2f | %.1f | %.1f |\n", r.scene.c_str(), r.size,
+                      r.threads, r.kernelMs, r.tickMs, tps, mcells);
+        md << buf;
+        std::snprintf(buf, sizeof buf, "%s,%d,%d,%.3f,%.3f,%.2f,%.2f\n", r.scene.c_str(), r.size, r.threads, r.kernelMs,
+                      r.tickMs, tps, mcells);
+        csv << buf;
+    }
+    auto find = [&](const char* scene) {
+        for (const Row& r : rows)
+            if (r.scene == scene && r.size == 1024 && r.threads == 2) return r;
+        return Row{};
+    };
+    const Row e = find("erosion"), w = find("waves");
+    std::snprintf(buf, sizeof buf,
+                  "\nTargets at 1024², 2 threads: erosion tick <= 15 ms: kernels %.2f ms, tick %.2f ms (%s); "
+                  "waves tick <= 8 ms: kernels %.2f ms, tick %.2f ms (%s).\n",
+                  e.kernelMs, e.tickMs, e.tickMs <= 15.0 ? "met" : "not met", w.kernelMs, w.tickMs,
+                  w.tickMs <= 8.0 ? "met" : "not met");
+    md << buf;
+    std::filesystem::create_directories(outDir);
+    std::ofstream(outDir + "/sim.md") << md.str();
+    std::ofstream(outDir + "/sim.csv") << csv.str();
+    std::printf("%s", buf);
+    std::printf("written %s/sim.md and %s/sim.csv\n", outDir.c_str(), outDir.c_str());
+    return 0;
+}
