@@ -69,7 +69,7 @@ void shadePreview(const TerrainState& s, const PreviewSettings& p, std::vector<s
                             const float w = s.water(xx, yy);
                             return w > 1e-3f ? s.ground(xx, yy) + w : s.ground(x, y) + d;
                         };
-                        const float k = 8.0f * inv2h;
+                        const float k = 30.0f * inv2h;
                         const float ex = (eta(x + 1, y) - eta(x - 1, y)) * k;
                         const float ey = (eta(x, y + 1) - eta(x, y - 1)) * k;
                         const float wi = 1.0f / std::sqrt(ex * ex + ey * ey + 1.0f);

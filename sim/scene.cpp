@@ -218,9 +218,13 @@ void Simulation::tick() {
     }
     // The tick is fixed; when the state's own limit (deeper water, faster
     // flow) drops below it, the tick is cut into equal sub-steps.
+    // stableDt() is the default step (Courant 0.5 for waves, half the linear
+    // limit for the pipes); a tick may run at up to kHeadroom times it (Courant
+    // 0.7, inside the 2-D staggered limit 1/sqrt(2)) before it is cut.
+    constexpr float kHeadroom = 1.4f;
     int substeps = 1;
     if (settings_.hydraulic || settings_.waves) {
-        const float limit = stableDt();
+        const float limit = kHeadroom * stableDt();
         if (limit < dt_) substeps = static_cast<int>(std::min(1024.0f, std::ceil(dt_ / limit)));
     }
     lastSubsteps_ = substeps;

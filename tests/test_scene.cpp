@@ -45,6 +45,15 @@ TEST_CASE("sim.scene: built-in scenes build on power-of-two and other sizes") {
             CHECK_NOTHROW(checkFinite(sim.state()));
         }
     }
+    for (const char* name : {"erosion", "waves"}) {  // non-square, non-power-of-two
+        SceneSettings s = builtinScene(name, 200, 5);
+        s.ny = 300;
+        Simulation sim(s);
+        CHECK(sim.state().nx == 200);
+        CHECK(sim.state().ny == 300);
+        for (int t = 0; t < 3; ++t) sim.tick();
+        CHECK_NOTHROW(checkFinite(sim.state()));
+    }
     SceneSettings w = builtinScene("waves", 64, 1);
     Simulation sim(w);
     // the water surface starts flat at the scene's level wherever there is water
