@@ -33,12 +33,15 @@ struct HydraulicSettings {
 
 /// Per-run scratch buffers (explicit state, reused across ticks).
 struct HydraulicScratch {
-    Grid a, b;  // temporaries sized nx x ny on first use
+    Grid conc;  // suspended * dt / (depth * cellSize^2): sediment sent per m^3/s of outflow this step
+    Grid sin2;  // max(sin^2(local tilt), minTilt^2) of the ground before this step's erosion
 };
 
 /// The largest stable time step (s) for the pipe model on this terrain:
-/// the flux update is explicit, so dt <= cellSize / sqrt(g * maxDepth) style
-/// limits apply (documented in the implementation).
+/// 0.5 * sqrt(cellSize / (2 g pipeArea)), half the linear stability limit of
+/// the explicit flux/depth update (derivation in hydraulic.cpp). Depth does
+/// not enter: pipe waves travel at sqrt(g pipeArea cellSize), and the
+/// K-scaling keeps depths non-negative for any dt.
 float hydraulicMaxDt(const TerrainState& s, const HydraulicSettings& settings);
 
 /// Advances water, fluxes, velocity, soil, bedrock and suspended sediment by dt.

@@ -13,8 +13,9 @@ struct ThermalSettings {
 };
 
 struct ThermalScratch {
-    Grid out;      // outflow per cell
-    Grid weights;  // packed per-neighbour shares, as the implementation needs
+    Grid ground;  // m, bedrock + soil before the step
+    Grid out;     // m, material leaving each cell this step
+    Grid share;   // out / sum of the cell's excess heights over its neighbours
 };
 
 /// Moves material from cells steeper than the talus angle to lower
