@@ -1,0 +1,154 @@
+#include "gi/frame.h"
+
+#include <chrono>
+#include <cmath>
+#include <string>
+
+#include "sim/error.h"
+#include "sim/parallel.h"
+
+namespace terrain::gi {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+bool sameLight(const KeyLight& a, const KeyLight& b) {
+    return a.azimuthDeg == b.azimuthDeg && a.elevationDeg == b.elevationDeg && a.radiusDeg == b.radiusDeg;
+}
+
+}  // namespace
+
+void checkHeightsFinite(ConstGridView h) {
+    for (int y = 0; y < h.ny; ++y)
+        for (int x = 0; x < h.nx; ++x)
+            if (!std::isfinite(h(x, y)))
+                throw InputError("heights: NaN or Inf at column " + std::to_string(x) + ", row " + std::to_string(y));
+}
+
+void computeGradient(ConstGridView h, float cellSize, Grid& gx, Grid& gy) {
+    const int nx = h.nx, ny = h.ny;
+    if (gx.nx != nx || gx.ny != ny) gx.resize(nx, ny);
+    if (gy.nx != nx || gy.ny != ny) gy.resize(nx, ny);
+    const float inv2 = 0.5f / cellSize, inv1 = 1.0f / cellSize;
+    parallelForRows(ny, nx, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < nx; ++x) {
+                float dx = 0.0f, dy = 0.0f;
+                if (nx > 1) {
+                    if (x == 0) dx = (h(1, y) - h(0, y)) * inv1;
+                    else if (x == nx - 1) dx = (h(x, y) - h(x - 1, y)) * inv1;
+                    else dx = (h(x + 1, y) - h(x - 1, y)) * inv2;
+                }
+                if (ny > 1) {
+                    if (y == 0) dy = (h(x, 1) - h(x, 0)) * inv1;
+                    else if (y == ny - 1) dy = (h(x, y) - h(x, y - 1)) * inv1;
+                    else dy = (h(x, y + 1) - h(x, y - 1)) * inv2;
+                }
+                gx(x, y) = dx;
+                gy(x, y) = dy;
+            }
+    });
+}
+
+void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lighting, const GiSettings& settings,
+                GiState& st, const AlbedoMap* albedo) {
+    // ---- validate inputs (boundary of the stage) --------------------------------
+    if (heights.nx < 1 || heights.ny < 1 || !heights.data) throw InputError("heights: empty grid");
+    if (!std::isfinite(cellSize) || cellSize <= 0.0f) throw InputError("cell size must be positive and finite");
+    if (settings.subsample != 1 && settings.subsample != 2 && settings.subsample != 4)
+        throw InputError("subsample must be 1, 2 or 4");
+    if (settings.visibility.azimuths < 3 || settings.visibility.azimuths > 4096) throw InputError("azimuths must be in [3, 4096]");
+    if (settings.pyramid.levelsPerOctave < 1 || settings.pyramid.levelsPerOctave > 64)
+        throw InputError("levels per octave must be in [1, 64]");
+    if (settings.pyramid.levelOffset < 0 || settings.pyramid.levelOffset > 32) throw InputError("level offset must be in [0, 32]");
+    if (settings.keyLightAzimuths < 2 || settings.keyLightAzimuths > 256) throw InputError("key light azimuths must be in [2, 256]");
+    if (!(settings.pyramid.peakBlend >= 0.0f && settings.pyramid.peakBlend <= 1.0f)) throw InputError("peak blend must be in [0, 1]");
+    for (const KeyLight& k : lighting.keys) validateKeyLight(k);
+    for (const ShVector& c : lighting.environment.c)
+        for (double v : c)
+            if (!std::isfinite(v)) throw InputError("environment light: NaN or Inf coefficient");
+    checkHeightsFinite(heights);
+    if (albedo)
+        for (const Grid& g : albedo->channel)
+            if (!g.empty() && (g.nx != heights.nx || g.ny != heights.ny)) throw InputError("albedo map size differs from the heights");
+
+    const auto t0 = Clock::now();
+    auto t = t0;
+    computeGradient(heights, cellSize, st.gradX, st.gradY);
+    st.timings.gradient = msSince(t);
+
+    t = Clock::now();
+    buildHeightPyramid(heights, cellSize, settings.subsample, settings.pyramid, st.pyramid);
+    st.timings.pyramid = msSince(t);
+
+    // ---- environment visibility ---------------------------------------------------
+    t = Clock::now();
+    if (st.envOperatorAzimuths != settings.visibility.azimuths || st.envOperatorInterp != settings.visibility.interp) {
+        st.envOperator = foldFullCircle(settings.visibility.azimuths, settings.visibility.interp);
+        st.envOperatorAzimuths = settings.visibility.azimuths;
+        st.envOperatorInterp = settings.visibility.interp;
+    }
+    VisibilityTarget envTarget;
+    envTarget.op = &st.envOperator;
+    computeVisibility(st.pyramid, st.gradX.cview(), st.gradY.cview(), settings.visibility, envTarget, st.visibilityState,
+                      st.envVisibility);
+    st.timings.visibility = msSince(t);
+
+    // ---- key lights: own visibility over their extent (Section 6) -------------------
+    t = Clock::now();
+    const std::size_t nKeys = lighting.keys.size();
+    st.keyOperators.resize(nKeys);
+    st.keyOperatorLights.resize(nKeys);
+    st.keyVisibility.resize(nKeys);
+    for (std::size_t k = 0; k < nKeys; ++k) {
+        const KeyLight& light = lighting.keys[k];
+        const KeyLightExtent ext = keyLightExtent(light);
+        if (st.keyOperators[k].azimuths != settings.keyLightAzimuths || !sameLight(st.keyOperatorLights[k], light)) {
+            st.keyOperators[k] = foldPartialRange(ext.phiStart, ext.phiEnd, settings.keyLightAzimuths);
+            st.keyOperatorLights[k] = light;
+        }
+        VisibilityTarget target;
+        target.op = &st.keyOperators[k];
+        target.window = true;
+        target.sinLow = ext.sinLow;
+        target.sinHigh = ext.sinHigh;
+        VisibilitySettings ks = settings.visibility;
+        ks.azimuths = settings.keyLightAzimuths;
+        computeVisibility(st.pyramid, st.gradX.cview(), st.gradY.cview(), ks, target, st.visibilityState,
+                          st.keyVisibility[k]);
+    }
+    st.timings.keyVisibility = msSince(t);
+
+    // ---- shading: lighting matrices once per frame, then every texel ------------------
+    t = Clock::now();
+    st.shadingLights.resize(1 + nKeys);
+    st.shadingLights[0].visibility = &st.envVisibility;
+    for (int ch = 0; ch < 3; ++ch)
+        st.shadingLights[0].product[static_cast<std::size_t>(ch)] = shProductMatrix(lighting.environment.c[static_cast<std::size_t>(ch)]);
+    for (std::size_t k = 0; k < nKeys; ++k) {
+        // Section 6: the key light's visibility is already restricted to the
+        // light's azimuthal extent and elevation interval, so V_key is the SH
+        // projection of "visible part of the light's region". Its incident
+        // radiance is that region's radiance times V_key: the product matrix
+        // is a scalar. The region's radiance gives the cap's irradiance at
+        // normal incidence, pi * RGB, over the region's solid angle.
+        const KeyLight& light = lighting.keys[k];
+        const KeyLightExtent ext = keyLightExtent(light);
+        const double solidAngle = (ext.phiEnd - ext.phiStart) * (static_cast<double>(ext.sinHigh) - ext.sinLow);
+        st.shadingLights[k + 1].visibility = &st.keyVisibility[k];
+        for (int ch = 0; ch < 3; ++ch) {
+            ShMatrix& m = st.shadingLights[k + 1].product[static_cast<std::size_t>(ch)];
+            m.fill(0.0);
+            const double radiance = solidAngle > 0.0 ? kPi * light.rgb[ch] / solidAngle : 0.0;
+            for (int i = 0; i < kShCount; ++i) m[static_cast<std::size_t>(i * kShCount + i)] = radiance;
+        }
+    }
+    shadeTexels(st.gradX.cview(), st.gradY.cview(), settings.subsample, st.envVisibility, st.shadingLights.data(),
+                static_cast<int>(st.shadingLights.size()), albedo, settings.shading, st.shade);
+    st.timings.shading = msSince(t);
+    st.timings.total = msSince(t0);
+}
+
+}  // namespace terrain::gi

@@ -1,0 +1,63 @@
+#pragma once
+// One GI frame: gradient -> height pyramid -> visibility (environment, then
+// each key light) -> shading. GiState holds every buffer and is reused across
+// frames: after the first frame of a given size and settings, a frame
+// allocates nothing.
+#include <vector>
+
+#include "gi/lights.h"
+#include "gi/pyramid.h"
+#include "gi/shading.h"
+#include "gi/visibility.h"
+#include "gi/wedge.h"
+#include "sim/grid.h"
+
+namespace terrain::gi {
+
+struct GiSettings {
+    int subsample = 1;          // 1, 2 or 4: visibility on the (N/s)^2 receiver grid (Fig. 7)
+    PyramidSettings pyramid;    // k_v = 4, o_v = 2
+    VisibilitySettings visibility;  // m = 32, linear wedges, B-spline maximum (Eq. 16)
+    int keyLightAzimuths = 3;   // azimuth samples per key light (Section 9)
+    ShadingSettings shading;
+};
+
+struct GiLighting {
+    ShRgb environment = uniformSkyLight(1.0f);
+    std::vector<KeyLight> keys;
+};
+
+/// Milliseconds per stage of the last frame.
+struct GiTimings {
+    double gradient = 0.0, pyramid = 0.0, visibility = 0.0, keyVisibility = 0.0, shading = 0.0, total = 0.0;
+};
+
+struct GiState {
+    Grid gradX, gradY;             // full resolution dh/dx, dh/dy (metres per metre)
+    HeightPyramid pyramid;
+    FoldedWedgeOperator envOperator;  // cached for (azimuths, interp)
+    int envOperatorAzimuths = -1;
+    AzimuthInterp envOperatorInterp = AzimuthInterp::Linear;
+    VisibilityState visibilityState;
+    VisibilityField envVisibility;
+    std::vector<FoldedWedgeOperator> keyOperators;
+    std::vector<KeyLight> keyOperatorLights;  // the lights the key operators were built for
+    std::vector<VisibilityField> keyVisibility;
+    std::vector<ShadingLight> shadingLights;
+    ShadeMaps shade;
+    GiTimings timings;
+};
+
+/// Runs one frame. Throws InputError when heights contain NaN/Inf, the cell
+/// size is not positive and finite, or a setting is out of range.
+void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lighting, const GiSettings& settings,
+                GiState& state, const AlbedoMap* albedo = nullptr);
+
+/// Central-difference height derivatives (one-sided at the borders, 0 on a
+/// 1-wide axis), in metres per metre.
+void computeGradient(ConstGridView heights, float cellSize, Grid& gradX, Grid& gradY);
+
+/// Throws InputError naming the first NaN/Inf height.
+void checkHeightsFinite(ConstGridView heights);
+
+}  // namespace terrain::gi

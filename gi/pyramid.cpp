@@ -1,0 +1,213 @@
+#include "gi/pyramid.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "sim/parallel.h"
+
+namespace terrain::gi {
+
+void PaddedField::resize(int w, int h) {
+    nx = w;
+    ny = h;
+    stride = w + 1;
+    v.resize(static_cast<std::size_t>(w + 1) * static_cast<std::size_t>(h + 1));
+}
+
+void PaddedField::padEdges() {
+    for (int y = 0; y < ny; ++y) row(y)[nx] = row(y)[nx - 1];
+    std::copy(row(ny - 1), row(ny - 1) + stride, row(ny));
+}
+
+int pyramidStepCount(int nx, int ny, int levelsPerOctave) {
+    const double diag = std::sqrt(static_cast<double>(nx - 1) * (nx - 1) + static_cast<double>(ny - 1) * (ny - 1));
+    if (diag <= 1.0) return 1;
+    return static_cast<int>(std::ceil(levelsPerOctave * std::log2(diag))) + 1;
+}
+
+namespace {
+
+// Cubic B-spline weights for fraction a, taps k0-1 .. k0+2.
+inline void bsplineWeights(float a, float w[4]) {
+    const float b = 1.0f - a;
+    w[0] = b * b * b / 6.0f;
+    w[1] = (3.0f * a * a * a - 6.0f * a * a + 4.0f) / 6.0f;
+    w[2] = (-3.0f * a * a * a + 3.0f * a * a + 3.0f * a + 1.0f) / 6.0f;
+    w[3] = a * a * a / 6.0f;
+}
+
+// ---- algorithm: one octave decimation row (2x2 box or 2x2 max) ----------
+void decimateRows(ConstGridView src, Grid& dst, bool useMax, int y0, int y1) {
+    for (int y = y0; y < y1; ++y) {
+        const int ya = std::min(2 * y, src.ny - 1), yb = std::min(2 * y + 1, src.ny - 1);
+        float* out = dst.data() + static_cast<std::size_t>(y) * dst.nx;
+        for (int x = 0; x < dst.nx; ++x) {
+            const int xa = std::min(2 * x, src.nx - 1), xb = std::min(2 * x + 1, src.nx - 1);
+            const float a = src(xa, ya), b = src(xb, ya), c = src(xa, yb), d = src(xb, yb);
+            out[x] = useMax ? std::max(std::max(a, b), std::max(c, d)) : 0.25f * ((a + b) + (c + d));
+        }
+    }
+}
+
+// Taps of the B-spline synthesis of octave o (spacing 2^o) at receiver
+// positions s * X (full-resolution cell centres at integers; octave texel k
+// is centred at (k + 0.5) 2^o - 0.5).
+void synthesisTaps(int receivers, int subsample, int octave, int octaveSize, int* index, float* weight) {
+    const double scale = std::ldexp(1.0, octave);
+    for (int X = 0; X < receivers; ++X) {
+        const double u = (subsample * X + 0.5) / scale - 0.5;
+        const double k0 = std::floor(u);
+        bsplineWeights(static_cast<float>(u - k0), weight + 4 * X);
+        for (int k = 0; k < 4; ++k)
+            index[4 * X + k] = std::clamp(static_cast<int>(k0) - 1 + k, 0, octaveSize - 1);
+    }
+}
+
+}  // namespace
+
+void buildHeightPyramid(ConstGridView heights, float cellSize, int subsample, const PyramidSettings& settings,
+                        HeightPyramid& p) {
+    const int nx = heights.nx, ny = heights.ny, s = subsample;
+    const int kv = std::max(1, settings.levelsPerOctave);
+    p.nx = nx;
+    p.ny = ny;
+    p.subsample = s;
+    p.nxr = receiverCount(nx, s);
+    p.nyr = receiverCount(ny, s);
+    p.cellSize = cellSize;
+    p.settings = settings;
+
+    // ---- steps (Eq. 14) and the level each reads (level offset o_v) ------
+    const int nSteps = pyramidStepCount(nx, ny, kv);
+    p.steps.resize(static_cast<std::size_t>(nSteps));
+    int maxLevel = -1;
+    for (int i = 0; i < nSteps; ++i) {
+        PyramidStep& st = p.steps[static_cast<std::size_t>(i)];
+        st.tauCells = std::exp2(static_cast<double>(i) / kv);
+        st.invTauWorld = static_cast<float>(1.0 / (st.tauCells * cellSize));
+        st.level = i - kv * settings.levelOffset;
+        if (st.level < 0) st.level = -1;
+        maxLevel = std::max(maxLevel, st.level);
+    }
+
+    // ---- raw heights, padded ----------------------------------------------
+    p.raw.resize(nx, ny);
+    parallelForRows(ny, nx, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y) {
+            std::copy(heights.row(y), heights.row(y) + nx, p.raw.row(y));
+            p.raw.row(y)[nx] = heights.row(y)[nx - 1];
+        }
+    });
+    std::copy(p.raw.row(ny - 1), p.raw.row(ny - 1) + p.raw.stride, p.raw.row(ny));
+
+    const int nLevels = maxLevel + 1;
+    if (nLevels <= 0) {
+        p.levels.resize(0);
+        return;
+    }
+
+    // ---- octave images B_o (2x2 decimation) ---------------------------------
+    // Octaves needed: up to floor((nLevels - 1) / kv) + 1, stopping at 1x1.
+    int nOctaves = (nLevels - 1) / kv + 2;
+    {
+        int w = nx, h = ny, count = 1;
+        while (count < nOctaves && (w > 1 || h > 1)) {
+            w = (w + 1) / 2;
+            h = (h + 1) / 2;
+            ++count;
+        }
+        nOctaves = count;
+    }
+    const bool withMax = settings.peakBlend > 0.0f;
+    p.meanOctaves.resize(static_cast<std::size_t>(nOctaves - 1));
+    p.maxOctaves.resize(withMax ? static_cast<std::size_t>(nOctaves - 1) : 0u);
+    for (int pass = 0; pass < (withMax ? 2 : 1); ++pass) {
+        std::vector<Grid>& oct = pass == 0 ? p.meanOctaves : p.maxOctaves;
+        ConstGridView src = heights;
+        for (int o = 1; o < nOctaves; ++o) {
+            Grid& dst = oct[static_cast<std::size_t>(o - 1)];
+            const int w = (src.nx + 1) / 2, h = (src.ny + 1) / 2;
+            if (dst.nx != w || dst.ny != h) dst.resize(w, h);
+            parallelForRows(h, w, [&](int y0, int y1) { decimateRows(src, dst, pass == 1, y0, y1); });
+            src = dst.cview();
+        }
+    }
+
+    // ---- B-spline synthesis of each octave at the receiver grid ---------------
+    // Separable: rows of B_o to receiver columns (rowTmp), then columns to
+    // receiver rows. Mean and (optionally) max syntheses are blended here.
+    const int nxr = p.nxr, nyr = p.nyr;
+    p.synth.resize(static_cast<std::size_t>(nOctaves));
+    p.tapIndex.resize(static_cast<std::size_t>(4 * (nxr + nyr)));
+    p.tapWeight.resize(static_cast<std::size_t>(4 * (nxr + nyr)));
+    for (int o = 0; o < nOctaves; ++o) {
+        PaddedField& out = p.synth[static_cast<std::size_t>(o)];
+        out.resize(nxr, nyr);
+        for (int pass = 0; pass < (withMax ? 2 : 1); ++pass) {
+            ConstGridView src = o == 0 ? heights
+                                       : (pass == 0 ? p.meanOctaves : p.maxOctaves)[static_cast<std::size_t>(o - 1)].cview();
+            int* ix = p.tapIndex.data();
+            int* iy = ix + 4 * nxr;
+            float* wx = p.tapWeight.data();
+            float* wy = wx + 4 * nxr;
+            synthesisTaps(nxr, s, o, src.nx, ix, wx);
+            synthesisTaps(nyr, s, o, src.ny, iy, wy);
+            p.rowTmp.resize(static_cast<std::size_t>(src.ny) * nxr);
+            float* tmp = p.rowTmp.data();
+            parallelForRows(src.ny, nxr, [&](int y0, int y1) {
+                for (int y = y0; y < y1; ++y) {
+                    const float* in = src.row(y);
+                    float* t = tmp + static_cast<std::size_t>(y) * nxr;
+                    for (int X = 0; X < nxr; ++X) {
+                        const int* k = ix + 4 * X;
+                        const float* w = wx + 4 * X;
+                        t[X] = (w[0] * in[k[0]] + w[1] * in[k[1]]) + (w[2] * in[k[2]] + w[3] * in[k[3]]);
+                    }
+                }
+            });
+            const float blend = withMax ? (pass == 0 ? 1.0f - settings.peakBlend : settings.peakBlend) : 1.0f;
+            parallelForRows(nyr, nxr, [&](int y0, int y1) {
+                for (int Y = y0; Y < y1; ++Y) {
+                    const int* k = iy + 4 * Y;
+                    const float* w = wy + 4 * Y;
+                    const float* r0 = tmp + static_cast<std::size_t>(k[0]) * nxr;
+                    const float* r1 = tmp + static_cast<std::size_t>(k[1]) * nxr;
+                    const float* r2 = tmp + static_cast<std::size_t>(k[2]) * nxr;
+                    const float* r3 = tmp + static_cast<std::size_t>(k[3]) * nxr;
+                    float* d = out.row(Y);
+                    for (int X = 0; X < nxr; ++X) {
+                        const float v = (w[0] * r0[X] + w[1] * r1[X]) + (w[2] * r2[X] + w[3] * r3[X]);
+                        d[X] = pass == 0 ? blend * v : d[X] + blend * v;
+                    }
+                }
+            });
+        }
+        out.padEdges();
+    }
+
+    // ---- levels between octaves: f_l = (1 - q) S_o + q S_(o+1) -----------------
+    p.levels.resize(static_cast<std::size_t>(nLevels));
+    for (int l = 0; l < nLevels; ++l) {
+        int o = l / kv;
+        float q = static_cast<float>(l % kv) / static_cast<float>(kv);
+        if (o >= nOctaves - 1) {
+            o = nOctaves - 1;
+            q = 0.0f;
+        }
+        PaddedField& lev = p.levels[static_cast<std::size_t>(l)];
+        lev.resize(nxr, nyr);
+        const PaddedField& a = p.synth[static_cast<std::size_t>(o)];
+        const PaddedField& b = p.synth[static_cast<std::size_t>(std::min(o + 1, nOctaves - 1))];
+        const float wa = 1.0f - q, wb = q;
+        parallelForRows(nyr + 1, nxr, [&](int y0, int y1) {
+            for (int Y = y0; Y < y1; ++Y) {
+                const float* ra = a.row(Y);
+                const float* rb = b.row(Y);
+                float* d = lev.row(Y);
+                for (int X = 0; X <= nxr; ++X) d[X] = wa * ra[X] + wb * rb[X];
+            }
+        });
+    }
+}
+
+}  // namespace terrain::gi

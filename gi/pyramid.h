@@ -1,0 +1,83 @@
+#pragma once
+// Height pyramid with B-spline filtering (Section 5.2, Eqs. 14-16).
+//
+// Steps along every ray grow exponentially (Eq. 14): tau_i = 2^(i / k_v)
+// cells, i = 0..n_v-1, n_v chosen so the last step reaches the domain
+// diagonal ("number of levels from the resolution and the domain size").
+// Step i reads pyramid level l = i - k_v * o_v (the level offset o_v biases
+// towards finer levels, Section 5.2); l < 0 reads the unfiltered full
+// resolution heights (bilinear), which makes the method converge to
+// brute-force marching as o_v grows.
+//
+// Level l is filtered at a scale of 2^(l / k_v) cells: octave images B_o are
+// repeated 2x2 box ("bilinear") decimations of the heights; each octave is
+// synthesised at the receiver grid by cubic B-spline reconstruction (as the
+// paper's GPU version does with [SH05]), S_o; a level between octaves blends
+// the two neighbouring syntheses: f_l = (1 - q) S_o + q S_(o+1), o + q = l / k_v.
+// Like the paper we keep the stack "blown out" to the receiver resolution,
+// so for a fixed azimuth and step every receiver reads its level at the same
+// fractional offset: the scan streams rows with constant bilinear weights.
+//
+// Optional peak keeping (PyramidSettings::peakBlend): the octave images can
+// also be max-decimated; levels then blend mean and max syntheses, which
+// counters the filtered pyramid's lowering of distant peaks.
+#include <vector>
+
+#include "sim/grid.h"
+
+namespace terrain::gi {
+
+struct PyramidSettings {
+    int levelsPerOctave = 4;  // k_v (paper: 4)
+    int levelOffset = 2;      // o_v in octaves (paper: 2 for visibility)
+    float peakBlend = 0.0f;   // 0 = mean pyramid (paper); 1 = max-decimated octaves
+};
+
+/// One sampled field: a row-major grid padded with one replicated column and
+/// row so bilinear reads at the last sample stay in bounds.
+struct PaddedField {
+    int nx = 0, ny = 0;        // logical size
+    std::ptrdiff_t stride = 0;  // nx + 1
+    std::vector<float> v;       // (nx + 1) * (ny + 1)
+    void resize(int w, int h);
+    float* row(int y) { return v.data() + y * stride; }
+    const float* row(int y) const { return v.data() + y * stride; }
+    void padEdges();  // copies the last column / row into the padding
+};
+
+struct PyramidStep {
+    double tauCells = 1.0;   // distance in full-resolution cells (Eq. 14)
+    float invTauWorld = 1.0f;  // 1 / (tau * cellSize)
+    int level = -1;          // -1: raw heights, else index into levels
+};
+
+struct HeightPyramid {
+    // Geometry of this build.
+    int nx = 0, ny = 0;           // full resolution
+    int subsample = 1;            // receiver spacing in cells (1, 2, 4)
+    int nxr = 0, nyr = 0;         // receiver grid: receiver (X, Y) sits at cell (s X, s Y)
+    float cellSize = 1.0f;        // metres
+    PyramidSettings settings;
+    std::vector<PyramidStep> steps;  // n_v steps
+
+    PaddedField raw;                  // full-resolution heights, spacing 1
+    std::vector<Grid> meanOctaves;    // B_1, B_2, ... (B_0 is the input)
+    std::vector<Grid> maxOctaves;     // same, max-decimated (only when peakBlend > 0)
+    std::vector<PaddedField> synth;   // S_o at the receiver grid, o = 0..
+    std::vector<PaddedField> levels;  // f_l at the receiver grid, spacing s
+    std::vector<float> rowTmp;        // scratch of the separable synthesis
+    std::vector<int> tapIndex;        // scratch: 4 taps per receiver column / row
+    std::vector<float> tapWeight;
+};
+
+/// Receiver grid size along one axis for n cells and sub-sampling s.
+inline int receiverCount(int n, int s) { return n <= 0 ? 0 : (n - 1) / s + 1; }
+
+/// Number of exponential steps n_v for a grid (Eq. 14 and the domain size).
+int pyramidStepCount(int nx, int ny, int levelsPerOctave);
+
+/// Builds (or rebuilds, reusing every buffer) the pyramid of `heights`.
+void buildHeightPyramid(ConstGridView heights, float cellSize, int subsample, const PyramidSettings& settings,
+                        HeightPyramid& out);
+
+}  // namespace terrain::gi

@@ -1,0 +1,203 @@
+#include "gi/reference.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <mutex>
+#include <vector>
+
+#include "gi/visibility.h"
+#include "sim/parallel.h"
+
+namespace terrain::gi {
+
+namespace {
+
+inline double bilinear(ConstGridView h, double px, double py) {
+    int x0 = static_cast<int>(std::floor(px)), y0 = static_cast<int>(std::floor(py));
+    x0 = std::clamp(x0, 0, std::max(h.nx - 2, 0));
+    y0 = std::clamp(y0, 0, std::max(h.ny - 2, 0));
+    const int x1 = std::min(x0 + 1, h.nx - 1), y1 = std::min(y0 + 1, h.ny - 1);
+    const double fx = std::clamp(px - x0, 0.0, 1.0), fy = std::clamp(py - y0, 0.0, 1.0);
+    return (1.0 - fy) * ((1.0 - fx) * h(x0, y0) + fx * h(x1, y0)) + fy * ((1.0 - fx) * h(x0, y1) + fx * h(x1, y1));
+}
+
+// Tables of P_i(lo) = int_lo^{pi/2} A_i(sin w) cos^2 w dw and
+// Q_i(lo) = int_lo^{pi/2} A_i(sin w) sin w cos w dw over lo in [-pi/2, pi/2].
+struct ElevationTables {
+    static constexpr int kN = 4096;
+    std::vector<double> p, q;  // (kN + 1) x 16
+    ElevationTables() : p(static_cast<std::size_t>(kN + 1) * kShCount), q(static_cast<std::size_t>(kN + 1) * kShCount) {
+        double x[8], w[8];
+        gaussLegendre(8, x, w);
+        const double h = kPi / kN;
+        double accP[kShCount] = {}, accQ[kShCount] = {};
+        // integrate from the top (pi/2) downwards
+        for (int k = kN; k >= 0; --k) {
+            if (k < kN) {
+                const double a = -0.5 * kPi + k * h, b = a + h;
+                for (int g = 0; g < 8; ++g) {
+                    const double om = 0.5 * (a + b) + 0.5 * h * x[g];
+                    const double wt = 0.5 * h * w[g];
+                    const double sw = std::sin(om), cw = std::cos(om);
+                    for (int i = 0; i < kShCount; ++i) {
+                        const double A = shAssociated(i, sw);
+                        accP[i] += wt * A * cw * cw;
+                        accQ[i] += wt * A * sw * cw;
+                    }
+                }
+            }
+            for (int i = 0; i < kShCount; ++i) {
+                p[static_cast<std::size_t>(k * kShCount + i)] = accP[i];
+                q[static_cast<std::size_t>(k * kShCount + i)] = accQ[i];
+            }
+        }
+    }
+    void lookup(double lo, double* P, double* Q) const {
+        const double u = std::clamp((lo + 0.5 * kPi) / (kPi / kN), 0.0, static_cast<double>(kN));
+        const int k = std::min(static_cast<int>(u), kN - 1);
+        const double f = u - k;
+        const double* p0 = &p[static_cast<std::size_t>(k * kShCount)];
+        const double* q0 = &q[static_cast<std::size_t>(k * kShCount)];
+        for (int i = 0; i < kShCount; ++i) {
+            P[i] = (1.0 - f) * p0[i] + f * p0[i + kShCount];
+            Q[i] = (1.0 - f) * q0[i] + f * q0[i + kShCount];
+        }
+    }
+};
+
+const ElevationTables& elevationTables() {
+    static const ElevationTables t;
+    return t;
+}
+
+}  // namespace
+
+double referenceMaxSlope(ConstGridView h, float cellSize, int x, int y, double c, double s, double heightMax) {
+    const double h0 = h(x, y);
+    const double xmax = h.nx - 1, ymax = h.ny - 1;
+    double best = kNoBlocker;
+    const double ac = std::abs(c), as = std::abs(s);
+    const double dtx = ac > 1e-12 ? 1.0 / ac : std::numeric_limits<double>::infinity();
+    const double dty = as > 1e-12 ? 1.0 / as : std::numeric_limits<double>::infinity();
+    double tx = dtx, ty = dty, tPrev = 0.0;
+    const double invCell = 1.0 / cellSize;
+    for (;;) {
+        const double t = std::min(tx, ty);
+        if (!std::isfinite(t)) break;
+        // midpoint of the previous segment, then the crossing
+        for (int k = 0; k < 2; ++k) {
+            const double tt = k == 0 ? 0.5 * (tPrev + t) : t;
+            const double px = x + tt * c, py = y + tt * s;
+            if (px < -1e-9 || py < -1e-9 || px > xmax + 1e-9 || py > ymax + 1e-9) return best;
+            if (tt < 1e-9) continue;
+            const double slope = (bilinear(h, px, py) - h0) * invCell / tt;
+            if (slope > best) best = slope;
+        }
+        // nothing farther can beat the current slope
+        if (best > 0.0 && heightMax - h0 <= best * t * cellSize) return best;
+        tPrev = t;
+        if (tx <= ty) tx += dtx;
+        else ty += dty;
+        if (t > 4.0 * (xmax + ymax + 2.0)) break;
+    }
+    return best;
+}
+
+void renderReference(ConstGridView heights, float cellSize, const ShRgb* lighting, const AlbedoMap* albedo,
+                     const ReferenceSettings& rs, ReferenceResult& out) {
+    const int nx = heights.nx, ny = heights.ny;
+    const int M = std::max(rs.azimuths, 1);
+    out.ambient.resize(nx, ny, 0.0f);
+    if (lighting)
+        for (Grid& g : out.rgb) g.resize(nx, ny, 0.0f);
+    Grid gx, gy;
+    // same central differences as the fast path
+    {
+        const float inv2 = 0.5f / cellSize, inv1 = 1.0f / cellSize;
+        gx.resize(nx, ny);
+        gy.resize(nx, ny);
+        for (int y = 0; y < ny; ++y)
+            for (int x = 0; x < nx; ++x) {
+                float dx = 0.0f, dy = 0.0f;
+                if (nx > 1) dx = x == 0 ? (heights(1, y) - heights(0, y)) * inv1
+                                : (x == nx - 1 ? (heights(x, y) - heights(x - 1, y)) * inv1
+                                               : (heights(x + 1, y) - heights(x - 1, y)) * inv2);
+                if (ny > 1) dy = y == 0 ? (heights(x, 1) - heights(x, 0)) * inv1
+                                : (y == ny - 1 ? (heights(x, y) - heights(x, y - 1)) * inv1
+                                               : (heights(x, y + 1) - heights(x, y - 1)) * inv2);
+                gx(x, y) = dx;
+                gy(x, y) = dy;
+            }
+    }
+    double heightMax = -std::numeric_limits<double>::infinity();
+    for (int y = 0; y < ny; ++y)
+        for (int x = 0; x < nx; ++x) heightMax = std::max(heightMax, static_cast<double>(heights(x, y)));
+    std::vector<double> cosA(static_cast<std::size_t>(M)), sinA(static_cast<std::size_t>(M));
+    std::vector<std::array<double, kShCount>> azim(static_cast<std::size_t>(M));
+    for (int a = 0; a < M; ++a) {
+        const double phi = 2.0 * kPi * (a + 0.5) / M;
+        cosA[static_cast<std::size_t>(a)] = std::cos(phi);
+        sinA[static_cast<std::size_t>(a)] = std::sin(phi);
+        for (int i = 0; i < kShCount; ++i) azim[static_cast<std::size_t>(a)][static_cast<std::size_t>(i)] = shAzimuthal(i, phi);
+    }
+    const ElevationTables* tables = lighting ? &elevationTables() : nullptr;
+    const double dphi = 2.0 * kPi / M;
+    const int stride = std::max(rs.stride, 1);
+    const int yBegin = rs.border, yEnd = ny - rs.border;
+    std::atomic<int> rowsDone{0};
+    std::mutex printMutex;
+    const int rowsTotal = std::max(0, (yEnd - yBegin + stride - 1) / stride);
+
+    parallelFor(0, rowsTotal, 1, [&](int r0, int r1) {
+        for (int r = r0; r < r1; ++r) {
+            const int y = yBegin + r * stride;
+            for (int x = rs.border; x < nx - rs.border; x += stride) {
+                const double gxv = gx(x, y), gyv = gy(x, y);
+                const double inv = 1.0 / std::sqrt(1.0 + gxv * gxv + gyv * gyv);
+                const double nxv = -gxv * inv, nyv = -gyv * inv, nzv = inv;
+                double amb = 0.0;
+                double transfer[kShCount] = {};
+                for (int a = 0; a < M; ++a) {
+                    const double c = cosA[static_cast<std::size_t>(a)], s = sinA[static_cast<std::size_t>(a)];
+                    const double slope = referenceMaxSlope(heights, cellSize, x, y, c, s, heightMax);
+                    const double tangent = gxv * c + gyv * s;
+                    const double lo = std::atan(std::max(slope, tangent));
+                    const double horiz = nxv * c + nyv * s;
+                    const double sl = std::sin(lo), cl = std::cos(lo);
+                    amb += horiz * (0.5 * kPi - lo - sl * cl) * 0.5 + nzv * cl * cl * 0.5;
+                    if (tables) {
+                        double P[kShCount], Q[kShCount];
+                        tables->lookup(lo, P, Q);
+                        const auto& az = azim[static_cast<std::size_t>(a)];
+                        for (int i = 0; i < kShCount; ++i)
+                            transfer[i] += az[static_cast<std::size_t>(i)] * (horiz * P[i] + nzv * Q[i]);
+                    }
+                }
+                out.ambient(x, y) = static_cast<float>(amb * dphi / kPi);
+                if (tables)
+                    for (int ch = 0; ch < 3; ++ch) {
+                        double e = 0.0;
+                        for (int i = 0; i < kShCount; ++i)
+                            e += lighting->c[static_cast<std::size_t>(ch)][static_cast<std::size_t>(i)] * transfer[i];
+                        const float alb = albedo && !albedo->channel[static_cast<std::size_t>(ch)].empty()
+                                              ? albedo->channel[static_cast<std::size_t>(ch)](x, y)
+                                              : 1.0f;
+                        out.rgb[static_cast<std::size_t>(ch)](x, y) = static_cast<float>(alb * e * dphi / kPi);
+                    }
+            }
+            if (rs.progress) {
+                const int done = ++rowsDone;
+                const int pct = static_cast<int>(100LL * done / std::max(rowsTotal, 1));
+                const int prevPct = static_cast<int>(100LL * (done - 1) / std::max(rowsTotal, 1));
+                if (pct / 5 != prevPct / 5) {
+                    std::lock_guard<std::mutex> lock(printMutex);
+                    std::fprintf(stderr, "reference: %d%%\n", pct);
+                }
+            }
+        }
+    });
+}
+
+}  // namespace terrain::gi

@@ -1,0 +1,62 @@
+#pragma once
+// Shading in SH (Section 7) with sub-sampling (Fig. 7).
+//
+// Direct light: the incident radiance of a light is the SH product of its
+// radiance L and the visibility V it sees (a triple product; the 16 x 16
+// matrix of "multiply by L" is built once per frame per light). It is formed
+// at the receivers (the possibly sub-sampled grid) and interpolated
+// bilinearly to full resolution as SH vectors, then dotted with the BRDF's
+// zonal vector rotated to each texel's own full-resolution normal (Lambert)
+// or reflection vector (Phong). Interpolating SH vectors, not shaded colours,
+// keeps full-resolution normal detail (Fig. 7).
+//
+// Lambert needs bands 0..2 only (the clamped cosine's band-3 coefficient is
+// 0), so Lambert-only shading interpolates 9 coefficients per channel.
+// The ambient map is lam(N) . V_env / pi: the direct-only irradiance / pi
+// under a uniform unit sky, i.e. the normal-weighted sky-view factor.
+#include <array>
+#include <vector>
+
+#include "gi/sh.h"
+#include "gi/visibility.h"
+#include "sim/grid.h"
+
+namespace terrain::gi {
+
+enum class Brdf { Lambert, Phong, LambertPlusPhong };
+
+struct ShadingSettings {
+    Brdf brdf = Brdf::Lambert;
+    float phongExponent = 32.0f;      // S in Section 7
+    float specularWeight = 0.25f;     // weight of the Phong lobe in LambertPlusPhong
+    float viewDir[3] = {0.0f, 0.0f, 1.0f};  // unit vector towards the viewer (distant viewer)
+};
+
+/// Per-texel RGB albedo; empty grids mean albedo 1.
+struct AlbedoMap {
+    std::array<Grid, 3> channel;
+};
+
+/// One light as the shading stage sees it.
+struct ShadingLight {
+    const VisibilityField* visibility = nullptr;
+    std::array<ShMatrix, 3> product{};  // shProductMatrix of the light's RGB radiance
+};
+
+struct ShadeMaps {
+    int nx = 0, ny = 0;
+    std::array<Grid, 3> rgb;  // outgoing radiance towards the viewer, full resolution
+    Grid ambient;             // normal-weighted sky-view factor, full resolution
+    // receiver-resolution buffers
+    std::vector<float> incident;  // 3 x coefficients planes: sum over lights of T_L V
+    std::vector<int> colIndex;    // per full-res column: left receiver
+    std::vector<float> colFrac;   // and the fraction towards the right one
+};
+
+/// Shades every texel. envVisibility supplies the ambient map; lights the
+/// incident radiance. gradX/gradY are the full resolution height derivatives.
+void shadeTexels(ConstGridView gradX, ConstGridView gradY, int subsample, const VisibilityField& envVisibility,
+                 const ShadingLight* lights, int lightCount, const AlbedoMap* albedo, const ShadingSettings& settings,
+                 ShadeMaps& out);
+
+}  // namespace terrain::gi
