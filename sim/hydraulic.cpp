@@ -280,30 +280,27 @@ inline void updateCell(const Fields F, const Coeffs& k, std::ptrdiff_t i, const 
     store(F.velY + i, v);
 }
 
+/// One row of a pass: edge cells on the scalar path, interior cells four at
+/// a time, the interior remainder one at a time.
 template <class Kernel>
-void forEachCell(const Fields& F, const Coeffs& k) {
+void runRow(const Fields& F, const Coeffs& k, int y) {
     const int nx = F.nx, ny = F.ny;
-    parallelForRows(ny, nx, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y) {
-            const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(y) * nx;
-            if (y == 0 || y == ny - 1 || nx < 3) {
-                for (int x = 0; x < nx; ++x)
-                    Kernel::template run<float, true>(F, k, row + x, edgeNeighbours(x, y, nx, ny, k.invCell));
-                continue;
-            }
-            Kernel::template run<float, true>(F, k, row, edgeNeighbours(0, y, nx, ny, k.invCell));
-            int x = 1;
-            for (; x + kLanes <= nx - 1; x += kLanes) {
-                const std::ptrdiff_t i = row + x;
-                Kernel::template run<F4, false>(F, k, i, Nbr{i - 1, i + 1, i - nx, i + nx, true, true, true, true, 0, 0});
-            }
-            for (; x < nx - 1; ++x) {
-                const std::ptrdiff_t i = row + x;
-                Kernel::template run<float, false>(F, k, i, Nbr{i - 1, i + 1, i - nx, i + nx, true, true, true, true, 0, 0});
-            }
-            Kernel::template run<float, true>(F, k, row + nx - 1, edgeNeighbours(nx - 1, y, nx, ny, k.invCell));
-        }
-    });
+    const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(y) * nx;
+    if (y == 0 || y == ny - 1 || nx < 3) {
+        for (int x = 0; x < nx; ++x) Kernel::template run<float, true>(F, k, row + x, edgeNeighbours(x, y, nx, ny, k.invCell));
+        return;
+    }
+    Kernel::template run<float, true>(F, k, row, edgeNeighbours(0, y, nx, ny, k.invCell));
+    int x = 1;
+    for (; x + kLanes <= nx - 1; x += kLanes) {
+        const std::ptrdiff_t i = row + x;
+        Kernel::template run<F4, false>(F, k, i, Nbr{i - 1, i + 1, i - nx, i + nx, true, true, true, true, 0, 0});
+    }
+    for (; x < nx - 1; ++x) {
+        const std::ptrdiff_t i = row + x;
+        Kernel::template run<float, false>(F, k, i, Nbr{i - 1, i + 1, i - nx, i + nx, true, true, true, true, 0, 0});
+    }
+    Kernel::template run<float, true>(F, k, row + nx - 1, edgeNeighbours(nx - 1, y, nx, ny, k.invCell));
 }
 
 struct PipePass {
@@ -314,6 +311,9 @@ struct UpdatePass {
     template <class T, bool kEdge>
     static void run(const Fields& F, const Coeffs& k, std::ptrdiff_t i, const Nbr& n) { updateCell<T, kEdge>(F, k, i, n); }
 };
+
+/// Rows per block of the pipelined schedule: about 32k cells, at least 4 rows.
+int blockRows(int nx, int ny) { return std::clamp(32768 / std::max(nx, 1), 4, std::max(ny, 4)); }
 
 void ensureScratch(Grid& g, int nx, int ny) {
     if (g.nx != nx || g.ny != ny) g.resize(nx, ny);
@@ -379,8 +379,33 @@ void hydraulicStep(TerrainState& s, const HydraulicSettings& settings, float dt,
                    s.velX.data(),    s.velY.data(),  scratch.conc.data(), scratch.sin2.data(),
                    nx,               ny};
 
-    forEachCell<PipePass>(F, k);   // pass A
-    forEachCell<UpdatePass>(F, k); // pass B
+    // Schedule (apart from the algorithm above): rows are cut into fixed
+    // blocks (independent of the thread count). Phase 1 runs pass A on the
+    // first and last row of every block. Phase 2 walks each block top-down,
+    // running pass A on row y + 1 just before pass B on row y, so the rows a
+    // pass B reads are still in cache from its pass A. This is hazard-free:
+    // pass A on row y + 1 reads ground and water of rows y..y + 2 before pass
+    // B touches row y, and a block's pass A never reads a row of another
+    // block (its edge rows were done in phase 1), while pass B reads only
+    // fluxes and concentrations, which phase 1 or the block itself wrote.
+    const int rows = blockRows(nx, ny);
+    const int blocks = (ny + rows - 1) / rows;
+    parallelFor(0, blocks, 1, [&](int b0, int b1) {
+        for (int b = b0; b < b1; ++b) {
+            const int y0 = b * rows, y1 = std::min(ny, y0 + rows);
+            runRow<PipePass>(F, k, y0);
+            if (y1 - 1 != y0) runRow<PipePass>(F, k, y1 - 1);
+        }
+    });
+    parallelFor(0, blocks, 1, [&](int b0, int b1) {
+        for (int b = b0; b < b1; ++b) {
+            const int y0 = b * rows, y1 = std::min(ny, y0 + rows);
+            for (int y = y0; y < y1; ++y) {
+                if (y + 1 < y1 - 1) runRow<PipePass>(F, k, y + 1);
+                runRow<UpdatePass>(F, k, y);
+            }
+        }
+    });
 }
 
 }  // namespace terrain
