@@ -81,7 +81,7 @@
 // Where the flow accelerates along itself (|u| grows downstream) the normal
 // term switches to the velocity (energy-head) form u (u - u_upwind) / dx, as
 // S&D do for contractions: the momentum form over-advects there by the ratio
-// of upwind to centred depth and slows a dam-break front (13 % -> 16 % lag).
+// of upwind to centred depth and slows a dam-break front (front lag at 1e-3 h_l: 16 % without the switch, 13 % with it).
 // Known limit: the first-order dry-bed tip still lags Ritter's 2 c0 t front
 // (front at 1e-3 h_l ~13 % short at 626 cells of run-out, converging slowly);
 // the bulk profile is within 0.2 % (L1).
