@@ -60,16 +60,16 @@ void shadePreview(const TerrainState& s, const PreviewSettings& p, std::vector<s
                 c = {c.r * light, c.g * light, c.b * light};
                 if (water) {
                     const float d = s.water(x, y);
-                    if (d > 1e-3f) {
+                    if (d > 0.05f) {
                         // The water surface, lit by its own normal (exaggerated so small
                         // waves show) with a Fresnel-like sky sheen.
                         auto eta = [&](int xx, int yy) {
                             xx = std::clamp(xx, 0, nx - 1);
                             yy = std::clamp(yy, 0, ny - 1);
                             const float w = s.water(xx, yy);
-                            return w > 1e-3f ? s.ground(xx, yy) + w : s.ground(x, y) + d;
+                            return w > 0.05f ? s.ground(xx, yy) + w : s.ground(x, y) + d;
                         };
-                        const float k = 30.0f * inv2h;
+                        const float k = 6.0f * inv2h;
                         const float ex = (eta(x + 1, y) - eta(x - 1, y)) * k;
                         const float ey = (eta(x, y + 1) - eta(x, y - 1)) * k;
                         const float wi = 1.0f / std::sqrt(ex * ex + ey * ey + 1.0f);
@@ -77,8 +77,10 @@ void shadePreview(const TerrainState& s, const PreviewSettings& p, std::vector<s
                         const float a = 1.0f - std::exp(-d / 1.5f);
                         const Rgb deep{0.02f * (0.4f + ws), 0.10f * (0.4f + ws), 0.22f * (0.4f + ws)};
                         c = lerp(c, deep, 0.3f + 0.65f * a);
-                        const float sheen = std::pow(1.0f - wi, 2.0f) * 2.0f + 0.25f * std::pow(ws, 40.0f);
+                        const float sheen = std::min(0.3f, std::pow(1.0f - wi, 2.0f) * 2.0f) + 0.25f * std::pow(ws, 40.0f);
                         c = {c.r + sheen * 0.6f, c.g + sheen * 0.7f, c.b + sheen * 0.8f};
+                    } else if (d > 1e-3f) {
+                        c = {c.r * 0.8f, c.g * 0.82f, c.b * 0.9f};  // wet ground
                     }
                 }
                 std::uint8_t* o = rgb.data() + (static_cast<std::size_t>(y) * nx + x) * 3;

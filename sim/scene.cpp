@@ -62,13 +62,21 @@ SceneSettings builtinScene(const std::string& name, int size, std::uint64_t seed
         const float extent = 4000.0f;
         s.cellSize = extent / static_cast<float>(size);
         s.terrain.kind = TerrainSource::Kind::Noise;
-        s.terrain.noise.amplitude = 700.0f;
+        s.terrain.noise.amplitude = 500.0f;
         s.terrain.noise.wavelength = 3000.0f;
         s.terrain.noise.octaves = 9;
         s.terrain.noise.ridged = true;
         s.soilDepth = 2.0f;
         s.hydraulic = true;
         s.thermal = true;
+        // A heavy, steady rain (0.72 m/h) so valleys show within a few
+        // thousand ticks; capacity and rates tuned down from the model's
+        // defaults so the carving stays gradual at 4-16 m cells.
+        s.hydraulicSettings.rainRate = 2.0e-4f;
+        s.hydraulicSettings.capacity = 0.2f;
+        s.hydraulicSettings.dissolve = 0.3f;
+        s.hydraulicSettings.deposit = 0.3f;
+        s.thermalSettings.talusAngleDeg = 38.0f;
     } else if (name == "waves") {
         // A 512 m bay: the bottom rises from 8 m deep at -x to a beach and
         // rocky islands at +x; a swell rolls in through the -x edge and drops

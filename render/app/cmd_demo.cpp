@@ -37,7 +37,7 @@ int runDemo(const DemoOptions& o) {
         int perFrame = o.ticksPerFrame;
         if (perFrame == 0) {
             if (settings.waves) perFrame = std::max(1, static_cast<int>(0.25f / sim.dt()));
-            else if (settings.hydraulic || settings.thermal) perFrame = 20;
+            else if (settings.hydraulic || settings.thermal) perFrame = 60;
             else perFrame = 1;
         }
         std::printf("demo: scene %s, %d x %d cells, %d frames of %d ticks (%.3g s each)\n", settings.name.c_str(),
