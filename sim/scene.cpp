@@ -97,6 +97,7 @@ SceneSettings builtinScene(const std::string& name, int size, std::uint64_t seed
         s.waveSettings.swell.edge = 0;
         s.waveSettings.swell.amplitude = 0.25f;
         s.waveSettings.swell.period = 6.0f;
+        s.waveSettings.swell.seaLevel = s.waterLevel;
         for (int i = 0; i < 4; ++i) {
             WaveDrop d;
             d.time = 2.0 + 5.0 * i;
@@ -224,25 +225,14 @@ void Simulation::tick() {
         for (std::size_t i = 0; i < prevGround_.v.size(); ++i) prevGround_.v[i] += state_.soil.v[i];
         if (!prevWater_.empty()) prevWater_.v = state_.water.v;
     }
-    // The tick is fixed; when the state's own limit (deeper water, faster
-    // flow) drops below it, the tick is cut into equal sub-steps.
-    // stableDt() is the default step (Courant 0.5 for waves, half the linear
-    // limit for the pipes); a tick may run at up to kHeadroom times it (Courant
-    // 0.7, inside the 2-D staggered limit 1/sqrt(2)) before it is cut.
-    constexpr float kHeadroom = 1.4f;
-    int substeps = 1;
-    if (settings_.hydraulic || settings_.waves) {
-        const float limit = kHeadroom * stableDt();
-        if (limit < dt_) substeps = static_cast<int>(std::min(1024.0f, std::ceil(dt_ / limit)));
-    }
-    lastSubsteps_ = substeps;
-    const float h = dt_ / static_cast<float>(substeps);
-    for (int k = 0; k < substeps; ++k) {
-        if (settings_.waves) waveStep(state_, settings_.waveSettings, h, waveScratch_);
-        if (settings_.hydraulic) hydraulicStep(state_, settings_.hydraulicSettings, h, hydraulicScratch_);
-        if (settings_.thermal) thermalStep(state_, settings_.thermalSettings, h, thermalScratch_);
-        state_.time += static_cast<double>(h);
-    }
+    // The tick is fixed. The pipe model's limit does not depend on the state
+    // (hydraulic.h), and waveStep cuts a step internally when the current flow
+    // exceeds its hard Courant limit (waves.h), so no check is needed here.
+    if (settings_.waves) waveStep(state_, settings_.waveSettings, dt_, waveScratch_);
+    if (settings_.hydraulic) hydraulicStep(state_, settings_.hydraulicSettings, dt_, hydraulicScratch_);
+    if (settings_.thermal) thermalStep(state_, settings_.thermalSettings, dt_, thermalScratch_);
+    state_.time += static_cast<double>(dt_);
+    lastSubsteps_ = settings_.waves ? waveScratch_.lastSubsteps : 1;
     state_.tick += 1;
     if (simulates) updateChanges();
     else {

@@ -81,8 +81,7 @@ class Simulation {
 public:
     explicit Simulation(const SceneSettings& settings);
 
-    /// Advances one fixed time step (sub-stepped when the state's current
-    /// stability limit drops below it) and updates the change report.
+    /// Advances one fixed time step and updates the change report.
     void tick();
 
     const TerrainState& state() const { return state_; }
@@ -93,6 +92,7 @@ public:
     /// The CFL-derived limit at start, and whether the requested dt was clamped to it.
     float dtLimit() const { return dtLimit_; }
     bool dtClamped() const { return dtClamped_; }
+    /// Internal sub-steps the last tick needed (waves only; 1 normally).
     int lastSubsteps() const { return lastSubsteps_; }
 
 private:

@@ -184,6 +184,7 @@ void readWaves(const std::string& file, const toml::table& t, SceneSettings& s) 
     r.flag("enabled", s.waves);
     r.num("gravity", w.gravity);
     r.num("courant", w.courant);
+    r.num("max_courant", w.maxCourant);
     r.num("dry_depth", w.dryDepth);
     r.num("friction", w.friction);
     r.flag("advection", w.advection);
@@ -196,6 +197,9 @@ void readWaves(const std::string& file, const toml::table& t, SceneSettings& s) 
         if (!edge.empty()) w.swell.edge = parseEdge(file, edge);
         q.num("amplitude", w.swell.amplitude);
         q.num("period", w.swell.period);
+        w.swell.seaLevel = s.waterLevel;  // default: the scene's water level
+        q.num("sea_level", w.swell.seaLevel);
+        q.num("ramp_periods", w.swell.rampPeriods);
         q.finish();
     }
     if (const toml::node* d = r.get("drops")) {
