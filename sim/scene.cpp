@@ -206,8 +206,10 @@ Simulation::Simulation(const SceneSettings& settings) : settings_(settings) {
     changes_.tilesY = (state_.ny + settings_.changeTile - 1) / settings_.changeTile;
     changes_.dirty.assign(static_cast<std::size_t>(changes_.tilesX) * changes_.tilesY, 1);
     changes_.dirtyCount = changes_.tilesX * changes_.tilesY;
-    prevGround_.resize(state_.nx, state_.ny);
-    if (!state_.water.empty()) prevWater_.resize(state_.nx, state_.ny);
+    // Ground and water as of the last tick: updateChanges compares against
+    // them and writes the new values back in the same pass.
+    state_.groundHeight(prevGround_);
+    if (!state_.water.empty()) prevWater_ = state_.water;
 }
 
 float Simulation::stableDt() const {
@@ -220,11 +222,6 @@ float Simulation::stableDt() const {
 
 void Simulation::tick() {
     const bool simulates = settings_.hydraulic || settings_.thermal || settings_.waves;
-    if (simulates) {
-        prevGround_.v = state_.bedrock.v;
-        for (std::size_t i = 0; i < prevGround_.v.size(); ++i) prevGround_.v[i] += state_.soil.v[i];
-        if (!prevWater_.empty()) prevWater_.v = state_.water.v;
-    }
     // The tick is fixed. The pipe model's limit does not depend on the state
     // (hydraulic.h), and waveStep cuts a step internally when the current flow
     // exceeds its hard Courant limit (waves.h), so no check is needed here.
@@ -255,15 +252,22 @@ void Simulation::updateChanges() {
             for (int y = ty * ts; y < std::min(ny, (ty + 1) * ts); ++y) {
                 const float* b = state_.bedrock.data() + static_cast<std::size_t>(y) * nx;
                 const float* so = state_.soil.data() + static_cast<std::size_t>(y) * nx;
-                const float* p = prevGround_.data() + static_cast<std::size_t>(y) * nx;
+                float* p = prevGround_.data() + static_cast<std::size_t>(y) * nx;
                 const float* w = prevWater_.empty() ? nullptr : state_.water.data() + static_cast<std::size_t>(y) * nx;
-                const float* pw = prevWater_.empty() ? nullptr : prevWater_.data() + static_cast<std::size_t>(y) * nx;
+                float* pw = prevWater_.empty() ? nullptr : prevWater_.data() + static_cast<std::size_t>(y) * nx;
                 for (int tx = 0; tx < changes_.tilesX; ++tx) {
                     float mg = 0.0f, mw = 0.0f;
-                    for (int x = tx * ts; x < std::min(nx, (tx + 1) * ts); ++x) {
-                        mg = std::max(mg, std::fabs(b[x] + so[x] - p[x]));
-                        if (w) mw = std::max(mw, std::fabs(w[x] - pw[x]));
+                    const int x1 = std::min(nx, (tx + 1) * ts);
+                    for (int x = tx * ts; x < x1; ++x) {
+                        const float g = b[x] + so[x];
+                        mg = std::max(mg, std::fabs(g - p[x]));
+                        p[x] = g;
                     }
+                    if (w)
+                        for (int x = tx * ts; x < x1; ++x) {
+                            mw = std::max(mw, std::fabs(w[x] - pw[x]));
+                            pw[x] = w[x];
+                        }
                     const std::size_t t = static_cast<std::size_t>(ty) * changes_.tilesX + tx;
                     tileGround[t] = std::max(tileGround[t], mg);
                     tileWater[t] = std::max(tileWater[t], mw);
