@@ -247,3 +247,22 @@ y = 30.0
     CHECK_THROWS_AS(loadSceneFile((dir / "missing.toml").string()), IoError);
     fs::remove_all(dir);
 }
+
+TEST_CASE("sim.scene: every example scene file in scenes/ loads and runs") {
+    int count = 0;
+    for (const auto& e : fs::directory_iterator(std::string(TERRAIN_SOURCE_DIR) + "/scenes")) {
+        if (e.path().extension() != ".toml") continue;
+        CAPTURE(e.path().string());
+        SceneSettings s = resolveScene(e.path().string(), 48, 1);
+        if (s.terrain.kind == TerrainSource::Kind::Dem && !fs::exists(s.terrain.demFile)) {
+            MESSAGE("DEM not present; skipped ", e.path().string());
+            continue;
+        }
+        Simulation sim(s);
+        CHECK(sim.state().nx == 48);
+        for (int t = 0; t < 3; ++t) sim.tick();
+        CHECK_NOTHROW(checkFinite(sim.state()));
+        ++count;
+    }
+    CHECK(count >= 2);
+}
