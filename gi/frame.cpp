@@ -20,6 +20,11 @@ bool sameLight(const KeyLight& a, const KeyLight& b) {
 
 }  // namespace
 
+GiSettings engineGiSettings() {
+    GiSettings s;
+    return s;
+}
+
 void checkHeightsFinite(ConstGridView h) {
     for (int y = 0; y < h.ny; ++y)
         for (int x = 0; x < h.nx; ++x)

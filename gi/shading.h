@@ -51,6 +51,9 @@ struct ShadeMaps {
     std::vector<float> incident;  // 3 x coefficients planes: sum over lights of T_L V
     std::vector<int> colIndex;    // per full-res column: left receiver
     std::vector<float> colFrac;   // and the fraction towards the right one
+    std::vector<float> lightMatrices;  // lights x 3 x 16 x 16, float copies of the product matrices
+    std::vector<float> rowScratch;    // per row block: interpolated SH planes of one row
+    std::vector<float> basisScratch;  // per row block: rotated BRDF coefficients of one row
 };
 
 /// Shades every texel. envVisibility supplies the ambient map; lights the

@@ -18,8 +18,8 @@ constexpr int kMaxBlocks = 64;
 // writes the blocking slope (sample - h0) / tau. Receivers whose sample falls
 // outside the domain keep the previous step's slope (the ray has left the
 // height field, nothing more can block).
-void stepSlopes(const float* field, std::ptrdiff_t fieldStride, int fieldNx, int fieldNy, int k, int Y, double dx,
-                double dy, const float* h0, float invTau, const float* prev, float* out, int nxr) {
+void stepSlopes(const float* __restrict field, std::ptrdiff_t fieldStride, int fieldNx, int fieldNy, int k, int Y, double dx,
+                double dy, const float* __restrict h0, float invTau, const float* __restrict prev, float* __restrict out, int nxr) {
     const double py = static_cast<double>(k) * Y + dy;
     int xa = nxr, xb = -1;  // valid receivers [xa, xb]
     double fy = 0.0;
@@ -41,8 +41,8 @@ void stepSlopes(const float* field, std::ptrdiff_t fieldStride, int fieldNx, int
     const float fx = static_cast<float>(dx - c0);
     const float fyf = static_cast<float>(fy);
     const float w00 = (1.0f - fx) * (1.0f - fyf), w01 = fx * (1.0f - fyf), w10 = (1.0f - fx) * fyf, w11 = fx * fyf;
-    const float* a = field + r0 * fieldStride + c0;
-    const float* b = a + fieldStride;  // padded row: in bounds even when fy == 0 at the last row
+    const float* __restrict a = field + r0 * fieldStride + c0;
+    const float* __restrict b = a + fieldStride;  // padded row: in bounds even when fy == 0 at the last row
     if (k == 1) {
         for (int X = xa; X <= xb; ++X) {
             const float v = (w00 * a[X] + w01 * a[X + 1]) + (w10 * b[X] + w11 * b[X + 1]);
@@ -67,20 +67,21 @@ void reduceMaxSlope(const float* slopes, int nSteps, int nxr, BlockingMax rule, 
         }
         return;
     }
-    // Cubic B-spline with control points s_i (ends replicated): value at knot
-    // i is (s_{i-1} + 4 s_i + s_{i+1}) / 6, at the midpoint between i and i+1
-    // (s_{i-1} + 23 s_i + 23 s_{i+1} + s_{i+2}) / 48.
-    for (int X = 0; X < nxr; ++X) out[X] = kNoBlocker;
-    for (int i = 0; i < nSteps; ++i) {
-        const float* sm = slopes + static_cast<std::size_t>(std::max(i - 1, 0)) * nxr;
-        const float* s0 = slopes + static_cast<std::size_t>(i) * nxr;
-        const float* s1 = slopes + static_cast<std::size_t>(std::min(i + 1, nSteps - 1)) * nxr;
-        const float* s2 = slopes + static_cast<std::size_t>(std::min(i + 2, nSteps - 1)) * nxr;
+    // Eq. 16: the maximum of the cubic interpolant through the samples s_i,
+    // evaluated at the knots (the samples themselves) and at the midpoints,
+    // (-s_{i-1} + 9 s_i + 9 s_{i+1} - s_{i+2}) / 16 (ends replicated). The
+    // interpolant can rise between samples, recovering part of a peak that
+    // falls between two exponential steps.
+    for (int X = 0; X < nxr; ++X) out[X] = slopes[X];
+    for (int i = 0; i + 1 < nSteps; ++i) {
+        const float* __restrict sm = slopes + static_cast<std::size_t>(std::max(i - 1, 0)) * nxr;
+        const float* __restrict s0 = slopes + static_cast<std::size_t>(i) * nxr;
+        const float* __restrict s1 = s0 + nxr;
+        const float* __restrict s2 = slopes + static_cast<std::size_t>(std::min(i + 2, nSteps - 1)) * nxr;
         for (int X = 0; X < nxr; ++X) {
-            const float knot = (sm[X] + 4.0f * s0[X] + s1[X]) * (1.0f / 6.0f);
-            const float mid = ((sm[X] + s2[X]) + 23.0f * (s0[X] + s1[X])) * (1.0f / 48.0f);
+            const float mid = (9.0f * (s0[X] + s1[X]) - (sm[X] + s2[X])) * (1.0f / 16.0f);
             float m = out[X];
-            m = m < knot ? knot : m;
+            m = m < s1[X] ? s1[X] : m;
             m = m < mid ? mid : m;
             out[X] = m;
         }
@@ -88,9 +89,16 @@ void reduceMaxSlope(const float* slopes, int nSteps, int nxr, BlockingMax rule, 
 }
 
 // ---- algorithm: Eq. 11 and the folded wedge operator for one azimuth -------
-void accumulateVisibility(const float* maxSlope, const float* gx, const float* gy, float cosPhi, float sinPhi,
-                          const VisibilityTarget& target, const float* opValues, const std::uint8_t* patRow,
-                          const std::uint8_t* patNlp, int patSize, float* const* vRows, int nxr) {
+// NLP vectors of a row of receivers (4 rows of nxr), then V += G_j w_j over
+// the sparse pattern, each entry a contiguous multiply-add over the row.
+void accumulateVisibility(const float* __restrict maxSlope, const float* __restrict gx, const float* __restrict gy,
+                          float cosPhi, float sinPhi, const VisibilityTarget& target, const float* opValues,
+                          const std::uint8_t* patRow, const std::uint8_t* patNlp, int patSize, float* const* vRows,
+                          float* __restrict nlp, int nxr) {
+    float* __restrict w0 = nlp;
+    float* __restrict w1 = nlp + nxr;
+    float* __restrict w2 = nlp + 2 * nxr;
+    float* __restrict w3 = nlp + 3 * nxr;
     for (int X = 0; X < nxr; ++X) {
         // omega_min: elevation of the tangent plane along this azimuth
         const float tangent = gx[X] * cosPhi + gy[X] * sinPhi;
@@ -104,7 +112,16 @@ void accumulateVisibility(const float* maxSlope, const float* gx, const float* g
         } else {
             nlpVisibleAbove(s, w);
         }
-        for (int e = 0; e < patSize; ++e) vRows[patRow[e]][X] += opValues[e] * w[patNlp[e]];
+        w0[X] = w[0];
+        w1[X] = w[1];
+        w2[X] = w[2];
+        w3[X] = w[3];
+    }
+    for (int e = 0; e < patSize; ++e) {
+        float* __restrict v = vRows[patRow[e]];
+        const float* __restrict w = nlp + static_cast<std::size_t>(patNlp[e]) * nxr;
+        const float g = opValues[e];
+        for (int X = 0; X < nxr; ++X) v[X] += g * w[X];
     }
 }
 
@@ -138,6 +155,7 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
         b.gradX.resize(static_cast<std::size_t>(nxr));
         b.gradY.resize(static_cast<std::size_t>(nxr));
         b.h0.resize(static_cast<std::size_t>(nxr));
+        b.nlp.resize(static_cast<std::size_t>(4) * nxr);
     }
     // ---- schedule: fixed row blocks in parallel, rows serially within a block
     parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
@@ -182,7 +200,7 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
                     accumulateVisibility(maxRow, sc.gradX.data(), sc.gradY.data(), static_cast<float>(c),
                                          static_cast<float>(sn), target,
                                          op.values.data() + static_cast<std::size_t>(j) * op.patternSize(),
-                                         op.patternRow.data(), op.patternNlp.data(), op.patternSize(), vRows, nxr);
+                                         op.patternRow.data(), op.patternNlp.data(), op.patternSize(), vRows, sc.nlp.data(), nxr);
                 }
             }
         }

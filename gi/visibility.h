@@ -5,7 +5,7 @@
 // steps of the height pyramid (Eq. 14) and records the blocking slope
 // tan(omega_i) = (f_l(p + tau_i d) - f(p)) / tau_i of each step (Eq. 15, as a
 // slope: atan is monotonic, GUIDE 3). The maximum blocking angle (Eq. 16) is
-// the maximum of the cubic B-spline through these samples, evaluated at the
+// the maximum of the cubic interpolant through these samples, evaluated at the
 // knots and midpoints (or, optionally, the plain maximum of the samples).
 //
 // omega_min comes from the receiver's normal: the tangent plane cuts the
@@ -37,7 +37,7 @@
 namespace terrain::gi {
 
 enum class BlockingMax {
-    BsplineKnotsAndMidpoints,  // Eq. 16 (paper)
+    BsplineKnotsAndMidpoints,  // Eq. 16 (paper): cubic interpolant at knots and midpoints
     Samples,                   // plain maximum over the step samples
 };
 
@@ -53,6 +53,7 @@ struct VisibilityScratch {
     std::vector<float> gradX;   // nxr: dh/dx at the receivers of the current row
     std::vector<float> gradY;
     std::vector<float> h0;      // nxr: receiver heights of the current row
+    std::vector<float> nlp;     // 4 x nxr: NLP visibility vectors of the current row and azimuth
 };
 
 /// Azimuth set and elevation window of one visibility computation.
