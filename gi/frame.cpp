@@ -21,7 +21,15 @@ bool sameLight(const KeyLight& a, const KeyLight& b) {
 }  // namespace
 
 GiSettings engineGiSettings() {
+    // Measured on alps-montblanc at true scale against gi/reference
+    // (bench/results/gi_accuracy.md, gi_explore.csv): a level offset of 3, a
+    // pyramid that blends 25 % of max-decimated octaves into the mean ones
+    // (keeps distant peaks that the mean filter lowers) and the plain maximum
+    // over the step samples remove the pyramid's positive bias at the same cost.
     GiSettings s;
+    s.pyramid.levelOffset = 3;
+    s.pyramid.peakBlend = 0.25f;
+    s.visibility.blockingMax = BlockingMax::Samples;
     return s;
 }
 

@@ -1,0 +1,21 @@
+#pragma once
+// Image files of the GI stage: float EXR and NumPy .npy writers (atomic:
+// temporary file + rename), and equirectangular environment maps (.exr,
+// Radiance .hdr) for lights. Every function throws IoError naming the file.
+#include <string>
+#include <vector>
+
+#include "sim/grid.h"
+
+namespace terrain::gi {
+
+/// float32 .npy, shape (rows, columns), row 0 = the first grid row.
+void writeNpy(const std::string& file, const Grid& g);
+
+/// Half-float OpenEXR with 1 channel ("Y") or 3 ("R", "G", "B").
+void writeExr(const std::string& file, const std::vector<const Grid*>& channels);
+
+/// Reads an RGB equirectangular image (.exr or .hdr): 3 floats per pixel, row 0 first.
+std::vector<float> readEquirect(const std::string& file, int& width, int& height);
+
+}  // namespace terrain::gi

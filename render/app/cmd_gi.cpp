@@ -1,0 +1,214 @@
+// `terrain gi`: light a DEM with the GI fast path (paper 001) or the ground
+// truth, write the shade and ambient maps, time the stages.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "gi/frame.h"
+#include "gi/image_io.h"
+#include "gi/reference.h"
+#include "render/app/commands.h"
+#include "sim/error.h"
+#include "sim/io.h"
+#include "sim/parallel.h"
+
+namespace terrain::app {
+namespace {
+
+struct GiOptions {
+    std::string heightmap;
+    double cellSize = 0.0;
+    double zScale = 1.0;
+    double zOffset = 0.0;
+    std::string light = "uniform";
+    std::vector<std::string> keys;
+    int subsample = 1;
+    int azimuths = 0, levelsPerOctave = 0, levelOffset = -1;
+    std::string interp;
+    int threads = 0;
+    bool reference = false;
+    std::string outShade, outAmbient;
+    int frames = 1;
+    bool time = false;
+};
+
+std::string extensionOf(const std::string& f) {
+    const auto dot = f.find_last_of('.');
+    std::string e = dot == std::string::npos ? "" : f.substr(dot);
+    for (char& c : e) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return e;
+}
+
+gi::KeyLight parseKey(const std::string& text) {
+    std::vector<float> v;
+    std::stringstream ss(text);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+        try {
+            std::size_t used = 0;
+            v.push_back(std::stof(item, &used));
+            if (used != item.size()) throw std::invalid_argument(item);
+        } catch (const std::exception&) {
+            throw InputError("--key '" + text + "': '" + item + "' is not a number");
+        }
+    }
+    if (v.size() != 6) throw InputError("--key '" + text + "': expected AZ_DEG,EL_DEG,RADIUS_DEG,R,G,B");
+    gi::KeyLight k;
+    k.azimuthDeg = v[0];
+    k.elevationDeg = v[1];
+    k.radiusDeg = v[2];
+    k.rgb[0] = v[3];
+    k.rgb[1] = v[4];
+    k.rgb[2] = v[5];
+    gi::validateKeyLight(k);
+    return k;
+}
+
+gi::ShRgb parseLight(const std::string& light) {
+    if (light == "uniform") return gi::uniformSkyLight(1.0f);
+    if (light == "sunsky") return gi::sunSkyLight();
+    if (light.rfind("env:", 0) == 0) {
+        const std::string file = light.substr(4);
+        int w = 0, h = 0;
+        const std::vector<float> rgb = gi::readEquirect(file, w, h);
+        try {
+            return gi::projectEquirect(rgb, w, h);
+        } catch (const InputError& e) {
+            throw IoError(file, e.what());
+        }
+    }
+    throw InputError("--light must be uniform, sunsky or env:FILE (got '" + light + "')");
+}
+
+void writeShade(const std::string& file, const std::array<Grid, 3>& rgb) {
+    const std::string ext = extensionOf(file);
+    if (ext == ".exr") {
+        gi::writeExr(file, {&rgb[0], &rgb[1], &rgb[2]});
+        return;
+    }
+    if (ext != ".png") throw InputError("--out-shade must end in .png or .exr (got '" + file + "')");
+    const int w = rgb[0].nx, h = rgb[0].ny;
+    std::vector<std::uint8_t> px(static_cast<std::size_t>(w) * h * 3);
+    for (std::size_t i = 0; i < rgb[0].size(); ++i)
+        for (int c = 0; c < 3; ++c) {
+            // linear radiance -> sRGB, clamped to [0, 1]
+            float v = std::clamp(rgb[static_cast<std::size_t>(c)].v[i], 0.0f, 1.0f);
+            v = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+            px[i * 3 + static_cast<std::size_t>(c)] = static_cast<std::uint8_t>(std::lround(v * 255.0f));
+        }
+    writePngRgb(file, w, h, px, 3);
+}
+
+void writeAmbient(const std::string& file, const Grid& ambient) {
+    const std::string ext = extensionOf(file);
+    if (ext == ".npy") gi::writeNpy(file, ambient);
+    else if (ext == ".exr") gi::writeExr(file, {&ambient});
+    else throw InputError("--out-ambient must end in .npy or .exr (got '" + file + "')");
+}
+
+int runGi(const GiOptions& o) {
+    // ---- validate everything before the work starts --------------------------
+    if (o.threads < 0 || o.threads > 256) throw InputError("--threads must be 0 (all) .. 256");
+    if (o.frames < 1 || o.frames > 100000) throw InputError("--frames must be >= 1");
+    if (o.subsample != 1 && o.subsample != 2 && o.subsample != 4) throw InputError("--subsample must be 1, 2 or 4");
+    if (!std::isfinite(o.zScale) || !std::isfinite(o.zOffset)) throw InputError("--z-scale and --z-offset must be finite");
+    if (!o.outShade.empty() && extensionOf(o.outShade) != ".png" && extensionOf(o.outShade) != ".exr")
+        throw InputError("--out-shade must end in .png or .exr (got '" + o.outShade + "')");
+    if (!o.outAmbient.empty() && extensionOf(o.outAmbient) != ".npy" && extensionOf(o.outAmbient) != ".exr")
+        throw InputError("--out-ambient must end in .npy or .exr (got '" + o.outAmbient + "')");
+    gi::GiSettings settings = gi::engineGiSettings();
+    settings.subsample = o.subsample;
+    if (o.azimuths != 0) settings.visibility.azimuths = o.azimuths;
+    if (o.levelsPerOctave != 0) settings.pyramid.levelsPerOctave = o.levelsPerOctave;
+    if (o.levelOffset >= 0) settings.pyramid.levelOffset = o.levelOffset;
+    if (!o.interp.empty()) {
+        if (o.interp == "linear") settings.visibility.interp = gi::AzimuthInterp::Linear;
+        else if (o.interp == "bspline") settings.visibility.interp = gi::AzimuthInterp::Bspline;
+        else throw InputError("--interp must be linear or bspline (got '" + o.interp + "')");
+    }
+    gi::GiLighting lighting;
+    for (const std::string& k : o.keys) lighting.keys.push_back(parseKey(k));
+    lighting.environment = parseLight(o.light);
+
+    float cellFromFile = 0.0f;
+    const Grid heights = readHeightmap(o.heightmap, static_cast<float>(o.zScale), static_cast<float>(o.zOffset), &cellFromFile);
+    double cell = o.cellSize;
+    if (cell <= 0.0) cell = cellFromFile;
+    if (!(cell > 0.0) || !std::isfinite(cell)) throw InputError("--cell-size must be > 0 (metres between grid points)");
+    std::fprintf(stderr, "terrain gi: %s, %d x %d cells of %.4g m\n", o.heightmap.c_str(), heights.nx, heights.ny, cell);
+
+    return withThreads(o.threads, [&] {
+        using Clock = std::chrono::steady_clock;
+        if (o.reference) {
+            gi::ReferenceSettings rs;
+            rs.progress = true;
+            gi::ReferenceResult rr;
+            // key lights enter the ground truth as SH caps added to the environment
+            gi::ShRgb total = lighting.environment;
+            for (const gi::KeyLight& k : lighting.keys) {
+                const gi::ShRgb cap = gi::keyLightSh(k);
+                for (int c = 0; c < 3; ++c)
+                    for (int i = 0; i < gi::kShCount; ++i)
+                        total.c[static_cast<std::size_t>(c)][static_cast<std::size_t>(i)] +=
+                            cap.c[static_cast<std::size_t>(c)][static_cast<std::size_t>(i)];
+            }
+            const auto t0 = Clock::now();
+            gi::renderReference(heights.cview(), static_cast<float>(cell), &total, nullptr, rs, rr);
+            const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+            if (o.time) std::printf("reference: %.1f ms\n", ms);
+            if (!o.outShade.empty()) writeShade(o.outShade, rr.rgb);
+            if (!o.outAmbient.empty()) writeAmbient(o.outAmbient, rr.ambient);
+            return 0;
+        }
+        gi::GiState state;
+        std::vector<double> totals;
+        for (int f = 0; f < o.frames; ++f) {
+            gi::runGiFrame(heights.cview(), static_cast<float>(cell), lighting, settings, state);
+            const gi::GiTimings& t = state.timings;
+            if (o.time)
+                std::printf("frame %d: gradient %.2f ms, pyramid %.2f ms, visibility %.2f ms, key lights %.2f ms, shading %.2f ms, total %.2f ms%s\n",
+                            f, t.gradient, t.pyramid, t.visibility, t.keyVisibility, t.shading, t.total,
+                            f == 0 && o.frames > 1 ? " (warm-up)" : "");
+            if (f > 0 || o.frames == 1) totals.push_back(t.total);
+        }
+        if (o.time) {
+            std::sort(totals.begin(), totals.end());
+            std::printf("%.2f ms per frame\n", totals[totals.size() / 2]);
+        }
+        if (!o.outShade.empty()) writeShade(o.outShade, state.shade.rgb);
+        if (!o.outAmbient.empty()) writeAmbient(o.outAmbient, state.shade.ambient);
+        return 0;
+    });
+}
+
+}  // namespace
+
+Runner addGiCommand(CLI::App& app) {
+    auto o = std::make_shared<GiOptions>();
+    CLI::App* sub = app.add_subcommand("gi", "Global illumination of a height field: soft shadows from sky and key lights");
+    sub->add_option("--heightmap", o->heightmap, "16-bit PNG (height = O + S * value) or .vdb")->required();
+    sub->add_option("--cell-size", o->cellSize, "Metres between grid points (required for PNG)");
+    sub->add_option("--z-scale", o->zScale, "Metres per PNG unit (S)");
+    sub->add_option("--z-offset", o->zOffset, "Height of PNG value 0 in metres (O)");
+    sub->add_option("--light", o->light, "uniform | sunsky | env:FILE (.exr/.hdr equirectangular)");
+    sub->add_option("--key", o->keys, "Key light AZ_DEG,EL_DEG,RADIUS_DEG,R,G,B (repeatable)");
+    sub->add_option("--subsample", o->subsample, "Visibility sub-sampling: 1, 2 or 4");
+    sub->add_option("--azimuths", o->azimuths, "Azimuth samples m (default 32)");
+    sub->add_option("--levels-per-octave", o->levelsPerOctave, "Pyramid levels per octave k_v (default 4)");
+    sub->add_option("--level-offset", o->levelOffset, "Pyramid level offset o_v in octaves (engine default 3, paper 2)");
+    sub->add_option("--interp", o->interp, "Azimuthal interpolation: linear | bspline");
+    sub->add_option("--threads", o->threads, "Worker threads (0 = all)");
+    sub->add_flag("--reference", o->reference, "Ground truth instead of the fast path (slow)");
+    sub->add_option("--out-shade", o->outShade, "RGB shade map (.png sRGB 8-bit, or .exr)");
+    sub->add_option("--out-ambient", o->outAmbient, "Ambient (sky-view) map (.npy float32, or .exr)");
+    sub->add_option("--frames", o->frames, "Run the frame N times on the same field (first = warm-up)");
+    sub->add_flag("--time", o->time, "Print the time of each stage and the median ms per frame");
+    return [o] { return runGi(*o); };
+}
+
+}  // namespace terrain::app
