@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
         if (subs.size() > before) commands.emplace_back(subs.back(), std::move(r));
     };
     add(&terrain::app::addSimCommand);
+    add(&terrain::app::addGiCommand);
     add(&terrain::app::addDemoCommand);
     try {
         app.parse(argc, argv);
