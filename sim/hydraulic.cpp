@@ -9,6 +9,7 @@
 #include <immintrin.h>
 
 #include "sim/parallel.h"
+#include "sim/simd.h"
 
 // Hydraulic erosion, virtual-pipe model (Mei, Decaudin & Hu 2007), written as
 // two gather passes over the grid:
@@ -112,35 +113,14 @@ inline Nbr edgeNeighbours(int x, int y, int nx, int ny, float invCell) {
 // than auto-vectorisation) because the build keeps -fmath-errno and
 // -ftrapping-math, which stop GCC from vectorising sqrt and guarded divisions.
 // ---------------------------------------------------------------------------
-using F4 = float __attribute__((vector_size(16)));
-constexpr int kLanes = 4;
-
-template <class T>
-inline T load(const float* p) {
-    if constexpr (std::is_same_v<T, float>) {
-        return *p;
-    } else {
-        T v;
-        std::memcpy(&v, p, sizeof v);
-        return v;
-    }
-}
-template <class T>
-inline void store(float* p, T v) {
-    if constexpr (std::is_same_v<T, float>) *p = v;
-    else std::memcpy(p, &v, sizeof v);
-}
-template <class T>
-inline T splat(float x) {
-    if constexpr (std::is_same_v<T, float>) return x;
-    else return T{} + x;
-}
-template <class T>
-inline T vmax(T a, T b) { return a > b ? a : b; }
-template <class T>
-inline T vmin(T a, T b) { return a < b ? a : b; }
-inline float vsqrt(float x) { return std::sqrt(x); }
-inline F4 vsqrt(F4 x) { return reinterpret_cast<F4>(_mm_sqrt_ps(reinterpret_cast<__m128>(x))); }
+using simd::F4;
+using simd::load;
+using simd::splat;
+using simd::store;
+using simd::vmax;
+using simd::vmin;
+using simd::vsqrt;
+constexpr int kLanes = simd::kLanes;
 
 // ---------------------------------------------------------------------------
 // Pass A: outflow fluxes (Mei et al., "flow simulation": pipe acceleration and

@@ -7,6 +7,7 @@
 #include <type_traits>
 
 #include "sim/parallel.h"
+#include "sim/simd.h"
 
 // Thermal erosion (talus relaxation) in the 8-neighbourhood, with the real
 // distance to each neighbour (c along the axes, c * sqrt(2) on the
@@ -65,33 +66,13 @@ struct Coeffs {
 // kernels are templated on the lane type, interior cells run four at a time,
 // edge cells one at a time with the same IEEE operations, so a cell's result
 // does not depend on the path.
-using F4 = float __attribute__((vector_size(16)));
-constexpr int kLanes = 4;
-
-template <class T>
-inline T load(const float* p) {
-    if constexpr (std::is_same_v<T, float>) {
-        return *p;
-    } else {
-        T v;
-        std::memcpy(&v, p, sizeof v);
-        return v;
-    }
-}
-template <class T>
-inline void store(float* p, T v) {
-    if constexpr (std::is_same_v<T, float>) *p = v;
-    else std::memcpy(p, &v, sizeof v);
-}
-template <class T>
-inline T splat(float x) {
-    if constexpr (std::is_same_v<T, float>) return x;
-    else return T{} + x;
-}
-template <class T>
-inline T vmax(T a, T b) { return a > b ? a : b; }
-template <class T>
-inline T vmin(T a, T b) { return a < b ? a : b; }
+using simd::F4;
+using simd::load;
+using simd::splat;
+using simd::store;
+using simd::vmax;
+using simd::vmin;
+constexpr int kLanes = simd::kLanes;
 
 // The eight neighbours in a fixed order: L, R, U, D, UL, UR, DL, DR. The
 // first four are at distance c, the last four at c * sqrt(2).

@@ -8,6 +8,7 @@
 
 #include "sim/error.h"
 #include "sim/parallel.h"
+#include "sim/simd.h"
 
 // ---------------------------------------------------------------------------
 // The algorithm
@@ -117,33 +118,13 @@ namespace {
 // Explicit vectors because the build keeps -ftrapping-math, under which GCC
 // turns upwind selects of divisions/products back into branches and gives up.
 // ---------------------------------------------------------------------------
-using F4 = float __attribute__((vector_size(16)));
-constexpr int kVec = 4;
-
-template <class T>
-inline T load(const float* p) {
-    if constexpr (std::is_same_v<T, float>) {
-        return *p;
-    } else {
-        T v;
-        std::memcpy(&v, p, sizeof v);
-        return v;
-    }
-}
-template <class T>
-inline void store(float* p, T v) {
-    if constexpr (std::is_same_v<T, float>) *p = v;
-    else std::memcpy(p, &v, sizeof v);
-}
-template <class T>
-inline T splat(float x) {
-    if constexpr (std::is_same_v<T, float>) return x;
-    else return T{} + x;
-}
-template <class T>
-inline T vmax(T a, T b) { return a > b ? a : b; }
-template <class T>
-inline T vmin(T a, T b) { return a < b ? a : b; }
+using simd::F4;
+using simd::load;
+using simd::splat;
+using simd::store;
+using simd::vmax;
+using simd::vmin;
+constexpr int kVec = simd::kLanes;
 
 // Hydrostatic reconstruction at a face (see above). bA, bB: grounds relative
 // to the step's reference level. Returns the pressure difference

@@ -1,0 +1,54 @@
+#pragma once
+// 4-wide SIMD over GCC vector extensions, shared by the grid kernels.
+//
+// A kernel is written once, templated on the lane type T (float or F4):
+// interior cells run four at a time, edge cells one at a time with the same
+// arithmetic. Every lane op is a correctly rounded IEEE-754 add/sub/mul/div/
+// sqrt or a select, so a cell's result does not depend on which path (or
+// thread) computed it. Explicit vectors rather than auto-vectorisation
+// because the build keeps -fmath-errno and -ftrapping-math (no fast-math, for
+// reproducible results), under which GCC will not vectorise sqrt, guarded
+// divisions or upwind selects by itself. Baseline x86-64 (SSE2) only.
+#include <cmath>
+#include <cstring>
+#include <type_traits>
+
+#include <emmintrin.h>
+
+namespace terrain::simd {
+
+using F4 = float __attribute__((vector_size(16)));
+constexpr int kLanes = 4;
+
+template <class T>
+inline T load(const float* p) {
+    if constexpr (std::is_same_v<T, float>) {
+        return *p;
+    } else {
+        T v;
+        std::memcpy(&v, p, sizeof v);
+        return v;
+    }
+}
+template <class T>
+inline void store(float* p, T v) {
+    if constexpr (std::is_same_v<T, float>) *p = v;
+    else std::memcpy(p, &v, sizeof v);
+}
+template <class T>
+inline T splat(float x) {
+    if constexpr (std::is_same_v<T, float>) return x;
+    else return T{} + x;
+}
+template <class T>
+inline T vmax(T a, T b) {
+    return a > b ? a : b;
+}
+template <class T>
+inline T vmin(T a, T b) {
+    return a < b ? a : b;
+}
+inline float vsqrt(float x) { return std::sqrt(x); }
+inline F4 vsqrt(F4 x) { return reinterpret_cast<F4>(_mm_sqrt_ps(reinterpret_cast<__m128>(x))); }
+
+}  // namespace terrain::simd
