@@ -1,0 +1,151 @@
+#include "gi/reference_gi.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "gi/frame.h"
+#include "sim/error.h"
+#include "sim/parallel.h"
+
+namespace terrain::gi {
+namespace {
+
+inline float bilinearF(const float* v, int nx, int ny, float px, float py) {
+    int x0 = static_cast<int>(px), y0 = static_cast<int>(py);
+    x0 = std::clamp(x0, 0, std::max(nx - 2, 0));
+    y0 = std::clamp(y0, 0, std::max(ny - 2, 0));
+    const int x1 = std::min(x0 + 1, nx - 1), y1 = std::min(y0 + 1, ny - 1);
+    const float fx = std::clamp(px - static_cast<float>(x0), 0.0f, 1.0f);
+    const float fy = std::clamp(py - static_cast<float>(y0), 0.0f, 1.0f);
+    const float* r0 = v + static_cast<std::size_t>(y0) * nx;
+    const float* r1 = v + static_cast<std::size_t>(y1) * nx;
+    const float a = r0[x0] + fx * (r0[x1] - r0[x0]);
+    const float b = r1[x0] + fx * (r1[x1] - r1[x0]);
+    return a + fy * (b - a);
+}
+
+// First hit of the ray from grid point (x, y) (at its height) in direction d
+// through the bilinear height field. Returns false when it escapes. All
+// positions in cells; heights in metres.
+bool firstHit(const float* h, int nx, int ny, float hMax, float cellSize, int x, int y, const std::array<float, 3>& d,
+              float step, float& hx, float& hy) {
+    const float horiz = std::sqrt(d[0] * d[0] + d[1] * d[1]);
+    if (horiz < 1e-6f) return d[2] < 0.0f ? (hx = static_cast<float>(x), hy = static_cast<float>(y), true) : false;
+    const float dx = d[0] / horiz, dy = d[1] / horiz;
+    const float rise = d[2] / horiz * cellSize;  // metres of ray height per cell travelled
+    const float h0 = h[static_cast<std::size_t>(y) * nx + x];
+    float prevGap = 0.0f;  // ray height - terrain height at the previous sample (0 at the start)
+    float prevT = 0.0f;
+    for (float t = step;; t += step) {
+        const float px = static_cast<float>(x) + t * dx, py = static_cast<float>(y) + t * dy;
+        if (px < 0.0f || py < 0.0f || px > static_cast<float>(nx - 1) || py > static_cast<float>(ny - 1)) return false;
+        const float rayZ = h0 + rise * t;
+        if (rise >= 0.0f && rayZ > hMax) return false;
+        const float gap = rayZ - bilinearF(h, nx, ny, px, py);
+        if (gap < 0.0f) {
+            // linear refinement between the last sample above and this one below
+            const float f = prevGap / (prevGap - gap);
+            const float th = prevT + f * (t - prevT);
+            hx = static_cast<float>(x) + th * dx;
+            hy = static_cast<float>(y) + th * dy;
+            return true;
+        }
+        prevGap = gap;
+        prevT = t;
+    }
+}
+
+}  // namespace
+
+void referenceDirections(int count, std::vector<std::array<float, 3>>& out) {
+    out.resize(static_cast<std::size_t>(count));
+    const double golden = kPi * (3.0 - std::sqrt(5.0));
+    for (int k = 0; k < count; ++k) {
+        const double z = 1.0 - (2.0 * k + 1.0) / count;
+        const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+        const double phi = golden * k;
+        out[static_cast<std::size_t>(k)] = {static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)),
+                                            static_cast<float>(z)};
+    }
+}
+
+void gatherReferenceBounce(ConstGridView heights, float cellSize, const std::array<Grid, 3>& prev,
+                           const AlbedoMap* albedo, const ReferenceGiSettings& s, std::array<Grid, 3>& next) {
+    const int nx = heights.nx, ny = heights.ny;
+    for (int c = 0; c < 3; ++c) next[c].resize(nx, ny, 0.0f);
+    if (nx < 2 || ny < 2) return;  // a line or a point sees nothing but sky
+    Grid hCopy(nx, ny);
+    for (int y = 0; y < ny; ++y)
+        for (int x = 0; x < nx; ++x) hCopy(x, y) = heights(x, y);
+    const float hMax = *std::max_element(hCopy.v.begin(), hCopy.v.end());
+    Grid gx, gy;
+    computeGradient(heights, cellSize, gx, gy);
+    std::vector<std::array<float, 3>> dirs;
+    referenceDirections(s.directions, dirs);
+    const float weight = static_cast<float>(4.0 * kPi / s.directions);
+    std::atomic<int> rowsDone{0};
+    parallelFor(0, ny, 1, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y) {
+            for (int x = 0; x < nx; ++x) {
+                // unit normal from the same central differences as the fast path
+                const float ddx = gx(x, y), ddy = gy(x, y);
+                const float inv = 1.0f / std::sqrt(ddx * ddx + ddy * ddy + 1.0f);
+                const float n0 = -ddx * inv, n1 = -ddy * inv, n2 = inv;
+                float e[3] = {0.0f, 0.0f, 0.0f};
+                for (const auto& dir : dirs) {
+                    const float cosine = n0 * dir[0] + n1 * dir[1] + n2 * dir[2];
+                    if (cosine <= 0.0f) continue;
+                    float qx, qy;
+                    if (!firstHit(hCopy.data(), nx, ny, hMax, cellSize, x, y, dir, s.marchStep, qx, qy)) continue;
+                    for (int c = 0; c < 3; ++c) e[c] += cosine * bilinearF(prev[c].data(), nx, ny, qx, qy);
+                }
+                for (int c = 0; c < 3; ++c) {
+                    const float a = albedo && !albedo->channel[c].empty() ? albedo->channel[c](x, y) : 1.0f;
+                    next[c](x, y) = a / static_cast<float>(kPi) * weight * e[c];
+                }
+            }
+            const int done = ++rowsDone;
+            if (s.progress && (done % 16 == 0 || done == ny))
+                std::fprintf(stderr, "\rreference indirect: %3d%%%s", 100 * done / ny, done == ny ? "\n" : "");
+        }
+    });
+}
+
+void renderReferenceGi(ConstGridView heights, float cellSize, const ShRgb& lighting, const AlbedoMap* albedo,
+                       const ReferenceGiSettings& s, ReferenceGiResult& out) {
+    if (s.directions < 16 || s.directions > 1 << 20) throw InputError("reference: directions must be 16 .. 2^20");
+    if (s.bounces < 0 || s.bounces > 16) throw InputError("reference: bounces must be 0 .. 16");
+    if (!(s.marchStep > 0.0f && s.marchStep <= 2.0f)) throw InputError("reference: march step must be in (0, 2] cells");
+    checkHeightsFinite(heights);
+    const int nx = heights.nx, ny = heights.ny;
+    // Bounce 0: the exact direct reference.
+    ReferenceSettings direct;
+    direct.azimuths = s.azimuths;
+    direct.progress = s.progress;
+    ReferenceResult d;
+    renderReference(heights, cellSize, &lighting, albedo, direct, d);
+    out.ambient = d.ambient;
+    for (int c = 0; c < 3; ++c) {
+        out.direct[c] = d.rgb[c];
+        out.indirect[c].resize(nx, ny, 0.0f);
+    }
+    std::array<Grid, 3> prev = out.direct, next;
+    for (int b = 1; b <= s.bounces; ++b) {
+        if (s.progress) std::fprintf(stderr, "reference: bounce %d of %d\n", b, s.bounces);
+        gatherReferenceBounce(heights, cellSize, prev, albedo, s, next);
+        for (int c = 0; c < 3; ++c) {
+            for (std::size_t i = 0; i < next[c].v.size(); ++i) out.indirect[c].v[i] += next[c].v[i];
+            std::swap(prev[c], next[c]);
+        }
+    }
+    for (int c = 0; c < 3; ++c) {
+        out.total[c].resize(nx, ny);
+        for (std::size_t i = 0; i < out.total[c].v.size(); ++i)
+            out.total[c].v[i] = out.direct[c].v[i] + out.indirect[c].v[i];
+    }
+}
+
+}  // namespace terrain::gi
