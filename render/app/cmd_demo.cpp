@@ -1,15 +1,16 @@
-// `terrain demo`: the animated demo. Runs a scene and writes its frames as
-// images with progress; prints where they are.
+// `terrain demo`: the animated demo. With a display: a window (orbit/zoom
+// camera, ImGui panel). Without one: says so in one line and renders a short
+// headless animation to a folder, printing its path.
 #include <cstdio>
-#include <filesystem>
 #include <memory>
 #include <string>
 
 #include "render/app/commands.h"
-#include "render/app/progress.h"
-#include "render/preview.h"
+#include "render/context.h"
+#include "render/demo_window.h"
+#include "render/gl.h"
+#include "render/pipeline.h"
 #include "sim/error.h"
-#include "sim/io.h"
 #include "sim/parallel.h"
 #include "sim/scene.h"
 
@@ -17,56 +18,39 @@ namespace terrain::app {
 namespace {
 
 struct DemoOptions {
-    std::string scene = "erosion";
-    int size = 256;
-    int frames = 48;
-    int ticksPerFrame = 0;
-    long long seed = 1;
-    int threads = 0;
-    std::string out = "out/demo";
+    RenderOptions render;
+    bool headless = false;
+    CLI::Option* frames = nullptr;  // given explicitly: the window closes after that many frames
 };
 
-int runDemo(const DemoOptions& o) {
-    if (o.frames < 1 || o.frames > 100000) throw InputError("--frames must be 1..100000");
-    if (o.ticksPerFrame < 0) throw InputError("--ticks-per-frame must be >= 0");
-    ensureWritableDirectory(o.out);
+int runDemo(DemoOptions& d) {
+    RenderOptions& o = d.render;
+    render::PipelineSettings ps;
+    render::RenderSettings rs;
+    toSettings(o, ps, rs);
+    const SceneSettings scene = resolveScene(o.scene, o.size, static_cast<std::uint64_t>(o.seed));
+    std::string why = d.headless ? "headless requested" : render::noDisplayReason();
+    std::unique_ptr<render::WindowContext> window;
+    if (why.empty()) {
+        try {
+            window = render::createWindowContext(o.width, o.height, "terrain demo: " + scene.name);
+        } catch (const render::ContextError& e) {
+            why = e.what();
+        }
+    }
+    if (!window) {
+        std::printf("demo: %s: rendering a headless animation to %s instead\n", why.c_str(), o.out.c_str());
+        o.quiet = false;
+        return runHeadlessRender(o, "demo");
+    }
     return withThreads(o.threads, [&] {
-        SceneSettings settings = resolveScene(o.scene, o.size, static_cast<std::uint64_t>(o.seed));
-        Simulation sim(settings);
-        // Default pacing: erosion needs many ticks per frame to show change; waves ~ 0.25 s per frame.
-        int perFrame = o.ticksPerFrame;
-        if (perFrame == 0) {
-            if (settings.waves) perFrame = std::max(1, static_cast<int>(0.25f / sim.dt()));
-            else if (settings.hydraulic || settings.thermal) perFrame = 60;
-            else perFrame = 1;
-        }
-        std::printf("demo: scene %s, %d x %d cells, %d frames of %d ticks (%.3g s each)\n", settings.name.c_str(),
-                    sim.state().nx, sim.state().ny, o.frames, perFrame,
-                    static_cast<double>(sim.dt()) * perFrame);
-        PreviewSettings ps;
-        {
-            const TerrainState& s = sim.state();
-            ps.zMin = ps.zMax = s.ground(0, 0);
-            for (int y = 0; y < s.ny; ++y)
-                for (int x = 0; x < s.nx; ++x) {
-                    ps.zMin = std::min(ps.zMin, s.ground(x, y));
-                    ps.zMax = std::max(ps.zMax, s.ground(x, y));
-                }
-        }
-        std::vector<std::uint8_t> rgb;
-        Progress progress("demo", o.frames, true);
-        for (int f = 0; f < o.frames; ++f) {
-            if (f > 0)
-                for (int t = 0; t < perFrame; ++t) sim.tick();
-            shadePreview(sim.state(), ps, rgb);
-            char name[48];
-            std::snprintf(name, sizeof name, "frame_%04d.png", f);
-            writePngRgb((std::filesystem::path(o.out) / name).string(), sim.state().nx, sim.state().ny, rgb);
-            progress.update(f + 1);
-        }
-        progress.finish();
-        std::printf("demo: %d frames written to %s\n", o.frames,
-                    std::filesystem::absolute(o.out).lexically_normal().string().c_str());
+        render::Gl gl;
+        render::loadGl(gl, window->procAddress());
+        render::FramePipeline pipeline(scene, ps);
+        std::printf("demo: scene %s in a window (%s); drag to orbit, wheel to zoom\n", scene.name.c_str(),
+                    render::glDescription(gl).c_str());
+        const int shown = render::runWindowDemo(*window, gl, pipeline, rs, d.frames->count() > 0 ? o.frames : 0);
+        std::printf("demo: %d frames shown\n", shown);
         return 0;
     });
 }
@@ -74,17 +58,21 @@ int runDemo(const DemoOptions& o) {
 }  // namespace
 
 Runner addDemoCommand(CLI::App& app) {
-    auto opt = std::make_shared<DemoOptions>();
-    CLI::App* sub = app.add_subcommand("demo", "The animated demo: run a scene and write its frames as images");
-    sub->add_option("--scene", opt->scene, "Built-in scene (erosion, waves, dem) or a .toml scene file")
+    auto d = std::make_shared<DemoOptions>();
+    d->render.out = "out/demo";
+    d->render.frames = 48;
+    d->render.width = 960;
+    d->render.height = 540;
+    CLI::App* sub = app.add_subcommand(
+        "demo", "The animated demo: a window when there is a display, else a headless animation written to --out");
+    sub->add_option("--scene", d->render.scene, "Built-in scene (erosion, waves, dem) or a .toml scene file")
         ->capture_default_str();
-    sub->add_option("--size", opt->size, "Grid side in cells")->capture_default_str();
-    sub->add_option("--frames", opt->frames, "Frames to write")->capture_default_str();
-    sub->add_option("--ticks-per-frame", opt->ticksPerFrame, "Simulation ticks between frames (0 = scene default)");
-    sub->add_option("--seed", opt->seed, "Seed for the scene generator")->capture_default_str();
-    sub->add_option("--threads", opt->threads, "Worker threads (0 = all cores)")->capture_default_str();
-    sub->add_option("--out", opt->out, "Output folder")->capture_default_str();
-    return [opt] { return runDemo(*opt); };
+    sub->add_option("--out", d->render.out, "Output folder of the headless fallback")->capture_default_str();
+    sub->add_flag("--headless", d->headless, "Render headless even when there is a display");
+    addRenderOptions(sub, d->render, true);
+    d->frames = sub->get_option("--frames");
+    d->frames->description("Frames of the headless animation; given with a window: close it after that many frames");
+    return [d] { return runDemo(*d); };
 }
 
 }  // namespace terrain::app

@@ -2,8 +2,11 @@
 // Each subcommand of build/terrain registers itself on the CLI11 app and
 // returns the function that runs it once parsing succeeded.
 #include <functional>
+#include <string>
 
 #include <CLI/CLI.hpp>
+
+#include "render/renderer.h"
 
 namespace terrain::app {
 
@@ -11,6 +14,41 @@ using Runner = std::function<int()>;
 
 Runner addSimCommand(CLI::App& app);
 Runner addGiCommand(CLI::App& app);
+Runner addRenderCommand(CLI::App& app);
 Runner addDemoCommand(CLI::App& app);
+
+/// Options shared by `terrain render` and the demo (its headless fallback).
+struct RenderOptions {
+    std::string scene = "erosion";
+    int size = 256;
+    int frames = 24;
+    int width = 1280, height = 720;
+    std::string out = "out/render";
+    std::string video;            // .mp4 through ffmpeg, when installed
+    long long seed = 1;
+    int threads = 0;
+    int ticksPerFrame = 0;        // 0 = the scene's pacing
+    int subsample = 2;            // GI receivers every 1, 2 or 4 cells
+    std::string lighting = "direct";  // key | direct | global
+    int bounces = 1;
+    std::string shadow = "soft";  // soft | map | none
+    std::string debug = "none";   // none | ambient | v | key | normals | pyramid | shade | u
+    int pyramidLevel = 4;
+    float exposure = 1.0f;
+    float exaggeration = 1.0f;
+    float yaw = 235.0f, pitch = 34.0f, distance = 1.35f;
+    bool quiet = false;
+};
+
+/// Adds the options above (except the scene) to a subcommand.
+void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize);
+
+/// Checks the options and turns them into pipeline and renderer settings
+/// (throws InputError naming the bad option).
+void toSettings(const RenderOptions& o, render::PipelineSettings& pipeline, render::RenderSettings& renderer);
+
+/// The headless render: PNG frames in o.out (atomic writes), a progress bar,
+/// the per-stage timing summary and, when asked, an mp4. Returns the exit code.
+int runHeadlessRender(const RenderOptions& o, const char* label);
 
 }  // namespace terrain::app

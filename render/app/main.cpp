@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
     };
     add(&terrain::app::addSimCommand);
     add(&terrain::app::addGiCommand);
+    add(&terrain::app::addRenderCommand);
     add(&terrain::app::addDemoCommand);
     try {
         app.parse(argc, argv);

@@ -1,0 +1,220 @@
+// `terrain render`: the animated scene rendered headless (OSMesa) to PNG
+// frames, optionally an mp4 through ffmpeg, with a per-stage timing summary.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include <unistd.h>
+
+#include "render/app/commands.h"
+#include "render/app/progress.h"
+#include "render/context.h"
+#include "render/gl.h"
+#include "render/pipeline.h"
+#include "render/renderer.h"
+#include "sim/error.h"
+#include "sim/io.h"
+#include "sim/parallel.h"
+#include "sim/scene.h"
+
+namespace terrain::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+std::string findOnPath(const std::string& program) {
+    const char* path = std::getenv("PATH");
+    if (!path) return "";
+    std::string p(path);
+    std::size_t start = 0;
+    while (start <= p.size()) {
+        const std::size_t end = std::min(p.find(':', start), p.size());
+        const std::filesystem::path candidate = std::filesystem::path(p.substr(start, end - start)) / program;
+        std::error_code ec;
+        if (std::filesystem::is_regular_file(candidate, ec) && access(candidate.c_str(), X_OK) == 0) return candidate.string();
+        start = end + 1;
+    }
+    return "";
+}
+
+double median(std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+std::string shellQuote(const std::string& s) {
+    std::string q = "'";
+    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+
+}  // namespace
+
+void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize) {
+    if (withSize) sub->add_option("--size", o.size, "Grid side in cells")->capture_default_str();
+    sub->add_option("--frames", o.frames, "Frames to render")->capture_default_str();
+    sub->add_option("--width", o.width, "Image width in pixels")->capture_default_str();
+    sub->add_option("--height", o.height, "Image height in pixels")->capture_default_str();
+    sub->add_option("--ticks-per-frame", o.ticksPerFrame, "Simulation ticks between frames (0 = scene default)");
+    sub->add_option("--seed", o.seed, "Seed for the scene generator")->capture_default_str();
+    sub->add_option("--threads", o.threads, "Worker threads (0 = all cores)")->capture_default_str();
+    sub->add_option("--subsample", o.subsample, "GI visibility sub-sampling: 1, 2 or 4")->capture_default_str();
+    sub->add_option("--lighting", o.lighting, "key (key light only) | direct (sky + key) | global (direct + bounces)")
+        ->capture_default_str();
+    sub->add_option("--bounces", o.bounces, "Indirect bounces 0..3 for --lighting global")->capture_default_str();
+    sub->add_option("--shadow", o.shadow, "Key light shadow: soft (engine visibility) | map (shadow map) | none")
+        ->capture_default_str();
+    sub->add_option("--debug", o.debug, "Debug view: none | ambient | v | key | normals | pyramid | shade")
+        ->capture_default_str();
+    sub->add_option("--pyramid-level", o.pyramidLevel, "Height-pyramid level for --debug pyramid")->capture_default_str();
+    sub->add_option("--exposure", o.exposure, "Exposure before tone mapping")->capture_default_str();
+    sub->add_option("--exaggeration", o.exaggeration, "Vertical exaggeration")->capture_default_str();
+    sub->add_option("--yaw", o.yaw, "Camera azimuth in degrees")->capture_default_str();
+    sub->add_option("--pitch", o.pitch, "Camera elevation in degrees")->capture_default_str();
+    sub->add_option("--distance", o.distance, "Camera distance in terrain extents")->capture_default_str();
+    sub->add_flag("--quiet", o.quiet, "Print only errors");
+}
+
+void toSettings(const RenderOptions& o, render::PipelineSettings& p, render::RenderSettings& r) {
+    using namespace render;
+    if (o.frames < 1 || o.frames > 100000) throw InputError("--frames must be 1..100000");
+    if (o.width < 16 || o.height < 16 || o.width > 8192 || o.height > 8192)
+        throw InputError("--width and --height must be 16..8192 pixels");
+    if (o.threads < 0 || o.threads > 256) throw InputError("--threads must be 0 (all) .. 256");
+    if (o.ticksPerFrame < 0) throw InputError("--ticks-per-frame must be >= 0");
+    if (o.subsample != 1 && o.subsample != 2 && o.subsample != 4) throw InputError("--subsample must be 1, 2 or 4");
+    if (o.bounces < 0 || o.bounces > 3) throw InputError("--bounces must be 0..3");
+    if (!(o.exposure > 0.0f && o.exposure < 1000.0f)) throw InputError("--exposure must be > 0");
+    if (!(o.exaggeration > 0.0f && o.exaggeration <= 100.0f)) throw InputError("--exaggeration must be in (0, 100]");
+    if (!(o.distance > 0.05f && o.distance < 100.0f)) throw InputError("--distance must be in (0.05, 100)");
+    if (!(o.pitch > -89.0f && o.pitch < 89.5f)) throw InputError("--pitch must be in (-89, 89.5) degrees");
+    p.gi = gi::engineGiSettings();
+    p.gi.subsample = o.subsample;
+    p.bounces = o.bounces;
+    p.ticksPerFrame = o.ticksPerFrame;
+    p.pyramidLevel = o.pyramidLevel;
+    if (o.lighting == "key") p.lighting = LightingMode::KeyOnly;
+    else if (o.lighting == "direct") p.lighting = LightingMode::Direct;
+    else if (o.lighting == "global") p.lighting = LightingMode::Global;
+    else throw InputError("--lighting must be key, direct or global (got '" + o.lighting + "')");
+    if (o.shadow == "soft") r.shadow = ShadowMode::SoftVisibility;
+    else if (o.shadow == "map") r.shadow = ShadowMode::ShadowMap;
+    else if (o.shadow == "none") r.shadow = ShadowMode::None;
+    else throw InputError("--shadow must be soft, map or none (got '" + o.shadow + "')");
+    if (o.debug == "none") r.debug = DebugView::None;
+    else if (o.debug == "ambient") r.debug = DebugView::Ambient;
+    else if (o.debug == "v") r.debug = DebugView::SkyVisibility;
+    else if (o.debug == "key") r.debug = DebugView::KeyVisibility;
+    else if (o.debug == "normals") r.debug = DebugView::Normals;
+    else if (o.debug == "pyramid") r.debug = DebugView::PyramidLevel;
+    else if (o.debug == "shade") r.debug = DebugView::ShadeMap;
+    else if (o.debug == "u") throw InputError("--debug u: gi/ computes no indirect radiance U yet (GI part 2)");
+    else throw InputError("--debug must be none, ambient, v, key, normals, pyramid or shade (got '" + o.debug + "')");
+    r.exposure = o.exposure;
+    r.verticalExaggeration = o.exaggeration;
+    r.camera.yawDeg = o.yaw;
+    r.camera.pitchDeg = o.pitch;
+    r.camera.distance = o.distance;
+}
+
+int runHeadlessRender(const RenderOptions& o, const char* label) {
+    render::PipelineSettings ps;
+    render::RenderSettings rs;
+    toSettings(o, ps, rs);
+    if (!o.video.empty() && std::filesystem::path(o.video).extension() != ".mp4")
+        throw InputError("--video must name an .mp4 file (got '" + o.video + "')");
+    // Everything that can fail on bad input fails before any file is written.
+    const SceneSettings scene = resolveScene(o.scene, o.size, static_cast<std::uint64_t>(o.seed));
+    ensureWritableDirectory(o.out);
+    return withThreads(o.threads, [&] {
+        std::unique_ptr<render::GlContext> context = render::createHeadlessContext();
+        render::Gl gl;
+        render::loadGl(gl, context->procAddress());
+        render::Renderer renderer(gl);
+        render::FramePipeline pipeline(scene, ps);
+        const TerrainState& st = pipeline.simulation().state();
+        if (!o.quiet) {
+            std::printf("%s: scene %s, %d x %d cells, %d frames of %d ticks, %d x %d pixels, %s\n", label,
+                        scene.name.c_str(), st.nx, st.ny, o.frames, pipeline.ticksPerFrame(), o.width, o.height,
+                        render::glDescription(gl).c_str());
+            if (ps.lighting == render::LightingMode::Global)
+                std::printf("%s: note: gi/ has no indirect bounces yet; global lighting shows direct light only\n", label);
+        }
+        std::vector<std::vector<double>> stage(7);
+        std::vector<std::uint8_t> rgb;
+        Progress progress(label, o.frames, !o.quiet);
+        for (int f = 0; f < o.frames; ++f) {
+            pipeline.advance();
+            pipeline.light();
+            auto t = Clock::now();
+            renderer.upload(pipeline.frame());
+            renderer.drawToImage(rs, o.width, o.height, rgb);
+            const double renderMs = msSince(t);
+            t = Clock::now();
+            char name[48];
+            std::snprintf(name, sizeof name, "frame_%04d.png", f);
+            writePngRgb((std::filesystem::path(o.out) / name).string(), o.width, o.height, rgb);
+            const double writeMs = msSince(t);
+            const render::StageTimings& tm = pipeline.timings();
+            const double values[7] = {tm.sim, tm.pyramids, tm.scan, tm.integrate, tm.shade, renderMs, writeMs};
+            for (int i = 0; i < 7; ++i) stage[static_cast<std::size_t>(i)].push_back(values[i]);
+            progress.update(f + 1);
+        }
+        progress.finish();
+        const std::string dir = std::filesystem::absolute(o.out).lexically_normal().string();
+        if (!o.quiet) {
+            static const char* names[7] = {"sim", "pyramids", "scan", "integrate", "shade", "render", "png write"};
+            std::printf("%s: per-stage time per frame (median of %d frames, ms):", label, o.frames);
+            double sum = 0.0;
+            for (int i = 0; i < 7; ++i) {
+                const double m = median(stage[static_cast<std::size_t>(i)]);
+                sum += m;
+                std::printf(" %s %.1f%s", names[i], m, i == 6 ? "" : ",");
+            }
+            std::printf(" (total %.1f; integrate is fused into scan in gi/)\n", sum);
+            std::printf("%s: %d frames written to %s\n", label, o.frames, dir.c_str());
+        }
+        if (!o.video.empty()) {
+            const std::string ffmpeg = findOnPath("ffmpeg");
+            if (ffmpeg.empty()) {
+                std::printf("%s: ffmpeg is not installed, so no %s was made (the PNG frames are in %s; "
+                            "install ffmpeg, e.g. apt-get install ffmpeg, for video)\n",
+                            label, o.video.c_str(), dir.c_str());
+            } else {
+                const std::string tmp = temporaryNameFor(o.video) + ".mp4";
+                const std::string cmd = shellQuote(ffmpeg) + " -loglevel error -y -framerate 24 -i " +
+                                        shellQuote((std::filesystem::path(o.out) / "frame_%04d.png").string()) +
+                                        " -c:v libx264 -pix_fmt yuv420p -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' " + shellQuote(tmp);
+                if (std::system(cmd.c_str()) != 0) {
+                    std::error_code ec;
+                    std::filesystem::remove(tmp, ec);
+                    throw IoError(o.video, "ffmpeg failed to encode the frames");
+                }
+                commitTemporary(tmp, o.video);
+                if (!o.quiet) std::printf("%s: video written to %s\n", label, o.video.c_str());
+            }
+        }
+        return 0;
+    });
+}
+
+Runner addRenderCommand(CLI::App& app) {
+    auto o = std::make_shared<RenderOptions>();
+    CLI::App* sub = app.add_subcommand("render", "Render an animated scene headless (OSMesa) to PNG frames, optionally an mp4");
+    sub->add_option("--scene", o->scene, "Built-in scene (erosion, waves, dem) or a .toml scene file")->capture_default_str();
+    sub->add_option("--out", o->out, "Output folder for frame_NNNN.png")->capture_default_str();
+    sub->add_option("--video", o->video, "Also encode the frames to this .mp4 (needs ffmpeg)");
+    addRenderOptions(sub, *o, true);
+    return [o] { return runHeadlessRender(*o, "render"); };
+}
+
+}  // namespace terrain::app

@@ -1,0 +1,138 @@
+#include "render/demo_window.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+
+#include <imgui.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+
+namespace terrain::render {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+// Exponential moving average, so the panel's numbers are readable.
+void smooth(double& avg, double v) { avg = avg == 0.0 ? v : 0.9 * avg + 0.1 * v; }
+
+struct ImGuiSession {
+    explicit ImGuiSession(void* window) {
+        IMGUI_CHECKVERSION();
+        ImGui::CreateContext();
+        ImGui::GetIO().IniFilename = nullptr;
+        ImGui::StyleColorsDark();
+        ImGui_ImplGlfw_InitForOpenGL(static_cast<GLFWwindow*>(window), true);
+        ImGui_ImplOpenGL3_Init("#version 330 core");
+    }
+    ~ImGuiSession() {
+        ImGui_ImplOpenGL3_Shutdown();
+        ImGui_ImplGlfw_Shutdown();
+        ImGui::DestroyContext();
+    }
+    ImGuiSession(const ImGuiSession&) = delete;
+    ImGuiSession& operator=(const ImGuiSession&) = delete;
+};
+
+}  // namespace
+
+int runWindowDemo(WindowContext& window, const Gl& gl, FramePipeline& pipeline, RenderSettings& rs, int maxFrames) {
+    Renderer renderer(gl);
+    ImGuiSession imgui(window.nativeHandle());
+    bool paused = false;
+    int frames = 0;
+    StageTimings avg;
+    double fpsAvg = 0.0;
+    auto last = Clock::now();
+    const char* lightingNames[] = {"key light only", "direct (sky + key)", "global (direct + bounces)"};
+    const char* shadowNames[] = {"engine soft visibility", "shadow map", "none"};
+    const char* debugNames[] = {"none", "ambient", "V (sky visibility)", "key visibility", "normals", "pyramid level",
+                                "GI shade map"};
+    while (!window.shouldClose() && (maxFrames <= 0 || frames < maxFrames)) {
+        window.pollEvents();
+        // ---- simulation + GI ----------------------------------------------------------
+        if (!paused) pipeline.advance();
+        else pipeline.timings().sim = 0.0;
+        pipeline.light();
+        // ---- camera: left drag orbits, wheel zooms (unless ImGui wants the mouse) -------
+        ImGui_ImplOpenGL3_NewFrame();
+        ImGui_ImplGlfw_NewFrame();
+        ImGui::NewFrame();
+        ImGuiIO& io = ImGui::GetIO();
+        if (!io.WantCaptureMouse) {
+            if (io.MouseDown[0]) {
+                rs.camera.yawDeg -= io.MouseDelta.x * 0.3f;
+                rs.camera.pitchDeg = std::clamp(rs.camera.pitchDeg + io.MouseDelta.y * 0.3f, 2.0f, 89.0f);
+            }
+            if (io.MouseWheel != 0.0f) rs.camera.distance = std::clamp(rs.camera.distance * (1.0f - 0.1f * io.MouseWheel), 0.2f, 6.0f);
+        }
+        // ---- panel ----------------------------------------------------------------------
+        PipelineSettings& ps = pipeline.settings();
+        SceneLights& lights = pipeline.lights();
+        ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
+        ImGui::Begin("terrain");
+        ImGui::Text("%s  %d x %d  tick %lld", pipeline.simulation().settings().name.c_str(), pipeline.frame().nx,
+                    pipeline.frame().ny, static_cast<long long>(pipeline.frame().tick));
+        ImGui::Text("%.1f fps", fpsAvg > 0.0 ? 1000.0 / fpsAvg : 0.0);
+        ImGui::Text("ms: sim %.1f  pyramids %.1f  scan %.1f", avg.sim, avg.pyramids, avg.scan);
+        ImGui::Text("    integrate %.1f  shade %.1f  render %.1f", avg.integrate, avg.shade, avg.render);
+        ImGui::Separator();
+        ImGui::Checkbox("pause simulation", &paused);
+        int lighting = static_cast<int>(ps.lighting);
+        if (ImGui::Combo("lighting", &lighting, lightingNames, 3)) ps.lighting = static_cast<LightingMode>(lighting);
+        ImGui::SliderInt("bounces", &ps.bounces, 0, 3);
+        if (ps.lighting == LightingMode::Global) ImGui::TextDisabled("gi/ has no indirect light yet: direct only");
+        int sub = ps.gi.subsample == 1 ? 0 : (ps.gi.subsample == 2 ? 1 : 2);
+        ImGui::Text("sub-sampling");
+        ImGui::SameLine();
+        ImGui::RadioButton("1", &sub, 0);
+        ImGui::SameLine();
+        ImGui::RadioButton("2", &sub, 1);
+        ImGui::SameLine();
+        ImGui::RadioButton("4", &sub, 2);
+        ps.gi.subsample = sub == 0 ? 1 : (sub == 1 ? 2 : 4);
+        int shadow = static_cast<int>(rs.shadow);
+        if (ImGui::Combo("key shadow", &shadow, shadowNames, 3)) rs.shadow = static_cast<ShadowMode>(shadow);
+        int debug = static_cast<int>(rs.debug);
+        if (ImGui::Combo("view", &debug, debugNames, 7)) rs.debug = static_cast<DebugView>(debug);
+        ImGui::SliderInt("pyramid level", &ps.pyramidLevel, 0, 16);
+        ImGui::Checkbox("water", &rs.water);
+        ImGui::SameLine();
+        ImGui::Checkbox("specular", &rs.specular);
+        ImGui::SliderFloat("exposure", &rs.exposure, 0.1f, 4.0f);
+        ImGui::SliderFloat("exaggeration", &rs.verticalExaggeration, 0.5f, 4.0f);
+        ImGui::Separator();
+        ImGui::SliderFloat("sun azimuth", &lights.key.azimuthDeg, 0.0f, 359.0f);
+        ImGui::SliderFloat("sun elevation", &lights.key.elevationDeg, 3.0f, 85.0f);
+        ImGui::SliderFloat("sun radius", &lights.key.radiusDeg, 0.5f, 15.0f);
+        ImGui::TextDisabled("drag: orbit, wheel: zoom");
+        ImGui::End();
+        ImGui::Render();
+        // ---- draw ------------------------------------------------------------------------
+        int w = 0, h = 0;
+        window.framebufferSize(w, h);
+        const auto t = Clock::now();
+        if (w > 0 && h > 0) {
+            renderer.upload(pipeline.frame());
+            renderer.draw(rs, w, h, 0);
+        }
+        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+        gl.Finish();
+        pipeline.timings().render = msSince(t);
+        window.swapBuffers();
+        const StageTimings& tm = pipeline.timings();
+        smooth(avg.sim, tm.sim);
+        smooth(avg.pyramids, tm.pyramids);
+        smooth(avg.scan, tm.scan);
+        smooth(avg.integrate, tm.integrate);
+        smooth(avg.shade, tm.shade);
+        smooth(avg.render, tm.render);
+        smooth(fpsAvg, msSince(last));
+        last = Clock::now();
+        ++frames;
+    }
+    return frames;
+}
+
+}  // namespace terrain::render

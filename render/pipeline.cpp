@@ -1,0 +1,165 @@
+#include "render/pipeline.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "sim/error.h"
+#include "sim/parallel.h"
+
+namespace terrain::render {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+constexpr float kDeg = 0.017453292519943295f;
+
+}  // namespace
+
+SceneLights defaultLights() {
+    SceneLights l;
+    // A clear sky without its own sun lobe: the sun is the key light (its
+    // visibility and specular are computed separately).
+    gi::SunSkySettings sky;
+    sky.sun[0] = sky.sun[1] = sky.sun[2] = 0.0f;
+    for (int c = 0; c < 3; ++c) {
+        sky.zenith[c] *= 0.7f;
+        sky.horizon[c] *= 0.7f;
+    }
+    l.sky = gi::sunSkyLight(sky);
+    l.key.azimuthDeg = 300.0f;
+    l.key.elevationDeg = 28.0f;
+    l.key.radiusDeg = 3.0f;
+    l.key.rgb[0] = 2.9f;
+    l.key.rgb[1] = 2.6f;
+    l.key.rgb[2] = 2.2f;
+    return l;
+}
+
+FramePipeline::FramePipeline(const SceneSettings& scene, const PipelineSettings& settings, const SceneLights& lights)
+    : sim_(scene), settings_(settings), lights_(lights) {
+    if (settings_.bounces < 0 || settings_.bounces > 3) throw InputError("bounces must be 0..3");
+    if (settings_.ticksPerFrame < 0) throw InputError("ticks per frame must be >= 0");
+    ticksPerFrame_ = settings_.ticksPerFrame;
+    if (ticksPerFrame_ == 0) {
+        // Erosion needs many ticks per frame to show change; waves ~0.25 s of water per frame.
+        if (scene.waves) ticksPerFrame_ = std::max(1, static_cast<int>(0.25f / sim_.dt()));
+        else if (scene.hydraulic || scene.thermal) ticksPerFrame_ = 60;
+        else ticksPerFrame_ = 1;
+    }
+    const TerrainState& s = sim_.state();
+    frame_.nx = s.nx;
+    frame_.ny = s.ny;
+    frame_.cellSize = s.cellSize;
+    frame_.hasWater = s.hasWater();
+    float lo = s.ground(0, 0), hi = lo;
+    for (int y = 0; y < s.ny; ++y)
+        for (int x = 0; x < s.nx; ++x) {
+            lo = std::min(lo, s.ground(x, y));
+            hi = std::max(hi, s.ground(x, y));
+        }
+    frame_.zMin = lo;
+    frame_.zMax = hi > lo ? hi : lo + 1.0f;
+}
+
+void FramePipeline::advance() {
+    const auto t0 = Clock::now();
+    if (!first_)
+        for (int t = 0; t < ticksPerFrame_; ++t) sim_.tick();
+    first_ = false;
+    timings_.sim = msSince(t0);
+}
+
+void FramePipeline::light() {
+    if (settings_.bounces < 0 || settings_.bounces > 3) throw InputError("bounces must be 0..3");
+    const TerrainState& s = sim_.state();
+    const int nx = s.nx, ny = s.ny;
+    auto t = Clock::now();
+    // The light sees the surface: ground, and water where there is water.
+    if (surface_.nx != nx || surface_.ny != ny) surface_.resize(nx, ny);
+    parallelForRows(ny, nx, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < nx; ++x) surface_(x, y) = s.ground(x, y) + (s.hasWater() ? s.water(x, y) : 0.0f);
+    });
+    gi::GiLighting lighting;
+    lighting.environment = lights_.sky;
+    lighting.keys = {lights_.key};
+    gi::runGiFrame(surface_.cview(), s.cellSize, lighting, settings_.gi, gi_);
+    const double surfaceMs = msSince(t);
+
+    // The key light's share of the shade map: gi/ shading with that light alone.
+    t = Clock::now();
+    gi::shadeTexels(gi_.gradX.cview(), gi_.gradY.cview(), settings_.gi.subsample, gi_.envVisibility,
+                    &gi_.shadingLights[1], 1, nullptr, settings_.gi.shading, keyOnly_);
+
+    // ---- pack what the renderer uploads -----------------------------------------
+    FrameData& f = frame_;
+    f.lighting = settings_.lighting;
+    f.lights = lights_;
+    f.tick = s.tick;
+    f.time = s.time;
+    const std::size_t n = static_cast<std::size_t>(nx) * ny;
+    f.heights.resize(2 * n);
+    f.shade.resize(4 * n);
+    f.key.resize(4 * n);
+    const gi::KeyLight& k = lights_.key;
+    const float ce = std::cos(k.elevationDeg * kDeg);
+    const float lx = ce * std::cos(k.azimuthDeg * kDeg), ly = ce * std::sin(k.azimuthDeg * kDeg);
+    const float lz = std::sin(k.elevationDeg * kDeg);
+    const float keyLum = 0.2126f * k.rgb[0] + 0.7152f * k.rgb[1] + 0.0722f * k.rgb[2];
+    const auto& total = gi_.shade.rgb;
+    const auto& keyRgb = keyOnly_.rgb;
+    parallelForRows(ny, nx, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < nx; ++x) {
+                const std::size_t i = static_cast<std::size_t>(y) * nx + x;
+                f.heights[2 * i] = s.ground(x, y);
+                f.heights[2 * i + 1] = s.hasWater() ? s.water(x, y) : 0.0f;
+                float keyC[3];
+                for (int c = 0; c < 3; ++c) {
+                    keyC[c] = std::max(0.0f, keyRgb[static_cast<std::size_t>(c)].v[i]);
+                    f.shade[4 * i + static_cast<std::size_t>(c)] =
+                        std::max(0.0f, total[static_cast<std::size_t>(c)].v[i] - keyRgb[static_cast<std::size_t>(c)].v[i]);
+                    f.key[4 * i + static_cast<std::size_t>(c)] = keyC[c];
+                }
+                // Soft visibility of the key light: its shade over the unshadowed N.L shade.
+                const float gx = gi_.gradX.v[i], gy = gi_.gradY.v[i];
+                const float nl = (-gx * lx - gy * ly + lz) / std::sqrt(gx * gx + gy * gy + 1.0f);
+                const float lum = 0.2126f * keyC[0] + 0.7152f * keyC[1] + 0.0722f * keyC[2];
+                const float vis = nl > 0.02f && keyLum > 0.0f ? std::clamp(lum / (keyLum * nl), 0.0f, 1.0f) : 0.0f;
+                f.shade[4 * i + 3] = vis;
+                f.key[4 * i + 3] = gi_.shade.ambient.v[i];
+            }
+    });
+    // Receiver grid: sky visibility fraction (V_00 sqrt(4 pi) / 2 pi) and one pyramid level.
+    const gi::VisibilityField& v = gi_.envVisibility;
+    f.nxr = v.nxr;
+    f.nyr = v.nyr;
+    f.subsample = settings_.gi.subsample;
+    f.receiver.resize(2 * static_cast<std::size_t>(v.nxr) * v.nyr);
+    const int levels = static_cast<int>(gi_.pyramid.levels.size());
+    f.pyramidLevel = levels > 0 ? std::clamp(settings_.pyramidLevel, 0, levels - 1) : -1;
+    const float vScale = static_cast<float>(std::sqrt(4.0 * gi::kPi) / (2.0 * gi::kPi));
+    for (int y = 0; y < v.nyr; ++y)
+        for (int x = 0; x < v.nxr; ++x) {
+            const std::size_t i = static_cast<std::size_t>(y) * v.nxr + x;
+            f.receiver[2 * i] = v.plane(0)[i] * vScale;
+            float level = surface_(std::min(x * f.subsample, nx - 1), std::min(y * f.subsample, ny - 1));
+            if (f.pyramidLevel >= 0) {
+                const gi::PaddedField& p = gi_.pyramid.levels[static_cast<std::size_t>(f.pyramidLevel)];
+                if (x < p.nx && y < p.ny) level = p.row(y)[x];
+            }
+            f.receiver[2 * i + 1] = level;
+        }
+    const double packMs = msSince(t);
+
+    const gi::GiTimings& g = gi_.timings;
+    timings_.pyramids = g.gradient + g.pyramid;
+    timings_.scan = g.visibility + g.keyVisibility;
+    timings_.integrate = 0.0;  // gi/ fuses the wedge integration into the scan (part 1)
+    timings_.shade = g.shading + packMs + (surfaceMs - g.total);
+    timings_.render = 0.0;
+}
+
+}  // namespace terrain::render

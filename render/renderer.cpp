@@ -1,0 +1,390 @@
+#include "render/renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "render/context.h"
+#include "render/shaders.h"
+
+namespace terrain::render {
+namespace {
+
+constexpr float kDeg = 0.017453292519943295f;
+
+GLuint compile(const Gl& gl, GLenum type, const std::vector<const char*>& sources, const char* name) {
+    const GLuint s = gl.CreateShader(type);
+    gl.ShaderSource(s, static_cast<GLsizei>(sources.size()), sources.data(), nullptr);
+    gl.CompileShader(s);
+    GLint ok = 0;
+    gl.GetShaderiv(s, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+        char log[2048] = {};
+        gl.GetShaderInfoLog(s, sizeof log, nullptr, log);
+        gl.DeleteShader(s);
+        std::string line(log);
+        for (char& c : line)
+            if (c == '\n') c = ' ';
+        throw ContextError(std::string("shader ") + name + " does not compile: " + line);
+    }
+    return s;
+}
+
+GLuint link(const Gl& gl, const std::vector<const char*>& vs, const std::vector<const char*>& fs, const char* name) {
+    const GLuint v = compile(gl, GL_VERTEX_SHADER, vs, name);
+    const GLuint f = compile(gl, GL_FRAGMENT_SHADER, fs, name);
+    const GLuint p = gl.CreateProgram();
+    gl.AttachShader(p, v);
+    gl.AttachShader(p, f);
+    gl.LinkProgram(p);
+    gl.DeleteShader(v);
+    gl.DeleteShader(f);
+    GLint ok = 0;
+    gl.GetProgramiv(p, GL_LINK_STATUS, &ok);
+    if (!ok) {
+        char log[2048] = {};
+        gl.GetProgramInfoLog(p, sizeof log, nullptr, log);
+        gl.DeleteProgram(p);
+        throw ContextError(std::string("shader program ") + name + " does not link: " + log);
+    }
+    return p;
+}
+
+struct Uniforms {
+    const Gl& gl;
+    GLuint p;
+    GLint at(const char* n) const { return gl.GetUniformLocation(p, n); }
+    void i(const char* n, int v) const { gl.Uniform1i(at(n), v); }
+    void i2(const char* n, int a, int b) const { gl.Uniform2i(at(n), a, b); }
+    void f(const char* n, float v) const { gl.Uniform1f(at(n), v); }
+    void f2(const char* n, float a, float b) const { gl.Uniform2f(at(n), a, b); }
+    void v3(const char* n, const glm::vec3& v) const { gl.Uniform3f(at(n), v.x, v.y, v.z); }
+    void m4(const char* n, const glm::mat4& m) const { gl.UniformMatrix4fv(at(n), 1, GL_FALSE, glm::value_ptr(m)); }
+};
+
+glm::vec3 keyDirection(const gi::KeyLight& k) {
+    const float ce = std::cos(k.elevationDeg * kDeg);
+    return {ce * std::cos(k.azimuthDeg * kDeg), ce * std::sin(k.azimuthDeg * kDeg), std::sin(k.elevationDeg * kDeg)};
+}
+
+}  // namespace
+
+std::uint64_t hashBytes(const std::vector<std::uint8_t>& bytes) {
+    std::uint64_t h = 1469598103934665603ull;
+    for (std::uint8_t b : bytes) {
+        h ^= b;
+        h *= 1099511628211ull;
+    }
+    return h;
+}
+
+Renderer::Renderer(const Gl& gl) : gl_(gl) {
+    using namespace shaders;
+    const char* version = "#version 330 core\n";
+    terrainProgram_ = link(gl_, {kMeshVertex}, {version, kCommon, kTerrainFragment}, "terrain");
+    waterProgram_ = link(gl_, {kMeshVertex}, {version, kCommon, kWaterFragment}, "water");
+    shadowProgram_ = link(gl_, {kMeshVertex}, {kShadowFragment}, "shadow");
+    postProgram_ = link(gl_, {kPostVertex}, {kPostFragment}, "post");
+    gl_.GenVertexArrays(1, &vao_);
+    gl_.GenBuffers(1, &indexBuffer_);
+    checkGlError(gl_, "renderer set-up");
+}
+
+Renderer::~Renderer() {
+    releaseTarget(hdr_);
+    releaseTarget(ldr_);
+    releaseTarget(shadow_);
+    const GLuint textures[] = {heightTex_, shadeTex_, keyTex_, receiverTex_, envTex_};
+    gl_.DeleteTextures(5, textures);
+    gl_.DeleteBuffers(1, &indexBuffer_);
+    gl_.DeleteVertexArrays(1, &vao_);
+    for (GLuint p : {terrainProgram_, waterProgram_, shadowProgram_, postProgram_}) gl_.DeleteProgram(p);
+}
+
+void Renderer::ensureTexture(GLuint& tex, int& w, int& h, int nw, int nh, GLenum internal, GLenum format, bool linear) {
+    if (tex && w == nw && h == nh) return;
+    if (!tex) gl_.GenTextures(1, &tex);
+    gl_.BindTexture(GL_TEXTURE_2D, tex);
+    gl_.TexImage2D(GL_TEXTURE_2D, 0, static_cast<GLint>(internal), nw, nh, 0, format, GL_FLOAT, nullptr);
+    const GLint filter = linear ? GL_LINEAR : GL_NEAREST;
+    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
+    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
+    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    w = nw;
+    h = nh;
+}
+
+void Renderer::upload(const FrameData& f) {
+    gl_.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    ensureTexture(heightTex_, heightW_, heightH_, f.nx, f.ny, GL_RG32F, GL_RG, true);
+    gl_.BindTexture(GL_TEXTURE_2D, heightTex_);
+    gl_.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, f.nx, f.ny, GL_RG, GL_FLOAT, f.heights.data());
+    ensureTexture(shadeTex_, shadeW_, shadeH_, f.nx, f.ny, GL_RGBA32F, GL_RGBA, true);
+    gl_.BindTexture(GL_TEXTURE_2D, shadeTex_);
+    gl_.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, f.nx, f.ny, GL_RGBA, GL_FLOAT, f.shade.data());
+    ensureTexture(keyTex_, keyW_, keyH_, f.nx, f.ny, GL_RGBA32F, GL_RGBA, true);
+    gl_.BindTexture(GL_TEXTURE_2D, keyTex_);
+    gl_.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, f.nx, f.ny, GL_RGBA, GL_FLOAT, f.key.data());
+    ensureTexture(receiverTex_, recvW_, recvH_, f.nxr, f.nyr, GL_RG32F, GL_RG, true);
+    gl_.BindTexture(GL_TEXTURE_2D, receiverTex_);
+    gl_.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, f.nxr, f.nyr, GL_RG, GL_FLOAT, f.receiver.data());
+
+    // The environment map: the sky's SH radiance baked to 64 x 32 texels
+    // (order 4 is band-limited, i.e. already a prefiltered map).
+    const int ew = 64, eh = 32;
+    const bool newEnv = !envTex_ || meta_.lights.sky.c != f.lights.sky.c;
+    ensureTexture(envTex_, envW_, envH_, ew, eh, GL_RGB32F, GL_RGB, true);
+    gl_.BindTexture(GL_TEXTURE_2D, envTex_);
+    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    if (newEnv || envPixels_.empty()) {
+        envPixels_.resize(static_cast<std::size_t>(ew) * eh * 3);
+        for (int v = 0; v < eh; ++v)
+            for (int u = 0; u < ew; ++u) {
+                const double phi = 2.0 * gi::kPi * (u + 0.5) / ew;
+                const double el = gi::kPi * (0.5 - (v + 0.5) / eh);
+                double rgb[3];
+                gi::evaluateShRgb(f.lights.sky, std::cos(el) * std::cos(phi), std::cos(el) * std::sin(phi), std::sin(el), rgb);
+                for (int c = 0; c < 3; ++c)
+                    envPixels_[(static_cast<std::size_t>(v) * ew + u) * 3 + static_cast<std::size_t>(c)] =
+                        static_cast<float>(std::max(0.0, rgb[c]));
+            }
+        gl_.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, ew, eh, GL_RGB, GL_FLOAT, envPixels_.data());
+    }
+
+    // Index buffer: two triangles per quad, rebuilt only when the size changes.
+    if (meshNx_ != f.nx || meshNy_ != f.ny) {
+        std::vector<std::uint32_t> idx;
+        idx.reserve(static_cast<std::size_t>(std::max(f.nx - 1, 0)) * std::max(f.ny - 1, 0) * 6);
+        for (int y = 0; y + 1 < f.ny; ++y)
+            for (int x = 0; x + 1 < f.nx; ++x) {
+                const std::uint32_t a = static_cast<std::uint32_t>(y * f.nx + x), b = a + 1,
+                                    c = a + static_cast<std::uint32_t>(f.nx), d = c + 1;
+                idx.insert(idx.end(), {a, b, d, a, d, c});
+            }
+        gl_.BindVertexArray(vao_);
+        gl_.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, indexBuffer_);
+        gl_.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(idx.size() * sizeof(std::uint32_t)), idx.data(),
+                       GL_STATIC_DRAW);
+        gl_.BindVertexArray(0);
+        indexCount_ = static_cast<std::int64_t>(idx.size());
+        meshNx_ = f.nx;
+        meshNy_ = f.ny;
+    }
+    meta_.nx = f.nx;
+    meta_.ny = f.ny;
+    meta_.nxr = f.nxr;
+    meta_.nyr = f.nyr;
+    meta_.subsample = f.subsample;
+    meta_.cellSize = f.cellSize;
+    meta_.zMin = f.zMin;
+    meta_.zMax = f.zMax;
+    meta_.hasWater = f.hasWater;
+    meta_.lights = f.lights;
+    meta_.lighting = f.lighting;
+    checkGlError(gl_, "upload");
+}
+
+void Renderer::ensureTarget(Target& t, int w, int h, GLenum colorFormat, bool depth) {
+    if (t.fbo && t.w == w && t.h == h) return;
+    releaseTarget(t);
+    gl_.GenFramebuffers(1, &t.fbo);
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
+    if (colorFormat) {
+        gl_.GenTextures(1, &t.color);
+        gl_.BindTexture(GL_TEXTURE_2D, t.color);
+        const GLenum type = colorFormat == GL_RGBA8 ? GL_UNSIGNED_BYTE : GL_FLOAT;
+        gl_.TexImage2D(GL_TEXTURE_2D, 0, static_cast<GLint>(colorFormat), w, h, 0, GL_RGBA, type, nullptr);
+        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        gl_.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, t.color, 0);
+    }
+    if (depth) {
+        gl_.GenTextures(1, &t.depth);
+        gl_.BindTexture(GL_TEXTURE_2D, t.depth);
+        gl_.TexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, w, h, 0, GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
+        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+        const float border[4] = {1.0f, 1.0f, 1.0f, 1.0f};
+        gl_.TexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, border);
+        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+        gl_.FramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, t.depth, 0);
+    }
+    if (!colorFormat) {
+        const GLenum none = GL_NONE;
+        gl_.DrawBuffers(1, &none);
+        gl_.ReadBuffer(GL_NONE);
+    }
+    if (gl_.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        throw ContextError("OpenGL: incomplete framebuffer " + std::to_string(w) + " x " + std::to_string(h));
+    t.w = w;
+    t.h = h;
+}
+
+void Renderer::releaseTarget(Target& t) {
+    if (t.fbo) gl_.DeleteFramebuffers(1, &t.fbo);
+    if (t.color) gl_.DeleteTextures(1, &t.color);
+    if (t.depth) gl_.DeleteTextures(1, &t.depth);
+    t = {};
+}
+
+void Renderer::draw(const RenderSettings& s, int width, int height, GLuint framebuffer) {
+    if (width < 1 || height < 1 || width > 16384 || height > 16384)
+        throw InputError("image size must be 1..16384 pixels per side");
+    if (!heightTex_) throw ContextError("renderer: draw before upload");
+    const FrameData& f = meta_;
+    const float exag = s.verticalExaggeration;
+    const float extent = static_cast<float>(std::max(f.nx, f.ny) - 1) * f.cellSize;
+    const glm::vec3 centre(0.5f * (f.nx - 1) * f.cellSize, 0.5f * (f.ny - 1) * f.cellSize,
+                           0.5f * (f.zMin + f.zMax) * exag);
+    // ---- camera ------------------------------------------------------------------
+    const OrbitCamera& cam = s.camera;
+    const float cp = std::cos(cam.pitchDeg * kDeg);
+    const glm::vec3 eye = centre + extent * cam.distance *
+                                       glm::vec3(cp * std::cos(cam.yawDeg * kDeg), cp * std::sin(cam.yawDeg * kDeg),
+                                                 std::sin(cam.pitchDeg * kDeg));
+    const float dist = extent * cam.distance;
+    const glm::mat4 view = glm::lookAt(eye, centre, glm::vec3(0, 0, 1));
+    const glm::mat4 proj = glm::perspective(cam.fovYDeg * kDeg, static_cast<float>(width) / height,
+                                            std::max(dist * 0.02f, 0.01f), dist * 4.0f + (f.zMax - f.zMin) * exag);
+    const glm::mat4 viewProj = proj * view;
+    // ---- key light shadow map (orthographic, covering the terrain) ---------------
+    const glm::vec3 keyDir = keyDirection(f.lights.key);
+    const float radius = 0.5f * std::sqrt(2.0f * extent * extent + (f.zMax - f.zMin) * exag * (f.zMax - f.zMin) * exag) + 1.0f;
+    const glm::vec3 up = std::abs(keyDir.z) > 0.99f ? glm::vec3(0, 1, 0) : glm::vec3(0, 0, 1);
+    const glm::mat4 lightViewProj = glm::ortho(-radius, radius, -radius, radius, 0.0f, 4.0f * radius) *
+                                    glm::lookAt(centre + keyDir * (2.0f * radius), centre, up);
+    const bool debug = s.debug != DebugView::None;
+    gl_.BindVertexArray(vao_);
+    const GLsizei indexCount = static_cast<GLsizei>(indexCount_);
+    auto meshUniforms = [&](GLuint p, const glm::mat4& vp, int water) {
+        Uniforms u{gl_, p};
+        u.i("uHeight", 0);
+        u.i2("uGrid", f.nx, f.ny);
+        u.f("uCell", f.cellSize);
+        u.f("uExag", exag);
+        u.m4("uViewProj", vp);
+        u.i("uWater", water);
+    };
+    gl_.ActiveTexture(GL_TEXTURE0);
+    gl_.BindTexture(GL_TEXTURE_2D, heightTex_);
+    const bool wantShadowMap = s.shadow == ShadowMode::ShadowMap && !debug;
+    if (wantShadowMap) {
+        const int side = std::clamp(s.shadowMapSize, 256, 8192);
+        ensureTarget(shadow_, side, side, 0, true);
+        gl_.BindFramebuffer(GL_FRAMEBUFFER, shadow_.fbo);
+        gl_.Viewport(0, 0, side, side);
+        gl_.ClearDepth(1.0);
+        gl_.Clear(GL_DEPTH_BUFFER_BIT);
+        gl_.Enable(GL_DEPTH_TEST);
+        gl_.DepthFunc(GL_LESS);
+        gl_.Enable(GL_POLYGON_OFFSET_FILL);
+        gl_.PolygonOffset(1.5f, 2.0f);
+        gl_.UseProgram(shadowProgram_);
+        meshUniforms(shadowProgram_, lightViewProj, 0);
+        gl_.DrawElements(GL_TRIANGLES, indexCount, GL_UNSIGNED_INT, nullptr);
+        gl_.Disable(GL_POLYGON_OFFSET_FILL);
+    }
+    // ---- terrain and water into the HDR target ------------------------------------
+    ensureTarget(hdr_, width, height, GL_RGBA16F, true);
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, hdr_.fbo);
+    gl_.Viewport(0, 0, width, height);
+    gl_.ClearColor(0, 0, 0, 0);
+    gl_.ClearDepth(1.0);
+    gl_.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    gl_.Enable(GL_DEPTH_TEST);
+    gl_.DepthFunc(GL_LESS);
+    gl_.Disable(GL_CULL_FACE);
+    const GLuint textures[] = {heightTex_, shadeTex_, keyTex_, receiverTex_, envTex_, shadow_.depth};
+    for (int i = 0; i < 6; ++i) {
+        gl_.ActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + i));
+        gl_.BindTexture(GL_TEXTURE_2D, textures[i]);
+    }
+    auto surfaceUniforms = [&](GLuint p, int water) {
+        gl_.UseProgram(p);
+        meshUniforms(p, viewProj, water);
+        Uniforms u{gl_, p};
+        u.i("uShade", 1);
+        u.i("uKey", 2);
+        u.i("uReceiver", 3);
+        u.i("uEnv", 4);
+        u.i("uShadowMap", 5);
+        u.i2("uReceiverGrid", f.nxr, f.nyr);
+        u.i("uSubsample", f.subsample);
+        u.v3("uEye", eye);
+        u.v3("uKeyDir", keyDir);
+        u.v3("uKeyRgb", glm::vec3(f.lights.key.rgb[0], f.lights.key.rgb[1], f.lights.key.rgb[2]));
+        u.i("uLighting", f.lighting == LightingMode::KeyOnly ? 0 : (f.lighting == LightingMode::Direct ? 1 : 2));
+        u.i("uShadowMode", s.shadow == ShadowMode::SoftVisibility ? 0 : (wantShadowMap ? 1 : 2));
+        u.i("uSpecular", s.specular ? 1 : 0);
+        u.i("uDebug", static_cast<int>(s.debug));
+        u.f2("uZRange", f.zMin, f.zMax);
+        u.m4("uLightViewProj", lightViewProj);
+        u.f("uShadowTexel", shadow_.w > 0 ? 1.0f / static_cast<float>(shadow_.w) : 0.0f);
+    };
+    surfaceUniforms(terrainProgram_, 0);
+    gl_.DrawElements(GL_TRIANGLES, indexCount, GL_UNSIGNED_INT, nullptr);
+    if (s.water && f.hasWater && !debug) {
+        surfaceUniforms(waterProgram_, 1);
+        gl_.Enable(GL_BLEND);
+        gl_.BlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+        gl_.DepthMask(GL_FALSE);
+        gl_.DrawElements(GL_TRIANGLES, indexCount, GL_UNSIGNED_INT, nullptr);
+        gl_.DepthMask(GL_TRUE);
+        gl_.Disable(GL_BLEND);
+    }
+    // ---- tone mapping + sRGB into the output --------------------------------------
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    gl_.Viewport(0, 0, width, height);
+    gl_.Disable(GL_DEPTH_TEST);
+    gl_.UseProgram(postProgram_);
+    gl_.ActiveTexture(GL_TEXTURE0);
+    gl_.BindTexture(GL_TEXTURE_2D, hdr_.color);
+    gl_.ActiveTexture(GL_TEXTURE1);
+    gl_.BindTexture(GL_TEXTURE_2D, envTex_);
+    Uniforms u{gl_, postProgram_};
+    u.i("uHdr", 0);
+    u.i("uEnv", 1);
+    u.m4("uInvViewProj", glm::inverse(viewProj));
+    u.v3("uEye", eye);
+    u.f2("uSize", static_cast<float>(width), static_cast<float>(height));
+    u.f("uExposure", s.exposure);
+    u.i("uTonemap", debug ? 0 : 1);
+    gl_.DrawArrays(GL_TRIANGLES, 0, 3);
+    gl_.BindVertexArray(0);
+    gl_.ActiveTexture(GL_TEXTURE0);
+    checkGlError(gl_, "draw");
+}
+
+void Renderer::drawToImage(const RenderSettings& s, int width, int height, std::vector<std::uint8_t>& rgb) {
+    if (width < 1 || height < 1 || width > 16384 || height > 16384)
+        throw InputError("image size must be 1..16384 pixels per side");
+    ensureTarget(ldr_, width, height, GL_RGBA8, false);
+    draw(s, width, height, ldr_.fbo);
+    std::vector<std::uint8_t> rgba(static_cast<std::size_t>(width) * height * 4);
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, ldr_.fbo);
+    gl_.ReadBuffer(GL_COLOR_ATTACHMENT0);
+    gl_.PixelStorei(GL_PACK_ALIGNMENT, 1);
+    gl_.ReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    checkGlError(gl_, "read-back");
+    rgb.resize(static_cast<std::size_t>(width) * height * 3);
+    for (int y = 0; y < height; ++y) {
+        const std::uint8_t* src = rgba.data() + static_cast<std::size_t>(height - 1 - y) * width * 4;  // GL: row 0 at the bottom
+        std::uint8_t* dst = rgb.data() + static_cast<std::size_t>(y) * width * 3;
+        for (int x = 0; x < width; ++x) {
+            dst[3 * x] = src[4 * x];
+            dst[3 * x + 1] = src[4 * x + 1];
+            dst[3 * x + 2] = src[4 * x + 2];
+        }
+    }
+}
+
+}  // namespace terrain::render

@@ -1,0 +1,235 @@
+#pragma once
+// GLSL 3.30 core sources of the renderer (render/renderer.h describes the passes).
+
+namespace terrain::render::shaders {
+
+// Shared by terrain, water and the shadow pass: one vertex per grid point,
+// its position fetched from the height texture (heights stream every frame).
+inline constexpr const char* kMeshVertex = R"(#version 330 core
+uniform sampler2D uHeight;   // RG32F: ground (m), water depth (m)
+uniform ivec2 uGrid;         // nx, ny
+uniform float uCell;         // m between grid points
+uniform float uExag;         // vertical exaggeration
+uniform mat4 uViewProj;
+uniform int uWater;          // 1: the water surface (ground + depth)
+out vec3 vWorld;
+out vec2 vCell;
+out float vDepth;
+void main() {
+    ivec2 g = ivec2(gl_VertexID % uGrid.x, gl_VertexID / uGrid.x);
+    vec2 hw = texelFetch(uHeight, g, 0).rg;
+    float z = hw.r;
+    // Dry points of the water surface sit just under the ground, so the
+    // surface ends at the shore and the depth test hides it on land.
+    if (uWater == 1) z = hw.g > 0.01 ? hw.r + hw.g : hw.r - 0.2;
+    vCell = vec2(g);
+    vDepth = hw.g;
+    vWorld = vec3(vec2(g) * uCell, z * uExag);
+    gl_Position = uViewProj * vec4(vWorld, 1.0);
+}
+)";
+
+inline constexpr const char* kShadowFragment = R"(#version 330 core
+void main() {}
+)";
+
+// Functions shared by the terrain and water fragment shaders.
+inline constexpr const char* kCommon = R"(
+const float PI = 3.14159265358979;
+uniform sampler2D uHeight;
+uniform sampler2D uShade;     // RGBA32F: sky shade RGB, key visibility
+uniform sampler2D uKey;       // RGBA32F: key shade RGB, ambient
+uniform sampler2D uReceiver;  // RG32F at the receiver grid: sky visibility, pyramid level
+uniform sampler2D uEnv;       // RGB32F equirectangular environment (prefiltered: order-4 SH)
+uniform sampler2DShadow uShadowMap;
+uniform ivec2 uGrid;
+uniform ivec2 uReceiverGrid;
+uniform int uSubsample;
+uniform float uCell;
+uniform float uExag;
+uniform vec3 uEye;
+uniform vec3 uKeyDir;         // unit, towards the key light
+uniform vec3 uKeyRgb;         // unshadowed key shade of a white surface facing the light
+uniform int uLighting;        // 0 key only, 1 direct (sky + key), 2 global
+uniform int uShadowMode;      // 0 soft visibility (engine), 1 shadow map, 2 none
+uniform int uSpecular;
+uniform int uDebug;
+uniform vec2 uZRange;
+uniform mat4 uLightViewProj;
+uniform float uShadowTexel;
+in vec3 vWorld;
+in vec2 vCell;
+in float vDepth;
+out vec4 fragColor;
+
+vec2 uvOf(vec2 cell) { return (cell + 0.5) / vec2(uGrid); }
+float surfaceAt(vec2 cell, bool water) {
+    vec2 hw = texture(uHeight, uvOf(cell)).rg;
+    return water ? hw.r + hw.g : hw.r;
+}
+// Full-resolution normal: central differences of the bilinear height field.
+vec3 normalAt(vec2 cell, bool water) {
+    float hl = surfaceAt(cell - vec2(1.0, 0.0), water), hr = surfaceAt(cell + vec2(1.0, 0.0), water);
+    float hd = surfaceAt(cell - vec2(0.0, 1.0), water), hu = surfaceAt(cell + vec2(0.0, 1.0), water);
+    float k = uExag / (2.0 * uCell);
+    return normalize(vec3(-(hr - hl) * k, -(hu - hd) * k, 1.0));
+}
+vec2 receiverUv(vec2 cell) { return (cell / float(uSubsample) + 0.5) / vec2(uReceiverGrid); }
+
+// Environment lookup: column = azimuth from +x towards +y, row 0 = zenith.
+vec3 environment(vec3 d) {
+    float u = atan(d.y, d.x) / (2.0 * PI);
+    float v = 0.5 - asin(clamp(d.z, -1.0, 1.0)) / PI;
+    return texture(uEnv, vec2(u, v)).rgb;
+}
+
+// Torrance-Sparrow (paper 002, Eq. 1): f = F D G / (4 (n.l) (n.v)), returned
+// as f * pi * (n.l), so that uKeyRgb * result is the reflected radiance (the
+// key light's irradiance is pi * uKeyRgb * (n.l)).
+float beckmann(float nh, float m) {
+    float c2 = nh * nh;
+    float t2 = (1.0 - c2) / max(c2, 1e-6);
+    return exp(-t2 / (m * m)) / (PI * m * m * c2 * c2);
+}
+float smithG1(float c, float m) {  // Smith's term for a Beckmann surface (rational fit)
+    if (c <= 0.0) return 0.0;
+    float t = sqrt(max(1.0 - c * c, 0.0)) / c;
+    if (t <= 0.0) return 1.0;
+    float a = 1.0 / (m * t);
+    return a < 1.6 ? (3.535 * a + 2.181 * a * a) / (1.0 + 2.276 * a + 2.577 * a * a) : 1.0;
+}
+float schlick(float c, float f0) { return f0 + (1.0 - f0) * pow(1.0 - clamp(c, 0.0, 1.0), 5.0); }
+float torranceSparrow(vec3 n, vec3 v, vec3 l, float m, float f0) {
+    float nl = dot(n, l), nv = dot(n, v);
+    if (nl <= 0.0 || nv <= 0.0) return 0.0;
+    vec3 h = normalize(l + v);
+    float nh = max(dot(n, h), 0.0), vh = max(dot(v, h), 0.0);
+    return schlick(vh, f0) * beckmann(nh, m) * smithG1(nl, m) * smithG1(nv, m) * PI / (4.0 * nv);
+}
+
+// Classic shadow map (paper 004) with 3x3 percentage-closer filtering.
+float shadowMapVisibility(vec3 world) {
+    vec4 p = uLightViewProj * vec4(world, 1.0);
+    vec3 q = p.xyz / p.w * 0.5 + 0.5;
+    float s = 0.0;
+    for (int j = -1; j <= 1; ++j)
+        for (int i = -1; i <= 1; ++i) s += texture(uShadowMap, vec3(q.xy + vec2(i, j) * uShadowTexel, q.z - 0.0015));
+    return s / 9.0;
+}
+
+// Key light: soft visibility, and the diffuse shade of a white surface.
+void keyLight(vec2 uv, vec3 n, out float vis, out vec3 diffuse) {
+    float nl = max(dot(n, uKeyDir), 0.0);
+    if (uShadowMode == 0) {
+        vis = texture(uShade, uv).a;
+        diffuse = texture(uKey, uv).rgb;
+    } else if (uShadowMode == 1) {
+        vis = shadowMapVisibility(vWorld);
+        diffuse = uKeyRgb * nl * vis;
+    } else {
+        vis = 1.0;
+        diffuse = uKeyRgb * nl;
+    }
+}
+vec3 skyShade(vec2 uv) { return uLighting == 0 ? vec3(0.0) : texture(uShade, uv).rgb; }
+)";
+
+inline constexpr const char* kTerrainFragment = R"(
+vec3 albedo(float h, vec3 n) {
+    float t = clamp((h - uZRange.x) / max(uZRange.y - uZRange.x, 1e-3), 0.0, 1.0);
+    vec3 low = vec3(0.16, 0.24, 0.08), mid = vec3(0.30, 0.27, 0.20), high = vec3(0.80, 0.80, 0.84);
+    vec3 c = t < 0.5 ? mix(low, mid, t * 2.0) : mix(mid, high, (t - 0.5) * 2.0);
+    // steep slopes are bare rock
+    return mix(c, vec3(0.30, 0.28, 0.26), clamp((0.78 - n.z) * 4.0, 0.0, 1.0));
+}
+void main() {
+    vec2 uv = uvOf(vCell);
+    vec3 n = normalAt(vCell, false);
+    if (uDebug != 0) {
+        vec3 c;
+        vec2 r = texture(uReceiver, receiverUv(vCell)).rg;
+        if (uDebug == 1) c = vec3(texture(uKey, uv).a);
+        else if (uDebug == 2) c = vec3(r.r);
+        else if (uDebug == 3) c = vec3(texture(uShade, uv).a);
+        else if (uDebug == 4) c = n * 0.5 + 0.5;
+        else if (uDebug == 5) c = vec3((r.g - uZRange.x) / max(uZRange.y - uZRange.x, 1e-3));
+        else c = texture(uShade, uv).rgb + texture(uKey, uv).rgb;
+        fragColor = vec4(clamp(c, 0.0, 1.0), 1.0);
+        return;
+    }
+    vec2 hw = texture(uHeight, uv).rg;
+    float vis;
+    vec3 keyDiffuse;
+    keyLight(uv, n, vis, keyDiffuse);
+    vec3 a = albedo(hw.r, n);
+    if (hw.g > 0.002) a *= 0.75;  // wet ground
+    vec3 c = a * (skyShade(uv) + keyDiffuse);
+    if (uSpecular == 1) c += 0.35 * uKeyRgb * vis * torranceSparrow(n, normalize(uEye - vWorld), uKeyDir, 0.4, 0.04);
+    fragColor = vec4(c, 1.0);
+}
+)";
+
+inline constexpr const char* kWaterFragment = R"(
+void main() {
+    if (vDepth < 0.02 || uDebug != 0) discard;
+    vec2 uv = uvOf(vCell);
+    vec3 n = normalAt(vCell, true);
+    vec3 v = normalize(uEye - vWorld);
+    float vis;
+    vec3 keyDiffuse;
+    keyLight(uv, n, vis, keyDiffuse);
+    // Mirror term: the prefiltered environment in the reflection direction,
+    // dimmed by how much of the sky the water sees.
+    vec3 r = reflect(-v, n);
+    float skyVis = clamp(texture(uReceiver, receiverUv(vCell)).r, 0.0, 1.0);
+    vec3 mirror = environment(r) * skyVis;
+    float f = schlick(max(dot(n, v), 0.0), 0.02);  // water, n = 1.33
+    vec3 glint = uSpecular == 1 ? uKeyRgb * vis * torranceSparrow(n, v, uKeyDir, 0.07, 0.02) : vec3(0.0);
+    // Diffuse part: light scattered by the water body; the lit terrain shows
+    // through where the water is shallow (transmittance down and back up).
+    vec3 body = vec3(0.015, 0.06, 0.08) * (skyShade(uv) + keyDiffuse);
+    float transmit = exp(-vDepth / 1.2);
+    vec3 c = f * mirror + glint + (1.0 - f) * (1.0 - transmit) * body;
+    float alpha = f + (1.0 - f) * (1.0 - transmit);
+    fragColor = vec4(c, alpha);  // premultiplied: blended ONE, ONE_MINUS_SRC_ALPHA over the terrain
+}
+)";
+
+inline constexpr const char* kPostVertex = R"(#version 330 core
+void main() {
+    vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);  // one triangle over the screen
+    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+}
+)";
+
+// Tone mapping (ACES fit) and sRGB encoding; the sky where no terrain was drawn.
+inline constexpr const char* kPostFragment = R"(#version 330 core
+const float PI = 3.14159265358979;
+uniform sampler2D uHdr;
+uniform sampler2D uEnv;
+uniform mat4 uInvViewProj;
+uniform vec3 uEye;
+uniform vec2 uSize;
+uniform float uExposure;
+uniform int uTonemap;
+out vec4 fragColor;
+vec3 aces(vec3 x) { return clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0); }
+vec3 srgb(vec3 c) {
+    return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+}
+void main() {
+    vec4 c = texelFetch(uHdr, ivec2(gl_FragCoord.xy), 0);
+    if (c.a <= 0.0) {
+        if (uTonemap == 0) { fragColor = vec4(0.0, 0.0, 0.0, 1.0); return; }
+        vec4 p = uInvViewProj * vec4(gl_FragCoord.xy / uSize * 2.0 - 1.0, 1.0, 1.0);
+        vec3 d = normalize(p.xyz / p.w - uEye);
+        float u = atan(d.y, d.x) / (2.0 * PI);
+        float v = 0.5 - asin(clamp(d.z, -1.0, 1.0)) / PI;
+        c.rgb = texture(uEnv, vec2(u, v)).rgb;
+    }
+    vec3 x = uTonemap == 1 ? aces(c.rgb * uExposure) : clamp(c.rgb, 0.0, 1.0);
+    fragColor = vec4(srgb(x), 1.0);
+}
+)";
+
+}  // namespace terrain::render::shaders
