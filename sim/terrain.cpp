@@ -90,7 +90,7 @@ struct Hasher {
             word(w);
         }
         std::uint64_t tail = 0;
-        std::memcpy(&tail, c + i, n - i);
+        if (n > i) std::memcpy(&tail, c + i, n - i);  // (c may be null when n == 0)
         word(tail ^ (static_cast<std::uint64_t>(n - i) << 56));
     }
     std::uint64_t finish() const {
