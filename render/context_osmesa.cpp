@@ -3,6 +3,8 @@
 // itself is a tiny placeholder that only makes the context current.
 #include <GL/osmesa.h>
 
+#include <cstdlib>
+#include <string>
 #include <vector>
 
 #include "render/context.h"
@@ -13,6 +15,12 @@ namespace {
 class OsMesaContext final : public GlContext {
 public:
     OsMesaContext() {
+        // Mesa crashes instead of failing when asked for a driver OSMesa cannot load.
+        if (const char* driver = std::getenv("GALLIUM_DRIVER")) {
+            const std::string d(driver);
+            if (!d.empty() && d != "llvmpipe" && d != "softpipe")
+                throw ContextError("OSMesa: GALLIUM_DRIVER='" + d + "' is not a software driver OSMesa can use (llvmpipe, softpipe)");
+        }
         // Newest first: 4.5 core (llvmpipe), then 3.3 core.
         const int versions[][2] = {{4, 5}, {3, 3}};
         for (const auto& v : versions) {

@@ -101,7 +101,7 @@ int runWindowDemo(WindowContext& window, const Gl& gl, FramePipeline& pipeline, 
         ImGui::SameLine();
         ImGui::Checkbox("specular", &rs.specular);
         ImGui::SliderFloat("exposure", &rs.exposure, 0.1f, 4.0f);
-        ImGui::SliderFloat("exaggeration", &rs.verticalExaggeration, 0.5f, 4.0f);
+        ImGui::SliderFloat("exaggeration (0 = auto)", &ps.verticalExaggeration, 0.0f, 10.0f);
         ImGui::Separator();
         ImGui::SliderFloat("sun azimuth", &lights.key.azimuthDeg, 0.0f, 359.0f);
         ImGui::SliderFloat("sun elevation", &lights.key.elevationDeg, 3.0f, 85.0f);

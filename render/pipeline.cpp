@@ -24,16 +24,16 @@ SceneLights defaultLights() {
     gi::SunSkySettings sky;
     sky.sun[0] = sky.sun[1] = sky.sun[2] = 0.0f;
     for (int c = 0; c < 3; ++c) {
-        sky.zenith[c] *= 0.7f;
-        sky.horizon[c] *= 0.7f;
+        sky.zenith[c] *= 0.45f;
+        sky.horizon[c] *= 0.45f;
     }
     l.sky = gi::sunSkyLight(sky);
     l.key.azimuthDeg = 300.0f;
-    l.key.elevationDeg = 28.0f;
+    l.key.elevationDeg = 22.0f;
     l.key.radiusDeg = 3.0f;
-    l.key.rgb[0] = 2.9f;
-    l.key.rgb[1] = 2.6f;
-    l.key.rgb[2] = 2.2f;
+    l.key.rgb[0] = 1.9f;
+    l.key.rgb[1] = 1.75f;
+    l.key.rgb[2] = 1.5f;
     return l;
 }
 
@@ -48,6 +48,10 @@ FramePipeline::FramePipeline(const SceneSettings& scene, const PipelineSettings&
         else if (scene.hydraulic || scene.thermal) ticksPerFrame_ = 60;
         else ticksPerFrame_ = 1;
     }
+    terrainReplaced();
+}
+
+void FramePipeline::terrainReplaced() {
     const TerrainState& s = sim_.state();
     frame_.nx = s.nx;
     frame_.ny = s.ny;
@@ -61,6 +65,8 @@ FramePipeline::FramePipeline(const SceneSettings& scene, const PipelineSettings&
         }
     frame_.zMin = lo;
     frame_.zMax = hi > lo ? hi : lo + 1.0f;
+    const float extent = static_cast<float>(std::max(s.nx, s.ny) - 1) * s.cellSize;
+    autoExaggeration_ = std::clamp(0.15f * extent / (frame_.zMax - frame_.zMin), 1.0f, 10.0f);
 }
 
 void FramePipeline::advance() {
@@ -73,6 +79,9 @@ void FramePipeline::advance() {
 
 void FramePipeline::light() {
     if (settings_.bounces < 0 || settings_.bounces > 3) throw InputError("bounces must be 0..3");
+    if (!(settings_.verticalExaggeration >= 0.0f && settings_.verticalExaggeration <= 100.0f))
+        throw InputError("vertical exaggeration must be in [0, 100] (0 = automatic)");
+    const float exag = settings_.verticalExaggeration > 0.0f ? settings_.verticalExaggeration : autoExaggeration_;
     const TerrainState& s = sim_.state();
     const int nx = s.nx, ny = s.ny;
     auto t = Clock::now();
@@ -80,7 +89,7 @@ void FramePipeline::light() {
     if (surface_.nx != nx || surface_.ny != ny) surface_.resize(nx, ny);
     parallelForRows(ny, nx, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y)
-            for (int x = 0; x < nx; ++x) surface_(x, y) = s.ground(x, y) + (s.hasWater() ? s.water(x, y) : 0.0f);
+            for (int x = 0; x < nx; ++x) surface_(x, y) = exag * (s.ground(x, y) + (s.hasWater() ? s.water(x, y) : 0.0f));
     });
     gi::GiLighting lighting;
     lighting.environment = lights_.sky;
@@ -96,6 +105,7 @@ void FramePipeline::light() {
     // ---- pack what the renderer uploads -----------------------------------------
     FrameData& f = frame_;
     f.lighting = settings_.lighting;
+    f.exaggeration = exag;
     f.lights = lights_;
     f.tick = s.tick;
     f.time = s.time;
@@ -145,10 +155,10 @@ void FramePipeline::light() {
         for (int x = 0; x < v.nxr; ++x) {
             const std::size_t i = static_cast<std::size_t>(y) * v.nxr + x;
             f.receiver[2 * i] = v.plane(0)[i] * vScale;
-            float level = surface_(std::min(x * f.subsample, nx - 1), std::min(y * f.subsample, ny - 1));
+            float level = surface_(std::min(x * f.subsample, nx - 1), std::min(y * f.subsample, ny - 1)) / exag;
             if (f.pyramidLevel >= 0) {
                 const gi::PaddedField& p = gi_.pyramid.levels[static_cast<std::size_t>(f.pyramidLevel)];
-                if (x < p.nx && y < p.ny) level = p.row(y)[x];
+                if (x < p.nx && y < p.ny) level = p.row(y)[x] / exag;
             }
             f.receiver[2 * i + 1] = level;
         }

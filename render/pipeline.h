@@ -43,6 +43,10 @@ struct PipelineSettings {
     int bounces = 1;         // 0..3; used once gi/ supports indirect light
     int pyramidLevel = 4;    // pyramid level exposed to the debug view
     int ticksPerFrame = 0;   // 0 = the scene's default pacing
+    // Vertical exaggeration of what is lit and drawn (GI, shadow map and mesh
+    // all see the same surface); 0 = automatic: relief at least 15 % of the
+    // extent (the waves bay is 512 m wide and 18 m deep).
+    float verticalExaggeration = 0.0f;
 };
 
 /// Milliseconds of one frame per stage.
@@ -57,6 +61,7 @@ struct FrameData {
     float cellSize = 1.0f;
     float zMin = 0.0f, zMax = 1.0f;       // ground range of the first frame (fixed colour ramp)
     bool hasWater = false;
+    float exaggeration = 1.0f;            // vertical exaggeration (applied by the renderer to the heights)
     std::vector<float> heights;           // 2 per texel: ground, water depth
     std::vector<float> shade;             // 4 per texel: sky RGB, key visibility
     std::vector<float> key;               // 4 per texel: key RGB, ambient
@@ -83,6 +88,10 @@ public:
     SceneLights& lights() { return lights_; }
     const FrameData& frame() const { return frame_; }
     const Simulation& simulation() const { return sim_; }
+    /// For tools and tests that set the ground themselves; call terrainReplaced() after.
+    Simulation& simulation() { return sim_; }
+    /// Recomputes the colour ramp range and the automatic exaggeration from the current ground.
+    void terrainReplaced();
     int ticksPerFrame() const { return ticksPerFrame_; }
     /// Timings of the last advance() + light() (render is filled by the caller).
     StageTimings& timings() { return timings_; }
@@ -93,6 +102,7 @@ private:
     PipelineSettings settings_;
     SceneLights lights_;
     int ticksPerFrame_ = 1;
+    float autoExaggeration_ = 1.0f;
     bool first_ = true;
     Grid surface_;          // ground + water: what the light sees
     gi::GiState gi_;

@@ -184,6 +184,7 @@ void Renderer::upload(const FrameData& f) {
     meta_.zMin = f.zMin;
     meta_.zMax = f.zMax;
     meta_.hasWater = f.hasWater;
+    meta_.exaggeration = f.exaggeration;
     meta_.lights = f.lights;
     meta_.lighting = f.lighting;
     checkGlError(gl_, "upload");
@@ -240,7 +241,7 @@ void Renderer::draw(const RenderSettings& s, int width, int height, GLuint frame
         throw InputError("image size must be 1..16384 pixels per side");
     if (!heightTex_) throw ContextError("renderer: draw before upload");
     const FrameData& f = meta_;
-    const float exag = s.verticalExaggeration;
+    const float exag = f.exaggeration;
     const float extent = static_cast<float>(std::max(f.nx, f.ny) - 1) * f.cellSize;
     const glm::vec3 centre(0.5f * (f.nx - 1) * f.cellSize, 0.5f * (f.ny - 1) * f.cellSize,
                            0.5f * (f.zMin + f.zMax) * exag);
@@ -273,12 +274,14 @@ void Renderer::draw(const RenderSettings& s, int width, int height, GLuint frame
         u.m4("uViewProj", vp);
         u.i("uWater", water);
     };
+    const bool wantShadowMap = s.shadow == ShadowMode::ShadowMap && !debug;
+    // Targets first: creating one binds its textures to the active unit.
+    if (wantShadowMap) ensureTarget(shadow_, std::clamp(s.shadowMapSize, 256, 8192), std::clamp(s.shadowMapSize, 256, 8192), 0, true);
+    ensureTarget(hdr_, width, height, GL_RGBA16F, true);
     gl_.ActiveTexture(GL_TEXTURE0);
     gl_.BindTexture(GL_TEXTURE_2D, heightTex_);
-    const bool wantShadowMap = s.shadow == ShadowMode::ShadowMap && !debug;
     if (wantShadowMap) {
-        const int side = std::clamp(s.shadowMapSize, 256, 8192);
-        ensureTarget(shadow_, side, side, 0, true);
+        const int side = shadow_.w;
         gl_.BindFramebuffer(GL_FRAMEBUFFER, shadow_.fbo);
         gl_.Viewport(0, 0, side, side);
         gl_.ClearDepth(1.0);
@@ -293,7 +296,6 @@ void Renderer::draw(const RenderSettings& s, int width, int height, GLuint frame
         gl_.Disable(GL_POLYGON_OFFSET_FILL);
     }
     // ---- terrain and water into the HDR target ------------------------------------
-    ensureTarget(hdr_, width, height, GL_RGBA16F, true);
     gl_.BindFramebuffer(GL_FRAMEBUFFER, hdr_.fbo);
     gl_.Viewport(0, 0, width, height);
     gl_.ClearColor(0, 0, 0, 0);
@@ -326,6 +328,7 @@ void Renderer::draw(const RenderSettings& s, int width, int height, GLuint frame
         u.i("uSpecular", s.specular ? 1 : 0);
         u.i("uDebug", static_cast<int>(s.debug));
         u.f2("uZRange", f.zMin, f.zMax);
+        u.i("uPalette", f.hasWater ? 1 : 0);
         u.m4("uLightViewProj", lightViewProj);
         u.f("uShadowTexel", shadow_.w > 0 ? 1.0f / static_cast<float>(shadow_.w) : 0.0f);
     };

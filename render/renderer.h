@@ -45,7 +45,6 @@ struct RenderSettings {
     ShadowMode shadow = ShadowMode::SoftVisibility;
     DebugView debug = DebugView::None;
     float exposure = 1.0f;
-    float verticalExaggeration = 1.0f;
     bool water = true;
     bool specular = true;
     int shadowMapSize = 2048;

@@ -55,6 +55,7 @@ uniform int uShadowMode;      // 0 soft visibility (engine), 1 shadow map, 2 non
 uniform int uSpecular;
 uniform int uDebug;
 uniform vec2 uZRange;
+uniform int uPalette;         // 0 mountains, 1 coast
 uniform mat4 uLightViewProj;
 uniform float uShadowTexel;
 in vec3 vWorld;
@@ -137,8 +138,13 @@ vec3 skyShade(vec2 uv) { return uLighting == 0 ? vec3(0.0) : texture(uShade, uv)
 inline constexpr const char* kTerrainFragment = R"(
 vec3 albedo(float h, vec3 n) {
     float t = clamp((h - uZRange.x) / max(uZRange.y - uZRange.x, 1e-3), 0.0, 1.0);
-    vec3 low = vec3(0.16, 0.24, 0.08), mid = vec3(0.30, 0.27, 0.20), high = vec3(0.80, 0.80, 0.84);
-    vec3 c = t < 0.5 ? mix(low, mid, t * 2.0) : mix(mid, high, (t - 0.5) * 2.0);
+    vec3 c;
+    if (uPalette == 1) {  // coast: sea bed sand, beach, grass above
+        c = h < 0.8 ? vec3(0.55, 0.48, 0.34) : mix(vec3(0.55, 0.48, 0.34), vec3(0.17, 0.25, 0.09), clamp((h - 0.8) / 1.5, 0.0, 1.0));
+    } else {  // mountains: meadows, scree, snow on the top fifth
+        c = t < 0.6 ? mix(vec3(0.13, 0.20, 0.07), vec3(0.27, 0.25, 0.19), t / 0.6)
+                    : mix(vec3(0.27, 0.25, 0.19), vec3(0.75, 0.76, 0.80), smoothstep(0.78, 0.86, t));
+    }
     // steep slopes are bare rock
     return mix(c, vec3(0.30, 0.28, 0.26), clamp((0.78 - n.z) * 4.0, 0.0, 1.0));
 }
@@ -223,6 +229,7 @@ void main() {
         if (uTonemap == 0) { fragColor = vec4(0.0, 0.0, 0.0, 1.0); return; }
         vec4 p = uInvViewProj * vec4(gl_FragCoord.xy / uSize * 2.0 - 1.0, 1.0, 1.0);
         vec3 d = normalize(p.xyz / p.w - uEye);
+        d.z = max(d.z, 0.0);  // below the horizon: the horizon's colour
         float u = atan(d.y, d.x) / (2.0 * PI);
         float v = 0.5 - asin(clamp(d.z, -1.0, 1.0)) / PI;
         c.rgb = texture(uEnv, vec2(u, v)).rgb;

@@ -77,7 +77,8 @@ void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize) {
         ->capture_default_str();
     sub->add_option("--pyramid-level", o.pyramidLevel, "Height-pyramid level for --debug pyramid")->capture_default_str();
     sub->add_option("--exposure", o.exposure, "Exposure before tone mapping")->capture_default_str();
-    sub->add_option("--exaggeration", o.exaggeration, "Vertical exaggeration")->capture_default_str();
+    sub->add_option("--exaggeration", o.exaggeration, "Vertical exaggeration (0 = automatic: relief >= 15% of the extent)")
+        ->capture_default_str();
     sub->add_option("--yaw", o.yaw, "Camera azimuth in degrees")->capture_default_str();
     sub->add_option("--pitch", o.pitch, "Camera elevation in degrees")->capture_default_str();
     sub->add_option("--distance", o.distance, "Camera distance in terrain extents")->capture_default_str();
@@ -94,7 +95,7 @@ void toSettings(const RenderOptions& o, render::PipelineSettings& p, render::Ren
     if (o.subsample != 1 && o.subsample != 2 && o.subsample != 4) throw InputError("--subsample must be 1, 2 or 4");
     if (o.bounces < 0 || o.bounces > 3) throw InputError("--bounces must be 0..3");
     if (!(o.exposure > 0.0f && o.exposure < 1000.0f)) throw InputError("--exposure must be > 0");
-    if (!(o.exaggeration > 0.0f && o.exaggeration <= 100.0f)) throw InputError("--exaggeration must be in (0, 100]");
+    if (!(o.exaggeration >= 0.0f && o.exaggeration <= 100.0f)) throw InputError("--exaggeration must be in [0, 100]");
     if (!(o.distance > 0.05f && o.distance < 100.0f)) throw InputError("--distance must be in (0.05, 100)");
     if (!(o.pitch > -89.0f && o.pitch < 89.5f)) throw InputError("--pitch must be in (-89, 89.5) degrees");
     p.gi = gi::engineGiSettings();
@@ -120,7 +121,7 @@ void toSettings(const RenderOptions& o, render::PipelineSettings& p, render::Ren
     else if (o.debug == "u") throw InputError("--debug u: gi/ computes no indirect radiance U yet (GI part 2)");
     else throw InputError("--debug must be none, ambient, v, key, normals, pyramid or shade (got '" + o.debug + "')");
     r.exposure = o.exposure;
-    r.verticalExaggeration = o.exaggeration;
+    p.verticalExaggeration = o.exaggeration;
     r.camera.yawDeg = o.yaw;
     r.camera.pitchDeg = o.pitch;
     r.camera.distance = o.distance;
@@ -134,18 +135,19 @@ int runHeadlessRender(const RenderOptions& o, const char* label) {
         throw InputError("--video must name an .mp4 file (got '" + o.video + "')");
     // Everything that can fail on bad input fails before any file is written.
     const SceneSettings scene = resolveScene(o.scene, o.size, static_cast<std::uint64_t>(o.seed));
+    std::unique_ptr<render::GlContext> context = render::createHeadlessContext();
     ensureWritableDirectory(o.out);
     return withThreads(o.threads, [&] {
-        std::unique_ptr<render::GlContext> context = render::createHeadlessContext();
         render::Gl gl;
         render::loadGl(gl, context->procAddress());
         render::Renderer renderer(gl);
         render::FramePipeline pipeline(scene, ps);
         const TerrainState& st = pipeline.simulation().state();
         if (!o.quiet) {
-            std::printf("%s: scene %s, %d x %d cells, %d frames of %d ticks, %d x %d pixels, %s\n", label,
-                        scene.name.c_str(), st.nx, st.ny, o.frames, pipeline.ticksPerFrame(), o.width, o.height,
-                        render::glDescription(gl).c_str());
+            std::printf("%s: scene %s, %d x %d cells of %.3g m, ground %.0f..%.0f m, %d frames of %d ticks, %d x %d pixels, %s\n",
+                        label, scene.name.c_str(), st.nx, st.ny, static_cast<double>(st.cellSize),
+                        static_cast<double>(pipeline.frame().zMin), static_cast<double>(pipeline.frame().zMax), o.frames,
+                        pipeline.ticksPerFrame(), o.width, o.height, render::glDescription(gl).c_str());
             if (ps.lighting == render::LightingMode::Global)
                 std::printf("%s: note: gi/ has no indirect bounces yet; global lighting shows direct light only\n", label);
         }

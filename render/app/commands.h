@@ -35,7 +35,7 @@ struct RenderOptions {
     std::string debug = "none";   // none | ambient | v | key | normals | pyramid | shade | u
     int pyramidLevel = 4;
     float exposure = 1.0f;
-    float exaggeration = 1.0f;
+    float exaggeration = 0.0f;    // 0 = automatic
     float yaw = 235.0f, pitch = 34.0f, distance = 1.35f;
     bool quiet = false;
 };

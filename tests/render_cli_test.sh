@@ -1,0 +1,82 @@
+#!/usr/bin/env bash
+# End-to-end checks of `terrain render` and `terrain demo`: frames, determinism,
+# the timing summary, the video message, the no-display fallback, the window
+# under Xvfb (when xvfb-run exists), and one-line errors with nothing written.
+# Usage: render_cli_test.sh path/to/terrain
+set -u
+T=$1
+pass=0
+fail=0
+ok() { pass=$((pass + 1)); }
+bad() { fail=$((fail + 1)); echo "FAIL: $*"; }
+tmp=$(mktemp -d)
+trap 'chmod -R u+w "$tmp" 2>/dev/null; rm -rf "$tmp"' EXIT
+small=(--size 32 --width 160 --height 90 --threads 2)
+
+# frames, timing summary, no temporary files
+if "$T" render --scene erosion "${small[@]}" --frames 3 --out "$tmp/a" >"$tmp/log" 2>&1; then ok; else bad "render: $(cat "$tmp/log")"; fi
+[ "$(ls "$tmp/a"/frame_*.png 2>/dev/null | wc -l)" = 3 ] && ok || bad "render wrote $(ls "$tmp/a" | wc -l) files"
+ls -A "$tmp/a" | grep -v '^frame_000[0-2].png$' | grep -q . && bad "extra files in the output: $(ls -A "$tmp/a")" || ok
+for stage in sim pyramids scan integrate shade render; do
+  grep -q "per-stage time per frame.* $stage [0-9.]*" "$tmp/log" && ok || bad "timing summary lacks $stage: $(cat "$tmp/log")"
+done
+grep -q "frames written to" "$tmp/log" && ok || bad "render does not print the folder"
+
+# determinism: same scene, same bytes (waves with water, any thread count)
+"$T" render --scene waves "${small[@]}" --frames 2 --out "$tmp/w1" --quiet && "$T" render --scene waves --size 32 --width 160 --height 90 --threads 1 --frames 2 --out "$tmp/w2" --quiet \
+  && cmp -s "$tmp/w1/frame_0001.png" "$tmp/w2/frame_0001.png" && ok || bad "waves frames differ between runs"
+
+# every mode renders
+for mode in "--lighting key" "--lighting global --bounces 2" "--shadow map" "--shadow none" "--subsample 1" "--subsample 4" \
+            "--debug ambient" "--debug v" "--debug key" "--debug normals" "--debug pyramid" "--debug shade"; do
+  # shellcheck disable=SC2086
+  "$T" render --scene waves "${small[@]}" --frames 1 --out "$tmp/m" --quiet $mode >"$tmp/o" 2>&1 && [ -s "$tmp/m/frame_0000.png" ] && ok || bad "render $mode: $(cat "$tmp/o")"
+done
+
+# video: an mp4 with ffmpeg, else a clear message and exit 0
+"$T" render --scene erosion "${small[@]}" --frames 2 --out "$tmp/v" --video "$tmp/v.mp4" >"$tmp/o" 2>&1
+rc=$?
+if command -v ffmpeg >/dev/null; then
+  [ $rc = 0 ] && [ -s "$tmp/v.mp4" ] && ok || bad "video with ffmpeg: $(cat "$tmp/o")"
+else
+  [ $rc = 0 ] && grep -q "ffmpeg is not installed" "$tmp/o" && [ ! -e "$tmp/v.mp4" ] && ok || bad "video message: $(cat "$tmp/o")"
+fi
+
+# demo without a display: one line saying so, then the headless render with its path
+env -u DISPLAY -u WAYLAND_DISPLAY "$T" demo --scene waves "${small[@]}" --frames 2 --out "$tmp/d" >"$tmp/o" 2>&1 \
+  && [ "$(grep -c 'no display' "$tmp/o")" = 1 ] && grep -q "frames written to .*/d" "$tmp/o" && [ -s "$tmp/d/frame_0001.png" ] \
+  && ok || bad "demo fallback: $(cat "$tmp/o")"
+
+# the window under Xvfb
+if command -v xvfb-run >/dev/null; then
+  timeout 120 xvfb-run -a "$T" demo --scene erosion --size 32 --frames 3 --width 320 --height 200 >"$tmp/o" 2>&1 \
+    && grep -q "3 frames shown" "$tmp/o" && ok || bad "demo window under Xvfb: $(cat "$tmp/o")"
+else
+  echo "render_cli: xvfb-run not found, window check skipped"
+fi
+
+# one clear error line, non-zero exit, nothing written
+expect_error() {  # description, pattern, output folder, command...
+  local what=$1 pattern=$2 out=$3
+  shift 3
+  "$@" >"$tmp/o" 2>"$tmp/e"
+  local rc=$?
+  if [ $rc -ne 0 ] && [ "$(wc -l <"$tmp/e")" = 1 ] && grep -q -- "$pattern" "$tmp/e" && [ -z "$(ls -A "$out" 2>/dev/null)" ]; then ok
+  else bad "$what: rc=$rc stderr=$(cat "$tmp/e") files=$(ls -A "$out" 2>/dev/null)"; fi
+}
+expect_error "bad scene" "unknown scene" "$tmp/e1" "$T" render --scene volcano "${small[@]}" --frames 1 --out "$tmp/e1"
+expect_error "bad scene (demo)" "unknown scene" "$tmp/e2" "$T" demo --scene volcano "${small[@]}" --frames 1 --out "$tmp/e2"
+expect_error "no OSMesa context" "OSMesa" "$tmp/e3" env MESA_GL_VERSION_OVERRIDE=2.1 "$T" render "${small[@]}" --frames 1 --out "$tmp/e3"
+expect_error "unusable OSMesa driver" "OSMesa" "$tmp/e4" env GALLIUM_DRIVER=bogus "$T" render "${small[@]}" --frames 1 --out "$tmp/e4"
+expect_error "bad mode" "shadow" "$tmp/e5" "$T" render "${small[@]}" --shadow sharp --out "$tmp/e5"
+expect_error "bad subsample" "subsample" "$tmp/e6" "$T" render "${small[@]}" --subsample 3 --out "$tmp/e6"
+expect_error "bad video name" "mp4" "$tmp/e7" "$T" render "${small[@]}" --video "$tmp/v.avi" --out "$tmp/e7"
+mkdir -p "$tmp/ro"
+chmod a-w "$tmp/ro"
+if [ "$(id -u)" != 0 ]; then
+  expect_error "unwritable output" "not writable" "$tmp/ro" "$T" render "${small[@]}" --frames 1 --out "$tmp/ro"
+fi
+expect_error "uncreatable output" "output folder" /proc/terrain-out "$T" render "${small[@]}" --frames 1 --out /proc/terrain-out
+
+echo "render_cli: $pass passed, $fail failed"
+[ $fail -eq 0 ]
