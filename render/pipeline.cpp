@@ -23,9 +23,10 @@ SceneLights defaultLights() {
     // visibility and specular are computed separately).
     gi::SunSkySettings sky;
     sky.sun[0] = sky.sun[1] = sky.sun[2] = 0.0f;
+    const float horizon[3] = {0.62f, 0.76f, 1.0f};
     for (int c = 0; c < 3; ++c) {
         sky.zenith[c] *= 0.45f;
-        sky.horizon[c] *= 0.45f;
+        sky.horizon[c] = 0.45f * horizon[c];
     }
     l.sky = gi::sunSkyLight(sky);
     l.key.azimuthDeg = 300.0f;
@@ -57,6 +58,7 @@ void FramePipeline::terrainReplaced() {
     frame_.ny = s.ny;
     frame_.cellSize = s.cellSize;
     frame_.hasWater = s.hasWater();
+    frame_.coast = sim_.settings().waves;
     float lo = s.ground(0, 0), hi = lo;
     for (int y = 0; y < s.ny; ++y)
         for (int x = 0; x < s.nx; ++x) {

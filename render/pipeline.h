@@ -62,6 +62,7 @@ struct FrameData {
     float zMin = 0.0f, zMax = 1.0f;       // ground range of the first frame (fixed colour ramp)
     bool hasWater = false;
     float exaggeration = 1.0f;            // vertical exaggeration (applied by the renderer to the heights)
+    bool coast = false;                   // colour palette: coast (waves scenes) or mountains
     std::vector<float> heights;           // 2 per texel: ground, water depth
     std::vector<float> shade;             // 4 per texel: sky RGB, key visibility
     std::vector<float> key;               // 4 per texel: key RGB, ambient

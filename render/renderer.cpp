@@ -184,6 +184,7 @@ void Renderer::upload(const FrameData& f) {
     meta_.zMin = f.zMin;
     meta_.zMax = f.zMax;
     meta_.hasWater = f.hasWater;
+    meta_.coast = f.coast;
     meta_.exaggeration = f.exaggeration;
     meta_.lights = f.lights;
     meta_.lighting = f.lighting;
@@ -328,7 +329,7 @@ void Renderer::draw(const RenderSettings& s, int width, int height, GLuint frame
         u.i("uSpecular", s.specular ? 1 : 0);
         u.i("uDebug", static_cast<int>(s.debug));
         u.f2("uZRange", f.zMin, f.zMax);
-        u.i("uPalette", f.hasWater ? 1 : 0);
+        u.i("uPalette", f.coast ? 1 : 0);
         u.m4("uLightViewProj", lightViewProj);
         u.f("uShadowTexel", shadow_.w > 0 ? 1.0f / static_cast<float>(shadow_.w) : 0.0f);
     };
