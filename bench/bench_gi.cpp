@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <fstream>
 #include <functional>
 #include <string>
@@ -129,9 +130,11 @@ Timing timeFrames(const Dem& d, const GiSettings& s, const GiLighting& light, Gi
         key.push_back(st.timings.keyVisibility);
         sh.push_back(st.timings.shading);
     }
-    auto med = [](std::vector<double> v) {
+    // median, or with GI_MIN set the minimum (robust to a busy machine while developing)
+    const bool useMin = std::getenv("GI_MIN") != nullptr;
+    auto med = [useMin](std::vector<double> v) {
         std::sort(v.begin(), v.end());
-        return v[v.size() / 2];
+        return useMin ? v.front() : v[v.size() / 2];
     };
     return {med(tot), med(pyr), med(vis), med(key), med(sh)};
 }
@@ -378,6 +381,114 @@ void timing() {
     writeFile("gi_timing.csv", csv);
 }
 
+// ---------------------------------------------------------------------------
+// stages: per-stage times of the target frames (quick check while optimising)
+// ---------------------------------------------------------------------------
+void stages() {
+    const Dem alps = loadAlps();
+    GiLighting light;
+    light.environment = sunSkyLight();
+    KeyLight key;
+    key.azimuthDeg = 135.0f;
+    key.elevationDeg = 30.0f;
+    key.radiusDeg = 4.0f;
+    light.keys.push_back(key);
+    struct Case { const Dem* dem; int s; const char* which; };
+    const Dem c512 = crop(alps, 512, "c512");
+    for (const Case& c : {Case{&c512, 2, "engine"}, Case{&c512, 2, "paper"}, Case{&alps, 1, "engine"}, Case{&alps, 1, "paper"}}) {
+        GiSettings set = std::string(c.which) == "paper" ? paperSettings() : engineDefaults();
+        set.subsample = c.s;
+        GiState st;
+        Timing t;
+        const int threads = std::getenv("GI_THREADS") ? std::atoi(std::getenv("GI_THREADS")) : 2;
+        timespec c0{}, c1{};
+        withThreads(threads, [&] {
+            t = timeFrames(*c.dem, set, light, st, gRuns);
+            clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
+            runGiFrame(c.dem->heights.cview(), c.dem->cell, light, set, st);
+            clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
+            return 0;
+        });
+        const double cpu = (c1.tv_sec - c0.tv_sec) * 1e3 + (c1.tv_nsec - c0.tv_nsec) * 1e-6;
+        std::printf("%-22s %dx %-6s %dT: %6.1f ms, cpu %6.1f ms (pyramid+grad %.1f, visibility %.1f, key %.1f, shading %.1f)\n",
+                    c.dem->name.c_str(), c.s, c.which, threads, t.median, cpu, t.pyramid, t.visibility, t.key, t.shading);
+        // GI_DUMP=write stores the outputs, GI_DUMP=compare reports the largest change against them
+        if (const char* dump = std::getenv("GI_DUMP")) {
+            const std::string file = "/tmp/gi_stage_" + c.dem->name + "_" + std::to_string(c.s) + c.which + ".bin";
+            std::vector<const Grid*> grids = {&st.shade.ambient, &st.shade.rgb[0], &st.shade.rgb[1], &st.shade.rgb[2]};
+            if (std::string(dump) == "write") {
+                std::ofstream out(file, std::ios::binary);
+                for (const Grid* g : grids) out.write(reinterpret_cast<const char*>(g->data()), static_cast<std::streamsize>(g->size() * 4));
+            } else {
+                std::ifstream in(file, std::ios::binary);
+                double maxd[4] = {}, sumd[4] = {};
+                for (int k = 0; k < 4; ++k) {
+                    std::vector<float> old(grids[static_cast<std::size_t>(k)]->size());
+                    in.read(reinterpret_cast<char*>(old.data()), static_cast<std::streamsize>(old.size() * 4));
+                    for (std::size_t i = 0; i < old.size(); ++i) {
+                        const double d = std::abs(static_cast<double>(grids[static_cast<std::size_t>(k)]->v[i]) - old[i]);
+                        maxd[k] = std::max(maxd[k], d);
+                        sumd[k] += d;
+                    }
+                    sumd[k] /= static_cast<double>(old.size());
+                }
+                std::printf("    vs stored: ambient max %.3g mean %.3g; rgb max %.3g %.3g %.3g\n", maxd[0], sumd[0], maxd[1], maxd[2], maxd[3]);
+            }
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// cpu: CPU time per stage, one thread, minimum over runs (robust on a busy machine)
+// ---------------------------------------------------------------------------
+double threadCpuMs() {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
+}
+
+void cpuStages() {
+    const Dem alps = loadAlps();
+    const Dem c512 = crop(alps, 512, "c512");
+    GiLighting light;
+    light.environment = sunSkyLight();
+    KeyLight key;
+    key.azimuthDeg = 135.0f;
+    key.elevationDeg = 30.0f;
+    key.radiusDeg = 4.0f;
+    light.keys.push_back(key);
+    struct Case { const Dem* dem; int s; const char* which; };
+    for (const Case& c : {Case{&c512, 2, "engine"}, Case{&c512, 2, "paper"}, Case{&alps, 1, "engine"}}) {
+        GiSettings set = std::string(c.which) == "paper" ? paperSettings() : engineDefaults();
+        set.subsample = c.s;
+        withThreads(1, [&] {
+            GiState st;
+            runGiFrame(c.dem->heights.cview(), c.dem->cell, light, set, st);
+            double best[5] = {1e30, 1e30, 1e30, 1e30, 1e30};
+            for (int r = 0; r < gRuns; ++r) {
+                double t0 = threadCpuMs();
+                computeGradient(c.dem->heights.cview(), c.dem->cell, st.gradX, st.gradY);
+                buildHeightPyramid(c.dem->heights.cview(), c.dem->cell, set.subsample, set.pyramid, st.pyramid);
+                double t1 = threadCpuMs();
+                VisibilityTarget env;
+                env.op = &st.envOperator;
+                computeVisibility(st.pyramid, st.gradX.cview(), st.gradY.cview(), set.visibility, env, st.visibilityState, st.envVisibility);
+                double t2 = threadCpuMs();
+                runGiFrame(c.dem->heights.cview(), c.dem->cell, light, set, st);
+                double t3 = threadCpuMs();
+                best[0] = std::min(best[0], t1 - t0);
+                best[1] = std::min(best[1], t2 - t1);
+                best[2] = std::min(best[2], t3 - t2);
+                best[3] = std::min(best[3], st.timings.keyVisibility);
+                best[4] = std::min(best[4], st.timings.shading);
+            }
+            std::printf("%-22s %dx %-6s cpu: grad+pyramid %.1f  env visibility %.1f  frame %.1f  (wall key %.1f shading %.1f)\n",
+                        c.dem->name.c_str(), c.s, c.which, best[0], best[1], best[2], best[3], best[4]);
+            return 0;
+        });
+    }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -396,6 +507,8 @@ int main(int argc, char** argv) {
             else if (m == "convergence") convergence();
             else if (m == "timing") timing();
             else if (m == "explore") explore();
+            else if (m == "stages") stages();
+            else if (m == "cpu") cpuStages();
             else {
                 std::fprintf(stderr, "bench_gi: unknown mode %s\n", m.c_str());
                 return 2;

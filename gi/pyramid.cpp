@@ -90,15 +90,20 @@ void buildHeightPyramid(ConstGridView heights, float cellSize, int subsample, co
         maxLevel = std::max(maxLevel, st.level);
     }
 
-    // ---- raw heights, padded ----------------------------------------------
-    p.raw.resize(nx, ny);
-    parallelForRows(ny, nx, [&](int y0, int y1) {
+    // ---- raw heights, split by column phase --------------------------------
+    const int wp = nx / s + 1;
+    p.rawPhaseWidth = wp;
+    p.rawPhasePlane = static_cast<std::ptrdiff_t>(wp) * (ny + 1);
+    p.rawPhase.resize(static_cast<std::size_t>(s) * static_cast<std::size_t>(p.rawPhasePlane));
+    parallelForRows(ny + 1, nx, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
-            std::copy(heights.row(y), heights.row(y) + nx, p.raw.row(y));
-            p.raw.row(y)[nx] = heights.row(y)[nx - 1];
+            const float* src = heights.row(std::min(y, ny - 1));
+            for (int q = 0; q < s; ++q) {
+                float* d = p.rawPhase.data() + q * p.rawPhasePlane + static_cast<std::ptrdiff_t>(y) * wp;
+                for (int x = 0; x < wp; ++x) d[x] = src[std::min(s * x + q, nx - 1)];
+            }
         }
     });
-    std::copy(p.raw.row(ny - 1), p.raw.row(ny - 1) + p.raw.stride, p.raw.row(ny));
 
     const int nLevels = maxLevel + 1;
     if (nLevels <= 0) {

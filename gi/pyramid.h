@@ -60,7 +60,19 @@ struct HeightPyramid {
     PyramidSettings settings;
     std::vector<PyramidStep> steps;  // n_v steps
 
-    PaddedField raw;                  // full-resolution heights, spacing 1
+    // Full-resolution heights split by column phase (sub-sampling s): plane q
+    // holds columns q, q + s, q + 2 s, ..., so receivers s cells apart read
+    // consecutive floats at any column offset (the scan's raw steps stream
+    // rows with SIMD). Plane width rawPhaseWidth = nx / s + 1 (columns past
+    // the last one replicate it), ny + 1 rows (the last row replicated), so
+    // the bilinear neighbours of any sample inside the domain are in bounds.
+    // Plane 0 row s Y holds the receiver heights of receiver row Y.
+    int rawPhaseWidth = 0;
+    std::ptrdiff_t rawPhasePlane = 0;  // floats per plane: rawPhaseWidth * (ny + 1)
+    std::vector<float> rawPhase;       // s planes
+    const float* rawPhaseRow(int q, int y) const {
+        return rawPhase.data() + q * rawPhasePlane + static_cast<std::ptrdiff_t>(y) * rawPhaseWidth;
+    }
     std::vector<Grid> meanOctaves;    // B_1, B_2, ... (B_0 is the input)
     std::vector<Grid> maxOctaves;     // same, max-decimated (only when peakBlend > 0)
     std::vector<PaddedField> synth;   // S_o at the receiver grid, o = 0..

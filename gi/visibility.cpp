@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <cstdio>
+#include <cstdlib>
 
 #include "gi/nlp.h"
 #include "sim/parallel.h"
@@ -11,135 +14,342 @@ namespace terrain::gi {
 namespace {
 
 constexpr int kMaxBlocks = 64;
+constexpr int kLanes = 16;  // receivers per kernel call at most (4 x 4-wide vectors); rows are padded to it
 
-// ---- algorithm: slopes of one step for a row of receivers -----------------
-// Samples `field` (spacing `g` cells, receivers `k` storage texels apart) at
-// receiver positions + (dx, dy) cells with one set of bilinear weights, and
-// writes the blocking slope (sample - h0) / tau. Receivers whose sample falls
-// outside the domain keep the previous step's slope (the ray has left the
-// height field, nothing more can block).
-void stepSlopes(const float* __restrict field, std::ptrdiff_t fieldStride, int fieldNx, int fieldNy, int k, int Y, double dx,
-                double dy, const float* __restrict h0, float invTau, const float* __restrict prev, float* __restrict out, int nxr) {
-    const double py = static_cast<double>(k) * Y + dy;
-    int xa = nxr, xb = -1;  // valid receivers [xa, xb]
-    double fy = 0.0;
-    int r0 = 0;
-    if (py >= 0.0 && py <= fieldNy - 1) {
-        r0 = static_cast<int>(std::floor(py));
-        fy = py - r0;
-        // k X + dx in [0, fieldNx - 1]
-        xa = std::max(0, static_cast<int>(std::ceil(-dx / k)));
-        xb = std::min(nxr - 1, static_cast<int>(std::floor((fieldNx - 1 - dx) / k)));
-        // guard against rounding at the ends
-        while (xa <= xb && k * xa + dx < 0.0) ++xa;
-        while (xb >= xa && k * xb + dx > fieldNx - 1) --xb;
-    }
-    for (int X = 0; X < std::min(xa, nxr); ++X) out[X] = prev ? prev[X] : kNoBlocker;
-    for (int X = std::max(xb + 1, 0); X < nxr; ++X) out[X] = prev ? prev[X] : kNoBlocker;
-    if (xa > xb) return;
-    const int c0 = static_cast<int>(std::floor(dx));
-    const float fx = static_cast<float>(dx - c0);
-    const float fyf = static_cast<float>(fy);
-    const float w00 = (1.0f - fx) * (1.0f - fyf), w01 = fx * (1.0f - fyf), w10 = (1.0f - fx) * fyf, w11 = fx * fyf;
-    const float* __restrict a = field + r0 * fieldStride + c0;
-    const float* __restrict b = a + fieldStride;  // padded row: in bounds even when fy == 0 at the last row
-    if (k == 1) {
-        for (int X = xa; X <= xb; ++X) {
-            const float v = (w00 * a[X] + w01 * a[X + 1]) + (w10 * b[X] + w11 * b[X + 1]);
-            out[X] = (v - h0[X]) * invTau;
-        }
-    } else {
-        for (int X = xa; X <= xb; ++X) {
-            const std::ptrdiff_t i = static_cast<std::ptrdiff_t>(k) * X;
-            const float v = (w00 * a[i] + w01 * a[i + 1]) + (w10 * b[i] + w11 * b[i + 1]);
-            out[X] = (v - h0[X]) * invTau;
-        }
+// 4-wide float vectors (GCC vector extensions, baseline SSE2). Lane-wise
+// IEEE operations: each lane computes exactly what the scalar code computes.
+typedef float v4 __attribute__((vector_size(16)));
+inline v4 load4(const float* p) {
+    v4 v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+}
+inline void store4(float* p, v4 v) { std::memcpy(p, &v, sizeof v); }
+inline v4 load4a(const float* p) { return *reinterpret_cast<const v4*>(__builtin_assume_aligned(p, 16)); }
+inline v4 splat(float x) { return v4{x, x, x, x}; }
+inline v4 vmax(v4 a, v4 b) { return a < b ? b : a; }  // the scalar rule m = m < s ? s : m
+inline v4 vsqrt(v4 a) { return __builtin_ia32_sqrtps(a); }  // correctly rounded, like std::sqrt
+
+inline int padLanes(int n) { return (n + kLanes - 1) / kLanes * kLanes; }
+
+// ---- algorithm: the step table (Eq. 14, level offset o_v) ---------------------
+// For azimuth (c, sn) and step i: where each receiver samples, with which
+// bilinear weights, and which receivers' samples lie inside the domain.
+// Raw steps (level < 0) sample the full-resolution heights in cells (receiver
+// X at column s X); level steps sample the level blown out to the receiver
+// grid (receiver X at X). Either way all receivers of a row share one
+// fractional offset, so the weights are per step, not per receiver.
+struct StepGeometry {
+    ScanStep step;
+    int xFirst = 0, xLast = -1, yFirst = 0, yLast = -1;  // valid receivers
+};
+
+void validRange(double d, int k, int fieldN, int receivers, int& first, int& last) {
+    // receivers R with k R + d in [0, fieldN - 1]
+    first = std::max(0, static_cast<int>(std::ceil(-d / k)));
+    last = std::min(receivers - 1, static_cast<int>(std::floor((fieldN - 1 - d) / k)));
+    while (first <= last && k * first + d < 0.0) ++first;  // guard against rounding at the ends
+    while (last >= first && k * last + d > fieldN - 1) --last;
+    if (first > last) {
+        first = 0;
+        last = -1;
     }
 }
 
-// ---- algorithm: the maximum blocking slope of each receiver (Eq. 16) --------
-void reduceMaxSlope(const float* slopes, int nSteps, int nxr, BlockingMax rule, float* out) {
-    if (rule == BlockingMax::Samples || nSteps < 2) {
-        for (int X = 0; X < nxr; ++X) out[X] = slopes[X];
-        for (int i = 1; i < nSteps; ++i) {
-            const float* s = slopes + static_cast<std::size_t>(i) * nxr;
-            for (int X = 0; X < nxr; ++X) out[X] = out[X] < s[X] ? s[X] : out[X];
-        }
-        return;
+StepGeometry makeStep(const HeightPyramid& pyr, int i, double c, double sn) {
+    const PyramidStep& ps = pyr.steps[static_cast<std::size_t>(i)];
+    const int s = pyr.subsample;
+    StepGeometry g;
+    ScanStep& st = g.step;
+    double dx = ps.tauCells * c, dy = ps.tauCells * sn;
+    int k, fieldNx, fieldNy;
+    if (ps.level < 0) {
+        k = s;
+        fieldNx = pyr.nx;
+        fieldNy = pyr.ny;
+    } else {
+        k = 1;
+        dx /= s;
+        dy /= s;
+        fieldNx = pyr.nxr;
+        fieldNy = pyr.nyr;
     }
-    // Eq. 16: the maximum of the cubic interpolant through the samples s_i,
-    // evaluated at the knots (the samples themselves) and at the midpoints,
-    // (-s_{i-1} + 9 s_i + 9 s_{i+1} - s_{i+2}) / 16 (ends replicated). The
-    // interpolant can rise between samples, recovering part of a peak that
-    // falls between two exponential steps.
-    for (int X = 0; X < nxr; ++X) out[X] = slopes[X];
-    for (int i = 0; i + 1 < nSteps; ++i) {
-        const float* __restrict sm = slopes + static_cast<std::size_t>(std::max(i - 1, 0)) * nxr;
-        const float* __restrict s0 = slopes + static_cast<std::size_t>(i) * nxr;
-        const float* __restrict s1 = s0 + nxr;
-        const float* __restrict s2 = slopes + static_cast<std::size_t>(std::min(i + 2, nSteps - 1)) * nxr;
-        for (int X = 0; X < nxr; ++X) {
-            const float mid = (9.0f * (s0[X] + s1[X]) - (sm[X] + s2[X])) * (1.0f / 16.0f);
-            float m = out[X];
-            m = m < s1[X] ? s1[X] : m;
-            m = m < mid ? mid : m;
-            out[X] = m;
+    validRange(dx, k, fieldNx, pyr.nxr, g.xFirst, g.xLast);
+    validRange(dy, k, fieldNy, pyr.nyr, g.yFirst, g.yLast);
+    const double c0d = std::floor(dx), r0d = std::floor(dy);
+    const int c0 = static_cast<int>(c0d), r0 = static_cast<int>(r0d);
+    const float fx = static_cast<float>(dx - c0d), fy = static_cast<float>(dy - r0d);
+    const float weights[5] = {(1.0f - fx) * (1.0f - fy), fx * (1.0f - fy), (1.0f - fx) * fy, fx * fy, ps.invTauWorld};
+    for (int q = 0; q < 5; ++q)
+        for (int l = 0; l < 4; ++l) st.w[q][l] = weights[q];
+    if (ps.level < 0) {
+        // column s X + c0 lies in phase plane (c0 mod s) at X + floor(c0 / s)
+        const int qa = ((c0 % s) + s) % s, qb = (((c0 + 1) % s) + s) % s;
+        const int colA = (c0 - qa) / s, colB = (c0 + 1 - qb) / s;
+        const std::ptrdiff_t w = pyr.rawPhaseWidth;
+        st.field = pyr.rawPhase.data();
+        st.rowStep = s * w;
+        st.rowNext = w;
+        st.offA = qa * pyr.rawPhasePlane + r0 * w + colA;
+        st.offB = qb * pyr.rawPhasePlane + r0 * w + colB;
+    } else {
+        const PaddedField& f = pyr.levels[static_cast<std::size_t>(ps.level)];
+        st.field = f.v.data();
+        st.rowStep = f.stride;
+        st.rowNext = f.stride;
+        st.offA = r0 * f.stride + c0;
+        st.offB = st.offA + 1;
+    }
+    return g;
+}
+
+// The blocking slope of one receiver at one step (the scalar form of the
+// kernel's lanes: the same operations in the same order).
+inline float sampleSlope(const ScanStep& st, std::ptrdiff_t index, float h0) {
+    const float* a = st.field + index + st.offA;
+    const float* b = st.field + index + st.offB;
+    const float v = (st.w[0][0] * a[0] + st.w[1][0] * b[0]) + (st.w[2][0] * a[st.rowNext] + st.w[3][0] * b[st.rowNext]);
+    return (v - h0) * st.w[4][0];
+}
+
+// ---- algorithm: per-step visitors over the slope sequence ---------------------
+// A visitor sees the slopes of 4 NV receivers step by step. all(i, s): step i,
+// every lane valid. some(i, s, steps): step i where lane L is valid only if
+// i < steps[L] (its ray has left the domain otherwise; its s is unspecified);
+// the kernel calls some() once more at i = max(steps) with no lane valid, so
+// a visitor can close what is still open.
+
+// Plain maximum over the samples.
+template <int NV>
+struct SampleMaxVisitor {
+    v4 m[NV];
+    SampleMaxVisitor() {
+        for (int k = 0; k < NV; ++k) m[k] = splat(kNoBlocker);
+    }
+    void all(int, const v4* s) {
+        for (int k = 0; k < NV; ++k) m[k] = vmax(m[k], s[k]);
+    }
+    void some(int i, const float* s, const int* steps) {
+        for (int L = 0; L < 4 * NV; ++L)
+            if (i < steps[L]) {
+                const float mL = m[L / 4][L % 4];
+                m[L / 4][L % 4] = mL < s[L] ? s[L] : mL;
+            }
+    }
+    void result(float* out) const {
+        for (int k = 0; k < NV; ++k) store4(out + 4 * k, m[k]);
+    }
+};
+
+// Eq. 16: the maximum of the cubic interpolant through the samples, at the
+// knots (the samples) and the midpoints (-s_{i-1} + 9 s_i + 9 s_{i+1} - s_{i+2}) / 16
+// of consecutive valid samples, ends replicated. The interpolant can rise
+// between samples, recovering part of a peak that falls between two steps.
+// At step i the midpoint between i-2 and i-1 is closed: p3, p2, p1 hold
+// s_{i-3}, s_{i-2}, s_{i-1} (s_{-1} = s_0).
+template <int NV>
+struct BsplineMaxVisitor {
+    v4 m[NV], p1[NV], p2[NV], p3[NV];
+    BsplineMaxVisitor() {
+        for (int k = 0; k < NV; ++k) m[k] = p1[k] = p2[k] = p3[k] = splat(kNoBlocker);
+    }
+    static float mid(float sm, float s0, float s1, float s2) { return (9.0f * (s0 + s1) - (sm + s2)) * (1.0f / 16.0f); }
+    static v4 mid(v4 sm, v4 s0, v4 s1, v4 s2) { return (9.0f * (s0 + s1) - (sm + s2)) * (1.0f / 16.0f); }
+    void all(int i, const v4* s) {
+        for (int k = 0; k < NV; ++k) {
+            if (i == 0) p1[k] = p2[k] = p3[k] = s[k];
+            m[k] = vmax(m[k], s[k]);
+            if (i >= 2) m[k] = vmax(m[k], mid(p3[k], p2[k], p1[k], s[k]));
+            p3[k] = p2[k];
+            p2[k] = p1[k];
+            p1[k] = s[k];
         }
+    }
+    void some(int i, const float* s, const int* steps) {
+        for (int L = 0; L < 4 * NV; ++L) {
+            const int k = L / 4, l = L % 4;
+            const bool valid = i < steps[L];
+            if (!valid && i == 0) continue;  // empty sequence
+            const float v = valid ? s[L] : p1[k][l];  // past the end: replicate the last sample
+            if (i == 0) p1[k][l] = p2[k][l] = p3[k][l] = v;
+            float mL = m[k][l];
+            if (valid) mL = mL < v ? v : mL;
+            if (i >= 2 && i <= steps[L]) {
+                const float md = mid(p3[k][l], p2[k][l], p1[k][l], v);
+                mL = mL < md ? md : mL;
+            }
+            m[k][l] = mL;
+            p3[k][l] = p2[k][l];
+            p2[k][l] = p1[k][l];
+            p1[k][l] = v;
+        }
+    }
+    void result(float* out) const {
+        for (int k = 0; k < NV; ++k) store4(out + 4 * k, m[k]);
+    }
+};
+
+// ---- algorithm: the scan of 4 NV receivers (X0 .. X0 + 4 NV - 1 of row Y) -------
+// steps[L]: valid-prefix length of lane L; all lanes are valid for i < nAll.
+template <int NV, class Visitor>
+inline void scanLanes(const ScanStep* table, int Y, int X0, const float* h0, const int* steps, int nAll, int nAny,
+                      Visitor& visit) {
+    v4 h[NV];
+    for (int k = 0; k < NV; ++k) h[k] = load4(h0 + X0 + 4 * k);
+    for (int i = 0; i < nAll; ++i) {
+        const ScanStep& st = table[i];
+        const std::ptrdiff_t o = Y * st.rowStep + X0;
+        const float* a = st.field + (o + st.offA);
+        const float* b = st.field + (o + st.offB);
+        const std::ptrdiff_t n = st.rowNext;
+        const v4 w00 = load4a(st.w[0]), w01 = load4a(st.w[1]), w10 = load4a(st.w[2]), w11 = load4a(st.w[3]);
+        const v4 inv = load4a(st.w[4]);
+        v4 s[NV];
+        for (int k = 0; k < NV; ++k) {
+            const v4 v = (w00 * load4(a + 4 * k) + w01 * load4(b + 4 * k)) + (w10 * load4(a + n + 4 * k) + w11 * load4(b + n + 4 * k));
+            s[k] = (v - h[k]) * inv;
+        }
+        visit.all(i, s);
+    }
+    for (int i = nAll; i <= nAny; ++i) {
+        float s[4 * NV] = {};
+        if (i < nAny) {
+            const ScanStep& st = table[i];
+            for (int L = 0; L < 4 * NV; ++L)
+                if (i < steps[L]) s[L] = sampleSlope(st, Y * st.rowStep + X0 + L, h0[X0 + L]);
+        }
+        visit.some(i, s, steps);
+    }
+}
+
+// Maximum blocking slope of a row of receivers for one azimuth.
+template <int NV, template <int> class Visitor>
+void scanRow(const ScanStep* table, const int* colSteps, int rowSteps, int Y, const float* h0, int nxrPad, float* out) {
+    constexpr int lanes = 4 * NV;
+    for (int X0 = 0; X0 < nxrPad; X0 += lanes) {
+        int steps[lanes];
+        int nAll = rowSteps, nAny = 0;
+        for (int L = 0; L < lanes; ++L) {
+            steps[L] = std::min(colSteps[X0 + L], rowSteps);
+            nAll = std::min(nAll, steps[L]);
+            nAny = std::max(nAny, steps[L]);
+        }
+        Visitor<NV> visit;
+        scanLanes<NV>(table, Y, X0, h0, steps, nAll, nAny, visit);
+        visit.result(out + X0);
     }
 }
 
 // ---- algorithm: Eq. 11 and the folded wedge operator for one azimuth -------
 // NLP vectors of a row of receivers (4 rows of nxr), then V += G_j w_j over
 // the sparse pattern, each entry a contiguous multiply-add over the row.
-void accumulateVisibility(const float* __restrict maxSlope, const float* __restrict gx, const float* __restrict gy,
-                          float cosPhi, float sinPhi, const VisibilityTarget& target, const float* opValues,
-                          const std::uint8_t* patRow, const std::uint8_t* patNlp, int patSize, float* const* vRows,
-                          float* __restrict nlp, int nxr) {
-    float* __restrict w0 = nlp;
-    float* __restrict w1 = nlp + nxr;
-    float* __restrict w2 = nlp + 2 * nxr;
-    float* __restrict w3 = nlp + 3 * nxr;
-    for (int X = 0; X < nxr; ++X) {
-        // omega_min: elevation of the tangent plane along this azimuth
-        const float tangent = gx[X] * cosPhi + gy[X] * sinPhi;
-        const float t = maxSlope[X] < tangent ? tangent : maxSlope[X];
-        const float s = sinFromSlope(t);
-        float w[kNlpCount];
+// omega_min: elevation of the tangent plane along the azimuth (Section 3).
+void nlpRow(const float* __restrict maxSlope, const float* __restrict gx, const float* __restrict gy, float cosPhi,
+            float sinPhi, const VisibilityTarget& target, float* __restrict nlp, int nxr, int nxrPad) {
+    const v4 c = splat(cosPhi), sn = splat(sinPhi);
+    const v4 one = splat(1.0f), lim = splat(1e6f), nlim = splat(-1e6f);
+    const v4 k0 = splat(0.70710678118654752440f), k1 = splat(0.61237243569579452455f);
+    const v4 k2 = splat(0.79056941504209483300f), k3 = splat(0.23385358667337133659f);
+    const v4 five = splat(5.0f), four = splat(4.0f);
+    const v4 sLow = splat(target.sinLow), sHigh = splat(target.sinHigh);
+    for (int X = 0; X < nxrPad; X += 4) {
+        const v4 tangent = load4(gx + X) * c + load4(gy + X) * sn;
+        const v4 ms = load4(maxSlope + X);
+        v4 t = ms < tangent ? tangent : ms;
+        t = t < nlim ? nlim : (t > lim ? lim : t);  // sinFromSlope
+        const v4 s = t / vsqrt(one + t * t);
+        v4 w0, w1, w2, w3;
         if (target.window) {
-            const float lo = s < target.sinLow ? target.sinLow : s;
-            const float hi = lo < target.sinHigh ? target.sinHigh : lo;
-            nlpVisibleBetween(lo, hi, w);
+            // nlpVisibleBetween(lo, hi): occlusion(hi) - occlusion(lo)
+            const v4 lo = s < sLow ? sLow : s;
+            const v4 hi = lo < sHigh ? sHigh : lo;
+            const v4 cl = one - lo * lo, ch = one - hi * hi;
+            w0 = (hi + one) * k0 - (lo + one) * k0;
+            w1 = (-k1) * ch - (-k1) * cl;
+            w2 = (-k2) * hi * ch - (-k2) * lo * cl;
+            w3 = k3 * ch * (five * ch - four) - k3 * cl * (five * cl - four);
         } else {
-            nlpVisibleAbove(s, w);
+            // nlpVisibleAbove(s)
+            const v4 c2 = one - s * s;
+            w0 = (one - s) * k0;
+            w1 = k1 * c2;
+            w2 = k2 * s * c2;
+            w3 = (-k3) * c2 * (five * c2 - four);
         }
-        w0[X] = w[0];
-        w1[X] = w[1];
-        w2[X] = w[2];
-        w3[X] = w[3];
+        store4(nlp + X, w0);
+        store4(nlp + nxrPad + X, w1);
+        store4(nlp + 2 * nxrPad + X, w2);
+        store4(nlp + 3 * nxrPad + X, w3);
     }
-    for (int e = 0; e < patSize; ++e) {
-        float* __restrict v = vRows[patRow[e]];
-        const float* __restrict w = nlp + static_cast<std::size_t>(patNlp[e]) * nxr;
-        const float g = opValues[e];
-        for (int X = 0; X < nxr; ++X) v[X] += g * w[X];
+    (void)nxr;
+}
+
+void accumulateRow(const float* __restrict nlp, const float* opValues, const std::uint8_t* patRow,
+                   const std::uint8_t* patNlp, int patSize, float* const* vRows, int nxr, int nxrPad) {
+    // entries are sorted by SH row: each row of V is read and written once
+    int e = 0;
+    while (e < patSize) {
+        const int r = patRow[e];
+        int e1 = e;
+        while (e1 < patSize && patRow[e1] == r) ++e1;
+        float* __restrict v = vRows[r];
+        if (e1 - e == 1) {
+            const float g = opValues[e];
+            const float* __restrict w = nlp + static_cast<std::size_t>(patNlp[e]) * nxrPad;
+            for (int X = 0; X < nxr; ++X) v[X] += g * w[X];
+        } else {
+            for (int q = e; q < e1; ++q) {
+                const float g = opValues[q];
+                const float* __restrict w = nlp + static_cast<std::size_t>(patNlp[q]) * nxrPad;
+                for (int X = 0; X < nxr; ++X) v[X] += g * w[X];
+            }
+        }
+        e = e1;
     }
 }
 
 }  // namespace
 
-float maxBlockingSlopeOfSequence(const float* slopes, int count, int stride, BlockingMax rule) {
-    (void)stride;
+float maxBlockingSlopeOfSequence(const float* slopes, int count, BlockingMax rule) {
     float out = kNoBlocker;
-    reduceMaxSlope(slopes, count, 1, rule, &out);
+    if (count <= 0) return out;
+    out = slopes[0];
+    for (int i = 1; i < count; ++i) out = out < slopes[i] ? slopes[i] : out;
+    if (rule == BlockingMax::Samples) return out;
+    for (int i = 0; i + 1 < count; ++i) {
+        const float sm = slopes[std::max(i - 1, 0)], s0 = slopes[i], s1 = slopes[i + 1];
+        const float s2 = slopes[std::min(i + 2, count - 1)];
+        const float mid = (9.0f * (s0 + s1) - (sm + s2)) * (1.0f / 16.0f);
+        out = out < mid ? mid : out;
+    }
     return out;
+}
+
+float scanReceiverScalar(const HeightPyramid& pyr, int X, int Y, double phi, BlockingMax rule) {
+    const double c = std::cos(phi), sn = std::sin(phi);
+    const int s = pyr.subsample;
+    const float h0 = pyr.rawPhaseRow(0, s * Y)[X];
+    std::vector<float> seq;
+    for (int i = 0; i < static_cast<int>(pyr.steps.size()); ++i) {
+        // own bounds test on the sample position
+        const PyramidStep& ps = pyr.steps[static_cast<std::size_t>(i)];
+        const bool raw = ps.level < 0;
+        const double px = raw ? s * X + ps.tauCells * c : X + ps.tauCells * c / s;
+        const double py = raw ? s * Y + ps.tauCells * sn : Y + ps.tauCells * sn / s;
+        const double xmax = raw ? pyr.nx - 1 : pyr.nxr - 1, ymax = raw ? pyr.ny - 1 : pyr.nyr - 1;
+        if (!(px >= 0.0 && px <= xmax && py >= 0.0 && py <= ymax)) break;
+        const StepGeometry g = makeStep(pyr, i, c, sn);
+        seq.push_back(sampleSlope(g.step, Y * g.step.rowStep + X, h0));
+    }
+    return maxBlockingSlopeOfSequence(seq.data(), static_cast<int>(seq.size()), rule);
 }
 
 void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridView gradY,
                        const VisibilitySettings& settings, const VisibilityTarget& target, VisibilityState& state,
                        VisibilityField& out) {
-    (void)settings.interp;
     const FoldedWedgeOperator& op = *target.op;
     const int nxr = pyr.nxr, nyr = pyr.nyr, s = pyr.subsample;
+    const int nxrPad = padLanes(nxr);
     const int m = op.azimuths;
     const int nSteps = static_cast<int>(pyr.steps.size());
     const std::size_t planeSize = static_cast<std::size_t>(nxr) * nyr;
@@ -148,59 +358,106 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
     out.sh.resize(planeSize * kShCount);
     out.maxSlope.resize(planeSize * m);
 
+    // ---- per frame: the step table and the valid-prefix lengths ----------------
+    const std::size_t tableSize = static_cast<std::size_t>(m) * nSteps;
+    state.steps.resize(tableSize);
+    state.validColumns.resize(2 * tableSize);
+    state.validRows.resize(2 * tableSize);
+    state.stepsPerColumn.resize(static_cast<std::size_t>(m) * nxrPad);
+    state.stepsPerRow.resize(static_cast<std::size_t>(m) * nyr);
+    parallelFor(0, m, 1, [&](int j0, int j1) {
+        for (int j = j0; j < j1; ++j) {
+            const double c = std::cos(op.phi[static_cast<std::size_t>(j)]);
+            const double sn = std::sin(op.phi[static_cast<std::size_t>(j)]);
+            const std::size_t base = static_cast<std::size_t>(j) * nSteps;
+            int* vc = state.validColumns.data() + 2 * base;
+            int* vr = state.validRows.data() + 2 * base;
+            for (int i = 0; i < nSteps; ++i) {
+                const StepGeometry g = makeStep(pyr, i, c, sn);
+                state.steps[base + static_cast<std::size_t>(i)] = g.step;
+                vc[2 * i] = g.xFirst;
+                vc[2 * i + 1] = g.xLast;
+                vr[2 * i] = g.yFirst;
+                vr[2 * i + 1] = g.yLast;
+            }
+            // a receiver's sequence is the prefix of steps before its first invalid one
+            int* colSteps = state.stepsPerColumn.data() + static_cast<std::size_t>(j) * nxrPad;
+            for (int X = 0; X < nxrPad; ++X) {
+                int n = 0;
+                if (X < nxr)
+                    while (n < nSteps && vc[2 * n] <= X && X <= vc[2 * n + 1]) ++n;
+                colSteps[X] = n;
+            }
+            int* rowSteps = state.stepsPerRow.data() + static_cast<std::size_t>(j) * nyr;
+            for (int Y = 0; Y < nyr; ++Y) {
+                int n = 0;
+                while (n < nSteps && vr[2 * n] <= Y && Y <= vr[2 * n + 1]) ++n;
+                rowSteps[Y] = n;
+            }
+        }
+    });
+
+    if (std::getenv("GI_COUNT")) {
+        long long total = 0;
+        for (int j = 0; j < m; ++j)
+            for (int Y = 0; Y < nyr; ++Y)
+                for (int X = 0; X < nxr; ++X)
+                    total += std::min(state.stepsPerColumn[static_cast<std::size_t>(j) * nxrPad + X], state.stepsPerRow[static_cast<std::size_t>(j) * nyr + Y]);
+        std::fprintf(stderr, "samples %lld (%.1f per receiver-azimuth, %d steps)\n", total, double(total) / (double(m) * nxr * nyr), nSteps);
+    }
     const int nBlocks = std::max(1, std::min(nyr, kMaxBlocks));
+    const int maxRows = (nyr + nBlocks - 1) / nBlocks;
     state.blocks.resize(static_cast<std::size_t>(nBlocks));
     for (VisibilityScratch& b : state.blocks) {
-        b.slopes.resize(static_cast<std::size_t>(nSteps) * nxr);
-        b.gradX.resize(static_cast<std::size_t>(nxr));
-        b.gradY.resize(static_cast<std::size_t>(nxr));
-        b.h0.resize(static_cast<std::size_t>(nxr));
-        b.nlp.resize(static_cast<std::size_t>(4) * nxr);
+        b.maxRow.resize(static_cast<std::size_t>(nxrPad));
+        b.gradX.resize(static_cast<std::size_t>(maxRows) * nxrPad);
+        b.gradY.resize(static_cast<std::size_t>(maxRows) * nxrPad);
+        b.h0.resize(static_cast<std::size_t>(maxRows) * nxrPad);
+        b.nlp.resize(static_cast<std::size_t>(4) * nxrPad);
     }
-    // ---- schedule: fixed row blocks in parallel, rows serially within a block
+    // ---- schedule: fixed row blocks in parallel; within a block azimuth by
+    // azimuth, rows in order, so consecutive rows reuse the same field rows
+    // from cache (a block's rows of one azimuth touch one band per step).
     parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
         for (int block = b0; block < b1; ++block) {
             VisibilityScratch& sc = state.blocks[static_cast<std::size_t>(block)];
             const int yBegin = static_cast<int>(static_cast<long long>(nyr) * block / nBlocks);
             const int yEnd = static_cast<int>(static_cast<long long>(nyr) * (block + 1) / nBlocks);
             for (int Y = yBegin; Y < yEnd; ++Y) {
-                // receiver heights and height gradients of this row
-                const float* rawRow = pyr.raw.row(s * Y);
-                for (int X = 0; X < nxr; ++X) {
-                    sc.h0[static_cast<std::size_t>(X)] = rawRow[static_cast<std::size_t>(s) * X];
-                    sc.gradX[static_cast<std::size_t>(X)] = gradX(s * X, s * Y);
-                    sc.gradY[static_cast<std::size_t>(X)] = gradY(s * X, s * Y);
+                // receiver heights and height gradients of the block's rows (padding lanes: 0)
+                const float* hRow = pyr.rawPhaseRow(0, s * Y);
+                const std::size_t r = static_cast<std::size_t>(Y - yBegin) * nxrPad;
+                for (int X = 0; X < nxrPad; ++X) {
+                    const bool in = X < nxr;
+                    sc.h0[r + static_cast<std::size_t>(X)] = in ? hRow[X] : 0.0f;
+                    sc.gradX[r + static_cast<std::size_t>(X)] = in ? gradX(s * X, s * Y) : 0.0f;
+                    sc.gradY[r + static_cast<std::size_t>(X)] = in ? gradY(s * X, s * Y) : 0.0f;
                 }
-                float* vRows[kShCount];
                 for (int i = 0; i < kShCount; ++i) {
-                    vRows[i] = out.plane(i) + static_cast<std::size_t>(Y) * nxr;
-                    std::fill(vRows[i], vRows[i] + nxr, 0.0f);
+                    float* v = out.plane(i) + static_cast<std::size_t>(Y) * nxr;
+                    std::fill(v, v + nxr, 0.0f);
                 }
-                for (int j = 0; j < m; ++j) {
-                    const double c = std::cos(op.phi[static_cast<std::size_t>(j)]);
-                    const double sn = std::sin(op.phi[static_cast<std::size_t>(j)]);
-                    for (int i = 0; i < nSteps; ++i) {
-                        const PyramidStep& st = pyr.steps[static_cast<std::size_t>(i)];
-                        const double dxCells = st.tauCells * c, dyCells = st.tauCells * sn;
-                        float* outRow = sc.slopes.data() + static_cast<std::size_t>(i) * nxr;
-                        const float* prevRow = i > 0 ? outRow - nxr : nullptr;
-                        if (st.level < 0) {
-                            // unfiltered heights: spacing 1, receivers s texels apart
-                            stepSlopes(pyr.raw.v.data(), pyr.raw.stride, pyr.nx, pyr.ny, s, Y, dxCells, dyCells,
-                                       sc.h0.data(), st.invTauWorld, prevRow, outRow, nxr);
-                        } else {
-                            // level blown out to the receiver grid: spacing s
-                            const PaddedField& f = pyr.levels[static_cast<std::size_t>(st.level)];
-                            stepSlopes(f.v.data(), f.stride, f.nx, f.ny, 1, Y, dxCells / s, dyCells / s, sc.h0.data(),
-                                       st.invTauWorld, prevRow, outRow, nxr);
-                        }
-                    }
-                    float* maxRow = out.maxSlope.data() + planeSize * j + static_cast<std::size_t>(Y) * nxr;
-                    reduceMaxSlope(sc.slopes.data(), nSteps, nxr, settings.blockingMax, maxRow);
-                    accumulateVisibility(maxRow, sc.gradX.data(), sc.gradY.data(), static_cast<float>(c),
-                                         static_cast<float>(sn), target,
-                                         op.values.data() + static_cast<std::size_t>(j) * op.patternSize(),
-                                         op.patternRow.data(), op.patternNlp.data(), op.patternSize(), vRows, sc.nlp.data(), nxr);
+            }
+            for (int j = 0; j < m; ++j) {
+                const ScanStep* table = state.steps.data() + static_cast<std::size_t>(j) * nSteps;
+                const int* colSteps = state.stepsPerColumn.data() + static_cast<std::size_t>(j) * nxrPad;
+                const double phi = op.phi[static_cast<std::size_t>(j)];
+                const float cosPhi = static_cast<float>(std::cos(phi)), sinPhi = static_cast<float>(std::sin(phi));
+                for (int Y = yBegin; Y < yEnd; ++Y) {
+                    const std::size_t r = static_cast<std::size_t>(Y - yBegin) * nxrPad;
+                    const int rowSteps = state.stepsPerRow[static_cast<std::size_t>(j) * nyr + static_cast<std::size_t>(Y)];
+                    if (settings.blockingMax == BlockingMax::Samples)
+                        scanRow<4, SampleMaxVisitor>(table, colSteps, rowSteps, Y, sc.h0.data() + r, nxrPad, sc.maxRow.data());
+                    else
+                        scanRow<2, BsplineMaxVisitor>(table, colSteps, rowSteps, Y, sc.h0.data() + r, nxrPad, sc.maxRow.data());
+                    float* maxOut = out.maxSlope.data() + planeSize * j + static_cast<std::size_t>(Y) * nxr;
+                    std::copy(sc.maxRow.data(), sc.maxRow.data() + nxr, maxOut);
+                    nlpRow(sc.maxRow.data(), sc.gradX.data() + r, sc.gradY.data() + r, cosPhi, sinPhi, target, sc.nlp.data(),
+                           nxr, nxrPad);
+                    float* vRows[kShCount];
+                    for (int i = 0; i < kShCount; ++i) vRows[i] = out.plane(i) + static_cast<std::size_t>(Y) * nxr;
+                    accumulateRow(sc.nlp.data(), op.values.data() + static_cast<std::size_t>(j) * op.patternSize(),
+                                  op.patternRow.data(), op.patternNlp.data(), op.patternSize(), vRows, nxr, nxrPad);
                 }
             }
         }

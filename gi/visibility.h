@@ -16,16 +16,30 @@
 // folded wedge operator turns the m vectors into the SH visibility V (Eqs.
 // 20-21). Directions below z = 0 are kept: on slopes omega_min < 0.
 //
-// Design for part 2 (indirect light): the scan keeps, per receiver row and
-// azimuth, the whole slope sequence over the steps (VisibilityScratch::slopes)
-// before reducing it. The casting set of Eq. 17 is the set of steps whose slope
-// exceeds every earlier one; an indirect pass can walk that same sequence and
-// accumulate Eq. 12 over it (reading a radiance pyramid at the same step
-// positions) without a second scan. maxSlope (per azimuth, per receiver) is
-// kept for the same reason.
+// Design for part 2 (indirect light): the scan is one row kernel templated
+// on a per-step visitor (gi/visibility.cpp, scanLanes): for 8 receivers at a
+// time it walks the steps of one azimuth and hands the visitor the slope
+// sequence, step by step, with the steps each receiver's ray still has inside
+// the domain. The maximum rules (samples, Eq. 16) are two such visitors; the
+// casting set of Eq. 17 (the steps whose slope beats every earlier one) and
+// the Eq. 12 accumulation over it are a third that can read a radiance
+// pyramid at the same step positions without a second scan. maxSlope (per
+// azimuth, per receiver) is kept for the same reason.
 //
-// Schedule: receiver rows are split into a fixed number of blocks; each block
-// owns a scratch buffer and runs its rows serially; blocks run in parallel.
+// Sequence semantics: a receiver's sequence is its valid prefix, the steps
+// whose sample lies inside the domain (the ray leaves a convex domain once
+// and for all; past that nothing can block). The B-spline maximum (Eq. 16)
+// uses the knots and the midpoints between consecutive valid samples, with
+// the end sample replicated as its outer neighbour.
+//
+// Schedule: per frame a table of steps (integer offsets into the phase-split
+// raw heights or the level, bilinear weights, 1 / tau) is built once per
+// (azimuth, step), with the number of valid steps per receiver column and
+// row. Receiver rows are split into a fixed number of blocks; each block owns
+// a scratch buffer and runs its rows serially; blocks run in parallel. Within
+// a row, for each azimuth, 16 receivers at a time run all their steps with 4-wide
+// SIMD (each receiver's arithmetic is exactly the scalar one), then the NLP
+// vectors and the folded wedge operator update the 16 SH planes of the row.
 // Every receiver is written by exactly one block (gather only), so the result
 // is bit-identical for any thread count.
 #include <vector>
@@ -47,13 +61,27 @@ struct VisibilitySettings {
     BlockingMax blockingMax = BlockingMax::BsplineKnotsAndMidpoints;
 };
 
-/// Per-block scratch of the scan (one per fixed row block).
+/// Per-block scratch of the scan (one per fixed row block), rows padded to a
+/// multiple of the kernel's 16 receivers.
 struct VisibilityScratch {
-    std::vector<float> slopes;  // steps x nxr: slope sequence of the current row and azimuth
+    std::vector<float> maxRow;  // nxr: maximum blocking slope of the current row and azimuth
     std::vector<float> gradX;   // nxr: dh/dx at the receivers of the current row
     std::vector<float> gradY;
     std::vector<float> h0;      // nxr: receiver heights of the current row
     std::vector<float> nlp;     // 4 x nxr: NLP visibility vectors of the current row and azimuth
+};
+
+/// One step of one azimuth, as the scan kernel reads it: the sample of
+/// receiver (X, Y) is the bilinear blend of field[Y rowStep + offA + X],
+/// field[... + offB + X] (the next column) and the same two one field row
+/// further (+ rowNext). offA/offB are element offsets from `field`; the raw
+/// steps address the phase-split planes, the level steps the level.
+struct ScanStep {
+    // w00, w01, w10, w11 ((row, column) bilinear weights) and 1 / (tau * cellSize),
+    // each repeated 4 times so the kernel reads them as aligned vectors
+    alignas(16) float w[5][4] = {};
+    const float* field = nullptr;
+    std::ptrdiff_t rowStep = 0, rowNext = 0, offA = 0, offB = 0;
 };
 
 /// Azimuth set and elevation window of one visibility computation.
@@ -75,6 +103,11 @@ struct VisibilityField {
 /// Reusable buffers of the visibility stage.
 struct VisibilityState {
     std::vector<VisibilityScratch> blocks;
+    std::vector<ScanStep> steps;    // azimuths x steps
+    std::vector<int> validColumns;  // azimuths x steps: receivers X in [first, last] sample inside (x)
+    std::vector<int> validRows;     // azimuths x steps: same for receiver rows Y (pairs)
+    std::vector<int> stepsPerColumn;  // azimuths x padded nxr: valid-prefix length from x alone
+    std::vector<int> stepsPerRow;     // azimuths x nyr: valid-prefix length from y alone
 };
 
 /// Lowest slope used for "nothing blocks in this direction".
@@ -86,8 +119,13 @@ void computeVisibility(const HeightPyramid& pyramid, ConstGridView gradX, ConstG
                        const VisibilitySettings& settings, const VisibilityTarget& target, VisibilityState& state,
                        VisibilityField& out);
 
-/// The m azimuths' maximum blocking slopes of one receiver, computed by the
-/// same row kernel (for tests and the casting-set work of part 2).
-float maxBlockingSlopeOfSequence(const float* slopes, int count, int stride, BlockingMax rule);
+/// Eq. 16 over one receiver's valid slope sequence (scalar twin of the scan's
+/// visitors, for tests and for part 2's casting-set work).
+float maxBlockingSlopeOfSequence(const float* slopes, int count, BlockingMax rule);
+
+/// Scalar twin of the scan for one receiver and azimuth phi: walks the same
+/// steps (same weights and arithmetic) with its own bounds test and returns
+/// the maximum blocking slope, bit-identical to VisibilityField::maxSlope.
+float scanReceiverScalar(const HeightPyramid& pyramid, int X, int Y, double phi, BlockingMax rule);
 
 }  // namespace terrain::gi

@@ -242,7 +242,7 @@ TEST_CASE("gi.visibility: a second frame on a changed field reuses every buffer"
     const float* p0 = st.envVisibility.sh.data();
     const float* p1 = st.shade.ambient.data();
     const float* p2 = st.pyramid.levels.back().v.data();
-    const float* p3 = st.visibilityState.blocks[0].slopes.data();
+    const float* p3 = st.visibilityState.blocks[0].maxRow.data();
     const float* p4 = st.shade.incident.data();
     const float* p5 = st.keyVisibility[0].sh.data();
     const std::uint64_t before = hashState(st);
@@ -251,7 +251,7 @@ TEST_CASE("gi.visibility: a second frame on a changed field reuses every buffer"
     CHECK(st.envVisibility.sh.data() == p0);
     CHECK(st.shade.ambient.data() == p1);
     CHECK(st.pyramid.levels.back().v.data() == p2);
-    CHECK(st.visibilityState.blocks[0].slopes.data() == p3);
+    CHECK(st.visibilityState.blocks[0].maxRow.data() == p3);
     CHECK(st.shade.incident.data() == p4);
     CHECK(st.keyVisibility[0].sh.data() == p5);
     CHECK(hashState(st) != before);
