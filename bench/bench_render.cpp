@@ -28,25 +28,14 @@
 #include "sim/scene.h"
 
 using namespace terrain;
+using terrain::bench::median;
 using namespace terrain::render;
 
 namespace {
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
-std::string cpuName() {
-    std::ifstream f("/proc/cpuinfo");
-    std::string line;
-    while (std::getline(f, line))
-        if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-    return "unknown CPU";
-}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -75,8 +64,7 @@ int main(int argc, char** argv) {
            << "Animated scenes, GI sub-sampling 2x, direct lighting (sky + key light with soft visibility; gi/ has no "
               "indirect bounces yet, so \"one bounce\" is not measurable), headless OSMesa at "
            << width << " x " << height << ", median of " << runs << " frames after one warm-up frame.\n\n"
-           << "Machine: " << cpuName() << ", " << std::thread::hardware_concurrency() << " hardware threads, "
-           << glDescription(gl) << " (software rasteriser: no GPU).\n\n"
+           << "Machine: " << terrain::bench::machineDescription() << ", " << glDescription(gl) << " (software rasteriser: no GPU).\n\n"
            << "| scene | size | ticks/frame | sim | pyramids | scan | integrate | shade | render | total ms | fps |\n"
            << "|---|---|---|---|---|---|---|---|---|---|---|\n";
         std::vector<std::uint8_t> rgb;

@@ -17,27 +17,17 @@
 #include <thread>
 #include <vector>
 
+#include "bench/bench_common.h"
 #include "sim/parallel.h"
 #include "sim/scene.h"
 
 using namespace terrain;
+using terrain::bench::median;
 
 namespace {
 double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
-std::string cpuName() {
-    std::ifstream f("/proc/cpuinfo");
-    std::string line;
-    while (std::getline(f, line))
-        if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-    return "unknown CPU";
-}
 
 struct Row {
     std::string scene;
@@ -94,12 +84,9 @@ int main(int argc, char** argv) {
                 rows.push_back(r);
             }
 
-    utsname u{};
-    uname(&u);
     std::ostringstream md, csv;
     md << "# Simulation benchmark\n\n"
-       << "Machine: " << cpuName() << ", " << std::thread::hardware_concurrency() << " hardware threads, " << u.sysname
-       << " " << u.release << ". Release build (-O3, baseline x86-64, no fast-math).\n\n"
+       << "Machine: " << terrain::bench::machineDescription() << ". Release build (-O3, baseline x86-64, no fast-math).\n\n"
        << "Command: `build/bench_sim --runs " << runs << " --ticks " << ticks << "`. Each figure is the median of "
        << runs << " runs of " << ticks << " ticks, after 10 warm-up ticks. *kernels*: the scene's simulation steps "
        << "alone (erosion: hydraulic + thermal; waves: shallow water); *tick*: `Simulation::tick` "
