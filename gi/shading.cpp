@@ -2,12 +2,27 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "sim/parallel.h"
 
 namespace terrain::gi {
 
 namespace {
+
+// 4-wide float vectors (GCC vector extensions, baseline SSE2; lane-wise IEEE
+// operations, so each texel gets exactly the scalar result).
+typedef float v4 __attribute__((vector_size(16)));
+typedef int v4i __attribute__((vector_size(16)));
+inline v4 load4(const float* p) {
+    v4 v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+}
+inline void store4(float* p, v4 v) { std::memcpy(p, &v, sizeof v); }
+inline v4 splat(float x) { return v4{x, x, x, x}; }
+
+constexpr int kMaxShadingLights = 8;  // lights per incident pass (more are folded in several passes)
 
 // SH basis in float at a unit direction (bands 0..3; only `count` filled).
 inline void shBasisFloat(float x, float y, float z, float* o, int count) {
@@ -30,6 +45,97 @@ inline void shBasisFloat(float x, float y, float z, float* o, int count) {
     o[15] = 0.59004358992664352f * x * (x * x - 3.0f * y * y);
 }
 
+// ---- algorithm: horizontal SH interpolation (Fig. 7), 4 texels x .. x+3 ------
+// Texel x = s X + k reads v[X] + (k / s) (v[X + 1] - v[X]), as the scalar code.
+template <int S>
+inline v4 expand4(const float* v, int x) {
+    if constexpr (S == 1) {
+        return load4(v + x);
+    } else if constexpr (S == 2) {
+        const v4 a = load4(v + x / 2);
+        const v4 lo = __builtin_shuffle(a, v4i{0, 0, 1, 1});
+        const v4 hi = __builtin_shuffle(a, v4i{1, 1, 2, 2});
+        return lo + v4{0.0f, 0.5f, 0.0f, 0.5f} * (hi - lo);
+    } else {
+        const v4 lo = splat(v[x / 4]), hi = splat(v[x / 4 + 1]);
+        return lo + v4{0.0f, 0.25f, 0.5f, 0.75f} * (hi - lo);
+    }
+}
+
+// ---- algorithm: Lambert shading of one full-resolution row -------------------
+// vert: the row's SH planes interpolated vertically at the receivers (planes
+// 0 .. 3 nCoef - 1: incident radiance per channel; then 9 planes of V_env).
+// Each texel: lam(N) . I_c for the channels, lam(N) . V_env for the ambient
+// map, with lam the clamped-cosine zonal vector turned to the texel's normal.
+template <int S>
+void lambertRowS(const float* vert, int nxrS, int nxr, int nCoef, const float* gxr, const float* gyr, const int* colIndex,
+                 const float* colFrac, float lam0, float lam1, float lam2, float diffuseWeight, const AlbedoMap* albedo, int y,
+                 int nx, ShadeMaps& out) {
+    float* amb = out.ambient.data() + static_cast<std::size_t>(y) * nx;
+    float* rgb[3];
+    const float* alb[3];
+    for (int ch = 0; ch < 3; ++ch) {
+        rgb[ch] = out.rgb[static_cast<std::size_t>(ch)].data() + static_cast<std::size_t>(y) * nx;
+        const Grid* a = albedo && !albedo->channel[static_cast<std::size_t>(ch)].empty() ? &albedo->channel[static_cast<std::size_t>(ch)] : nullptr;
+        alb[ch] = a ? a->data() + static_cast<std::size_t>(y) * nx : nullptr;
+    }
+    const float c0 = lam0 * 0.28209479177387814f, c1 = lam1 * 0.48860251190291992f;
+    const float c4 = lam2 * 1.0925484305920792f, c6 = lam2 * 0.31539156525252005f, c8 = lam2 * 0.54627421529603959f;
+    // texels [0, xVec) take the vector path: all of x .. x+3 below s (nxr - 1)
+    const int interior = S * std::max(nxr - 1, 0);
+    const int xVec = nxr >= 3 ? (interior - (S == 2 ? 2 : 0)) / 4 * 4 : 0;
+    const v4 fmax = splat(3.40282347e38f);
+    for (int x = 0; x < xVec; x += 4) {
+        const v4 gx = load4(gxr + x), gy = load4(gyr + x);
+        const v4 inv = splat(1.0f) / __builtin_ia32_sqrtps(splat(1.0f) + gx * gx + gy * gy);
+        const v4 X = -gx * inv, Yn = -gy * inv, Z = inv;
+        const v4 lam[9] = {splat(c0), splat(c1) * Yn, splat(c1) * Z, splat(c1) * X, splat(c4) * X * Yn, splat(c4) * Yn * Z,
+                           splat(c6) * (3.0f * Z * Z - 1.0f), splat(c4) * X * Z, splat(c8) * (X * X - Yn * Yn)};
+        v4 acc = splat(0.0f);
+        for (int i = 0; i < 9; ++i) acc += lam[i] * expand4<S>(vert + static_cast<std::size_t>(3 * nCoef + i) * nxrS, x);
+        store4(amb + x, acc);
+        for (int ch = 0; ch < 3; ++ch) {
+            v4 o = splat(0.0f);
+            for (int i = 0; i < 9; ++i) o += lam[i] * expand4<S>(vert + static_cast<std::size_t>(ch * nCoef + i) * nxrS, x);
+            o *= diffuseWeight * (alb[ch] ? load4(alb[ch] + x) : splat(1.0f));
+            const v4i finite = (o < fmax) & (o > -fmax);  // false for NaN and +-Inf
+            store4(rgb[ch] + x, finite ? o : splat(0.0f));
+        }
+    }
+    // remaining texels, scalar (same operations)
+    for (int x = xVec; x < nx; ++x) {
+        const int X0 = colIndex[x];
+        const int X1 = std::min(X0 + 1, nxr - 1);
+        const float f = colFrac[x];
+        const float gx = gxr[x], gy = gyr[x];
+        const float inv = 1.0f / std::sqrt(1.0f + gx * gx + gy * gy);
+        const float X = -gx * inv, Yn = -gy * inv, Z = inv;
+        const float lam[9] = {c0, c1 * Yn, c1 * Z, c1 * X, c4 * X * Yn, c4 * Yn * Z, c6 * (3.0f * Z * Z - 1.0f), c4 * X * Z,
+                              c8 * (X * X - Yn * Yn)};
+        auto u = [&](int plane) {
+            const float* v = vert + static_cast<std::size_t>(plane) * nxrS;
+            return S == 1 ? v[x] : v[X0] + f * (v[X1] - v[X0]);
+        };
+        float acc = 0.0f;
+        for (int i = 0; i < 9; ++i) acc += lam[i] * u(3 * nCoef + i);
+        amb[x] = acc;
+        for (int ch = 0; ch < 3; ++ch) {
+            float o = 0.0f;
+            for (int i = 0; i < 9; ++i) o += lam[i] * u(ch * nCoef + i);
+            o *= diffuseWeight * (alb[ch] ? alb[ch][x] : 1.0f);
+            rgb[ch][x] = std::isfinite(o) ? o : 0.0f;
+        }
+    }
+}
+
+void lambertRow(const float* vert, int nxrS, int nxr, int s, int nCoef, const float* gxr, const float* gyr, const int* colIndex,
+                const float* colFrac, float lam0, float lam1, float lam2, float diffuseWeight, const AlbedoMap* albedo, int y,
+                int nx, ShadeMaps& out) {
+    if (s == 1) lambertRowS<1>(vert, nxrS, nxr, nCoef, gxr, gyr, colIndex, colFrac, lam0, lam1, lam2, diffuseWeight, albedo, y, nx, out);
+    else if (s == 2) lambertRowS<2>(vert, nxrS, nxr, nCoef, gxr, gyr, colIndex, colFrac, lam0, lam1, lam2, diffuseWeight, albedo, y, nx, out);
+    else lambertRowS<4>(vert, nxrS, nxr, nCoef, gxr, gyr, colIndex, colFrac, lam0, lam1, lam2, diffuseWeight, albedo, y, nx, out);
+}
+
 }  // namespace
 
 void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const VisibilityField& env,
@@ -48,7 +154,8 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
     out.incident.resize(planeR * 3 * nCoef);
     const int nPlanes = 3 * nCoef + 9;  // incident radiance + V_env bands 0..2 (ambient)
     const int nBlocks = std::max(1, std::min(ny, 64));
-    out.rowScratch.resize(static_cast<std::size_t>(nBlocks) * nPlanes * (nxr + nx));
+    const int nxrS = nxr + 4;  // vertical scratch rows padded for 4-wide reads
+    out.rowScratch.resize(static_cast<std::size_t>(nBlocks) * nPlanes * (nxrS + nx));
     out.basisScratch.resize(static_cast<std::size_t>(nBlocks) * 24 * nx);
 
     out.colIndex.resize(static_cast<std::size_t>(nx));
@@ -64,22 +171,58 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
                     static_cast<float>(lights[L].product[static_cast<std::size_t>(ch)][static_cast<std::size_t>(e)]);
 
     // ---- algorithm, receivers: incident radiance I_c = sum_L T_{L,c} V_L ------
-    // (vectorised along receiver rows; zero matrix entries skipped)
+    // 4 receivers at a time: the lights' V vectors are read once, each output
+    // coefficient sums its non-zero matrix entries in a fixed order (light, k).
+    out.incidentTerms.clear();
+    out.incidentTermStart.assign(static_cast<std::size_t>(3 * nCoef + 1), 0);
+    for (int ch = 0; ch < 3; ++ch)
+        for (int i = 0; i < nCoef; ++i) {
+            for (int L = 0; L < nl; ++L)
+                for (int k = 0; k < kShCount; ++k) {
+                    const float t = out.lightMatrices[((static_cast<std::size_t>(L) * 3 + ch) * kShCount + i) * kShCount + k];
+                    if (t != 0.0f) {
+                        ShadeMaps::Term term;
+                        term.value = v4{t, t, t, t};
+                        term.index = L * kShCount + k;
+                        out.incidentTerms.push_back(term);
+                    }
+                }
+            out.incidentTermStart[static_cast<std::size_t>(ch * nCoef + i + 1)] = static_cast<int>(out.incidentTerms.size());
+        }
     parallelForRows(nyr, nxr * 16, [&](int y0, int y1) {
         for (int Y = y0; Y < y1; ++Y) {
             const std::size_t r0 = static_cast<std::size_t>(Y) * nxr;
-            for (int ch = 0; ch < 3; ++ch)
-                for (int i = 0; i < nCoef; ++i) {
-                    float* __restrict o = out.incident.data() + (static_cast<std::size_t>(ch) * nCoef + i) * planeR + r0;
-                    std::fill(o, o + nxr, 0.0f);
-                    for (int L = 0; L < nl; ++L)
+            for (int X = 0; X < nxr; X += 4) {
+                const int n = std::min(4, nxr - X);
+                for (int g0 = 0; g0 < nl; g0 += kMaxShadingLights) {
+                    const int g1 = std::min(nl, g0 + kMaxShadingLights);
+                    v4 v[kMaxShadingLights * kShCount];
+                    for (int L = g0; L < g1; ++L)
                         for (int k = 0; k < kShCount; ++k) {
-                            const float t = out.lightMatrices[((static_cast<std::size_t>(L) * 3 + ch) * kShCount + i) * kShCount + k];
-                            if (t == 0.0f) continue;
-                            const float* __restrict v = lights[L].visibility->plane(k) + r0;
-                            for (int X = 0; X < nxr; ++X) o[X] += t * v[X];
+                            const float* p = lights[L].visibility->plane(k) + r0 + X;
+                            v4 a = splat(0.0f);
+                            if (n == 4) a = load4(p);
+                            else
+                                for (int q = 0; q < n; ++q) a[q] = p[q];
+                            v[(L - g0) * kShCount + k] = a;
                         }
+                    for (int c = 0; c < 3 * nCoef; ++c) {
+                        float* o = out.incident.data() + static_cast<std::size_t>(c) * planeR + r0 + X;
+                        v4 acc = splat(0.0f);
+                        if (g0 > 0)
+                            for (int q = 0; q < n; ++q) acc[q] = o[q];
+                        for (int e = out.incidentTermStart[static_cast<std::size_t>(c)]; e < out.incidentTermStart[static_cast<std::size_t>(c + 1)]; ++e) {
+                            const ShadeMaps::Term& term = out.incidentTerms[static_cast<std::size_t>(e)];
+                            const int slot = term.index - g0 * kShCount;
+                            if (slot < 0 || slot >= kMaxShadingLights * kShCount) continue;
+                            acc += term.value * v[slot];
+                        }
+                        if (n == 4) store4(o, acc);
+                        else
+                            for (int q = 0; q < n; ++q) o[q] = acc[q];
+                    }
                 }
+            }
         }
     });
 
@@ -106,8 +249,8 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
     // ---- schedule: fixed row blocks, each with its own scratch ---------------
     parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
         for (int block = b0; block < b1; ++block) {
-            float* vert = out.rowScratch.data() + static_cast<std::size_t>(block) * nPlanes * (nxr + nx);
-            float* up = vert + static_cast<std::size_t>(nPlanes) * nxr;
+            float* vert = out.rowScratch.data() + static_cast<std::size_t>(block) * nPlanes * (nxrS + nx);
+            float* up = vert + static_cast<std::size_t>(nPlanes) * nxrS;
             float* basis = out.basisScratch.data() + static_cast<std::size_t>(block) * 24 * nx;
             const int yBegin = static_cast<int>(static_cast<long long>(ny) * block / nBlocks);
             const int yEnd = static_cast<int>(static_cast<long long>(ny) * (block + 1) / nBlocks);
@@ -122,8 +265,10 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
                                                        : env.plane(p - 3 * nCoef);
                     const float* __restrict ra = plane + static_cast<std::size_t>(Y0) * nxr;
                     const float* __restrict rb = plane + static_cast<std::size_t>(Y1) * nxr;
-                    float* __restrict v = vert + static_cast<std::size_t>(p) * nxr;
+                    float* __restrict v = vert + static_cast<std::size_t>(p) * nxrS;
                     for (int X = 0; X < nxr; ++X) v[X] = ra[X] + fy * (rb[X] - ra[X]);
+                    for (int X = nxr; X < nxrS; ++X) v[X] = 0.0f;
+                    if (!phong) continue;  // Lambert: interpolated horizontally on the fly below
                     float* __restrict u = up + static_cast<std::size_t>(p) * nx;
                     if (s == 1) {
                         std::copy(v, v + nx, u);
@@ -140,6 +285,11 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
                             u[x] = v[X0] + fx * (v[X1] - v[X0]);
                         }
                     }
+                }
+                if (!phong) {
+                    lambertRow(vert, nxrS, nxr, s, nCoef, gradX.row(y), gradY.row(y), out.colIndex.data(), out.colFrac.data(),
+                               lam0, lam1, lam2, diffuseWeight, albedo, y, nx, out);
+                    continue;
                 }
                 // ---- algorithm: rotated BRDF at each full-resolution normal -----
                 const float* __restrict gxr = gradX.row(y);

@@ -52,6 +52,12 @@ struct ShadeMaps {
     std::vector<int> colIndex;    // per full-res column: left receiver
     std::vector<float> colFrac;   // and the fraction towards the right one
     std::vector<float> lightMatrices;  // lights x 3 x 16 x 16, float copies of the product matrices
+    struct Term {
+        alignas(16) float value __attribute__((vector_size(16)));  // the matrix entry, 4 times
+        int index;  // light * 16 + k
+    };
+    std::vector<Term> incidentTerms;     // non-zero matrix entries per output coefficient
+    std::vector<int> incidentTermStart;  // 3 x coefficients + 1
     std::vector<float> rowScratch;    // per row block: interpolated SH planes of one row
     std::vector<float> basisScratch;  // per row block: rotated BRDF coefficients of one row
 };
