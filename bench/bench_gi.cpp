@@ -180,6 +180,25 @@ struct Row {
     Timing t;
 };
 
+// quick: alps ambient error of the engine defaults and paper settings at 1x/2x/4x (for trying changes)
+void quickAccuracy() {
+    const Dem alps = loadAlps();
+    const int border = alps.heights.nx / 10;
+    const Grid ref = referenceAmbient(alps, 1, border);
+    for (const char* which : {"paper", "engine"})
+        for (int s : {1, 2, 4}) {
+            GiSettings set = std::string(which) == "paper" ? GiSettings{} : engineGiSettings();
+            set.subsample = s;
+            GiState st;
+            withThreads(2, [&] {
+                runGiFrame(alps.heights.cview(), alps.cell, GiLighting{}, set, st);
+                return 0;
+            });
+            const ErrorStats e = compare(st.shade.ambient, ref, 1, border);
+            std::printf("%-6s %dx: rmse %.5f bias %+.5f max %.4f\n", which, s, e.rmse, e.bias, e.maxAbs);
+        }
+}
+
 void runSettingsRows(const Dem& d, const Grid& ref, int border, std::vector<Row>& rows, int threads) {
     for (Row& r : rows) {
         GiState st;
@@ -508,6 +527,7 @@ int main(int argc, char** argv) {
             else if (m == "timing") timing();
             else if (m == "explore") explore();
             else if (m == "stages") stages();
+            else if (m == "quick") quickAccuracy();
             else if (m == "cpu") cpuStages();
             else {
                 std::fprintf(stderr, "bench_gi: unknown mode %s\n", m.c_str());

@@ -11,7 +11,7 @@ void PaddedField::resize(int w, int h) {
     nx = w;
     ny = h;
     stride = w + 1;
-    v.resize(static_cast<std::size_t>(w + 1) * static_cast<std::size_t>(h + 1));
+    v.resize(static_cast<std::size_t>(w + 1) * static_cast<std::size_t>(h + 1) + 2 * kFieldGuard, 0.0f);
 }
 
 void PaddedField::padEdges() {
@@ -78,11 +78,17 @@ void buildHeightPyramid(ConstGridView heights, float cellSize, int subsample, co
     p.settings = settings;
 
     // ---- steps (Eq. 14) and the level each reads (level offset o_v) ------
-    const int nSteps = pyramidStepCount(nx, ny, kv);
+    // Sub-sampling: the stack lives at the receiver grid (Section 9), so the
+    // first step is one receiver spacing, tau_0 = s cells (steps shorter than
+    // the receiver spacing would sample relief that the interpolated SH
+    // vectors cannot carry: measured on alps at 2x/4x they add error).
+    const int i0 = kv * (s == 4 ? 2 : (s == 2 ? 1 : 0));
+    const int nSteps = std::max(1, pyramidStepCount(nx, ny, kv) - i0);
     p.steps.resize(static_cast<std::size_t>(nSteps));
     int maxLevel = -1;
-    for (int i = 0; i < nSteps; ++i) {
-        PyramidStep& st = p.steps[static_cast<std::size_t>(i)];
+    for (int ii = 0; ii < nSteps; ++ii) {
+        const int i = ii + i0;
+        PyramidStep& st = p.steps[static_cast<std::size_t>(ii)];
         st.tauCells = std::exp2(static_cast<double>(i) / kv);
         st.invTauWorld = static_cast<float>(1.0 / (st.tauCells * cellSize));
         st.level = i - kv * settings.levelOffset;
@@ -94,12 +100,12 @@ void buildHeightPyramid(ConstGridView heights, float cellSize, int subsample, co
     const int wp = nx / s + 1;
     p.rawPhaseWidth = wp;
     p.rawPhasePlane = static_cast<std::ptrdiff_t>(wp) * (ny + 1);
-    p.rawPhase.resize(static_cast<std::size_t>(s) * static_cast<std::size_t>(p.rawPhasePlane));
+    p.rawPhase.resize(static_cast<std::size_t>(s) * static_cast<std::size_t>(p.rawPhasePlane) + 2 * kFieldGuard, 0.0f);
     parallelForRows(ny + 1, nx, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
             const float* src = heights.row(std::min(y, ny - 1));
             for (int q = 0; q < s; ++q) {
-                float* d = p.rawPhase.data() + q * p.rawPhasePlane + static_cast<std::ptrdiff_t>(y) * wp;
+                float* d = p.rawPhase.data() + kFieldGuard + q * p.rawPhasePlane + static_cast<std::ptrdiff_t>(y) * wp;
                 for (int x = 0; x < wp; ++x) d[x] = src[std::min(s * x + q, nx - 1)];
             }
         }

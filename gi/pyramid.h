@@ -2,8 +2,10 @@
 // Height pyramid with B-spline filtering (Section 5.2, Eqs. 14-16).
 //
 // Steps along every ray grow exponentially (Eq. 14): tau_i = 2^(i / k_v)
-// cells, i = 0..n_v-1, n_v chosen so the last step reaches the domain
+// cells, i = i_0..n_v-1, n_v chosen so the last step reaches the domain
 // diagonal ("number of levels from the resolution and the domain size").
+// With sub-sampling s the first step is one receiver spacing, 2^(i_0 / k_v) = s
+// (the synthesised stack lives at the receiver grid, Section 9).
 // Step i reads pyramid level l = i - k_v * o_v (the level offset o_v biases
 // towards finer levels, Section 5.2); l < 0 reads the unfiltered full
 // resolution heights (bilinear), which makes the method converge to
@@ -33,15 +35,22 @@ struct PyramidSettings {
     float peakBlend = 0.0f;   // 0 = mean pyramid (paper); 1 = max-decimated octaves
 };
 
+/// Floats of slack before and after a scanned field: the scan's 16-receiver
+/// vector reads at a step where some receivers' samples have left the domain
+/// stay inside the allocation (those lanes are discarded).
+inline constexpr std::ptrdiff_t kFieldGuard = 32;
+
 /// One sampled field: a row-major grid padded with one replicated column and
 /// row so bilinear reads at the last sample stay in bounds.
 struct PaddedField {
     int nx = 0, ny = 0;        // logical size
     std::ptrdiff_t stride = 0;  // nx + 1
-    std::vector<float> v;       // (nx + 1) * (ny + 1)
+    std::vector<float> v;       // guard + (nx + 1) * (ny + 1) + guard
     void resize(int w, int h);
-    float* row(int y) { return v.data() + y * stride; }
-    const float* row(int y) const { return v.data() + y * stride; }
+    float* data() { return v.data() + kFieldGuard; }
+    const float* data() const { return v.data() + kFieldGuard; }
+    float* row(int y) { return data() + y * stride; }
+    const float* row(int y) const { return data() + y * stride; }
     void padEdges();  // copies the last column / row into the padding
 };
 
@@ -69,9 +78,10 @@ struct HeightPyramid {
     // Plane 0 row s Y holds the receiver heights of receiver row Y.
     int rawPhaseWidth = 0;
     std::ptrdiff_t rawPhasePlane = 0;  // floats per plane: rawPhaseWidth * (ny + 1)
-    std::vector<float> rawPhase;       // s planes
+    std::vector<float> rawPhase;       // guard + s planes + guard
+    const float* rawPhaseData() const { return rawPhase.data() + kFieldGuard; }
     const float* rawPhaseRow(int q, int y) const {
-        return rawPhase.data() + q * rawPhasePlane + static_cast<std::ptrdiff_t>(y) * rawPhaseWidth;
+        return rawPhaseData() + q * rawPhasePlane + static_cast<std::ptrdiff_t>(y) * rawPhaseWidth;
     }
     std::vector<Grid> meanOctaves;    // B_1, B_2, ... (B_0 is the input)
     std::vector<Grid> maxOctaves;     // same, max-decimated (only when peakBlend > 0)
@@ -85,7 +95,8 @@ struct HeightPyramid {
 /// Receiver grid size along one axis for n cells and sub-sampling s.
 inline int receiverCount(int n, int s) { return n <= 0 ? 0 : (n - 1) / s + 1; }
 
-/// Number of exponential steps n_v for a grid (Eq. 14 and the domain size).
+/// Number of exponential steps n_v for a grid (Eq. 14 and the domain size),
+/// before dropping the i_0 steps shorter than the receiver spacing.
 int pyramidStepCount(int nx, int ny, int levelsPerOctave);
 
 /// Builds (or rebuilds, reusing every buffer) the pyramid of `heights`.

@@ -192,34 +192,39 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
     parallelForRows(nyr, nxr * 16, [&](int y0, int y1) {
         for (int Y = y0; Y < y1; ++Y) {
             const std::size_t r0 = static_cast<std::size_t>(Y) * nxr;
-            for (int X = 0; X < nxr; X += 4) {
-                const int n = std::min(4, nxr - X);
+            // 16 receivers at a time: four independent accumulation chains
+            for (int X = 0; X < nxr; X += 16) {
+                const int n = std::min(16, nxr - X);
                 for (int g0 = 0; g0 < nl; g0 += kMaxShadingLights) {
                     const int g1 = std::min(nl, g0 + kMaxShadingLights);
-                    v4 v[kMaxShadingLights * kShCount];
+                    v4 v[kMaxShadingLights * kShCount][4];
                     for (int L = g0; L < g1; ++L)
                         for (int k = 0; k < kShCount; ++k) {
                             const float* p = lights[L].visibility->plane(k) + r0 + X;
-                            v4 a = splat(0.0f);
-                            if (n == 4) a = load4(p);
-                            else
-                                for (int q = 0; q < n; ++q) a[q] = p[q];
-                            v[(L - g0) * kShCount + k] = a;
+                            for (int q = 0; q < 4; ++q) {
+                                v4 a = splat(0.0f);
+                                if (4 * q + 4 <= n) a = load4(p + 4 * q);
+                                else
+                                    for (int e = 4 * q; e < n; ++e) a[e - 4 * q] = p[e];
+                                v[(L - g0) * kShCount + k][q] = a;
+                            }
                         }
                     for (int c = 0; c < 3 * nCoef; ++c) {
                         float* o = out.incident.data() + static_cast<std::size_t>(c) * planeR + r0 + X;
-                        v4 acc = splat(0.0f);
+                        v4 acc[4] = {splat(0.0f), splat(0.0f), splat(0.0f), splat(0.0f)};
                         if (g0 > 0)
-                            for (int q = 0; q < n; ++q) acc[q] = o[q];
+                            for (int e = 0; e < n; ++e) acc[e / 4][e % 4] = o[e];
                         for (int e = out.incidentTermStart[static_cast<std::size_t>(c)]; e < out.incidentTermStart[static_cast<std::size_t>(c + 1)]; ++e) {
                             const ShadeMaps::Term& term = out.incidentTerms[static_cast<std::size_t>(e)];
                             const int slot = term.index - g0 * kShCount;
                             if (slot < 0 || slot >= kMaxShadingLights * kShCount) continue;
-                            acc += term.value * v[slot];
+                            for (int q = 0; q < 4; ++q) acc[q] += term.value * v[slot][q];
                         }
-                        if (n == 4) store4(o, acc);
-                        else
-                            for (int q = 0; q < n; ++q) o[q] = acc[q];
+                        for (int q = 0; q < 4; ++q) {
+                            if (4 * q + 4 <= n) store4(o + 4 * q, acc[q]);
+                            else
+                                for (int e = 4 * q; e < n; ++e) o[e] = acc[q][e - 4 * q];
+                        }
                     }
                 }
             }

@@ -79,7 +79,11 @@ StepGeometry makeStep(const HeightPyramid& pyr, int i, double c, double sn) {
     const double c0d = std::floor(dx), r0d = std::floor(dy);
     const int c0 = static_cast<int>(c0d), r0 = static_cast<int>(r0d);
     const float fx = static_cast<float>(dx - c0d), fy = static_cast<float>(dy - r0d);
-    const float weights[5] = {(1.0f - fx) * (1.0f - fy), fx * (1.0f - fy), (1.0f - fx) * fy, fx * fy, ps.invTauWorld};
+    // bilinear weights scaled by 1 / tau: the kernel forms the slope as
+    // sum_k (w_k / tau) h_k - h0 / tau (one multiply less per sample)
+    const float it = ps.invTauWorld;
+    const float weights[5] = {((1.0f - fx) * (1.0f - fy)) * it, (fx * (1.0f - fy)) * it, ((1.0f - fx) * fy) * it,
+                              (fx * fy) * it, it};
     for (int q = 0; q < 5; ++q)
         for (int l = 0; l < 4; ++l) st.w[q][l] = weights[q];
     if (ps.level < 0) {
@@ -87,14 +91,14 @@ StepGeometry makeStep(const HeightPyramid& pyr, int i, double c, double sn) {
         const int qa = ((c0 % s) + s) % s, qb = (((c0 + 1) % s) + s) % s;
         const int colA = (c0 - qa) / s, colB = (c0 + 1 - qb) / s;
         const std::ptrdiff_t w = pyr.rawPhaseWidth;
-        st.field = pyr.rawPhase.data();
+        st.field = pyr.rawPhaseData();
         st.rowStep = s * w;
         st.rowNext = w;
         st.offA = qa * pyr.rawPhasePlane + r0 * w + colA;
         st.offB = qb * pyr.rawPhasePlane + r0 * w + colB;
     } else {
         const PaddedField& f = pyr.levels[static_cast<std::size_t>(ps.level)];
-        st.field = f.v.data();
+        st.field = f.data();
         st.rowStep = f.stride;
         st.rowNext = f.stride;
         st.offA = r0 * f.stride + c0;
@@ -104,20 +108,21 @@ StepGeometry makeStep(const HeightPyramid& pyr, int i, double c, double sn) {
 }
 
 // The blocking slope of one receiver at one step (the scalar form of the
-// kernel's lanes: the same operations in the same order).
-inline float sampleSlope(const ScanStep& st, std::ptrdiff_t index, float h0) {
+// kernel's lanes: the same operations in the same order). h0s = h0 / tau.
+inline float sampleSlope(const ScanStep& st, std::ptrdiff_t index, float h0s) {
     const float* a = st.field + index + st.offA;
     const float* b = st.field + index + st.offB;
     const float v = (st.w[0][0] * a[0] + st.w[1][0] * b[0]) + (st.w[2][0] * a[st.rowNext] + st.w[3][0] * b[st.rowNext]);
-    return (v - h0) * st.w[4][0];
+    return v - h0s;
 }
 
 // ---- algorithm: per-step visitors over the slope sequence ---------------------
 // A visitor sees the slopes of 4 NV receivers step by step. all(i, s): step i,
-// every lane valid. some(i, s, steps): step i where lane L is valid only if
-// i < steps[L] (its ray has left the domain otherwise; its s is unspecified);
-// the kernel calls some() once more at i = max(steps) with no lane valid, so
-// a visitor can close what is still open.
+// every lane valid. some(i, s, valid): step i where only the lanes of `valid`
+// are (the others' rays have left the domain; their s is garbage); the kernel
+// calls some() once more at i = (longest sequence) with no lane valid, so a
+// visitor can close what is still open. steps: each lane's sequence length.
+typedef int v4i __attribute__((vector_size(16)));
 
 // Plain maximum over the samples.
 template <int NV>
@@ -126,15 +131,12 @@ struct SampleMaxVisitor {
     SampleMaxVisitor() {
         for (int k = 0; k < NV; ++k) m[k] = splat(kNoBlocker);
     }
+    // m = maxps(m, s): the larger; equal values are the same number (no -0 arises)
     void all(int, const v4* s) {
-        for (int k = 0; k < NV; ++k) m[k] = vmax(m[k], s[k]);
+        for (int k = 0; k < NV; ++k) m[k] = m[k] > s[k] ? m[k] : s[k];
     }
-    void some(int i, const float* s, const int* steps) {
-        for (int L = 0; L < 4 * NV; ++L)
-            if (i < steps[L]) {
-                const float mL = m[L / 4][L % 4];
-                m[L / 4][L % 4] = mL < s[L] ? s[L] : mL;
-            }
+    void some(int, const v4* s, const v4i* valid, const v4i*) {
+        for (int k = 0; k < NV; ++k) m[k] = valid[k] & (s[k] > m[k]) ? s[k] : m[k];
     }
     void result(float* out) const {
         for (int k = 0; k < NV; ++k) store4(out + 4 * k, m[k]);
@@ -153,35 +155,35 @@ struct BsplineMaxVisitor {
     BsplineMaxVisitor() {
         for (int k = 0; k < NV; ++k) m[k] = p1[k] = p2[k] = p3[k] = splat(kNoBlocker);
     }
-    static float mid(float sm, float s0, float s1, float s2) { return (9.0f * (s0 + s1) - (sm + s2)) * (1.0f / 16.0f); }
     static v4 mid(v4 sm, v4 s0, v4 s1, v4 s2) { return (9.0f * (s0 + s1) - (sm + s2)) * (1.0f / 16.0f); }
     void all(int i, const v4* s) {
         for (int k = 0; k < NV; ++k) {
             if (i == 0) p1[k] = p2[k] = p3[k] = s[k];
-            m[k] = vmax(m[k], s[k]);
-            if (i >= 2) m[k] = vmax(m[k], mid(p3[k], p2[k], p1[k], s[k]));
+            m[k] = m[k] > s[k] ? m[k] : s[k];
+            if (i >= 2) {
+                const v4 md = mid(p3[k], p2[k], p1[k], s[k]);
+                m[k] = m[k] > md ? m[k] : md;
+            }
             p3[k] = p2[k];
             p2[k] = p1[k];
             p1[k] = s[k];
         }
     }
-    void some(int i, const float* s, const int* steps) {
-        for (int L = 0; L < 4 * NV; ++L) {
-            const int k = L / 4, l = L % 4;
-            const bool valid = i < steps[L];
-            if (!valid && i == 0) continue;  // empty sequence
-            const float v = valid ? s[L] : p1[k][l];  // past the end: replicate the last sample
-            if (i == 0) p1[k][l] = p2[k][l] = p3[k][l] = v;
-            float mL = m[k][l];
-            if (valid) mL = mL < v ? v : mL;
-            if (i >= 2 && i <= steps[L]) {
-                const float md = mid(p3[k][l], p2[k][l], p1[k][l], v);
-                mL = mL < md ? md : mL;
+    void some(int i, const v4* s, const v4i* valid, const v4i* steps) {
+        const v4i iv = {i, i, i, i};
+        for (int k = 0; k < NV; ++k) {
+            const v4 v = valid[k] ? s[k] : p1[k];  // past the end: replicate the last sample
+            if (i == 0) {
+                p1[k] = p2[k] = p3[k] = v;  // invalid lanes: empty sequence, stays kNoBlocker
             }
-            m[k][l] = mL;
-            p3[k][l] = p2[k][l];
-            p2[k][l] = p1[k][l];
-            p1[k][l] = v;
+            m[k] = valid[k] & (v > m[k]) ? v : m[k];
+            if (i >= 2) {
+                const v4 md = mid(p3[k], p2[k], p1[k], v);
+                m[k] = (iv <= steps[k]) & (md > m[k]) ? md : m[k];
+            }
+            p3[k] = p2[k];
+            p2[k] = p1[k];
+            p1[k] = v;
         }
     }
     void result(float* out) const {
@@ -190,52 +192,64 @@ struct BsplineMaxVisitor {
 };
 
 // ---- algorithm: the scan of 4 NV receivers (X0 .. X0 + 4 NV - 1 of row Y) -------
-// steps[L]: valid-prefix length of lane L; all lanes are valid for i < nAll.
+// h0s: the row's h0 / tau table (steps x nxrPad); steps: valid-prefix length
+// of each lane; all lanes are valid for i < nAll, none for i >= nAny.
 template <int NV, class Visitor>
-inline void scanLanes(const ScanStep* table, int Y, int X0, const float* h0, const int* steps, int nAll, int nAny,
-                      Visitor& visit) {
-    v4 h[NV];
-    for (int k = 0; k < NV; ++k) h[k] = load4(h0 + X0 + 4 * k);
-    for (int i = 0; i < nAll; ++i) {
+inline void scanLanes(const ScanStep* table, int Y, int X0, const float* h0s, std::ptrdiff_t h0sStride, const v4i* steps,
+                      int nAll, int nAny, Visitor& visit) {
+    auto sample = [&](int i, v4* s) {
         const ScanStep& st = table[i];
         const std::ptrdiff_t o = Y * st.rowStep + X0;
         const float* a = st.field + (o + st.offA);
         const float* b = st.field + (o + st.offB);
+        const float* hs = h0s + i * h0sStride + X0;
         const std::ptrdiff_t n = st.rowNext;
         const v4 w00 = load4a(st.w[0]), w01 = load4a(st.w[1]), w10 = load4a(st.w[2]), w11 = load4a(st.w[3]);
-        const v4 inv = load4a(st.w[4]);
-        v4 s[NV];
         for (int k = 0; k < NV; ++k) {
             const v4 v = (w00 * load4(a + 4 * k) + w01 * load4(b + 4 * k)) + (w10 * load4(a + n + 4 * k) + w11 * load4(b + n + 4 * k));
-            s[k] = (v - h[k]) * inv;
+            s[k] = v - load4a(hs + 4 * k);
         }
+    };
+    for (int i = 0; i < nAll; ++i) {
+        v4 s[NV];
+        sample(i, s);
         visit.all(i, s);
     }
+    // Steps where some rays have left the domain: the row is inside (the row
+    // limit is common to all lanes), the outside lanes read neighbouring
+    // columns (inside the field's guard) and are masked out.
     for (int i = nAll; i <= nAny; ++i) {
-        float s[4 * NV] = {};
-        if (i < nAny) {
-            const ScanStep& st = table[i];
-            for (int L = 0; L < 4 * NV; ++L)
-                if (i < steps[L]) s[L] = sampleSlope(st, Y * st.rowStep + X0 + L, h0[X0 + L]);
-        }
-        visit.some(i, s, steps);
+        v4 s[NV];
+        v4i valid[NV];
+        const v4i iv = {i, i, i, i};
+        for (int k = 0; k < NV; ++k) valid[k] = iv < steps[k];
+        if (i < nAny) sample(i, s);
+        else
+            for (int k = 0; k < NV; ++k) s[k] = splat(0.0f);
+        visit.some(i, s, valid, steps);
     }
 }
 
 // Maximum blocking slope of a row of receivers for one azimuth.
 template <int NV, template <int> class Visitor>
-void scanRow(const ScanStep* table, const int* colSteps, int rowSteps, int Y, const float* h0, int nxrPad, float* out) {
+void scanRow(const ScanStep* table, const int* colSteps, int rowSteps, int Y, const float* h0s, std::ptrdiff_t h0sStride,
+             int nxrPad, float* out) {
     constexpr int lanes = 4 * NV;
+    const v4i rowLimit = {rowSteps, rowSteps, rowSteps, rowSteps};
     for (int X0 = 0; X0 < nxrPad; X0 += lanes) {
-        int steps[lanes];
-        int nAll = rowSteps, nAny = 0;
-        for (int L = 0; L < lanes; ++L) {
-            steps[L] = std::min(colSteps[X0 + L], rowSteps);
-            nAll = std::min(nAll, steps[L]);
-            nAny = std::max(nAny, steps[L]);
+        v4i steps[NV];
+        v4i lo = rowLimit, hi = {0, 0, 0, 0};
+        for (int k = 0; k < NV; ++k) {
+            v4i c;
+            std::memcpy(&c, colSteps + X0 + 4 * k, sizeof c);
+            steps[k] = c < rowLimit ? c : rowLimit;
+            lo = steps[k] < lo ? steps[k] : lo;
+            hi = steps[k] > hi ? steps[k] : hi;
         }
+        const int nAll = std::min(std::min(lo[0], lo[1]), std::min(lo[2], lo[3]));
+        const int nAny = std::max(std::max(hi[0], hi[1]), std::max(hi[2], hi[3]));
         Visitor<NV> visit;
-        scanLanes<NV>(table, Y, X0, h0, steps, nAll, nAny, visit);
+        scanLanes<NV>(table, Y, X0, h0s, h0sStride, steps, nAll, nAny, visit);
         visit.result(out + X0);
     }
 }
@@ -339,7 +353,7 @@ float scanReceiverScalar(const HeightPyramid& pyr, int X, int Y, double phi, Blo
         const double xmax = raw ? pyr.nx - 1 : pyr.nxr - 1, ymax = raw ? pyr.ny - 1 : pyr.nyr - 1;
         if (!(px >= 0.0 && px <= xmax && py >= 0.0 && py <= ymax)) break;
         const StepGeometry g = makeStep(pyr, i, c, sn);
-        seq.push_back(sampleSlope(g.step, Y * g.step.rowStep + X, h0));
+        seq.push_back(sampleSlope(g.step, Y * g.step.rowStep + X, h0 * ps.invTauWorld));
     }
     return maxBlockingSlopeOfSequence(seq.data(), static_cast<int>(seq.size()), rule);
 }
@@ -406,56 +420,54 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
         std::fprintf(stderr, "samples %lld (%.1f per receiver-azimuth, %d steps)\n", total, double(total) / (double(m) * nxr * nyr), nSteps);
     }
     const int nBlocks = std::max(1, std::min(nyr, kMaxBlocks));
-    const int maxRows = (nyr + nBlocks - 1) / nBlocks;
     state.blocks.resize(static_cast<std::size_t>(nBlocks));
     for (VisibilityScratch& b : state.blocks) {
         b.maxRow.resize(static_cast<std::size_t>(nxrPad));
-        b.gradX.resize(static_cast<std::size_t>(maxRows) * nxrPad);
-        b.gradY.resize(static_cast<std::size_t>(maxRows) * nxrPad);
-        b.h0.resize(static_cast<std::size_t>(maxRows) * nxrPad);
+        b.gradX.resize(static_cast<std::size_t>(nxrPad));
+        b.gradY.resize(static_cast<std::size_t>(nxrPad));
+        b.h0.resize(static_cast<std::size_t>(nSteps) * nxrPad);
         b.nlp.resize(static_cast<std::size_t>(4) * nxrPad);
     }
-    // ---- schedule: fixed row blocks in parallel; within a block azimuth by
-    // azimuth, rows in order, so consecutive rows reuse the same field rows
-    // from cache (a block's rows of one azimuth touch one band per step).
+    // ---- schedule: fixed row blocks in parallel, rows serially within a block,
+    // every azimuth of a row before the next row (the row's h0 / tau table is
+    // built once for all azimuths).
     parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
         for (int block = b0; block < b1; ++block) {
             VisibilityScratch& sc = state.blocks[static_cast<std::size_t>(block)];
             const int yBegin = static_cast<int>(static_cast<long long>(nyr) * block / nBlocks);
             const int yEnd = static_cast<int>(static_cast<long long>(nyr) * (block + 1) / nBlocks);
             for (int Y = yBegin; Y < yEnd; ++Y) {
-                // receiver heights and height gradients of the block's rows (padding lanes: 0)
+                // h0 / tau per step and height gradients of this row (padding lanes: 0)
                 const float* hRow = pyr.rawPhaseRow(0, s * Y);
-                const std::size_t r = static_cast<std::size_t>(Y - yBegin) * nxrPad;
                 for (int X = 0; X < nxrPad; ++X) {
                     const bool in = X < nxr;
-                    sc.h0[r + static_cast<std::size_t>(X)] = in ? hRow[X] : 0.0f;
-                    sc.gradX[r + static_cast<std::size_t>(X)] = in ? gradX(s * X, s * Y) : 0.0f;
-                    sc.gradY[r + static_cast<std::size_t>(X)] = in ? gradY(s * X, s * Y) : 0.0f;
+                    sc.gradX[static_cast<std::size_t>(X)] = in ? gradX(s * X, s * Y) : 0.0f;
+                    sc.gradY[static_cast<std::size_t>(X)] = in ? gradY(s * X, s * Y) : 0.0f;
                 }
+                for (int i = 0; i < nSteps; ++i) {
+                    const float it = pyr.steps[static_cast<std::size_t>(i)].invTauWorld;
+                    float* h = sc.h0.data() + static_cast<std::size_t>(i) * nxrPad;
+                    for (int X = 0; X < nxr; ++X) h[X] = hRow[X] * it;
+                    for (int X = nxr; X < nxrPad; ++X) h[X] = 0.0f;
+                }
+                float* vRows[kShCount];
                 for (int i = 0; i < kShCount; ++i) {
-                    float* v = out.plane(i) + static_cast<std::size_t>(Y) * nxr;
-                    std::fill(v, v + nxr, 0.0f);
+                    vRows[i] = out.plane(i) + static_cast<std::size_t>(Y) * nxr;
+                    std::fill(vRows[i], vRows[i] + nxr, 0.0f);
                 }
-            }
-            for (int j = 0; j < m; ++j) {
-                const ScanStep* table = state.steps.data() + static_cast<std::size_t>(j) * nSteps;
-                const int* colSteps = state.stepsPerColumn.data() + static_cast<std::size_t>(j) * nxrPad;
-                const double phi = op.phi[static_cast<std::size_t>(j)];
-                const float cosPhi = static_cast<float>(std::cos(phi)), sinPhi = static_cast<float>(std::sin(phi));
-                for (int Y = yBegin; Y < yEnd; ++Y) {
-                    const std::size_t r = static_cast<std::size_t>(Y - yBegin) * nxrPad;
+                for (int j = 0; j < m; ++j) {
+                    const ScanStep* table = state.steps.data() + static_cast<std::size_t>(j) * nSteps;
+                    const int* colSteps = state.stepsPerColumn.data() + static_cast<std::size_t>(j) * nxrPad;
                     const int rowSteps = state.stepsPerRow[static_cast<std::size_t>(j) * nyr + static_cast<std::size_t>(Y)];
                     if (settings.blockingMax == BlockingMax::Samples)
-                        scanRow<4, SampleMaxVisitor>(table, colSteps, rowSteps, Y, sc.h0.data() + r, nxrPad, sc.maxRow.data());
+                        scanRow<4, SampleMaxVisitor>(table, colSteps, rowSteps, Y, sc.h0.data(), nxrPad, nxrPad, sc.maxRow.data());
                     else
-                        scanRow<2, BsplineMaxVisitor>(table, colSteps, rowSteps, Y, sc.h0.data() + r, nxrPad, sc.maxRow.data());
+                        scanRow<2, BsplineMaxVisitor>(table, colSteps, rowSteps, Y, sc.h0.data(), nxrPad, nxrPad, sc.maxRow.data());
                     float* maxOut = out.maxSlope.data() + planeSize * j + static_cast<std::size_t>(Y) * nxr;
                     std::copy(sc.maxRow.data(), sc.maxRow.data() + nxr, maxOut);
-                    nlpRow(sc.maxRow.data(), sc.gradX.data() + r, sc.gradY.data() + r, cosPhi, sinPhi, target, sc.nlp.data(),
-                           nxr, nxrPad);
-                    float* vRows[kShCount];
-                    for (int i = 0; i < kShCount; ++i) vRows[i] = out.plane(i) + static_cast<std::size_t>(Y) * nxr;
+                    const double phi = op.phi[static_cast<std::size_t>(j)];
+                    nlpRow(sc.maxRow.data(), sc.gradX.data(), sc.gradY.data(), static_cast<float>(std::cos(phi)),
+                           static_cast<float>(std::sin(phi)), target, sc.nlp.data(), nxr, nxrPad);
                     accumulateRow(sc.nlp.data(), op.values.data() + static_cast<std::size_t>(j) * op.patternSize(),
                                   op.patternRow.data(), op.patternNlp.data(), op.patternSize(), vRows, nxr, nxrPad);
                 }

@@ -67,7 +67,7 @@ struct VisibilityScratch {
     std::vector<float> maxRow;  // nxr: maximum blocking slope of the current row and azimuth
     std::vector<float> gradX;   // nxr: dh/dx at the receivers of the current row
     std::vector<float> gradY;
-    std::vector<float> h0;      // nxr: receiver heights of the current row
+    std::vector<float> h0;      // steps x nxr: receiver height / tau_i of the current row
     std::vector<float> nlp;     // 4 x nxr: NLP visibility vectors of the current row and azimuth
 };
 
