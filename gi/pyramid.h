@@ -12,10 +12,11 @@
 // brute-force marching as o_v grows.
 //
 // Level l is filtered at a scale of 2^(l / k_v) cells: octave images B_o are
-// repeated 2x2 box ("bilinear") decimations of the heights; each octave is
-// synthesised at the receiver grid by cubic B-spline reconstruction (as the
-// paper's GPU version does with [SH05]), S_o; a level between octaves blends
-// the two neighbouring syntheses: f_l = (1 - q) S_o + q S_(o+1), o + q = l / k_v.
+// repeated 2x2 box ("bilinear") decimations of the heights; each octave o >= 1
+// is synthesised at the receiver grid by cubic B-spline reconstruction (as the
+// paper's GPU version does with [SH05]), S_o; S_0 is the height field itself
+// at the receivers (level 0 is unfiltered, f_0 = f); a level between octaves
+// blends the two neighbouring ones: f_l = (1 - q) S_o + q S_(o+1), o + q = l / k_v.
 // Like the paper we keep the stack "blown out" to the receiver resolution,
 // so for a fixed azimuth and step every receiver reads its level at the same
 // fractional offset: the scan streams rows with constant bilinear weights.
