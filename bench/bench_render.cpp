@@ -20,6 +20,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench/bench_common.h"
 #include "render/context.h"
 #include "render/gl.h"
 #include "render/pipeline.h"
