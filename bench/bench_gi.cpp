@@ -170,6 +170,14 @@ std::string machine() {
     return cpu + ", " + std::to_string(std::thread::hardware_concurrency()) + " hardware threads";
 }
 
+std::string buildFlags() {
+    return std::string("GCC ") + __VERSION__ +
+           ", CMAKE_BUILD_TYPE=Release (-O3 -DNDEBUG), -ffp-contract=off -fno-fast-math, baseline x86-64 (SSE2, no -march), "
+           "4-wide GCC vector extensions in gi/";
+}
+
+std::string gCommand = "build-gi/bench_gi";
+
 // ---------------------------------------------------------------------------
 // accuracy: paper settings vs engine defaults on alps at true scale
 // ---------------------------------------------------------------------------
@@ -226,7 +234,7 @@ void accuracy() {
     md += "Ground truth: gi/reference (256 azimuths, exact march of the bilinear field, exact elevation integrals). ";
     md += "Ambient = direct irradiance / pi under a uniform unit sky (normal-weighted sky-view factor). ";
     md += "Time: whole frame (gradient, pyramid, visibility, shading; uniform sky, no key light) with 2 threads, median of " +
-          std::to_string(gRuns) + " after a warm-up. Machine: " + machine() + ".\n\n";
+          std::to_string(gRuns) + " after a warm-up.\n\nMachine: " + machine() + ". Build: " + buildFlags() + ".\n\nCommand: `" + gCommand + "` (from the repository root; reference cached in /tmp).\n\n";
     md += "| settings | RMSE | bias | max abs | ms/frame |\n|---|---|---|---|---|\n";
     std::string csv = "label,azimuths,levels_per_octave,level_offset,interp,blocking_max,peak_blend,subsample,rmse,bias,max_abs,ms\n";
     for (const Row& r : rows) {
@@ -284,12 +292,13 @@ void explore() {
 }
 
 // ---------------------------------------------------------------------------
-// convergence: error vs m, k_v, o_v
+// convergence: error vs m, k_v, o_v and sub-sampling on a small terrain
 // ---------------------------------------------------------------------------
 void convergence() {
     const Dem alps = loadAlps();
-    const int border = alps.heights.nx / 10;
-    const Grid ref = referenceAmbient(alps, 1, border);
+    const Dem small = crop(alps, 256, "c256");
+    const int border = small.heights.nx / 10;
+    const Grid ref = referenceAmbient(small, 1, border);
     std::vector<Row> rows;
     auto base = [] {
         GiSettings s;
@@ -317,27 +326,184 @@ void convergence() {
         s.pyramid.levelOffset = o;
         rows.push_back({"vary o_v (m=128, k_v=8)", s, {}, {}});
     }
-    const int savedRuns = gRuns;
-    gRuns = 1;
-    runSettingsRows(alps, ref, border, rows, 2);
-    gRuns = savedRuns;
-    std::string md = "# GI convergence to the ground truth (alps-montblanc, true scale, interior)\n\n";
-    md += "Ambient RMSE / bias against gi/reference (256 azimuths). The plain sample maximum is used (the B-spline "
-          "maximum of Eq. 16 smooths the blocking-angle sequence and does not converge to the exact horizon). "
-          "The remaining floor is the order-4 SH truncation of visibility. Times: 2 threads, one frame.\n\n";
-    md += "| sweep | settings | RMSE | bias | ms/frame |\n|---|---|---|---|---|\n";
-    std::string csv = "sweep,azimuths,levels_per_octave,level_offset,rmse,bias,ms\n";
+    for (const char* which : {"paper", "engine"})
+        for (int sub : {4, 2, 1}) {
+            GiSettings s = std::string(which) == "paper" ? paperSettings() : engineDefaults();
+            s.subsample = sub;
+            rows.push_back({std::string("sub-sampling, ") + which + " settings", s, {}, {}});
+        }
+    runSettingsRows(small, ref, border, rows, 2);
+    std::string md = "# GI convergence to the ground truth (small terrain)\n\n";
+    md += "Terrain: alps-montblanc centre crop 256 x 256 at true scale (cell 92.74 m), interior only (25-texel border left out, " +
+          std::to_string(rows[0].e.count) + " texels). Ambient RMSE / bias against gi/reference (256 azimuths, exact march "
+          "of the bilinear field, exact elevation integrals). The m / k_v / o_v sweeps use the plain sample maximum (the "
+          "B-spline maximum of Eq. 16 smooths the blocking-angle sequence and does not converge to the exact horizon); "
+          "what remains at large m, k_v, o_v is the order-4 SH truncation of visibility (and m = 128 azimuth interpolation). "
+          "Sub-sampling rows: the paper settings (m = 32, k_v = 4, o_v = 2, Eq. 16 maximum) and the engine defaults "
+          "(o_v = 3, 25 % peak-keeping pyramid, sample maximum), 4x -> 2x -> 1x. Times: whole frame (uniform sky, no key "
+          "light), 2 threads, median of " + std::to_string(gRuns) + ".\n\nMachine: " + machine() + ". Build: " + buildFlags() +
+          ".\n\nCommand: `" + gCommand + "` (from the repository root; reference cached in /tmp).\n\n";
+    md += "| sweep | settings | RMSE | bias | max abs | ms/frame |\n|---|---|---|---|---|---|\n";
+    std::string csv = "sweep,azimuths,levels_per_octave,level_offset,blocking_max,peak_blend,subsample,rmse,bias,max_abs,ms\n";
     for (const Row& r : rows) {
         char buf[400];
-        std::snprintf(buf, sizeof buf, "| %s | %s | %.4f | %+.4f | %.1f |\n", r.label.c_str(), settingsName(r.s).c_str(), r.e.rmse,
-                      r.e.bias, r.t.median);
+        std::snprintf(buf, sizeof buf, "| %s | %s | %.4f | %+.4f | %.3f | %.1f |\n", r.label.c_str(), settingsName(r.s).c_str(),
+                      r.e.rmse, r.e.bias, r.e.maxAbs, r.t.median);
         md += buf;
-        std::snprintf(buf, sizeof buf, "%s,%d,%d,%d,%.5f,%.5f,%.2f\n", r.label.c_str(), r.s.visibility.azimuths,
-                      r.s.pyramid.levelsPerOctave, r.s.pyramid.levelOffset, r.e.rmse, r.e.bias, r.t.median);
+        std::snprintf(buf, sizeof buf, "%s,%d,%d,%d,%s,%.2f,%d,%.5f,%.5f,%.4f,%.2f\n", r.label.c_str(), r.s.visibility.azimuths,
+                      r.s.pyramid.levelsPerOctave, r.s.pyramid.levelOffset,
+                      r.s.visibility.blockingMax == BlockingMax::Samples ? "samples" : "bspline", r.s.pyramid.peakBlend,
+                      r.s.subsample, r.e.rmse, r.e.bias, r.e.maxAbs, r.t.median);
         csv += buf;
     }
     writeFile("gi_convergence.md", md);
     writeFile("gi_convergence.csv", csv);
+}
+
+// ---------------------------------------------------------------------------
+// speed-vs-error plot: rasterised here (lines, points, axes, a 5x7 font)
+// ---------------------------------------------------------------------------
+struct Canvas {
+    int w, h;
+    std::vector<std::uint8_t> px;
+    Canvas(int width, int height) : w(width), h(height), px(static_cast<std::size_t>(width) * height * 3, 255) {}
+    void set(int x, int y, const std::uint8_t c[3]) {
+        if (x < 0 || y < 0 || x >= w || y >= h) return;
+        for (int k = 0; k < 3; ++k) px[(static_cast<std::size_t>(y) * w + x) * 3 + k] = c[k];
+    }
+    void line(double x0, double y0, double x1, double y1, const std::uint8_t c[3], int thick = 1) {
+        const int n = static_cast<int>(std::max(std::abs(x1 - x0), std::abs(y1 - y0))) + 1;
+        for (int i = 0; i <= n; ++i) {
+            const double t = static_cast<double>(i) / n;
+            const int x = static_cast<int>(std::lround(x0 + t * (x1 - x0))), y = static_cast<int>(std::lround(y0 + t * (y1 - y0)));
+            for (int dy = -(thick / 2); dy <= thick / 2; ++dy)
+                for (int dx = -(thick / 2); dx <= thick / 2; ++dx) set(x + dx, y + dy, c);
+        }
+    }
+    void dot(double x, double y, int r, const std::uint8_t c[3]) {
+        for (int dy = -r; dy <= r; ++dy)
+            for (int dx = -r; dx <= r; ++dx)
+                if (dx * dx + dy * dy <= r * r) set(static_cast<int>(std::lround(x)) + dx, static_cast<int>(std::lround(y)) + dy, c);
+    }
+    void square(double x, double y, int r, const std::uint8_t c[3]) {
+        for (int dy = -r; dy <= r; ++dy)
+            for (int dx = -r; dx <= r; ++dx) set(static_cast<int>(std::lround(x)) + dx, static_cast<int>(std::lround(y)) + dy, c);
+    }
+    // 5x7 glyphs, each row a 5-bit mask (bit 4 = leftmost), scaled by `scale`
+    void text(int x, int y, const std::string& str, const std::uint8_t c[3], int scale = 2) {
+        for (char ch : str) {
+            const std::uint8_t* g = glyph(ch);
+            for (int r = 0; r < 7; ++r)
+                for (int col = 0; col < 5; ++col)
+                    if (g[r] & (16 >> col))
+                        for (int sy = 0; sy < scale; ++sy)
+                            for (int sx = 0; sx < scale; ++sx) set(x + col * scale + sx, y + r * scale + sy, c);
+            x += 6 * scale;
+        }
+    }
+    static const std::uint8_t* glyph(char ch) {
+        static const struct { char c; std::uint8_t rows[7]; } font[] = {
+            {'0', {14, 17, 19, 21, 25, 17, 14}}, {'1', {4, 12, 4, 4, 4, 4, 14}},   {'2', {14, 17, 1, 2, 4, 8, 31}},
+            {'3', {30, 1, 1, 14, 1, 1, 30}},     {'4', {2, 6, 10, 18, 31, 2, 2}},  {'5', {31, 16, 30, 1, 1, 17, 14}},
+            {'6', {6, 8, 16, 30, 17, 17, 14}},   {'7', {31, 1, 2, 4, 8, 8, 8}},    {'8', {14, 17, 17, 14, 17, 17, 14}},
+            {'9', {14, 17, 17, 15, 1, 2, 12}},   {'.', {0, 0, 0, 0, 0, 12, 12}},   {'x', {0, 0, 17, 10, 4, 10, 17}},
+            {'m', {0, 0, 26, 21, 21, 21, 21}},   {'s', {0, 0, 15, 16, 14, 1, 30}}, {'R', {30, 17, 17, 30, 20, 18, 17}},
+            {'M', {17, 27, 21, 21, 17, 17, 17}}, {'S', {15, 16, 16, 14, 1, 1, 30}}, {'E', {31, 16, 16, 30, 16, 16, 31}},
+            {'p', {0, 0, 30, 17, 30, 16, 16}},   {'a', {0, 0, 14, 1, 15, 17, 15}}, {'e', {0, 0, 14, 17, 31, 16, 14}},
+            {'r', {0, 0, 22, 25, 16, 16, 16}},   {'n', {0, 0, 22, 25, 17, 17, 17}}, {'g', {0, 0, 15, 17, 15, 1, 14}},
+            {'i', {4, 0, 12, 4, 4, 4, 14}},      {'o', {0, 0, 14, 17, 17, 17, 14}}, {'f', {6, 9, 8, 28, 8, 8, 8}},
+            {'t', {8, 8, 28, 8, 8, 9, 6}},       {'l', {12, 4, 4, 4, 4, 4, 14}},   {'h', {16, 16, 22, 25, 17, 17, 17}},
+            {'d', {1, 1, 13, 19, 17, 19, 13}},   {'c', {0, 0, 14, 16, 16, 17, 14}}, {'u', {0, 0, 17, 17, 17, 19, 13}},
+            {'b', {16, 16, 22, 25, 17, 17, 30}}, {'v', {0, 0, 17, 17, 17, 10, 4}},  {'w', {0, 0, 17, 17, 21, 21, 10}},
+            {'k', {16, 16, 18, 20, 24, 20, 18}}, {'y', {0, 0, 17, 17, 15, 1, 14}},  {'T', {31, 4, 4, 4, 4, 4, 4}},
+            {'(', {2, 4, 8, 8, 8, 4, 2}},        {')', {8, 4, 2, 2, 2, 4, 8}},     {',', {0, 0, 0, 0, 12, 4, 8}},
+            {'-', {0, 0, 0, 31, 0, 0, 0}},       {'=', {0, 0, 31, 0, 31, 0, 0}},   {'/', {1, 1, 2, 4, 8, 16, 16}},
+            {':', {0, 12, 12, 0, 12, 12, 0}},    {'^', {4, 10, 17, 0, 0, 0, 0}},   {' ', {0, 0, 0, 0, 0, 0, 0}},
+        };
+        static const std::uint8_t unknown[7] = {31, 17, 17, 17, 17, 17, 31};
+        for (const auto& f : font)
+            if (f.c == ch) return f.rows;
+        return unknown;
+    }
+};
+
+struct PlotPoint {
+    int size, subsample, threads;
+    std::string settings;
+    double ms, rmse;
+};
+
+void speedErrorPlot(const std::vector<PlotPoint>& pts, const std::string& file) {
+    const int W = 1000, H = 680, left = 110, right = 250, top = 60, bottom = 90;
+    Canvas c(W, H);
+    const std::uint8_t black[3] = {0, 0, 0}, grey[3] = {215, 215, 215};
+    double msLo = 1e30, msHi = 0.0, eHi = 0.0;
+    for (const PlotPoint& p : pts)
+        if (p.threads == 2) {
+            msLo = std::min(msLo, p.ms);
+            msHi = std::max(msHi, p.ms);
+            eHi = std::max(eHi, p.rmse);
+        }
+    const double lx0 = std::floor(std::log10(msLo)), lx1 = std::ceil(std::log10(msHi));
+    const double eTop = std::ceil(eHi / 0.01) * 0.01;
+    auto X = [&](double ms) { return left + (std::log10(ms) - lx0) / (lx1 - lx0) * (W - left - right); };
+    auto Y = [&](double e) { return H - bottom - e / eTop * (H - top - bottom); };
+    // grid and axes
+    for (double d = lx0; d <= lx1 + 1e-9; d += 1.0)
+        for (int k = 1; k < 10; ++k) {
+            const double v = std::pow(10.0, d) * k;
+            if (std::log10(v) > lx1 + 1e-9) break;
+            c.line(X(v), top, X(v), H - bottom, grey);
+            if (k == 1 || k == 2 || k == 5) {
+                char b[32];
+                std::snprintf(b, sizeof b, "%g", v);
+                c.text(static_cast<int>(X(v)) - 6 * static_cast<int>(std::string(b).size()), H - bottom + 10, b, black);
+            }
+        }
+    for (double e = 0.0; e <= eTop + 1e-9; e += 0.005) {
+        c.line(left, Y(e), W - right, Y(e), grey);
+        char b[32];
+        std::snprintf(b, sizeof b, "%.3f", e);
+        c.text(left - 80, static_cast<int>(Y(e)) - 7, b, black);
+    }
+    c.line(left, top, left, H - bottom, black, 2);
+    c.line(left, H - bottom, W - right, H - bottom, black, 2);
+    c.text(left + 120, H - 40, "ms per frame (2 threads, log scale)", black);
+    c.text(20, 20, "ambient RMSE vs ground truth", black);
+    c.text(left + 330, 20, "GI frame: speed vs error", black);
+    // one polyline per (size, settings) through 4x -> 2x -> 1x; 15 ms target line
+    const std::uint8_t colours[3][3] = {{200, 40, 40}, {40, 110, 200}, {30, 150, 60}};
+    const int sizes[3] = {256, 512, 1024};
+    const std::uint8_t target[3] = {150, 150, 150};
+    c.line(X(15.0), top, X(15.0), H - bottom, target, 1);
+    c.text(static_cast<int>(X(15.0)) + 4, top + 4, "15", target);
+    int legendY = top + 10;
+    for (int si = 0; si < 3; ++si)
+        for (const char* which : {"paper", "engine"}) {
+            std::vector<const PlotPoint*> line;
+            for (int sub : {4, 2, 1})
+                for (const PlotPoint& p : pts)
+                    if (p.threads == 2 && p.size == sizes[si] && p.settings == which && p.subsample == sub) line.push_back(&p);
+            const bool paper = std::string(which) == "paper";
+            for (std::size_t i = 0; i + 1 < line.size(); ++i)
+                c.line(X(line[i]->ms), Y(line[i]->rmse), X(line[i + 1]->ms), Y(line[i + 1]->rmse), colours[si], paper ? 1 : 3);
+            for (const PlotPoint* p : line) {
+                if (paper) c.square(X(p->ms), Y(p->rmse), 4, colours[si]);
+                else c.dot(X(p->ms), Y(p->rmse), 5, colours[si]);
+                char b[8];
+                std::snprintf(b, sizeof b, "%dx", p->subsample);
+                c.text(static_cast<int>(X(p->ms)) + 7, static_cast<int>(Y(p->rmse)) - 16, b, colours[si]);
+            }
+            const int lx = W - right + 20;
+            if (paper) c.square(lx + 6, legendY + 7, 4, colours[si]);
+            else c.dot(lx + 6, legendY + 7, 5, colours[si]);
+            c.text(lx + 20, legendY, std::to_string(sizes[si]) + "^2 " + which, colours[si]);
+            legendY += 24;
+        }
+    c.text(W - right + 20, legendY + 10, "squares: paper", black);
+    c.text(W - right + 20, legendY + 34, "dots: engine", black);
+    writePngRgb(file, W, H, c.px);
+    std::fprintf(stderr, "wrote %s\n", file.c_str());
 }
 
 // ---------------------------------------------------------------------------
@@ -348,9 +514,9 @@ void timing() {
     const Dem perdu = loadPerdu();
     struct Size { Dem dem; std::string source; };
     std::vector<Size> sizes;
-    sizes.push_back({crop(alps, 256, "c256"), "alps-montblanc centre crop 256 x 256 (cell 92.74 m)"});
-    sizes.push_back({crop(alps, 512, "c512"), "alps-montblanc centre crop 512 x 512 (cell 92.74 m)"});
-    sizes.push_back({crop(perdu, 1024, "c1024"), "mtperdu_20m centre crop 1024 x 1024 (cell 20 m)"});
+    sizes.push_back({crop(alps, 256, "c256"), "alps c256"});
+    sizes.push_back({crop(alps, 512, "c512"), "alps c512"});
+    sizes.push_back({crop(perdu, 1024, "c1024"), "mtperdu c1024"});
     GiLighting light;
     light.environment = sunSkyLight();
     KeyLight key;
@@ -359,14 +525,22 @@ void timing() {
     key.radiusDeg = 4.0f;
     light.keys.push_back(key);
     std::string md = "# GI time per frame\n\n";
-    md += "Frame = gradient + pyramid + environment visibility + key-light visibility + direct shading (Lambert, RGB), "
-          "one sun-and-sky environment light (m azimuths) and one key light (3 azimuths). Median of " +
-          std::to_string(gRuns) + " frames after a warm-up. Machine: " + machine() +
-          ". Error: ambient RMSE / bias against gi/reference (256 azimuths) over the interior (10 % border left out), "
-          "every 4th texel in x and y for 1024^2.\n\n";
-    md += "| DEM | size | subsample | settings | threads | ms/frame | pyramid | visibility | key light | shading | RMSE | bias |\n";
+    md += "Frame = gradient + pyramid + environment visibility + key-light visibility + direct shading (Lambert, RGB + ambient "
+          "map), one sun-and-sky environment light (m azimuths) and one key light (3 azimuths over its extent), as "
+          "`terrain gi --frames N --time` runs it. Median of " + std::to_string(gRuns) +
+          " frames after a warm-up; stage columns are medians too (ms).\n\n"
+          "DEMs (centre crops at true scale, no resampling): 256^2 and 512^2 = ../shared/data/alps-montblanc.png (cell 92.74 m), "
+          "1024^2 = ../shared/data/mtperdu_20m.png (cell 20 m).\n\n"
+          "Error: ambient map (normal-weighted sky-view factor) RMSE / bias against gi/reference (256 azimuths, exact march) "
+          "over the interior (10 % border left out); at 1024^2 over every 4th texel in x and y of the interior (the "
+          "reference is computed and cached only there). The error does not depend on the thread count.\n\n"
+          "Settings: paper = m 32, k_v 4, o_v 2, Eq. 16 B-spline maximum; engine = the engine defaults (o_v 3, 25 % "
+          "peak-keeping pyramid, sample maximum).\n\nMachine: " + machine() + " (shared with other work; taken when idle). Build: " +
+          buildFlags() + ".\n\nCommand: `" + gCommand + "` (from the repository root; references cached in /tmp).\n\n";
+    md += "| DEM | size | sub | settings | threads | ms/frame | pyramid | visibility | key light | shading | RMSE | bias |\n";
     md += "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     std::string csv = "dem,size,subsample,settings,threads,ms,pyramid_ms,visibility_ms,key_ms,shading_ms,rmse,bias\n";
+    std::vector<PlotPoint> pts;
     for (const Size& sz : sizes) {
         const int n = sz.dem.heights.nx;
         const int border = n / 10;
@@ -392,12 +566,33 @@ void timing() {
                     std::snprintf(buf, sizeof buf, "%s,%d,%d,%s,%d,%.2f,%.2f,%.2f,%.2f,%.2f,%.5f,%.5f\n", sz.dem.name.c_str(), n, s,
                                   which, threads, t.median, t.pyramid, t.visibility, t.key, t.shading, e.rmse, e.bias);
                     csv += buf;
+                    pts.push_back({n, s, threads, which, t.median, e.rmse});
                     std::fprintf(stderr, "%s %d %dx %s %dT: %.1f ms (rmse %.4f)\n", sz.dem.name.c_str(), n, s, which, threads,
                                  t.median, e.rmse);
                 }
     }
+    md += "\n![speed vs error](gi_speed_error.png)\n";
     writeFile("gi_timing.md", md);
     writeFile("gi_timing.csv", csv);
+    speedErrorPlot(pts, gOutDir + "/gi_speed_error.png");
+}
+
+// plot only, from an existing gi_timing.csv
+void plotFromCsv() {
+    std::ifstream in(gOutDir + "/gi_timing.csv");
+    std::string line;
+    std::getline(in, line);
+    std::vector<PlotPoint> pts;
+    while (std::getline(in, line)) {
+        std::vector<std::string> f;
+        std::size_t a = 0;
+        for (std::size_t b; (b = line.find(',', a)) != std::string::npos; a = b + 1) f.push_back(line.substr(a, b - a));
+        f.push_back(line.substr(a));
+        if (f.size() < 12) continue;
+        pts.push_back({std::atoi(f[1].c_str()), std::atoi(f[2].c_str()), std::atoi(f[4].c_str()), f[3], std::atof(f[5].c_str()),
+                       std::atof(f[10].c_str())});
+    }
+    speedErrorPlot(pts, gOutDir + "/gi_speed_error.png");
 }
 
 // ---------------------------------------------------------------------------
@@ -519,6 +714,7 @@ int main(int argc, char** argv) {
         else if (a == "--runs" && i + 1 < argc) gRuns = std::max(1, std::atoi(argv[++i]));
         else modes.push_back(a);
     }
+    for (int i = 1; i < argc; ++i) gCommand += std::string(" ") + argv[i];
     if (modes.empty()) modes = {"accuracy", "convergence", "timing"};
     try {
         for (const std::string& m : modes) {
@@ -528,6 +724,7 @@ int main(int argc, char** argv) {
             else if (m == "explore") explore();
             else if (m == "stages") stages();
             else if (m == "quick") quickAccuracy();
+            else if (m == "plot") plotFromCsv();
             else if (m == "cpu") cpuStages();
             else {
                 std::fprintf(stderr, "bench_gi: unknown mode %s\n", m.c_str());

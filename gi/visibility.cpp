@@ -298,25 +298,31 @@ void nlpRow(const float* __restrict maxSlope, const float* __restrict gx, const 
     (void)nxr;
 }
 
-void accumulateRow(const float* __restrict nlp, const float* opValues, const std::uint8_t* patRow,
-                   const std::uint8_t* patNlp, int patSize, float* const* vRows, int nxr, int nxrPad) {
-    // entries are sorted by SH row: each row of V is read and written once
+// V += G_j w_j for a batch of azimuths (1 or 2), each SH row of V read and
+// written once per batch; the additions run in the same order as one azimuth
+// and one entry after the other (bit-identical to the plain sequence).
+// opSplat: the folded operator's entries, each repeated 4 times.
+void accumulateRows(const float* const* nlp, const float* const* opSplat, int batch, const std::uint8_t* patRow,
+                    const std::uint8_t* patNlp, int patSize, float* const* vRows, int nxr, int nxrPad) {
+    const int nVec = nxr / 4 * 4;
     int e = 0;
     while (e < patSize) {
         const int r = patRow[e];
         int e1 = e;
         while (e1 < patSize && patRow[e1] == r) ++e1;
         float* __restrict v = vRows[r];
-        if (e1 - e == 1) {
-            const float g = opValues[e];
-            const float* __restrict w = nlp + static_cast<std::size_t>(patNlp[e]) * nxrPad;
-            for (int X = 0; X < nxr; ++X) v[X] += g * w[X];
-        } else {
-            for (int q = e; q < e1; ++q) {
-                const float g = opValues[q];
-                const float* __restrict w = nlp + static_cast<std::size_t>(patNlp[q]) * nxrPad;
-                for (int X = 0; X < nxr; ++X) v[X] += g * w[X];
-            }
+        for (int X = 0; X < nVec; X += 4) {
+            v4 acc = load4(v + X);
+            for (int a = 0; a < batch; ++a)
+                for (int q = e; q < e1; ++q)
+                    acc += load4a(opSplat[a] + 4 * q) * load4(nlp[a] + static_cast<std::size_t>(patNlp[q]) * nxrPad + X);
+            store4(v + X, acc);
+        }
+        for (int X = nVec; X < nxr; ++X) {
+            float acc = v[X];
+            for (int a = 0; a < batch; ++a)
+                for (int q = e; q < e1; ++q) acc += opSplat[a][4 * q] * nlp[a][static_cast<std::size_t>(patNlp[q]) * nxrPad + X];
+            v[X] = acc;
         }
         e = e1;
     }
@@ -419,6 +425,10 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
                     total += std::min(state.stepsPerColumn[static_cast<std::size_t>(j) * nxrPad + X], state.stepsPerRow[static_cast<std::size_t>(j) * nyr + Y]);
         std::fprintf(stderr, "samples %lld (%.1f per receiver-azimuth, %d steps)\n", total, double(total) / (double(m) * nxr * nyr), nSteps);
     }
+    state.opSplat.resize(static_cast<std::size_t>(m) * 4 * op.patternSize());
+    for (std::size_t e = 0; e < op.values.size(); ++e)
+        for (int l = 0; l < 4; ++l) state.opSplat[4 * e + static_cast<std::size_t>(l)] = op.values[e];
+
     const int nBlocks = std::max(1, std::min(nyr, kMaxBlocks));
     state.blocks.resize(static_cast<std::size_t>(nBlocks));
     for (VisibilityScratch& b : state.blocks) {
@@ -426,7 +436,7 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
         b.gradX.resize(static_cast<std::size_t>(nxrPad));
         b.gradY.resize(static_cast<std::size_t>(nxrPad));
         b.h0.resize(static_cast<std::size_t>(nSteps) * nxrPad);
-        b.nlp.resize(static_cast<std::size_t>(4) * nxrPad);
+        b.nlp.resize(static_cast<std::size_t>(8) * nxrPad);
     }
     // ---- schedule: fixed row blocks in parallel, rows serially within a block,
     // every azimuth of a row before the next row (the row's h0 / tau table is
@@ -455,21 +465,30 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
                     vRows[i] = out.plane(i) + static_cast<std::size_t>(Y) * nxr;
                     std::fill(vRows[i], vRows[i] + nxr, 0.0f);
                 }
-                for (int j = 0; j < m; ++j) {
-                    const ScanStep* table = state.steps.data() + static_cast<std::size_t>(j) * nSteps;
-                    const int* colSteps = state.stepsPerColumn.data() + static_cast<std::size_t>(j) * nxrPad;
-                    const int rowSteps = state.stepsPerRow[static_cast<std::size_t>(j) * nyr + static_cast<std::size_t>(Y)];
-                    if (settings.blockingMax == BlockingMax::Samples)
-                        scanRow<4, SampleMaxVisitor>(table, colSteps, rowSteps, Y, sc.h0.data(), nxrPad, nxrPad, sc.maxRow.data());
-                    else
-                        scanRow<2, BsplineMaxVisitor>(table, colSteps, rowSteps, Y, sc.h0.data(), nxrPad, nxrPad, sc.maxRow.data());
-                    float* maxOut = out.maxSlope.data() + planeSize * j + static_cast<std::size_t>(Y) * nxr;
-                    std::copy(sc.maxRow.data(), sc.maxRow.data() + nxr, maxOut);
-                    const double phi = op.phi[static_cast<std::size_t>(j)];
-                    nlpRow(sc.maxRow.data(), sc.gradX.data(), sc.gradY.data(), static_cast<float>(std::cos(phi)),
-                           static_cast<float>(std::sin(phi)), target, sc.nlp.data(), nxr, nxrPad);
-                    accumulateRow(sc.nlp.data(), op.values.data() + static_cast<std::size_t>(j) * op.patternSize(),
-                                  op.patternRow.data(), op.patternNlp.data(), op.patternSize(), vRows, nxr, nxrPad);
+                for (int j0 = 0; j0 < m; j0 += 2) {
+                    const int batch = std::min(2, m - j0);
+                    const float* nlps[2];
+                    const float* ops[2];
+                    for (int a = 0; a < batch; ++a) {
+                        const int j = j0 + a;
+                        const ScanStep* table = state.steps.data() + static_cast<std::size_t>(j) * nSteps;
+                        const int* colSteps = state.stepsPerColumn.data() + static_cast<std::size_t>(j) * nxrPad;
+                        const int rowSteps = state.stepsPerRow[static_cast<std::size_t>(j) * nyr + static_cast<std::size_t>(Y)];
+                        if (settings.blockingMax == BlockingMax::Samples)
+                            scanRow<4, SampleMaxVisitor>(table, colSteps, rowSteps, Y, sc.h0.data(), nxrPad, nxrPad, sc.maxRow.data());
+                        else
+                            scanRow<2, BsplineMaxVisitor>(table, colSteps, rowSteps, Y, sc.h0.data(), nxrPad, nxrPad, sc.maxRow.data());
+                        float* maxOut = out.maxSlope.data() + planeSize * j + static_cast<std::size_t>(Y) * nxr;
+                        std::copy(sc.maxRow.data(), sc.maxRow.data() + nxr, maxOut);
+                        const double phi = op.phi[static_cast<std::size_t>(j)];
+                        float* nlp = sc.nlp.data() + static_cast<std::size_t>(a) * 4 * nxrPad;
+                        nlpRow(sc.maxRow.data(), sc.gradX.data(), sc.gradY.data(), static_cast<float>(std::cos(phi)),
+                               static_cast<float>(std::sin(phi)), target, nlp, nxr, nxrPad);
+                        nlps[a] = nlp;
+                        ops[a] = state.opSplat.data() + static_cast<std::size_t>(j) * 4 * op.patternSize();
+                    }
+                    accumulateRows(nlps, ops, batch, op.patternRow.data(), op.patternNlp.data(), op.patternSize(), vRows, nxr,
+                                   nxrPad);
                 }
             }
         }

@@ -68,7 +68,7 @@ struct VisibilityScratch {
     std::vector<float> gradX;   // nxr: dh/dx at the receivers of the current row
     std::vector<float> gradY;
     std::vector<float> h0;      // steps x nxr: receiver height / tau_i of the current row
-    std::vector<float> nlp;     // 4 x nxr: NLP visibility vectors of the current row and azimuth
+    std::vector<float> nlp;     // 2 x 4 x nxr: NLP visibility vectors of the current row, two azimuths
 };
 
 /// One step of one azimuth, as the scan kernel reads it: the sample of
@@ -108,6 +108,7 @@ struct VisibilityState {
     std::vector<int> validRows;     // azimuths x steps: same for receiver rows Y (pairs)
     std::vector<int> stepsPerColumn;  // azimuths x padded nxr: valid-prefix length from x alone
     std::vector<int> stepsPerRow;     // azimuths x nyr: valid-prefix length from y alone
+    std::vector<float> opSplat;       // the folded operator's entries, each 4 times (16-byte aligned)
 };
 
 /// Lowest slope used for "nothing blocks in this direction".
