@@ -419,6 +419,7 @@ struct Canvas {
             {'(', {2, 4, 8, 8, 8, 4, 2}},        {')', {8, 4, 2, 2, 2, 4, 8}},     {',', {0, 0, 0, 0, 12, 4, 8}},
             {'-', {0, 0, 0, 31, 0, 0, 0}},       {'=', {0, 0, 31, 0, 31, 0, 0}},   {'/', {1, 1, 2, 4, 8, 16, 16}},
             {':', {0, 12, 12, 0, 12, 12, 0}},    {'^', {4, 10, 17, 0, 0, 0, 0}},   {' ', {0, 0, 0, 0, 0, 0, 0}},
+            {'G', {14, 17, 16, 23, 17, 17, 15}}, {'I', {14, 4, 4, 4, 4, 4, 14}},   {'q', {0, 0, 15, 17, 15, 1, 1}},
         };
         static const std::uint8_t unknown[7] = {31, 17, 17, 17, 17, 17, 31};
         for (const auto& f : font)
@@ -476,7 +477,7 @@ void speedErrorPlot(const std::vector<PlotPoint>& pts, const std::string& file) 
     const int sizes[3] = {256, 512, 1024};
     const std::uint8_t target[3] = {150, 150, 150};
     c.line(X(15.0), top, X(15.0), H - bottom, target, 1);
-    c.text(static_cast<int>(X(15.0)) + 4, top + 4, "15", target);
+    c.text(static_cast<int>(X(15.0)) + 4, top + 4, "15 ms target", target);
     int legendY = top + 10;
     for (int si = 0; si < 3; ++si)
         for (const char* which : {"paper", "engine"}) {
