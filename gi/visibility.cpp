@@ -42,6 +42,8 @@ inline int padLanes(int n) { return (n + kLanes - 1) / kLanes * kLanes; }
 struct StepGeometry {
     ScanStep step;
     int xFirst = 0, xLast = -1, yFirst = 0, yLast = -1;  // valid receivers
+    double dx = 0.0, dy = 0.0;                            // sample offset in field texels
+    int k = 1, fieldNx = 0, fieldNy = 0;                  // receiver spacing in field texels, field size
 };
 
 void validRange(double d, int k, int fieldN, int receivers, int& first, int& last) {
@@ -59,11 +61,24 @@ void validRange(double d, int k, int fieldN, int receivers, int& first, int& las
 StepGeometry makeStep(const HeightPyramid& pyr, int i, double c, double sn) {
     const PyramidStep& ps = pyr.steps[static_cast<std::size_t>(i)];
     const int s = pyr.subsample;
+    const bool raw = ps.level < 0;
     StepGeometry g;
     ScanStep& st = g.step;
-    double dx = ps.tauCells * c, dy = ps.tauCells * sn;
+    // Sample on a grid line of the field it reads (as the reference march
+    // does): the step is moved along the ray to the nearest crossing of the
+    // lines across the ray's major axis, where the bilinear field is linear
+    // between two texels (two taps instead of four). The move is at most half a
+    // texel along that axis; 1 / tau is that of the moved sample.
+    const double unit = raw ? 1.0 : static_cast<double>(s);  // texel spacing of the field, cells
+    const bool alongX = std::abs(c) >= std::abs(sn);
+    const double major = alongX ? c : sn;
+    const double texels = std::max(1.0, std::round(std::abs(ps.tauCells * major) / unit));
+    const double tau = texels * unit / std::abs(major);
+    double dx = tau * c, dy = tau * sn;
+    if (alongX) dx = std::copysign(texels * unit, c);
+    else dy = std::copysign(texels * unit, sn);
     int k, fieldNx, fieldNy;
-    if (ps.level < 0) {
+    if (raw) {
         k = s;
         fieldNx = pyr.nx;
         fieldNy = pyr.ny;
@@ -76,44 +91,41 @@ StepGeometry makeStep(const HeightPyramid& pyr, int i, double c, double sn) {
     }
     validRange(dx, k, fieldNx, pyr.nxr, g.xFirst, g.xLast);
     validRange(dy, k, fieldNy, pyr.nyr, g.yFirst, g.yLast);
+    g.dx = dx;
+    g.dy = dy;
+    g.k = k;
+    g.fieldNx = fieldNx;
+    g.fieldNy = fieldNy;
     const double c0d = std::floor(dx), r0d = std::floor(dy);
     const int c0 = static_cast<int>(c0d), r0 = static_cast<int>(r0d);
-    const float fx = static_cast<float>(dx - c0d), fy = static_cast<float>(dy - r0d);
-    // bilinear weights scaled by 1 / tau: the kernel forms the slope as
-    // sum_k (w_k / tau) h_k - h0 / tau (one multiply less per sample)
-    const float it = ps.invTauWorld;
-    const float weights[5] = {((1.0f - fx) * (1.0f - fy)) * it, (fx * (1.0f - fy)) * it, ((1.0f - fx) * fy) * it,
-                              (fx * fy) * it, it};
-    for (int q = 0; q < 5; ++q)
+    const float f = static_cast<float>(alongX ? dy - r0d : dx - c0d);  // the other coordinate's fraction
+    const float weights[3] = {1.0f - f, f, static_cast<float>(1.0 / (tau * pyr.cellSize))};
+    for (int q = 0; q < 3; ++q)
         for (int l = 0; l < 4; ++l) st.w[q][l] = weights[q];
-    if (ps.level < 0) {
+    if (raw) {
         // column s X + c0 lies in phase plane (c0 mod s) at X + floor(c0 / s)
         const int qa = ((c0 % s) + s) % s, qb = (((c0 + 1) % s) + s) % s;
         const int colA = (c0 - qa) / s, colB = (c0 + 1 - qb) / s;
         const std::ptrdiff_t w = pyr.rawPhaseWidth;
         st.field = pyr.rawPhaseData();
         st.rowStep = s * w;
-        st.rowNext = w;
         st.offA = qa * pyr.rawPhasePlane + r0 * w + colA;
-        st.offB = qb * pyr.rawPhasePlane + r0 * w + colB;
+        st.offB = alongX ? st.offA + w : qb * pyr.rawPhasePlane + r0 * w + colB;  // next row / next column
     } else {
-        const PaddedField& f = pyr.levels[static_cast<std::size_t>(ps.level)];
-        st.field = f.data();
-        st.rowStep = f.stride;
-        st.rowNext = f.stride;
-        st.offA = r0 * f.stride + c0;
-        st.offB = st.offA + 1;
+        const PaddedField& fl = pyr.levels[static_cast<std::size_t>(ps.level)];
+        st.field = fl.data();
+        st.rowStep = fl.stride;
+        st.offA = r0 * fl.stride + c0;
+        st.offB = st.offA + (alongX ? fl.stride : 1);
     }
     return g;
 }
 
 // The blocking slope of one receiver at one step (the scalar form of the
-// kernel's lanes: the same operations in the same order). h0s = h0 / tau.
-inline float sampleSlope(const ScanStep& st, std::ptrdiff_t index, float h0s) {
-    const float* a = st.field + index + st.offA;
-    const float* b = st.field + index + st.offB;
-    const float v = (st.w[0][0] * a[0] + st.w[1][0] * b[0]) + (st.w[2][0] * a[st.rowNext] + st.w[3][0] * b[st.rowNext]);
-    return v - h0s;
+// kernel's lanes: the same operations in the same order).
+inline float sampleSlope(const ScanStep& st, std::ptrdiff_t index, float h0) {
+    const float v = st.w[0][0] * st.field[index + st.offA] + st.w[1][0] * st.field[index + st.offB];
+    return (v - h0) * st.w[2][0];
 }
 
 // ---- algorithm: per-step visitors over the slope sequence ---------------------
@@ -192,23 +204,18 @@ struct BsplineMaxVisitor {
 };
 
 // ---- algorithm: the scan of 4 NV receivers (X0 .. X0 + 4 NV - 1 of row Y) -------
-// h0s: the row's h0 / tau table (steps x nxrPad); steps: valid-prefix length
+// h0: the row's receiver heights; steps: valid-prefix length
 // of each lane; all lanes are valid for i < nAll, none for i >= nAny.
 template <int NV, class Visitor>
-inline void scanLanes(const ScanStep* table, int Y, int X0, const float* h0s, std::ptrdiff_t h0sStride, const v4i* steps,
+inline void scanLanes(const ScanStep* table, int Y, int X0, const float* h0, const v4i* steps,
                       int nAll, int nAny, Visitor& visit) {
     auto sample = [&](int i, v4* s) {
         const ScanStep& st = table[i];
         const std::ptrdiff_t o = Y * st.rowStep + X0;
         const float* a = st.field + (o + st.offA);
         const float* b = st.field + (o + st.offB);
-        const float* hs = h0s + i * h0sStride + X0;
-        const std::ptrdiff_t n = st.rowNext;
-        const v4 w00 = load4a(st.w[0]), w01 = load4a(st.w[1]), w10 = load4a(st.w[2]), w11 = load4a(st.w[3]);
-        for (int k = 0; k < NV; ++k) {
-            const v4 v = (w00 * load4(a + 4 * k) + w01 * load4(b + 4 * k)) + (w10 * load4(a + n + 4 * k) + w11 * load4(b + n + 4 * k));
-            s[k] = v - load4a(hs + 4 * k);
-        }
+        const v4 wa = load4a(st.w[0]), wb = load4a(st.w[1]), inv = load4a(st.w[2]);
+        for (int k = 0; k < NV; ++k) s[k] = ((wa * load4(a + 4 * k) + wb * load4(b + 4 * k)) - load4a(h0 + X0 + 4 * k)) * inv;
     };
     for (int i = 0; i < nAll; ++i) {
         v4 s[NV];
@@ -232,8 +239,7 @@ inline void scanLanes(const ScanStep* table, int Y, int X0, const float* h0s, st
 
 // Maximum blocking slope of a row of receivers for one azimuth.
 template <int NV, template <int> class Visitor>
-void scanRow(const ScanStep* table, const int* colSteps, int rowSteps, int Y, const float* h0s, std::ptrdiff_t h0sStride,
-             int nxrPad, float* out) {
+void scanRow(const ScanStep* table, const int* colSteps, int rowSteps, int Y, const float* h0, int nxrPad, float* out) {
     constexpr int lanes = 4 * NV;
     const v4i rowLimit = {rowSteps, rowSteps, rowSteps, rowSteps};
     for (int X0 = 0; X0 < nxrPad; X0 += lanes) {
@@ -249,7 +255,7 @@ void scanRow(const ScanStep* table, const int* colSteps, int rowSteps, int Y, co
         const int nAll = std::min(std::min(lo[0], lo[1]), std::min(lo[2], lo[3]));
         const int nAny = std::max(std::max(hi[0], hi[1]), std::max(hi[2], hi[3]));
         Visitor<NV> visit;
-        scanLanes<NV>(table, Y, X0, h0s, h0sStride, steps, nAll, nAny, visit);
+        scanLanes<NV>(table, Y, X0, h0, steps, nAll, nAny, visit);
         visit.result(out + X0);
     }
 }
@@ -351,15 +357,11 @@ float scanReceiverScalar(const HeightPyramid& pyr, int X, int Y, double phi, Blo
     const float h0 = pyr.rawPhaseRow(0, s * Y)[X];
     std::vector<float> seq;
     for (int i = 0; i < static_cast<int>(pyr.steps.size()); ++i) {
-        // own bounds test on the sample position
-        const PyramidStep& ps = pyr.steps[static_cast<std::size_t>(i)];
-        const bool raw = ps.level < 0;
-        const double px = raw ? s * X + ps.tauCells * c : X + ps.tauCells * c / s;
-        const double py = raw ? s * Y + ps.tauCells * sn : Y + ps.tauCells * sn / s;
-        const double xmax = raw ? pyr.nx - 1 : pyr.nxr - 1, ymax = raw ? pyr.ny - 1 : pyr.nyr - 1;
-        if (!(px >= 0.0 && px <= xmax && py >= 0.0 && py <= ymax)) break;
+        // own bounds test on the (moved) sample position
         const StepGeometry g = makeStep(pyr, i, c, sn);
-        seq.push_back(sampleSlope(g.step, Y * g.step.rowStep + X, h0 * ps.invTauWorld));
+        const double px = g.k * X + g.dx, py = g.k * Y + g.dy;
+        if (!(px >= 0.0 && px <= g.fieldNx - 1 && py >= 0.0 && py <= g.fieldNy - 1)) break;
+        seq.push_back(sampleSlope(g.step, Y * g.step.rowStep + X, h0));
     }
     return maxBlockingSlopeOfSequence(seq.data(), static_cast<int>(seq.size()), rule);
 }
@@ -435,7 +437,7 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
         b.maxRow.resize(static_cast<std::size_t>(nxrPad));
         b.gradX.resize(static_cast<std::size_t>(nxrPad));
         b.gradY.resize(static_cast<std::size_t>(nxrPad));
-        b.h0.resize(static_cast<std::size_t>(nSteps) * nxrPad);
+        b.h0.resize(static_cast<std::size_t>(nxrPad));
         b.nlp.resize(static_cast<std::size_t>(8) * nxrPad);
     }
     // ---- schedule: fixed row blocks in parallel, rows serially within a block,
@@ -454,12 +456,7 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
                     sc.gradX[static_cast<std::size_t>(X)] = in ? gradX(s * X, s * Y) : 0.0f;
                     sc.gradY[static_cast<std::size_t>(X)] = in ? gradY(s * X, s * Y) : 0.0f;
                 }
-                for (int i = 0; i < nSteps; ++i) {
-                    const float it = pyr.steps[static_cast<std::size_t>(i)].invTauWorld;
-                    float* h = sc.h0.data() + static_cast<std::size_t>(i) * nxrPad;
-                    for (int X = 0; X < nxr; ++X) h[X] = hRow[X] * it;
-                    for (int X = nxr; X < nxrPad; ++X) h[X] = 0.0f;
-                }
+                for (int X = 0; X < nxrPad; ++X) sc.h0[static_cast<std::size_t>(X)] = X < nxr ? hRow[X] : 0.0f;
                 float* vRows[kShCount];
                 for (int i = 0; i < kShCount; ++i) {
                     vRows[i] = out.plane(i) + static_cast<std::size_t>(Y) * nxr;
@@ -475,9 +472,9 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
                         const int* colSteps = state.stepsPerColumn.data() + static_cast<std::size_t>(j) * nxrPad;
                         const int rowSteps = state.stepsPerRow[static_cast<std::size_t>(j) * nyr + static_cast<std::size_t>(Y)];
                         if (settings.blockingMax == BlockingMax::Samples)
-                            scanRow<4, SampleMaxVisitor>(table, colSteps, rowSteps, Y, sc.h0.data(), nxrPad, nxrPad, sc.maxRow.data());
+                            scanRow<4, SampleMaxVisitor>(table, colSteps, rowSteps, Y, sc.h0.data(), nxrPad, sc.maxRow.data());
                         else
-                            scanRow<2, BsplineMaxVisitor>(table, colSteps, rowSteps, Y, sc.h0.data(), nxrPad, nxrPad, sc.maxRow.data());
+                            scanRow<2, BsplineMaxVisitor>(table, colSteps, rowSteps, Y, sc.h0.data(), nxrPad, sc.maxRow.data());
                         float* maxOut = out.maxSlope.data() + planeSize * j + static_cast<std::size_t>(Y) * nxr;
                         std::copy(sc.maxRow.data(), sc.maxRow.data() + nxr, maxOut);
                         const double phi = op.phi[static_cast<std::size_t>(j)];

@@ -4,7 +4,10 @@
 // For every receiver and every azimuth phi_j the scan walks the exponential
 // steps of the height pyramid (Eq. 14) and records the blocking slope
 // tan(omega_i) = (f_l(p + tau_i d) - f(p)) / tau_i of each step (Eq. 15, as a
-// slope: atan is monotonic, GUIDE 3). The maximum blocking angle (Eq. 16) is
+// slope: atan is monotonic, GUIDE 3). Each sample is moved along the ray to the
+// nearest crossing of the field's grid lines across the ray's major axis (at
+// most half a texel along that axis), where the bilinear field is linear
+// between two texels, as in the reference march; tau_i is the moved distance. The maximum blocking angle (Eq. 16) is
 // the maximum of the cubic interpolant through these samples, evaluated at the
 // knots and midpoints (or, optionally, the plain maximum of the samples).
 //
@@ -67,21 +70,21 @@ struct VisibilityScratch {
     std::vector<float> maxRow;  // nxr: maximum blocking slope of the current row and azimuth
     std::vector<float> gradX;   // nxr: dh/dx at the receivers of the current row
     std::vector<float> gradY;
-    std::vector<float> h0;      // steps x nxr: receiver height / tau_i of the current row
+    std::vector<float> h0;      // nxr: receiver heights of the current row
     std::vector<float> nlp;     // 2 x 4 x nxr: NLP visibility vectors of the current row, two azimuths
 };
 
 /// One step of one azimuth, as the scan kernel reads it: the sample of
-/// receiver (X, Y) is the bilinear blend of field[Y rowStep + offA + X],
-/// field[... + offB + X] (the next column) and the same two one field row
-/// further (+ rowNext). offA/offB are element offsets from `field`; the raw
-/// steps address the phase-split planes, the level steps the level.
+/// receiver (X, Y) lies on a grid line of the field, between
+/// field[Y rowStep + offA + X] and field[Y rowStep + offB + X] (the next row or
+/// the next column); the slope is (wA a + wB b - h0) / tau. The raw steps
+/// address the phase-split planes, the level steps the level.
 struct ScanStep {
-    // w00, w01, w10, w11 ((row, column) bilinear weights) and 1 / (tau * cellSize),
+    // wA, wB (linear weights) and 1 / (tau * cellSize) of the moved sample,
     // each repeated 4 times so the kernel reads them as aligned vectors
-    alignas(16) float w[5][4] = {};
+    alignas(16) float w[3][4] = {};
     const float* field = nullptr;
-    std::ptrdiff_t rowStep = 0, rowNext = 0, offA = 0, offB = 0;
+    std::ptrdiff_t rowStep = 0, offA = 0, offB = 0;
 };
 
 /// Azimuth set and elevation window of one visibility computation.
