@@ -673,7 +673,10 @@ void cpuStages() {
     key.radiusDeg = 4.0f;
     light.keys.push_back(key);
     struct Case { const Dem* dem; int s; const char* which; };
+    int caseIndex = -1;
     for (const Case& c : {Case{&c512, 2, "engine"}, Case{&c512, 2, "paper"}, Case{&alps, 1, "engine"}}) {
+        ++caseIndex;
+        if (std::getenv("GI_CASE") && std::atoi(std::getenv("GI_CASE")) != caseIndex) continue;
         GiSettings set = std::string(c.which) == "paper" ? paperSettings() : engineDefaults();
         set.subsample = c.s;
         withThreads(1, [&] {

@@ -310,24 +310,34 @@ void nlpRow(const float* __restrict maxSlope, const float* __restrict gx, const 
 // opSplat: the folded operator's entries, each repeated 4 times.
 void accumulateRows(const float* const* nlp, const float* const* opSplat, int batch, const std::uint8_t* patRow,
                     const std::uint8_t* patNlp, int patSize, float* const* vRows, int nxr, int nxrPad) {
-    const int nVec = nxr / 4 * 4;
+    constexpr int kMaxTerms = 8;
+    const int n16 = nxr / 16 * 16;
     int e = 0;
     while (e < patSize) {
         const int r = patRow[e];
         int e1 = e;
-        while (e1 < patSize && patRow[e1] == r) ++e1;
+        while (e1 < patSize && patRow[e1] == r && e1 - e < kMaxTerms / 2) ++e1;
+        // the terms of this SH row, in addition order: azimuth, then entry
+        const float* w[kMaxTerms];
+        v4 g[kMaxTerms];
+        int nt = 0;
+        for (int a = 0; a < batch; ++a)
+            for (int q = e; q < e1; ++q) {
+                w[nt] = nlp[a] + static_cast<std::size_t>(patNlp[q]) * nxrPad;
+                g[nt] = load4a(opSplat[a] + 4 * q);
+                ++nt;
+            }
         float* __restrict v = vRows[r];
-        for (int X = 0; X < nVec; X += 4) {
-            v4 acc = load4(v + X);
-            for (int a = 0; a < batch; ++a)
-                for (int q = e; q < e1; ++q)
-                    acc += load4a(opSplat[a] + 4 * q) * load4(nlp[a] + static_cast<std::size_t>(patNlp[q]) * nxrPad + X);
-            store4(v + X, acc);
+        // 16 receivers at a time: four independent addition chains
+        for (int X = 0; X < n16; X += 16) {
+            v4 acc[4] = {load4(v + X), load4(v + X + 4), load4(v + X + 8), load4(v + X + 12)};
+            for (int t = 0; t < nt; ++t)
+                for (int k = 0; k < 4; ++k) acc[k] += g[t] * load4(w[t] + X + 4 * k);
+            for (int k = 0; k < 4; ++k) store4(v + X + 4 * k, acc[k]);
         }
-        for (int X = nVec; X < nxr; ++X) {
+        for (int X = n16; X < nxr; ++X) {
             float acc = v[X];
-            for (int a = 0; a < batch; ++a)
-                for (int q = e; q < e1; ++q) acc += opSplat[a][4 * q] * nlp[a][static_cast<std::size_t>(patNlp[q]) * nxrPad + X];
+            for (int t = 0; t < nt; ++t) acc += g[t][0] * w[t][X];
             v[X] = acc;
         }
         e = e1;
