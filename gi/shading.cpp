@@ -91,12 +91,15 @@ void lambertRowS(const float* vert, int nxrS, int nxr, int nCoef, const float* g
         const v4 X = -gx * inv, Yn = -gy * inv, Z = inv;
         const v4 lam[9] = {splat(c0), splat(c1) * Yn, splat(c1) * Z, splat(c1) * X, splat(c4) * X * Yn, splat(c4) * Yn * Z,
                            splat(c6) * (3.0f * Z * Z - 1.0f), splat(c4) * X * Z, splat(c8) * (X * X - Yn * Yn)};
-        v4 acc = splat(0.0f);
-        for (int i = 0; i < 9; ++i) acc += lam[i] * expand4<S>(vert + static_cast<std::size_t>(3 * nCoef + i) * nxrS, x);
+        // the four dot products interleaved: independent addition chains
+        v4 acc = splat(0.0f), oc[3] = {splat(0.0f), splat(0.0f), splat(0.0f)};
+        for (int i = 0; i < 9; ++i) {
+            acc += lam[i] * expand4<S>(vert + static_cast<std::size_t>(3 * nCoef + i) * nxrS, x);
+            for (int ch = 0; ch < 3; ++ch) oc[ch] += lam[i] * expand4<S>(vert + static_cast<std::size_t>(ch * nCoef + i) * nxrS, x);
+        }
         store4(amb + x, acc);
         for (int ch = 0; ch < 3; ++ch) {
-            v4 o = splat(0.0f);
-            for (int i = 0; i < 9; ++i) o += lam[i] * expand4<S>(vert + static_cast<std::size_t>(ch * nCoef + i) * nxrS, x);
+            v4 o = oc[ch];
             o *= diffuseWeight * (alb[ch] ? load4(alb[ch] + x) : splat(1.0f));
             const v4i finite = (o < fmax) & (o > -fmax);  // false for NaN and +-Inf
             store4(rgb[ch] + x, finite ? o : splat(0.0f));
