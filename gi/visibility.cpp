@@ -346,6 +346,17 @@ void accumulateRows(const float* const* nlp, const float* const* opSplat, int ba
 
 }  // namespace
 
+ScanStepInfo scanStepInfo(const HeightPyramid& pyr, int i, double cosPhi, double sinPhi) {
+    const StepGeometry g = makeStep(pyr, i, cosPhi, sinPhi);
+    ScanStepInfo info;
+    info.step = g.step;
+    info.xFirst = g.xFirst;
+    info.xLast = g.xLast;
+    info.yFirst = g.yFirst;
+    info.yLast = g.yLast;
+    return info;
+}
+
 float maxBlockingSlopeOfSequence(const float* slopes, int count, BlockingMax rule) {
     float out = kNoBlocker;
     if (count <= 0) return out;

@@ -114,6 +114,17 @@ struct VisibilityState {
     std::vector<float> opSplat;       // the folded operator's entries, each 4 times (16-byte aligned)
 };
 
+/// One step of the scan table as computeVisibility builds it (exposed for
+/// gi/indirect, which walks the same steps over a radiance pyramid): step i of
+/// azimuth (cosPhi, sinPhi) read from `pyramid` (raw heights or a level), and
+/// the receivers X in [xFirst, xLast], Y in [yFirst, yLast] whose sample lies
+/// inside the domain.
+struct ScanStepInfo {
+    ScanStep step;
+    int xFirst = 0, xLast = -1, yFirst = 0, yLast = -1;
+};
+ScanStepInfo scanStepInfo(const HeightPyramid& pyramid, int i, double cosPhi, double sinPhi);
+
 /// Lowest slope used for "nothing blocks in this direction".
 inline constexpr float kNoBlocker = -1.0e6f;
 
