@@ -14,6 +14,14 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
+// Indirect bounces over the last computed direct shade (issue 4).
+void runIndirectStage(const GiSettings& settings, GiState& st, const AlbedoMap* albedo) {
+    const auto t = Clock::now();
+    computeIndirect(st.pyramid, st.gradX.cview(), st.gradY.cview(), st.envOperator, st.envVisibility, st.shade.rgb, albedo,
+                    settings.shading, settings.indirect, st.indirect);
+    st.timings.indirect = msSince(t);
+}
+
 bool sameLight(const KeyLight& a, const KeyLight& b) {
     return a.azimuthDeg == b.azimuthDeg && a.elevationDeg == b.elevationDeg && a.radiusDeg == b.radiusDeg;
 }
@@ -86,6 +94,27 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
     if (albedo)
         for (const Grid& g : albedo->channel)
             if (!g.empty() && (g.nx != heights.nx || g.ny != heights.ny)) throw InputError("albedo map size differs from the heights");
+
+    validateIndirectSettings(settings.indirect);
+
+    // ---- amortisation (Section 7): on static geometry alternate direct / indirect --
+    const std::array<int, 6> key = {heights.nx, heights.ny, settings.subsample, settings.indirect.bounces,
+                                    settings.visibility.azimuths, static_cast<int>(settings.shading.brdf)};
+    const bool amortised = settings.indirect.amortise && settings.indirect.bounces > 0 && !st.geometryChanged &&
+                           st.amortiseReady && st.amortiseKey == key;
+    st.directUpdated = !amortised || st.amortisePhase == 0;
+    st.indirectUpdated = settings.indirect.bounces > 0 && (!amortised || st.amortisePhase == 1);
+    st.amortisePhase = amortised ? 1 - st.amortisePhase : 0;
+    st.amortiseReady = true;
+    st.amortiseKey = key;
+    st.timings.indirect = 0.0;
+    if (!st.directUpdated) {
+        // indirect only: geometry, pyramid, visibility and direct shade are the last frame's
+        const auto ti = Clock::now();
+        runIndirectStage(settings, st, albedo);
+        st.timings.total = msSince(ti);
+        return;
+    }
 
     const auto t0 = Clock::now();
     auto t = t0;
@@ -161,6 +190,14 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
     shadeTexels(st.gradX.cview(), st.gradY.cview(), settings.subsample, st.envVisibility, st.shadingLights.data(),
                 static_cast<int>(st.shadingLights.size()), albedo, settings.shading, st.shade);
     st.timings.shading = msSince(t);
+    if (st.indirectUpdated) runIndirectStage(settings, st, albedo);
+    else if (settings.indirect.bounces > 0)
+        for (int c = 0; c < 3; ++c) {  // direct only: the last indirect light on the new direct shade
+            Grid& tot = st.indirect.total[static_cast<std::size_t>(c)];
+            const Grid& d = st.shade.rgb[static_cast<std::size_t>(c)];
+            const Grid& ind = st.indirect.indirect[static_cast<std::size_t>(c)];
+            for (std::size_t i = 0; i < tot.v.size(); ++i) tot.v[i] = d.v[i] + ind.v[i];
+        }
     st.timings.total = msSince(t0);
 }
 

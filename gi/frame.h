@@ -5,6 +5,7 @@
 // allocates nothing.
 #include <vector>
 
+#include "gi/indirect.h"
 #include "gi/lights.h"
 #include "gi/pyramid.h"
 #include "gi/shading.h"
@@ -20,6 +21,7 @@ struct GiSettings {
     VisibilitySettings visibility;  // m = 32, linear wedges, B-spline maximum (Eq. 16)
     int keyLightAzimuths = 3;   // azimuth samples per key light (Section 9)
     ShadingSettings shading;
+    IndirectSettings indirect;  // bounces, radiance pyramid (k_u = 4, o_u = 2), amortisation (issue 4)
 };
 
 struct GiLighting {
@@ -30,6 +32,7 @@ struct GiLighting {
 /// Milliseconds per stage of the last frame.
 struct GiTimings {
     double gradient = 0.0, pyramid = 0.0, visibility = 0.0, keyVisibility = 0.0, shading = 0.0, total = 0.0;
+    double indirect = 0.0;  // all bounces (pyramids, scans, shading); 0 when not updated this frame
 };
 
 struct GiState {
@@ -46,6 +49,18 @@ struct GiState {
     std::vector<ShadingLight> shadingLights;
     ShadeMaps shade;
     GiTimings timings;
+    // Indirect light (gi/indirect.h): indirect.indirect and indirect.total
+    // (= shade.rgb + indirect) are valid when settings.indirect.bounces > 0.
+    IndirectState indirect;
+    // Shading amortisation (Section 7): the caller sets geometryChanged = false
+    // when the heights did not change since the last frame (e.g. from the
+    // simulator's change report); with settings.indirect.amortise such frames
+    // update the direct and the indirect light alternately.
+    bool geometryChanged = true;
+    int amortisePhase = 0;            // next static frame: 0 direct, 1 indirect
+    bool amortiseReady = false;       // a full frame with the current key ran before
+    std::array<int, 6> amortiseKey{}; // nx, ny, subsample, bounces, azimuths, brdf of that frame
+    bool directUpdated = false, indirectUpdated = false;  // what the last frame recomputed
 };
 
 /// The engine's default settings (chosen from measurements on real DEMs,

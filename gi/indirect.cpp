@@ -1,0 +1,314 @@
+#include "gi/indirect.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+
+#include "gi/nlp.h"
+#include "sim/error.h"
+#include "sim/parallel.h"
+#include "sim/simd.h"
+
+namespace terrain::gi {
+
+namespace {
+
+using simd::F4;
+typedef int I4 __attribute__((vector_size(16)));
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+constexpr int kMaxBlocks = 64;
+constexpr int kGroup = 8;  // receivers per kernel call (2 x 4 lanes); rows are padded to it
+constexpr float kMarginRel = 1.0f / 1048576.0f;  // 2^-20 |h0|: height differences below it are rounding
+
+inline int padGroup(int n) { return (n + kGroup - 1) / kGroup * kGroup; }
+inline F4 ld(const float* p) { return simd::load<F4>(p); }
+inline F4 spl(float x) { return simd::splat<F4>(x); }
+inline bool anyLane(I4 m) { return (m[0] | m[1] | m[2] | m[3]) != 0; }
+
+// ---- algorithm: the casting set and Eq. 12 for 4 NV receivers of row Y ------
+// hTab: the height steps of this azimuth; rTab[c]: channel c's radiance steps.
+// Out: 3 channels x 4 NLP coefficients, written at nlp[(c * 4 + l) * pad + X].
+template <int NV>
+void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* steps, int nAny, int Y, int X0,
+               const float* h0, const float* margin, const float* gx, const float* gy, float cosPhi, float sinPhi,
+               float* nlp, int pad) {
+    F4 M[NV], g[NV], q1[NV], q2[NV], q3[NV], q4[NV], A[NV][3][4];
+    const F4 one = spl(1.0f), lim = spl(1e6f), nlim = spl(-1e6f);
+    for (int k = 0; k < NV; ++k) {
+        M[k] = spl(kNoBlocker);
+        // omega_min: the tangent plane's slope along the azimuth (Section 3)
+        g[k] = ld(gx + X0 + 4 * k) * spl(cosPhi) + ld(gy + X0 + 4 * k) * spl(sinPhi);
+        F4 t = g[k] < nlim ? nlim : (g[k] > lim ? lim : g[k]);
+        const F4 s = t / simd::vsqrt(one + t * t);
+        q1[k] = s;
+        q2[k] = s * s;
+        q3[k] = q2[k] * s;
+        q4[k] = q2[k] * q2[k];
+        for (int c = 0; c < 3; ++c)
+            for (int p = 0; p < 4; ++p) A[k][c][p] = spl(0.0f);
+    }
+    for (int i = 0; i < nAny; ++i) {
+        const ScanStep& st = hTab[i];
+        const std::ptrdiff_t o = Y * st.rowStep + X0;
+        const float* a = st.field + (o + st.offA);
+        const float* b = st.field + (o + st.offB);
+        const F4 wa = ld(st.w[0]), wb = ld(st.w[1]), inv = ld(st.w[2]);
+        const I4 iv = {i, i, i, i};
+        F4 t[NV];
+        I4 nw[NV];
+        bool any = false;
+        for (int k = 0; k < NV; ++k) {
+            t[k] = (((wa * ld(a + 4 * k) + wb * ld(b + 4 * k)) - ld(h0 + X0 + 4 * k)) - ld(margin + X0 + 4 * k)) * inv;
+            nw[k] = (iv < steps[k]) & (t[k] > M[k]);  // Eq. 17: above every earlier sample
+            any = any || anyLane(nw[k]);
+        }
+        if (!any) continue;
+        F4 r[NV][3];
+        for (int c = 0; c < 3; ++c) {
+            const ScanStep& rs = rTab[c][i];
+            const std::ptrdiff_t ro = Y * rs.rowStep + X0;
+            const float* ra = rs.field + (ro + rs.offA);
+            const float* rb = rs.field + (ro + rs.offB);
+            const F4 rwa = ld(rs.w[0]), rwb = ld(rs.w[1]);
+            for (int k = 0; k < NV; ++k) r[k][c] = rwa * ld(ra + 4 * k) + rwb * ld(rb + 4 * k);
+        }
+        for (int k = 0; k < NV; ++k) {
+            M[k] = nw[k] ? t[k] : M[k];
+            // the segment [c_(i-1), c_i] clamped to [omega_min, pi/2]
+            F4 tc = t[k] < g[k] ? g[k] : t[k];
+            tc = tc < nlim ? nlim : (tc > lim ? lim : tc);
+            const F4 s = tc / simd::vsqrt(one + tc * tc);
+            const F4 s2 = s * s, s3 = s2 * s, s4 = s2 * s2;
+            const F4 zero = spl(0.0f);
+            const F4 d1 = nw[k] ? s - q1[k] : zero, d2 = nw[k] ? s2 - q2[k] : zero;
+            const F4 d3 = nw[k] ? s3 - q3[k] : zero, d4 = nw[k] ? s4 - q4[k] : zero;
+            q1[k] = nw[k] ? s : q1[k];
+            q2[k] = nw[k] ? s2 : q2[k];
+            q3[k] = nw[k] ? s3 : q3[k];
+            q4[k] = nw[k] ? s4 : q4[k];
+            for (int c = 0; c < 3; ++c) {
+                const F4 u = nw[k] ? r[k][c] : zero;  // lanes outside: never read garbage into the sums
+                A[k][c][0] += u * d1;
+                A[k][c][1] += u * d2;
+                A[k][c][2] += u * d3;
+                A[k][c][3] += u * d4;
+            }
+        }
+    }
+    // Eq. 10's closed form as a polynomial in s: the NLP coefficients
+    const F4 k0 = spl(0.70710678118654752440f), k1 = spl(0.61237243569579452455f);
+    const F4 k2 = spl(0.79056941504209483300f), k3 = spl(0.23385358667337133659f);
+    for (int k = 0; k < NV; ++k)
+        for (int c = 0; c < 3; ++c) {
+            float* base = nlp + static_cast<std::size_t>(c) * 4 * pad + X0 + 4 * k;
+            simd::store(base, k0 * A[k][c][0]);
+            simd::store(base + pad, k1 * A[k][c][1]);
+            simd::store(base + 2 * pad, k2 * (A[k][c][2] - A[k][c][0]));
+            simd::store(base + 3 * pad, k3 * (spl(5.0f) * A[k][c][3] - spl(6.0f) * A[k][c][1]));
+        }
+}
+
+// Row of receivers for one azimuth.
+void castRow(const ScanStep* hTab, const ScanStep* const* rTab, const int* colSteps, int rowSteps, int Y,
+             const IndirectScratch& sc, float cosPhi, float sinPhi, float* nlp, int pad) {
+    const I4 rowLimit = {rowSteps, rowSteps, rowSteps, rowSteps};
+    for (int X0 = 0; X0 < pad; X0 += kGroup) {
+        I4 steps[2];
+        int nAny = 0;
+        for (int k = 0; k < 2; ++k) {
+            I4 c;
+            std::memcpy(&c, colSteps + X0 + 4 * k, sizeof c);
+            steps[k] = c < rowLimit ? c : rowLimit;
+            for (int l = 0; l < 4; ++l) nAny = std::max(nAny, steps[k][l]);
+        }
+        castGroup<2>(hTab, rTab, steps, nAny, Y, X0, sc.h0.data(), sc.margin.data(), sc.gx.data(), sc.gy.data(), cosPhi,
+                     sinPhi, nlp, pad);
+    }
+}
+
+}  // namespace
+
+void validateIndirectSettings(const IndirectSettings& s) {
+    if (s.bounces < 0 || s.bounces > 16) throw InputError("bounces must be in [0, 16]");
+    if (s.radiance.levelsPerOctave < 1 || s.radiance.levelsPerOctave > 64)
+        throw InputError("radiance levels per octave must be in [1, 64]");
+    if (s.radiance.levelOffset < 0 || s.radiance.levelOffset > 32) throw InputError("radiance level offset must be in [0, 32]");
+}
+
+void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridView gradY, const FoldedWedgeOperator& op,
+                     const VisibilityField& envVisibility, const std::array<Grid, 3>& direct, const AlbedoMap* albedo,
+                     const ShadingSettings& shading, const IndirectSettings& settings, IndirectState& st) {
+    validateIndirectSettings(settings);
+    const auto t0 = Clock::now();
+    st.timings = IndirectTimings{};
+    const int nx = pyr.nx, ny = pyr.ny, s = pyr.subsample;
+    const int nxr = pyr.nxr, nyr = pyr.nyr, pad = padGroup(nxr);
+    const int m = op.azimuths;
+    const int nSteps = static_cast<int>(pyr.steps.size());
+    const std::size_t planeR = static_cast<std::size_t>(nxr) * nyr;
+    const int nRows = shading.brdf == Brdf::Lambert ? 9 : kShCount;  // Lambert reads bands 0..2 only
+
+    for (int c = 0; c < 3; ++c) {
+        Grid& g = st.indirect[static_cast<std::size_t>(c)];
+        if (g.nx != nx || g.ny != ny) g.resize(nx, ny);
+        std::fill(g.v.begin(), g.v.end(), 0.0f);
+        VisibilityField& u = st.u[static_cast<std::size_t>(c)];
+        u.nxr = nxr;
+        u.nyr = nyr;
+        u.sh.resize(planeR * kShCount);
+    }
+    st.bounceMean.resize(static_cast<std::size_t>(settings.bounces));
+
+    // per-block scratch
+    const int nBlocks = std::max(1, std::min(nyr, kMaxBlocks));
+    st.blocks.resize(static_cast<std::size_t>(nBlocks));
+    for (IndirectScratch& b : st.blocks) {
+        b.gx.resize(static_cast<std::size_t>(pad));
+        b.gy.resize(static_cast<std::size_t>(pad));
+        b.h0.resize(static_cast<std::size_t>(pad));
+        b.margin.resize(static_cast<std::size_t>(pad));
+        b.nlp.resize(static_cast<std::size_t>(12) * pad);
+    }
+    // shading: U of channel c lights channel c only (identity product matrix)
+    for (int c = 0; c < 3; ++c) {
+        ShadingLight& L = st.lights[static_cast<std::size_t>(c)];
+        L.visibility = &st.u[static_cast<std::size_t>(c)];
+        for (int ch = 0; ch < 3; ++ch) {
+            ShMatrix& mtx = L.product[static_cast<std::size_t>(ch)];
+            mtx.fill(0.0);
+            if (ch == c)
+                for (int i = 0; i < kShCount; ++i) mtx[static_cast<std::size_t>(i * kShCount + i)] = 1.0;
+        }
+    }
+
+    const std::size_t tableSize = static_cast<std::size_t>(m) * nSteps;
+    st.heightSteps.resize(tableSize);
+    st.radianceSteps.resize(3 * tableSize);
+    st.stepsPerColumn.resize(static_cast<std::size_t>(m) * pad);
+    st.stepsPerRow.resize(static_cast<std::size_t>(m) * nyr);
+
+    const std::array<Grid, 3>* source = &direct;
+    for (int b = 1; b <= settings.bounces; ++b) {
+        // ---- radiance pyramid of bounce b - 1 (Section 5.3) ------------------------
+        auto t = Clock::now();
+        buildRadiancePyramid(*source, pyr, settings.radiance, st.radiance);
+        st.timings.pyramid += msSince(t);
+
+        // ---- step table: height and radiance steps, valid prefixes --------------------
+        t = Clock::now();
+        parallelFor(0, m, 1, [&](int j0, int j1) {
+            for (int j = j0; j < j1; ++j) {
+                const double c = std::cos(op.phi[static_cast<std::size_t>(j)]);
+                const double sn = std::sin(op.phi[static_cast<std::size_t>(j)]);
+                const std::size_t base = static_cast<std::size_t>(j) * nSteps;
+                int* colSteps = st.stepsPerColumn.data() + static_cast<std::size_t>(j) * pad;
+                int* rowSteps = st.stepsPerRow.data() + static_cast<std::size_t>(j) * nyr;
+                std::fill(colSteps, colSteps + pad, 0);
+                std::fill(rowSteps, rowSteps + nyr, 0);
+                // a receiver's sequence is its prefix of steps inside the domain
+                // (for the heights and the radiance sample alike)
+                int xLo = 0, xHi = nxr - 1, yLo = 0, yHi = nyr - 1;
+                for (int i = 0; i < nSteps; ++i) {
+                    const ScanStepInfo h = scanStepInfo(pyr, i, c, sn);
+                    st.heightSteps[base + static_cast<std::size_t>(i)] = h.step;
+                    int xf = h.xFirst, xl = h.xLast, yf = h.yFirst, yl = h.yLast;
+                    for (int ch = 0; ch < 3; ++ch) {
+                        const ScanStepInfo r = scanStepInfo(st.radiance.fields[static_cast<std::size_t>(ch)], i, c, sn);
+                        st.radianceSteps[static_cast<std::size_t>(ch) * tableSize + base + static_cast<std::size_t>(i)] = r.step;
+                        xf = std::max(xf, r.xFirst);
+                        xl = std::min(xl, r.xLast);
+                        yf = std::max(yf, r.yFirst);
+                        yl = std::min(yl, r.yLast);
+                    }
+                    // receivers still inside at step i: those inside at every step so far
+                    xLo = std::max(xLo, xf);
+                    xHi = std::min(xHi, xl);
+                    yLo = std::max(yLo, yf);
+                    yHi = std::min(yHi, yl);
+                    for (int X = xLo; X <= xHi; ++X) colSteps[X] = i + 1;
+                    for (int Y = yLo; Y <= yHi; ++Y) rowSteps[Y] = i + 1;
+                }
+            }
+        });
+
+        // ---- scan: casting sets, Eq. 12, U through the folded wedge operator ----------
+        const int P = op.patternSize();
+        parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
+            for (int block = b0; block < b1; ++block) {
+                IndirectScratch& sc = st.blocks[static_cast<std::size_t>(block)];
+                const int yBegin = static_cast<int>(static_cast<long long>(nyr) * block / nBlocks);
+                const int yEnd = static_cast<int>(static_cast<long long>(nyr) * (block + 1) / nBlocks);
+                for (int Y = yBegin; Y < yEnd; ++Y) {
+                    const float* hRow = pyr.rawPhaseRow(0, s * Y);
+                    for (int X = 0; X < pad; ++X) {
+                        const bool in = X < nxr;
+                        const std::size_t xi = static_cast<std::size_t>(X);
+                        sc.gx[xi] = in ? gradX(s * X, s * Y) : 0.0f;
+                        sc.gy[xi] = in ? gradY(s * X, s * Y) : 0.0f;
+                        sc.h0[xi] = in ? hRow[X] : 0.0f;
+                        sc.margin[xi] = std::fabs(sc.h0[xi]) * kMarginRel;
+                    }
+                    float* uRows[3][kShCount];
+                    for (int c = 0; c < 3; ++c)
+                        for (int i = 0; i < kShCount; ++i) {
+                            uRows[c][i] = st.u[static_cast<std::size_t>(c)].plane(i) + static_cast<std::size_t>(Y) * nxr;
+                            std::fill(uRows[c][i], uRows[c][i] + nxr, 0.0f);
+                        }
+                    for (int j = 0; j < m; ++j) {
+                        const std::size_t base = static_cast<std::size_t>(j) * nSteps;
+                        const ScanStep* rTab[3] = {st.radianceSteps.data() + base, st.radianceSteps.data() + tableSize + base,
+                                                   st.radianceSteps.data() + 2 * tableSize + base};
+                        const double phi = op.phi[static_cast<std::size_t>(j)];
+                        castRow(st.heightSteps.data() + base, rTab, st.stepsPerColumn.data() + static_cast<std::size_t>(j) * pad,
+                                st.stepsPerRow[static_cast<std::size_t>(j) * nyr + static_cast<std::size_t>(Y)], Y, sc,
+                                static_cast<float>(std::cos(phi)), static_cast<float>(std::sin(phi)), sc.nlp.data(), pad);
+                        // U_c += G_j u_(c, j) over the sparse pattern (Eq. 21)
+                        const float* vals = op.values.data() + static_cast<std::size_t>(j) * P;
+                        for (int e = 0; e < P; ++e) {
+                            const int r = op.patternRow[static_cast<std::size_t>(e)];
+                            if (r >= nRows) continue;
+                            const float gval = vals[e];
+                            const int l = op.patternNlp[static_cast<std::size_t>(e)];
+                            for (int c = 0; c < 3; ++c) {
+                                float* __restrict dst = uRows[c][r];
+                                const float* __restrict w = sc.nlp.data() + static_cast<std::size_t>(c * 4 + l) * pad;
+                                for (int X = 0; X < nxr; ++X) dst[X] += gval * w[X];
+                            }
+                        }
+                    }
+                }
+            }
+        });
+        st.timings.scan += msSince(t);
+
+        // ---- shading of U at full-resolution normals: L_b ------------------------------
+        t = Clock::now();
+        ShadeMaps& out = st.bounceShade[static_cast<std::size_t>(b & 1)];
+        shadeTexels(gradX, gradY, s, envVisibility, st.lights.data(), 3, albedo, shading, out);
+        double sum = 0.0;
+        for (int c = 0; c < 3; ++c) {
+            Grid& acc = st.indirect[static_cast<std::size_t>(c)];
+            const Grid& add = out.rgb[static_cast<std::size_t>(c)];
+            for (std::size_t i = 0; i < acc.v.size(); ++i) {
+                acc.v[i] += add.v[i];
+                sum += add.v[i];
+            }
+        }
+        st.bounceMean[static_cast<std::size_t>(b - 1)] = sum / (3.0 * std::max<std::size_t>(1, static_cast<std::size_t>(nx) * ny));
+        source = &out.rgb;
+        st.timings.shading += msSince(t);
+    }
+    for (int c = 0; c < 3; ++c) {
+        Grid& tot = st.total[static_cast<std::size_t>(c)];
+        if (tot.nx != nx || tot.ny != ny) tot.resize(nx, ny);
+        const Grid& d = direct[static_cast<std::size_t>(c)];
+        const Grid& ind = st.indirect[static_cast<std::size_t>(c)];
+        for (std::size_t i = 0; i < tot.v.size(); ++i) tot.v[i] = d.v[i] + ind.v[i];
+    }
+    st.timings.total = msSince(t0);
+}
+
+}  // namespace terrain::gi

@@ -1,0 +1,49 @@
+#pragma once
+// Radiance pyramids for indirect light (Section 5.3).
+//
+// Diffuse surfaces: the exit radiance of bounce b-1 is one RGB value per
+// texel. Each channel gets the same multi-resolution treatment as the heights
+// (gi/pyramid.h): 2x2 box octaves, cubic B-spline synthesis at the receiver
+// grid, k_u levels per octave, level offset o_u (paper defaults k_u = 4,
+// o_u = 2); level 0 is the field itself, steps whose level would be negative
+// read the full-resolution radiance (bilinear, phase-split like the heights).
+//
+// The scan samples heights and radiance at the same steps: step i of the
+// height pyramid (distance tau_i) reads radiance level
+//   l_u(i) = round(k_u log2(tau_i)) - k_u o_u,
+// so k_u may differ from the heights' k_v (with k_u = k_v the level index is
+// the step index minus k_u o_u, as in the paper).
+//
+// Glossy surfaces (vector pyramid): the same pyramid over each coefficient of
+// an SH radiance vector field (RGB x `coefficients` planes), see
+// buildShRadiancePyramid.
+#include <array>
+#include <vector>
+
+#include "gi/pyramid.h"
+#include "sim/grid.h"
+
+namespace terrain::gi {
+
+struct RadiancePyramidSettings {
+    int levelsPerOctave = 4;  // k_u (paper: 4)
+    int levelOffset = 2;      // o_u in octaves (paper: 2)
+};
+
+/// One pyramid per scalar field (3 for RGB radiance, 3 x n for SH vectors),
+/// each with the height pyramid's steps (same tau) and its own level map.
+struct RadiancePyramid {
+    std::vector<HeightPyramid> fields;
+};
+
+/// Builds the RGB radiance pyramid of `radiance` (full resolution, the height
+/// pyramid's size) at the height pyramid's receiver grid and steps.
+void buildRadiancePyramid(const std::array<Grid, 3>& radiance, const HeightPyramid& heights,
+                          const RadiancePyramidSettings& settings, RadiancePyramid& out);
+
+/// Builds the pyramid of `count` scalar fields (row-major nx x ny each,
+/// consecutive in `fields`), e.g. RGB x SH coefficients of incident radiance.
+void buildScalarPyramids(const float* fields, int count, const HeightPyramid& heights,
+                         const RadiancePyramidSettings& settings, RadiancePyramid& out);
+
+}  // namespace terrain::gi
