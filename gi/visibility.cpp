@@ -448,6 +448,11 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
                     total += std::min(state.stepsPerColumn[static_cast<std::size_t>(j) * nxrPad + X], state.stepsPerRow[static_cast<std::size_t>(j) * nyr + Y]);
         std::fprintf(stderr, "samples %lld (%.1f per receiver-azimuth, %d steps)\n", total, double(total) / (double(m) * nxr * nyr), nSteps);
     }
+    state.cosSin.resize(2 * static_cast<std::size_t>(m));
+    for (int j = 0; j < m; ++j) {
+        state.cosSin[2 * static_cast<std::size_t>(j)] = static_cast<float>(std::cos(op.phi[static_cast<std::size_t>(j)]));
+        state.cosSin[2 * static_cast<std::size_t>(j) + 1] = static_cast<float>(std::sin(op.phi[static_cast<std::size_t>(j)]));
+    }
     state.opSplat.resize(static_cast<std::size_t>(m) * 4 * op.patternSize());
     for (std::size_t e = 0; e < op.values.size(); ++e)
         for (int l = 0; l < 4; ++l) state.opSplat[4 * e + static_cast<std::size_t>(l)] = op.values[e];
@@ -498,10 +503,9 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
                             scanRow<2, BsplineMaxVisitor>(table, colSteps, rowSteps, Y, sc.h0.data(), nxrPad, sc.maxRow.data());
                         float* maxOut = out.maxSlope.data() + planeSize * j + static_cast<std::size_t>(Y) * nxr;
                         std::copy(sc.maxRow.data(), sc.maxRow.data() + nxr, maxOut);
-                        const double phi = op.phi[static_cast<std::size_t>(j)];
                         float* nlp = sc.nlp.data() + static_cast<std::size_t>(a) * 4 * nxrPad;
-                        nlpRow(sc.maxRow.data(), sc.gradX.data(), sc.gradY.data(), static_cast<float>(std::cos(phi)),
-                               static_cast<float>(std::sin(phi)), target, nlp, nxr, nxrPad);
+                        nlpRow(sc.maxRow.data(), sc.gradX.data(), sc.gradY.data(), state.cosSin[2 * static_cast<std::size_t>(j)],
+                               state.cosSin[2 * static_cast<std::size_t>(j) + 1], target, nlp, nxr, nxrPad);
                         nlps[a] = nlp;
                         ops[a] = state.opSplat.data() + static_cast<std::size_t>(j) * 4 * op.patternSize();
                     }

@@ -7,9 +7,10 @@
 // slope: atan is monotonic, GUIDE 3). Each sample is moved along the ray to the
 // nearest crossing of the field's grid lines across the ray's major axis (at
 // most half a texel along that axis), where the bilinear field is linear
-// between two texels, as in the reference march; tau_i is the moved distance. The maximum blocking angle (Eq. 16) is
-// the maximum of the cubic interpolant through these samples, evaluated at the
-// knots and midpoints (or, optionally, the plain maximum of the samples).
+// between two texels, as in the reference march; tau_i is the moved distance.
+// The maximum blocking angle (Eq. 16) is the maximum of the cubic interpolant
+// through these samples, evaluated at the knots and midpoints (or, optionally,
+// the plain maximum of the samples).
 //
 // omega_min comes from the receiver's normal: the tangent plane cuts the
 // vertical plane of azimuth phi at elevation atan(g), g the directional
@@ -20,8 +21,8 @@
 // 20-21). Directions below z = 0 are kept: on slopes omega_min < 0.
 //
 // Design for part 2 (indirect light): the scan is one row kernel templated
-// on a per-step visitor (gi/visibility.cpp, scanLanes): for 8 receivers at a
-// time it walks the steps of one azimuth and hands the visitor the slope
+// on a per-step visitor (gi/visibility.cpp, scanLanes): for 16 receivers at a
+// time (8 for Eq. 16) it walks the steps of one azimuth and hands the visitor the slope
 // sequence, step by step, with the steps each receiver's ray still has inside
 // the domain. The maximum rules (samples, Eq. 16) are two such visitors; the
 // casting set of Eq. 17 (the steps whose slope beats every earlier one) and
@@ -36,13 +37,14 @@
 // the end sample replicated as its outer neighbour.
 //
 // Schedule: per frame a table of steps (integer offsets into the phase-split
-// raw heights or the level, bilinear weights, 1 / tau) is built once per
+// raw heights or the level, two linear weights, 1 / tau) is built once per
 // (azimuth, step), with the number of valid steps per receiver column and
 // row. Receiver rows are split into a fixed number of blocks; each block owns
 // a scratch buffer and runs its rows serially; blocks run in parallel. Within
 // a row, for each azimuth, 16 receivers at a time run all their steps with 4-wide
 // SIMD (each receiver's arithmetic is exactly the scalar one), then the NLP
-// vectors and the folded wedge operator update the 16 SH planes of the row.
+// vectors of two azimuths at a time and the folded wedge operator update the
+// 16 SH planes of the row.
 // Every receiver is written by exactly one block (gather only), so the result
 // is bit-identical for any thread count.
 #include <vector>
@@ -112,6 +114,7 @@ struct VisibilityState {
     std::vector<int> stepsPerColumn;  // azimuths x padded nxr: valid-prefix length from x alone
     std::vector<int> stepsPerRow;     // azimuths x nyr: valid-prefix length from y alone
     std::vector<float> opSplat;       // the folded operator's entries, each 4 times (16-byte aligned)
+    std::vector<float> cosSin;        // azimuths x 2: cos, sin of each azimuth (float)
 };
 
 /// One step of the scan table as computeVisibility builds it (exposed for
