@@ -29,27 +29,28 @@ inline F4 spl(float x) { return simd::splat<F4>(x); }
 inline bool anyLane(I4 m) { return (m[0] | m[1] | m[2] | m[3]) != 0; }
 
 // ---- algorithm: the casting set and Eq. 12 for 4 NV receivers of row Y ------
-// hTab: the height steps of this azimuth; rTab[c]: channel c's radiance steps.
+// Pass 1 walks the height steps (Eq. 17) and, at each step where some lane
+// has a new casting-set member, stores the clamped segment's moments
+// Delta(s^p), p = 1..4 (0 in the other lanes) and the step index. Pass 2
+// multiplies them with the radiance samples at those steps, one channel at a
+// time (few live registers; each lane's sums run in step order).
+// hTab: the height steps of this azimuth; rTab[c]: channel c's radiance steps;
+// moments: scratch of nSteps x NV x 4 vectors; list: nSteps ints.
 // Out: 3 channels x 4 NLP coefficients, written at nlp[(c * 4 + l) * pad + X].
 template <int NV>
 void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* steps, int nAny, int Y, int X0,
                const float* h0, const float* margin, const float* gx, const float* gy, float cosPhi, float sinPhi,
-               float* nlp, int pad) {
-    F4 M[NV], g[NV], q1[NV], q2[NV], q3[NV], q4[NV], A[NV][3][4];
-    const F4 one = spl(1.0f), lim = spl(1e6f), nlim = spl(-1e6f);
+               F4* moments, int* list, float* nlp, int pad) {
+    F4 M[NV], g[NV], q1[NV];
+    const F4 one = spl(1.0f), lim = spl(1e6f), nlim = spl(-1e6f), zero = spl(0.0f);
     for (int k = 0; k < NV; ++k) {
         M[k] = spl(kNoBlocker);
         // omega_min: the tangent plane's slope along the azimuth (Section 3)
         g[k] = ld(gx + X0 + 4 * k) * spl(cosPhi) + ld(gy + X0 + 4 * k) * spl(sinPhi);
-        F4 t = g[k] < nlim ? nlim : (g[k] > lim ? lim : g[k]);
-        const F4 s = t / simd::vsqrt(one + t * t);
-        q1[k] = s;
-        q2[k] = s * s;
-        q3[k] = q2[k] * s;
-        q4[k] = q2[k] * q2[k];
-        for (int c = 0; c < 3; ++c)
-            for (int p = 0; p < 4; ++p) A[k][c][p] = spl(0.0f);
+        const F4 t = g[k] < nlim ? nlim : (g[k] > lim ? lim : g[k]);
+        q1[k] = t / simd::vsqrt(one + t * t);
     }
+    int n = 0;
     for (int i = 0; i < nAny; ++i) {
         const ScanStep& st = hTab[i];
         const std::ptrdiff_t o = Y * st.rowStep + X0;
@@ -59,73 +60,77 @@ void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* step
         const I4 iv = {i, i, i, i};
         F4 t[NV];
         I4 nw[NV];
-        bool any = false;
+        I4 any = {0, 0, 0, 0};
         for (int k = 0; k < NV; ++k) {
             t[k] = (((wa * ld(a + 4 * k) + wb * ld(b + 4 * k)) - ld(h0 + X0 + 4 * k)) - ld(margin + X0 + 4 * k)) * inv;
             nw[k] = (iv < steps[k]) & (t[k] > M[k]);  // Eq. 17: above every earlier sample
-            any = any || anyLane(nw[k]);
+            any |= nw[k];
         }
-        if (!any) continue;
-        F4 r[NV][3];
-        for (int c = 0; c < 3; ++c) {
-            const ScanStep& rs = rTab[c][i];
-            const std::ptrdiff_t ro = Y * rs.rowStep + X0;
-            const float* ra = rs.field + (ro + rs.offA);
-            const float* rb = rs.field + (ro + rs.offB);
-            const F4 rwa = ld(rs.w[0]), rwb = ld(rs.w[1]);
-            for (int k = 0; k < NV; ++k) r[k][c] = rwa * ld(ra + 4 * k) + rwb * ld(rb + 4 * k);
-        }
+        if (!anyLane(any)) continue;
+        F4* mo = moments + static_cast<std::size_t>(n) * NV * 4;
+        list[n++] = i;
         for (int k = 0; k < NV; ++k) {
             M[k] = nw[k] ? t[k] : M[k];
             // the segment [c_(i-1), c_i] clamped to [omega_min, pi/2]
             F4 tc = t[k] < g[k] ? g[k] : t[k];
             tc = tc < nlim ? nlim : (tc > lim ? lim : tc);
-            const F4 s = tc / simd::vsqrt(one + tc * tc);
-            const F4 s2 = s * s, s3 = s2 * s, s4 = s2 * s2;
-            const F4 zero = spl(0.0f);
-            const F4 d1 = nw[k] ? s - q1[k] : zero, d2 = nw[k] ? s2 - q2[k] : zero;
-            const F4 d3 = nw[k] ? s3 - q3[k] : zero, d4 = nw[k] ? s4 - q4[k] : zero;
-            q1[k] = nw[k] ? s : q1[k];
-            q2[k] = nw[k] ? s2 : q2[k];
-            q3[k] = nw[k] ? s3 : q3[k];
-            q4[k] = nw[k] ? s4 : q4[k];
-            for (int c = 0; c < 3; ++c) {
-                const F4 u = nw[k] ? r[k][c] : zero;  // lanes outside: never read garbage into the sums
-                A[k][c][0] += u * d1;
-                A[k][c][1] += u * d2;
-                A[k][c][2] += u * d3;
-                A[k][c][3] += u * d4;
-            }
+            const F4 sNew = tc / simd::vsqrt(one + tc * tc);
+            const F4 sv = nw[k] ? sNew : q1[k];  // no new member: an empty segment
+            const F4 p = q1[k], p2 = p * p, s2 = sv * sv;
+            mo[4 * k + 0] = sv - p;
+            mo[4 * k + 1] = s2 - p2;
+            mo[4 * k + 2] = s2 * sv - p2 * p;
+            mo[4 * k + 3] = s2 * s2 - p2 * p2;
+            q1[k] = sv;
         }
     }
-    // Eq. 10's closed form as a polynomial in s: the NLP coefficients
+    // pass 2: moments x radiance, then Eq. 10's closed form as a polynomial in s
     const F4 k0 = spl(0.70710678118654752440f), k1 = spl(0.61237243569579452455f);
     const F4 k2 = spl(0.79056941504209483300f), k3 = spl(0.23385358667337133659f);
-    for (int k = 0; k < NV; ++k)
-        for (int c = 0; c < 3; ++c) {
-            float* base = nlp + static_cast<std::size_t>(c) * 4 * pad + X0 + 4 * k;
-            simd::store(base, k0 * A[k][c][0]);
-            simd::store(base + pad, k1 * A[k][c][1]);
-            simd::store(base + 2 * pad, k2 * (A[k][c][2] - A[k][c][0]));
-            simd::store(base + 3 * pad, k3 * (spl(5.0f) * A[k][c][3] - spl(6.0f) * A[k][c][1]));
+    for (int c = 0; c < 3; ++c) {
+        F4 A[NV][4];
+        for (int k = 0; k < NV; ++k)
+            for (int p = 0; p < 4; ++p) A[k][p] = zero;
+        const ScanStep* tab = rTab[c];
+        for (int e = 0; e < n; ++e) {
+            const ScanStep& rs = tab[list[e]];
+            const std::ptrdiff_t ro = Y * rs.rowStep + X0;
+            const float* ra = rs.field + (ro + rs.offA);
+            const float* rb = rs.field + (ro + rs.offB);
+            const F4 rwa = ld(rs.w[0]), rwb = ld(rs.w[1]);
+            const F4* mo = moments + static_cast<std::size_t>(e) * NV * 4;
+            for (int k = 0; k < NV; ++k) {
+                // lanes without a new member have zero moments; the radiance
+                // read there is finite (inside the field's padding and guard)
+                const F4 u = rwa * ld(ra + 4 * k) + rwb * ld(rb + 4 * k);
+                for (int p = 0; p < 4; ++p) A[k][p] += u * mo[4 * k + p];
+            }
         }
+        for (int k = 0; k < NV; ++k) {
+            float* base = nlp + static_cast<std::size_t>(c) * 4 * pad + X0 + 4 * k;
+            simd::store(base, k0 * A[k][0]);
+            simd::store(base + pad, k1 * A[k][1]);
+            simd::store(base + 2 * pad, k2 * (A[k][2] - A[k][0]));
+            simd::store(base + 3 * pad, k3 * (spl(5.0f) * A[k][3] - spl(6.0f) * A[k][1]));
+        }
+    }
 }
 
 // Row of receivers for one azimuth.
 void castRow(const ScanStep* hTab, const ScanStep* const* rTab, const int* colSteps, int rowSteps, int Y,
-             const IndirectScratch& sc, float cosPhi, float sinPhi, float* nlp, int pad) {
+             IndirectScratch& sc, float cosPhi, float sinPhi, float* nlp, int pad) {
     const I4 rowLimit = {rowSteps, rowSteps, rowSteps, rowSteps};
     for (int X0 = 0; X0 < pad; X0 += kGroup) {
-        I4 steps[2];
+        I4 steps[kGroup / 4];
         int nAny = 0;
-        for (int k = 0; k < 2; ++k) {
+        for (int k = 0; k < kGroup / 4; ++k) {
             I4 c;
             std::memcpy(&c, colSteps + X0 + 4 * k, sizeof c);
             steps[k] = c < rowLimit ? c : rowLimit;
             for (int l = 0; l < 4; ++l) nAny = std::max(nAny, steps[k][l]);
         }
-        castGroup<2>(hTab, rTab, steps, nAny, Y, X0, sc.h0.data(), sc.margin.data(), sc.gx.data(), sc.gy.data(), cosPhi,
-                     sinPhi, nlp, pad);
+        castGroup<kGroup / 4>(hTab, rTab, steps, nAny, Y, X0, sc.h0.data(), sc.margin.data(), sc.gx.data(), sc.gy.data(), cosPhi,
+                     sinPhi, reinterpret_cast<F4*>(sc.moments.data()), sc.list.data(), nlp, pad);
     }
 }
 
@@ -171,6 +176,8 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
         b.h0.resize(static_cast<std::size_t>(pad));
         b.margin.resize(static_cast<std::size_t>(pad));
         b.nlp.resize(static_cast<std::size_t>(12) * pad);
+        b.moments.resize(static_cast<std::size_t>(std::max(nSteps, 1)) * 2 * 4 * 4 + 4);  // nSteps x 2 vectors x 4 moments x 4 lanes
+        b.list.resize(static_cast<std::size_t>(std::max(nSteps, 1)));
     }
     // shading: U of channel c lights channel c only (identity product matrix)
     for (int c = 0; c < 3; ++c) {

@@ -68,7 +68,8 @@ struct IndirectTimings {
 struct IndirectScratch {
     std::vector<float> gx, gy, h0, margin;  // padded receiver row
     std::vector<float> nlp;                 // 3 channels x 4 NLP x padded row, one azimuth
-    std::vector<float> shRow;               // glossy: per lane scratch
+    std::vector<float> moments;             // casting-set moments of one group (pass 1 -> pass 2)
+    std::vector<int> list;                  // steps with a new casting-set member in the group
 };
 
 struct IndirectState {

@@ -9,9 +9,11 @@
 #include <string>
 #include <vector>
 
+#include "gi/albedo_io.h"
 #include "gi/frame.h"
 #include "gi/image_io.h"
 #include "gi/reference.h"
+#include "gi/reference_gi.h"
 #include "render/app/commands.h"
 #include "sim/error.h"
 #include "sim/io.h"
@@ -35,7 +37,54 @@ struct GiOptions {
     std::string outShade, outAmbient;
     int frames = 1;
     bool time = false;
+    // indirect light (issue 4)
+    int bounces = 0;
+    std::string brdf = "lambert";
+    std::string albedo;
+    bool amortise = false;
+    std::string outIndirect;
+    int radianceLevelsPerOctave = 0, radianceLevelOffset = -1;
+    int referenceDirections = 2048;
 };
+
+// --brdf lambert | phong:EXP | mix:W[,EXP] (Lambert + W x normalised Phong)
+void parseBrdf(const std::string& text, gi::ShadingSettings& s) {
+    auto number = [&](const std::string& item) {
+        try {
+            std::size_t used = 0;
+            const float v = std::stof(item, &used);
+            if (used != item.size() || !std::isfinite(v)) throw std::invalid_argument(item);
+            return v;
+        } catch (const std::exception&) {
+            throw InputError("--brdf '" + text + "': '" + item + "' is not a number");
+        }
+    };
+    if (text == "lambert") {
+        s.brdf = gi::Brdf::Lambert;
+    } else if (text.rfind("phong:", 0) == 0) {
+        s.brdf = gi::Brdf::Phong;
+        s.phongExponent = number(text.substr(6));
+    } else if (text.rfind("mix:", 0) == 0) {
+        s.brdf = gi::Brdf::LambertPlusPhong;
+        const std::string rest = text.substr(4);
+        const auto comma = rest.find(',');
+        s.specularWeight = number(rest.substr(0, comma));
+        if (comma != std::string::npos) s.phongExponent = number(rest.substr(comma + 1));
+        if (!(s.specularWeight >= 0.0f && s.specularWeight <= 1.0f)) throw InputError("--brdf mix: weight must be in [0, 1]");
+    } else {
+        throw InputError("--brdf must be lambert, phong:EXP or mix:W[,EXP] (got '" + text + "')");
+    }
+    if (!(s.phongExponent >= 1.0f && s.phongExponent <= 10000.0f)) throw InputError("--brdf: Phong exponent must be in [1, 10000]");
+}
+
+void writeIndirect(const std::string& file, const std::array<Grid, 3>& rgb) {
+    const std::string e = file.size() >= 4 ? file.substr(file.size() - 4) : "";
+    std::string ext = e;
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (ext == ".npy") gi::writeNpyRgb(file, rgb);
+    else if (ext == ".exr") gi::writeExr(file, {&rgb[0], &rgb[1], &rgb[2]});
+    else throw InputError("--out-indirect must end in .npy or .exr (got '" + file + "')");
+}
 
 std::string extensionOf(const std::string& f) {
     const auto dot = f.find_last_of('.');
@@ -121,8 +170,19 @@ int runGi(const GiOptions& o) {
         throw InputError("--out-shade must end in .png or .exr (got '" + o.outShade + "')");
     if (!o.outAmbient.empty() && extensionOf(o.outAmbient) != ".npy" && extensionOf(o.outAmbient) != ".exr")
         throw InputError("--out-ambient must end in .npy or .exr (got '" + o.outAmbient + "')");
+    if (o.bounces < 0 || o.bounces > 16) throw InputError("--bounces must be 0 .. 16");
+    if (!o.outIndirect.empty() && extensionOf(o.outIndirect) != ".npy" && extensionOf(o.outIndirect) != ".exr")
+        throw InputError("--out-indirect must end in .npy or .exr (got '" + o.outIndirect + "')");
+    if (o.referenceDirections < 16 || o.referenceDirections > (1 << 20)) throw InputError("--reference-directions must be 16 .. 2^20");
     gi::GiSettings settings = gi::engineGiSettings();
     settings.subsample = o.subsample;
+    parseBrdf(o.brdf, settings.shading);
+    if (o.reference && settings.shading.brdf != gi::Brdf::Lambert) throw InputError("--reference supports --brdf lambert only");
+    settings.indirect.bounces = o.bounces;
+    settings.indirect.amortise = o.amortise;
+    if (o.radianceLevelsPerOctave != 0) settings.indirect.radiance.levelsPerOctave = o.radianceLevelsPerOctave;
+    if (o.radianceLevelOffset >= 0) settings.indirect.radiance.levelOffset = o.radianceLevelOffset;
+    gi::validateIndirectSettings(settings.indirect);
     if (o.azimuths != 0) settings.visibility.azimuths = o.azimuths;
     if (o.levelsPerOctave != 0) settings.pyramid.levelsPerOctave = o.levelsPerOctave;
     if (o.levelOffset >= 0) settings.pyramid.levelOffset = o.levelOffset;
@@ -141,6 +201,9 @@ int runGi(const GiOptions& o) {
     if (cell <= 0.0) cell = cellFromFile;
     if (!(cell > 0.0) || !std::isfinite(cell)) throw InputError("--cell-size must be > 0 (metres between grid points)");
     std::fprintf(stderr, "terrain gi: %s, %d x %d cells of %.4g m\n", o.heightmap.c_str(), heights.nx, heights.ny, cell);
+    gi::AlbedoMap albedoMap;
+    if (!o.albedo.empty()) albedoMap = gi::loadAlbedo(o.albedo, heights.nx, heights.ny);
+    const gi::AlbedoMap* albedo = o.albedo.empty() ? nullptr : &albedoMap;
 
     return withThreads(o.threads, [&] {
         using Clock = std::chrono::steady_clock;
@@ -158,7 +221,22 @@ int runGi(const GiOptions& o) {
                             cap.c[static_cast<std::size_t>(c)][static_cast<std::size_t>(i)];
             }
             const auto t0 = Clock::now();
-            gi::renderReference(heights.cview(), static_cast<float>(cell), &total, nullptr, rs, rr);
+            if (o.bounces > 0 || !o.outIndirect.empty()) {
+                // with indirect light: bounce b gathers bounce b - 1 (gi/reference_gi.h)
+                gi::ReferenceGiSettings gs;
+                gs.bounces = o.bounces;
+                gs.directions = o.referenceDirections;
+                gs.progress = true;
+                gi::ReferenceGiResult gr;
+                gi::renderReferenceGi(heights.cview(), static_cast<float>(cell), total, albedo, gs, gr);
+                const double gms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+                if (o.time) std::printf("reference: %.1f ms\n", gms);
+                if (!o.outShade.empty()) writeShade(o.outShade, gr.total);
+                if (!o.outAmbient.empty()) writeAmbient(o.outAmbient, gr.ambient);
+                if (!o.outIndirect.empty()) writeIndirect(o.outIndirect, gr.indirect);
+                return 0;
+            }
+            gi::renderReference(heights.cview(), static_cast<float>(cell), &total, albedo, rs, rr);
             const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
             if (o.time) std::printf("reference: %.1f ms\n", ms);
             if (!o.outShade.empty()) writeShade(o.outShade, rr.rgb);
@@ -168,20 +246,28 @@ int runGi(const GiOptions& o) {
         gi::GiState state;
         std::vector<double> totals;
         for (int f = 0; f < o.frames; ++f) {
-            gi::runGiFrame(heights.cview(), static_cast<float>(cell), lighting, settings, state);
+            state.geometryChanged = f == 0;  // the same field every frame: static geometry after the first
+            gi::runGiFrame(heights.cview(), static_cast<float>(cell), lighting, settings, state, albedo);
             const gi::GiTimings& t = state.timings;
             if (o.time)
-                std::printf("frame %d: gradient %.2f ms, pyramid %.2f ms, visibility %.2f ms, key lights %.2f ms, shading %.2f ms, total %.2f ms%s\n",
-                            f, t.gradient, t.pyramid, t.visibility, t.keyVisibility, t.shading, t.total,
+                std::printf("frame %d: gradient %.2f ms, pyramid %.2f ms, visibility %.2f ms, key lights %.2f ms, shading %.2f ms, indirect %.2f ms, total %.2f ms%s\n",
+                            f, t.gradient, t.pyramid, t.visibility, t.keyVisibility, t.shading, t.indirect, t.total,
                             f == 0 && o.frames > 1 ? " (warm-up)" : "");
+            if (o.time && o.bounces > 0)
+                std::printf("  indirect: radiance pyramids %.2f ms, scans %.2f ms, shading %.2f ms\n", state.indirect.timings.pyramid,
+                            state.indirect.timings.scan, state.indirect.timings.shading);
             if (f > 0 || o.frames == 1) totals.push_back(t.total);
         }
         if (o.time) {
             std::sort(totals.begin(), totals.end());
             std::printf("%.2f ms per frame\n", totals[totals.size() / 2]);
         }
-        if (!o.outShade.empty()) writeShade(o.outShade, state.shade.rgb);
+        if (!o.outShade.empty()) writeShade(o.outShade, o.bounces > 0 ? state.indirect.total : state.shade.rgb);
         if (!o.outAmbient.empty()) writeAmbient(o.outAmbient, state.shade.ambient);
+        if (!o.outIndirect.empty()) {
+            if (o.bounces == 0) throw InputError("--out-indirect needs --bounces >= 1");
+            writeIndirect(o.outIndirect, state.indirect.indirect);
+        }
         return 0;
     });
 }
@@ -208,6 +294,14 @@ Runner addGiCommand(CLI::App& app) {
     sub->add_option("--out-ambient", o->outAmbient, "Ambient (sky-view) map (.npy float32, or .exr)");
     sub->add_option("--frames", o->frames, "Run the frame N times on the same field (first = warm-up)");
     sub->add_flag("--time", o->time, "Print the time of each stage and the median ms per frame");
+    sub->add_option("--bounces", o->bounces, "Indirect light bounces (0 = direct only)");
+    sub->add_option("--brdf", o->brdf, "lambert | phong:EXP | mix:W[,EXP] (Lambert + W x Phong)");
+    sub->add_option("--albedo", o->albedo, "Albedo R,G,B in [0, 1] or an sRGB PNG of the field's size");
+    sub->add_flag("--amortise", o->amortise, "With --frames on static geometry: alternate direct and indirect updates");
+    sub->add_option("--out-indirect", o->outIndirect, "Indirect light alone, RGB (.npy float32 (rows, columns, 3), or .exr)");
+    sub->add_option("--radiance-levels-per-octave", o->radianceLevelsPerOctave, "Radiance pyramid k_u (default 4)");
+    sub->add_option("--radiance-level-offset", o->radianceLevelOffset, "Radiance pyramid level offset o_u (default 2)");
+    sub->add_option("--reference-directions", o->referenceDirections, "Directions of the indirect reference (default 2048)");
     return [o] { return runGi(*o); };
 }
 

@@ -1,0 +1,85 @@
+#include "gi/albedo_io.h"
+
+#include <png.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <sstream>
+#include <vector>
+
+#include "sim/error.h"
+#include "sim/io.h"
+
+namespace terrain::gi {
+
+namespace {
+float srgbToLinear(std::uint8_t v) {
+    const float c = static_cast<float>(v) / 255.0f;
+    return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+}  // namespace
+
+AlbedoMap loadAlbedo(const std::string& spec, int nx, int ny) {
+    AlbedoMap m;
+    const bool looksNumeric = !spec.empty() && spec.find(',') != std::string::npos &&
+                              spec.find_first_not_of("0123456789.,eE+- ") == std::string::npos;
+    if (looksNumeric) {
+        std::vector<float> v;
+        std::stringstream ss(spec);
+        std::string item;
+        while (std::getline(ss, item, ',')) {
+            try {
+                std::size_t used = 0;
+                v.push_back(std::stof(item, &used));
+                if (used != item.size()) throw std::invalid_argument(item);
+            } catch (const std::exception&) {
+                throw InputError("--albedo '" + spec + "': '" + item + "' is not a number");
+            }
+        }
+        if (v.size() != 3) throw InputError("--albedo '" + spec + "': expected R,G,B or a PNG file");
+        for (float a : v)
+            if (!(a >= 0.0f && a <= 1.0f)) throw InputError("--albedo '" + spec + "': each value must be in [0, 1]");
+        for (int c = 0; c < 3; ++c) m.channel[static_cast<std::size_t>(c)].resize(nx, ny, v[static_cast<std::size_t>(c)]);
+        return m;
+    }
+    png_image img;
+    std::memset(&img, 0, sizeof img);
+    img.version = PNG_IMAGE_VERSION;
+    if (!png_image_begin_read_from_file(&img, spec.c_str())) throw IoError(spec, std::string("cannot read PNG: ") + img.message);
+    img.format = PNG_FORMAT_RGB;
+    if (static_cast<int>(img.width) != nx || static_cast<int>(img.height) != ny) {
+        png_image_free(&img);
+        throw InputError("--albedo " + spec + ": " + std::to_string(img.width) + " x " + std::to_string(img.height) +
+                         " pixels, the height field has " + std::to_string(nx) + " x " + std::to_string(ny));
+    }
+    std::vector<std::uint8_t> px(PNG_IMAGE_SIZE(img));
+    if (!png_image_finish_read(&img, nullptr, px.data(), 0, nullptr)) throw IoError(spec, std::string("cannot decode PNG: ") + img.message);
+    for (int c = 0; c < 3; ++c) m.channel[static_cast<std::size_t>(c)].resize(nx, ny);
+    for (std::size_t i = 0; i < static_cast<std::size_t>(nx) * ny; ++i)
+        for (int c = 0; c < 3; ++c) m.channel[static_cast<std::size_t>(c)].v[i] = srgbToLinear(px[3 * i + static_cast<std::size_t>(c)]);
+    return m;
+}
+
+void writeNpyRgb(const std::string& file, const std::array<Grid, 3>& rgb) {
+    const Grid& g0 = rgb[0];
+    std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': (" + std::to_string(g0.ny) + ", " +
+                         std::to_string(g0.nx) + ", 3), }";
+    const std::size_t total = 10 + header.size() + 1;  // magic, version, length, header, '\n'
+    header.append((64 - total % 64) % 64, ' ');
+    header.push_back('\n');
+    std::string bytes = "\x93NUMPY";
+    bytes.push_back('\x01');
+    bytes.push_back('\x00');
+    const std::uint16_t len = static_cast<std::uint16_t>(header.size());
+    bytes.push_back(static_cast<char>(len & 0xff));
+    bytes.push_back(static_cast<char>(len >> 8));
+    bytes += header;
+    const std::size_t off = bytes.size();
+    bytes.resize(off + g0.size() * 12);
+    for (std::size_t i = 0; i < g0.size(); ++i)
+        for (int c = 0; c < 3; ++c) std::memcpy(&bytes[off + 12 * i + 4 * static_cast<std::size_t>(c)], &rgb[static_cast<std::size_t>(c)].v[i], 4);
+    writeFileAtomic(file, bytes);
+}
+
+}  // namespace terrain::gi
