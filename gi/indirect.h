@@ -21,11 +21,10 @@
 // giving the bounce's exit radiance L_b. Bounce b + 1 builds its radiance
 // pyramid from L_b (Section 7); the result accumulates L_1 + ... + L_B.
 //
-// Glossy surfaces: ScalarPyramid forwards the scalar shade (diffuse +
-// glossy towards the viewer) to the next bounce (the single-pyramid
-// approximation of Fig. 5). ShVectorPyramid filters the incident radiance SH
-// vectors of the previous bounce and evaluates the Phong lobe in the direction
-// towards the receiver at every casting-set member (Section 5.3).
+// Glossy surfaces: the scalar shade (diffuse + glossy towards the viewer,
+// per ShadingSettings::brdf) is forwarded to the next bounce's RGB pyramid:
+// the single-pyramid approximation of Fig. 5 (right). The vector pyramid of SH
+// radiance (Fig. 5 middle) is not implemented yet.
 //
 // Heights equal up to float rounding must not count as blockers (a flat
 // plane gets exactly no indirect light): a sample counts in the casting set
@@ -49,8 +48,7 @@
 namespace terrain::gi {
 
 enum class GlossyIndirect {
-    ScalarPyramid,    // one RGB pyramid of the scalar shade (diffuse + glossy towards the viewer), Fig. 5 right
-    ShVectorPyramid,  // pyramid of SH incident radiance vectors, glossy lobe towards the receiver, Fig. 5 middle
+    ScalarPyramid,  // one RGB pyramid of the scalar shade (diffuse + glossy towards the viewer), Fig. 5 right
 };
 
 struct IndirectSettings {
@@ -81,7 +79,6 @@ struct IndirectState {
     std::array<VisibilityField, 3> u;    // U per channel (16 SH planes at the receivers)
     std::array<ShadingLight, 3> lights;
     std::array<ShadeMaps, 2> bounceShade;  // exit radiance of the current / previous bounce
-    std::vector<float> shIncident;         // glossy: previous bounce's incident SH radiance, full resolution
     std::array<Grid, 3> indirect;  // sum of bounces 1..B, full resolution
     std::array<Grid, 3> total;     // direct + indirect
     std::vector<double> bounceMean;  // mean exit radiance (RGB average) of each bounce
@@ -90,8 +87,6 @@ struct IndirectState {
 
 /// Indirect light of `bounces` bounces over the frame's height pyramid.
 /// direct: bounce 0's exit radiance (full resolution, albedo applied);
-/// directIncident (optional, glossy vector pyramid only): bounce 0's incident
-/// SH radiance at the receivers (ShadeMaps::incident, 3 x 16 planes).
 void computeIndirect(const HeightPyramid& heights, ConstGridView gradX, ConstGridView gradY,
                      const FoldedWedgeOperator& op, const VisibilityField& envVisibility,
                      const std::array<Grid, 3>& direct, const AlbedoMap* albedo, const ShadingSettings& shading,

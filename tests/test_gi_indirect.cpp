@@ -100,3 +100,206 @@ TEST_CASE("gi.indirect: V-shaped valley with white walls under a uniform sky mat
     CHECK(fast == doctest::Approx(exact).epsilon(0.10));
     CHECK(fastWall == doctest::Approx(exactWall).epsilon(0.10));
 }
+
+TEST_CASE("gi.indirect: a flat plane gets exactly no indirect light for any bounce count") {
+    for (int s : {1, 2, 4})
+        for (int b : {1, 2, 3, 5}) {
+            const Grid h(37, 23, 123.0f);
+            const AlbedoMap a = uniformAlbedo(37, 23, 0.9f);
+            GiState st;
+            runGiFrame(h.view(), 2.0f, GiLighting{}, indirectSettings(b, s), st, &a);
+            for (int c = 0; c < 3; ++c)
+                for (float v : st.indirect.indirect[static_cast<std::size_t>(c)].v) REQUIRE(v == 0.0f);
+            CHECK(st.indirect.total[0](10, 10) == st.shade.rgb[0](10, 10));
+        }
+}
+
+TEST_CASE("gi.indirect: indirect >= 0, each bounce adds less than the last, below the albedo / (1 - albedo) bound") {
+    const int n = 64;
+    const Grid h = hills(n, 12.0f);
+    const float albedo = 0.6f;
+    const AlbedoMap a = uniformAlbedo(n, n, albedo);
+    GiState st;
+    runGiFrame(h.view(), 1.0f, GiLighting{}, indirectSettings(4), st, &a);
+    float directMax = 0.0f;
+    for (float v : st.shade.rgb[0].v) directMax = std::max(directMax, v);
+    float minInd = 1e30f, maxInd = 0.0f;
+    for (float v : st.indirect.indirect[0].v) {
+        minInd = std::min(minInd, v);
+        maxInd = std::max(maxInd, v);
+    }
+    const auto& m = st.indirect.bounceMean;
+    MESSAGE("bounce means " << m[0] << ", " << m[1] << ", " << m[2] << ", " << m[3] << "; indirect min " << minInd << ", max "
+                            << maxInd << ", bound " << directMax * albedo / (1.0f - albedo));
+    CHECK(minInd >= -1e-3f * directMax);  // SH ringing of order-4 U may dip a hair below 0
+    CHECK(m[0] > 0.0);
+    for (int b = 1; b < 4; ++b) CHECK(m[static_cast<std::size_t>(b)] < m[static_cast<std::size_t>(b - 1)]);
+    CHECK(maxInd <= directMax * albedo / (1.0f - albedo));
+}
+
+TEST_CASE("gi.indirect: a red wall bleeds red onto a white floor, not green") {
+    Grid h(48, 24, 0.0f);
+    AlbedoMap a = uniformAlbedo(48, 24, 0.8f);
+    for (int y = 0; y < 24; ++y)
+        for (int x = 27; x < 48; ++x) {
+            h(x, y) = std::min(16.0f, 3.0f * static_cast<float>(x - 27));
+            a.channel[1](x, y) = 0.05f;
+            a.channel[2](x, y) = 0.05f;
+        }
+    GiState st;
+    runGiFrame(h.view(), 1.0f, GiLighting{}, indirectSettings(1), st, &a);
+    const double r = meanOver(st.indirect.indirect[0], 18, 26, 6, 18);
+    const double g = meanOver(st.indirect.indirect[1], 18, 26, 6, 18);
+    const double b = meanOver(st.indirect.indirect[2], 18, 26, 6, 18);
+    MESSAGE("floor beside the red wall: indirect R " << r << ", G " << g << ", B " << b);
+    CHECK(r > 0.02);
+    CHECK(r > 4.0 * g);
+    CHECK(g == doctest::Approx(b).epsilon(1e-3));
+}
+
+TEST_CASE("gi.indirect: outputs are bit-identical for 1, 2, 3 and 8 threads") {
+    const Grid h = hills(71, 10.0f);
+    AlbedoMap a = uniformAlbedo(71, 71, 0.7f);
+    for (int y = 0; y < 71; ++y)
+        for (int x = 0; x < 71; ++x) a.channel[1](x, y) = 0.3f + 0.4f * static_cast<float>((x * 7 + y * 3) % 11) / 11.0f;
+    for (int s : {1, 2}) {
+        std::vector<std::vector<float>> results;
+        for (int threads : {1, 2, 3, 8}) {
+            GiState st;
+            withThreads(threads, [&] { runGiFrame(h.view(), 1.5f, GiLighting{}, indirectSettings(2, s), st, &a); });
+            std::vector<float> all;
+            for (int c = 0; c < 3; ++c) all.insert(all.end(), st.indirect.indirect[static_cast<std::size_t>(c)].v.begin(), st.indirect.indirect[static_cast<std::size_t>(c)].v.end());
+            results.push_back(all);
+        }
+        for (std::size_t i = 1; i < results.size(); ++i) CHECK(results[i] == results[0]);
+    }
+}
+
+TEST_CASE("gi.indirect: hard cases stay finite") {
+    auto finite = [](const GiState& st) {
+        for (int c = 0; c < 3; ++c)
+            for (float v : st.indirect.total[static_cast<std::size_t>(c)].v)
+                if (!std::isfinite(v) || v < -1e-2f) return false;
+        return true;
+    };
+    std::vector<std::pair<std::string, Grid>> cases;
+    {
+        Grid g(40, 40, 0.0f);
+        for (int y = 0; y < 40; ++y)
+            for (int x = 20; x < 40; ++x) g(x, y) = 1000.0f;
+        cases.emplace_back("1000 m cliff", g);
+    }
+    {
+        Grid g(33, 33, 0.0f);
+        g(16, 16) = 500.0f;
+        cases.emplace_back("one-texel spike", g);
+    }
+    {
+        Grid g = hills(32, 30.0f);
+        for (float& v : g.v) v += 1.0e5f;
+        cases.emplace_back("1e5 m heights", g);
+    }
+    {
+        Grid g = hills(32, 30.0f);
+        for (float& v : g.v) v -= 3000.0f;
+        cases.emplace_back("negative heights", g);
+    }
+    cases.emplace_back("1x1", Grid(1, 1, 5.0f));
+    cases.emplace_back("2x2", hills(2, 3.0f));
+    cases.emplace_back("non-power-of-two 37x19", hills(37, 5.0f));
+    for (auto& [name, g] : cases)
+        for (int s : {1, 2, 4}) {
+            GiState st;
+            const AlbedoMap a = uniformAlbedo(g.nx, g.ny, 0.8f);
+            runGiFrame(g.view(), 1.0f, GiLighting{}, indirectSettings(2, s), st, &a);
+            INFO(name << " at " << s << "x");
+            CHECK(finite(st));
+        }
+}
+
+TEST_CASE("gi.indirect: amortised frames equal the full update once two frames have passed on static geometry") {
+    const int n = 48;
+    const Grid h = hills(n, 8.0f);
+    const AlbedoMap a = uniformAlbedo(n, n, 0.7f);
+    GiSettings full = indirectSettings(1, 2);
+    GiSettings amort = full;
+    amort.indirect.amortise = true;
+    GiLighting l1, l2;
+    l2.environment = sunSkyLight();
+    GiState sf, sa;
+    // frame 0: geometry new; frames 1, 2: static geometry, the light changed at frame 1
+    for (int f = 0; f < 3; ++f) {
+        const GiLighting& l = f == 0 ? l1 : l2;
+        sa.geometryChanged = f == 0;
+        runGiFrame(h.view(), 1.0f, l, amort, sa, &a);
+        runGiFrame(h.view(), 1.0f, l, full, sf, &a);
+        if (f == 0) CHECK((sa.directUpdated && sa.indirectUpdated));
+        if (f == 1) {
+            CHECK((sa.directUpdated && !sa.indirectUpdated));
+            CHECK(sa.shade.rgb[0].v == sf.shade.rgb[0].v);
+            CHECK(sa.indirect.indirect[0].v != sf.indirect.indirect[0].v);  // still the previous light's bounce
+        }
+        if (f == 2) {
+            CHECK((!sa.directUpdated && sa.indirectUpdated));
+            for (int c = 0; c < 3; ++c) {
+                CHECK(sa.indirect.indirect[static_cast<std::size_t>(c)].v == sf.indirect.indirect[static_cast<std::size_t>(c)].v);
+                CHECK(sa.indirect.total[static_cast<std::size_t>(c)].v == sf.indirect.total[static_cast<std::size_t>(c)].v);
+            }
+        }
+    }
+    // a geometry change updates both at once
+    sa.geometryChanged = true;
+    runGiFrame(h.view(), 1.0f, l2, amort, sa, &a);
+    CHECK((sa.directUpdated && sa.indirectUpdated));
+}
+
+TEST_CASE("gi.indirect: a second frame allocates nothing new") {
+    const Grid h = hills(40, 8.0f);
+    const AlbedoMap a = uniformAlbedo(40, 40, 0.7f);
+    GiState st;
+    runGiFrame(h.view(), 1.0f, GiLighting{}, indirectSettings(2, 2), st, &a);
+    const float* p0 = st.indirect.indirect[0].data();
+    const float* p1 = st.indirect.u[0].sh.data();
+    const float* p2 = st.indirect.radiance.fields[1].levels.empty() ? nullptr : st.indirect.radiance.fields[1].levels[0].data();
+    Grid h2 = h;
+    for (float& v : h2.v) v *= 1.5f;
+    runGiFrame(h2.view(), 1.0f, GiLighting{}, indirectSettings(2, 2), st, &a);
+    CHECK(st.indirect.indirect[0].data() == p0);
+    CHECK(st.indirect.u[0].sh.data() == p1);
+    if (p2) CHECK(st.indirect.radiance.fields[1].levels[0].data() == p2);
+}
+
+TEST_CASE("gi.indirect: converges to the reference as m, k, o grow and as sub-sampling goes 4x -> 2x -> 1x") {
+    const int n = 48;
+    const Grid h = hills(n, 6.0f);
+    const AlbedoMap a = uniformAlbedo(n, n, 1.0f);
+    GiLighting light;
+    ReferenceGiSettings rs;
+    rs.directions = 4096;
+    rs.azimuths = 256;
+    rs.bounces = 1;
+    rs.marchStep = 0.25f;
+    ReferenceGiResult ref;
+    renderReferenceGi(h.view(), 1.0f, light.environment, &a, rs, ref);
+    auto error = [&](int m, int k, int o, int s) {
+        GiSettings g = indirectSettings(1, s);
+        g.visibility.azimuths = m;
+        g.pyramid.levelsPerOctave = k;
+        g.pyramid.levelOffset = o;
+        g.indirect.radiance.levelsPerOctave = k;
+        g.indirect.radiance.levelOffset = o;
+        GiState st;
+        runGiFrame(h.view(), 1.0f, light, g, st, &a);
+        return relRmse(st.indirect.indirect[0], ref.indirect[0], 0.1f);
+    };
+    const double e0 = error(8, 2, 0, 1), e1 = error(16, 4, 1, 1), e2 = error(32, 4, 2, 1), e3 = error(64, 8, 4, 1);
+    MESSAGE("indirect rel. RMSE vs reference: (m, k, o) = (8, 2, 0) " << e0 << ", (16, 4, 1) " << e1 << ", (32, 4, 2) " << e2
+                                                                        << ", (64, 8, 4) " << e3);
+    CHECK(e1 < e0);
+    CHECK(e3 < e1);
+    CHECK(e3 < 0.08);
+    const double s4 = error(32, 4, 2, 4), s2 = error(32, 4, 2, 2), s1 = error(32, 4, 2, 1);
+    MESSAGE("sub-sampling: 4x " << s4 << ", 2x " << s2 << ", 1x " << s1);
+    CHECK(s2 < s4);
+    CHECK(s1 < s2);
+}
