@@ -47,8 +47,8 @@ int runWindowDemo(WindowContext& window, const Gl& gl, FramePipeline& pipeline, 
     auto last = Clock::now();
     const char* lightingNames[] = {"key light only", "direct (sky + key)", "global (direct + bounces)"};
     const char* shadowNames[] = {"engine soft visibility", "shadow map", "none"};
-    const char* debugNames[] = {"none", "ambient", "V (sky visibility)", "key visibility", "normals", "pyramid level",
-                                "GI shade map"};
+    const char* debugNames[] = {"none",          "ambient",      "V (sky visibility)", "key visibility", "normals",
+                                "pyramid level", "GI shade map", "U (indirect, global)"};
     while (!window.shouldClose() && (maxFrames <= 0 || frames < maxFrames)) {
         window.pollEvents();
         // ---- simulation + GI ----------------------------------------------------------
@@ -82,7 +82,7 @@ int runWindowDemo(WindowContext& window, const Gl& gl, FramePipeline& pipeline, 
         int lighting = static_cast<int>(ps.lighting);
         if (ImGui::Combo("lighting", &lighting, lightingNames, 3)) ps.lighting = static_cast<LightingMode>(lighting);
         ImGui::SliderInt("bounces", &ps.bounces, 0, 3);
-        if (ps.lighting == LightingMode::Global) ImGui::TextDisabled("gi/ has no indirect light yet: direct only");
+        ImGui::Checkbox("amortise shading", &ps.amortise);
         int sub = ps.gi.subsample == 1 ? 0 : (ps.gi.subsample == 2 ? 1 : 2);
         ImGui::Text("sub-sampling");
         ImGui::SameLine();
@@ -95,7 +95,7 @@ int runWindowDemo(WindowContext& window, const Gl& gl, FramePipeline& pipeline, 
         int shadow = static_cast<int>(rs.shadow);
         if (ImGui::Combo("key shadow", &shadow, shadowNames, 3)) rs.shadow = static_cast<ShadowMode>(shadow);
         int debug = static_cast<int>(rs.debug);
-        if (ImGui::Combo("view", &debug, debugNames, 7)) rs.debug = static_cast<DebugView>(debug);
+        if (ImGui::Combo("view", &debug, debugNames, 8)) rs.debug = static_cast<DebugView>(debug);
         ImGui::SliderInt("pyramid level", &ps.pyramidLevel, 0, 16);
         ImGui::Checkbox("water", &rs.water);
         ImGui::SameLine();

@@ -96,7 +96,16 @@ void FramePipeline::light() {
     gi::GiLighting lighting;
     lighting.environment = lights_.sky;
     lighting.keys = {lights_.key};
-    gi::runGiFrame(surface_.cview(), s.cellSize, lighting, settings_.gi, gi_);
+    // Global lighting adds `bounces` indirect bounces (gi/indirect.h); the
+    // simulator's change report says whether the lit surface moved, which
+    // drives the shading amortisation (Section 7) when it is on.
+    gi::GiSettings gs = settings_.gi;
+    gs.indirect.bounces = settings_.lighting == LightingMode::Global ? settings_.bounces : 0;
+    gs.indirect.amortise = settings_.amortise;
+    const ChangeReport& ch = sim_.changes();
+    gi_.geometryChanged = exag != lastExaggeration_ || ch.maxGroundChange > 0.0f || ch.maxWaterChange > 0.0f;
+    lastExaggeration_ = exag;
+    gi::runGiFrame(surface_.cview(), s.cellSize, lighting, gs, gi_);
     const double surfaceMs = msSince(t);
 
     // The key light's share of the shade map: gi/ shading with that light alone.
@@ -120,7 +129,8 @@ void FramePipeline::light() {
     const float lx = ce * std::cos(k.azimuthDeg * kDeg), ly = ce * std::sin(k.azimuthDeg * kDeg);
     const float lz = std::sin(k.elevationDeg * kDeg);
     const float keyLum = 0.2126f * k.rgb[0] + 0.7152f * k.rgb[1] + 0.0722f * k.rgb[2];
-    const auto& total = gi_.shade.rgb;
+    const bool indirect = gs.indirect.bounces > 0;
+    const auto& total = indirect ? gi_.indirect.total : gi_.shade.rgb;
     const auto& keyRgb = keyOnly_.rgb;
     parallelForRows(ny, nx, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y)
@@ -149,26 +159,34 @@ void FramePipeline::light() {
     f.nxr = v.nxr;
     f.nyr = v.nyr;
     f.subsample = settings_.gi.subsample;
-    f.receiver.resize(2 * static_cast<std::size_t>(v.nxr) * v.nyr);
+    f.receiver.resize(4 * static_cast<std::size_t>(v.nxr) * v.nyr);
     const int levels = static_cast<int>(gi_.pyramid.levels.size());
     f.pyramidLevel = levels > 0 ? std::clamp(settings_.pyramidLevel, 0, levels - 1) : -1;
     const float vScale = static_cast<float>(std::sqrt(4.0 * gi::kPi) / (2.0 * gi::kPi));
+    // U's constant term: the mean incident indirect radiance U_00 / sqrt(4 pi) (luminance)
+    const float uScale = static_cast<float>(1.0 / std::sqrt(4.0 * gi::kPi));
+    const auto& u = gi_.indirect.u;
+    const bool hasU = indirect && u[0].nxr == v.nxr && u[0].nyr == v.nyr && !u[0].sh.empty();
     for (int y = 0; y < v.nyr; ++y)
         for (int x = 0; x < v.nxr; ++x) {
             const std::size_t i = static_cast<std::size_t>(y) * v.nxr + x;
-            f.receiver[2 * i] = v.plane(0)[i] * vScale;
+            f.receiver[4 * i] = v.plane(0)[i] * vScale;
             float level = surface_(std::min(x * f.subsample, nx - 1), std::min(y * f.subsample, ny - 1)) / exag;
             if (f.pyramidLevel >= 0) {
                 const gi::PaddedField& p = gi_.pyramid.levels[static_cast<std::size_t>(f.pyramidLevel)];
                 if (x < p.nx && y < p.ny) level = p.row(y)[x] / exag;
             }
-            f.receiver[2 * i + 1] = level;
+            f.receiver[4 * i + 1] = level;
+            f.receiver[4 * i + 2] =
+                hasU ? uScale * (0.2126f * u[0].plane(0)[i] + 0.7152f * u[1].plane(0)[i] + 0.0722f * u[2].plane(0)[i])
+                     : 0.0f;
+            f.receiver[4 * i + 3] = 0.0f;
         }
     const double packMs = msSince(t);
 
     const gi::GiTimings& g = gi_.timings;
     timings_.pyramids = g.gradient + g.pyramid;
-    timings_.scan = g.visibility + g.keyVisibility;
+    timings_.scan = g.visibility + g.keyVisibility + g.indirect;  // indirect: its pyramids, casting-set scans, shading
     timings_.integrate = 0.0;  // gi/ fuses the wedge integration into the scan (part 1)
     timings_.shade = g.shading + packMs + (surfaceMs - g.total);
     timings_.render = 0.0;

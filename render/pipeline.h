@@ -14,7 +14,8 @@
 //              soft visibility, which also modulates the specular term
 //   ambient    gi/ ambient map (normal-weighted sky-view factor)
 //   and at the receiver resolution: the sky visibility fraction (V's
-//   constant term) and one height-pyramid level, for debug views.
+//   constant term), one height-pyramid level and the mean incident indirect
+//   radiance (U's constant term), for debug views.
 #include <cstdint>
 #include <vector>
 
@@ -27,7 +28,7 @@ namespace terrain::render {
 enum class LightingMode {
     KeyOnly,  // the key light only (with its visibility), no sky
     Direct,   // sky + key light, each with the engine's soft visibility
-    Global,   // direct + `bounces` indirect bounces (gi/ has no indirect light yet: same as Direct)
+    Global,   // direct + `bounces` indirect bounces (gi/indirect.h)
 };
 
 /// Lights of the demo scenes.
@@ -40,7 +41,8 @@ SceneLights defaultLights();
 struct PipelineSettings {
     gi::GiSettings gi = gi::engineGiSettings();  // sub-sampling lives here (1, 2, 4)
     LightingMode lighting = LightingMode::Direct;
-    int bounces = 1;         // 0..3; used once gi/ supports indirect light
+    int bounces = 1;         // 0..3 indirect bounces in LightingMode::Global
+    bool amortise = false;   // Section 7: on static geometry alternate direct / indirect updates
     int pyramidLevel = 4;    // pyramid level exposed to the debug view
     int ticksPerFrame = 0;   // 0 = the scene's default pacing
     // Vertical exaggeration of what is lit and drawn (GI, shadow map and mesh
@@ -67,7 +69,8 @@ struct FrameData {
     std::vector<float> shade;             // 4 per texel: sky RGB, key visibility
     std::vector<float> key;               // 4 per texel: key RGB, ambient
     int nxr = 0, nyr = 0, subsample = 1;  // receiver grid
-    std::vector<float> receiver;          // 2 per receiver: sky visibility fraction, pyramid level height
+    std::vector<float> receiver;          // 4 per receiver: sky visibility fraction, pyramid level height,
+                                          // mean incident indirect radiance (U's constant term; 0 without bounces), 0
     int pyramidLevel = -1;                // level in `receiver` (-1: none built)
     SceneLights lights;
     LightingMode lighting = LightingMode::Direct;
@@ -105,6 +108,7 @@ private:
     int ticksPerFrame_ = 1;
     float autoExaggeration_ = 1.0f;
     bool first_ = true;
+    float lastExaggeration_ = -1.0f;  // exaggeration of the last lit frame (a change moves the surface)
     Grid surface_;          // ground + water: what the light sees
     gi::GiState gi_;
     gi::ShadeMaps keyOnly_;  // the key light's shading alone

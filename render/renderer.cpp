@@ -130,9 +130,9 @@ void Renderer::upload(const FrameData& f) {
     ensureTexture(keyTex_, keyW_, keyH_, f.nx, f.ny, GL_RGBA32F, GL_RGBA, true);
     gl_.BindTexture(GL_TEXTURE_2D, keyTex_);
     gl_.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, f.nx, f.ny, GL_RGBA, GL_FLOAT, f.key.data());
-    ensureTexture(receiverTex_, recvW_, recvH_, f.nxr, f.nyr, GL_RG32F, GL_RG, true);
+    ensureTexture(receiverTex_, recvW_, recvH_, f.nxr, f.nyr, GL_RGBA32F, GL_RGBA, true);
     gl_.BindTexture(GL_TEXTURE_2D, receiverTex_);
-    gl_.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, f.nxr, f.nyr, GL_RG, GL_FLOAT, f.receiver.data());
+    gl_.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, f.nxr, f.nyr, GL_RGBA, GL_FLOAT, f.receiver.data());
 
     // The environment map: the sky's SH radiance baked to 64 x 32 texels
     // (order 4 is band-limited, i.e. already a prefiltered map).

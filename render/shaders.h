@@ -153,12 +153,13 @@ void main() {
     vec3 n = normalAt(vCell, false);
     if (uDebug != 0) {
         vec3 c;
-        vec2 r = texture(uReceiver, receiverUv(vCell)).rg;
+        vec3 r = texture(uReceiver, receiverUv(vCell)).rgb;
         if (uDebug == 1) c = vec3(texture(uKey, uv).a);
         else if (uDebug == 2) c = vec3(r.r);
         else if (uDebug == 3) c = vec3(texture(uShade, uv).a);
         else if (uDebug == 4) c = n * 0.5 + 0.5;
         else if (uDebug == 5) c = vec3((r.g - uZRange.x) / max(uZRange.y - uZRange.x, 1e-3));
+        else if (uDebug == 7) c = vec3(r.b * 2.0);
         else c = texture(uShade, uv).rgb + texture(uKey, uv).rgb;
         fragColor = vec4(clamp(c, 0.0, 1.0), 1.0);
         return;

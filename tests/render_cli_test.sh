@@ -28,7 +28,8 @@ grep -q "frames written to" "$tmp/log" && ok || bad "render does not print the f
 
 # every mode renders
 for mode in "--lighting key" "--lighting global --bounces 2" "--shadow map" "--shadow none" "--subsample 1" "--subsample 4" \
-            "--debug ambient" "--debug v" "--debug key" "--debug normals" "--debug pyramid" "--debug shade"; do
+            "--debug ambient" "--debug v" "--debug key" "--debug normals" "--debug pyramid" "--debug shade" \
+            "--lighting global --debug u" "--lighting global --amortise"; do
   # shellcheck disable=SC2086
   "$T" render --scene waves "${small[@]}" --frames 1 --out "$tmp/m" --quiet $mode >"$tmp/o" 2>&1 && [ -s "$tmp/m/frame_0000.png" ] && ok || bad "render $mode: $(cat "$tmp/o")"
 done

@@ -160,6 +160,20 @@ TEST_CASE("render.lighting: sky light brightens a shadowed valley floor (direct 
     CHECK(bDirect > bKey + 20.0);
 }
 
+TEST_CASE("render.lighting: with global illumination a valley floor is brighter than with direct light only") {
+    // The same shadowed V valley: one indirect bounce off the lit walls adds
+    // light on the floor (albedo 1 in gi/, the renderer's palette on top).
+    auto valley = [](float x, float) {
+        const float d = std::abs(x - 315.0f);
+        return d < 30.0f ? 0.0f : std::min(60.0f, (d - 30.0f) * 1.2f);
+    };
+    const auto direct = renderShape(valley, LightingMode::Direct, ShadowMode::SoftVisibility, 15.0f);
+    const auto global = renderShape(valley, LightingMode::Global, ShadowMode::SoftVisibility, 15.0f);
+    const double bDirect = centreBrightness(direct, 4, 4), bGlobal = centreBrightness(global, 4, 4);
+    MESSAGE("valley floor: direct only " << bDirect << ", direct + one bounce " << bGlobal);
+    CHECK(bGlobal > bDirect + 5.0);
+}
+
 TEST_CASE("render.shadow: the shadow map and the engine's soft visibility both shadow a valley floor") {
     auto valley = [](float x, float) {
         const float d = std::abs(x - 315.0f);

@@ -71,9 +71,11 @@ void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize) {
     sub->add_option("--lighting", o.lighting, "key (key light only) | direct (sky + key) | global (direct + bounces)")
         ->capture_default_str();
     sub->add_option("--bounces", o.bounces, "Indirect bounces 0..3 for --lighting global")->capture_default_str();
+    sub->add_flag("--amortise", o.amortise,
+                  "Shading amortisation: on static geometry update direct and indirect light on alternate frames");
     sub->add_option("--shadow", o.shadow, "Key light shadow: soft (engine visibility) | map (shadow map) | none")
         ->capture_default_str();
-    sub->add_option("--debug", o.debug, "Debug view: none | ambient | v | key | normals | pyramid | shade")
+    sub->add_option("--debug", o.debug, "Debug view: none | ambient | v | u (with --lighting global) | key | normals | pyramid | shade")
         ->capture_default_str();
     sub->add_option("--pyramid-level", o.pyramidLevel, "Height-pyramid level for --debug pyramid")->capture_default_str();
     sub->add_option("--exposure", o.exposure, "Exposure before tone mapping")->capture_default_str();
@@ -101,6 +103,7 @@ void toSettings(const RenderOptions& o, render::PipelineSettings& p, render::Ren
     p.gi = gi::engineGiSettings();
     p.gi.subsample = o.subsample;
     p.bounces = o.bounces;
+    p.amortise = o.amortise;
     p.ticksPerFrame = o.ticksPerFrame;
     p.pyramidLevel = o.pyramidLevel;
     if (o.lighting == "key") p.lighting = LightingMode::KeyOnly;
@@ -118,8 +121,11 @@ void toSettings(const RenderOptions& o, render::PipelineSettings& p, render::Ren
     else if (o.debug == "normals") r.debug = DebugView::Normals;
     else if (o.debug == "pyramid") r.debug = DebugView::PyramidLevel;
     else if (o.debug == "shade") r.debug = DebugView::ShadeMap;
-    else if (o.debug == "u") throw InputError("--debug u: gi/ computes no indirect radiance U yet (GI part 2)");
-    else throw InputError("--debug must be none, ambient, v, key, normals, pyramid or shade (got '" + o.debug + "')");
+    else if (o.debug == "u") {
+        r.debug = DebugView::IndirectRadiance;
+        if (p.lighting != LightingMode::Global) throw InputError("--debug u needs --lighting global (U is the indirect light)");
+    } else
+        throw InputError("--debug must be none, ambient, v, u, key, normals, pyramid or shade (got '" + o.debug + "')");
     r.exposure = o.exposure;
     p.verticalExaggeration = o.exaggeration;
     r.camera.yawDeg = o.yaw;
@@ -148,8 +154,6 @@ int runHeadlessRender(const RenderOptions& o, const char* label) {
                         label, scene.name.c_str(), st.nx, st.ny, static_cast<double>(st.cellSize),
                         static_cast<double>(pipeline.frame().zMin), static_cast<double>(pipeline.frame().zMax), o.frames,
                         pipeline.ticksPerFrame(), o.width, o.height, render::glDescription(gl).c_str());
-            if (ps.lighting == render::LightingMode::Global)
-                std::printf("%s: note: gi/ has no indirect bounces yet; global lighting shows direct light only\n", label);
         }
         std::vector<std::vector<double>> stage(7);
         std::vector<std::uint8_t> rgb;

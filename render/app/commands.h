@@ -31,6 +31,7 @@ struct RenderOptions {
     int subsample = 2;            // GI receivers every 1, 2 or 4 cells
     std::string lighting = "direct";  // key | direct | global
     int bounces = 1;
+    bool amortise = false;
     std::string shadow = "soft";  // soft | map | none
     std::string debug = "none";   // none | ambient | v | key | normals | pyramid | shade | u
     int pyramidLevel = 4;
