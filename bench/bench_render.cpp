@@ -62,8 +62,8 @@ int main(int argc, char** argv) {
         for (const char* s : stageNames) csv << ',' << s << "_ms";
         csv << '\n';
         md << "# Renderer benchmark: per-stage time per frame\n\n"
-           << "Animated scenes, GI sub-sampling 2x, direct lighting (sky + key light with soft visibility; gi/ has no "
-              "indirect bounces yet, so \"one bounce\" is not measurable), headless OSMesa at "
+           << "Animated scenes, GI sub-sampling 2x, global lighting with one indirect bounce (sky + key light with soft "
+              "visibility, no amortisation), headless OSMesa at "
            << width << " x " << height << ", median of " << runs << " frames after one warm-up frame.\n\n"
            << "Machine: " << terrain::bench::machineDescription() << ", " << glDescription(gl) << " (software rasteriser: no GPU).\n\n"
            << "| scene | size | ticks/frame | sim | pyramids | scan | integrate | shade | render | total ms | fps |\n"
@@ -73,6 +73,8 @@ int main(int argc, char** argv) {
             for (int size : {256, 512}) {
                 PipelineSettings ps;
                 ps.gi.subsample = 2;
+                ps.lighting = LightingMode::Global;
+                ps.bounces = 1;
                 FramePipeline pipeline(resolveScene(scene, size, 1), ps);
                 std::vector<std::vector<double>> t(7);
                 for (int f = 0; f <= runs; ++f) {

@@ -185,10 +185,14 @@ void FramePipeline::light() {
     const double packMs = msSince(t);
 
     const gi::GiTimings& g = gi_.timings;
-    timings_.pyramids = g.gradient + g.pyramid;
-    timings_.scan = g.visibility + g.keyVisibility + g.indirect;  // indirect: its pyramids, casting-set scans, shading
+    // Indirect light's own radiance pyramids, casting-set scans and shading go
+    // into the matching stages (zero on frames that did not update it).
+    const gi::IndirectTimings& ind = gi_.indirect.timings;
+    const bool indirectRan = gs.indirect.bounces > 0 && g.indirect > 0.0;
+    timings_.pyramids = g.gradient + g.pyramid + (indirectRan ? ind.pyramid : 0.0);
+    timings_.scan = g.visibility + g.keyVisibility + (indirectRan ? ind.scan : 0.0);
     timings_.integrate = 0.0;  // gi/ fuses the wedge integration into the scan (part 1)
-    timings_.shade = g.shading + packMs + (surfaceMs - g.total);
+    timings_.shade = g.shading + (indirectRan ? ind.shading : 0.0) + packMs + (surfaceMs - g.total);
     timings_.render = 0.0;
 }
 
