@@ -60,6 +60,71 @@ bool firstHit(const float* h, int nx, int ny, float hMax, float cellSize, int x,
 
 }  // namespace
 
+void addReferenceKeyLight(ConstGridView heights, float cellSize, const KeyLight& key, const AlbedoMap* albedo,
+                          int azimuths, std::array<Grid, 3>& rgb) {
+    validateKeyLight(key);
+    const int nx = heights.nx, ny = heights.ny;
+    for (Grid& g : rgb)
+        if (g.nx != nx || g.ny != ny) g.resize(nx, ny, 0.0f);
+    const int A = std::max(azimuths, 1);
+    const KeyLightExtent ext = keyLightExtent(key);
+    const double r = key.radiusDeg * kPi / 180.0, el = key.elevationDeg * kPi / 180.0, az = key.azimuthDeg * kPi / 180.0;
+    const double cosR = std::cos(r), sr = std::sin(r);
+    const double radianceScale = 1.0 / (sr * sr);  // cap radiance = RGB / sin^2(r): irradiance ~ pi RGB at normal incidence
+    // per azimuth: the cap's elevation chord [lo, hi] (A sin w + B cos w >= cos r)
+    struct Az {
+        double c, s, lo, hi;
+        bool any;
+    };
+    std::vector<Az> az_(static_cast<std::size_t>(A));
+    const double dphi = (ext.phiEnd - ext.phiStart) / A;
+    for (int a = 0; a < A; ++a) {
+        const double phi = ext.phiStart + (a + 0.5) * dphi;
+        const double pa = std::sin(el), pb = std::cos(el) * std::cos(phi - az);
+        const double R = std::sqrt(pa * pa + pb * pb);
+        Az& z = az_[static_cast<std::size_t>(a)];
+        z.c = std::cos(phi);
+        z.s = std::sin(phi);
+        z.any = R > cosR;
+        if (!z.any) continue;
+        const double centre = std::atan2(pa, pb), half = std::acos(std::min(1.0, cosR / R));
+        z.lo = std::max(-0.5 * kPi, centre - half);
+        z.hi = std::min(0.5 * kPi, centre + half);
+        z.any = z.hi > z.lo;
+    }
+    Grid gx, gy;
+    computeGradient(heights, cellSize, gx, gy);
+    double heightMax = -1e300;
+    for (int y = 0; y < ny; ++y)
+        for (int x = 0; x < nx; ++x) heightMax = std::max(heightMax, static_cast<double>(heights(x, y)));
+    parallelFor(0, ny, 1, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < nx; ++x) {
+                const double gxv = gx(x, y), gyv = gy(x, y);
+                const double inv = 1.0 / std::sqrt(1.0 + gxv * gxv + gyv * gyv);
+                double e = 0.0;  // int over the visible cap of (N . d) d(solid angle)
+                for (const Az& z : az_) {
+                    if (!z.any) continue;
+                    const double slope = referenceMaxSlope(heights, cellSize, x, y, z.c, z.s, heightMax);
+                    const double lo = std::max(z.lo, std::atan(std::max(slope, gxv * z.c + gyv * z.s)));
+                    if (lo >= z.hi) continue;
+                    // (N . d) cos w = (horiz cos w + nz sin w) cos w
+                    const double horiz = -(gxv * z.c + gyv * z.s) * inv;
+                    const double c2 = 0.5 * (z.hi - lo) + 0.25 * (std::sin(2.0 * z.hi) - std::sin(2.0 * lo));
+                    const double sc = 0.5 * (std::sin(z.hi) * std::sin(z.hi) - std::sin(lo) * std::sin(lo));
+                    e += horiz * c2 + inv * sc;
+                }
+                e *= dphi * radianceScale / kPi;
+                for (int c = 0; c < 3; ++c) {
+                    const float alb = albedo && !albedo->channel[static_cast<std::size_t>(c)].empty()
+                                          ? albedo->channel[static_cast<std::size_t>(c)](x, y)
+                                          : 1.0f;
+                    rgb[static_cast<std::size_t>(c)](x, y) += static_cast<float>(alb * key.rgb[c] * e);
+                }
+            }
+    });
+}
+
 void referenceDirections(int count, std::vector<std::array<float, 3>>& out) {
     out.resize(static_cast<std::size_t>(count));
     const double golden = kPi * (3.0 - std::sqrt(5.0));
@@ -100,7 +165,8 @@ void gatherReferenceBounce(ConstGridView heights, float cellSize, const std::arr
                     if (cosine <= 0.0f) continue;
                     float qx, qy;
                     if (!firstHit(hCopy.data(), nx, ny, hMax, cellSize, x, y, dir, s.marchStep, qx, qy)) continue;
-                    for (int c = 0; c < 3; ++c) e[c] += cosine * bilinearF(prev[c].data(), nx, ny, qx, qy);
+                    const float k = s.shLambert ? 0.25f + 0.5f * cosine + 0.15625f * (3.0f * cosine * cosine - 1.0f) : cosine;
+                    for (int c = 0; c < 3; ++c) e[c] += k * bilinearF(prev[c].data(), nx, ny, qx, qy);
                 }
                 for (int c = 0; c < 3; ++c) {
                     const float a = albedo && !albedo->channel[c].empty() ? albedo->channel[c](x, y) : 1.0f;
@@ -128,6 +194,7 @@ void renderReferenceGi(ConstGridView heights, float cellSize, const ShRgb& light
     ReferenceResult d;
     renderReference(heights, cellSize, &lighting, albedo, direct, d);
     out.ambient = d.ambient;
+    for (const KeyLight& k : s.keys) addReferenceKeyLight(heights, cellSize, k, albedo, s.keyAzimuths, d.rgb);
     for (int c = 0; c < 3; ++c) {
         out.direct[c] = d.rgb[c];
         out.indirect[c].resize(nx, ny, 0.0f);

@@ -28,6 +28,19 @@ struct ReferenceGiSettings {
     int azimuths = 256;       // of the direct (bounce 0) reference
     float marchStep = 0.5f;   // march step along the ray, in cells
     bool progress = false;    // progress on stderr
+    // Key lights as exact spherical caps (radiance RGB / sin^2(radius) inside
+    // the cap, 0 outside): exact visibility per azimuth across the cap's
+    // azimuthal extent and the exact elevation integral of the cap's chord
+    // above max(horizon, tangent plane). Added to bounce 0. (Folding a small
+    // cap into the SH lighting with keyLightSh instead spreads it over the
+    // sphere and softens its shadows: not the light the fast path renders.)
+    std::vector<KeyLight> keys;
+    // Diagnostic: gather with the fast path's Lambert kernel, the clamped
+    // cosine projected to SH bands 0-2 (k(c) = 1/4 + c/2 + 5/32 (3c^2 - 1),
+    // still 0 below the tangent plane), instead of max(0, c): isolates the
+    // order-4 SH truncation of indirect light (a floor for the fast path).
+    bool shLambert = false;
+    int keyAzimuths = 48;     // midpoint azimuths across each cap's extent
 };
 
 struct ReferenceGiResult {
@@ -37,8 +50,8 @@ struct ReferenceGiResult {
     Grid ambient;                  // direct-only normal-weighted sky-view factor
 };
 
-/// Renders the reference with indirect light. `lighting` holds every light
-/// as SH (key lights folded in with keyLightSh). albedo may be null (1).
+/// Renders the reference with indirect light. `lighting`: the environment as
+/// SH; settings.keys: key lights, integrated as exact caps. albedo may be null (1).
 void renderReferenceGi(ConstGridView heights, float cellSize, const ShRgb& lighting, const AlbedoMap* albedo,
                        const ReferenceGiSettings& settings, ReferenceGiResult& out);
 
@@ -46,6 +59,11 @@ void renderReferenceGi(ConstGridView heights, float cellSize, const ShRgb& light
 /// over the fixed direction set (the rays' first hits q_k). next is resized.
 void gatherReferenceBounce(ConstGridView heights, float cellSize, const std::array<Grid, 3>& prev,
                            const AlbedoMap* albedo, const ReferenceGiSettings& settings, std::array<Grid, 3>& next);
+
+/// Adds the direct light of an exact cap key light (Lambert, albedo applied)
+/// to rgb (resized to the heights' size when empty).
+void addReferenceKeyLight(ConstGridView heights, float cellSize, const KeyLight& key, const AlbedoMap* albedo,
+                          int azimuths, std::array<Grid, 3>& rgb);
 
 /// The fixed direction set: K unit vectors spread evenly over the sphere.
 void referenceDirections(int count, std::vector<std::array<float, 3>>& out);

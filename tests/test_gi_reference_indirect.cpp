@@ -161,3 +161,34 @@ TEST_CASE("gi.reference_gi: bit-identical for 1, 2, 3 and 8 threads") {
     const auto ref = withThreads(1, run);
     for (int t : {2, 3, 8}) CHECK(withThreads(t, run) == ref);
 }
+
+TEST_CASE("gi.reference.keycap: exact cap on a flat plane and in a shadowed pit") {
+    using namespace terrain;
+    using namespace terrain::gi;
+    // flat plane: int_cap (N . d) = pi sin^2(r) (N . l), radiance RGB / sin^2 r -> albedo RGB sin(el)
+    Grid h(33, 33, 5.0f);
+    KeyLight k;
+    k.azimuthDeg = 30.0f;
+    k.elevationDeg = 40.0f;
+    k.radiusDeg = 6.0f;
+    k.rgb[0] = 1.0f;
+    k.rgb[1] = 0.5f;
+    k.rgb[2] = 2.0f;
+    std::array<Grid, 3> rgb;
+    addReferenceKeyLight(h.cview(), 1.0f, k, nullptr, 64, rgb);
+    const double expect = std::sin(40.0 * kPi / 180.0);
+    for (int c = 0; c < 3; ++c) CHECK(rgb[c](16, 16) == doctest::Approx(k.rgb[c] * expect).epsilon(2e-3));
+    // a 10 m wall towards the light: 10 cells away it rises 45 deg (cap fully hidden),
+    // 40 cells away 14 deg (below the cap's lowest 15 deg: fully lit)
+    Grid w(64, 64, 0.0f);
+    for (int y = 0; y < 64; ++y)
+        for (int x = 40; x < 64; ++x) w(x, y) = 10.0f;
+    KeyLight e;
+    e.azimuthDeg = 0.0f;
+    e.elevationDeg = 20.0f;
+    e.radiusDeg = 5.0f;
+    std::array<Grid, 3> sh;
+    addReferenceKeyLight(w.cview(), 1.0f, e, nullptr, 32, sh);
+    CHECK(sh[0](30, 32) == 0.0f);
+    CHECK(sh[0](0, 32) == doctest::Approx(std::sin(20.0 * kPi / 180.0)).epsilon(2e-3));
+}
