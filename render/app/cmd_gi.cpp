@@ -211,22 +211,16 @@ int runGi(const GiOptions& o) {
             gi::ReferenceSettings rs;
             rs.progress = true;
             gi::ReferenceResult rr;
-            // key lights enter the ground truth as SH caps added to the environment
-            gi::ShRgb total = lighting.environment;
-            for (const gi::KeyLight& k : lighting.keys) {
-                const gi::ShRgb cap = gi::keyLightSh(k);
-                for (int c = 0; c < 3; ++c)
-                    for (int i = 0; i < gi::kShCount; ++i)
-                        total.c[static_cast<std::size_t>(c)][static_cast<std::size_t>(i)] +=
-                            cap.c[static_cast<std::size_t>(c)][static_cast<std::size_t>(i)];
-            }
+            // key lights enter the ground truth as exact caps (gi/reference_gi.h), not as SH
+            const gi::ShRgb& total = lighting.environment;
             const auto t0 = Clock::now();
-            if (o.bounces > 0 || !o.outIndirect.empty()) {
+            if (o.bounces > 0 || !o.outIndirect.empty() || !lighting.keys.empty()) {
                 // with indirect light: bounce b gathers bounce b - 1 (gi/reference_gi.h)
                 gi::ReferenceGiSettings gs;
                 gs.bounces = o.bounces;
                 gs.directions = o.referenceDirections;
                 gs.progress = true;
+                gs.keys = lighting.keys;
                 gi::ReferenceGiResult gr;
                 gi::renderReferenceGi(heights.cview(), static_cast<float>(cell), total, albedo, gs, gr);
                 const double gms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
