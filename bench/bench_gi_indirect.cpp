@@ -308,7 +308,7 @@ int main(int argc, char** argv) {
     std::vector<Dem> dems = {alpsCrop(accSize), erodedScene(accSize, gQuick ? 200 : 2000)};
     std::string accMd = "# GI indirect light: accuracy against the reference (gi/reference_gi)\n\n";
     accMd += "Machine: " + bench::machineDescription() + ". Lighting: sun-and-sky environment + one key light (az 135, el 35, r 5 deg; "
-             "folded into the reference's SH lighting), albedo " + std::to_string(albedo).substr(0, 3) +
+             "integrated as an exact cap by the reference), albedo " + std::to_string(albedo).substr(0, 3) +
              " everywhere, Lambert. Reference: exact direct light (256 azimuths) and " + std::to_string(refDirections) +
              " fixed gathering directions per texel, march step 0.5 cell. Relative RMSE over all three channels on the interior "
              "(10 % border excluded); bias = mean difference / RMS of the reference.\n\n";
