@@ -471,7 +471,7 @@ void speedErrorPlot(const std::vector<PlotPoint>& pts, const std::string& file) 
             const double v = std::pow(10.0, d) * k;
             if (std::log10(v) > lx1 + 1e-9) break;
             c.line(X(v), top, X(v), H - bottom, grey);
-            if (k == 1 || k == 2 || k == 5) {
+            if (k == 1 || (lx1 - lx0 <= 3.0 ? (k == 2 || k == 5) : k == 3)) {  // sparser labels over many decades
                 char b[32];
                 std::snprintf(b, sizeof b, "%g", v);
                 c.text(static_cast<int>(X(v)) - 6 * static_cast<int>(std::string(b).size()), H - bottom + 10, b, black);
