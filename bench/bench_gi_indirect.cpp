@@ -348,7 +348,7 @@ int main(int argc, char** argv) {
     // ---- Table 1: frame time -----------------------------------------------------------
     std::string tMd = "# GI with indirect light: frame time (the paper's Table 1 on this machine)\n\n";
     tMd += "Machine: " + bench::machineDescription() + ", 2 threads. Scene: builtinScene(\"erosion\", N, 1) initial ground; engine "
-           "settings (m 32, k_v 4, o_v 3, k_u 4, o_u 2), sun-and-sky environment + one key light, albedo 0.6, Lambert. Median of " +
+           "settings (m 32, k_v 4, o_v 3, k_u 4, o_u 3), sun-and-sky environment + one key light, albedo 0.6, Lambert. Median of " +
            std::to_string(gRuns) + " frames after one warm-up; amortised = static geometry, frames alternate direct and indirect "
            "updates; the amortised figure is the mean over an even number of frames (as many cheap as expensive). Memory: every buffer of the frame (inputs and intermediates, float32). Error: indirect / "
            "total relative RMSE at 256^2 against the reference of the accuracy table's erosion frame (at " + std::to_string(accSize) +
