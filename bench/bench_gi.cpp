@@ -655,7 +655,10 @@ void stages() {
     light.keys.push_back(key);
     struct Case { const Dem* dem; int s; const char* which; };
     const Dem c512 = crop(alps, 512, "c512");
+    int caseIndex = -1;
     for (const Case& c : {Case{&c512, 2, "engine"}, Case{&c512, 2, "paper"}, Case{&alps, 1, "engine"}, Case{&alps, 1, "paper"}}) {
+        ++caseIndex;
+        if (std::getenv("GI_CASE") && std::atoi(std::getenv("GI_CASE")) != caseIndex) continue;  // one case only
         GiSettings set = std::string(c.which) == "paper" ? paperSettings() : engineDefaults();
         set.subsample = c.s;
         GiState st;

@@ -207,15 +207,16 @@ struct BsplineMaxVisitor {
 // h0: the row's receiver heights; steps: valid-prefix length
 // of each lane; all lanes are valid for i < nAll, none for i >= nAny.
 template <int NV, class Visitor>
-inline void scanLanes(const ScanStep* table, int Y, int X0, const float* h0, const v4i* steps,
+inline void scanLanes(const ScanStep* table, const float* const* rowPtr, int X0, const float* h0, const v4i* steps,
                       int nAll, int nAny, Visitor& visit) {
+    v4 h[NV];
+    for (int k = 0; k < NV; ++k) h[k] = load4a(h0 + X0 + 4 * k);
     auto sample = [&](int i, v4* s) {
         const ScanStep& st = table[i];
-        const std::ptrdiff_t o = Y * st.rowStep + X0;
-        const float* a = st.field + (o + st.offA);
-        const float* b = st.field + (o + st.offB);
+        const float* a = rowPtr[2 * i] + X0;
+        const float* b = rowPtr[2 * i + 1] + X0;
         const v4 wa = load4a(st.w[0]), wb = load4a(st.w[1]), inv = load4a(st.w[2]);
-        for (int k = 0; k < NV; ++k) s[k] = ((wa * load4(a + 4 * k) + wb * load4(b + 4 * k)) - load4a(h0 + X0 + 4 * k)) * inv;
+        for (int k = 0; k < NV; ++k) s[k] = ((wa * load4(a + 4 * k) + wb * load4(b + 4 * k)) - h[k]) * inv;
     };
     for (int i = 0; i < nAll; ++i) {
         v4 s[NV];
@@ -237,10 +238,18 @@ inline void scanLanes(const ScanStep* table, int Y, int X0, const float* h0, con
     }
 }
 
-// Maximum blocking slope of a row of receivers for one azimuth.
+// Maximum blocking slope of a row of receivers for one azimuth. rowPtr:
+// scratch for 2 x rowSteps pointers (each step's taps at receiver 0 of row Y).
 template <int NV, template <int> class Visitor>
-void scanRow(const ScanStep* table, const int* colSteps, int rowSteps, int Y, const float* h0, int nxrPad, float* out) {
+void scanRow(const ScanStep* table, const int* colSteps, int rowSteps, int Y, const float* h0, int nxrPad, float* out,
+             const float** rowPtr) {
     constexpr int lanes = 4 * NV;
+    for (int i = 0; i < rowSteps; ++i) {
+        const ScanStep& st = table[i];
+        const std::ptrdiff_t o = Y * st.rowStep;
+        rowPtr[2 * i] = st.field + (o + st.offA);
+        rowPtr[2 * i + 1] = st.field + (o + st.offB);
+    }
     const v4i rowLimit = {rowSteps, rowSteps, rowSteps, rowSteps};
     for (int X0 = 0; X0 < nxrPad; X0 += lanes) {
         v4i steps[NV];
@@ -255,7 +264,7 @@ void scanRow(const ScanStep* table, const int* colSteps, int rowSteps, int Y, co
         const int nAll = std::min(std::min(lo[0], lo[1]), std::min(lo[2], lo[3]));
         const int nAny = std::max(std::max(hi[0], hi[1]), std::max(hi[2], hi[3]));
         Visitor<NV> visit;
-        scanLanes<NV>(table, Y, X0, h0, steps, nAll, nAny, visit);
+        scanLanes<NV>(table, rowPtr, X0, h0, steps, nAll, nAny, visit);
         visit.result(out + X0);
     }
 }
@@ -465,6 +474,7 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
         b.gradY.resize(static_cast<std::size_t>(nxrPad));
         b.h0.resize(static_cast<std::size_t>(nxrPad));
         b.nlp.resize(static_cast<std::size_t>(8) * nxrPad);
+        b.rowPtr.resize(2 * static_cast<std::size_t>(nSteps));
     }
     // ---- schedule: fixed row blocks in parallel, rows serially within a block,
     // every azimuth of a row before the next row (the row's h0 / tau table is
@@ -498,9 +508,9 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
                         const int* colSteps = state.stepsPerColumn.data() + static_cast<std::size_t>(j) * nxrPad;
                         const int rowSteps = state.stepsPerRow[static_cast<std::size_t>(j) * nyr + static_cast<std::size_t>(Y)];
                         if (settings.blockingMax == BlockingMax::Samples)
-                            scanRow<4, SampleMaxVisitor>(table, colSteps, rowSteps, Y, sc.h0.data(), nxrPad, sc.maxRow.data());
+                            scanRow<4, SampleMaxVisitor>(table, colSteps, rowSteps, Y, sc.h0.data(), nxrPad, sc.maxRow.data(), sc.rowPtr.data());
                         else
-                            scanRow<2, BsplineMaxVisitor>(table, colSteps, rowSteps, Y, sc.h0.data(), nxrPad, sc.maxRow.data());
+                            scanRow<2, BsplineMaxVisitor>(table, colSteps, rowSteps, Y, sc.h0.data(), nxrPad, sc.maxRow.data(), sc.rowPtr.data());
                         float* maxOut = out.maxSlope.data() + planeSize * j + static_cast<std::size_t>(Y) * nxr;
                         std::copy(sc.maxRow.data(), sc.maxRow.data() + nxr, maxOut);
                         float* nlp = sc.nlp.data() + static_cast<std::size_t>(a) * 4 * nxrPad;

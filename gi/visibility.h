@@ -74,6 +74,7 @@ struct VisibilityScratch {
     std::vector<float> gradY;
     std::vector<float> h0;      // nxr: receiver heights of the current row
     std::vector<float> nlp;     // 2 x 4 x nxr: NLP visibility vectors of the current row, two azimuths
+    std::vector<const float*> rowPtr;  // 2 x steps: each step's two taps for receiver 0 of the current row
 };
 
 /// One step of one azimuth, as the scan kernel reads it: the sample of
