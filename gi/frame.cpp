@@ -26,7 +26,8 @@ void runIndirectStage(const GiSettings& settings, GiState& st, const AlbedoMap* 
 // Key light with the exact cosine (GiSettings::keyLightExactCosine): adds
 // albedo RGB f max(0, N . l) to the shade, f = visible fraction of the light's
 // region, bilinear from the receiver grid like the SH vectors (Fig. 7).
-void addKeyLightExactCosine(const KeyLight& light, const VisibilityField& v, int s, const AlbedoMap* albedo, GiState& st) {
+void addKeyLightExactCosine(const KeyLight& light, const VisibilityField& v, int s, const AlbedoMap* albedo,
+                            const GiState& st, std::array<Grid, 3>& out) {
     const KeyLightExtent ext = keyLightExtent(light);
     const double solidAngle = (ext.phiEnd - ext.phiStart) * (static_cast<double>(ext.sinHigh) - ext.sinLow);
     if (!(solidAngle > 0.0)) return;
@@ -56,11 +57,31 @@ void addKeyLightExactCosine(const KeyLight& light, const VisibilityField& v, int
                     const float alb = albedo && !albedo->channel[static_cast<std::size_t>(c)].empty()
                                           ? albedo->channel[static_cast<std::size_t>(c)](x, y)
                                           : 1.0f;
-                    st.shade.rgb[static_cast<std::size_t>(c)](x, y) += alb * light.rgb[c] * f * cosine;
+                    out[static_cast<std::size_t>(c)](x, y) += alb * light.rgb[c] * f * cosine;
                 }
             }
         }
     });
+}
+
+// The key light as the SH shading stage sees it (Section 6): its visibility
+// is already restricted to the light's azimuthal extent and elevation
+// interval, so V_key is the SH projection of "visible part of the light's
+// region". Its incident radiance is that region's radiance times V_key: the
+// product matrix is a scalar. The region's radiance gives the cap's
+// irradiance at normal incidence, pi * RGB, over the region's solid angle.
+ShadingLight keyShadingLight(const KeyLight& light, const VisibilityField& v) {
+    ShadingLight out;
+    const KeyLightExtent ext = keyLightExtent(light);
+    const double solidAngle = (ext.phiEnd - ext.phiStart) * (static_cast<double>(ext.sinHigh) - ext.sinLow);
+    out.visibility = &v;
+    for (int ch = 0; ch < 3; ++ch) {
+        ShMatrix& m = out.product[static_cast<std::size_t>(ch)];
+        m.fill(0.0);
+        const double radiance = solidAngle > 0.0 ? kPi * light.rgb[ch] / solidAngle : 0.0;
+        for (int i = 0; i < kShCount; ++i) m[static_cast<std::size_t>(i * kShCount + i)] = radiance;
+    }
+    return out;
 }
 
 bool sameLight(const KeyLight& a, const KeyLight& b) {
@@ -222,21 +243,13 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
         // radiance is that region's radiance times V_key: the product matrix
         // is a scalar. The region's radiance gives the cap's irradiance at
         // normal incidence, pi * RGB, over the region's solid angle.
-        const KeyLight& light = lighting.keys[k];
-        const KeyLightExtent ext = keyLightExtent(light);
-        const double solidAngle = (ext.phiEnd - ext.phiStart) * (static_cast<double>(ext.sinHigh) - ext.sinLow);
-        st.shadingLights[k + 1].visibility = &st.keyVisibility[k];
-        for (int ch = 0; ch < 3; ++ch) {
-            ShMatrix& m = st.shadingLights[k + 1].product[static_cast<std::size_t>(ch)];
-            m.fill(0.0);
-            const double radiance = solidAngle > 0.0 ? kPi * light.rgb[ch] / solidAngle : 0.0;
-            for (int i = 0; i < kShCount; ++i) m[static_cast<std::size_t>(i * kShCount + i)] = radiance;
-        }
+        st.shadingLights[k + 1] = keyShadingLight(lighting.keys[k], st.keyVisibility[k]);
     }
     shadeTexels(st.gradX.cview(), st.gradY.cview(), settings.subsample, st.envVisibility, st.shadingLights.data(),
                 static_cast<int>(st.shadingLights.size()), albedo, settings.shading, st.shade);
     if (exactKeys)
-        for (std::size_t k = 0; k < nKeys; ++k) addKeyLightExactCosine(lighting.keys[k], st.keyVisibility[k], settings.subsample, albedo, st);
+        for (std::size_t k = 0; k < nKeys; ++k) addKeyLightExactCosine(lighting.keys[k], st.keyVisibility[k], settings.subsample, albedo, st,
+                                   st.shade.rgb);
     st.timings.shading = msSince(t);
     if (st.indirectUpdated) runIndirectStage(settings, st, albedo);
     else if (settings.indirect.bounces > 0)
@@ -247,6 +260,23 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
             for (std::size_t i = 0; i < tot.v.size(); ++i) tot.v[i] = d.v[i] + ind.v[i];
         }
     st.timings.total = msSince(t0);
+}
+
+void shadeKeyLight(const GiState& st, const GiSettings& settings, const GiLighting& lighting, int k,
+                   ShadeMaps& scratch, std::array<Grid, 3>& out) {
+    if (k < 0 || k >= static_cast<int>(lighting.keys.size()) || k >= static_cast<int>(st.keyVisibility.size()))
+        throw InputError("shadeKeyLight: no key light " + std::to_string(k) + " in the last frame");
+    const KeyLight& light = lighting.keys[static_cast<std::size_t>(k)];
+    const VisibilityField& v = st.keyVisibility[static_cast<std::size_t>(k)];
+    if (settings.keyLightExactCosine) {
+        for (Grid& g : out) g.resize(st.gradX.nx, st.gradX.ny, 0.0f);
+        addKeyLightExactCosine(light, v, settings.subsample, nullptr, st, out);
+        return;
+    }
+    const ShadingLight sl = keyShadingLight(light, v);
+    shadeTexels(st.gradX.cview(), st.gradY.cview(), settings.subsample, st.envVisibility, &sl, 1, nullptr,
+                settings.shading, scratch);
+    out = scratch.rgb;
 }
 
 }  // namespace terrain::gi

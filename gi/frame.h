@@ -85,4 +85,10 @@ void computeGradient(ConstGridView heights, float cellSize, Grid& gradX, Grid& g
 /// Throws InputError naming the first NaN/Inf height.
 void checkHeightsFinite(ConstGridView heights);
 
+/// The shade key light k alone gives every texel (white albedo) in the last
+/// frame run on `st`, the way that frame computed it (exact cosine times the
+/// visible fraction, or SH shading of its visibility). scratch is reused.
+void shadeKeyLight(const GiState& st, const GiSettings& settings, const GiLighting& lighting, int k,
+                   ShadeMaps& scratch, std::array<Grid, 3>& out);
+
 }  // namespace terrain::gi

@@ -110,8 +110,7 @@ void FramePipeline::light() {
 
     // The key light's share of the shade map: gi/ shading with that light alone.
     t = Clock::now();
-    gi::shadeTexels(gi_.gradX.cview(), gi_.gradY.cview(), settings_.gi.subsample, gi_.envVisibility,
-                    &gi_.shadingLights[1], 1, nullptr, settings_.gi.shading, keyOnly_);
+    gi::shadeKeyLight(gi_, gs, lighting, 0, keyScratch_, keyOnly_);
 
     // ---- pack what the renderer uploads -----------------------------------------
     FrameData& f = frame_;
@@ -131,7 +130,7 @@ void FramePipeline::light() {
     const float keyLum = 0.2126f * k.rgb[0] + 0.7152f * k.rgb[1] + 0.0722f * k.rgb[2];
     const bool indirect = gs.indirect.bounces > 0;
     const auto& total = indirect ? gi_.indirect.total : gi_.shade.rgb;
-    const auto& keyRgb = keyOnly_.rgb;
+    const auto& keyRgb = keyOnly_;
     parallelForRows(ny, nx, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y)
             for (int x = 0; x < nx; ++x) {

@@ -16,6 +16,7 @@
 //   and at the receiver resolution: the sky visibility fraction (V's
 //   constant term), one height-pyramid level and the mean incident indirect
 //   radiance (U's constant term), for debug views.
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -111,7 +112,8 @@ private:
     float lastExaggeration_ = -1.0f;  // exaggeration of the last lit frame (a change moves the surface)
     Grid surface_;          // ground + water: what the light sees
     gi::GiState gi_;
-    gi::ShadeMaps keyOnly_;  // the key light's shading alone
+    gi::ShadeMaps keyScratch_;           // buffers of the key light's own shading
+    std::array<Grid, 3> keyOnly_;        // the key light's shade alone (white albedo)
     FrameData frame_;
     StageTimings timings_;
 };
