@@ -1,5 +1,7 @@
 #include "gi/albedo_io.h"
 
+#include "gi/image_io.h"
+
 #include <png.h>
 
 #include <cmath>
@@ -63,23 +65,10 @@ AlbedoMap loadAlbedo(const std::string& spec, int nx, int ny) {
 
 void writeNpyRgb(const std::string& file, const std::array<Grid, 3>& rgb) {
     const Grid& g0 = rgb[0];
-    std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': (" + std::to_string(g0.ny) + ", " +
-                         std::to_string(g0.nx) + ", 3), }";
-    const std::size_t total = 10 + header.size() + 1;  // magic, version, length, header, '\n'
-    header.append((64 - total % 64) % 64, ' ');
-    header.push_back('\n');
-    std::string bytes = "\x93NUMPY";
-    bytes.push_back('\x01');
-    bytes.push_back('\x00');
-    const std::uint16_t len = static_cast<std::uint16_t>(header.size());
-    bytes.push_back(static_cast<char>(len & 0xff));
-    bytes.push_back(static_cast<char>(len >> 8));
-    bytes += header;
-    const std::size_t off = bytes.size();
-    bytes.resize(off + g0.size() * 12);
+    std::vector<float> interleaved(g0.size() * 3);
     for (std::size_t i = 0; i < g0.size(); ++i)
-        for (int c = 0; c < 3; ++c) std::memcpy(&bytes[off + 12 * i + 4 * static_cast<std::size_t>(c)], &rgb[static_cast<std::size_t>(c)].v[i], 4);
-    writeFileAtomic(file, bytes);
+        for (std::size_t c = 0; c < 3; ++c) interleaved[3 * i + c] = rgb[c].v[i];
+    writeNpyArray(file, {static_cast<std::size_t>(g0.ny), static_cast<std::size_t>(g0.nx), 3}, interleaved.data());
 }
 
 }  // namespace terrain::gi

@@ -29,9 +29,16 @@ std::string lowerExtension(const std::string& file) {
 
 }  // namespace
 
-void writeNpy(const std::string& file, const Grid& g) {
-    std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': (" + std::to_string(g.ny) + ", " +
-                         std::to_string(g.nx) + "), }";
+void writeNpyArray(const std::string& file, const std::vector<std::size_t>& shape, const float* data) {
+    std::string dims;
+    std::size_t count = 1;
+    for (std::size_t d : shape) {
+        dims += std::to_string(d) + ", ";
+        count *= d;
+    }
+    if (shape.size() > 1) dims.erase(dims.size() - 2);  // "(ny, nx)"; a 1-tuple keeps its comma: "(n,)"
+    else if (!dims.empty()) dims.erase(dims.size() - 1);
+    std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': (" + dims + "), }";
     // magic (6) + version (2) + header length (2) + header, padded to 64 bytes, ending in '\n'
     const std::size_t total = 10 + header.size() + 1;
     header.append((64 - total % 64) % 64, ' ');
@@ -44,9 +51,13 @@ void writeNpy(const std::string& file, const Grid& g) {
     bytes.push_back(static_cast<char>(len >> 8));
     bytes += header;
     const std::size_t off = bytes.size();
-    bytes.resize(off + g.size() * 4);
-    std::memcpy(&bytes[off], g.data(), g.size() * 4);  // x86-64 is little-endian
+    bytes.resize(off + count * 4);
+    if (count) std::memcpy(&bytes[off], data, count * 4);  // x86-64 is little-endian
     writeFileAtomic(file, bytes);
+}
+
+void writeNpy(const std::string& file, const Grid& g) {
+    writeNpyArray(file, {static_cast<std::size_t>(g.ny), static_cast<std::size_t>(g.nx)}, g.data());
 }
 
 void writeExr(const std::string& file, const std::vector<const Grid*>& channels) {

@@ -10,6 +10,8 @@
 namespace terrain::gi {
 
 /// float32 .npy, shape (rows, columns), row 0 = the first grid row.
+/// Writes float32 data (C order) with the given shape as a .npy file (atomic).
+void writeNpyArray(const std::string& file, const std::vector<std::size_t>& shape, const float* data);
 void writeNpy(const std::string& file, const Grid& g);
 
 /// Half-float OpenEXR with 1 channel ("Y") or 3 ("R", "G", "B").
