@@ -29,7 +29,7 @@ struct RenderOptions {
     int threads = 0;
     int ticksPerFrame = 0;        // 0 = the scene's pacing
     int subsample = 2;            // GI receivers every 1, 2 or 4 cells
-    std::string lighting = "direct";  // key | direct | global
+    std::string lighting = "global";  // key | direct | global (direct + `bounces` indirect bounces)
     int bounces = 1;
     bool amortise = false;
     std::string shadow = "soft";  // soft | map | none
