@@ -2,7 +2,7 @@
 // gi/reference_gi, and the paper's Table 1 (frame time x size x sub-sampling x
 // bounces, with and without amortisation) on this machine.
 //
-//   bench_gi_indirect [--data DIR] [--out DIR] [--runs N] [--quick]
+//   bench_gi_indirect [--data DIR] [--out DIR] [--runs N] [--quick] [--exact-cosine | --exact-cosine-receiver]
 //
 // Writes bench/results/gi_indirect_accuracy.{md,csv} and gi_indirect_timing.{md,csv}.
 #include <algorithm>
@@ -30,6 +30,7 @@ std::string gDataDir = "/work/shared/data";
 std::string gOutDir = "bench/results";
 int gRuns = 5;
 bool gQuick = false;
+int gExactCosine = 0;  // --exact-cosine [receiver]: IndirectSettings::exactCosine (1), at the receiver normal (2)
 bool gDiagnose = false;
 
 struct Dem {
@@ -193,6 +194,10 @@ GiSettings settingsFor(int s, int bounces, bool paper) {
     GiSettings g = paper ? GiSettings{} : engineGiSettings();
     g.subsample = s;
     g.indirect.bounces = bounces;
+    if (!paper && gExactCosine > 0) {
+        g.indirect.exactCosine = true;
+        g.indirect.exactCosineReceiverNormal = gExactCosine == 2;
+    }
     return g;
 }
 
@@ -286,8 +291,10 @@ int main(int argc, char** argv) {
         else if (a == "--runs" && i + 1 < argc) gRuns = std::max(1, std::atoi(argv[++i]));
         else if (a == "--quick") gQuick = true;
         else if (a == "--diagnose") gDiagnose = true;
+        else if (a == "--exact-cosine") gExactCosine = 1;
+        else if (a == "--exact-cosine-receiver") gExactCosine = 2;
         else {
-            std::fprintf(stderr, "usage: bench_gi_indirect [--data DIR] [--out DIR] [--runs N] [--quick]\n");
+            std::fprintf(stderr, "usage: bench_gi_indirect [--data DIR] [--out DIR] [--runs N] [--quick] [--exact-cosine | --exact-cosine-receiver]\n");
             return 2;
         }
     }

@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "gi/nlp.h"
+#include "gi/sh.h"
 #include "sim/error.h"
 #include "sim/parallel.h"
 #include "sim/simd.h"
@@ -28,6 +29,33 @@ inline F4 ld(const float* p) { return simd::load<F4>(p); }
 inline F4 spl(float x) { return simd::splat<F4>(x); }
 inline bool anyLane(I4 m) { return (m[0] | m[1] | m[2] | m[3]) != 0; }
 
+// Deterministic float atan (Cephes atanf: range reduction to |x| <= tan(pi/8),
+// then a degree-9 odd minimax polynomial; ~1e-7 relative): a pure function of
+// its argument, so bit-identical for any thread count.
+inline F4 atan4(F4 t) {
+    const F4 zero = spl(0.0f), one = spl(1.0f);
+    const F4 x = t < zero ? -t : t;
+    const auto big = x > spl(2.414213562373095f);
+    const auto mid = (x > spl(0.4142135623730950f)) & ~big;
+    const F4 dBig = big ? x : one;
+    const F4 xr = big ? -one / dBig : (mid ? (x - one) / (x + one) : x);
+    const F4 y0 = big ? spl(1.5707963267948966f) : (mid ? spl(0.7853981633974483f) : zero);
+    const F4 z = xr * xr;
+    const F4 p = ((((spl(8.05374449538e-2f) * z - spl(1.38776856032e-1f)) * z + spl(1.99777106478e-1f)) * z -
+                   spl(3.33329491539e-1f)) * z) * xr + xr;
+    const F4 r = y0 + p;
+    return t < zero ? -r : r;
+}
+
+// Exact clamped-cosine antiderivatives at elevation w = atan(t):
+// f1 = (w + sin w cos w) / 2 = int cos^2, f2 = sin^2 w / 2 = int sin cos.
+inline void cosineAntiderivatives(F4 t, F4& f1, F4& f2) {
+    const F4 one = spl(1.0f), half = spl(0.5f);
+    const F4 inv = one / (one + t * t);
+    f1 = half * (atan4(t) + t * inv);
+    f2 = half * (t * t * inv);
+}
+
 // ---- algorithm: the casting set and Eq. 12 for 4 NV receivers of row Y ------
 // Pass 1 walks the height steps (Eq. 17) and, at each step where some lane
 // has a new casting-set member, stores the clamped segment's moments
@@ -37,11 +65,14 @@ inline bool anyLane(I4 m) { return (m[0] | m[1] | m[2] | m[3]) != 0; }
 // hTab: the height steps of this azimuth; rTab[c]: channel c's radiance steps;
 // moments: scratch of nSteps x NV x 4 vectors; list: nSteps ints.
 // Out: 3 channels x 4 NLP coefficients, written at nlp[(c * 4 + l) * pad + X].
-template <int NV>
+// Exact (IndirectSettings::exactCosine): the moments are Delta f1, Delta f2
+// of each clamped segment instead; out: nlp[(c * 4 + 0 / 1) * pad + X] =
+// sum u Delta f1 / sum u Delta f2.
+template <int NV, bool Exact>
 void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* steps, int nAny, int Y, int X0,
                const float* h0, const float* margin, const float* gx, const float* gy, float cosPhi, float sinPhi,
                F4* moments, int* list, float* nlp, int pad) {
-    F4 M[NV], g[NV], q1[NV];
+    F4 M[NV], g[NV], q1[NV], f1[NV], f2[NV];
     const F4 one = spl(1.0f), lim = spl(1e6f), nlim = spl(-1e6f), zero = spl(0.0f);
     for (int k = 0; k < NV; ++k) {
         M[k] = spl(kNoBlocker);
@@ -49,6 +80,7 @@ void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* step
         g[k] = ld(gx + X0 + 4 * k) * spl(cosPhi) + ld(gy + X0 + 4 * k) * spl(sinPhi);
         const F4 t = g[k] < nlim ? nlim : (g[k] > lim ? lim : g[k]);
         q1[k] = t / simd::vsqrt(one + t * t);
+        if constexpr (Exact) cosineAntiderivatives(t, f1[k], f2[k]);
     }
     int n = 0;
     for (int i = 0; i < nAny; ++i) {
@@ -74,6 +106,17 @@ void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* step
             // the segment [c_(i-1), c_i] clamped to [omega_min, pi/2]
             F4 tc = t[k] < g[k] ? g[k] : t[k];
             tc = tc < nlim ? nlim : (tc > lim ? lim : tc);
+            if constexpr (Exact) {
+                F4 a1, a2;
+                cosineAntiderivatives(tc, a1, a2);
+                a1 = nw[k] ? a1 : f1[k];  // no new member: an empty segment (exactly 0)
+                a2 = nw[k] ? a2 : f2[k];
+                mo[4 * k + 0] = a1 - f1[k];
+                mo[4 * k + 1] = a2 - f2[k];
+                f1[k] = a1;
+                f2[k] = a2;
+                continue;
+            }
             const F4 sNew = tc / simd::vsqrt(one + tc * tc);
             const F4 sv = nw[k] ? sNew : q1[k];  // no new member: an empty segment
             const F4 p = q1[k], p2 = p * p, s2 = sv * sv;
@@ -103,8 +146,16 @@ void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* step
                 // lanes without a new member have zero moments; the radiance
                 // read there is finite (inside the field's padding and guard)
                 const F4 u = rwa * ld(ra + 4 * k) + rwb * ld(rb + 4 * k);
-                for (int p = 0; p < 4; ++p) A[k][p] += u * mo[4 * k + p];
+                for (int p = 0; p < (Exact ? 2 : 4); ++p) A[k][p] += u * mo[4 * k + p];
             }
+        }
+        if constexpr (Exact) {
+            for (int k = 0; k < NV; ++k) {
+                float* base = nlp + static_cast<std::size_t>(c) * 4 * pad + X0 + 4 * k;
+                simd::store(base, A[k][0]);
+                simd::store(base + pad, A[k][1]);
+            }
+            continue;
         }
         for (int k = 0; k < NV; ++k) {
             float* base = nlp + static_cast<std::size_t>(c) * 4 * pad + X0 + 4 * k;
@@ -117,6 +168,7 @@ void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* step
 }
 
 // Row of receivers for one azimuth.
+template <bool Exact>
 void castRow(const ScanStep* hTab, const ScanStep* const* rTab, const int* colSteps, int rowSteps, int Y,
              IndirectScratch& sc, float cosPhi, float sinPhi, float* nlp, int pad) {
     const I4 rowLimit = {rowSteps, rowSteps, rowSteps, rowSteps};
@@ -129,7 +181,7 @@ void castRow(const ScanStep* hTab, const ScanStep* const* rTab, const int* colSt
             steps[k] = c < rowLimit ? c : rowLimit;
             for (int l = 0; l < 4; ++l) nAny = std::max(nAny, steps[k][l]);
         }
-        castGroup<kGroup / 4>(hTab, rTab, steps, nAny, Y, X0, sc.h0.data(), sc.margin.data(), sc.gx.data(), sc.gy.data(), cosPhi,
+        castGroup<kGroup / 4, Exact>(hTab, rTab, steps, nAny, Y, X0, sc.h0.data(), sc.margin.data(), sc.gx.data(), sc.gy.data(), cosPhi,
                      sinPhi, reinterpret_cast<F4*>(sc.moments.data()), sc.list.data(), nlp, pad);
     }
 }
@@ -155,6 +207,12 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
     const int nSteps = static_cast<int>(pyr.steps.size());
     const std::size_t planeR = static_cast<std::size_t>(nxr) * nyr;
     const int nRows = shading.brdf == Brdf::Lambert ? 9 : kShCount;  // Lambert reads bands 0..2 only
+    const bool exact = settings.exactCosine && shading.brdf == Brdf::Lambert;
+    // dphi / (pi lam1 c1), lam1 = sqrt(4 pi / 3) z_1 / pi as in gi/shading
+    const double lam1 = std::sqrt(4.0 * kPi / 3.0) * lambertZonal()[1] / kPi;
+    const bool scalarE = exact && settings.exactCosineReceiverNormal;
+    const float scalarScale = static_cast<float>(lam1 * 0.48860251190291992 / (std::sqrt(4.0 * kPi) * lambertZonal()[0] / kPi * 0.28209479177387814));
+    const double exactScale = (2.0 * kPi / m) / (kPi * lam1 * 0.48860251190291992);
 
     for (int c = 0; c < 3; ++c) {
         Grid& g = st.indirect[static_cast<std::size_t>(c)];
@@ -269,9 +327,29 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
                         const ScanStep* rTab[3] = {st.radianceSteps.data() + base, st.radianceSteps.data() + tableSize + base,
                                                    st.radianceSteps.data() + 2 * tableSize + base};
                         const double phi = op.phi[static_cast<std::size_t>(j)];
-                        castRow(st.heightSteps.data() + base, rTab, st.stepsPerColumn.data() + static_cast<std::size_t>(j) * pad,
+                        (exact ? castRow<true> : castRow<false>)(st.heightSteps.data() + base, rTab, st.stepsPerColumn.data() + static_cast<std::size_t>(j) * pad,
                                 st.stepsPerRow[static_cast<std::size_t>(j) * nyr + static_cast<std::size_t>(Y)], Y, sc,
                                 static_cast<float>(std::cos(phi)), static_cast<float>(std::sin(phi)), sc.nlp.data(), pad);
+                        if (exact) {
+                            // A and B (box weight dphi) into U's band-1 planes, scaled so
+                            // that the Lambert shade lam1 c1 (Yn U1 + Z U2 + X U3) = E / pi
+                            const float ax = static_cast<float>(exactScale * std::cos(phi));
+                            const float ay = static_cast<float>(exactScale * std::sin(phi));
+                            const float bz = static_cast<float>(exactScale);
+                            for (int c = 0; c < 3; ++c) {
+                                const float* __restrict w1 = sc.nlp.data() + static_cast<std::size_t>(c * 4) * pad;
+                                const float* __restrict w2 = w1 + pad;
+                                float* __restrict u1 = uRows[c][1];
+                                float* __restrict u2 = uRows[c][2];
+                                float* __restrict u3 = uRows[c][3];
+                                for (int X = 0; X < nxr; ++X) {
+                                    u1[X] += ay * w1[X];
+                                    u2[X] += bz * w2[X];
+                                    u3[X] += ax * w1[X];
+                                }
+                            }
+                            continue;
+                        }
                         // U_c += G_j u_(c, j) over the sparse pattern (Eq. 21)
                         const float* vals = op.values.data() + static_cast<std::size_t>(j) * P;
                         for (int e = 0; e < P; ++e) {
@@ -285,6 +363,17 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
                                 for (int X = 0; X < nxr; ++X) dst[X] += gval * w[X];
                             }
                         }
+                    }
+                    if (scalarE) {
+                        // E at the receiver's own normal, interpolated as a scalar (band 0)
+                        for (int c = 0; c < 3; ++c)
+                            for (int X = 0; X < nxr; ++X) {
+                                const float gx = sc.gx[static_cast<std::size_t>(X)], gy = sc.gy[static_cast<std::size_t>(X)];
+                                const float inv = 1.0f / std::sqrt(1.0f + gx * gx + gy * gy);
+                                const float e = (-gx * inv) * uRows[c][3][X] + (-gy * inv) * uRows[c][1][X] + inv * uRows[c][2][X];
+                                uRows[c][0][X] = scalarScale * e;
+                                uRows[c][1][X] = uRows[c][2][X] = uRows[c][3][X] = 0.0f;
+                            }
                     }
                 }
             }
