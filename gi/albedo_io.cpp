@@ -22,23 +22,28 @@ float srgbToLinear(std::uint8_t v) {
 }
 }  // namespace
 
+std::vector<float> parseNumberList(const std::string& text, const std::string& option) {
+    std::vector<float> v;
+    std::stringstream ss(text);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+        try {
+            std::size_t used = 0;
+            v.push_back(std::stof(item, &used));
+            if (used != item.size()) throw std::invalid_argument(item);
+        } catch (const std::exception&) {
+            throw InputError(option + " '" + text + "': '" + item + "' is not a number");
+        }
+    }
+    return v;
+}
+
 AlbedoMap loadAlbedo(const std::string& spec, int nx, int ny) {
     AlbedoMap m;
     const bool looksNumeric = !spec.empty() && spec.find(',') != std::string::npos &&
                               spec.find_first_not_of("0123456789.,eE+- ") == std::string::npos;
     if (looksNumeric) {
-        std::vector<float> v;
-        std::stringstream ss(spec);
-        std::string item;
-        while (std::getline(ss, item, ',')) {
-            try {
-                std::size_t used = 0;
-                v.push_back(std::stof(item, &used));
-                if (used != item.size()) throw std::invalid_argument(item);
-            } catch (const std::exception&) {
-                throw InputError("--albedo '" + spec + "': '" + item + "' is not a number");
-            }
-        }
+        const std::vector<float> v = parseNumberList(spec, "--albedo");
         if (v.size() != 3) throw InputError("--albedo '" + spec + "': expected R,G,B or a PNG file");
         for (float a : v)
             if (!(a >= 0.0f && a <= 1.0f)) throw InputError("--albedo '" + spec + "': each value must be in [0, 1]");

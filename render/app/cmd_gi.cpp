@@ -94,18 +94,7 @@ std::string extensionOf(const std::string& f) {
 }
 
 gi::KeyLight parseKey(const std::string& text) {
-    std::vector<float> v;
-    std::stringstream ss(text);
-    std::string item;
-    while (std::getline(ss, item, ',')) {
-        try {
-            std::size_t used = 0;
-            v.push_back(std::stof(item, &used));
-            if (used != item.size()) throw std::invalid_argument(item);
-        } catch (const std::exception&) {
-            throw InputError("--key '" + text + "': '" + item + "' is not a number");
-        }
-    }
+    const std::vector<float> v = gi::parseNumberList(text, "--key");
     if (v.size() != 6) throw InputError("--key '" + text + "': expected AZ_DEG,EL_DEG,RADIUS_DEG,R,G,B");
     gi::KeyLight k;
     k.azimuthDeg = v[0];
