@@ -18,7 +18,17 @@ double msSince(Clock::time_point t0) { return std::chrono::duration<double, std:
 // Indirect bounces over the last computed direct shade (issue 4).
 void runIndirectStage(const GiSettings& settings, GiState& st, const AlbedoMap* albedo) {
     const auto t = Clock::now();
-    computeIndirect(st.pyramid, st.gradX.cview(), st.gradY.cview(), st.envOperator, st.envVisibility, st.shade.rgb, albedo,
+    const int m = settings.indirect.azimuths;
+    const FoldedWedgeOperator* op = &st.envOperator;
+    if (m != 0 && m != settings.visibility.azimuths) {
+        if (st.indirectOperatorAzimuths != m || st.indirectOperatorInterp != settings.visibility.interp) {
+            st.indirectOperator = foldFullCircle(m, settings.visibility.interp);
+            st.indirectOperatorAzimuths = m;
+            st.indirectOperatorInterp = settings.visibility.interp;
+        }
+        op = &st.indirectOperator;
+    }
+    computeIndirect(st.pyramid, st.gradX.cview(), st.gradY.cview(), *op, st.envVisibility, st.shade.rgb, albedo,
                     settings.shading, settings.indirect, st.indirect);
     st.timings.indirect = msSince(t);
 }
@@ -110,6 +120,11 @@ GiSettings engineGiSettings() {
     // radiance pyramid offset 3 like the heights' (bench/results/gi_indirect_accuracy.md:
     // alps crop indirect 9.6 -> 8.1 % at 1x, 13.8 -> 13.0 % at 2x, from the reference's direct light)
     s.indirect.radiance.levelOffset = 3;
+    // indirect light: the exact clamped cosine at the receivers (no SH-kernel
+    // bias), U's normal detail between them; direct light: the footprint's
+    // lowest tangent plane (bench/results/gi_indirect_accuracy.md)
+    s.indirect.lambert = LambertIndirect::ExactAtReceivers;
+    s.visibility.footprintTangent = true;
     return s;
 }
 
@@ -170,8 +185,8 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
     validateIndirectSettings(settings.indirect);
 
     // ---- amortisation (Section 7): on static geometry alternate direct / indirect --
-    const std::array<int, 6> key = {heights.nx, heights.ny, settings.subsample, settings.indirect.bounces,
-                                    settings.visibility.azimuths, static_cast<int>(settings.shading.brdf)};
+    const std::array<int, 7> key = {heights.nx, heights.ny, settings.subsample, settings.indirect.bounces,
+                                    settings.visibility.azimuths, static_cast<int>(settings.shading.brdf), settings.indirect.azimuths};
     const bool amortised = settings.indirect.amortise && settings.indirect.bounces > 0 && !st.geometryChanged &&
                            st.amortiseReady && st.amortiseKey == key;
     st.directUpdated = !amortised || st.amortisePhase == 0;

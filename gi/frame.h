@@ -47,6 +47,9 @@ struct GiState {
     FoldedWedgeOperator envOperator;  // cached for (azimuths, interp)
     int envOperatorAzimuths = -1;
     AzimuthInterp envOperatorInterp = AzimuthInterp::Linear;
+    FoldedWedgeOperator indirectOperator;  // cached when the indirect scan has its own azimuths
+    int indirectOperatorAzimuths = -1;
+    AzimuthInterp indirectOperatorInterp = AzimuthInterp::Linear;
     VisibilityState visibilityState;
     VisibilityField envVisibility;
     std::vector<FoldedWedgeOperator> keyOperators;
@@ -65,7 +68,7 @@ struct GiState {
     bool geometryChanged = true;
     int amortisePhase = 0;            // next static frame: 0 direct, 1 indirect
     bool amortiseReady = false;       // a full frame with the current key ran before
-    std::array<int, 6> amortiseKey{}; // nx, ny, subsample, bounces, azimuths, brdf of that frame
+    std::array<int, 7> amortiseKey{}; // nx, ny, subsample, bounces, azimuths, brdf, indirect azimuths of that frame
     bool directUpdated = false, indirectUpdated = false;  // what the last frame recomputed
 };
 

@@ -20,7 +20,7 @@ typedef int I4 __attribute__((vector_size(16)));
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
-constexpr int kMaxBlocks = 64;
+constexpr int kIndirectRows = 8;  // receiver rows per block
 constexpr int kGroup = 8;  // receivers per kernel call (2 x 4 lanes); rows are padded to it
 constexpr float kMarginRel = 1.0f / 1048576.0f;  // 2^-20 |h0|: height differences below it are rounding
 
@@ -63,24 +63,37 @@ inline void cosineAntiderivatives(F4 t, F4& f1, F4& f2) {
 // multiplies them with the radiance samples at those steps, one channel at a
 // time (few live registers; each lane's sums run in step order).
 // hTab: the height steps of this azimuth; rTab[c]: channel c's radiance steps;
-// moments: scratch of nSteps x NV x 4 vectors; list: nSteps ints.
+// moments: scratch of nSteps x NV x 5 vectors; list: nSteps ints.
 // Out: 3 channels x 4 NLP coefficients, written at nlp[(c * 4 + l) * pad + X].
-// Exact (IndirectSettings::exactCosine): the moments are Delta f1, Delta f2
-// of each clamped segment instead; out: nlp[(c * 4 + 0 / 1) * pad + X] =
-// sum u Delta f1 / sum u Delta f2.
+// Exact (LambertIndirect::ExactAtReceivers): a fifth moment per segment, the
+// exact clamped-cosine irradiance at the receiver's own normal up to
+// dphi / |n|: Delta f2 - g Delta f1 over the segment clamped to the
+// receiver's plane (n = (-gx, -gy, 1), so d . n_h = -g); out at
+// nlp[(12 + c) * pad + X]. The four NLP moments then use segments clamped to
+// the footprint's lowered plane (lowSlope) instead.
+struct RowInputs {
+    const float *h0, *margin, *gx, *gy;
+    const float* lowSlope;  // Exact: the lowered tangent slope per receiver (this azimuth)
+};
+
 template <int NV, bool Exact>
-void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* steps, int nAny, int Y, int X0,
-               const float* h0, const float* margin, const float* gx, const float* gy, float cosPhi, float sinPhi,
-               F4* moments, int* list, float* nlp, int pad) {
-    F4 M[NV], g[NV], q1[NV], f1[NV], f2[NV];
+void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* steps, int nAny, int Y, int X0, const RowInputs& in,
+               float cosPhi, float sinPhi, F4* moments, int* list, float* nlp, int pad) {
+    constexpr int nMo = Exact ? 5 : 4;
+    F4 M[NV], g[NV], gLow[NV], q1[NV], f1[NV], f2[NV];
     const F4 one = spl(1.0f), lim = spl(1e6f), nlim = spl(-1e6f), zero = spl(0.0f);
     for (int k = 0; k < NV; ++k) {
         M[k] = spl(kNoBlocker);
         // omega_min: the tangent plane's slope along the azimuth (Section 3)
-        g[k] = ld(gx + X0 + 4 * k) * spl(cosPhi) + ld(gy + X0 + 4 * k) * spl(sinPhi);
-        const F4 t = g[k] < nlim ? nlim : (g[k] > lim ? lim : g[k]);
+        g[k] = ld(in.gx + X0 + 4 * k) * spl(cosPhi) + ld(in.gy + X0 + 4 * k) * spl(sinPhi);
+        gLow[k] = g[k];
+        if constexpr (Exact) {
+            const F4 t = g[k] < nlim ? nlim : (g[k] > lim ? lim : g[k]);
+            cosineAntiderivatives(t, f1[k], f2[k]);
+            gLow[k] = ld(in.lowSlope + X0 + 4 * k);
+        }
+        const F4 t = gLow[k] < nlim ? nlim : (gLow[k] > lim ? lim : gLow[k]);
         q1[k] = t / simd::vsqrt(one + t * t);
-        if constexpr (Exact) cosineAntiderivatives(t, f1[k], f2[k]);
     }
     int n = 0;
     for (int i = 0; i < nAny; ++i) {
@@ -94,46 +107,46 @@ void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* step
         I4 nw[NV];
         I4 any = {0, 0, 0, 0};
         for (int k = 0; k < NV; ++k) {
-            t[k] = (((wa * ld(a + 4 * k) + wb * ld(b + 4 * k)) - ld(h0 + X0 + 4 * k)) - ld(margin + X0 + 4 * k)) * inv;
+            t[k] = (((wa * ld(a + 4 * k) + wb * ld(b + 4 * k)) - ld(in.h0 + X0 + 4 * k)) - ld(in.margin + X0 + 4 * k)) * inv;
             nw[k] = (iv < steps[k]) & (t[k] > M[k]);  // Eq. 17: above every earlier sample
             any |= nw[k];
         }
         if (!anyLane(any)) continue;
-        F4* mo = moments + static_cast<std::size_t>(n) * NV * 4;
+        F4* mo = moments + static_cast<std::size_t>(n) * NV * nMo;
         list[n++] = i;
         for (int k = 0; k < NV; ++k) {
             M[k] = nw[k] ? t[k] : M[k];
             // the segment [c_(i-1), c_i] clamped to [omega_min, pi/2]
-            F4 tc = t[k] < g[k] ? g[k] : t[k];
+            F4 tc = t[k] < gLow[k] ? gLow[k] : t[k];
             tc = tc < nlim ? nlim : (tc > lim ? lim : tc);
+            const F4 sNew = tc / simd::vsqrt(one + tc * tc);
+            const F4 sv = nw[k] ? sNew : q1[k];  // no new member: an empty segment (exactly 0)
+            const F4 p = q1[k], p2 = p * p, s2 = sv * sv;
+            mo[nMo * k + 0] = sv - p;
+            mo[nMo * k + 1] = s2 - p2;
+            mo[nMo * k + 2] = s2 * sv - p2 * p;
+            mo[nMo * k + 3] = s2 * s2 - p2 * p2;
+            q1[k] = sv;
             if constexpr (Exact) {
+                F4 te = t[k] < g[k] ? g[k] : t[k];
+                te = te < nlim ? nlim : (te > lim ? lim : te);
                 F4 a1, a2;
-                cosineAntiderivatives(tc, a1, a2);
-                a1 = nw[k] ? a1 : f1[k];  // no new member: an empty segment (exactly 0)
+                cosineAntiderivatives(te, a1, a2);
+                a1 = nw[k] ? a1 : f1[k];
                 a2 = nw[k] ? a2 : f2[k];
-                mo[4 * k + 0] = a1 - f1[k];
-                mo[4 * k + 1] = a2 - f2[k];
+                mo[nMo * k + 4] = (a2 - f2[k]) - g[k] * (a1 - f1[k]);
                 f1[k] = a1;
                 f2[k] = a2;
-                continue;
             }
-            const F4 sNew = tc / simd::vsqrt(one + tc * tc);
-            const F4 sv = nw[k] ? sNew : q1[k];  // no new member: an empty segment
-            const F4 p = q1[k], p2 = p * p, s2 = sv * sv;
-            mo[4 * k + 0] = sv - p;
-            mo[4 * k + 1] = s2 - p2;
-            mo[4 * k + 2] = s2 * sv - p2 * p;
-            mo[4 * k + 3] = s2 * s2 - p2 * p2;
-            q1[k] = sv;
         }
     }
     // pass 2: moments x radiance, then Eq. 10's closed form as a polynomial in s
     const F4 k0 = spl(0.70710678118654752440f), k1 = spl(0.61237243569579452455f);
     const F4 k2 = spl(0.79056941504209483300f), k3 = spl(0.23385358667337133659f);
     for (int c = 0; c < 3; ++c) {
-        F4 A[NV][4];
+        F4 A[NV][nMo];
         for (int k = 0; k < NV; ++k)
-            for (int p = 0; p < 4; ++p) A[k][p] = zero;
+            for (int p = 0; p < nMo; ++p) A[k][p] = zero;
         const ScanStep* tab = rTab[c];
         for (int e = 0; e < n; ++e) {
             const ScanStep& rs = tab[list[e]];
@@ -141,21 +154,13 @@ void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* step
             const float* ra = rs.field + (ro + rs.offA);
             const float* rb = rs.field + (ro + rs.offB);
             const F4 rwa = ld(rs.w[0]), rwb = ld(rs.w[1]);
-            const F4* mo = moments + static_cast<std::size_t>(e) * NV * 4;
+            const F4* mo = moments + static_cast<std::size_t>(e) * NV * nMo;
             for (int k = 0; k < NV; ++k) {
                 // lanes without a new member have zero moments; the radiance
                 // read there is finite (inside the field's padding and guard)
                 const F4 u = rwa * ld(ra + 4 * k) + rwb * ld(rb + 4 * k);
-                for (int p = 0; p < (Exact ? 2 : 4); ++p) A[k][p] += u * mo[4 * k + p];
+                for (int p = 0; p < nMo; ++p) A[k][p] += u * mo[nMo * k + p];
             }
-        }
-        if constexpr (Exact) {
-            for (int k = 0; k < NV; ++k) {
-                float* base = nlp + static_cast<std::size_t>(c) * 4 * pad + X0 + 4 * k;
-                simd::store(base, A[k][0]);
-                simd::store(base + pad, A[k][1]);
-            }
-            continue;
         }
         for (int k = 0; k < NV; ++k) {
             float* base = nlp + static_cast<std::size_t>(c) * 4 * pad + X0 + 4 * k;
@@ -163,14 +168,15 @@ void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* step
             simd::store(base + pad, k1 * A[k][1]);
             simd::store(base + 2 * pad, k2 * (A[k][2] - A[k][0]));
             simd::store(base + 3 * pad, k3 * (spl(5.0f) * A[k][3] - spl(6.0f) * A[k][1]));
+            if constexpr (Exact) simd::store(nlp + static_cast<std::size_t>(12 + c) * pad + X0 + 4 * k, A[k][4]);
         }
     }
 }
 
 // Row of receivers for one azimuth.
 template <bool Exact>
-void castRow(const ScanStep* hTab, const ScanStep* const* rTab, const int* colSteps, int rowSteps, int Y,
-             IndirectScratch& sc, float cosPhi, float sinPhi, float* nlp, int pad) {
+void castRow(const ScanStep* hTab, const ScanStep* const* rTab, const int* colSteps, int rowSteps, int Y, const RowInputs& in,
+             float cosPhi, float sinPhi, IndirectScratch& sc, int pad) {
     const I4 rowLimit = {rowSteps, rowSteps, rowSteps, rowSteps};
     for (int X0 = 0; X0 < pad; X0 += kGroup) {
         I4 steps[kGroup / 4];
@@ -181,8 +187,8 @@ void castRow(const ScanStep* hTab, const ScanStep* const* rTab, const int* colSt
             steps[k] = c < rowLimit ? c : rowLimit;
             for (int l = 0; l < 4; ++l) nAny = std::max(nAny, steps[k][l]);
         }
-        castGroup<kGroup / 4, Exact>(hTab, rTab, steps, nAny, Y, X0, sc.h0.data(), sc.margin.data(), sc.gx.data(), sc.gy.data(), cosPhi,
-                     sinPhi, reinterpret_cast<F4*>(sc.moments.data()), sc.list.data(), nlp, pad);
+        castGroup<kGroup / 4, Exact>(hTab, rTab, steps, nAny, Y, X0, in, cosPhi, sinPhi, reinterpret_cast<F4*>(sc.moments.data()),
+                                     sc.list.data(), sc.nlp.data(), pad);
     }
 }
 
@@ -193,6 +199,9 @@ void validateIndirectSettings(const IndirectSettings& s) {
     if (s.radiance.levelsPerOctave < 1 || s.radiance.levelsPerOctave > 64)
         throw InputError("radiance levels per octave must be in [1, 64]");
     if (s.radiance.levelOffset < 0 || s.radiance.levelOffset > 32) throw InputError("radiance level offset must be in [0, 32]");
+    if (!(s.footprintDrop >= 0.0f && s.footprintDrop <= 1.0e3f)) throw InputError("indirect footprint drop must be in [0, 1000]");
+    if (!(s.footprintDropMax >= 0.0f && s.footprintDropMax <= 1.0e3f)) throw InputError("indirect footprint drop maximum must be in [0, 1000]");
+    if (s.azimuths != 0 && (s.azimuths < 3 || s.azimuths > 4096)) throw InputError("indirect azimuths must be 0 or in [3, 4096]");
 }
 
 void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridView gradY, const FoldedWedgeOperator& op,
@@ -207,12 +216,10 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
     const int nSteps = static_cast<int>(pyr.steps.size());
     const std::size_t planeR = static_cast<std::size_t>(nxr) * nyr;
     const int nRows = shading.brdf == Brdf::Lambert ? 9 : kShCount;  // Lambert reads bands 0..2 only
-    const bool exact = settings.exactCosine && shading.brdf == Brdf::Lambert;
-    // dphi / (pi lam1 c1), lam1 = sqrt(4 pi / 3) z_1 / pi as in gi/shading
-    const double lam1 = std::sqrt(4.0 * kPi / 3.0) * lambertZonal()[1] / kPi;
-    const bool scalarE = exact && settings.exactCosineReceiverNormal;
-    const float scalarScale = static_cast<float>(lam1 * 0.48860251190291992 / (std::sqrt(4.0 * kPi) * lambertZonal()[0] / kPi * 0.28209479177387814));
-    const double exactScale = (2.0 * kPi / m) / (kPi * lam1 * 0.48860251190291992);
+    const bool exact = settings.lambert == LambertIndirect::ExactAtReceivers && shading.brdf == Brdf::Lambert;
+    // the shading footprint of a receiver (ExactAtReceivers): offsets {-s/2, 0, s/2}^2 cells
+    const int half = s / 2;
+    const int nFoot = s > 1 ? 9 : 1;
 
     for (int c = 0; c < 3; ++c) {
         Grid& g = st.indirect[static_cast<std::size_t>(c)];
@@ -225,16 +232,23 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
     }
     st.bounceMean.resize(static_cast<std::size_t>(settings.bounces));
 
-    // per-block scratch
-    const int nBlocks = std::max(1, std::min(nyr, kMaxBlocks));
+    // per-block scratch: blocks of kIndirectRows receiver rows
+    const int nBlocks = std::max(1, (nyr + kIndirectRows - 1) / kIndirectRows);
+    const std::size_t rowFloats = static_cast<std::size_t>(kIndirectRows) * pad;
     st.blocks.resize(static_cast<std::size_t>(nBlocks));
     for (IndirectScratch& b : st.blocks) {
-        b.gx.resize(static_cast<std::size_t>(pad));
-        b.gy.resize(static_cast<std::size_t>(pad));
-        b.h0.resize(static_cast<std::size_t>(pad));
-        b.margin.resize(static_cast<std::size_t>(pad));
-        b.nlp.resize(static_cast<std::size_t>(12) * pad);
-        b.moments.resize(static_cast<std::size_t>(std::max(nSteps, 1)) * 2 * 4 * 4 + 4);  // nSteps x 2 vectors x 4 moments x 4 lanes
+        b.gx.resize(rowFloats);
+        b.gy.resize(rowFloats);
+        b.h0.resize(rowFloats);
+        b.margin.resize(rowFloats);
+        if (exact) {
+            b.footGx.resize(rowFloats * static_cast<std::size_t>(nFoot));
+            b.footGy.resize(rowFloats * static_cast<std::size_t>(nFoot));
+            b.exact.resize(rowFloats * 3);
+            b.lowSlope.resize(static_cast<std::size_t>(pad));
+        }
+        b.nlp.resize(static_cast<std::size_t>(15) * pad);
+        b.moments.resize(static_cast<std::size_t>(std::max(nSteps, 1)) * 2 * 5 * 4 + 4);  // nSteps x 2 vectors x 5 moments x 4 lanes
         b.list.resize(static_cast<std::size_t>(std::max(nSteps, 1)));
     }
     // shading: U of channel c lights channel c only (identity product matrix)
@@ -304,76 +318,123 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
         parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
             for (int block = b0; block < b1; ++block) {
                 IndirectScratch& sc = st.blocks[static_cast<std::size_t>(block)];
-                const int yBegin = static_cast<int>(static_cast<long long>(nyr) * block / nBlocks);
-                const int yEnd = static_cast<int>(static_cast<long long>(nyr) * (block + 1) / nBlocks);
-                for (int Y = yBegin; Y < yEnd; ++Y) {
+                const int yBegin = block * kIndirectRows;
+                const int rows = std::min(kIndirectRows, nyr - yBegin);
+                // the rows' receiver heights, gradients (and footprints); U rows zeroed
+                for (int r = 0; r < rows; ++r) {
+                    const int Y = yBegin + r;
+                    const std::size_t ro = static_cast<std::size_t>(r) * pad;
                     const float* hRow = pyr.rawPhaseRow(0, s * Y);
                     for (int X = 0; X < pad; ++X) {
                         const bool in = X < nxr;
-                        const std::size_t xi = static_cast<std::size_t>(X);
+                        const std::size_t xi = ro + static_cast<std::size_t>(X);
                         sc.gx[xi] = in ? gradX(s * X, s * Y) : 0.0f;
                         sc.gy[xi] = in ? gradY(s * X, s * Y) : 0.0f;
                         sc.h0[xi] = in ? hRow[X] : 0.0f;
                         sc.margin[xi] = std::fabs(sc.h0[xi]) * kMarginRel;
                     }
-                    float* uRows[3][kShCount];
-                    for (int c = 0; c < 3; ++c)
-                        for (int i = 0; i < kShCount; ++i) {
-                            uRows[c][i] = st.u[static_cast<std::size_t>(c)].plane(i) + static_cast<std::size_t>(Y) * nxr;
-                            std::fill(uRows[c][i], uRows[c][i] + nxr, 0.0f);
-                        }
-                    for (int j = 0; j < m; ++j) {
-                        const std::size_t base = static_cast<std::size_t>(j) * nSteps;
-                        const ScanStep* rTab[3] = {st.radianceSteps.data() + base, st.radianceSteps.data() + tableSize + base,
-                                                   st.radianceSteps.data() + 2 * tableSize + base};
-                        const double phi = op.phi[static_cast<std::size_t>(j)];
-                        (exact ? castRow<true> : castRow<false>)(st.heightSteps.data() + base, rTab, st.stepsPerColumn.data() + static_cast<std::size_t>(j) * pad,
-                                st.stepsPerRow[static_cast<std::size_t>(j) * nyr + static_cast<std::size_t>(Y)], Y, sc,
-                                static_cast<float>(std::cos(phi)), static_cast<float>(std::sin(phi)), sc.nlp.data(), pad);
-                        if (exact) {
-                            // A and B (box weight dphi) into U's band-1 planes, scaled so
-                            // that the Lambert shade lam1 c1 (Yn U1 + Z U2 + X U3) = E / pi
-                            const float ax = static_cast<float>(exactScale * std::cos(phi));
-                            const float ay = static_cast<float>(exactScale * std::sin(phi));
-                            const float bz = static_cast<float>(exactScale);
-                            for (int c = 0; c < 3; ++c) {
-                                const float* __restrict w1 = sc.nlp.data() + static_cast<std::size_t>(c * 4) * pad;
-                                const float* __restrict w2 = w1 + pad;
-                                float* __restrict u1 = uRows[c][1];
-                                float* __restrict u2 = uRows[c][2];
-                                float* __restrict u3 = uRows[c][3];
-                                for (int X = 0; X < nxr; ++X) {
-                                    u1[X] += ay * w1[X];
-                                    u2[X] += bz * w2[X];
-                                    u3[X] += ax * w1[X];
+                    if (exact) {
+                        int f = 0;
+                        for (int oy = -half; oy <= half; oy += std::max(half, 1))
+                            for (int ox = -half; ox <= half; ox += std::max(half, 1), ++f) {
+                                float* fx = sc.footGx.data() + (static_cast<std::size_t>(r) * nFoot + static_cast<std::size_t>(f)) * pad;
+                                float* fy = sc.footGy.data() + (static_cast<std::size_t>(r) * nFoot + static_cast<std::size_t>(f)) * pad;
+                                const int yy = std::clamp(s * Y + oy, 0, ny - 1);
+                                for (int X = 0; X < pad; ++X) {
+                                    const int xx = std::clamp(s * X + ox, 0, nx - 1);
+                                    fx[X] = X < nxr ? gradX(xx, yy) : 0.0f;
+                                    fy[X] = X < nxr ? gradY(xx, yy) : 0.0f;
                                 }
                             }
-                            continue;
+                        std::fill(sc.exact.data() + 3 * ro, sc.exact.data() + 3 * ro + 3 * static_cast<std::size_t>(pad), 0.0f);
+                    }
+                    for (int c = 0; c < 3; ++c)
+                        for (int i = 0; i < kShCount; ++i) {
+                            float* u = st.u[static_cast<std::size_t>(c)].plane(i) + static_cast<std::size_t>(Y) * nxr;
+                            std::fill(u, u + nxr, 0.0f);
                         }
+                }
+                for (int j = 0; j < m; ++j) {
+                    const std::size_t base = static_cast<std::size_t>(j) * nSteps;
+                    const ScanStep* rTab[3] = {st.radianceSteps.data() + base, st.radianceSteps.data() + tableSize + base,
+                                               st.radianceSteps.data() + 2 * tableSize + base};
+                    const double phi = op.phi[static_cast<std::size_t>(j)];
+                    const float cosPhi = static_cast<float>(std::cos(phi)), sinPhi = static_cast<float>(std::sin(phi));
+                    const float* vals = op.values.data() + static_cast<std::size_t>(j) * P;
+                    for (int r = 0; r < rows; ++r) {
+                        const int Y = yBegin + r;
+                        const std::size_t ro = static_cast<std::size_t>(r) * pad;
+                        RowInputs in{sc.h0.data() + ro, sc.margin.data() + ro, sc.gx.data() + ro, sc.gy.data() + ro, nullptr};
+                        if (exact) {
+                            // U's segments start at the footprint's lowest tangent slope, lowered
+                            // (by footprintDrop x the footprint's spread of slopes, at most footprintDropMax:
+                            // 0 where the footprint is one plane)
+                            const F4 dropMax = spl(settings.footprintDropMax);
+                            const F4 c4 = spl(cosPhi), s4 = spl(sinPhi), drop = spl(settings.footprintDrop);
+                            const float* fx = sc.footGx.data() + static_cast<std::size_t>(r) * nFoot * pad;
+                            const float* fy = sc.footGy.data() + static_cast<std::size_t>(r) * nFoot * pad;
+                            for (int X = 0; X < pad; X += 4) {
+                                F4 lo = ld(fx + X) * c4 + ld(fy + X) * s4;
+                                for (int f = 1; f < nFoot; ++f) {
+                                    const F4 v = ld(fx + static_cast<std::size_t>(f) * pad + X) * c4 + ld(fy + static_cast<std::size_t>(f) * pad + X) * s4;
+                                    lo = v < lo ? v : lo;
+                                }
+                                const F4 own = ld(fx + X) * c4 + ld(fy + X) * s4;
+                                const F4 d = drop * (own - lo);
+                                simd::store(sc.lowSlope.data() + X, lo - (d < dropMax ? d : dropMax));
+                            }
+                            in.lowSlope = sc.lowSlope.data();
+                        }
+                        (exact ? castRow<true> : castRow<false>)(st.heightSteps.data() + base, rTab,
+                                                                 st.stepsPerColumn.data() + static_cast<std::size_t>(j) * pad,
+                                                                 st.stepsPerRow[static_cast<std::size_t>(j) * nyr + static_cast<std::size_t>(Y)], Y,
+                                                                 in, cosPhi, sinPhi, sc, pad);
+                        if (exact)
+                            for (int c = 0; c < 3; ++c) {
+                                float* __restrict e = sc.exact.data() + 3 * ro + static_cast<std::size_t>(c) * pad;
+                                const float* __restrict w = sc.nlp.data() + static_cast<std::size_t>(12 + c) * pad;
+                                for (int X = 0; X < nxr; ++X) e[X] += w[X];
+                            }
                         // U_c += G_j u_(c, j) over the sparse pattern (Eq. 21)
-                        const float* vals = op.values.data() + static_cast<std::size_t>(j) * P;
                         for (int e = 0; e < P; ++e) {
-                            const int r = op.patternRow[static_cast<std::size_t>(e)];
-                            if (r >= nRows) continue;
+                            const int row = op.patternRow[static_cast<std::size_t>(e)];
+                            if (row >= nRows) continue;
                             const float gval = vals[e];
                             const int l = op.patternNlp[static_cast<std::size_t>(e)];
                             for (int c = 0; c < 3; ++c) {
-                                float* __restrict dst = uRows[c][r];
+                                float* __restrict dst = st.u[static_cast<std::size_t>(c)].plane(row) + static_cast<std::size_t>(Y) * nxr;
                                 const float* __restrict w = sc.nlp.data() + static_cast<std::size_t>(c * 4 + l) * pad;
                                 for (int X = 0; X < nxr; ++X) dst[X] += gval * w[X];
                             }
                         }
                     }
-                    if (scalarE) {
-                        // E at the receiver's own normal, interpolated as a scalar (band 0)
-                        for (int c = 0; c < 3; ++c)
-                            for (int X = 0; X < nxr; ++X) {
-                                const float gx = sc.gx[static_cast<std::size_t>(X)], gy = sc.gy[static_cast<std::size_t>(X)];
-                                const float inv = 1.0f / std::sqrt(1.0f + gx * gx + gy * gy);
-                                const float e = (-gx * inv) * uRows[c][3][X] + (-gy * inv) * uRows[c][1][X] + inv * uRows[c][2][X];
-                                uRows[c][0][X] = scalarScale * e;
-                                uRows[c][1][X] = uRows[c][2][X] = uRows[c][3][X] = 0.0f;
-                            }
+                }
+                if (!exact) continue;
+                // ExactAtReceivers: the shade at the receiver's normal, lam(N) . U
+                // (as gi/shading evaluates it there), becomes E / pi through band 0
+                const float lam0 = static_cast<float>(std::sqrt(4.0 * kPi) * lambertZonal()[0] / kPi);
+                const float lam1 = static_cast<float>(std::sqrt(4.0 * kPi / 3.0) * lambertZonal()[1] / kPi);
+                const float lam2 = static_cast<float>(std::sqrt(4.0 * kPi / 5.0) * lambertZonal()[2] / kPi);
+                const float c0 = lam0 * 0.28209479177387814f, c1 = lam1 * 0.48860251190291992f;
+                const float c4 = lam2 * 1.0925484305920792f, c6 = lam2 * 0.31539156525252005f, c8 = lam2 * 0.54627421529603959f;
+                const float eScale = 2.0f / static_cast<float>(m);  // (2 pi / m) / pi
+                for (int r = 0; r < rows; ++r) {
+                    const int Y = yBegin + r;
+                    const std::size_t ro = static_cast<std::size_t>(r) * pad;
+                    for (int X = 0; X < nxr; ++X) {
+                        const float gx = sc.gx[ro + static_cast<std::size_t>(X)], gy = sc.gy[ro + static_cast<std::size_t>(X)];
+                        const float inv = 1.0f / std::sqrt(1.0f + gx * gx + gy * gy);
+                        const float Xn = -gx * inv, Yn = -gy * inv, Z = inv;
+                        const float lam[9] = {c0, c1 * Yn, c1 * Z, c1 * Xn, c4 * Xn * Yn, c4 * Yn * Z, c6 * (3.0f * Z * Z - 1.0f), c4 * Xn * Z,
+                                              c8 * (Xn * Xn - Yn * Yn)};
+                        const std::size_t at = static_cast<std::size_t>(Y) * nxr + static_cast<std::size_t>(X);
+                        for (int c = 0; c < 3; ++c) {
+                            VisibilityField& u = st.u[static_cast<std::size_t>(c)];
+                            float shade = 0.0f;
+                            for (int i = 0; i < 9; ++i) shade += lam[i] * u.plane(i)[at];
+                            const float e = eScale * inv * sc.exact[3 * ro + static_cast<std::size_t>(c) * pad + static_cast<std::size_t>(X)];
+                            u.plane(0)[at] += (e - shade) / c0;
+                        }
                     }
                 }
             }

@@ -31,10 +31,12 @@
 // only when it rises above the receiver's height by more than 2^-20 |h0|
 // (a few ulp), which is subtracted from every height difference.
 //
-// Schedule: like gi/visibility: a per-bounce step table, fixed row blocks in
-// parallel, each row's azimuths serially, every receiver written by one block:
-// bit-identical for any thread count; no allocation after the first frame of
-// a given size and settings.
+// Schedule: like gi/visibility: a per-bounce step table, fixed blocks of
+// kIndirectRows receiver rows in parallel; within a block azimuth by azimuth,
+// the block's rows one after the other (consecutive rows read neighbouring
+// rows of every level, which stay in cache), every receiver written by one
+// block: bit-identical for any thread count; no allocation after the first
+// frame of a given size and settings.
 #include <array>
 #include <vector>
 
@@ -51,28 +53,42 @@ enum class GlossyIndirect {
     ScalarPyramid,  // one RGB pyramid of the scalar shade (diffuse + glossy towards the viewer), Fig. 5 right
 };
 
+// How Lambert receivers turn their casting sets into irradiance.
+enum class LambertIndirect {
+    // Eq. 12 + the folded wedge operator + the order-4 SH clamped cosine (the
+    // paper). The SH kernel over-weights light near the horizon (k(0) = 0.094):
+    // +21 % indirect bias on an eroded terrain (bench/results/gi_indirect_diagnosis.md).
+    ShKernel,
+    // The same U, with its band-0 coefficient shifted per receiver so that the
+    // shade at the receiver's own normal is the exact clamped-cosine
+    // irradiance of its casting sets, E = sum_j dphi sum_i u_i Delta(f2 - g_j f1)
+    // / |n| (f1 = (w + sin w cos w) / 2, f2 = sin^2 w / 2 at the clamped
+    // segment ends, g_j the tangent slope along azimuth j, box weights in
+    // azimuth); texels between receivers keep U's normal detail (Fig. 7).
+    // With sub-sampling U's segments reach below the receiver's tangent plane
+    // (see footprintDrop), so that texels of other normals find their light.
+    ExactAtReceivers,
+};
+
 struct IndirectSettings {
     int bounces = 0;                   // 0: direct light only
     RadiancePyramidSettings radiance;  // k_u = 4, o_u = 2
     bool amortise = false;             // Section 7: alternate direct / indirect on static geometry
     GlossyIndirect glossy = GlossyIndirect::ScalarPyramid;
-    // Lambert receivers only (ignored for other BRDFs): irradiance from the
-    // casting-set segments with the exact clamped cosine instead of Eq. 12 +
-    // the wedge operator + the order-4 SH Lambert kernel. Per receiver and
-    // channel the scan accumulates A = sum_j dphi d_j sum u Delta((w + sin w cos w) / 2)
-    // and B = sum_j dphi sum u Delta(sin^2 w / 2) (box weights in azimuth);
-    // E = A . N_h + B N_z at each full-resolution normal N, written into U's
-    // band-1 planes so that gi/shading's Lambert path evaluates exactly that.
-    // Measured (bench_gi_indirect --quick, 96^2 crops, 1 bounce): at 1x
-    // the indirect error drops (alps 8.6 -> 6.6 %, erosion 22.3 -> 7.1 %), at
-    // 2x it rises (alps 17.1 -> 30.2 %, bias -17 %): the linear E(N) misses the
-    // light between the receiver's and a texel's tangent planes where the
-    // full-resolution normal departs from the receiver's. Off by default.
-    bool exactCosine = false;
-    // With exactCosine: E evaluated at the receiver's own normal and
-    // interpolated as a scalar (band 0); no full-resolution normal detail
-    // (2x alps 20.7 %, bias -4.3 %).
-    bool exactCosineReceiverNormal = false;
+    LambertIndirect lambert = LambertIndirect::ShKernel;
+    // ExactAtReceivers with sub-sampling: U's segments start below the lowest
+    // tangent plane of the texels that interpolate the receiver (offsets
+    // {-s/2, 0, s/2}^2 cells), lowered by min(footprintDropMax, footprintDrop x
+    // (receiver's slope - lowest slope)) (tan, per azimuth; 0 where the
+    // footprint is one plane, so a plane stays exactly dark). Measured on 96^2
+    // crops at 2x, alps / erosion indirect rel. RMSE: receiver's own plane
+    // 18.4 / 23.9 %, footprint 11.7 / 17.2 %, + drop 1 x spread 11.7 / 16.3 %,
+    // 8 x 11.5 / 15.2 %, 16 x (at most 1.5) 11.5 / 14.9 %; a constant drop of
+    // 1: 11.6 / 14.6 % but light from below a plane receiver's own plane.
+    float footprintDrop = 16.0f;
+    float footprintDropMax = 1.5f;
+    // Azimuths of the indirect scan (0: the visibility's m).
+    int azimuths = 0;
 };
 
 struct IndirectTimings {
@@ -81,8 +97,11 @@ struct IndirectTimings {
 
 /// Per-block scratch of the indirect scan.
 struct IndirectScratch {
-    std::vector<float> gx, gy, h0, margin;  // padded receiver row
-    std::vector<float> nlp;                 // 3 channels x 4 NLP x padded row, one azimuth
+    std::vector<float> gx, gy, h0, margin;  // rows of the block x padded row
+    std::vector<float> footGx, footGy;      // ExactAtReceivers: rows x footprint texels x padded row
+    std::vector<float> exact;               // ExactAtReceivers: rows x 3 channels x padded row, E sums
+    std::vector<float> lowSlope;            // ExactAtReceivers: padded row, the lowered footprint slope of one azimuth
+    std::vector<float> nlp;                 // 3 channels x 4 NLP (+ 3 exact) x padded row, one row and azimuth
     std::vector<float> moments;             // casting-set moments of one group (pass 1 -> pass 2)
     std::vector<int> list;                  // steps with a new casting-set member in the group
 };
@@ -103,6 +122,7 @@ struct IndirectState {
 };
 
 /// Indirect light of `bounces` bounces over the frame's height pyramid.
+/// op: the folded wedge operator of the indirect azimuths (settings.azimuths);
 /// direct: bounce 0's exit radiance (full resolution, albedo applied);
 void computeIndirect(const HeightPyramid& heights, ConstGridView gradX, ConstGridView gradY,
                      const FoldedWedgeOperator& op, const VisibilityField& envVisibility,

@@ -274,7 +274,7 @@ void scanRow(const ScanStep* table, const int* colSteps, int rowSteps, int Y, co
 // the sparse pattern, each entry a contiguous multiply-add over the row.
 // omega_min: elevation of the tangent plane along the azimuth (Section 3).
 void nlpRow(const float* __restrict maxSlope, const float* __restrict gx, const float* __restrict gy, float cosPhi,
-            float sinPhi, const VisibilityTarget& target, float* __restrict nlp, int nxr, int nxrPad) {
+            float sinPhi, const VisibilityTarget& target, float* __restrict nlp, int nxr, int nxrPad, int nFoot) {
     const v4 c = splat(cosPhi), sn = splat(sinPhi);
     const v4 one = splat(1.0f), lim = splat(1e6f), nlim = splat(-1e6f);
     const v4 k0 = splat(0.70710678118654752440f), k1 = splat(0.61237243569579452455f);
@@ -282,7 +282,11 @@ void nlpRow(const float* __restrict maxSlope, const float* __restrict gx, const 
     const v4 five = splat(5.0f), four = splat(4.0f);
     const v4 sLow = splat(target.sinLow), sHigh = splat(target.sinHigh);
     for (int X = 0; X < nxrPad; X += 4) {
-        const v4 tangent = load4(gx + X) * c + load4(gy + X) * sn;
+        v4 tangent = load4(gx + X) * c + load4(gy + X) * sn;
+        for (int f = 1; f < nFoot; ++f) {  // the footprint's lowest tangent plane
+            const v4 tf = load4(gx + static_cast<std::size_t>(f) * nxrPad + X) * c + load4(gy + static_cast<std::size_t>(f) * nxrPad + X) * sn;
+            tangent = tf < tangent ? tf : tangent;
+        }
         const v4 ms = load4(maxSlope + X);
         v4 t = ms < tangent ? tangent : ms;
         t = t < nlim ? nlim : (t > lim ? lim : t);  // sinFromSlope
@@ -470,8 +474,8 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
     state.blocks.resize(static_cast<std::size_t>(nBlocks));
     for (VisibilityScratch& b : state.blocks) {
         b.maxRow.resize(static_cast<std::size_t>(nxrPad));
-        b.gradX.resize(static_cast<std::size_t>(nxrPad));
-        b.gradY.resize(static_cast<std::size_t>(nxrPad));
+        b.gradX.resize(static_cast<std::size_t>(9) * nxrPad);
+        b.gradY.resize(static_cast<std::size_t>(9) * nxrPad);
         b.h0.resize(static_cast<std::size_t>(nxrPad));
         b.nlp.resize(static_cast<std::size_t>(8) * nxrPad);
         b.rowPtr.resize(2 * static_cast<std::size_t>(nSteps));
@@ -493,6 +497,23 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
                     sc.gradY[static_cast<std::size_t>(X)] = in ? gradY(s * X, s * Y) : 0.0f;
                 }
                 for (int X = 0; X < nxrPad; ++X) sc.h0[static_cast<std::size_t>(X)] = X < nxr ? hRow[X] : 0.0f;
+                int nFoot = 1;
+                if (settings.footprintTangent && s > 1) {
+                    const int half = s / 2;
+                    for (int oy = -half; oy <= half; oy += half)
+                        for (int ox = -half; ox <= half; ox += half) {
+                            if (ox == 0 && oy == 0) continue;
+                            float* fx = sc.gradX.data() + static_cast<std::size_t>(nFoot) * nxrPad;
+                            float* fy = sc.gradY.data() + static_cast<std::size_t>(nFoot) * nxrPad;
+                            const int yy = std::clamp(s * Y + oy, 0, pyr.ny - 1);
+                            for (int X = 0; X < nxrPad; ++X) {
+                                const int xx = std::clamp(s * X + ox, 0, pyr.nx - 1);
+                                fx[X] = X < nxr ? gradX(xx, yy) : 0.0f;
+                                fy[X] = X < nxr ? gradY(xx, yy) : 0.0f;
+                            }
+                            ++nFoot;
+                        }
+                }
                 float* vRows[kShCount];
                 for (int i = 0; i < kShCount; ++i) {
                     vRows[i] = out.plane(i) + static_cast<std::size_t>(Y) * nxr;
@@ -515,7 +536,7 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
                         std::copy(sc.maxRow.data(), sc.maxRow.data() + nxr, maxOut);
                         float* nlp = sc.nlp.data() + static_cast<std::size_t>(a) * 4 * nxrPad;
                         nlpRow(sc.maxRow.data(), sc.gradX.data(), sc.gradY.data(), state.cosSin[2 * static_cast<std::size_t>(j)],
-                               state.cosSin[2 * static_cast<std::size_t>(j) + 1], target, nlp, nxr, nxrPad);
+                               state.cosSin[2 * static_cast<std::size_t>(j) + 1], target, nlp, nxr, nxrPad, nFoot);
                         nlps[a] = nlp;
                         ops[a] = state.opSplat.data() + static_cast<std::size_t>(j) * 4 * op.patternSize();
                     }

@@ -64,13 +64,21 @@ struct VisibilitySettings {
     int azimuths = 32;                                    // m (paper: 32)
     AzimuthInterp interp = AzimuthInterp::Linear;         // M_lin (paper's main operator)
     BlockingMax blockingMax = BlockingMax::BsplineKnotsAndMidpoints;
+    // Sub-sampling: omega_min from the lowest tangent plane among the texels
+    // that interpolate the receiver's V (offsets {-s/2, 0, s/2}^2 cells)
+    // instead of the receiver's own (paper). V is shaded at every texel's own
+    // normal (Fig. 7); sky between the receiver's plane and a neighbour's
+    // lower one is visible to that neighbour. Measured on 96^2 crops, total
+    // shade rel. RMSE with indirect light, alps / erosion: 2x 4.3 -> 3.2 % /
+    // 2.0 -> 1.7 %, 4x 7.8 -> 5.4 % / 2.3 -> 1.5 %; 1x unchanged.
+    bool footprintTangent = false;
 };
 
 /// Per-block scratch of the scan (one per fixed row block), rows padded to a
 /// multiple of the kernel's 16 receivers.
 struct VisibilityScratch {
     std::vector<float> maxRow;  // nxr: maximum blocking slope of the current row and azimuth
-    std::vector<float> gradX;   // nxr: dh/dx at the receivers of the current row
+    std::vector<float> gradX;   // nxr (x 9 footprint texels): dh/dx at the receivers of the current row
     std::vector<float> gradY;
     std::vector<float> h0;      // nxr: receiver heights of the current row
     std::vector<float> nlp;     // 2 x 4 x nxr: NLP visibility vectors of the current row, two azimuths
