@@ -3,6 +3,7 @@
 // bounces, with and without amortisation) on this machine.
 //
 //   bench_gi_indirect [--data DIR] [--out DIR] [--runs N] [--quick] [--diagnose] [--sh-kernel] [--indirect-azimuths N]
+//                     [--accuracy-only] [--probe N]
 //
 // Writes bench/results/gi_indirect_accuracy.{md,csv} and gi_indirect_timing.{md,csv}.
 #include <algorithm>
@@ -33,6 +34,8 @@ int gRuns = 5;
 bool gQuick = false;
 bool gShKernel = false;     // --sh-kernel: the engine settings with the paper's SH Lambert kernel and receiver planes
 int gIndirectAzimuths = 0;  // --indirect-azimuths N
+bool gAccuracyOnly = false;  // --accuracy-only: no Table 1
+int gProbe = 0;             // --probe N: only the frame time of an N^2 erosion frame, 2x, one bounce (stderr)
 bool gDiagnose = false;
 
 struct Dem {
@@ -295,9 +298,11 @@ int main(int argc, char** argv) {
         else if (a == "--quick") gQuick = true;
         else if (a == "--diagnose") gDiagnose = true;
         else if (a == "--sh-kernel") gShKernel = true;
+        else if (a == "--accuracy-only") gAccuracyOnly = true;
+        else if (a == "--probe" && i + 1 < argc) gProbe = std::atoi(argv[++i]);
         else if (a == "--indirect-azimuths" && i + 1 < argc) gIndirectAzimuths = std::atoi(argv[++i]);
         else {
-            std::fprintf(stderr, "usage: bench_gi_indirect [--data DIR] [--out DIR] [--runs N] [--quick] [--diagnose] [--sh-kernel] [--indirect-azimuths N]\n");
+            std::fprintf(stderr, "usage: bench_gi_indirect [--data DIR] [--out DIR] [--runs N] [--quick] [--diagnose] [--sh-kernel] [--indirect-azimuths N] [--accuracy-only] [--probe N]\n");
             return 2;
         }
     }
@@ -308,6 +313,25 @@ int main(int argc, char** argv) {
     light.environment = sunSkyLight();
     light.keys.push_back(benchKey());
 
+    if (gProbe > 0) {
+        const Dem d = erodedScene(gProbe, 0);
+        const AlbedoMap a = uniformAlbedo(gProbe, gProbe, albedo);
+        GiState st;
+        std::vector<double> t, ti, ts;
+        withThreads(2, [&] {
+            for (int f = 0; f <= gRuns; ++f) {
+                const auto t0 = Clock::now();
+                runGiFrame(d.heights.cview(), d.cell, light, settingsFor(2, 1, false), st, &a);
+                if (f == 0) continue;
+                t.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+                ti.push_back(st.timings.indirect);
+                ts.push_back(st.indirect.timings.scan);
+            }
+        });
+        std::fprintf(stderr, "%d^2 2x 1 bounce: frame %.1f ms, indirect %.1f ms, scan %.1f ms (medians of %d, 2 threads)\n", gProbe,
+                     bench::median(t), bench::median(ti), bench::median(ts), gRuns);
+        return 0;
+    }
     if (gDiagnose) {
         std::string md = "# Indirect light: error breakdown (bench_gi_indirect --diagnose)\n\n";
         for (const Dem& d : {alpsCrop(accSize), erodedScene(accSize, gQuick ? 200 : 2000)}) md += diagnose(d, light, albedo);
@@ -379,6 +403,7 @@ int main(int argc, char** argv) {
         std::ofstream(gOutDir + "/gi_indirect_accuracy.csv") << accCsv;
     }
 
+    if (gAccuracyOnly) return 0;
     // ---- Table 1: frame time -----------------------------------------------------------
     std::string tMd = "# GI with indirect light: frame time (the paper's Table 1 on this machine)\n\n";
     tMd += "Machine: " + bench::machineDescription() + ", 2 threads. Scene: builtinScene(\"erosion\", N, 1) initial ground; engine "

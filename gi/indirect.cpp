@@ -37,8 +37,8 @@ inline F4 atan4(F4 t) {
     const F4 x = t < zero ? -t : t;
     const auto big = x > spl(2.414213562373095f);
     const auto mid = (x > spl(0.4142135623730950f)) & ~big;
-    const F4 dBig = big ? x : one;
-    const F4 xr = big ? -one / dBig : (mid ? (x - one) / (x + one) : x);
+    // one division: -1 / x, (x - 1) / (x + 1) or x / 1
+    const F4 xr = (big ? -one : (mid ? x - one : x)) / (big ? x : (mid ? x + one : one));
     const F4 y0 = big ? spl(1.5707963267948966f) : (mid ? spl(0.7853981633974483f) : zero);
     const F4 z = xr * xr;
     const F4 p = ((((spl(8.05374449538e-2f) * z - spl(1.38776856032e-1f)) * z + spl(1.99777106478e-1f)) * z -
@@ -76,10 +76,17 @@ struct RowInputs {
     const float* lowSlope;  // Exact: the lowered tangent slope per receiver (this azimuth)
 };
 
-template <int NV, bool Exact>
+// Mode: kShOnly, kShAndExact, kExactOnly (1x: every texel is a receiver, so
+// U's normal detail is never used and only the exact moment is needed; out:
+// nlp[(12 + c) * pad + X] alone).
+constexpr int kShOnly = 0, kShAndExact = 1, kExactOnly = 2;
+
+template <int NV, int Mode>
 void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* steps, int nAny, int Y, int X0, const RowInputs& in,
                float cosPhi, float sinPhi, F4* moments, int* list, float* nlp, int pad) {
-    constexpr int nMo = Exact ? 5 : 4;
+    constexpr bool Exact = Mode != kShOnly, Sh = Mode != kExactOnly;
+    constexpr int nMo = (Sh ? 4 : 0) + (Exact ? 1 : 0);
+    constexpr int e5 = nMo - 1;  // index of the exact moment
     F4 M[NV], g[NV], gLow[NV], q1[NV], f1[NV], f2[NV];
     const F4 one = spl(1.0f), lim = spl(1e6f), nlim = spl(-1e6f), zero = spl(0.0f);
     for (int k = 0; k < NV; ++k) {
@@ -90,10 +97,12 @@ void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* step
         if constexpr (Exact) {
             const F4 t = g[k] < nlim ? nlim : (g[k] > lim ? lim : g[k]);
             cosineAntiderivatives(t, f1[k], f2[k]);
-            gLow[k] = ld(in.lowSlope + X0 + 4 * k);
         }
-        const F4 t = gLow[k] < nlim ? nlim : (gLow[k] > lim ? lim : gLow[k]);
-        q1[k] = t / simd::vsqrt(one + t * t);
+        if constexpr (Sh) {
+            if constexpr (Exact) gLow[k] = ld(in.lowSlope + X0 + 4 * k);
+            const F4 t = gLow[k] < nlim ? nlim : (gLow[k] > lim ? lim : gLow[k]);
+            q1[k] = t / simd::vsqrt(one + t * t);
+        }
     }
     int n = 0;
     for (int i = 0; i < nAny; ++i) {
@@ -117,16 +126,18 @@ void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* step
         for (int k = 0; k < NV; ++k) {
             M[k] = nw[k] ? t[k] : M[k];
             // the segment [c_(i-1), c_i] clamped to [omega_min, pi/2]
-            F4 tc = t[k] < gLow[k] ? gLow[k] : t[k];
-            tc = tc < nlim ? nlim : (tc > lim ? lim : tc);
-            const F4 sNew = tc / simd::vsqrt(one + tc * tc);
-            const F4 sv = nw[k] ? sNew : q1[k];  // no new member: an empty segment (exactly 0)
-            const F4 p = q1[k], p2 = p * p, s2 = sv * sv;
-            mo[nMo * k + 0] = sv - p;
-            mo[nMo * k + 1] = s2 - p2;
-            mo[nMo * k + 2] = s2 * sv - p2 * p;
-            mo[nMo * k + 3] = s2 * s2 - p2 * p2;
-            q1[k] = sv;
+            if constexpr (Sh) {
+                F4 tc = t[k] < gLow[k] ? gLow[k] : t[k];
+                tc = tc < nlim ? nlim : (tc > lim ? lim : tc);
+                const F4 sNew = tc / simd::vsqrt(one + tc * tc);
+                const F4 sv = nw[k] ? sNew : q1[k];  // no new member: an empty segment (exactly 0)
+                const F4 p = q1[k], p2 = p * p, s2 = sv * sv;
+                mo[nMo * k + 0] = sv - p;
+                mo[nMo * k + 1] = s2 - p2;
+                mo[nMo * k + 2] = s2 * sv - p2 * p;
+                mo[nMo * k + 3] = s2 * s2 - p2 * p2;
+                q1[k] = sv;
+            }
             if constexpr (Exact) {
                 F4 te = t[k] < g[k] ? g[k] : t[k];
                 te = te < nlim ? nlim : (te > lim ? lim : te);
@@ -134,7 +145,7 @@ void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* step
                 cosineAntiderivatives(te, a1, a2);
                 a1 = nw[k] ? a1 : f1[k];
                 a2 = nw[k] ? a2 : f2[k];
-                mo[nMo * k + 4] = (a2 - f2[k]) - g[k] * (a1 - f1[k]);
+                mo[nMo * k + e5] = (a2 - f2[k]) - g[k] * (a1 - f1[k]);
                 f1[k] = a1;
                 f2[k] = a2;
             }
@@ -163,18 +174,19 @@ void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* step
             }
         }
         for (int k = 0; k < NV; ++k) {
+            if constexpr (Exact) simd::store(nlp + static_cast<std::size_t>(12 + c) * pad + X0 + 4 * k, A[k][e5]);
+            if constexpr (!Sh) continue;
             float* base = nlp + static_cast<std::size_t>(c) * 4 * pad + X0 + 4 * k;
             simd::store(base, k0 * A[k][0]);
             simd::store(base + pad, k1 * A[k][1]);
             simd::store(base + 2 * pad, k2 * (A[k][2] - A[k][0]));
             simd::store(base + 3 * pad, k3 * (spl(5.0f) * A[k][3] - spl(6.0f) * A[k][1]));
-            if constexpr (Exact) simd::store(nlp + static_cast<std::size_t>(12 + c) * pad + X0 + 4 * k, A[k][4]);
         }
     }
 }
 
 // Row of receivers for one azimuth.
-template <bool Exact>
+template <int Mode>
 void castRow(const ScanStep* hTab, const ScanStep* const* rTab, const int* colSteps, int rowSteps, int Y, const RowInputs& in,
              float cosPhi, float sinPhi, IndirectScratch& sc, int pad) {
     const I4 rowLimit = {rowSteps, rowSteps, rowSteps, rowSteps};
@@ -187,7 +199,7 @@ void castRow(const ScanStep* hTab, const ScanStep* const* rTab, const int* colSt
             steps[k] = c < rowLimit ? c : rowLimit;
             for (int l = 0; l < 4; ++l) nAny = std::max(nAny, steps[k][l]);
         }
-        castGroup<kGroup / 4, Exact>(hTab, rTab, steps, nAny, Y, X0, in, cosPhi, sinPhi, reinterpret_cast<F4*>(sc.moments.data()),
+        castGroup<kGroup / 4, Mode>(hTab, rTab, steps, nAny, Y, X0, in, cosPhi, sinPhi, reinterpret_cast<F4*>(sc.moments.data()),
                                      sc.list.data(), sc.nlp.data(), pad);
     }
 }
@@ -217,6 +229,7 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
     const std::size_t planeR = static_cast<std::size_t>(nxr) * nyr;
     const int nRows = shading.brdf == Brdf::Lambert ? 9 : kShCount;  // Lambert reads bands 0..2 only
     const bool exact = settings.lambert == LambertIndirect::ExactAtReceivers && shading.brdf == Brdf::Lambert;
+    const int mode = !exact ? kShOnly : (s == 1 ? kExactOnly : kShAndExact);
     // the shading footprint of a receiver (ExactAtReceivers): offsets {-s/2, 0, s/2}^2 cells
     const int half = s / 2;
     const int nFoot = s > 1 ? 9 : 1;
@@ -248,7 +261,7 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
             b.lowSlope.resize(static_cast<std::size_t>(pad));
         }
         b.nlp.resize(static_cast<std::size_t>(15) * pad);
-        b.moments.resize(static_cast<std::size_t>(std::max(nSteps, 1)) * 2 * 5 * 4 + 4);  // nSteps x 2 vectors x 5 moments x 4 lanes
+        b.moments.resize(static_cast<std::size_t>(std::max(nSteps, 1)) * kGroup * 5 + 4);  // nSteps x kGroup / 4 vectors x 5 moments x 4 lanes
         b.list.resize(static_cast<std::size_t>(std::max(nSteps, 1)));
     }
     // shading: U of channel c lights channel c only (identity product matrix)
@@ -365,7 +378,7 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
                         const int Y = yBegin + r;
                         const std::size_t ro = static_cast<std::size_t>(r) * pad;
                         RowInputs in{sc.h0.data() + ro, sc.margin.data() + ro, sc.gx.data() + ro, sc.gy.data() + ro, nullptr};
-                        if (exact) {
+                        if (mode == kShAndExact) {
                             // U's segments start at the footprint's lowest tangent slope, lowered
                             // (by footprintDrop x the footprint's spread of slopes, at most footprintDropMax:
                             // 0 where the footprint is one plane)
@@ -385,7 +398,7 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
                             }
                             in.lowSlope = sc.lowSlope.data();
                         }
-                        (exact ? castRow<true> : castRow<false>)(st.heightSteps.data() + base, rTab,
+                        (mode == kShOnly ? castRow<kShOnly> : (mode == kShAndExact ? castRow<kShAndExact> : castRow<kExactOnly>))(st.heightSteps.data() + base, rTab,
                                                                  st.stepsPerColumn.data() + static_cast<std::size_t>(j) * pad,
                                                                  st.stepsPerRow[static_cast<std::size_t>(j) * nyr + static_cast<std::size_t>(Y)], Y,
                                                                  in, cosPhi, sinPhi, sc, pad);
@@ -396,7 +409,7 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
                                 for (int X = 0; X < nxr; ++X) e[X] += w[X];
                             }
                         // U_c += G_j u_(c, j) over the sparse pattern (Eq. 21)
-                        for (int e = 0; e < P; ++e) {
+                        for (int e = 0; e < (mode == kExactOnly ? 0 : P); ++e) {
                             const int row = op.patternRow[static_cast<std::size_t>(e)];
                             if (row >= nRows) continue;
                             const float gval = vals[e];

@@ -31,6 +31,8 @@ struct GiOptions {
     std::vector<std::string> keys;
     int subsample = 1;
     int azimuths = 0, levelsPerOctave = 0, levelOffset = -1;
+    int indirectAzimuths = -1;
+    std::string indirectKernel;
     std::string interp;
     int threads = 0;
     bool reference = false;
@@ -171,6 +173,12 @@ int runGi(const GiOptions& o) {
     settings.indirect.amortise = o.amortise;
     if (o.radianceLevelsPerOctave != 0) settings.indirect.radiance.levelsPerOctave = o.radianceLevelsPerOctave;
     if (o.radianceLevelOffset >= 0) settings.indirect.radiance.levelOffset = o.radianceLevelOffset;
+    if (o.indirectAzimuths >= 0) settings.indirect.azimuths = o.indirectAzimuths;
+    if (!o.indirectKernel.empty()) {
+        if (o.indirectKernel == "sh") settings.indirect.lambert = gi::LambertIndirect::ShKernel;
+        else if (o.indirectKernel == "exact") settings.indirect.lambert = gi::LambertIndirect::ExactAtReceivers;
+        else throw InputError("--indirect-kernel must be sh or exact (got '" + o.indirectKernel + "')");
+    }
     gi::validateIndirectSettings(settings.indirect);
     if (o.azimuths != 0) settings.visibility.azimuths = o.azimuths;
     if (o.levelsPerOctave != 0) settings.pyramid.levelsPerOctave = o.levelsPerOctave;
@@ -267,7 +275,7 @@ Runner addGiCommand(CLI::App& app) {
     sub->add_option("--light", o->light, "uniform | sunsky | env:FILE (.exr/.hdr equirectangular)");
     sub->add_option("--key", o->keys, "Key light AZ_DEG,EL_DEG,RADIUS_DEG,R,G,B (repeatable)");
     sub->add_option("--subsample", o->subsample, "Visibility sub-sampling: 1, 2 or 4");
-    sub->add_option("--azimuths", o->azimuths, "Azimuth samples m (default 32)");
+    sub->add_option("--azimuths", o->azimuths, "Azimuth samples m (engine default 16, paper 32)");
     sub->add_option("--levels-per-octave", o->levelsPerOctave, "Pyramid levels per octave k_v (default 4)");
     sub->add_option("--level-offset", o->levelOffset, "Pyramid level offset o_v in octaves (engine default 3, paper 2)");
     sub->add_option("--interp", o->interp, "Azimuthal interpolation: linear | bspline");
@@ -283,7 +291,10 @@ Runner addGiCommand(CLI::App& app) {
     sub->add_flag("--amortise", o->amortise, "With --frames on static geometry: alternate direct and indirect updates");
     sub->add_option("--out-indirect", o->outIndirect, "Indirect light alone, RGB (.npy float32 (rows, columns, 3), or .exr)");
     sub->add_option("--radiance-levels-per-octave", o->radianceLevelsPerOctave, "Radiance pyramid k_u (default 4)");
-    sub->add_option("--radiance-level-offset", o->radianceLevelOffset, "Radiance pyramid level offset o_u (default 2)");
+    sub->add_option("--radiance-level-offset", o->radianceLevelOffset, "Radiance pyramid level offset o_u (engine default 3, paper 2)");
+    sub->add_option("--indirect-azimuths", o->indirectAzimuths, "Azimuths of the indirect scan (0 = --azimuths)");
+    sub->add_option("--indirect-kernel", o->indirectKernel,
+                    "Lambert indirect light: exact (exact cosine at the receivers, engine default) | sh (order-4 SH kernel, paper)");
     sub->add_option("--reference-directions", o->referenceDirections, "Directions of the indirect reference (default 2048)");
     return [o] { return runGi(*o); };
 }
