@@ -19,7 +19,7 @@ double msSince(Clock::time_point t0) { return std::chrono::duration<double, std:
 void runIndirectStage(const GiSettings& settings, GiState& st, const AlbedoMap* albedo) {
     const auto t = Clock::now();
     computeIndirect(st.pyramid, st.gradX.cview(), st.gradY.cview(), st.envOperator, st.envVisibility, st.shade.rgb, albedo,
-                    settings.shading, settings.indirect, st.indirect);
+                    settings.shading, settings.indirect, st.indirect, &st.shade);
     st.timings.indirect = msSince(t);
 }
 
@@ -166,6 +166,10 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
     if (albedo)
         for (const Grid& g : albedo->channel)
             if (!g.empty() && (g.nx != heights.nx || g.ny != heights.ny)) throw InputError("albedo map size differs from the heights");
+    if (albedo)
+        for (const Grid& g : albedo->phongLobe)
+            if (!g.empty() && (g.nx != heights.nx || g.ny != heights.ny))
+                throw InputError("Phong exponent map size differs from the heights");
 
     validateIndirectSettings(settings.indirect);
 
