@@ -215,11 +215,12 @@ int runGi(const GiOptions& o) {
     double cell = o.cellSize;
     if (cell <= 0.0) cell = cellFromFile;
     if (!(cell > 0.0) || !std::isfinite(cell)) throw InputError("--cell-size must be > 0 (metres between grid points)");
-    std::fprintf(stderr, "terrain gi: %s, %d x %d cells of %.4g m\n", o.heightmap.c_str(), heights.nx, heights.ny, cell);
     gi::AlbedoMap albedoMap;
     if (!o.albedo.empty()) albedoMap = gi::loadAlbedo(o.albedo, heights.nx, heights.ny);
     if (exponentFile) gi::loadPhongExponentMap(o.phongExponent, heights.nx, heights.ny, exponentLo, exponentHi, albedoMap);
     const gi::AlbedoMap* albedo = o.albedo.empty() && !exponentFile ? nullptr : &albedoMap;
+    // after every input is read: a bad input gives one error line on stderr
+    std::fprintf(stderr, "terrain gi: %s, %d x %d cells of %.4g m\n", o.heightmap.c_str(), heights.nx, heights.ny, cell);
 
     return withThreads(o.threads, [&] {
         using Clock = std::chrono::steady_clock;
