@@ -4,6 +4,7 @@
 
 #include <png.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -66,6 +67,23 @@ AlbedoMap loadAlbedo(const std::string& spec, int nx, int ny) {
     for (std::size_t i = 0; i < static_cast<std::size_t>(nx) * ny; ++i)
         for (int c = 0; c < 3; ++c) m.channel[static_cast<std::size_t>(c)].v[i] = srgbToLinear(px[3 * i + static_cast<std::size_t>(c)]);
     return m;
+}
+
+void loadPhongExponentMap(const std::string& file, int nx, int ny, float lo, float hi, AlbedoMap& map) {
+    if (!(lo >= kMinPhongExponent && hi <= kMaxPhongExponent && lo <= hi))
+        throw InputError("--phong-exponent-range: need " + std::to_string(kMinPhongExponent) + " <= MIN <= MAX <= " +
+                         std::to_string(kMaxPhongExponent));
+    const Grid raw = readPngHeightmap(file, 1.0f, 0.0f);
+    if (raw.nx != nx || raw.ny != ny)
+        throw InputError("--phong-exponent " + file + ": " + std::to_string(raw.nx) + " x " + std::to_string(raw.ny) +
+                         " pixels, the height field has " + std::to_string(nx) + " x " + std::to_string(ny));
+    Grid s(nx, ny);
+    const double ratio = static_cast<double>(hi) / lo;
+    for (std::size_t i = 0; i < s.v.size(); ++i) {
+        const double e = lo * std::pow(ratio, raw.v[i] / 65535.0);
+        s.v[i] = static_cast<float>(std::clamp(e, static_cast<double>(lo), static_cast<double>(hi)));
+    }
+    setPhongExponentMap(map, s);
 }
 
 void writeNpyRgb(const std::string& file, const std::array<Grid, 3>& rgb) {

@@ -17,6 +17,14 @@ std::vector<float> parseNumberList(const std::string& text, const std::string& o
 /// IoError (unreadable file).
 AlbedoMap loadAlbedo(const std::string& spec, int nx, int ny);
 
+/// Per-texel Phong exponents for the command line (`--phong-exponent`): a
+/// 16-bit greyscale PNG of exactly nx x ny pixels, sample v in 0..65535 mapped
+/// log-uniformly to S = lo (hi / lo)^(v / 65535) (so equal steps of v are
+/// equal ratios of S: the lobe width e^{-l^2/(2S)} varies smoothly), set into
+/// map with setPhongExponentMap. Throws InputError (size mismatch, bad range)
+/// or IoError (unreadable file).
+void loadPhongExponentMap(const std::string& file, int nx, int ny, float lo, float hi, AlbedoMap& map);
+
 /// float32 .npy of an RGB map, shape (rows, columns, 3).
 void writeNpyRgb(const std::string& file, const std::array<Grid, 3>& rgb);
 

@@ -29,7 +29,7 @@ void runIndirectStage(const GiSettings& settings, GiState& st, const AlbedoMap* 
         op = &st.indirectOperator;
     }
     computeIndirect(st.pyramid, st.gradX.cview(), st.gradY.cview(), *op, st.envVisibility, st.shade.rgb, albedo,
-                    settings.shading, settings.indirect, st.indirect);
+                    settings.shading, settings.indirect, st.indirect, &st.shade);
     st.timings.indirect = msSince(t);
 }
 
@@ -181,6 +181,10 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
     if (albedo)
         for (const Grid& g : albedo->channel)
             if (!g.empty() && (g.nx != heights.nx || g.ny != heights.ny)) throw InputError("albedo map size differs from the heights");
+    if (albedo)
+        for (const Grid& g : albedo->phongLobe)
+            if (!g.empty() && (g.nx != heights.nx || g.ny != heights.ny))
+                throw InputError("Phong exponent map size differs from the heights");
 
     validateIndirectSettings(settings.indirect);
 

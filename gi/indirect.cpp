@@ -218,8 +218,15 @@ void validateIndirectSettings(const IndirectSettings& s) {
 
 void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridView gradY, const FoldedWedgeOperator& op,
                      const VisibilityField& envVisibility, const std::array<Grid, 3>& direct, const AlbedoMap* albedo,
-                     const ShadingSettings& shading, const IndirectSettings& settings, IndirectState& st) {
+                     const ShadingSettings& shading, const IndirectSettings& settings, IndirectState& st,
+                     const ShadeMaps* directShade) {
     validateIndirectSettings(settings);
+    // ---- glossy vector pyramid (Fig. 5 middle): its own scan, gi/indirect_glossy.cpp ----
+    if (settings.glossy == GlossyIndirect::VectorPyramid && shading.brdf != Brdf::Lambert && settings.bounces > 0) {
+        if (!directShade) throw InputError("glossy vector pyramid: the direct shading (incident SH) is required");
+        computeGlossyIndirect(pyr, gradX, gradY, op, envVisibility, *directShade, albedo, shading, settings, st);
+        return;
+    }
     const auto t0 = Clock::now();
     st.timings = IndirectTimings{};
     const int nx = pyr.nx, ny = pyr.ny, s = pyr.subsample;

@@ -21,10 +21,12 @@
 // giving the bounce's exit radiance L_b. Bounce b + 1 builds its radiance
 // pyramid from L_b (Section 7); the result accumulates L_1 + ... + L_B.
 //
-// Glossy surfaces: the scalar shade (diffuse + glossy towards the viewer,
-// per ShadingSettings::brdf) is forwarded to the next bounce's RGB pyramid:
-// the single-pyramid approximation of Fig. 5 (right). The vector pyramid of SH
-// radiance (Fig. 5 middle) is not implemented yet.
+// Glossy surfaces (IndirectSettings::glossy): ScalarPyramid forwards the
+// scalar shade (diffuse + glossy towards the viewer, per
+// ShadingSettings::brdf) to the next bounce's RGB pyramid: the single-pyramid
+// approximation of Fig. 5 (right). VectorPyramid filters SH exit-radiance
+// vectors and evaluates them towards each receiver (Fig. 5 middle):
+// gi/indirect_glossy.h.
 //
 // Heights equal up to float rounding must not count as blockers (a flat
 // plane gets exactly no indirect light): a sample counts in the casting set
@@ -40,6 +42,7 @@
 #include <array>
 #include <vector>
 
+#include "gi/indirect_glossy.h"
 #include "gi/pyramid.h"
 #include "gi/radiance_pyramid.h"
 #include "gi/shading.h"
@@ -51,6 +54,7 @@ namespace terrain::gi {
 
 enum class GlossyIndirect {
     ScalarPyramid,  // one RGB pyramid of the scalar shade (diffuse + glossy towards the viewer), Fig. 5 right
+    VectorPyramid,  // a pyramid of SH exit-radiance vectors, evaluated towards each receiver (Fig. 5 middle; gi/indirect_glossy.h)
 };
 
 // How Lambert receivers turn their casting sets into irradiance.
@@ -119,15 +123,19 @@ struct IndirectState {
     std::array<Grid, 3> total;     // direct + indirect
     std::vector<double> bounceMean;  // mean exit radiance (RGB average) of each bounce
     IndirectTimings timings;
+    GlossyIndirectState glossy;    // vector-pyramid buffers (GlossyIndirect::VectorPyramid)
 };
 
 /// Indirect light of `bounces` bounces over the frame's height pyramid.
 /// op: the folded wedge operator of the indirect azimuths (settings.azimuths);
 /// direct: bounce 0's exit radiance (full resolution, albedo applied);
+/// directShade: the direct shading it came from (its incident SH vectors),
+/// needed by GlossyIndirect::VectorPyramid with a non-Lambert BRDF (without
+/// it that case throws InputError).
 void computeIndirect(const HeightPyramid& heights, ConstGridView gradX, ConstGridView gradY,
                      const FoldedWedgeOperator& op, const VisibilityField& envVisibility,
                      const std::array<Grid, 3>& direct, const AlbedoMap* albedo, const ShadingSettings& shading,
-                     const IndirectSettings& settings, IndirectState& state);
+                     const IndirectSettings& settings, IndirectState& state, const ShadeMaps* directShade = nullptr);
 
 /// Throws InputError when a setting is out of range.
 void validateIndirectSettings(const IndirectSettings& s);

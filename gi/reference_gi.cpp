@@ -27,10 +27,9 @@ inline float bilinearF(const float* v, int nx, int ny, float px, float py) {
     return a + fy * (b - a);
 }
 
-// First hit of the ray from grid point (x, y) (at its height) in direction d
-// through the bilinear height field. Returns false when it escapes. All
-// positions in cells; heights in metres.
-bool firstHit(const float* h, int nx, int ny, float hMax, float cellSize, int x, int y, const std::array<float, 3>& d,
+}  // namespace
+
+bool referenceFirstHit(const float* h, int nx, int ny, float hMax, float cellSize, int x, int y, const std::array<float, 3>& d,
               float step, float& hx, float& hy) {
     const float horiz = std::sqrt(d[0] * d[0] + d[1] * d[1]);
     if (horiz < 1e-6f) return d[2] < 0.0f ? (hx = static_cast<float>(x), hy = static_cast<float>(y), true) : false;
@@ -57,8 +56,6 @@ bool firstHit(const float* h, int nx, int ny, float hMax, float cellSize, int x,
         prevT = t;
     }
 }
-
-}  // namespace
 
 void addReferenceKeyLight(ConstGridView heights, float cellSize, const KeyLight& key, const AlbedoMap* albedo,
                           int azimuths, std::array<Grid, 3>& rgb) {
@@ -164,7 +161,7 @@ void gatherReferenceBounce(ConstGridView heights, float cellSize, const std::arr
                     const float cosine = n0 * dir[0] + n1 * dir[1] + n2 * dir[2];
                     if (cosine <= 0.0f) continue;
                     float qx, qy;
-                    if (!firstHit(hCopy.data(), nx, ny, hMax, cellSize, x, y, dir, s.marchStep, qx, qy)) continue;
+                    if (!referenceFirstHit(hCopy.data(), nx, ny, hMax, cellSize, x, y, dir, s.marchStep, qx, qy)) continue;
                     const float k = s.shLambert ? 0.25f + 0.5f * cosine + 0.15625f * (3.0f * cosine * cosine - 1.0f) : cosine;
                     for (int c = 0; c < 3; ++c) e[c] += k * bilinearF(prev[c].data(), nx, ny, qx, qy);
                 }
@@ -186,6 +183,10 @@ void renderReferenceGi(ConstGridView heights, float cellSize, const ShRgb& light
     if (s.bounces < 0 || s.bounces > 16) throw InputError("reference: bounces must be 0 .. 16");
     if (!(s.marchStep > 0.0f && s.marchStep <= 2.0f)) throw InputError("reference: march step must be in (0, 2] cells");
     checkHeightsFinite(heights);
+    if (s.shading.brdf != Brdf::Lambert) {  // glossy surfaces: SH incident radiance per texel (gi/reference_glossy.cpp)
+        renderReferenceGlossy(heights, cellSize, lighting, albedo, s, out);
+        return;
+    }
     const int nx = heights.nx, ny = heights.ny;
     // Bounce 0: the exact direct reference.
     ReferenceSettings direct;

@@ -14,6 +14,7 @@
 // highest point escape (they see the sky, which bounce 0 already counted).
 // Indirect = sum of L_b over b = 1..bounces; total = direct + indirect.
 #include <array>
+#include <vector>
 
 #include "gi/lights.h"
 #include "gi/reference.h"
@@ -41,6 +42,9 @@ struct ReferenceGiSettings {
     // order-4 SH truncation of indirect light (a floor for the fast path).
     bool shLambert = false;
     int keyAzimuths = 48;     // midpoint azimuths across each cap's extent
+    // BRDF of every texel. Lambert (default): the scalar gathering above.
+    // Phong / LambertPlusPhong: the glossy reference (renderReferenceGlossy).
+    ShadingSettings shading;
 };
 
 struct ReferenceGiResult {
@@ -54,6 +58,38 @@ struct ReferenceGiResult {
 /// SH; settings.keys: key lights, integrated as exact caps. albedo may be null (1).
 void renderReferenceGi(ConstGridView heights, float cellSize, const ShRgb& lighting, const AlbedoMap* albedo,
                        const ReferenceGiSettings& settings, ReferenceGiResult& out);
+
+/// The glossy reference (ReferenceGiSettings::shading not Lambert): the same
+/// BRDFs and order-4 SH lighting as the fast path (gi/shading.h, Section 7).
+/// Per texel p it keeps the incident radiance projected to order-4 SH, I_b(p)
+/// (RGB x 16), and the isotropic exit radiance D_b(p); the exit radiance
+/// towards a direction w is
+///   L_b(p, w) = D_b(p) + w_s sum_lm g_l(p) I_b,lm(p) Y_lm(R_N(w)),
+/// R_N(w) = 2 (N . w) N - w, g_l = e^{-l^2/(2S)} of p's exponent (the
+/// AlbedoMap's exponent map or ShadingSettings::phongExponent), w_s the
+/// specular weight (1 for Phong); outputs are L_b towards the viewer.
+/// Bounce 0: I_0 = the exact projection of (SH lighting x exact visibility),
+/// I_0,i = sum_j L_j int_visible Y_i Y_j (dense azimuths as gi/reference,
+/// elevation integrals of A_i A_j cos tabulated by Gauss-Legendre);
+/// D_0 = (1 - w_s for Phong: 0) x the exact Lambert shade of gi/reference
+/// + exact-cap key lights (Lambert, like the fast path's exact-cosine keys).
+/// Bounce b: over the fixed direction set w_k with N . w_k > 0 and first hit q_k,
+///   I_b(p) = 4 pi / K sum_k L_(b-1)(q_k, -w_k) Y(w_k),
+///   D_b(p) = w_d albedo(p) / pi 4 pi / K sum_k L_(b-1)(q_k, -w_k) (N . w_k),
+/// with D, I, the normal and g bilinear at q_k.
+void renderReferenceGlossy(ConstGridView heights, float cellSize, const ShRgb& lighting, const AlbedoMap* surface,
+                           const ReferenceGiSettings& settings, ReferenceGiResult& out);
+
+/// I_0 of the glossy reference: per texel the exact incident radiance of the
+/// SH `lighting` through the exact visibility, projected to order-4 SH
+/// (out: 3 x 16 planes of nx * ny, plane c * 16 + i).
+void referenceIncidentSh(ConstGridView heights, float cellSize, const ShRgb& lighting, int azimuths, std::vector<float>& out);
+
+/// First hit of the ray from grid point (x, y) (at its height) in direction d
+/// through the bilinear height field; false when it escapes. Positions in
+/// cells, heights in metres; hMax the field's maximum.
+bool referenceFirstHit(const float* h, int nx, int ny, float hMax, float cellSize, int x, int y, const std::array<float, 3>& d,
+                       float step, float& hx, float& hy);
 
 /// One gathering bounce: next(p) = albedo(p) / pi * sum_k prev(q_k) (N . w_k) 4 pi / K
 /// over the fixed direction set (the rays' first hits q_k). next is resized.

@@ -3,10 +3,32 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <string>
 
+#include "sim/error.h"
 #include "sim/parallel.h"
 
 namespace terrain::gi {
+
+void phongLobeFactors(double exponent, float ph[kShOrder]) {
+    double zh[kShOrder];
+    phongZonal(exponent, zh);
+    for (int l = 0; l < kShOrder; ++l) ph[l] = static_cast<float>(std::sqrt(4.0 * kPi / (2.0 * l + 1.0)) * zh[l]);
+}
+
+void setPhongExponentMap(AlbedoMap& map, const Grid& exponent) {
+    for (std::size_t i = 0; i < exponent.v.size(); ++i)
+        if (!(exponent.v[i] >= kMinPhongExponent && exponent.v[i] <= kMaxPhongExponent))
+            throw InputError("Phong exponent map: value " + std::to_string(exponent.v[i]) + " at index " + std::to_string(i) +
+                             " is not in [" + std::to_string(kMinPhongExponent) + ", " + std::to_string(kMaxPhongExponent) + "]");
+    map.phongExponent = exponent;
+    for (Grid& g : map.phongLobe) g.resize(exponent.nx, exponent.ny);
+    for (std::size_t i = 0; i < exponent.v.size(); ++i) {
+        float ph[kShOrder];
+        phongLobeFactors(exponent.v[i], ph);
+        for (int l = 1; l < kShOrder; ++l) map.phongLobe[static_cast<std::size_t>(l - 1)].v[i] = ph[l];
+    }
+}
 
 namespace {
 
@@ -246,10 +268,8 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
     double lamZh[kShOrder];
     for (int l = 0; l < kShOrder; ++l) lamZh[l] = std::sqrt(4.0 * kPi / (2.0 * l + 1.0)) * lambertZonal()[l] / kPi;
     const float lam0 = static_cast<float>(lamZh[0]), lam1 = static_cast<float>(lamZh[1]), lam2 = static_cast<float>(lamZh[2]);
-    double phZh[kShOrder];
-    phongZonal(settings.phongExponent, phZh);
-    float ph[kShOrder];
-    for (int l = 0; l < kShOrder; ++l) ph[l] = static_cast<float>(std::sqrt(4.0 * kPi / (2.0 * l + 1.0)) * phZh[l]);
+    float phUniform[kShOrder];
+    phongLobeFactors(settings.phongExponent, phUniform);
     const float diffuseWeight = settings.brdf == Brdf::Phong ? 0.0f : 1.0f;
     const float specWeight = settings.brdf == Brdf::Phong ? 1.0f : (settings.brdf == Brdf::LambertPlusPhong ? settings.specularWeight : 0.0f);
     const float vx = settings.viewDir[0], vy = settings.viewDir[1], vz = settings.viewDir[2];
@@ -343,6 +363,8 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
                             const float inv = 1.0f / std::sqrt(1.0f + gx * gx + gy * gy);
                             const float nxv = -gx * inv, nyv = -gy * inv, nzv = inv;
                             const float nv = nxv * vx + nyv * vy + nzv * vz;
+                            float ph[kShOrder];  // the texel's exponent (AlbedoMap::phongExponent) or the uniform one
+                            texelPhongLobe(albedo, static_cast<std::size_t>(y) * nx + x, phUniform, ph);
                             float yb[kShCount];
                             shBasisFloat(2.0f * nv * nxv - vx, 2.0f * nv * nyv - vy, 2.0f * nv * nzv - vz, yb, kShCount);
                             float sp = 0.0f;

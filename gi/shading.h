@@ -32,10 +32,37 @@ struct ShadingSettings {
     float viewDir[3] = {0.0f, 0.0f, 1.0f};  // unit vector towards the viewer (distant viewer)
 };
 
-/// Per-texel RGB albedo; empty grids mean albedo 1.
+/// Per-texel surface parameters; empty grids mean the uniform values.
 struct AlbedoMap {
-    std::array<Grid, 3> channel;
+    std::array<Grid, 3> channel;  // RGB albedo (empty: 1)
+    // Per-texel Phong exponent S (empty: ShadingSettings::phongExponent) and
+    // the lobe factors the shading reads, phongLobe[l - 1] = e^{-l^2 / (2 S)}
+    // (l = 1..3, rounded to float exactly as phongLobeFactors does). Filled
+    // together by setPhongExponentMap: the factors are computed once per map
+    // in double, so shading costs 3 loads per texel, has no table error, and
+    // a map of constant S shades bit for bit like the scalar exponent S.
+    Grid phongExponent;
+    std::array<Grid, 3> phongLobe;
 };
+
+/// The Phong lobe's per-band factors as shading applies them:
+/// ph[l] = float(sqrt(4 pi / (2l+1)) zh_l) with zh = phongZonal(exponent),
+/// i.e. e^{-l^2 / (2 S)} (Section 7, [RH02]).
+void phongLobeFactors(double exponent, float ph[kShOrder]);
+
+/// Sets the per-texel Phong exponent map (and its lobe factors). Throws
+/// InputError when an exponent is not finite or outside [kMinPhongExponent,
+/// kMaxPhongExponent].
+void setPhongExponentMap(AlbedoMap& map, const Grid& exponent);
+inline constexpr float kMinPhongExponent = 0.01f, kMaxPhongExponent = 10000.0f;
+
+/// Lobe factors of texel i (index into the full-resolution grid): from the
+/// map when it has one, else `uniform` (phongLobeFactors of the settings).
+inline void texelPhongLobe(const AlbedoMap* map, std::size_t i, const float uniform[kShOrder], float ph[kShOrder]) {
+    ph[0] = uniform[0];
+    const bool m = map && !map->phongLobe[0].empty();
+    for (int l = 1; l < kShOrder; ++l) ph[l] = m ? map->phongLobe[static_cast<std::size_t>(l - 1)].v[i] : uniform[l];
+}
 
 /// One light as the shading stage sees it.
 struct ShadingLight {

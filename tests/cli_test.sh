@@ -62,5 +62,26 @@ expect_error "uncreatable output" "output folder" "$T" sim --scene erosion --siz
 touch "$tmp/afile"
 expect_error "output is a file" "afile" "$T" sim --scene erosion --size 16 --ticks 1 --out "$tmp/afile/sub"
 
+# glossy GI: heightmaps (16-bit PNG) from the simulator double as exponent maps
+"$T" sim --scene erosion --size 24 --ticks 1 --out "$tmp/g24" --format png --quiet >/dev/null 2>&1
+"$T" sim --scene erosion --size 16 --ticks 1 --out "$tmp/g16" --format png --quiet >/dev/null 2>&1
+hm24="$tmp/g24/frame_000000.png"
+hm16="$tmp/g16/frame_000000.png"
+"$T" gi --heightmap "$hm24" --cell-size 10 --brdf phong:20 --bounces 1 --glossy vector --phong-exponent "$hm24" \
+  --out-indirect "$tmp/gv.npy" >/dev/null 2>&1 && [ -s "$tmp/gv.npy" ] && ok || bad "gi --glossy vector with an exponent map"
+"$T" gi --heightmap "$hm24" --cell-size 10 --brdf mix:0.5,30 --bounces 1 --reference --reference-directions 128 \
+  --out-indirect "$tmp/gr.npy" >/dev/null 2>&1 && [ -s "$tmp/gr.npy" ] && ok || bad "gi --reference with a glossy BRDF"
+expect_error "exponent map of the wrong size" "16 x 16 pixels" "$T" gi --heightmap "$hm24" --cell-size 10 --brdf phong:20 \
+  --bounces 1 --phong-exponent "$hm16"
+expect_error "unreadable exponent map" "missing.png" "$T" gi --heightmap "$hm24" --cell-size 10 --brdf phong:20 \
+  --phong-exponent "$tmp/missing.png"
+printf 'not a png' >"$tmp/bogus.png"
+expect_error "exponent file that is not a PNG" "bogus.png" "$T" gi --heightmap "$hm24" --cell-size 10 --brdf phong:20 \
+  --phong-exponent "$tmp/bogus.png"
+expect_error "constant exponent out of range" "phong-exponent" "$T" gi --heightmap "$hm24" --cell-size 10 --phong-exponent -3
+expect_error "bad exponent range" "phong-exponent-range" "$T" gi --heightmap "$hm24" --cell-size 10 --phong-exponent "$hm24" \
+  --phong-exponent-range 100,10
+expect_error "bad glossy mode" "glossy" "$T" gi --heightmap "$hm24" --cell-size 10 --glossy shiny
+
 echo "cli: $pass passed, $fail failed"
 [ $fail -eq 0 ]

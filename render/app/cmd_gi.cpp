@@ -47,6 +47,9 @@ struct GiOptions {
     std::string outIndirect;
     int radianceLevelsPerOctave = 0, radianceLevelOffset = -1;
     int referenceDirections = 2048;
+    std::string glossy;          // vector | scalar (glossy indirect light)
+    std::string phongExponent;   // VALUE or a 16-bit PNG
+    std::string phongExponentRange = "1,1000";
 };
 
 // --brdf lambert | phong:EXP | mix:W[,EXP] (Lambert + W x normalised Phong)
@@ -168,7 +171,30 @@ int runGi(const GiOptions& o) {
     gi::GiSettings settings = gi::engineGiSettings();
     settings.subsample = o.subsample;
     parseBrdf(o.brdf, settings.shading);
-    if (o.reference && settings.shading.brdf != gi::Brdf::Lambert) throw InputError("--reference supports --brdf lambert only");
+    if (!o.glossy.empty()) {
+        if (o.glossy == "vector") settings.indirect.glossy = gi::GlossyIndirect::VectorPyramid;
+        else if (o.glossy == "scalar") settings.indirect.glossy = gi::GlossyIndirect::ScalarPyramid;
+        else throw InputError("--glossy must be vector or scalar (got '" + o.glossy + "')");
+    }
+    bool exponentFile = false;
+    float exponentLo = 1.0f, exponentHi = 1000.0f;
+    if (!o.phongExponent.empty()) {
+        const bool numeric = o.phongExponent.find_first_not_of("0123456789.eE+-") == std::string::npos;
+        if (numeric) {
+            const std::vector<float> v = gi::parseNumberList(o.phongExponent, "--phong-exponent");
+            if (v.size() != 1 || !(v[0] >= gi::kMinPhongExponent && v[0] <= gi::kMaxPhongExponent))
+                throw InputError("--phong-exponent: a constant must be one number in [0.01, 10000] (got '" + o.phongExponent + "')");
+            settings.shading.phongExponent = v[0];
+        } else {
+            exponentFile = true;
+            const std::vector<float> r = gi::parseNumberList(o.phongExponentRange, "--phong-exponent-range");
+            if (r.size() != 2) throw InputError("--phong-exponent-range: expected MIN,MAX (got '" + o.phongExponentRange + "')");
+            exponentLo = r[0];
+            exponentHi = r[1];
+            if (!(exponentLo >= gi::kMinPhongExponent && exponentHi <= gi::kMaxPhongExponent && exponentLo <= exponentHi))
+                throw InputError("--phong-exponent-range: need 0.01 <= MIN <= MAX <= 10000 (got '" + o.phongExponentRange + "')");
+        }
+    }
     settings.indirect.bounces = o.bounces;
     settings.indirect.amortise = o.amortise;
     if (o.radianceLevelsPerOctave != 0) settings.indirect.radiance.levelsPerOctave = o.radianceLevelsPerOctave;
@@ -197,10 +223,12 @@ int runGi(const GiOptions& o) {
     double cell = o.cellSize;
     if (cell <= 0.0) cell = cellFromFile;
     if (!(cell > 0.0) || !std::isfinite(cell)) throw InputError("--cell-size must be > 0 (metres between grid points)");
-    std::fprintf(stderr, "terrain gi: %s, %d x %d cells of %.4g m\n", o.heightmap.c_str(), heights.nx, heights.ny, cell);
     gi::AlbedoMap albedoMap;
     if (!o.albedo.empty()) albedoMap = gi::loadAlbedo(o.albedo, heights.nx, heights.ny);
-    const gi::AlbedoMap* albedo = o.albedo.empty() ? nullptr : &albedoMap;
+    if (exponentFile) gi::loadPhongExponentMap(o.phongExponent, heights.nx, heights.ny, exponentLo, exponentHi, albedoMap);
+    const gi::AlbedoMap* albedo = o.albedo.empty() && !exponentFile ? nullptr : &albedoMap;
+    // after every input is read: a bad input gives one error line on stderr
+    std::fprintf(stderr, "terrain gi: %s, %d x %d cells of %.4g m\n", o.heightmap.c_str(), heights.nx, heights.ny, cell);
 
     return withThreads(o.threads, [&] {
         using Clock = std::chrono::steady_clock;
@@ -211,13 +239,14 @@ int runGi(const GiOptions& o) {
             // key lights enter the ground truth as exact caps (gi/reference_gi.h), not as SH
             const gi::ShRgb& total = lighting.environment;
             const auto t0 = Clock::now();
-            if (o.bounces > 0 || !o.outIndirect.empty() || !lighting.keys.empty()) {
+            if (o.bounces > 0 || !o.outIndirect.empty() || !lighting.keys.empty() || settings.shading.brdf != gi::Brdf::Lambert) {
                 // with indirect light: bounce b gathers bounce b - 1 (gi/reference_gi.h)
                 gi::ReferenceGiSettings gs;
                 gs.bounces = o.bounces;
                 gs.directions = o.referenceDirections;
                 gs.progress = true;
                 gs.keys = lighting.keys;
+                gs.shading = settings.shading;  // Lambert, Phong or mixture (glossy reference: gi/reference_gi.h)
                 gi::ReferenceGiResult gr;
                 gi::renderReferenceGi(heights.cview(), static_cast<float>(cell), total, albedo, gs, gr);
                 const double gms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
@@ -296,6 +325,11 @@ Runner addGiCommand(CLI::App& app) {
     sub->add_option("--indirect-kernel", o->indirectKernel,
                     "Lambert indirect light: exact (exact cosine at the receivers, engine default) | sh (order-4 SH kernel, paper)");
     sub->add_option("--reference-directions", o->referenceDirections, "Directions of the indirect reference (default 2048)");
+    sub->add_option("--glossy", o->glossy,
+                    "Glossy indirect light (phong/mix BRDFs): vector (SH radiance-vector pyramid, Fig. 5 middle) | scalar (shade pyramid, Fig. 5 right)");
+    sub->add_option("--phong-exponent", o->phongExponent,
+                    "Phong exponent: a constant VALUE, or a 16-bit PNG of the field's size mapped log-uniformly to --phong-exponent-range");
+    sub->add_option("--phong-exponent-range", o->phongExponentRange, "MIN,MAX exponents of PNG values 0 and 65535 (default 1,1000)");
     return [o] { return runGi(*o); };
 }
 
