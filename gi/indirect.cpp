@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "gi/nlp.h"
 #include "gi/sh.h"
@@ -74,6 +75,7 @@ inline void cosineAntiderivatives(F4 t, F4& f1, F4& f2) {
 struct RowInputs {
     const float *h0, *margin, *gx, *gy;
     const float* lowSlope;  // Exact: the lowered tangent slope per receiver (this azimuth)
+    float hMax;             // highest height of the field: no sample rises above it
 };
 
 // Mode: kShOnly, kShAndExact, kExactOnly (1x: every texel is a receiver, so
@@ -120,7 +122,14 @@ void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* step
             nw[k] = (iv < steps[k]) & (t[k] > M[k]);  // Eq. 17: above every earlier sample
             any |= nw[k];
         }
-        if (!anyLane(any)) continue;
+        if (!anyLane(any)) {
+            // past the point where even the field's highest height would not
+            // beat any lane's running maximum, no new member can come: stop
+            I4 done = {-1, -1, -1, -1};
+            for (int k = 0; k < NV; ++k) done &= M[k] >= (spl(in.hMax) - ld(in.h0 + X0 + 4 * k)) * inv;
+            if (done[0] & done[1] & done[2] & done[3]) break;
+            continue;
+        }
         F4* mo = moments + static_cast<std::size_t>(n) * NV * nMo;
         list[n++] = i;
         for (int k = 0; k < NV; ++k) {
@@ -283,6 +292,16 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
         }
     }
 
+    // the field's highest height (the raw heights; the pyramid levels are
+    // filters of it and so stay below it, up to float rounding: 1e-6 relative slack)
+    float hMax = -std::numeric_limits<float>::infinity();
+    for (int y = 0; y < ny; ++y) {
+        const float* r = pyr.rawPhaseRow(0, y);
+        for (int q = 0; q < s; ++q)
+            for (int x = 0; x < pyr.rawPhaseWidth; ++x) hMax = std::max(hMax, pyr.rawPhaseRow(q, y)[x]);
+        (void)r;
+    }
+    hMax += std::fabs(hMax) * 1e-6f + 1e-30f;
     const std::size_t tableSize = static_cast<std::size_t>(m) * nSteps;
     st.heightSteps.resize(tableSize);
     st.radianceSteps.resize(3 * tableSize);
@@ -384,7 +403,7 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
                     for (int r = 0; r < rows; ++r) {
                         const int Y = yBegin + r;
                         const std::size_t ro = static_cast<std::size_t>(r) * pad;
-                        RowInputs in{sc.h0.data() + ro, sc.margin.data() + ro, sc.gx.data() + ro, sc.gy.data() + ro, nullptr};
+                        RowInputs in{sc.h0.data() + ro, sc.margin.data() + ro, sc.gx.data() + ro, sc.gy.data() + ro, nullptr, hMax};
                         if (mode == kShAndExact) {
                             // U's segments start at the footprint's lowest tangent slope, lowered
                             // (by footprintDrop x the footprint's spread of slopes, at most footprintDropMax:
