@@ -124,6 +124,11 @@ GiSettings engineGiSettings() {
     // bias), U's normal detail between them; direct light: the footprint's
     // lowest tangent plane (bench/results/gi_indirect_accuracy.md)
     s.indirect.lambert = LambertIndirect::ExactAtReceivers;
+    // 8 azimuths for the indirect scan: 256^2 crops at 2x, indirect rel. RMSE
+    // alps 10.1 -> 10.9 %, erosion 12.3 -> 12.5 % (total 2.7 / 1.9 % either
+    // way) at about 0.55x the scan time of 16 (erosion 512^2 2x frame
+    // 125 -> 76 ms, 2 threads)
+    s.indirect.azimuths = 8;
     s.visibility.footprintTangent = true;
     return s;
 }
