@@ -295,12 +295,9 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
     // the field's highest height (the raw heights; the pyramid levels are
     // filters of it and so stay below it, up to float rounding: 1e-6 relative slack)
     float hMax = -std::numeric_limits<float>::infinity();
-    for (int y = 0; y < ny; ++y) {
-        const float* r = pyr.rawPhaseRow(0, y);
+    for (int y = 0; y < ny; ++y)
         for (int q = 0; q < s; ++q)
             for (int x = 0; x < pyr.rawPhaseWidth; ++x) hMax = std::max(hMax, pyr.rawPhaseRow(q, y)[x]);
-        (void)r;
-    }
     hMax += std::fabs(hMax) * 1e-6f + 1e-30f;
     const std::size_t tableSize = static_cast<std::size_t>(m) * nSteps;
     st.heightSteps.resize(tableSize);

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <cstdio>
 #include <cstdlib>
 
 #include "gi/nlp.h"
@@ -453,14 +452,6 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
         }
     });
 
-    if (std::getenv("GI_COUNT")) {
-        long long total = 0;
-        for (int j = 0; j < m; ++j)
-            for (int Y = 0; Y < nyr; ++Y)
-                for (int X = 0; X < nxr; ++X)
-                    total += std::min(state.stepsPerColumn[static_cast<std::size_t>(j) * nxrPad + X], state.stepsPerRow[static_cast<std::size_t>(j) * nyr + Y]);
-        std::fprintf(stderr, "samples %lld (%.1f per receiver-azimuth, %d steps)\n", total, double(total) / (double(m) * nxr * nyr), nSteps);
-    }
     state.cosSin.resize(2 * static_cast<std::size_t>(m));
     for (int j = 0; j < m; ++j) {
         state.cosSin[2 * static_cast<std::size_t>(j)] = static_cast<float>(std::cos(op.phi[static_cast<std::size_t>(j)]));
