@@ -48,15 +48,6 @@ inline F4 atan4(F4 t) {
     return t < zero ? -r : r;
 }
 
-// Exact clamped-cosine antiderivatives at elevation w = atan(t):
-// f1 = (w + sin w cos w) / 2 = int cos^2, f2 = sin^2 w / 2 = int sin cos.
-inline void cosineAntiderivatives(F4 t, F4& f1, F4& f2) {
-    const F4 one = spl(1.0f), half = spl(0.5f);
-    const F4 inv = one / (one + t * t);
-    f1 = half * (atan4(t) + t * inv);
-    f2 = half * (t * t * inv);
-}
-
 // ---- algorithm: the casting set and Eq. 12 for 4 NV receivers of row Y ------
 // Pass 1 walks the height steps (Eq. 17) and, at each step where some lane
 // has a new casting-set member, stores the clamped segment's moments
@@ -89,21 +80,24 @@ void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* step
     constexpr bool Exact = Mode != kShOnly, Sh = Mode != kExactOnly;
     constexpr int nMo = (Sh ? 4 : 0) + (Exact ? 1 : 0);
     constexpr int e5 = nMo - 1;  // index of the exact moment
-    F4 M[NV], g[NV], gLow[NV], q1[NV], f1[NV], f2[NV];
-    const F4 one = spl(1.0f), lim = spl(1e6f), nlim = spl(-1e6f), zero = spl(0.0f);
+    // Exact: F(t) = f2 - g f1 at the clamped segment end (f1, f2 the clamped
+    // cosine's antiderivatives), kept as the running value F[k]; F is smallest at
+    // t = g (the receiver's plane), so ends below g keep F(g)
+    F4 M[NV], g[NV], gLow[NV], q1[NV], F[NV];
+    const F4 one = spl(1.0f), half = spl(0.5f), lim = spl(1e6f), nlim = spl(-1e6f), zero = spl(0.0f);
     for (int k = 0; k < NV; ++k) {
         M[k] = spl(kNoBlocker);
         // omega_min: the tangent plane's slope along the azimuth (Section 3)
         g[k] = ld(in.gx + X0 + 4 * k) * spl(cosPhi) + ld(in.gy + X0 + 4 * k) * spl(sinPhi);
         gLow[k] = g[k];
+        if constexpr (Sh && Exact) gLow[k] = ld(in.lowSlope + X0 + 4 * k);
+        const F4 t = gLow[k] < nlim ? nlim : (gLow[k] > lim ? lim : gLow[k]);
+        const F4 r = one / simd::vsqrt(one + t * t);  // cos of the lower bound
+        q1[k] = t * r;
         if constexpr (Exact) {
-            const F4 t = g[k] < nlim ? nlim : (g[k] > lim ? lim : g[k]);
-            cosineAntiderivatives(t, f1[k], f2[k]);
-        }
-        if constexpr (Sh) {
-            if constexpr (Exact) gLow[k] = ld(in.lowSlope + X0 + 4 * k);
-            const F4 t = gLow[k] < nlim ? nlim : (gLow[k] > lim ? lim : gLow[k]);
-            q1[k] = t / simd::vsqrt(one + t * t);
+            const F4 te = g[k] < nlim ? nlim : (g[k] > lim ? lim : g[k]);
+            const F4 re = one / simd::vsqrt(one + te * te), se = te * re;
+            F[k] = half * (se * se) - g[k] * (half * (atan4(te) + se * re));
         }
     }
     int n = 0;
@@ -132,13 +126,20 @@ void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* step
         }
         F4* mo = moments + static_cast<std::size_t>(n) * NV * nMo;
         list[n++] = i;
+        // pass 2 reads the radiance at this step: start fetching it now
+        for (int c = 0; c < 3; ++c) {
+            const ScanStep& rs = rTab[c][i];
+            const std::ptrdiff_t ro = Y * rs.rowStep + X0;
+            __builtin_prefetch(rs.field + (ro + rs.offA));
+            __builtin_prefetch(rs.field + (ro + rs.offB));
+        }
         for (int k = 0; k < NV; ++k) {
             M[k] = nw[k] ? t[k] : M[k];
             // the segment [c_(i-1), c_i] clamped to [omega_min, pi/2]
+            F4 tc = t[k] < gLow[k] ? gLow[k] : t[k];
+            tc = tc < nlim ? nlim : (tc > lim ? lim : tc);
+            const F4 r = one / simd::vsqrt(one + tc * tc), sNew = tc * r;  // cos, sin of the end
             if constexpr (Sh) {
-                F4 tc = t[k] < gLow[k] ? gLow[k] : t[k];
-                tc = tc < nlim ? nlim : (tc > lim ? lim : tc);
-                const F4 sNew = tc / simd::vsqrt(one + tc * tc);
                 const F4 sv = nw[k] ? sNew : q1[k];  // no new member: an empty segment (exactly 0)
                 const F4 p = q1[k], p2 = p * p, s2 = sv * sv;
                 mo[nMo * k + 0] = sv - p;
@@ -148,15 +149,10 @@ void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* step
                 q1[k] = sv;
             }
             if constexpr (Exact) {
-                F4 te = t[k] < g[k] ? g[k] : t[k];
-                te = te < nlim ? nlim : (te > lim ? lim : te);
-                F4 a1, a2;
-                cosineAntiderivatives(te, a1, a2);
-                a1 = nw[k] ? a1 : f1[k];
-                a2 = nw[k] ? a2 : f2[k];
-                mo[nMo * k + e5] = (a2 - f2[k]) - g[k] * (a1 - f1[k]);
-                f1[k] = a1;
-                f2[k] = a2;
+                const F4 fNew = half * (sNew * sNew) - g[k] * (half * (atan4(tc) + sNew * r));
+                const F4 fv = nw[k] & (tc >= g[k]) ? fNew : F[k];  // below the receiver's plane: nothing
+                mo[nMo * k + e5] = fv - F[k];
+                F[k] = fv;
             }
         }
     }
