@@ -29,7 +29,8 @@ void runIndirectStage(const GiSettings& settings, GiState& st, const AlbedoMap* 
         op = &st.indirectOperator;
     }
     computeIndirect(st.pyramid, st.gradX.cview(), st.gradY.cview(), *op, st.envVisibility, st.shade.rgb, albedo,
-                    settings.shading, settings.indirect, st.indirect, &st.shade);
+                    settings.shading, settings.indirect, st.indirect, &st.shade,
+                    st.footprint.nxr == st.pyramid.nxr && st.footprint.subsample == settings.subsample ? &st.footprint : nullptr);
     st.timings.indirect = msSince(t);
 }
 
@@ -228,8 +229,15 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
         st.envOperatorAzimuths = settings.visibility.azimuths;
         st.envOperatorInterp = settings.visibility.interp;
     }
+    // the receivers' footprint boxes (sub-sampling): direct omega_min and the indirect U
+    const bool footprint = settings.subsample > 1 &&
+                           (settings.visibility.footprintTangent || settings.indirect.lambert == LambertIndirect::ExactAtReceivers);
+    if (footprint) computeFootprintBox(st.gradX.cview(), st.gradY.cview(), settings.subsample, st.footprint);
+    else st.footprint.nxr = 0;
+    const FootprintBox* box = settings.subsample > 1 && settings.visibility.footprintTangent ? &st.footprint : nullptr;
     VisibilityTarget envTarget;
     envTarget.op = &st.envOperator;
+    envTarget.footprint = box;
     computeVisibility(st.pyramid, st.gradX.cview(), st.gradY.cview(), settings.visibility, envTarget, st.visibilityState,
                       st.envVisibility);
     st.timings.visibility = msSince(t);
@@ -252,6 +260,7 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
         target.window = true;
         target.sinLow = ext.sinLow;
         target.sinHigh = ext.sinHigh;
+        target.footprint = box;
         VisibilitySettings ks = settings.visibility;
         ks.azimuths = settings.keyLightAzimuths;
         computeVisibility(st.pyramid, st.gradX.cview(), st.gradY.cview(), ks, target, st.visibilityState,

@@ -51,6 +51,7 @@ struct GiState {
     int indirectOperatorAzimuths = -1;
     AzimuthInterp indirectOperatorInterp = AzimuthInterp::Linear;
     VisibilityState visibilityState;
+    FootprintBox footprint;  // this frame's receiver footprint boxes (sub-sampling)
     VisibilityField envVisibility;
     std::vector<FoldedWedgeOperator> keyOperators;
     std::vector<KeyLight> keyOperatorLights;  // the lights the key operators were built for

@@ -224,7 +224,7 @@ void validateIndirectSettings(const IndirectSettings& s) {
 void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridView gradY, const FoldedWedgeOperator& op,
                      const VisibilityField& envVisibility, const std::array<Grid, 3>& direct, const AlbedoMap* albedo,
                      const ShadingSettings& shading, const IndirectSettings& settings, IndirectState& st,
-                     const ShadeMaps* directShade) {
+                     const ShadeMaps* directShade, const FootprintBox* footprint) {
     validateIndirectSettings(settings);
     // ---- glossy vector pyramid (Fig. 5 middle): its own scan, gi/indirect_glossy.cpp ----
     if (settings.glossy == GlossyIndirect::VectorPyramid && shading.brdf != Brdf::Lambert && settings.bounces > 0) {
@@ -242,9 +242,12 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
     const int nRows = shading.brdf == Brdf::Lambert ? 9 : kShCount;  // Lambert reads bands 0..2 only
     const bool exact = settings.lambert == LambertIndirect::ExactAtReceivers && shading.brdf == Brdf::Lambert;
     const int mode = !exact ? kShOnly : (s == 1 ? kExactOnly : kShAndExact);
+    const FootprintBox* box = footprint;
+    if (mode == kShAndExact && (!box || box->nxr != nxr || box->nyr != nyr || box->subsample != s)) {
+        computeFootprintBox(gradX, gradY, s, st.footprint);
+        box = &st.footprint;
+    }
     // the shading footprint of a receiver (ExactAtReceivers): offsets {-s/2, 0, s/2}^2 cells
-    const int half = s / 2;
-    const int nFoot = s > 1 ? 9 : 1;
 
     for (int c = 0; c < 3; ++c) {
         Grid& g = st.indirect[static_cast<std::size_t>(c)];
@@ -267,8 +270,8 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
         b.h0.resize(rowFloats);
         b.margin.resize(rowFloats);
         if (exact) {
-            b.footGx.resize(rowFloats * static_cast<std::size_t>(nFoot));
-            b.footGy.resize(rowFloats * static_cast<std::size_t>(nFoot));
+            b.footGx.resize(rowFloats * 2);
+            b.footGy.resize(rowFloats * 2);
             b.exact.resize(rowFloats * 3);
             b.lowSlope.resize(static_cast<std::size_t>(pad));
         }
@@ -366,18 +369,17 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
                         sc.margin[xi] = std::fabs(sc.h0[xi]) * kMarginRel;
                     }
                     if (exact) {
-                        int f = 0;
-                        for (int oy = -half; oy <= half; oy += std::max(half, 1))
-                            for (int ox = -half; ox <= half; ox += std::max(half, 1), ++f) {
-                                float* fx = sc.footGx.data() + (static_cast<std::size_t>(r) * nFoot + static_cast<std::size_t>(f)) * pad;
-                                float* fy = sc.footGy.data() + (static_cast<std::size_t>(r) * nFoot + static_cast<std::size_t>(f)) * pad;
-                                const int yy = std::clamp(s * Y + oy, 0, ny - 1);
-                                for (int X = 0; X < pad; ++X) {
-                                    const int xx = std::clamp(s * X + ox, 0, nx - 1);
-                                    fx[X] = X < nxr ? gradX(xx, yy) : 0.0f;
-                                    fy[X] = X < nxr ? gradY(xx, yy) : 0.0f;
-                                }
-                            }
+                        // the footprint box's rows (FootprintBox), padded
+                        if (mode == kShAndExact) {
+                            const std::size_t at = static_cast<std::size_t>(Y) * nxr;
+                            float* loX = sc.footGx.data() + 2 * ro;
+                            float* loY = sc.footGy.data() + 2 * ro;
+                            std::copy(box->loX.begin() + at, box->loX.begin() + at + nxr, loX);
+                            std::copy(box->hiX.begin() + at, box->hiX.begin() + at + nxr, loX + pad);
+                            std::copy(box->loY.begin() + at, box->loY.begin() + at + nxr, loY);
+                            std::copy(box->hiY.begin() + at, box->hiY.begin() + at + nxr, loY + pad);
+                            for (int X = nxr; X < pad; ++X) loX[X] = loX[pad + X] = loY[X] = loY[pad + X] = 0.0f;
+                        }
                         std::fill(sc.exact.data() + 3 * ro, sc.exact.data() + 3 * ro + 3 * static_cast<std::size_t>(pad), 0.0f);
                     }
                     for (int c = 0; c < 3; ++c)
@@ -403,15 +405,12 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
                             // 0 where the footprint is one plane)
                             const F4 dropMax = spl(settings.footprintDropMax);
                             const F4 c4 = spl(cosPhi), s4 = spl(sinPhi), drop = spl(settings.footprintDrop);
-                            const float* fx = sc.footGx.data() + static_cast<std::size_t>(r) * nFoot * pad;
-                            const float* fy = sc.footGy.data() + static_cast<std::size_t>(r) * nFoot * pad;
+                            // the box's lowest slope along (cos, sin): lo or hi per axis by the sign
+                            const float* fx = sc.footGx.data() + 2 * ro + (cosPhi >= 0.0f ? 0 : pad);
+                            const float* fy = sc.footGy.data() + 2 * ro + (sinPhi >= 0.0f ? 0 : pad);
                             for (int X = 0; X < pad; X += 4) {
-                                F4 lo = ld(fx + X) * c4 + ld(fy + X) * s4;
-                                for (int f = 1; f < nFoot; ++f) {
-                                    const F4 v = ld(fx + static_cast<std::size_t>(f) * pad + X) * c4 + ld(fy + static_cast<std::size_t>(f) * pad + X) * s4;
-                                    lo = v < lo ? v : lo;
-                                }
-                                const F4 own = ld(fx + X) * c4 + ld(fy + X) * s4;
+                                const F4 lo = ld(fx + X) * c4 + ld(fy + X) * s4;
+                                const F4 own = ld(in.gx + X) * c4 + ld(in.gy + X) * s4;
                                 const F4 d = drop * (own - lo);
                                 simd::store(sc.lowSlope.data() + X, lo - (d < dropMax ? d : dropMax));
                             }

@@ -102,7 +102,7 @@ struct IndirectTimings {
 /// Per-block scratch of the indirect scan.
 struct IndirectScratch {
     std::vector<float> gx, gy, h0, margin;  // rows of the block x padded row
-    std::vector<float> footGx, footGy;      // ExactAtReceivers: rows x footprint texels x padded row
+    std::vector<float> footGx, footGy;      // ExactAtReceivers: rows x (lo, hi) x padded row, the footprint's gradient box
     std::vector<float> exact;               // ExactAtReceivers: rows x 3 channels x padded row, E sums
     std::vector<float> lowSlope;            // ExactAtReceivers: padded row, the lowered footprint slope of one azimuth
     std::vector<float> nlp;                 // 3 channels x 4 NLP (+ 3 exact) x padded row, one row and azimuth
@@ -124,6 +124,7 @@ struct IndirectState {
     std::vector<double> bounceMean;  // mean exit radiance (RGB average) of each bounce
     IndirectTimings timings;
     GlossyIndirectState glossy;    // vector-pyramid buffers (GlossyIndirect::VectorPyramid)
+    FootprintBox footprint;        // when the caller passes none
 };
 
 /// Indirect light of `bounces` bounces over the frame's height pyramid.
@@ -131,11 +132,13 @@ struct IndirectState {
 /// direct: bounce 0's exit radiance (full resolution, albedo applied);
 /// directShade: the direct shading it came from (its incident SH vectors),
 /// needed by GlossyIndirect::VectorPyramid with a non-Lambert BRDF (without
-/// it that case throws InputError).
+/// it that case throws InputError); footprint: this frame's FootprintBox
+/// (ExactAtReceivers with sub-sampling; computed here when null).
 void computeIndirect(const HeightPyramid& heights, ConstGridView gradX, ConstGridView gradY,
                      const FoldedWedgeOperator& op, const VisibilityField& envVisibility,
                      const std::array<Grid, 3>& direct, const AlbedoMap* albedo, const ShadingSettings& shading,
-                     const IndirectSettings& settings, IndirectState& state, const ShadeMaps* directShade = nullptr);
+                     const IndirectSettings& settings, IndirectState& state, const ShadeMaps* directShade = nullptr,
+                     const FootprintBox* footprint = nullptr);
 
 /// Throws InputError when a setting is out of range.
 void validateIndirectSettings(const IndirectSettings& s);

@@ -273,7 +273,7 @@ void scanRow(const ScanStep* table, const int* colSteps, int rowSteps, int Y, co
 // the sparse pattern, each entry a contiguous multiply-add over the row.
 // omega_min: elevation of the tangent plane along the azimuth (Section 3).
 void nlpRow(const float* __restrict maxSlope, const float* __restrict gx, const float* __restrict gy, float cosPhi,
-            float sinPhi, const VisibilityTarget& target, float* __restrict nlp, int nxr, int nxrPad, int nFoot) {
+            float sinPhi, const VisibilityTarget& target, float* __restrict nlp, int nxr, int nxrPad) {
     const v4 c = splat(cosPhi), sn = splat(sinPhi);
     const v4 one = splat(1.0f), lim = splat(1e6f), nlim = splat(-1e6f);
     const v4 k0 = splat(0.70710678118654752440f), k1 = splat(0.61237243569579452455f);
@@ -281,11 +281,7 @@ void nlpRow(const float* __restrict maxSlope, const float* __restrict gx, const 
     const v4 five = splat(5.0f), four = splat(4.0f);
     const v4 sLow = splat(target.sinLow), sHigh = splat(target.sinHigh);
     for (int X = 0; X < nxrPad; X += 4) {
-        v4 tangent = load4(gx + X) * c + load4(gy + X) * sn;
-        for (int f = 1; f < nFoot; ++f) {  // the footprint's lowest tangent plane
-            const v4 tf = load4(gx + static_cast<std::size_t>(f) * nxrPad + X) * c + load4(gy + static_cast<std::size_t>(f) * nxrPad + X) * sn;
-            tangent = tf < tangent ? tf : tangent;
-        }
+        const v4 tangent = load4(gx + X) * c + load4(gy + X) * sn;
         const v4 ms = load4(maxSlope + X);
         v4 t = ms < tangent ? tangent : ms;
         t = t < nlim ? nlim : (t > lim ? lim : t);  // sinFromSlope
@@ -357,6 +353,38 @@ void accumulateRows(const float* const* nlp, const float* const* opSplat, int ba
 }
 
 }  // namespace
+
+void computeFootprintBox(ConstGridView gradX, ConstGridView gradY, int s, FootprintBox& out) {
+    const int nx = gradX.nx, ny = gradX.ny, nxr = receiverCount(nx, s), nyr = receiverCount(ny, s), half = s / 2;
+    const std::size_t n = static_cast<std::size_t>(nxr) * nyr;
+    out.nxr = nxr;
+    out.nyr = nyr;
+    out.subsample = s;
+    out.loX.resize(n);
+    out.hiX.resize(n);
+    out.loY.resize(n);
+    out.hiY.resize(n);
+    parallelForRows(nyr, nxr, [&](int y0, int y1) {
+        for (int Y = y0; Y < y1; ++Y)
+            for (int X = 0; X < nxr; ++X) {
+                float ax = gradX(s * X, s * Y), bx = ax, ay = gradY(s * X, s * Y), by = ay;
+                for (int oy = -half; oy <= half && half > 0; oy += half)
+                    for (int ox = -half; ox <= half; ox += half) {
+                        const int xx = std::clamp(s * X + ox, 0, nx - 1), yy = std::clamp(s * Y + oy, 0, ny - 1);
+                        const float vx = gradX(xx, yy), vy = gradY(xx, yy);
+                        ax = std::min(ax, vx);
+                        bx = std::max(bx, vx);
+                        ay = std::min(ay, vy);
+                        by = std::max(by, vy);
+                    }
+                const std::size_t at = static_cast<std::size_t>(Y) * nxr + static_cast<std::size_t>(X);
+                out.loX[at] = ax;
+                out.hiX[at] = bx;
+                out.loY[at] = ay;
+                out.hiY[at] = by;
+            }
+    });
+}
 
 ScanStepInfo scanStepInfo(const HeightPyramid& pyr, int i, double cosPhi, double sinPhi) {
     const StepGeometry g = makeStep(pyr, i, cosPhi, sinPhi);
@@ -465,8 +493,8 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
     state.blocks.resize(static_cast<std::size_t>(nBlocks));
     for (VisibilityScratch& b : state.blocks) {
         b.maxRow.resize(static_cast<std::size_t>(nxrPad));
-        b.gradX.resize(static_cast<std::size_t>(9) * nxrPad);
-        b.gradY.resize(static_cast<std::size_t>(9) * nxrPad);
+        b.gradX.resize(static_cast<std::size_t>(3) * nxrPad);  // receiver, footprint lo, hi
+        b.gradY.resize(static_cast<std::size_t>(3) * nxrPad);
         b.h0.resize(static_cast<std::size_t>(nxrPad));
         b.nlp.resize(static_cast<std::size_t>(8) * nxrPad);
         b.rowPtr.resize(2 * static_cast<std::size_t>(nSteps));
@@ -488,22 +516,19 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
                     sc.gradY[static_cast<std::size_t>(X)] = in ? gradY(s * X, s * Y) : 0.0f;
                 }
                 for (int X = 0; X < nxrPad; ++X) sc.h0[static_cast<std::size_t>(X)] = X < nxr ? hRow[X] : 0.0f;
-                int nFoot = 1;
-                if (settings.footprintTangent && s > 1) {
-                    const int half = s / 2;
-                    for (int oy = -half; oy <= half; oy += half)
-                        for (int ox = -half; ox <= half; ox += half) {
-                            if (ox == 0 && oy == 0) continue;
-                            float* fx = sc.gradX.data() + static_cast<std::size_t>(nFoot) * nxrPad;
-                            float* fy = sc.gradY.data() + static_cast<std::size_t>(nFoot) * nxrPad;
-                            const int yy = std::clamp(s * Y + oy, 0, pyr.ny - 1);
-                            for (int X = 0; X < nxrPad; ++X) {
-                                const int xx = std::clamp(s * X + ox, 0, pyr.nx - 1);
-                                fx[X] = X < nxr ? gradX(xx, yy) : 0.0f;
-                                fy[X] = X < nxr ? gradY(xx, yy) : 0.0f;
-                            }
-                            ++nFoot;
-                        }
+                // footprint box rows (sub-sampling), padded like the receiver row
+                const FootprintBox* box = target.footprint && s > 1 && target.footprint->nxr == nxr && target.footprint->nyr == nyr
+                                              ? target.footprint : nullptr;
+                const bool foot = box != nullptr;
+                if (foot) {
+                    const std::size_t at = static_cast<std::size_t>(Y) * nxr;
+                    float* loX = sc.gradX.data() + nxrPad;
+                    float* loY = sc.gradY.data() + nxrPad;
+                    std::copy(box->loX.begin() + at, box->loX.begin() + at + nxr, loX);
+                    std::copy(box->hiX.begin() + at, box->hiX.begin() + at + nxr, loX + nxrPad);
+                    std::copy(box->loY.begin() + at, box->loY.begin() + at + nxr, loY);
+                    std::copy(box->hiY.begin() + at, box->hiY.begin() + at + nxr, loY + nxrPad);
+                    for (int X = nxr; X < nxrPad; ++X) loX[X] = loX[nxrPad + X] = loY[X] = loY[nxrPad + X] = 0.0f;
                 }
                 float* vRows[kShCount];
                 for (int i = 0; i < kShCount; ++i) {
@@ -526,8 +551,10 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
                         float* maxOut = out.maxSlope.data() + planeSize * j + static_cast<std::size_t>(Y) * nxr;
                         std::copy(sc.maxRow.data(), sc.maxRow.data() + nxr, maxOut);
                         float* nlp = sc.nlp.data() + static_cast<std::size_t>(a) * 4 * nxrPad;
-                        nlpRow(sc.maxRow.data(), sc.gradX.data(), sc.gradY.data(), state.cosSin[2 * static_cast<std::size_t>(j)],
-                               state.cosSin[2 * static_cast<std::size_t>(j) + 1], target, nlp, nxr, nxrPad, nFoot);
+                        const float cj = state.cosSin[2 * static_cast<std::size_t>(j)], sj = state.cosSin[2 * static_cast<std::size_t>(j) + 1];
+                        const float* tgx = foot ? sc.gradX.data() + (cj >= 0.0f ? 1 : 2) * nxrPad : sc.gradX.data();
+                        const float* tgy = foot ? sc.gradY.data() + (sj >= 0.0f ? 1 : 2) * nxrPad : sc.gradY.data();
+                        nlpRow(sc.maxRow.data(), tgx, tgy, cj, sj, target, nlp, nxr, nxrPad);
                         nlps[a] = nlp;
                         ops[a] = state.opSplat.data() + static_cast<std::size_t>(j) * 4 * op.patternSize();
                     }

@@ -64,9 +64,10 @@ struct VisibilitySettings {
     int azimuths = 32;                                    // m (paper: 32)
     AzimuthInterp interp = AzimuthInterp::Linear;         // M_lin (paper's main operator)
     BlockingMax blockingMax = BlockingMax::BsplineKnotsAndMidpoints;
-    // Sub-sampling: omega_min from the lowest tangent plane among the texels
-    // that interpolate the receiver's V (offsets {-s/2, 0, s/2}^2 cells)
-    // instead of the receiver's own (paper). V is shaded at every texel's own
+    // Sub-sampling: omega_min from the lowest tangent plane of the box of
+    // gradients of the texels that interpolate the receiver's V (offsets
+    // {-s/2, 0, s/2}^2 cells, FootprintBox; gi/frame passes it in the
+    // VisibilityTarget) instead of the receiver's own (paper). V is shaded at every texel's own
     // normal (Fig. 7); sky between the receiver's plane and a neighbour's
     // lower one is visible to that neighbour. Measured on 96^2 crops, total
     // shade rel. RMSE with indirect light, alps / erosion: 2x 4.3 -> 3.2 % /
@@ -78,7 +79,7 @@ struct VisibilitySettings {
 /// multiple of the kernel's 16 receivers.
 struct VisibilityScratch {
     std::vector<float> maxRow;  // nxr: maximum blocking slope of the current row and azimuth
-    std::vector<float> gradX;   // nxr (x 9 footprint texels): dh/dx at the receivers of the current row
+    std::vector<float> gradX;   // 3 x nxr: dh/dx at the receivers of the current row, footprint box lo, hi
     std::vector<float> gradY;
     std::vector<float> h0;      // nxr: receiver heights of the current row
     std::vector<float> nlp;     // 2 x 4 x nxr: NLP visibility vectors of the current row, two azimuths
@@ -98,10 +99,26 @@ struct ScanStep {
     std::ptrdiff_t rowStep = 0, offA = 0, offB = 0;
 };
 
+/// The box [lo, hi] of the height gradients over each receiver's shading
+/// footprint: the texels at offsets {-s/2, 0, s/2}^2 cells (clamped to the
+/// field), which interpolate the receiver's SH vectors (Fig. 7). Along an
+/// azimuth (c, sn) the box's lowest tangent slope, (c >= 0 ? loX : hiX) c +
+/// (sn >= 0 ? loY : hiY) sn, bounds the footprint texels' slopes from below.
+/// Receiver-grid planes (nxr * nyr each), computed once per frame.
+struct FootprintBox {
+    int nxr = 0, nyr = 0, subsample = 0;
+    std::vector<float> loX, hiX, loY, hiY;
+};
+void computeFootprintBox(ConstGridView gradX, ConstGridView gradY, int subsample, FootprintBox& out);
+
 /// Azimuth set and elevation window of one visibility computation.
 struct VisibilityTarget {
     const FoldedWedgeOperator* op = nullptr;  // azimuths + folded wedge operator
     bool window = false;       // key light: restrict to [sinLow, sinHigh] (Section 6)
+    // Sub-sampling: omega_min from the footprint box's lowest tangent plane
+    // instead of the receiver's own (VisibilitySettings::footprintTangent;
+    // null: the receiver's plane).
+    const FootprintBox* footprint = nullptr;
     float sinLow = -1.0f, sinHigh = 1.0f;
 };
 
