@@ -33,6 +33,13 @@
 // only when it rises above the receiver's height by more than 2^-20 |h0|
 // (a few ulp), which is subtracted from every height difference.
 //
+// Speed: a group of 8 receivers stops walking once the field's highest
+// height, seen from each lane's receiver at the current distance, can no
+// longer beat that lane's running maximum (no member can follow; results
+// unchanged), and pass 1 prefetches the radiance of each new member for pass 2
+// (its radiance reads were the kernel's hot spot). With ExactAtReceivers at 1x
+// only the exact moment is computed (every texel is a receiver).
+//
 // Schedule: like gi/visibility: a per-bounce step table, fixed blocks of
 // kIndirectRows receiver rows in parallel; within a block azimuth by azimuth,
 // the block's rows one after the other (consecutive rows read neighbouring
