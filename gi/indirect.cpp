@@ -318,32 +318,20 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
                 const double c = std::cos(op.phi[static_cast<std::size_t>(j)]);
                 const double sn = std::sin(op.phi[static_cast<std::size_t>(j)]);
                 const std::size_t base = static_cast<std::size_t>(j) * nSteps;
-                int* colSteps = st.stepsPerColumn.data() + static_cast<std::size_t>(j) * pad;
-                int* rowSteps = st.stepsPerRow.data() + static_cast<std::size_t>(j) * nyr;
-                std::fill(colSteps, colSteps + pad, 0);
-                std::fill(rowSteps, rowSteps + nyr, 0);
                 // a receiver's sequence is its prefix of steps inside the domain
                 // (for the heights and the radiance sample alike)
-                int xLo = 0, xHi = nxr - 1, yLo = 0, yHi = nyr - 1;
+                ValidPrefix prefix(nxr, nyr, pad, st.stepsPerColumn.data() + static_cast<std::size_t>(j) * pad,
+                                   st.stepsPerRow.data() + static_cast<std::size_t>(j) * nyr);
                 for (int i = 0; i < nSteps; ++i) {
                     const ScanStepInfo h = scanStepInfo(pyr, i, c, sn);
                     st.heightSteps[base + static_cast<std::size_t>(i)] = h.step;
-                    int xf = h.xFirst, xl = h.xLast, yf = h.yFirst, yl = h.yLast;
+                    prefix.narrow(h);
                     for (int ch = 0; ch < 3; ++ch) {
                         const ScanStepInfo r = scanStepInfo(st.radiance.fields[static_cast<std::size_t>(ch)], i, c, sn);
                         st.radianceSteps[static_cast<std::size_t>(ch) * tableSize + base + static_cast<std::size_t>(i)] = r.step;
-                        xf = std::max(xf, r.xFirst);
-                        xl = std::min(xl, r.xLast);
-                        yf = std::max(yf, r.yFirst);
-                        yl = std::min(yl, r.yLast);
+                        prefix.narrow(r);
                     }
-                    // receivers still inside at step i: those inside at every step so far
-                    xLo = std::max(xLo, xf);
-                    xHi = std::min(xHi, xl);
-                    yLo = std::max(yLo, yf);
-                    yHi = std::min(yHi, yl);
-                    for (int X = xLo; X <= xHi; ++X) colSteps[X] = i + 1;
-                    for (int Y = yLo; Y <= yHi; ++Y) rowSteps[Y] = i + 1;
+                    prefix.commit(i);
                 }
             }
         });

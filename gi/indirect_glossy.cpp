@@ -401,11 +401,8 @@ void computeGlossyIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstG
                 const double c = std::cos(op.phi[static_cast<std::size_t>(j)]);
                 const double sn = std::sin(op.phi[static_cast<std::size_t>(j)]);
                 const std::size_t base = static_cast<std::size_t>(j) * nSteps;
-                int* colSteps = st.stepsPerColumn.data() + static_cast<std::size_t>(j) * pad;
-                int* rowSteps = st.stepsPerRow.data() + static_cast<std::size_t>(j) * nyr;
-                std::fill(colSteps, colSteps + pad, 0);
-                std::fill(rowSteps, rowSteps + nyr, 0);
-                int xLo = 0, xHi = nxr - 1, yLo = 0, yHi = nyr - 1;
+                ValidPrefix prefix(nxr, nyr, pad, st.stepsPerColumn.data() + static_cast<std::size_t>(j) * pad,
+                                   st.stepsPerRow.data() + static_cast<std::size_t>(j) * nyr);
                 for (int i = 0; i < nSteps; ++i) {
                     const ScanStepInfo h = scanStepInfo(pyr, i, c, sn);
                     st.heightSteps[base + static_cast<std::size_t>(i)] = h.step;
@@ -417,12 +414,9 @@ void computeGlossyIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstG
                         const ScanStep rf = f == 0 ? r.step : scanStepInfo(gs.pyramid.fields[static_cast<std::size_t>(f)], i, c, sn).step;
                         fp[f] = rf.field + rf.offA;
                     }
-                    xLo = std::max({xLo, h.xFirst, r.xFirst});
-                    xHi = std::min({xHi, h.xLast, r.xLast});
-                    yLo = std::max({yLo, h.yFirst, r.yFirst});
-                    yHi = std::min({yHi, h.yLast, r.yLast});
-                    for (int X = xLo; X <= xHi; ++X) colSteps[X] = i + 1;
-                    for (int Y = yLo; Y <= yHi; ++Y) rowSteps[Y] = i + 1;
+                    prefix.narrow(h);
+                    prefix.narrow(r);
+                    prefix.commit(i);
                 }
             }
         });

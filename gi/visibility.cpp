@@ -397,6 +397,25 @@ ScanStepInfo scanStepInfo(const HeightPyramid& pyr, int i, double cosPhi, double
     return info;
 }
 
+ValidPrefix::ValidPrefix(int nxr, int nyr, int pad, int* colSteps, int* rowSteps)
+    : xLo_(0), xHi_(nxr - 1), yLo_(0), yHi_(nyr - 1), col_(colSteps), row_(rowSteps) {
+    std::fill(colSteps, colSteps + pad, 0);
+    std::fill(rowSteps, rowSteps + nyr, 0);
+}
+
+void ValidPrefix::narrow(const ScanStepInfo& s) {
+    xLo_ = std::max(xLo_, s.xFirst);
+    xHi_ = std::min(xHi_, s.xLast);
+    yLo_ = std::max(yLo_, s.yFirst);
+    yHi_ = std::min(yHi_, s.yLast);
+}
+
+void ValidPrefix::commit(int step) {
+    // receivers still inside at this step: those inside at every step so far
+    for (int X = xLo_; X <= xHi_; ++X) col_[X] = step + 1;
+    for (int Y = yLo_; Y <= yHi_; ++Y) row_[Y] = step + 1;
+}
+
 float maxBlockingSlopeOfSequence(const float* slopes, int count, BlockingMax rule) {
     float out = kNoBlocker;
     if (count <= 0) return out;

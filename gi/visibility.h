@@ -154,6 +154,23 @@ struct ScanStepInfo {
 };
 ScanStepInfo scanStepInfo(const HeightPyramid& pyramid, int i, double cosPhi, double sinPhi);
 
+/// Valid prefixes of one azimuth's step table when several fields are read
+/// at each step (gi/indirect: heights and radiance): a receiver's sequence
+/// is its prefix of steps whose samples lie inside the domain in every field
+/// (the ray leaves a convex domain once and for all). Per step: narrow() with
+/// each field's ScanStepInfo, then commit(i); colSteps (pad) and rowSteps
+/// (nyr) then hold each receiver column's / row's prefix length.
+class ValidPrefix {
+public:
+    ValidPrefix(int nxr, int nyr, int pad, int* colSteps, int* rowSteps);
+    void narrow(const ScanStepInfo& s);
+    void commit(int step);
+
+private:
+    int xLo_, xHi_, yLo_, yHi_;
+    int *col_, *row_;
+};
+
 /// Lowest slope used for "nothing blocks in this direction".
 inline constexpr float kNoBlocker = -1.0e6f;
 
