@@ -120,7 +120,8 @@ void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* step
             // past the point where even the field's highest height would not
             // beat any lane's running maximum, no new member can come: stop
             I4 done = {-1, -1, -1, -1};
-            for (int k = 0; k < NV; ++k) done &= M[k] >= (spl(in.hMax) - ld(in.h0 + X0 + 4 * k)) * inv;
+            // (lanes whose ray has left the domain are done too)
+            for (int k = 0; k < NV; ++k) done &= (iv >= steps[k]) | (M[k] >= (spl(in.hMax) - ld(in.h0 + X0 + 4 * k)) * inv);
             if (done[0] & done[1] & done[2] & done[3]) break;
             continue;
         }
