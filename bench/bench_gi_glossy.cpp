@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "bench/bench_common.h"
+#include "bench/bench_gi_common.h"
 #include "gi/frame.h"
 #include "gi/reference_gi.h"
 #include "sim/io.h"
@@ -31,40 +32,8 @@ int gRuns = 5;
 int gSize = 96;
 int gDirections = 2048;
 
-// alps-montblanc at true scale (cell 60000/647 m, heights 454 + v (4810 - 454) / 65535), central crop
-Grid alpsCrop(int size, float& cell) {
-    const Grid full = readPngHeightmap(gDataDir + "/alps-montblanc.png", (4810.0f - 454.0f) / 65535.0f, 454.0f);
-    cell = 60000.0f / 647.0f;
-    Grid g(size, size);
-    const int x0 = (full.nx - size) / 2, y0 = (full.ny - size) / 2;
-    for (int y = 0; y < size; ++y)
-        for (int x = 0; x < size; ++x) g(x, y) = full(x0 + x, y0 + y);
-    return g;
-}
-
-// Relative RMSE and bias over the interior (10 % border left out), RGB.
-double relRmse(const std::array<Grid, 3>& a, const std::array<Grid, 3>& b, double& bias) {
-    const int bx = a[0].nx / 10, by = a[0].ny / 10;
-    double se = 0.0, sr = 0.0, sd = 0.0;
-    long n = 0;
-    for (std::size_t c = 0; c < 3; ++c)
-        for (int y = by; y < a[0].ny - by; ++y)
-            for (int x = bx; x < a[0].nx - bx; ++x) {
-                const double d = a[c](x, y) - b[c](x, y);
-                se += d * d;
-                sd += d;
-                sr += static_cast<double>(b[c](x, y)) * b[c](x, y);
-                ++n;
-            }
-    bias = sd / n / std::sqrt(sr / n);
-    return std::sqrt(se / n) / std::sqrt(sr / n);
-}
-
-AlbedoMap uniformAlbedo(int nx, int ny, float a) {
-    AlbedoMap m;
-    for (auto& c : m.channel) c.resize(nx, ny, a);
-    return m;
-}
+Grid alpsCrop(int size, float& cell) { return bench::alpsCentreCrop(gDataDir, size, cell); }
+using bench::relRmse;
 
 GiSettings settingsFor(Brdf brdf, float exponent, int s, int bounces, GlossyIndirect mode) {
     GiSettings g = engineGiSettings();

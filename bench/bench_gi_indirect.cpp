@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "bench/bench_common.h"
+#include "bench/bench_gi_common.h"
 #include "gi/frame.h"
 #include "gi/reference_gi.h"
 #include "sim/io.h"
@@ -47,15 +48,10 @@ struct Dem {
 // alps-montblanc at true scale, the central 256^2 crop (the 647^2 reference
 // with 2048 directions takes too long for this benchmark's budget)
 Dem alpsCrop(int size) {
-    const Grid full = readPngHeightmap(gDataDir + "/alps-montblanc.png", (4810.0f - 454.0f) / 65535.0f, 454.0f);
     Dem d;
     d.name = "alps-montblanc";
     d.note = "central " + std::to_string(size) + "^2 crop at true scale (cell 92.74 m)";
-    d.cell = 60000.0f / 647.0f;
-    d.heights.resize(size, size);
-    const int x0 = (full.nx - size) / 2, y0 = (full.ny - size) / 2;
-    for (int y = 0; y < size; ++y)
-        for (int x = 0; x < size; ++x) d.heights(x, y) = full(x0 + x, y0 + y);
+    d.heights = bench::alpsCentreCrop(gDataDir, size, d.cell);
     return d;
 }
 
@@ -70,28 +66,7 @@ Dem erodedScene(int size, int ticks) {
     return d;
 }
 
-double relRmse(const std::array<Grid, 3>& a, const std::array<Grid, 3>& b, double& bias) {
-    const int bx = a[0].nx / 10, by = a[0].ny / 10;
-    double se = 0.0, sr = 0.0, sd = 0.0;
-    long n = 0;
-    for (int c = 0; c < 3; ++c)
-        for (int y = by; y < a[0].ny - by; ++y)
-            for (int x = bx; x < a[0].nx - bx; ++x) {
-                const double d = a[static_cast<std::size_t>(c)](x, y) - b[static_cast<std::size_t>(c)](x, y);
-                se += d * d;
-                sd += d;
-                sr += static_cast<double>(b[static_cast<std::size_t>(c)](x, y)) * b[static_cast<std::size_t>(c)](x, y);
-                ++n;
-            }
-    bias = sd / n / std::sqrt(sr / n);
-    return std::sqrt(se / n) / std::sqrt(sr / n);
-}
-
-AlbedoMap uniformAlbedo(int nx, int ny, float a) {
-    AlbedoMap m;
-    for (auto& c : m.channel) c.resize(nx, ny, a);
-    return m;
-}
+using bench::relRmse;
 
 template <class T>
 std::size_t bytesOf(const std::vector<T>& v) {

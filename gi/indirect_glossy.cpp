@@ -278,7 +278,7 @@ void glossyExitRadiance(ConstGridView gradX, ConstGridView gradY, int s, int nxr
     const MirrorTables& mt = mirrorTables();
     float phUniform[kShOrder];
     phongLobeFactors(shading.phongExponent, phUniform);
-    const float ws = shading.brdf == Brdf::Phong ? 1.0f : (shading.brdf == Brdf::LambertPlusPhong ? shading.specularWeight : 0.0f);
+    const float ws = specularWeightOf(shading);
     const float vx = shading.viewDir[0], vy = shading.viewDir[1], vz = shading.viewDir[2];
     const int nBlocks = std::max(1, std::min(ny, kMaxBlocks));
     st.rowScratch.resize(static_cast<std::size_t>(nBlocks) * kGlossyFields * std::max(nxr, 1));
@@ -289,10 +289,9 @@ void glossyExitRadiance(ConstGridView gradX, ConstGridView gradY, int s, int nxr
             const int yEnd = static_cast<int>(static_cast<long long>(ny) * (block + 1) / nBlocks);
             for (int y = yBegin; y < yEnd; ++y) {
                 // ---- the incident SH vectors of this row, interpolated as gi/shading does (Fig. 7)
-                const int Y0 = std::min(y / s, std::max(nyr - 2, 0));
-                float fy = nyr > 1 ? static_cast<float>(y - s * Y0) / static_cast<float>(s) : 0.0f;
-                if (fy > 1.0f) fy = 1.0f;
-                const int Y1 = std::min(Y0 + 1, nyr - 1);
+                const ReceiverLerp ry = receiverLerp(y, s, nyr);
+                const int Y0 = ry.i0, Y1 = ry.i1;
+                const float fy = ry.f;
                 for (int p = 0; p < kGlossyFields; ++p) {
                     const float* ra = incident + p * planeR + static_cast<std::size_t>(Y0) * nxr;
                     const float* rb = incident + p * planeR + static_cast<std::size_t>(Y1) * nxr;
@@ -300,10 +299,9 @@ void glossyExitRadiance(ConstGridView gradX, ConstGridView gradY, int s, int nxr
                     for (int X = 0; X < nxr; ++X) v[X] = ra[X] + fy * (rb[X] - ra[X]);
                 }
                 for (int x = 0; x < nx; ++x) {
-                    const int X0 = std::min(x / s, std::max(nxr - 2, 0));
-                    const int X1 = std::min(X0 + 1, nxr - 1);
-                    float fx = nxr > 1 ? static_cast<float>(x - s * X0) / static_cast<float>(s) : 0.0f;
-                    if (fx > 1.0f) fx = 1.0f;
+                    const ReceiverLerp rx = receiverLerp(x, s, nxr);
+                    const int X0 = rx.i0, X1 = rx.i1;
+                    const float fx = rx.f;
                     float I[3][kShCount];
                     for (int c = 0; c < 3; ++c)
                         for (int i = 0; i < kShCount; ++i) {

@@ -165,7 +165,7 @@ void renderReferenceGlossy(ConstGridView heights, float cellSize, const ShRgb& l
     const int nx = heights.nx, ny = heights.ny;
     const std::size_t plane = static_cast<std::size_t>(nx) * ny;
     const ShadingSettings& sh = s.shading;
-    const double ws = sh.brdf == Brdf::Phong ? 1.0 : (sh.brdf == Brdf::LambertPlusPhong ? sh.specularWeight : 0.0);
+    const double ws = specularWeightOf(sh);
     const double wd = sh.brdf == Brdf::Phong ? 0.0 : 1.0;
     const double view[3] = {sh.viewDir[0], sh.viewDir[1], sh.viewDir[2]};
     Grid gx, gy;

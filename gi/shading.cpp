@@ -163,6 +163,12 @@ void lambertRow(const float* vert, int nxrS, int nxr, int s, int nCoef, const fl
 
 }  // namespace
 
+AlbedoMap uniformAlbedo(int nx, int ny, float albedo) {
+    AlbedoMap m;
+    for (Grid& c : m.channel) c.resize(nx, ny, albedo);
+    return m;
+}
+
 void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const VisibilityField& env,
                  const ShadingLight* lights, int lightCount, const AlbedoMap* albedo, const ShadingSettings& settings,
                  ShadeMaps& out) {
@@ -258,11 +264,9 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
 
     // ---- interpolation tables (receiver X sits at column s X) -----------------
     for (int x = 0; x < nx; ++x) {
-        const int X0 = std::min(x / s, std::max(nxr - 2, 0));
-        float f = nxr > 1 ? static_cast<float>(x - s * X0) / static_cast<float>(s) : 0.0f;
-        if (f > 1.0f) f = 1.0f;  // texels beyond the last receiver: clamp
-        out.colIndex[static_cast<std::size_t>(x)] = X0;
-        out.colFrac[static_cast<std::size_t>(x)] = f;
+        const ReceiverLerp r = receiverLerp(x, s, nxr);
+        out.colIndex[static_cast<std::size_t>(x)] = r.i0;
+        out.colFrac[static_cast<std::size_t>(x)] = r.f;
     }
 
     double lamZh[kShOrder];
@@ -271,7 +275,7 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
     float phUniform[kShOrder];
     phongLobeFactors(settings.phongExponent, phUniform);
     const float diffuseWeight = settings.brdf == Brdf::Phong ? 0.0f : 1.0f;
-    const float specWeight = settings.brdf == Brdf::Phong ? 1.0f : (settings.brdf == Brdf::LambertPlusPhong ? settings.specularWeight : 0.0f);
+    const float specWeight = specularWeightOf(settings);
     const float vx = settings.viewDir[0], vy = settings.viewDir[1], vz = settings.viewDir[2];
 
     // ---- schedule: fixed row blocks, each with its own scratch ---------------
@@ -284,10 +288,9 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
             const int yEnd = static_cast<int>(static_cast<long long>(ny) * (block + 1) / nBlocks);
             for (int y = yBegin; y < yEnd; ++y) {
                 // ---- algorithm: SH vectors interpolated to this row (Fig. 7) ----
-                const int Y0 = std::min(y / s, std::max(nyr - 2, 0));
-                float fy = nyr > 1 ? static_cast<float>(y - s * Y0) / static_cast<float>(s) : 0.0f;
-                if (fy > 1.0f) fy = 1.0f;
-                const int Y1 = std::min(Y0 + 1, nyr - 1);
+                const ReceiverLerp ry = receiverLerp(y, s, nyr);
+                const int Y0 = ry.i0, Y1 = ry.i1;
+                const float fy = ry.f;
                 for (int p = 0; p < nPlanes; ++p) {
                     const float* plane = p < 3 * nCoef ? out.incident.data() + static_cast<std::size_t>(p) * planeR
                                                        : env.plane(p - 3 * nCoef);

@@ -64,6 +64,30 @@ inline void texelPhongLobe(const AlbedoMap* map, std::size_t i, const float unif
     for (int l = 1; l < kShOrder; ++l) ph[l] = m ? map->phongLobe[static_cast<std::size_t>(l - 1)].v[i] : uniform[l];
 }
 
+/// Weight of the Phong lobe in a BRDF (1 Phong, specularWeight mixture, 0 Lambert).
+inline float specularWeightOf(const ShadingSettings& s) {
+    return s.brdf == Brdf::Phong ? 1.0f : (s.brdf == Brdf::LambertPlusPhong ? s.specularWeight : 0.0f);
+}
+
+/// Where full-resolution texel x reads the receiver grid (receiver X at s X,
+/// n receivers; Fig. 7): between receivers i0 and i1 = min(i0 + 1, n - 1) at
+/// fraction f, clamped past the last receiver.
+struct ReceiverLerp {
+    int i0 = 0, i1 = 0;
+    float f = 0.0f;
+};
+inline ReceiverLerp receiverLerp(int x, int s, int n) {
+    ReceiverLerp r;
+    r.i0 = x / s < n - 2 ? x / s : (n - 2 > 0 ? n - 2 : 0);
+    r.i1 = r.i0 + 1 < n - 1 ? r.i0 + 1 : n - 1;
+    r.f = n > 1 ? static_cast<float>(x - s * r.i0) / static_cast<float>(s) : 0.0f;
+    if (r.f > 1.0f) r.f = 1.0f;
+    return r;
+}
+
+/// An albedo map of one value everywhere (every channel).
+AlbedoMap uniformAlbedo(int nx, int ny, float albedo);
+
 /// One light as the shading stage sees it.
 struct ShadingLight {
     const VisibilityField* visibility = nullptr;

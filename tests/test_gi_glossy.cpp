@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "gi/frame.h"
+#include "tests/gi_test_terrain.h"
 #include "gi/indirect_glossy.h"
 #include "gi/reference_gi.h"
 #include "sim/error.h"
@@ -17,33 +18,11 @@
 
 using namespace terrain;
 using namespace terrain::gi;
+using gi_test::hills;
+using gi_test::valley;
 
 namespace {
 
-Grid valley(int nx, int ny, float slope) {
-    Grid g(nx, ny);
-    const float c = 0.5f * static_cast<float>(nx - 1);
-    for (int y = 0; y < ny; ++y)
-        for (int x = 0; x < nx; ++x) g(x, y) = slope * std::fabs(static_cast<float>(x) - c);
-    return g;
-}
-
-Grid hills(int n, float amp) {
-    Grid g(n, n);
-    for (int y = 0; y < n; ++y)
-        for (int x = 0; x < n; ++x) {
-            const float u = static_cast<float>(x) / static_cast<float>(n), v = static_cast<float>(y) / static_cast<float>(n);
-            g(x, y) = amp * (std::sin(6.3f * u) * std::cos(4.1f * v) + 0.5f * std::sin(13.0f * u + 7.0f * v) +
-                             0.25f * std::cos(23.0f * v - 3.0f * u));
-        }
-    return g;
-}
-
-AlbedoMap uniformAlbedo(int nx, int ny, float a) {
-    AlbedoMap m;
-    for (auto& c : m.channel) c.resize(nx, ny, a);
-    return m;
-}
 
 GiSettings glossySettings(Brdf brdf, float exponent, int bounces, GlossyIndirect mode, int subsample = 1) {
     GiSettings s = engineGiSettings();

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "gi/reference_gi.h"
+#include "tests/gi_test_terrain.h"
 #include "sim/parallel.h"
 
 using namespace terrain;
@@ -22,14 +23,7 @@ Grid pit(int n, float r, float d) {
         }
     return g;
 }
-// A V-shaped valley along y: walls rising at `slope` (m per m) from the floor line.
-Grid valley(int nx, int ny, float slope) {
-    Grid g(nx, ny);
-    const float c = 0.5f * static_cast<float>(nx - 1);
-    for (int y = 0; y < ny; ++y)
-        for (int x = 0; x < nx; ++x) g(x, y) = slope * std::fabs(static_cast<float>(x) - c);
-    return g;
-}
+using gi_test::valley;
 std::array<Grid, 3> constant(int nx, int ny, float v) {
     std::array<Grid, 3> g;
     for (auto& c : g) c.resize(nx, ny, v);

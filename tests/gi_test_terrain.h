@@ -1,0 +1,30 @@
+#pragma once
+// Small analytic terrains shared by the GI tests.
+#include <cmath>
+
+#include "sim/grid.h"
+
+namespace terrain::gi_test {
+
+// A V-shaped valley along y: walls rising at `slope` (m per m) from the floor line.
+inline Grid valley(int nx, int ny, float slope) {
+    Grid g(nx, ny);
+    const float c = 0.5f * static_cast<float>(nx - 1);
+    for (int y = 0; y < ny; ++y)
+        for (int x = 0; x < nx; ++x) g(x, y) = slope * std::fabs(static_cast<float>(x) - c);
+    return g;
+}
+
+// Smooth rolling hills (a few sines), heights in metres.
+inline Grid hills(int n, float amp) {
+    Grid g(n, n);
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            const float u = static_cast<float>(x) / static_cast<float>(n), v = static_cast<float>(y) / static_cast<float>(n);
+            g(x, y) = amp * (std::sin(6.3f * u) * std::cos(4.1f * v) + 0.5f * std::sin(13.0f * u + 7.0f * v) +
+                             0.25f * std::cos(23.0f * v - 3.0f * u));
+        }
+    return g;
+}
+
+}  // namespace terrain::gi_test
