@@ -12,39 +12,64 @@
 #include "sim/parallel.h"
 #include "sim/simd.h"
 
+// F8 values pass between always-inline helpers compiled into the AVX2 kernel
+// only; GCC's note that their out-of-line ABI would differ does not apply.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
 namespace terrain::gi {
 
 namespace {
 
 using simd::F4;
 typedef int I4 __attribute__((vector_size(16)));
+typedef float F8 __attribute__((vector_size(32)));
+typedef int I8 __attribute__((vector_size(32)));
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 constexpr int kIndirectRows = 8;  // receiver rows per block
-constexpr int kGroup = 8;  // receivers per kernel call (2 x 4 lanes); rows are padded to it
+constexpr int kGroup = 8;  // receivers per kernel call (2 x 4 or 1 x 8 lanes); rows are padded to it
 constexpr float kMarginRel = 1.0f / 1048576.0f;  // 2^-20 |h0|: height differences below it are rounding
 
 inline int padGroup(int n) { return (n + kGroup - 1) / kGroup * kGroup; }
-inline F4 ld(const float* p) { return simd::load<F4>(p); }
-inline F4 spl(float x) { return simd::splat<F4>(x); }
-inline bool anyLane(I4 m) { return (m[0] | m[1] | m[2] | m[3]) != 0; }
+
+// The kernel is written once over a lane type V: F4 (SSE2, the baseline) or
+// F8 (AVX2, chosen at run time where the processor has it). Both use the
+// same correctly rounded IEEE operations lane by lane and neither may fuse a
+// multiply-add (the AVX2 path is compiled without FMA), so the two give
+// bit-identical results (tests/test_gi_indirect.cpp checks it).
+template <class V> struct LaneTraits;
+template <> struct LaneTraits<F4> { using I = I4; static constexpr int n = 4; };
+template <> struct LaneTraits<F8> { using I = I8; static constexpr int n = 8; };
+
+template <class V> [[gnu::always_inline]] inline V ldv(const float* p) {
+    V v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+}
+template <class V> [[gnu::always_inline]] inline void stv(float* p, V v) { std::memcpy(p, &v, sizeof v); }
+template <class V> [[gnu::always_inline]] inline V splv(float x) { return V{} + x; }
+[[gnu::always_inline]] inline F4 sqrtv(F4 x) { return __builtin_ia32_sqrtps(x); }
+[[gnu::target("avx")]] inline F8 sqrtv(F8 x) { return __builtin_ia32_sqrtps256(x); }
+[[gnu::always_inline]] inline int laneBits(I4 m) { return __builtin_ia32_movmskps(reinterpret_cast<F4>(m)); }
+[[gnu::target("avx")]] inline int laneBits(I8 m) { return __builtin_ia32_movmskps256(reinterpret_cast<F8>(m)); }
 
 // Deterministic float atan (Cephes atanf: range reduction to |x| <= tan(pi/8),
 // then a degree-9 odd minimax polynomial; ~1e-7 relative): a pure function of
 // its argument, so bit-identical for any thread count.
-inline F4 atan4(F4 t) {
-    const F4 zero = spl(0.0f), one = spl(1.0f);
-    const F4 x = t < zero ? -t : t;
-    const auto big = x > spl(2.414213562373095f);
-    const auto mid = (x > spl(0.4142135623730950f)) & ~big;
+template <class V>
+[[gnu::always_inline]] inline V atanv(V t) {
+    const V zero = splv<V>(0.0f), one = splv<V>(1.0f);
+    const V x = t < zero ? -t : t;
+    const auto big = x > splv<V>(2.414213562373095f);
+    const auto mid = (x > splv<V>(0.4142135623730950f)) & ~big;
     // one division: -1 / x, (x - 1) / (x + 1) or x / 1
-    const F4 xr = (big ? -one : (mid ? x - one : x)) / (big ? x : (mid ? x + one : one));
-    const F4 y0 = big ? spl(1.5707963267948966f) : (mid ? spl(0.7853981633974483f) : zero);
-    const F4 z = xr * xr;
-    const F4 p = ((((spl(8.05374449538e-2f) * z - spl(1.38776856032e-1f)) * z + spl(1.99777106478e-1f)) * z -
-                   spl(3.33329491539e-1f)) * z) * xr + xr;
-    const F4 r = y0 + p;
+    const V xr = (big ? -one : (mid ? x - one : x)) / (big ? x : (mid ? x + one : one));
+    const V y0 = big ? splv<V>(1.5707963267948966f) : (mid ? splv<V>(0.7853981633974483f) : zero);
+    const V z = xr * xr;
+    const V p = ((((splv<V>(8.05374449538e-2f) * z - splv<V>(1.38776856032e-1f)) * z + splv<V>(1.99777106478e-1f)) * z -
+                  splv<V>(3.33329491539e-1f)) * z) * xr + xr;
+    const V r = y0 + p;
     return t < zero ? -r : r;
 }
 
@@ -74,30 +99,34 @@ struct RowInputs {
 // nlp[(12 + c) * pad + X] alone).
 constexpr int kShOnly = 0, kShAndExact = 1, kExactOnly = 2;
 
-template <int NV, int Mode>
-void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* steps, int nAny, int Y, int X0, const RowInputs& in,
-               float cosPhi, float sinPhi, F4* moments, int* list, float* nlp, int pad) {
+template <class V, int NV, int Mode>
+[[gnu::always_inline]] inline void castGroup(const ScanStep* hTab, const ScanStep* const* rTab,
+                                             const typename LaneTraits<V>::I* steps, int nAny, int Y, int X0,
+                                             const RowInputs& in, float cosPhi, float sinPhi, float* moments, int* list,
+                                             float* nlp, int pad) {
+    using I = typename LaneTraits<V>::I;
+    constexpr int L = LaneTraits<V>::n;
     constexpr bool Exact = Mode != kShOnly, Sh = Mode != kExactOnly;
     constexpr int nMo = (Sh ? 4 : 0) + (Exact ? 1 : 0);
     constexpr int e5 = nMo - 1;  // index of the exact moment
     // Exact: F(t) = f2 - g f1 at the clamped segment end (f1, f2 the clamped
     // cosine's antiderivatives), kept as the running value F[k]; F is smallest at
     // t = g (the receiver's plane), so ends below g keep F(g)
-    F4 M[NV], g[NV], gLow[NV], q1[NV], F[NV];
-    const F4 one = spl(1.0f), half = spl(0.5f), lim = spl(1e6f), nlim = spl(-1e6f), zero = spl(0.0f);
+    V M[NV], g[NV], gLow[NV], q1[NV], F[NV];
+    const V one = splv<V>(1.0f), half = splv<V>(0.5f), lim = splv<V>(1e6f), nlim = splv<V>(-1e6f), zero = splv<V>(0.0f);
     for (int k = 0; k < NV; ++k) {
-        M[k] = spl(kNoBlocker);
+        M[k] = splv<V>(kNoBlocker);
         // omega_min: the tangent plane's slope along the azimuth (Section 3)
-        g[k] = ld(in.gx + X0 + 4 * k) * spl(cosPhi) + ld(in.gy + X0 + 4 * k) * spl(sinPhi);
+        g[k] = ldv<V>(in.gx + X0 + L * k) * splv<V>(cosPhi) + ldv<V>(in.gy + X0 + L * k) * splv<V>(sinPhi);
         gLow[k] = g[k];
-        if constexpr (Sh && Exact) gLow[k] = ld(in.lowSlope + X0 + 4 * k);
-        const F4 t = gLow[k] < nlim ? nlim : (gLow[k] > lim ? lim : gLow[k]);
-        const F4 r = one / simd::vsqrt(one + t * t);  // cos of the lower bound
+        if constexpr (Sh && Exact) gLow[k] = ldv<V>(in.lowSlope + X0 + L * k);
+        const V t = gLow[k] < nlim ? nlim : (gLow[k] > lim ? lim : gLow[k]);
+        const V r = one / sqrtv(one + t * t);  // cos of the lower bound
         q1[k] = t * r;
         if constexpr (Exact) {
-            const F4 te = g[k] < nlim ? nlim : (g[k] > lim ? lim : g[k]);
-            const F4 re = one / simd::vsqrt(one + te * te), se = te * re;
-            F[k] = half * (se * se) - g[k] * (half * (atan4(te) + se * re));
+            const V te = g[k] < nlim ? nlim : (g[k] > lim ? lim : g[k]);
+            const V re = one / sqrtv(one + te * te), se = te * re;
+            F[k] = half * (se * se) - g[k] * (half * (atanv(te) + se * re));
         }
     }
     int n = 0;
@@ -106,26 +135,28 @@ void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* step
         const std::ptrdiff_t o = Y * st.rowStep + X0;
         const float* a = st.field + (o + st.offA);
         const float* b = st.field + (o + st.offB);
-        const F4 wa = ld(st.w[0]), wb = ld(st.w[1]), inv = ld(st.w[2]);
-        const I4 iv = {i, i, i, i};
-        F4 t[NV];
-        I4 nw[NV];
-        I4 any = {0, 0, 0, 0};
+        const V wa = splv<V>(st.w[0][0]), wb = splv<V>(st.w[1][0]), inv = splv<V>(st.w[2][0]);
+        const I iv = I{} + i;
+        V t[NV];
+        I nw[NV];
+        I any = I{};
         for (int k = 0; k < NV; ++k) {
-            t[k] = (((wa * ld(a + 4 * k) + wb * ld(b + 4 * k)) - ld(in.h0 + X0 + 4 * k)) - ld(in.margin + X0 + 4 * k)) * inv;
+            t[k] = (((wa * ldv<V>(a + L * k) + wb * ldv<V>(b + L * k)) - ldv<V>(in.h0 + X0 + L * k)) -
+                    ldv<V>(in.margin + X0 + L * k)) * inv;
             nw[k] = (iv < steps[k]) & (t[k] > M[k]);  // Eq. 17: above every earlier sample
             any |= nw[k];
         }
-        if (!anyLane(any)) {
+        if (laneBits(any) == 0) {
             // past the point where even the field's highest height would not
             // beat any lane's running maximum, no new member can come: stop
-            I4 done = {-1, -1, -1, -1};
             // (lanes whose ray has left the domain are done too)
-            for (int k = 0; k < NV; ++k) done &= (iv >= steps[k]) | (M[k] >= (spl(in.hMax) - ld(in.h0 + X0 + 4 * k)) * inv);
-            if (done[0] & done[1] & done[2] & done[3]) break;
+            I done = I{} - 1;
+            for (int k = 0; k < NV; ++k)
+                done &= (iv >= steps[k]) | (M[k] >= (splv<V>(in.hMax) - ldv<V>(in.h0 + X0 + L * k)) * inv);
+            if (laneBits(~done) == 0) break;
             continue;
         }
-        F4* mo = moments + static_cast<std::size_t>(n) * NV * nMo;
+        float* mo = moments + static_cast<std::size_t>(n) * NV * nMo * L;
         list[n++] = i;
         // pass 2 reads the radiance at this step: start fetching it now
         for (int c = 0; c < 3; ++c) {
@@ -137,31 +168,31 @@ void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* step
         for (int k = 0; k < NV; ++k) {
             M[k] = nw[k] ? t[k] : M[k];
             // the segment [c_(i-1), c_i] clamped to [omega_min, pi/2]
-            F4 tc = t[k] < gLow[k] ? gLow[k] : t[k];
+            V tc = t[k] < gLow[k] ? gLow[k] : t[k];
             tc = tc < nlim ? nlim : (tc > lim ? lim : tc);
-            const F4 r = one / simd::vsqrt(one + tc * tc), sNew = tc * r;  // cos, sin of the end
+            const V r = one / sqrtv(one + tc * tc), sNew = tc * r;  // cos, sin of the end
             if constexpr (Sh) {
-                const F4 sv = nw[k] ? sNew : q1[k];  // no new member: an empty segment (exactly 0)
-                const F4 p = q1[k], p2 = p * p, s2 = sv * sv;
-                mo[nMo * k + 0] = sv - p;
-                mo[nMo * k + 1] = s2 - p2;
-                mo[nMo * k + 2] = s2 * sv - p2 * p;
-                mo[nMo * k + 3] = s2 * s2 - p2 * p2;
+                const V sv = nw[k] ? sNew : q1[k];  // no new member: an empty segment (exactly 0)
+                const V p = q1[k], p2 = p * p, s2 = sv * sv;
+                stv(mo + (nMo * k + 0) * L, sv - p);
+                stv(mo + (nMo * k + 1) * L, s2 - p2);
+                stv(mo + (nMo * k + 2) * L, s2 * sv - p2 * p);
+                stv(mo + (nMo * k + 3) * L, s2 * s2 - p2 * p2);
                 q1[k] = sv;
             }
             if constexpr (Exact) {
-                const F4 fNew = half * (sNew * sNew) - g[k] * (half * (atan4(tc) + sNew * r));
-                const F4 fv = nw[k] & (tc >= g[k]) ? fNew : F[k];  // below the receiver's plane: nothing
-                mo[nMo * k + e5] = fv - F[k];
+                const V fNew = half * (sNew * sNew) - g[k] * (half * (atanv(tc) + sNew * r));
+                const V fv = nw[k] & (tc >= g[k]) ? fNew : F[k];  // below the receiver's plane: nothing
+                stv(mo + (nMo * k + e5) * L, fv - F[k]);
                 F[k] = fv;
             }
         }
     }
     // pass 2: moments x radiance, then Eq. 10's closed form as a polynomial in s
-    const F4 k0 = spl(0.70710678118654752440f), k1 = spl(0.61237243569579452455f);
-    const F4 k2 = spl(0.79056941504209483300f), k3 = spl(0.23385358667337133659f);
+    const V k0 = splv<V>(0.70710678118654752440f), k1 = splv<V>(0.61237243569579452455f);
+    const V k2 = splv<V>(0.79056941504209483300f), k3 = splv<V>(0.23385358667337133659f);
     for (int c = 0; c < 3; ++c) {
-        F4 A[NV][nMo];
+        V A[NV][nMo];
         for (int k = 0; k < NV; ++k)
             for (int p = 0; p < nMo; ++p) A[k][p] = zero;
         const ScanStep* tab = rTab[c];
@@ -170,44 +201,68 @@ void castGroup(const ScanStep* hTab, const ScanStep* const* rTab, const I4* step
             const std::ptrdiff_t ro = Y * rs.rowStep + X0;
             const float* ra = rs.field + (ro + rs.offA);
             const float* rb = rs.field + (ro + rs.offB);
-            const F4 rwa = ld(rs.w[0]), rwb = ld(rs.w[1]);
-            const F4* mo = moments + static_cast<std::size_t>(e) * NV * nMo;
+            const V rwa = splv<V>(rs.w[0][0]), rwb = splv<V>(rs.w[1][0]);
+            const float* mo = moments + static_cast<std::size_t>(e) * NV * nMo * L;
             for (int k = 0; k < NV; ++k) {
                 // lanes without a new member have zero moments; the radiance
                 // read there is finite (inside the field's padding and guard)
-                const F4 u = rwa * ld(ra + 4 * k) + rwb * ld(rb + 4 * k);
-                for (int p = 0; p < nMo; ++p) A[k][p] += u * mo[nMo * k + p];
+                const V u = rwa * ldv<V>(ra + L * k) + rwb * ldv<V>(rb + L * k);
+                for (int p = 0; p < nMo; ++p) A[k][p] += u * ldv<V>(mo + (nMo * k + p) * L);
             }
         }
         for (int k = 0; k < NV; ++k) {
-            if constexpr (Exact) simd::store(nlp + static_cast<std::size_t>(12 + c) * pad + X0 + 4 * k, A[k][e5]);
+            if constexpr (Exact) stv(nlp + static_cast<std::size_t>(12 + c) * pad + X0 + L * k, A[k][e5]);
             if constexpr (!Sh) continue;
-            float* base = nlp + static_cast<std::size_t>(c) * 4 * pad + X0 + 4 * k;
-            simd::store(base, k0 * A[k][0]);
-            simd::store(base + pad, k1 * A[k][1]);
-            simd::store(base + 2 * pad, k2 * (A[k][2] - A[k][0]));
-            simd::store(base + 3 * pad, k3 * (spl(5.0f) * A[k][3] - spl(6.0f) * A[k][1]));
+            float* base = nlp + static_cast<std::size_t>(c) * 4 * pad + X0 + L * k;
+            stv(base, k0 * A[k][0]);
+            stv(base + pad, k1 * A[k][1]);
+            stv(base + 2 * pad, k2 * (A[k][2] - A[k][0]));
+            stv(base + 3 * pad, k3 * (splv<V>(5.0f) * A[k][3] - splv<V>(6.0f) * A[k][1]));
         }
     }
 }
 
-// Row of receivers for one azimuth.
-template <int Mode>
-void castRow(const ScanStep* hTab, const ScanStep* const* rTab, const int* colSteps, int rowSteps, int Y, const RowInputs& in,
-             float cosPhi, float sinPhi, IndirectScratch& sc, int pad) {
-    const I4 rowLimit = {rowSteps, rowSteps, rowSteps, rowSteps};
+// Row of receivers for one azimuth, in groups of kGroup = NV x L receivers.
+template <class V, int Mode>
+[[gnu::always_inline]] inline void castRowImpl(const ScanStep* hTab, const ScanStep* const* rTab, const int* colSteps,
+                                               int rowSteps, int Y, const RowInputs& in, float cosPhi, float sinPhi,
+                                               IndirectScratch& sc, int pad) {
+    using I = typename LaneTraits<V>::I;
+    constexpr int L = LaneTraits<V>::n, NV = kGroup / L;
+    const I rowLimit = I{} + rowSteps;
     for (int X0 = 0; X0 < pad; X0 += kGroup) {
-        I4 steps[kGroup / 4];
+        I steps[NV];
         int nAny = 0;
-        for (int k = 0; k < kGroup / 4; ++k) {
-            I4 c;
-            std::memcpy(&c, colSteps + X0 + 4 * k, sizeof c);
+        for (int k = 0; k < NV; ++k) {
+            I c;
+            std::memcpy(&c, colSteps + X0 + L * k, sizeof c);
             steps[k] = c < rowLimit ? c : rowLimit;
-            for (int l = 0; l < 4; ++l) nAny = std::max(nAny, steps[k][l]);
+            for (int l = 0; l < L; ++l) nAny = std::max(nAny, static_cast<int>(steps[k][l]));
         }
-        castGroup<kGroup / 4, Mode>(hTab, rTab, steps, nAny, Y, X0, in, cosPhi, sinPhi, reinterpret_cast<F4*>(sc.moments.data()),
-                                     sc.list.data(), sc.nlp.data(), pad);
+        castGroup<V, NV, Mode>(hTab, rTab, steps, nAny, Y, X0, in, cosPhi, sinPhi, sc.moments.data(), sc.list.data(),
+                               sc.nlp.data(), pad);
     }
+}
+
+template <int Mode>
+void castRowSse(const ScanStep* hTab, const ScanStep* const* rTab, const int* colSteps, int rowSteps, int Y,
+                const RowInputs& in, float cosPhi, float sinPhi, IndirectScratch& sc, int pad) {
+    castRowImpl<F4, Mode>(hTab, rTab, colSteps, rowSteps, Y, in, cosPhi, sinPhi, sc, pad);
+}
+template <int Mode>
+[[gnu::target("avx2"), gnu::flatten]] void castRowAvx2(const ScanStep* hTab, const ScanStep* const* rTab, const int* colSteps,
+                                         int rowSteps, int Y, const RowInputs& in, float cosPhi, float sinPhi,
+                                         IndirectScratch& sc, int pad) {
+    castRowImpl<F8, Mode>(hTab, rTab, colSteps, rowSteps, Y, in, cosPhi, sinPhi, sc, pad);
+}
+
+using CastRowFn = void (*)(const ScanStep*, const ScanStep* const*, const int*, int, int, const RowInputs&, float, float,
+                           IndirectScratch&, int);
+CastRowFn castRowFor(int mode) {
+    const bool wide = simd::wideEnabled();
+    if (mode == kShOnly) return wide ? castRowAvx2<kShOnly> : castRowSse<kShOnly>;
+    if (mode == kShAndExact) return wide ? castRowAvx2<kShAndExact> : castRowSse<kShAndExact>;
+    return wide ? castRowAvx2<kExactOnly> : castRowSse<kExactOnly>;
 }
 
 }  // namespace
@@ -339,6 +394,7 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
 
         // ---- scan: casting sets, Eq. 12, U through the folded wedge operator ----------
         const int P = op.patternSize();
+        const CastRowFn castRow = castRowFor(mode);
         parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
             for (int block = b0; block < b1; ++block) {
                 IndirectScratch& sc = st.blocks[static_cast<std::size_t>(block)];
@@ -392,20 +448,20 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
                             // U's segments start at the footprint's lowest tangent slope, lowered
                             // (by footprintDrop x the footprint's spread of slopes, at most footprintDropMax:
                             // 0 where the footprint is one plane)
-                            const F4 dropMax = spl(settings.footprintDropMax);
-                            const F4 c4 = spl(cosPhi), s4 = spl(sinPhi), drop = spl(settings.footprintDrop);
+                            const F4 dropMax = splv<F4>(settings.footprintDropMax);
+                            const F4 c4 = splv<F4>(cosPhi), s4 = splv<F4>(sinPhi), drop = splv<F4>(settings.footprintDrop);
                             // the box's lowest slope along (cos, sin): lo or hi per axis by the sign
                             const float* fx = sc.footGx.data() + 2 * ro + (cosPhi >= 0.0f ? 0 : pad);
                             const float* fy = sc.footGy.data() + 2 * ro + (sinPhi >= 0.0f ? 0 : pad);
                             for (int X = 0; X < pad; X += 4) {
-                                const F4 lo = ld(fx + X) * c4 + ld(fy + X) * s4;
-                                const F4 own = ld(in.gx + X) * c4 + ld(in.gy + X) * s4;
+                                const F4 lo = ldv<F4>(fx + X) * c4 + ldv<F4>(fy + X) * s4;
+                                const F4 own = ldv<F4>(in.gx + X) * c4 + ldv<F4>(in.gy + X) * s4;
                                 const F4 d = drop * (own - lo);
-                                simd::store(sc.lowSlope.data() + X, lo - (d < dropMax ? d : dropMax));
+                                stv(sc.lowSlope.data() + X, lo - (d < dropMax ? d : dropMax));
                             }
                             in.lowSlope = sc.lowSlope.data();
                         }
-                        (mode == kShOnly ? castRow<kShOnly> : (mode == kShAndExact ? castRow<kShAndExact> : castRow<kExactOnly>))(st.heightSteps.data() + base, rTab,
+                        castRow(st.heightSteps.data() + base, rTab,
                                                                  st.stepsPerColumn.data() + static_cast<std::size_t>(j) * pad,
                                                                  st.stepsPerRow[static_cast<std::size_t>(j) * nyr + static_cast<std::size_t>(Y)], Y,
                                                                  in, cosPhi, sinPhi, sc, pad);

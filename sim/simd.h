@@ -49,6 +49,21 @@ inline T vmin(T a, T b) {
     return a < b ? a : b;
 }
 inline float vsqrt(float x) { return std::sqrt(x); }
+
+/// Kernels with an 8-wide AVX2 variant (gi/indirect.cpp) use it when the
+/// processor has AVX2 and it is enabled (the default). The variants give
+/// bit-identical results (no fused multiply-add in either); tests and
+/// benchmarks switch it off to compare. Not thread-safe: set it between frames.
+inline bool& wideFlag() {
+    static bool on = __builtin_cpu_supports("avx2");
+    return on;
+}
+inline bool wideEnabled() { return wideFlag(); }
+/// Returns whether the wide variants are now in use (false without AVX2).
+inline bool setWideEnabled(bool on) {
+    wideFlag() = on && __builtin_cpu_supports("avx2");
+    return wideFlag();
+}
 inline F4 vsqrt(F4 x) { return reinterpret_cast<F4>(_mm_sqrt_ps(reinterpret_cast<__m128>(x))); }
 
 }  // namespace terrain::simd
