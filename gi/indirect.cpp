@@ -12,18 +12,11 @@
 #include "sim/parallel.h"
 #include "sim/simd.h"
 
-// F8 values pass between always-inline helpers compiled into the AVX2 kernel
-// only; GCC's note that their out-of-line ABI would differ does not apply.
-#pragma GCC diagnostic ignored "-Wpsabi"
-
 namespace terrain::gi {
 
 namespace {
 
 using simd::F4;
-typedef int I4 __attribute__((vector_size(16)));
-typedef float F8 __attribute__((vector_size(32)));
-typedef int I8 __attribute__((vector_size(32)));
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
@@ -34,25 +27,16 @@ constexpr float kMarginRel = 1.0f / 1048576.0f;  // 2^-20 |h0|: height differenc
 inline int padGroup(int n) { return (n + kGroup - 1) / kGroup * kGroup; }
 
 // The kernel is written once over a lane type V: F4 (SSE2, the baseline) or
-// F8 (AVX2, chosen at run time where the processor has it). Both use the
-// same correctly rounded IEEE operations lane by lane and neither may fuse a
-// multiply-add (the AVX2 path is compiled without FMA), so the two give
-// bit-identical results (tests/test_gi_indirect.cpp checks it).
-template <class V> struct LaneTraits;
-template <> struct LaneTraits<F4> { using I = I4; static constexpr int n = 4; };
-template <> struct LaneTraits<F8> { using I = I8; static constexpr int n = 8; };
-
-template <class V> [[gnu::always_inline]] inline V ldv(const float* p) {
-    V v;
-    std::memcpy(&v, p, sizeof v);
-    return v;
-}
-template <class V> [[gnu::always_inline]] inline void stv(float* p, V v) { std::memcpy(p, &v, sizeof v); }
-template <class V> [[gnu::always_inline]] inline V splv(float x) { return V{} + x; }
-[[gnu::always_inline]] inline F4 sqrtv(F4 x) { return __builtin_ia32_sqrtps(x); }
-[[gnu::target("avx")]] inline F8 sqrtv(F8 x) { return __builtin_ia32_sqrtps256(x); }
-[[gnu::always_inline]] inline int laneBits(I4 m) { return __builtin_ia32_movmskps(reinterpret_cast<F4>(m)); }
-[[gnu::target("avx")]] inline int laneBits(I8 m) { return __builtin_ia32_movmskps256(reinterpret_cast<F8>(m)); }
+// F8 (AVX2, chosen at run time where the processor has it): sim/simd.h.
+using simd::F8;
+using simd::I4;
+using simd::I8;
+using simd::LaneTraits;
+using simd::laneBits;
+using simd::ldv;
+using simd::splv;
+using simd::sqrtv;
+using simd::stv;
 
 // Deterministic float atan (Cephes atanf: range reduction to |x| <= tan(pi/8),
 // then a degree-9 odd minimax polynomial; ~1e-7 relative): a pure function of
@@ -265,6 +249,47 @@ CastRowFn castRowFor(int mode) {
     return wide ? castRowAvx2<kExactOnly> : castRowSse<kExactOnly>;
 }
 
+// One row and azimuth's results into the sums: the exact moments into E
+// (ExactAtReceivers), and U_c += G_j u_(c, j) over the sparse pattern (Eq. 21).
+struct RowSums {
+    const float* nlp;  // 3 channels x 4 NLP (+ 3 exact) x pad
+    int pad, nxr;
+    float* exact;      // 3 channels x pad E sums of the row, or null
+    int patSize;       // 0: no U (kExactOnly)
+    const std::uint8_t *patRow, *patNlp;
+    const float* vals;  // the operator's entries of this azimuth
+    int nRows;          // SH rows of U that shading reads
+    float* u[3];        // U of each channel: plane 0, row Y
+    std::size_t planeR; // plane stride
+};
+
+template <class V>
+[[gnu::always_inline]] inline void accumulateImpl(const RowSums& r) {
+    constexpr int L = LaneTraits<V>::n;
+    const int nv = r.nxr / L * L;
+    auto axpy = [&](float* __restrict dst, const float* __restrict w, float gval) {
+        const V g = splv<V>(gval);
+        for (int X = 0; X < nv; X += L) stv(dst + X, ldv<V>(dst + X) + g * ldv<V>(w + X));
+        for (int X = nv; X < r.nxr; ++X) dst[X] += gval * w[X];
+    };
+    if (r.exact)
+        for (int c = 0; c < 3; ++c) {
+            float* __restrict e = r.exact + static_cast<std::size_t>(c) * r.pad;
+            const float* __restrict w = r.nlp + static_cast<std::size_t>(12 + c) * r.pad;
+            for (int X = 0; X < nv; X += L) stv(e + X, ldv<V>(e + X) + ldv<V>(w + X));
+            for (int X = nv; X < r.nxr; ++X) e[X] += w[X];
+        }
+    for (int e = 0; e < r.patSize; ++e) {
+        const int row = r.patRow[e];
+        if (row >= r.nRows) continue;
+        const int l = r.patNlp[e];
+        for (int c = 0; c < 3; ++c)
+            axpy(r.u[c] + static_cast<std::size_t>(row) * r.planeR, r.nlp + static_cast<std::size_t>(c * 4 + l) * r.pad, r.vals[e]);
+    }
+}
+void accumulateSse(const RowSums& r) { accumulateImpl<F4>(r); }
+[[gnu::target("avx2"), gnu::flatten]] void accumulateAvx2(const RowSums& r) { accumulateImpl<F8>(r); }
+
 }  // namespace
 
 void validateIndirectSettings(const IndirectSettings& s) {
@@ -395,6 +420,7 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
         // ---- scan: casting sets, Eq. 12, U through the folded wedge operator ----------
         const int P = op.patternSize();
         const CastRowFn castRow = castRowFor(mode);
+        void (*const accumulate)(const RowSums&) = simd::wideEnabled() ? accumulateAvx2 : accumulateSse;
         parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
             for (int block = b0; block < b1; ++block) {
                 IndirectScratch& sc = st.blocks[static_cast<std::size_t>(block)];
@@ -465,24 +491,12 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
                                                                  st.stepsPerColumn.data() + static_cast<std::size_t>(j) * pad,
                                                                  st.stepsPerRow[static_cast<std::size_t>(j) * nyr + static_cast<std::size_t>(Y)], Y,
                                                                  in, cosPhi, sinPhi, sc, pad);
-                        if (exact)
-                            for (int c = 0; c < 3; ++c) {
-                                float* __restrict e = sc.exact.data() + 3 * ro + static_cast<std::size_t>(c) * pad;
-                                const float* __restrict w = sc.nlp.data() + static_cast<std::size_t>(12 + c) * pad;
-                                for (int X = 0; X < nxr; ++X) e[X] += w[X];
-                            }
-                        // U_c += G_j u_(c, j) over the sparse pattern (Eq. 21)
-                        for (int e = 0; e < (mode == kExactOnly ? 0 : P); ++e) {
-                            const int row = op.patternRow[static_cast<std::size_t>(e)];
-                            if (row >= nRows) continue;
-                            const float gval = vals[e];
-                            const int l = op.patternNlp[static_cast<std::size_t>(e)];
-                            for (int c = 0; c < 3; ++c) {
-                                float* __restrict dst = st.u[static_cast<std::size_t>(c)].plane(row) + static_cast<std::size_t>(Y) * nxr;
-                                const float* __restrict w = sc.nlp.data() + static_cast<std::size_t>(c * 4 + l) * pad;
-                                for (int X = 0; X < nxr; ++X) dst[X] += gval * w[X];
-                            }
-                        }
+                        accumulate({sc.nlp.data(), pad, nxr, exact ? sc.exact.data() + 3 * ro : nullptr,
+                                    mode == kExactOnly ? 0 : P, op.patternRow.data(), op.patternNlp.data(), vals, nRows,
+                                    {st.u[0].plane(0) + static_cast<std::size_t>(Y) * nxr,
+                                     st.u[1].plane(0) + static_cast<std::size_t>(Y) * nxr,
+                                     st.u[2].plane(0) + static_cast<std::size_t>(Y) * nxr},
+                                    planeR});
                     }
                 }
                 if (!exact) continue;

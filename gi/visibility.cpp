@@ -7,27 +7,20 @@
 
 #include "gi/nlp.h"
 #include "sim/parallel.h"
+#include "sim/simd.h"
 
 namespace terrain::gi {
 
 namespace {
 
 constexpr int kMaxBlocks = 64;
-constexpr int kLanes = 16;  // receivers per kernel call at most (4 x 4-wide vectors); rows are padded to it
+constexpr int kLanes = 16;  // receivers per kernel call at most (4 x 4 or 2 x 8 lanes); rows are padded to it
 
-// 4-wide float vectors (GCC vector extensions, baseline SSE2). Lane-wise
-// IEEE operations: each lane computes exactly what the scalar code computes.
-typedef float v4 __attribute__((vector_size(16)));
-inline v4 load4(const float* p) {
-    v4 v;
-    std::memcpy(&v, p, sizeof v);
-    return v;
-}
-inline void store4(float* p, v4 v) { std::memcpy(p, &v, sizeof v); }
-inline v4 load4a(const float* p) { return *reinterpret_cast<const v4*>(__builtin_assume_aligned(p, 16)); }
-inline v4 splat(float x) { return v4{x, x, x, x}; }
-inline v4 vmax(v4 a, v4 b) { return a < b ? b : a; }  // the scalar rule m = m < s ? s : m
-inline v4 vsqrt(v4 a) { return __builtin_ia32_sqrtps(a); }  // correctly rounded, like std::sqrt
+using simd::LaneTraits;
+using simd::ldv;
+using simd::splv;
+using simd::sqrtv;
+using simd::stv;
 
 inline int padLanes(int n) { return (n + kLanes - 1) / kLanes * kLanes; }
 
@@ -128,29 +121,31 @@ inline float sampleSlope(const ScanStep& st, std::ptrdiff_t index, float h0) {
 }
 
 // ---- algorithm: per-step visitors over the slope sequence ---------------------
-// A visitor sees the slopes of 4 NV receivers step by step. all(i, s): step i,
-// every lane valid. some(i, s, valid): step i where only the lanes of `valid`
-// are (the others' rays have left the domain; their s is garbage); the kernel
-// calls some() once more at i = (longest sequence) with no lane valid, so a
-// visitor can close what is still open. steps: each lane's sequence length.
-typedef int v4i __attribute__((vector_size(16)));
+// A visitor sees the slopes of NV vectors of receivers step by step. all(i, s):
+// step i, every lane valid. some(i, s, valid): step i where only the lanes of
+// `valid` are (the others' rays have left the domain; their s is garbage); the
+// kernel calls some() once more at i = (longest sequence) with no lane valid,
+// so a visitor can close what is still open. steps: each lane's sequence length.
+// Lane type V: F4 (SSE2) or F8 (AVX2), sim/simd.h; the same lane-wise
+// operations either way.
 
 // Plain maximum over the samples.
-template <int NV>
+template <class V, int NV>
 struct SampleMaxVisitor {
-    v4 m[NV];
+    using I = typename LaneTraits<V>::I;
+    V m[NV];
     SampleMaxVisitor() {
-        for (int k = 0; k < NV; ++k) m[k] = splat(kNoBlocker);
+        for (int k = 0; k < NV; ++k) m[k] = splv<V>(kNoBlocker);
     }
     // m = maxps(m, s): the larger; equal values are the same number (no -0 arises)
-    void all(int, const v4* s) {
+    void all(int, const V* s) {
         for (int k = 0; k < NV; ++k) m[k] = m[k] > s[k] ? m[k] : s[k];
     }
-    void some(int, const v4* s, const v4i* valid, const v4i*) {
+    void some(int, const V* s, const I* valid, const I*) {
         for (int k = 0; k < NV; ++k) m[k] = valid[k] & (s[k] > m[k]) ? s[k] : m[k];
     }
     void result(float* out) const {
-        for (int k = 0; k < NV; ++k) store4(out + 4 * k, m[k]);
+        for (int k = 0; k < NV; ++k) stv(out + LaneTraits<V>::n * k, m[k]);
     }
 };
 
@@ -160,19 +155,20 @@ struct SampleMaxVisitor {
 // between samples, recovering part of a peak that falls between two steps.
 // At step i the midpoint between i-2 and i-1 is closed: p3, p2, p1 hold
 // s_{i-3}, s_{i-2}, s_{i-1} (s_{-1} = s_0).
-template <int NV>
+template <class V, int NV>
 struct BsplineMaxVisitor {
-    v4 m[NV], p1[NV], p2[NV], p3[NV];
+    using I = typename LaneTraits<V>::I;
+    V m[NV], p1[NV], p2[NV], p3[NV];
     BsplineMaxVisitor() {
-        for (int k = 0; k < NV; ++k) m[k] = p1[k] = p2[k] = p3[k] = splat(kNoBlocker);
+        for (int k = 0; k < NV; ++k) m[k] = p1[k] = p2[k] = p3[k] = splv<V>(kNoBlocker);
     }
-    static v4 mid(v4 sm, v4 s0, v4 s1, v4 s2) { return (9.0f * (s0 + s1) - (sm + s2)) * (1.0f / 16.0f); }
-    void all(int i, const v4* s) {
+    static V mid(V sm, V s0, V s1, V s2) { return (9.0f * (s0 + s1) - (sm + s2)) * (1.0f / 16.0f); }
+    void all(int i, const V* s) {
         for (int k = 0; k < NV; ++k) {
             if (i == 0) p1[k] = p2[k] = p3[k] = s[k];
             m[k] = m[k] > s[k] ? m[k] : s[k];
             if (i >= 2) {
-                const v4 md = mid(p3[k], p2[k], p1[k], s[k]);
+                const V md = mid(p3[k], p2[k], p1[k], s[k]);
                 m[k] = m[k] > md ? m[k] : md;
             }
             p3[k] = p2[k];
@@ -180,16 +176,16 @@ struct BsplineMaxVisitor {
             p1[k] = s[k];
         }
     }
-    void some(int i, const v4* s, const v4i* valid, const v4i* steps) {
-        const v4i iv = {i, i, i, i};
+    void some(int i, const V* s, const I* valid, const I* steps) {
+        const I iv = I{} + i;
         for (int k = 0; k < NV; ++k) {
-            const v4 v = valid[k] ? s[k] : p1[k];  // past the end: replicate the last sample
+            const V v = valid[k] ? s[k] : p1[k];  // past the end: replicate the last sample
             if (i == 0) {
                 p1[k] = p2[k] = p3[k] = v;  // invalid lanes: empty sequence, stays kNoBlocker
             }
             m[k] = valid[k] & (v > m[k]) ? v : m[k];
             if (i >= 2) {
-                const v4 md = mid(p3[k], p2[k], p1[k], v);
+                const V md = mid(p3[k], p2[k], p1[k], v);
                 m[k] = (iv <= steps[k]) & (md > m[k]) ? md : m[k];
             }
             p3[k] = p2[k];
@@ -198,27 +194,29 @@ struct BsplineMaxVisitor {
         }
     }
     void result(float* out) const {
-        for (int k = 0; k < NV; ++k) store4(out + 4 * k, m[k]);
+        for (int k = 0; k < NV; ++k) stv(out + LaneTraits<V>::n * k, m[k]);
     }
 };
 
-// ---- algorithm: the scan of 4 NV receivers (X0 .. X0 + 4 NV - 1 of row Y) -------
+// ---- algorithm: the scan of L NV receivers (X0 .. X0 + L NV - 1 of row Y) -------
 // h0: the row's receiver heights; steps: valid-prefix length
 // of each lane; all lanes are valid for i < nAll, none for i >= nAny.
-template <int NV, class Visitor>
-inline void scanLanes(const ScanStep* table, const float* const* rowPtr, int X0, const float* h0, const v4i* steps,
-                      int nAll, int nAny, Visitor& visit) {
-    v4 h[NV];
-    for (int k = 0; k < NV; ++k) h[k] = load4a(h0 + X0 + 4 * k);
-    auto sample = [&](int i, v4* s) {
+template <class V, int NV, class Visitor>
+[[gnu::always_inline]] inline void scanLanes(const ScanStep* table, const float* const* rowPtr, int X0, const float* h0,
+                                             const typename LaneTraits<V>::I* steps, int nAll, int nAny, Visitor& visit) {
+    using I = typename LaneTraits<V>::I;
+    constexpr int L = LaneTraits<V>::n;
+    V h[NV];
+    for (int k = 0; k < NV; ++k) h[k] = ldv<V>(h0 + X0 + L * k);
+    auto sample = [&](int i, V* s) {
         const ScanStep& st = table[i];
         const float* a = rowPtr[2 * i] + X0;
         const float* b = rowPtr[2 * i + 1] + X0;
-        const v4 wa = load4a(st.w[0]), wb = load4a(st.w[1]), inv = load4a(st.w[2]);
-        for (int k = 0; k < NV; ++k) s[k] = ((wa * load4(a + 4 * k) + wb * load4(b + 4 * k)) - h[k]) * inv;
+        const V wa = splv<V>(st.w[0][0]), wb = splv<V>(st.w[1][0]), inv = splv<V>(st.w[2][0]);
+        for (int k = 0; k < NV; ++k) s[k] = ((wa * ldv<V>(a + L * k) + wb * ldv<V>(b + L * k)) - h[k]) * inv;
     };
     for (int i = 0; i < nAll; ++i) {
-        v4 s[NV];
+        V s[NV];
         sample(i, s);
         visit.all(i, s);
     }
@@ -226,44 +224,49 @@ inline void scanLanes(const ScanStep* table, const float* const* rowPtr, int X0,
     // limit is common to all lanes), the outside lanes read neighbouring
     // columns (inside the field's guard) and are masked out.
     for (int i = nAll; i <= nAny; ++i) {
-        v4 s[NV];
-        v4i valid[NV];
-        const v4i iv = {i, i, i, i};
+        V s[NV];
+        I valid[NV];
+        const I iv = I{} + i;
         for (int k = 0; k < NV; ++k) valid[k] = iv < steps[k];
         if (i < nAny) sample(i, s);
         else
-            for (int k = 0; k < NV; ++k) s[k] = splat(0.0f);
+            for (int k = 0; k < NV; ++k) s[k] = splv<V>(0.0f);
         visit.some(i, s, valid, steps);
     }
 }
 
-// Maximum blocking slope of a row of receivers for one azimuth. rowPtr:
-// scratch for 2 x rowSteps pointers (each step's taps at receiver 0 of row Y).
-template <int NV, template <int> class Visitor>
-void scanRow(const ScanStep* table, const int* colSteps, int rowSteps, int Y, const float* h0, int nxrPad, float* out,
-             const float** rowPtr) {
-    constexpr int lanes = 4 * NV;
+// Maximum blocking slope of a row of receivers for one azimuth, in groups of
+// `lanes` receivers (NV vectors). rowPtr: scratch for 2 x rowSteps pointers
+// (each step's taps at receiver 0 of row Y).
+template <class V, int lanes, template <class, int> class Visitor>
+[[gnu::always_inline]] inline void scanRow(const ScanStep* table, const int* colSteps, int rowSteps, int Y, const float* h0,
+                                           int nxrPad, float* out, const float** rowPtr) {
+    using I = typename LaneTraits<V>::I;
+    constexpr int L = LaneTraits<V>::n, NV = lanes / L;
     for (int i = 0; i < rowSteps; ++i) {
         const ScanStep& st = table[i];
         const std::ptrdiff_t o = Y * st.rowStep;
         rowPtr[2 * i] = st.field + (o + st.offA);
         rowPtr[2 * i + 1] = st.field + (o + st.offB);
     }
-    const v4i rowLimit = {rowSteps, rowSteps, rowSteps, rowSteps};
+    const I rowLimit = I{} + rowSteps;
     for (int X0 = 0; X0 < nxrPad; X0 += lanes) {
-        v4i steps[NV];
-        v4i lo = rowLimit, hi = {0, 0, 0, 0};
+        I steps[NV];
+        I lo = rowLimit, hi = I{};
         for (int k = 0; k < NV; ++k) {
-            v4i c;
-            std::memcpy(&c, colSteps + X0 + 4 * k, sizeof c);
+            I c;
+            std::memcpy(&c, colSteps + X0 + L * k, sizeof c);
             steps[k] = c < rowLimit ? c : rowLimit;
             lo = steps[k] < lo ? steps[k] : lo;
             hi = steps[k] > hi ? steps[k] : hi;
         }
-        const int nAll = std::min(std::min(lo[0], lo[1]), std::min(lo[2], lo[3]));
-        const int nAny = std::max(std::max(hi[0], hi[1]), std::max(hi[2], hi[3]));
-        Visitor<NV> visit;
-        scanLanes<NV>(table, rowPtr, X0, h0, steps, nAll, nAny, visit);
+        int nAll = lo[0], nAny = hi[0];
+        for (int l = 1; l < L; ++l) {
+            nAll = std::min(nAll, static_cast<int>(lo[l]));
+            nAny = std::max(nAny, static_cast<int>(hi[l]));
+        }
+        Visitor<V, NV> visit;
+        scanLanes<V, NV>(table, rowPtr, X0, h0, steps, nAll, nAny, visit);
         visit.result(out + X0);
     }
 }
@@ -272,53 +275,57 @@ void scanRow(const ScanStep* table, const int* colSteps, int rowSteps, int Y, co
 // NLP vectors of a row of receivers (4 rows of nxr), then V += G_j w_j over
 // the sparse pattern, each entry a contiguous multiply-add over the row.
 // omega_min: elevation of the tangent plane along the azimuth (Section 3).
-void nlpRow(const float* __restrict maxSlope, const float* __restrict gx, const float* __restrict gy, float cosPhi,
-            float sinPhi, const VisibilityTarget& target, float* __restrict nlp, int nxr, int nxrPad) {
-    const v4 c = splat(cosPhi), sn = splat(sinPhi);
-    const v4 one = splat(1.0f), lim = splat(1e6f), nlim = splat(-1e6f);
-    const v4 k0 = splat(0.70710678118654752440f), k1 = splat(0.61237243569579452455f);
-    const v4 k2 = splat(0.79056941504209483300f), k3 = splat(0.23385358667337133659f);
-    const v4 five = splat(5.0f), four = splat(4.0f);
-    const v4 sLow = splat(target.sinLow), sHigh = splat(target.sinHigh);
-    for (int X = 0; X < nxrPad; X += 4) {
-        const v4 tangent = load4(gx + X) * c + load4(gy + X) * sn;
-        const v4 ms = load4(maxSlope + X);
-        v4 t = ms < tangent ? tangent : ms;
+template <class V>
+[[gnu::always_inline]] inline void nlpRow(const float* __restrict maxSlope, const float* __restrict gx,
+                                          const float* __restrict gy, float cosPhi, float sinPhi,
+                                          const VisibilityTarget& target, float* __restrict nlp, int nxrPad) {
+    constexpr int L = LaneTraits<V>::n;
+    const V c = splv<V>(cosPhi), sn = splv<V>(sinPhi);
+    const V one = splv<V>(1.0f), lim = splv<V>(1e6f), nlim = splv<V>(-1e6f);
+    const V k0 = splv<V>(0.70710678118654752440f), k1 = splv<V>(0.61237243569579452455f);
+    const V k2 = splv<V>(0.79056941504209483300f), k3 = splv<V>(0.23385358667337133659f);
+    const V five = splv<V>(5.0f), four = splv<V>(4.0f);
+    const V sLow = splv<V>(target.sinLow), sHigh = splv<V>(target.sinHigh);
+    for (int X = 0; X < nxrPad; X += L) {
+        const V tangent = ldv<V>(gx + X) * c + ldv<V>(gy + X) * sn;
+        const V ms = ldv<V>(maxSlope + X);
+        V t = ms < tangent ? tangent : ms;
         t = t < nlim ? nlim : (t > lim ? lim : t);  // sinFromSlope
-        const v4 s = t / vsqrt(one + t * t);
-        v4 w0, w1, w2, w3;
+        const V s = t / sqrtv(one + t * t);
+        V w0, w1, w2, w3;
         if (target.window) {
             // nlpVisibleBetween(lo, hi): occlusion(hi) - occlusion(lo)
-            const v4 lo = s < sLow ? sLow : s;
-            const v4 hi = lo < sHigh ? sHigh : lo;
-            const v4 cl = one - lo * lo, ch = one - hi * hi;
+            const V lo = s < sLow ? sLow : s;
+            const V hi = lo < sHigh ? sHigh : lo;
+            const V cl = one - lo * lo, ch = one - hi * hi;
             w0 = (hi + one) * k0 - (lo + one) * k0;
             w1 = (-k1) * ch - (-k1) * cl;
             w2 = (-k2) * hi * ch - (-k2) * lo * cl;
             w3 = k3 * ch * (five * ch - four) - k3 * cl * (five * cl - four);
         } else {
             // nlpVisibleAbove(s)
-            const v4 c2 = one - s * s;
+            const V c2 = one - s * s;
             w0 = (one - s) * k0;
             w1 = k1 * c2;
             w2 = k2 * s * c2;
             w3 = (-k3) * c2 * (five * c2 - four);
         }
-        store4(nlp + X, w0);
-        store4(nlp + nxrPad + X, w1);
-        store4(nlp + 2 * nxrPad + X, w2);
-        store4(nlp + 3 * nxrPad + X, w3);
+        stv(nlp + X, w0);
+        stv(nlp + nxrPad + X, w1);
+        stv(nlp + 2 * nxrPad + X, w2);
+        stv(nlp + 3 * nxrPad + X, w3);
     }
-    (void)nxr;
 }
 
 // V += G_j w_j for a batch of azimuths (1 or 2), each SH row of V read and
 // written once per batch; the additions run in the same order as one azimuth
 // and one entry after the other (bit-identical to the plain sequence).
-// opSplat: the folded operator's entries, each repeated 4 times.
-void accumulateRows(const float* const* nlp, const float* const* opSplat, int batch, const std::uint8_t* patRow,
-                    const std::uint8_t* patNlp, int patSize, float* const* vRows, int nxr, int nxrPad) {
-    constexpr int kMaxTerms = 8;
+// opValues: the folded operator's entries of each azimuth.
+template <class V>
+[[gnu::always_inline]] inline void accumulateRows(const float* const* nlp, const float* const* opValues, int batch,
+                                                  const std::uint8_t* patRow, const std::uint8_t* patNlp, int patSize,
+                                                  float* const* vRows, int nxr, int nxrPad) {
+    constexpr int kMaxTerms = 8, L = LaneTraits<V>::n, NA = 16 / L;
     const int n16 = nxr / 16 * 16;
     int e = 0;
     while (e < patSize) {
@@ -327,30 +334,87 @@ void accumulateRows(const float* const* nlp, const float* const* opSplat, int ba
         while (e1 < patSize && patRow[e1] == r && e1 - e < kMaxTerms / 2) ++e1;
         // the terms of this SH row, in addition order: azimuth, then entry
         const float* w[kMaxTerms];
-        v4 g[kMaxTerms];
+        V g[kMaxTerms];
+        float gs[kMaxTerms];
         int nt = 0;
         for (int a = 0; a < batch; ++a)
             for (int q = e; q < e1; ++q) {
                 w[nt] = nlp[a] + static_cast<std::size_t>(patNlp[q]) * nxrPad;
-                g[nt] = load4a(opSplat[a] + 4 * q);
+                gs[nt] = opValues[a][q];
+                g[nt] = splv<V>(gs[nt]);
                 ++nt;
             }
         float* __restrict v = vRows[r];
-        // 16 receivers at a time: four independent addition chains
+        // 16 receivers at a time: independent addition chains
         for (int X = 0; X < n16; X += 16) {
-            v4 acc[4] = {load4(v + X), load4(v + X + 4), load4(v + X + 8), load4(v + X + 12)};
+            V acc[NA];
+            for (int k = 0; k < NA; ++k) acc[k] = ldv<V>(v + X + L * k);
             for (int t = 0; t < nt; ++t)
-                for (int k = 0; k < 4; ++k) acc[k] += g[t] * load4(w[t] + X + 4 * k);
-            for (int k = 0; k < 4; ++k) store4(v + X + 4 * k, acc[k]);
+                for (int k = 0; k < NA; ++k) acc[k] += g[t] * ldv<V>(w[t] + X + L * k);
+            for (int k = 0; k < NA; ++k) stv(v + X + L * k, acc[k]);
         }
         for (int X = n16; X < nxr; ++X) {
             float acc = v[X];
-            for (int t = 0; t < nt; ++t) acc += g[t][0] * w[t][X];
+            for (int t = 0; t < nt; ++t) acc += gs[t] * w[t][X];
             v[X] = acc;
         }
         e = e1;
     }
+    (void)nxrPad;
 }
+
+// One row's azimuth batch (1 or 2 azimuths from j0): the scans, their maximum
+// slopes out, NLP vectors and V += G_j w_j.
+struct RowBatch {
+    const ScanStep* steps;        // the step table (azimuths x nSteps)
+    int nSteps, nxr, nyr, nxrPad, Y, j0, batch;
+    const int* stepsPerColumn;   // azimuths x nxrPad
+    const int* stepsPerRow;      // azimuths x nyr
+    const float* cosSin;         // azimuths x 2
+    const float* h0;             // the row's receiver heights
+    const float* gradX;          // receiver, footprint lo, hi (x nxrPad)
+    const float* gradY;
+    bool foot;                   // footprint rows present
+    BlockingMax blockingMax;
+    const VisibilityTarget* target;
+    const FoldedWedgeOperator* op;
+    float* maxRow;               // nxrPad scratch
+    float* nlp;                  // 2 x 4 x nxrPad scratch
+    const float** rowPtr;        // 2 x nSteps scratch
+    float* maxSlope;             // out.maxSlope (azimuths x planes)
+    float* const* vRows;         // the row of each SH plane of V
+};
+
+template <class V>
+[[gnu::always_inline]] inline void rowBatchImpl(const RowBatch& r) {
+    const float* nlps[2];
+    const float* ops[2];
+    const std::size_t planeSize = static_cast<std::size_t>(r.nxr) * r.nyr;
+    const int P = r.op->patternSize();
+    for (int a = 0; a < r.batch; ++a) {
+        const int j = r.j0 + a;
+        const ScanStep* table = r.steps + static_cast<std::size_t>(j) * r.nSteps;
+        const int* colSteps = r.stepsPerColumn + static_cast<std::size_t>(j) * r.nxrPad;
+        const int rowSteps = r.stepsPerRow[static_cast<std::size_t>(j) * r.nyr + static_cast<std::size_t>(r.Y)];
+        if (r.blockingMax == BlockingMax::Samples)
+            scanRow<V, 16, SampleMaxVisitor>(table, colSteps, rowSteps, r.Y, r.h0, r.nxrPad, r.maxRow, r.rowPtr);
+        else
+            scanRow<V, 8, BsplineMaxVisitor>(table, colSteps, rowSteps, r.Y, r.h0, r.nxrPad, r.maxRow, r.rowPtr);
+        float* maxOut = r.maxSlope + planeSize * j + static_cast<std::size_t>(r.Y) * r.nxr;
+        std::copy(r.maxRow, r.maxRow + r.nxr, maxOut);
+        float* nlp = r.nlp + static_cast<std::size_t>(a) * 4 * r.nxrPad;
+        const float cj = r.cosSin[2 * static_cast<std::size_t>(j)], sj = r.cosSin[2 * static_cast<std::size_t>(j) + 1];
+        const float* tgx = r.foot ? r.gradX + (cj >= 0.0f ? 1 : 2) * r.nxrPad : r.gradX;
+        const float* tgy = r.foot ? r.gradY + (sj >= 0.0f ? 1 : 2) * r.nxrPad : r.gradY;
+        nlpRow<V>(r.maxRow, tgx, tgy, cj, sj, *r.target, nlp, r.nxrPad);
+        nlps[a] = nlp;
+        ops[a] = r.op->values.data() + static_cast<std::size_t>(j) * P;
+    }
+    accumulateRows<V>(nlps, ops, r.batch, r.op->patternRow.data(), r.op->patternNlp.data(), P, r.vRows, r.nxr, r.nxrPad);
+}
+
+void rowBatchSse(const RowBatch& r) { rowBatchImpl<simd::F4>(r); }
+[[gnu::target("avx2"), gnu::flatten]] void rowBatchAvx2(const RowBatch& r) { rowBatchImpl<simd::F8>(r); }
 
 }  // namespace
 
@@ -504,9 +568,7 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
         state.cosSin[2 * static_cast<std::size_t>(j)] = static_cast<float>(std::cos(op.phi[static_cast<std::size_t>(j)]));
         state.cosSin[2 * static_cast<std::size_t>(j) + 1] = static_cast<float>(std::sin(op.phi[static_cast<std::size_t>(j)]));
     }
-    state.opSplat.resize(static_cast<std::size_t>(m) * 4 * op.patternSize());
-    for (std::size_t e = 0; e < op.values.size(); ++e)
-        for (int l = 0; l < 4; ++l) state.opSplat[4 * e + static_cast<std::size_t>(l)] = op.values[e];
+    void (*const rowBatch)(const RowBatch&) = simd::wideEnabled() ? rowBatchAvx2 : rowBatchSse;
 
     const int nBlocks = std::max(1, std::min(nyr, kMaxBlocks));
     state.blocks.resize(static_cast<std::size_t>(nBlocks));
@@ -555,30 +617,11 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
                     std::fill(vRows[i], vRows[i] + nxr, 0.0f);
                 }
                 for (int j0 = 0; j0 < m; j0 += 2) {
-                    const int batch = std::min(2, m - j0);
-                    const float* nlps[2];
-                    const float* ops[2];
-                    for (int a = 0; a < batch; ++a) {
-                        const int j = j0 + a;
-                        const ScanStep* table = state.steps.data() + static_cast<std::size_t>(j) * nSteps;
-                        const int* colSteps = state.stepsPerColumn.data() + static_cast<std::size_t>(j) * nxrPad;
-                        const int rowSteps = state.stepsPerRow[static_cast<std::size_t>(j) * nyr + static_cast<std::size_t>(Y)];
-                        if (settings.blockingMax == BlockingMax::Samples)
-                            scanRow<4, SampleMaxVisitor>(table, colSteps, rowSteps, Y, sc.h0.data(), nxrPad, sc.maxRow.data(), sc.rowPtr.data());
-                        else
-                            scanRow<2, BsplineMaxVisitor>(table, colSteps, rowSteps, Y, sc.h0.data(), nxrPad, sc.maxRow.data(), sc.rowPtr.data());
-                        float* maxOut = out.maxSlope.data() + planeSize * j + static_cast<std::size_t>(Y) * nxr;
-                        std::copy(sc.maxRow.data(), sc.maxRow.data() + nxr, maxOut);
-                        float* nlp = sc.nlp.data() + static_cast<std::size_t>(a) * 4 * nxrPad;
-                        const float cj = state.cosSin[2 * static_cast<std::size_t>(j)], sj = state.cosSin[2 * static_cast<std::size_t>(j) + 1];
-                        const float* tgx = foot ? sc.gradX.data() + (cj >= 0.0f ? 1 : 2) * nxrPad : sc.gradX.data();
-                        const float* tgy = foot ? sc.gradY.data() + (sj >= 0.0f ? 1 : 2) * nxrPad : sc.gradY.data();
-                        nlpRow(sc.maxRow.data(), tgx, tgy, cj, sj, target, nlp, nxr, nxrPad);
-                        nlps[a] = nlp;
-                        ops[a] = state.opSplat.data() + static_cast<std::size_t>(j) * 4 * op.patternSize();
-                    }
-                    accumulateRows(nlps, ops, batch, op.patternRow.data(), op.patternNlp.data(), op.patternSize(), vRows, nxr,
-                                   nxrPad);
+                    const RowBatch rb{state.steps.data(), nSteps, nxr, nyr, nxrPad, Y, j0, std::min(2, m - j0),
+                                      state.stepsPerColumn.data(), state.stepsPerRow.data(), state.cosSin.data(),
+                                      sc.h0.data(), sc.gradX.data(), sc.gradY.data(), foot, settings.blockingMax, &target,
+                                      &op, sc.maxRow.data(), sc.nlp.data(), sc.rowPtr.data(), out.maxSlope.data(), vRows};
+                    rowBatch(rb);
                 }
             }
         }

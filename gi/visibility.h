@@ -139,7 +139,6 @@ struct VisibilityState {
     std::vector<int> validRows;     // azimuths x steps: same for receiver rows Y (pairs)
     std::vector<int> stepsPerColumn;  // azimuths x padded nxr: valid-prefix length from x alone
     std::vector<int> stepsPerRow;     // azimuths x nyr: valid-prefix length from y alone
-    std::vector<float> opSplat;       // the folded operator's entries, each 4 times (16-byte aligned)
     std::vector<float> cosSin;        // azimuths x 2: cos, sin of each azimuth (float)
 };
 

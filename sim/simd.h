@@ -20,6 +20,53 @@ namespace terrain::simd {
 using F4 = float __attribute__((vector_size(16)));
 constexpr int kLanes = 4;
 
+// ---- width-generic kernels: F4 (SSE2) and F8 (AVX2) -------------------------
+// A hot kernel written once over V = F4 or F8 is compiled twice: as usual, and
+// inside a [[gnu::target("avx2"), gnu::flatten]] wrapper that inlines the F8
+// instance (wideEnabled() picks one at run time). The helpers below are
+// always-inline (the two AVX ones plain inline: they may only be inlined into
+// AVX code, which flatten does). Both paths use the same correctly rounded
+// lane-wise IEEE operations and neither fuses a multiply-add (the wrappers
+// enable AVX2 but not FMA), so they give bit-identical results.
+// F8 values only pass between inlined helpers; GCC's note that their
+// out-of-line ABI would differ without AVX does not apply (silenced for every
+// file that includes this header: instances are made where kernels use them).
+#pragma GCC diagnostic ignored "-Wpsabi"
+using I4 = int __attribute__((vector_size(16)));
+using F8 = float __attribute__((vector_size(32)));
+using I8 = int __attribute__((vector_size(32)));
+template <class V>
+struct LaneTraits;
+template <>
+struct LaneTraits<F4> {
+    using I = I4;
+    static constexpr int n = 4;
+};
+template <>
+struct LaneTraits<F8> {
+    using I = I8;
+    static constexpr int n = 8;
+};
+template <class V>
+[[gnu::always_inline]] inline V ldv(const float* p) {
+    V v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+}
+template <class V>
+[[gnu::always_inline]] inline void stv(float* p, V v) {
+    std::memcpy(p, &v, sizeof v);
+}
+template <class V>
+[[gnu::always_inline]] inline V splv(float x) {
+    return V{} + x;
+}
+[[gnu::always_inline]] inline F4 sqrtv(F4 x) { return __builtin_ia32_sqrtps(x); }
+[[gnu::target("avx")]] inline F8 sqrtv(F8 x) { return __builtin_ia32_sqrtps256(x); }
+/// One bit per lane: the lane's sign bit (a comparison mask's "true").
+[[gnu::always_inline]] inline int laneBits(I4 m) { return __builtin_ia32_movmskps(reinterpret_cast<F4>(m)); }
+[[gnu::target("avx")]] inline int laneBits(I8 m) { return __builtin_ia32_movmskps256(reinterpret_cast<F8>(m)); }
+
 template <class T>
 inline T load(const float* p) {
     if constexpr (std::is_same_v<T, float>) {
