@@ -292,7 +292,7 @@ int main(int argc, char** argv) {
         const Dem d = erodedScene(gProbe, 0);
         const AlbedoMap a = uniformAlbedo(gProbe, gProbe, albedo);
         GiState st;
-        std::vector<double> t, ti, ts;
+        std::vector<double> t, ti, ts, parts[9];
         withThreads(2, [&] {
             for (int f = 0; f <= gRuns; ++f) {
                 const auto t0 = Clock::now();
@@ -301,10 +301,20 @@ int main(int argc, char** argv) {
                 t.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
                 ti.push_back(st.timings.indirect);
                 ts.push_back(st.indirect.timings.scan);
+                const double v[9] = {st.timings.gradient, st.timings.pyramid, st.timings.visibility, st.timings.keyVisibility,
+                                     st.timings.shading, st.indirect.timings.pyramid, st.indirect.timings.scan,
+                                     st.indirect.timings.shading, st.indirect.timings.total};
+                for (int k = 0; k < 9; ++k) parts[k].push_back(v[k]);
             }
         });
         std::fprintf(stderr, "%d^2 2x 1 bounce: frame %.1f ms, indirect %.1f ms, scan %.1f ms (medians of %d, 2 threads)\n", gProbe,
                      bench::median(t), bench::median(ti), bench::median(ts), gRuns);
+        std::fprintf(stderr,
+                     "  gradient %.2f, height pyramid %.2f, env visibility %.2f, key visibility %.2f, direct shading %.2f; "
+                     "indirect: radiance pyramid %.2f, scan %.2f, shading %.2f, total %.2f ms\n",
+                     bench::median(parts[0]), bench::median(parts[1]), bench::median(parts[2]), bench::median(parts[3]),
+                     bench::median(parts[4]), bench::median(parts[5]), bench::median(parts[6]), bench::median(parts[7]),
+                     bench::median(parts[8]));
         return 0;
     }
     if (gDiagnose) {

@@ -534,7 +534,7 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
         // ---- shading of U at full-resolution normals: L_b ------------------------------
         t = Clock::now();
         ShadeMaps& out = st.bounceShade[static_cast<std::size_t>(b & 1)];
-        shadeTexels(gradX, gradY, s, envVisibility, st.lights.data(), 3, albedo, shading, out);
+        shadeTexels(gradX, gradY, s, envVisibility, st.lights.data(), 3, albedo, shading, out, false);
         double sum = 0.0;
         for (int c = 0; c < 3; ++c) {
             Grid& acc = st.indirect[static_cast<std::size_t>(c)];

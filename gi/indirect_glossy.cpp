@@ -490,7 +490,7 @@ void computeGlossyIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstG
         // ---- shading of U at full-resolution normals: L_b; its incident SH feeds bounce b + 1
         t = Clock::now();
         ShadeMaps& out = st.bounceShade[static_cast<std::size_t>(b & 1)];
-        shadeTexels(gradX, gradY, s, envVisibility, st.lights.data(), 3, surface, shading, out);
+        shadeTexels(gradX, gradY, s, envVisibility, st.lights.data(), 3, surface, shading, out, false);
         double sum = 0.0;
         for (int c = 0; c < 3; ++c) {
             Grid& acc = st.indirect[static_cast<std::size_t>(c)];

@@ -4,9 +4,11 @@
 #include <cmath>
 #include <cstring>
 #include <string>
+#include <type_traits>
 
 #include "sim/error.h"
 #include "sim/parallel.h"
+#include "sim/simd.h"
 
 namespace terrain::gi {
 
@@ -32,17 +34,16 @@ void setPhongExponentMap(AlbedoMap& map, const Grid& exponent) {
 
 namespace {
 
-// 4-wide float vectors (GCC vector extensions, baseline SSE2; lane-wise IEEE
-// operations, so each texel gets exactly the scalar result).
-typedef float v4 __attribute__((vector_size(16)));
-typedef int v4i __attribute__((vector_size(16)));
-inline v4 load4(const float* p) {
-    v4 v;
-    std::memcpy(&v, p, sizeof v);
-    return v;
-}
-inline void store4(float* p, v4 v) { std::memcpy(p, &v, sizeof v); }
-inline v4 splat(float x) { return v4{x, x, x, x}; }
+// Kernels over the lane type V: F4 (SSE2) or F8 (AVX2, chosen at run time),
+// sim/simd.h; lane-wise IEEE operations, so each texel gets exactly the
+// scalar result either way.
+using simd::F4;
+using simd::F8;
+using simd::LaneTraits;
+using simd::ldv;
+using simd::splv;
+using simd::sqrtv;
+using simd::stv;
 
 constexpr int kMaxShadingLights = 8;  // lights per incident pass (more are folded in several passes)
 
@@ -67,20 +68,26 @@ inline void shBasisFloat(float x, float y, float z, float* o, int count) {
     o[15] = 0.59004358992664352f * x * (x * x - 3.0f * y * y);
 }
 
-// ---- algorithm: horizontal SH interpolation (Fig. 7), 4 texels x .. x+3 ------
+// ---- algorithm: horizontal SH interpolation (Fig. 7), L texels x .. x+L-1 ----
 // Texel x = s X + k reads v[X] + (k / s) (v[X + 1] - v[X]), as the scalar code.
-template <int S>
-inline v4 expand4(const float* v, int x) {
+template <class V, int S>
+[[gnu::always_inline]] inline V expandV(const float* v, int x) {
+    using I = typename LaneTraits<V>::I;
+    constexpr int L = LaneTraits<V>::n;
     if constexpr (S == 1) {
-        return load4(v + x);
-    } else if constexpr (S == 2) {
-        const v4 a = load4(v + x / 2);
-        const v4 lo = __builtin_shuffle(a, v4i{0, 0, 1, 1});
-        const v4 hi = __builtin_shuffle(a, v4i{1, 1, 2, 2});
-        return lo + v4{0.0f, 0.5f, 0.0f, 0.5f} * (hi - lo);
+        return ldv<V>(v + x);
     } else {
-        const v4 lo = splat(v[x / 4]), hi = splat(v[x / 4 + 1]);
-        return lo + v4{0.0f, 0.25f, 0.5f, 0.75f} * (hi - lo);
+        // lane l reads X0 + l / S and X0 + l / S + 1 with the weight (l % S) / S
+        I lo{}, fr{};
+        V f{};
+        for (int l = 0; l < L; ++l) {
+            lo[l] = l / S;
+            fr[l] = l / S + 1;
+            f[l] = static_cast<float>(l % S) / static_cast<float>(S);
+        }
+        const V a = ldv<V>(v + x / S);
+        const V vlo = __builtin_shuffle(a, lo), vhi = __builtin_shuffle(a, fr);
+        return vlo + f * (vhi - vlo);
     }
 }
 
@@ -89,11 +96,11 @@ inline v4 expand4(const float* v, int x) {
 // 0 .. 3 nCoef - 1: incident radiance per channel; then 9 planes of V_env).
 // Each texel: lam(N) . I_c for the channels, lam(N) . V_env for the ambient
 // map, with lam the clamped-cosine zonal vector turned to the texel's normal.
-template <int S>
-void lambertRowS(const float* vert, int nxrS, int nxr, int nCoef, const float* gxr, const float* gyr, const int* colIndex,
+template <class V, int S>
+[[gnu::always_inline]] inline void lambertRowS(const float* vert, int nxrS, int nxr, int nCoef, const float* gxr, const float* gyr, const int* colIndex,
                  const float* colFrac, float lam0, float lam1, float lam2, float diffuseWeight, const AlbedoMap* albedo, int y,
                  int nx, ShadeMaps& out) {
-    float* amb = out.ambient.data() + static_cast<std::size_t>(y) * nx;
+    float* amb = out.ambient.empty() ? nullptr : out.ambient.data() + static_cast<std::size_t>(y) * nx;
     float* rgb[3];
     const float* alb[3];
     for (int ch = 0; ch < 3; ++ch) {
@@ -103,28 +110,31 @@ void lambertRowS(const float* vert, int nxrS, int nxr, int nCoef, const float* g
     }
     const float c0 = lam0 * 0.28209479177387814f, c1 = lam1 * 0.48860251190291992f;
     const float c4 = lam2 * 1.0925484305920792f, c6 = lam2 * 0.31539156525252005f, c8 = lam2 * 0.54627421529603959f;
-    // texels [0, xVec) take the vector path: all of x .. x+3 below s (nxr - 1)
+    // texels [0, xVec) take the vector path: all of x .. x+L-1 below s (nxr - 1)
+    using I = typename LaneTraits<V>::I;
+    constexpr int L = LaneTraits<V>::n;
     const int interior = S * std::max(nxr - 1, 0);
-    const int xVec = nxr >= 3 ? (interior - (S == 2 ? 2 : 0)) / 4 * 4 : 0;
-    const v4 fmax = splat(3.40282347e38f);
-    for (int x = 0; x < xVec; x += 4) {
-        const v4 gx = load4(gxr + x), gy = load4(gyr + x);
-        const v4 inv = splat(1.0f) / __builtin_ia32_sqrtps(splat(1.0f) + gx * gx + gy * gy);
-        const v4 X = -gx * inv, Yn = -gy * inv, Z = inv;
-        const v4 lam[9] = {splat(c0), splat(c1) * Yn, splat(c1) * Z, splat(c1) * X, splat(c4) * X * Yn, splat(c4) * Yn * Z,
+    const int xVec = nxr >= 3 ? std::max(0, interior - (S == 2 ? 2 : 0)) / L * L : 0;
+    const V fmax = splv<V>(3.40282347e38f);
+    auto splat = [](float x) { return splv<V>(x); };
+    for (int x = 0; x < xVec; x += L) {
+        const V gx = ldv<V>(gxr + x), gy = ldv<V>(gyr + x);
+        const V inv = splat(1.0f) / sqrtv(splat(1.0f) + gx * gx + gy * gy);
+        const V X = -gx * inv, Yn = -gy * inv, Z = inv;
+        const V lam[9] = {splat(c0), splat(c1) * Yn, splat(c1) * Z, splat(c1) * X, splat(c4) * X * Yn, splat(c4) * Yn * Z,
                            splat(c6) * (3.0f * Z * Z - 1.0f), splat(c4) * X * Z, splat(c8) * (X * X - Yn * Yn)};
         // the four dot products interleaved: independent addition chains
-        v4 acc = splat(0.0f), oc[3] = {splat(0.0f), splat(0.0f), splat(0.0f)};
+        V acc = splat(0.0f), oc[3] = {splat(0.0f), splat(0.0f), splat(0.0f)};
         for (int i = 0; i < 9; ++i) {
-            acc += lam[i] * expand4<S>(vert + static_cast<std::size_t>(3 * nCoef + i) * nxrS, x);
-            for (int ch = 0; ch < 3; ++ch) oc[ch] += lam[i] * expand4<S>(vert + static_cast<std::size_t>(ch * nCoef + i) * nxrS, x);
+            if (amb) acc += lam[i] * expandV<V, S>(vert + static_cast<std::size_t>(3 * nCoef + i) * nxrS, x);
+            for (int ch = 0; ch < 3; ++ch) oc[ch] += lam[i] * expandV<V, S>(vert + static_cast<std::size_t>(ch * nCoef + i) * nxrS, x);
         }
-        store4(amb + x, acc);
+        if (amb) stv(amb + x, acc);
         for (int ch = 0; ch < 3; ++ch) {
-            v4 o = oc[ch];
-            o *= diffuseWeight * (alb[ch] ? load4(alb[ch] + x) : splat(1.0f));
-            const v4i finite = (o < fmax) & (o > -fmax);  // false for NaN and +-Inf
-            store4(rgb[ch] + x, finite ? o : splat(0.0f));
+            V o = oc[ch];
+            o *= diffuseWeight * (alb[ch] ? ldv<V>(alb[ch] + x) : splat(1.0f));
+            const I finite = (o < fmax) & (o > -fmax);  // false for NaN and +-Inf
+            stv(rgb[ch] + x, finite ? o : splat(0.0f));
         }
     }
     // remaining texels, scalar (same operations)
@@ -141,9 +151,11 @@ void lambertRowS(const float* vert, int nxrS, int nxr, int nCoef, const float* g
             const float* v = vert + static_cast<std::size_t>(plane) * nxrS;
             return S == 1 ? v[x] : v[X0] + f * (v[X1] - v[X0]);
         };
-        float acc = 0.0f;
-        for (int i = 0; i < 9; ++i) acc += lam[i] * u(3 * nCoef + i);
-        amb[x] = acc;
+        if (amb) {
+            float acc = 0.0f;
+            for (int i = 0; i < 9; ++i) acc += lam[i] * u(3 * nCoef + i);
+            amb[x] = acc;
+        }
         for (int ch = 0; ch < 3; ++ch) {
             float o = 0.0f;
             for (int i = 0; i < 9; ++i) o += lam[i] * u(ch * nCoef + i);
@@ -153,12 +165,109 @@ void lambertRowS(const float* vert, int nxrS, int nxr, int nCoef, const float* g
     }
 }
 
-void lambertRow(const float* vert, int nxrS, int nxr, int s, int nCoef, const float* gxr, const float* gyr, const int* colIndex,
-                const float* colFrac, float lam0, float lam1, float lam2, float diffuseWeight, const AlbedoMap* albedo, int y,
-                int nx, ShadeMaps& out) {
-    if (s == 1) lambertRowS<1>(vert, nxrS, nxr, nCoef, gxr, gyr, colIndex, colFrac, lam0, lam1, lam2, diffuseWeight, albedo, y, nx, out);
-    else if (s == 2) lambertRowS<2>(vert, nxrS, nxr, nCoef, gxr, gyr, colIndex, colFrac, lam0, lam1, lam2, diffuseWeight, albedo, y, nx, out);
-    else lambertRowS<4>(vert, nxrS, nxr, nCoef, gxr, gyr, colIndex, colFrac, lam0, lam1, lam2, diffuseWeight, albedo, y, nx, out);
+// One full-resolution Lambert row: the SH planes interpolated vertically at
+// the receivers (Fig. 7), then lambertRowS.
+struct LambertRowJob {
+    const float* incident;  // 3 nCoef planes at the receivers
+    const VisibilityField* env;  // V_env (ambient); null: no ambient map
+    std::size_t planeR;
+    int nxr, nyr, nxrS, s, nCoef, nx;
+    const int* colIndex;
+    const float* colFrac;
+    float lam0, lam1, lam2, diffuseWeight;
+    const AlbedoMap* albedo;
+    ShadeMaps* out;
+};
+
+template <class V>
+[[gnu::always_inline]] inline void lambertShadeRowImpl(const LambertRowJob& j, float* vert, const float* gxr,
+                                                       const float* gyr, int y) {
+    constexpr int L = LaneTraits<V>::n;
+    const ReceiverLerp ry = receiverLerp(y, j.s, j.nyr);
+    const int nPlanes = 3 * j.nCoef + (j.env ? 9 : 0);
+    const int nv = j.nxr / L * L;
+    const V fy = splv<V>(ry.f);
+    for (int p = 0; p < nPlanes; ++p) {
+        const float* plane = p < 3 * j.nCoef ? j.incident + static_cast<std::size_t>(p) * j.planeR : j.env->plane(p - 3 * j.nCoef);
+        const float* __restrict ra = plane + static_cast<std::size_t>(ry.i0) * j.nxr;
+        const float* __restrict rb = plane + static_cast<std::size_t>(ry.i1) * j.nxr;
+        float* __restrict v = vert + static_cast<std::size_t>(p) * j.nxrS;
+        for (int X = 0; X < nv; X += L) {
+            const V a = ldv<V>(ra + X);
+            stv(v + X, a + fy * (ldv<V>(rb + X) - a));
+        }
+        for (int X = nv; X < j.nxr; ++X) v[X] = ra[X] + ry.f * (rb[X] - ra[X]);
+        for (int X = j.nxr; X < j.nxrS; ++X) v[X] = 0.0f;
+    }
+    auto row = [&](auto sTag) {
+        constexpr int S = decltype(sTag)::value;
+        lambertRowS<V, S>(vert, j.nxrS, j.nxr, j.nCoef, gxr, gyr, j.colIndex, j.colFrac, j.lam0, j.lam1, j.lam2,
+                          j.diffuseWeight, j.albedo, y, j.nx, *j.out);
+    };
+    if (j.s == 1) row(std::integral_constant<int, 1>{});
+    else if (j.s == 2) row(std::integral_constant<int, 2>{});
+    else row(std::integral_constant<int, 4>{});
+}
+void lambertShadeRowSse(const LambertRowJob& j, float* vert, const float* gxr, const float* gyr, int y) {
+    lambertShadeRowImpl<F4>(j, vert, gxr, gyr, y);
+}
+[[gnu::target("avx2"), gnu::flatten]] void lambertShadeRowAvx2(const LambertRowJob& j, float* vert, const float* gxr,
+                                                                const float* gyr, int y) {
+    lambertShadeRowImpl<F8>(j, vert, gxr, gyr, y);
+}
+
+// ---- algorithm, receivers: incident radiance I_c = sum_L T_{L,c} V_L, row Y ----
+// 16 receivers at a time: the lights' V vectors are read once, each output
+// coefficient sums its non-zero matrix entries in a fixed order (light, k).
+template <class V>
+[[gnu::always_inline]] inline void incidentRowImpl(const ShadingLight* lights, int nl, int nCoef, int nxr, std::size_t planeR,
+                                                   ShadeMaps& out, int Y) {
+    constexpr int L = LaneTraits<V>::n, NQ = 16 / L;
+    const std::size_t r0 = static_cast<std::size_t>(Y) * nxr;
+    for (int X = 0; X < nxr; X += 16) {
+        const int n = std::min(16, nxr - X);
+        for (int g0 = 0; g0 < nl; g0 += kMaxShadingLights) {
+            const int g1 = std::min(nl, g0 + kMaxShadingLights);
+            V v[kMaxShadingLights * kShCount][NQ];
+            for (int Li = g0; Li < g1; ++Li)
+                for (int k = 0; k < kShCount; ++k) {
+                    const float* p = lights[Li].visibility->plane(k) + r0 + X;
+                    for (int q = 0; q < NQ; ++q) {
+                        V a = splv<V>(0.0f);
+                        if (L * q + L <= n) a = ldv<V>(p + L * q);
+                        else
+                            for (int e = L * q; e < n; ++e) a[e - L * q] = p[e];
+                        v[(Li - g0) * kShCount + k][q] = a;
+                    }
+                }
+            for (int c = 0; c < 3 * nCoef; ++c) {
+                float* o = out.incident.data() + static_cast<std::size_t>(c) * planeR + r0 + X;
+                V acc[NQ];
+                for (int q = 0; q < NQ; ++q) acc[q] = splv<V>(0.0f);
+                if (g0 > 0)
+                    for (int e = 0; e < n; ++e) acc[e / L][e % L] = o[e];
+                for (int e = out.incidentTermStart[static_cast<std::size_t>(c)]; e < out.incidentTermStart[static_cast<std::size_t>(c + 1)]; ++e) {
+                    const ShadeMaps::Term& term = out.incidentTerms[static_cast<std::size_t>(e)];
+                    const int slot = term.index - g0 * kShCount;
+                    if (slot < 0 || slot >= kMaxShadingLights * kShCount) continue;
+                    const V t = splv<V>(term.value);
+                    for (int q = 0; q < NQ; ++q) acc[q] += t * v[slot][q];
+                }
+                for (int q = 0; q < NQ; ++q) {
+                    if (L * q + L <= n) stv(o + L * q, acc[q]);
+                    else
+                        for (int e = L * q; e < n; ++e) o[e] = acc[q][e - L * q];
+                }
+            }
+        }
+    }
+}
+void incidentRowSse(const ShadingLight* lights, int nl, int nCoef, int nxr, std::size_t planeR, ShadeMaps& out, int Y) {
+    incidentRowImpl<F4>(lights, nl, nCoef, nxr, planeR, out, Y);
+}
+[[gnu::target("avx2"), gnu::flatten]] void incidentRowAvx2(const ShadingLight* lights, int nl, int nCoef, int nxr,
+                                                            std::size_t planeR, ShadeMaps& out, int Y) {
+    incidentRowImpl<F8>(lights, nl, nCoef, nxr, planeR, out, Y);
 }
 
 }  // namespace
@@ -171,7 +280,7 @@ AlbedoMap uniformAlbedo(int nx, int ny, float albedo) {
 
 void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const VisibilityField& env,
                  const ShadingLight* lights, int lightCount, const AlbedoMap* albedo, const ShadingSettings& settings,
-                 ShadeMaps& out) {
+                 ShadeMaps& out, bool ambient) {
     const int nx = gradX.nx, ny = gradX.ny;
     const int nxr = env.nxr, nyr = env.nyr;
     const std::size_t planeR = static_cast<std::size_t>(nxr) * nyr;
@@ -181,11 +290,12 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
     out.ny = ny;
     for (Grid& g : out.rgb)
         if (g.nx != nx || g.ny != ny) g.resize(nx, ny);
-    if (out.ambient.nx != nx || out.ambient.ny != ny) out.ambient.resize(nx, ny);
+    if (!ambient) out.ambient = Grid{};
+    else if (out.ambient.nx != nx || out.ambient.ny != ny) out.ambient.resize(nx, ny);
     out.incident.resize(planeR * 3 * nCoef);
-    const int nPlanes = 3 * nCoef + 9;  // incident radiance + V_env bands 0..2 (ambient)
+    const int nPlanes = 3 * nCoef + (ambient ? 9 : 0);  // incident radiance + V_env bands 0..2 (ambient)
     const int nBlocks = std::max(1, std::min(ny, 64));
-    const int nxrS = nxr + 4;  // vertical scratch rows padded for 4-wide reads
+    const int nxrS = nxr + 8;  // vertical scratch rows padded for 8-wide reads
     out.rowScratch.resize(static_cast<std::size_t>(nBlocks) * nPlanes * (nxrS + nx));
     out.basisScratch.resize(static_cast<std::size_t>(nBlocks) * 24 * nx);
 
@@ -202,8 +312,7 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
                     static_cast<float>(lights[L].product[static_cast<std::size_t>(ch)][static_cast<std::size_t>(e)]);
 
     // ---- algorithm, receivers: incident radiance I_c = sum_L T_{L,c} V_L ------
-    // 4 receivers at a time: the lights' V vectors are read once, each output
-    // coefficient sums its non-zero matrix entries in a fixed order (light, k).
+    // (incidentRowImpl) over the non-zero matrix entries of each output coefficient
     out.incidentTerms.clear();
     out.incidentTermStart.assign(static_cast<std::size_t>(3 * nCoef + 1), 0);
     for (int ch = 0; ch < 3; ++ch)
@@ -213,53 +322,16 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
                     const float t = out.lightMatrices[((static_cast<std::size_t>(L) * 3 + ch) * kShCount + i) * kShCount + k];
                     if (t != 0.0f) {
                         ShadeMaps::Term term;
-                        term.value = v4{t, t, t, t};
+                        term.value = t;
                         term.index = L * kShCount + k;
                         out.incidentTerms.push_back(term);
                     }
                 }
             out.incidentTermStart[static_cast<std::size_t>(ch * nCoef + i + 1)] = static_cast<int>(out.incidentTerms.size());
         }
+    const bool wide = simd::wideEnabled();
     parallelForRows(nyr, nxr * 16, [&](int y0, int y1) {
-        for (int Y = y0; Y < y1; ++Y) {
-            const std::size_t r0 = static_cast<std::size_t>(Y) * nxr;
-            // 16 receivers at a time: four independent accumulation chains
-            for (int X = 0; X < nxr; X += 16) {
-                const int n = std::min(16, nxr - X);
-                for (int g0 = 0; g0 < nl; g0 += kMaxShadingLights) {
-                    const int g1 = std::min(nl, g0 + kMaxShadingLights);
-                    v4 v[kMaxShadingLights * kShCount][4];
-                    for (int L = g0; L < g1; ++L)
-                        for (int k = 0; k < kShCount; ++k) {
-                            const float* p = lights[L].visibility->plane(k) + r0 + X;
-                            for (int q = 0; q < 4; ++q) {
-                                v4 a = splat(0.0f);
-                                if (4 * q + 4 <= n) a = load4(p + 4 * q);
-                                else
-                                    for (int e = 4 * q; e < n; ++e) a[e - 4 * q] = p[e];
-                                v[(L - g0) * kShCount + k][q] = a;
-                            }
-                        }
-                    for (int c = 0; c < 3 * nCoef; ++c) {
-                        float* o = out.incident.data() + static_cast<std::size_t>(c) * planeR + r0 + X;
-                        v4 acc[4] = {splat(0.0f), splat(0.0f), splat(0.0f), splat(0.0f)};
-                        if (g0 > 0)
-                            for (int e = 0; e < n; ++e) acc[e / 4][e % 4] = o[e];
-                        for (int e = out.incidentTermStart[static_cast<std::size_t>(c)]; e < out.incidentTermStart[static_cast<std::size_t>(c + 1)]; ++e) {
-                            const ShadeMaps::Term& term = out.incidentTerms[static_cast<std::size_t>(e)];
-                            const int slot = term.index - g0 * kShCount;
-                            if (slot < 0 || slot >= kMaxShadingLights * kShCount) continue;
-                            for (int q = 0; q < 4; ++q) acc[q] += term.value * v[slot][q];
-                        }
-                        for (int q = 0; q < 4; ++q) {
-                            if (4 * q + 4 <= n) store4(o + 4 * q, acc[q]);
-                            else
-                                for (int e = 4 * q; e < n; ++e) o[e] = acc[q][e - 4 * q];
-                        }
-                    }
-                }
-            }
-        }
+        for (int Y = y0; Y < y1; ++Y) (wide ? incidentRowAvx2 : incidentRowSse)(lights, nl, nCoef, nxr, planeR, out, Y);
     });
 
     // ---- interpolation tables (receiver X sits at column s X) -----------------
@@ -277,6 +349,9 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
     const float diffuseWeight = settings.brdf == Brdf::Phong ? 0.0f : 1.0f;
     const float specWeight = specularWeightOf(settings);
     const float vx = settings.viewDir[0], vy = settings.viewDir[1], vz = settings.viewDir[2];
+    const LambertRowJob lambertJob{out.incident.data(), ambient ? &env : nullptr, planeR, nxr, nyr, nxrS, s, nCoef, nx,
+                                   out.colIndex.data(), out.colFrac.data(), lam0, lam1, lam2, diffuseWeight, albedo, &out};
+    const auto lambertShadeRow = wide ? lambertShadeRowAvx2 : lambertShadeRowSse;
 
     // ---- schedule: fixed row blocks, each with its own scratch ---------------
     parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
@@ -287,6 +362,10 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
             const int yBegin = static_cast<int>(static_cast<long long>(ny) * block / nBlocks);
             const int yEnd = static_cast<int>(static_cast<long long>(ny) * (block + 1) / nBlocks);
             for (int y = yBegin; y < yEnd; ++y) {
+                if (!phong) {
+                    lambertShadeRow(lambertJob, vert, gradX.row(y), gradY.row(y), y);
+                    continue;
+                }
                 // ---- algorithm: SH vectors interpolated to this row (Fig. 7) ----
                 const ReceiverLerp ry = receiverLerp(y, s, nyr);
                 const int Y0 = ry.i0, Y1 = ry.i1;
@@ -299,7 +378,6 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
                     float* __restrict v = vert + static_cast<std::size_t>(p) * nxrS;
                     for (int X = 0; X < nxr; ++X) v[X] = ra[X] + fy * (rb[X] - ra[X]);
                     for (int X = nxr; X < nxrS; ++X) v[X] = 0.0f;
-                    if (!phong) continue;  // Lambert: interpolated horizontally on the fly below
                     float* __restrict u = up + static_cast<std::size_t>(p) * nx;
                     if (s == 1) {
                         std::copy(v, v + nx, u);
@@ -316,11 +394,6 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
                             u[x] = v[X0] + fx * (v[X1] - v[X0]);
                         }
                     }
-                }
-                if (!phong) {
-                    lambertRow(vert, nxrS, nxr, s, nCoef, gradX.row(y), gradY.row(y), out.colIndex.data(), out.colFrac.data(),
-                               lam0, lam1, lam2, diffuseWeight, albedo, y, nx, out);
-                    continue;
                 }
                 // ---- algorithm: rotated BRDF at each full-resolution normal -----
                 const float* __restrict gxr = gradX.row(y);
@@ -340,9 +413,10 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
                     lamRow[7 * nx + x] = lam2 * 1.0925484305920792f * X * Z;
                     lamRow[8 * nx + x] = lam2 * 0.54627421529603959f * (X * X - Yn * Yn);
                 }
-                float* __restrict amb = out.ambient.data() + static_cast<std::size_t>(y) * nx;
-                for (int x = 0; x < nx; ++x) amb[x] = 0.0f;
-                for (int i = 0; i < 9; ++i) {
+                float* __restrict amb = ambient ? out.ambient.data() + static_cast<std::size_t>(y) * nx : nullptr;
+                if (amb)
+                    for (int x = 0; x < nx; ++x) amb[x] = 0.0f;
+                for (int i = 0; i < (amb ? 9 : 0); ++i) {
                     const float* __restrict l = lamRow + static_cast<std::size_t>(i) * nx;
                     const float* __restrict u = up + static_cast<std::size_t>(3 * nCoef + i) * nx;
                     for (int x = 0; x < nx; ++x) amb[x] += l[x] * u[x];

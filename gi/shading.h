@@ -104,7 +104,7 @@ struct ShadeMaps {
     std::vector<float> colFrac;   // and the fraction towards the right one
     std::vector<float> lightMatrices;  // lights x 3 x 16 x 16, float copies of the product matrices
     struct Term {
-        alignas(16) float value __attribute__((vector_size(16)));  // the matrix entry, 4 times
+        float value;  // the matrix entry
         int index;  // light * 16 + k
     };
     std::vector<Term> incidentTerms;     // non-zero matrix entries per output coefficient
@@ -113,10 +113,12 @@ struct ShadeMaps {
     std::vector<float> basisScratch;  // per row block: rotated BRDF coefficients of one row
 };
 
-/// Shades every texel. envVisibility supplies the ambient map; lights the
-/// incident radiance. gradX/gradY are the full resolution height derivatives.
+/// Shades every texel. envVisibility supplies the ambient map (with ambient
+/// false none is made and out.ambient is left empty: the indirect bounces);
+/// lights the incident radiance. gradX/gradY are the full resolution height
+/// derivatives.
 void shadeTexels(ConstGridView gradX, ConstGridView gradY, int subsample, const VisibilityField& envVisibility,
                  const ShadingLight* lights, int lightCount, const AlbedoMap* albedo, const ShadingSettings& settings,
-                 ShadeMaps& out);
+                 ShadeMaps& out, bool ambient = true);
 
 }  // namespace terrain::gi
