@@ -83,149 +83,153 @@ struct RowInputs {
 // nlp[(12 + c) * pad + X] alone).
 constexpr int kShOnly = 0, kShAndExact = 1, kExactOnly = 2;
 
-template <class V, int NV, int Mode>
-[[gnu::always_inline]] inline void castGroup(const ScanStep* hTab, const ScanStep* const* rTab,
-                                             const typename LaneTraits<V>::I* steps, int nAny, int Y, int X0,
-                                             const RowInputs& in, float cosPhi, float sinPhi, float* moments, int* list,
-                                             float* nlp, int pad) {
-    using I = typename LaneTraits<V>::I;
-    constexpr int L = LaneTraits<V>::n;
-    constexpr bool Exact = Mode != kShOnly, Sh = Mode != kExactOnly;
-    constexpr int nMo = (Sh ? 4 : 0) + (Exact ? 1 : 0);
-    constexpr int e5 = nMo - 1;  // index of the exact moment
-    // Exact: F(t) = f2 - g f1 at the clamped segment end (f1, f2 the clamped
-    // cosine's antiderivatives), kept as the running value F[k]; F is smallest at
-    // t = g (the receiver's plane), so ends below g keep F(g)
-    V M[NV], g[NV], gLow[NV], q1[NV], F[NV];
-    const V one = splv<V>(1.0f), half = splv<V>(0.5f), lim = splv<V>(1e6f), nlim = splv<V>(-1e6f), zero = splv<V>(0.0f);
-    for (int k = 0; k < NV; ++k) {
-        M[k] = splv<V>(kNoBlocker);
-        // omega_min: the tangent plane's slope along the azimuth (Section 3)
-        g[k] = ldv<V>(in.gx + X0 + L * k) * splv<V>(cosPhi) + ldv<V>(in.gy + X0 + L * k) * splv<V>(sinPhi);
-        gLow[k] = g[k];
-        if constexpr (Sh && Exact) gLow[k] = ldv<V>(in.lowSlope + X0 + L * k);
-        const V t = gLow[k] < nlim ? nlim : (gLow[k] > lim ? lim : gLow[k]);
-        const V r = one / sqrtv(one + t * t);  // cos of the lower bound
-        q1[k] = t * r;
-        if constexpr (Exact) {
-            const V te = g[k] < nlim ? nlim : (g[k] > lim ? lim : g[k]);
-            const V re = one / sqrtv(one + te * te), se = te * re;
-            F[k] = half * (se * se) - g[k] * (half * (atanv(te) + se * re));
-        }
-    }
-    int n = 0;
-    for (int i = 0; i < nAny; ++i) {
-        const ScanStep& st = hTab[i];
-        const std::ptrdiff_t o = Y * st.rowStep + X0;
-        const float* a = st.field + (o + st.offA);
-        const float* b = st.field + (o + st.offB);
-        const V wa = splv<V>(st.w[0][0]), wb = splv<V>(st.w[1][0]), inv = splv<V>(st.w[2][0]);
-        const I iv = I{} + i;
-        V t[NV];
-        I nw[NV];
-        I any = I{};
-        for (int k = 0; k < NV; ++k) {
-            t[k] = (((wa * ldv<V>(a + L * k) + wb * ldv<V>(b + L * k)) - ldv<V>(in.h0 + X0 + L * k)) -
-                    ldv<V>(in.margin + X0 + L * k)) * inv;
-            nw[k] = (iv < steps[k]) & (t[k] > M[k]);  // Eq. 17: above every earlier sample
-            any |= nw[k];
-        }
-        if (laneBits(any) == 0) {
-            // past the point where even the field's highest height would not
-            // beat any lane's running maximum, no new member can come: stop
-            // (lanes whose ray has left the domain are done too)
-            I done = I{} - 1;
-            for (int k = 0; k < NV; ++k)
-                done &= (iv >= steps[k]) | (M[k] >= (splv<V>(in.hMax) - ldv<V>(in.h0 + X0 + L * k)) * inv);
-            if (laneBits(~done) == 0) break;
-            continue;
-        }
-        float* mo = moments + static_cast<std::size_t>(n) * NV * nMo * L;
-        list[n++] = i;
-        // pass 2 reads the radiance at this step: start fetching it now
-        for (int c = 0; c < 3; ++c) {
-            const ScanStep& rs = rTab[c][i];
-            const std::ptrdiff_t ro = Y * rs.rowStep + X0;
-            __builtin_prefetch(rs.field + (ro + rs.offA));
-            __builtin_prefetch(rs.field + (ro + rs.offB));
-        }
-        for (int k = 0; k < NV; ++k) {
-            M[k] = nw[k] ? t[k] : M[k];
-            // the segment [c_(i-1), c_i] clamped to [omega_min, pi/2]
-            V tc = t[k] < gLow[k] ? gLow[k] : t[k];
-            tc = tc < nlim ? nlim : (tc > lim ? lim : tc);
-            const V r = one / sqrtv(one + tc * tc), sNew = tc * r;  // cos, sin of the end
-            if constexpr (Sh) {
-                const V sv = nw[k] ? sNew : q1[k];  // no new member: an empty segment (exactly 0)
-                const V p = q1[k], p2 = p * p, s2 = sv * sv;
-                stv(mo + (nMo * k + 0) * L, sv - p);
-                stv(mo + (nMo * k + 1) * L, s2 - p2);
-                stv(mo + (nMo * k + 2) * L, s2 * sv - p2 * p);
-                stv(mo + (nMo * k + 3) * L, s2 * s2 - p2 * p2);
-                q1[k] = sv;
-            }
-            if constexpr (Exact) {
-                const V fNew = half * (sNew * sNew) - g[k] * (half * (atanv(tc) + sNew * r));
-                const V fv = nw[k] & (tc >= g[k]) ? fNew : F[k];  // below the receiver's plane: nothing
-                stv(mo + (nMo * k + e5) * L, fv - F[k]);
-                F[k] = fv;
-            }
-        }
-    }
-    // pass 2: moments x radiance, then Eq. 10's closed form as a polynomial in s
-    const V k0 = splv<V>(0.70710678118654752440f), k1 = splv<V>(0.61237243569579452455f);
-    const V k2 = splv<V>(0.79056941504209483300f), k3 = splv<V>(0.23385358667337133659f);
-    for (int c = 0; c < 3; ++c) {
-        V A[NV][nMo];
-        for (int k = 0; k < NV; ++k)
-            for (int p = 0; p < nMo; ++p) A[k][p] = zero;
-        const ScanStep* tab = rTab[c];
-        for (int e = 0; e < n; ++e) {
-            const ScanStep& rs = tab[list[e]];
-            const std::ptrdiff_t ro = Y * rs.rowStep + X0;
-            const float* ra = rs.field + (ro + rs.offA);
-            const float* rb = rs.field + (ro + rs.offB);
-            const V rwa = splv<V>(rs.w[0][0]), rwb = splv<V>(rs.w[1][0]);
-            const float* mo = moments + static_cast<std::size_t>(e) * NV * nMo * L;
-            for (int k = 0; k < NV; ++k) {
-                // lanes without a new member have zero moments; the radiance
-                // read there is finite (inside the field's padding and guard)
-                const V u = rwa * ldv<V>(ra + L * k) + rwb * ldv<V>(rb + L * k);
-                for (int p = 0; p < nMo; ++p) A[k][p] += u * ldv<V>(mo + (nMo * k + p) * L);
-            }
-        }
-        for (int k = 0; k < NV; ++k) {
-            if constexpr (Exact) stv(nlp + static_cast<std::size_t>(12 + c) * pad + X0 + L * k, A[k][e5]);
-            if constexpr (!Sh) continue;
-            float* base = nlp + static_cast<std::size_t>(c) * 4 * pad + X0 + L * k;
-            stv(base, k0 * A[k][0]);
-            stv(base + pad, k1 * A[k][1]);
-            stv(base + 2 * pad, k2 * (A[k][2] - A[k][0]));
-            stv(base + 3 * pad, k3 * (splv<V>(5.0f) * A[k][3] - splv<V>(6.0f) * A[k][1]));
-        }
-    }
-}
-
-// Row of receivers for one azimuth, in groups of kGroup = NV x L receivers.
+// Row of receivers for one azimuth, step by step over the whole row: at
+// step i every group of L receivers still walking reads its 2 height taps
+// and, where some lane has a new casting-set member, the 3 channels'
+// radiance taps: each step's reads sweep one contiguous stretch of its field
+// (hardware prefetch follows them), and the groups' running values live in
+// the row scratch (sc.state). Per lane the same operations in the same order
+// as walking each group alone (step order; lanes without a new member add
+// exactly 0), so the result does not depend on the schedule.
 template <class V, int Mode>
 [[gnu::always_inline]] inline void castRowImpl(const ScanStep* hTab, const ScanStep* const* rTab, const int* colSteps,
                                                int rowSteps, int Y, const RowInputs& in, float cosPhi, float sinPhi,
                                                IndirectScratch& sc, int pad) {
     using I = typename LaneTraits<V>::I;
-    constexpr int L = LaneTraits<V>::n, NV = kGroup / L;
+    constexpr int L = LaneTraits<V>::n;
+    constexpr bool Exact = Mode != kShOnly, Sh = Mode != kExactOnly;
+    constexpr int nMo = (Sh ? 4 : 0) + (Exact ? 1 : 0);
+    constexpr int e5 = nMo - 1;  // index of the exact moment
+    const int nGroups = pad / L;
+    // state planes (pad floats each): M, g, gLow, q1, F, then 3 x nMo sums A
+    float* S = sc.state.data();
+    float *M = S, *g = S + pad, *gLow = S + 2 * pad, *q1 = S + 3 * pad, *F = S + 4 * pad, *A = S + 5 * pad;
+    int* steps = sc.groupSteps.data();  // per lane: the valid prefix (row limit applied)
+    int* active = sc.active.data();     // groups still walking
+    const V one = splv<V>(1.0f), half = splv<V>(0.5f), lim = splv<V>(1e6f), nlim = splv<V>(-1e6f), zero = splv<V>(0.0f);
     const I rowLimit = I{} + rowSteps;
-    for (int X0 = 0; X0 < pad; X0 += kGroup) {
-        I steps[NV];
+    int nActive = 0, nMax = 0;
+    for (int G = 0; G < nGroups; ++G) {
+        const int X0 = G * L;
+        I c;
+        std::memcpy(&c, colSteps + X0, sizeof c);
+        c = c < rowLimit ? c : rowLimit;
+        std::memcpy(steps + X0, &c, sizeof c);
         int nAny = 0;
-        for (int k = 0; k < NV; ++k) {
-            I c;
-            std::memcpy(&c, colSteps + X0 + L * k, sizeof c);
-            steps[k] = c < rowLimit ? c : rowLimit;
-            for (int l = 0; l < L; ++l) nAny = std::max(nAny, static_cast<int>(steps[k][l]));
+        for (int l = 0; l < L; ++l) nAny = std::max(nAny, static_cast<int>(c[l]));
+        nMax = std::max(nMax, nAny);
+        if (nAny > 0) active[nActive++] = G;
+        stv(M + X0, splv<V>(kNoBlocker));
+        // omega_min: the tangent plane's slope along the azimuth (Section 3)
+        const V gv = ldv<V>(in.gx + X0) * splv<V>(cosPhi) + ldv<V>(in.gy + X0) * splv<V>(sinPhi);
+        V gl = gv;
+        if constexpr (Sh && Exact) gl = ldv<V>(in.lowSlope + X0);
+        stv(g + X0, gv);
+        stv(gLow + X0, gl);
+        const V t = gl < nlim ? nlim : (gl > lim ? lim : gl);
+        const V r = one / sqrtv(one + t * t);  // cos of the lower bound
+        stv(q1 + X0, t * r);
+        if constexpr (Exact) {
+            // F(t) = f2 - g f1 at the clamped segment end (f1, f2 the clamped
+            // cosine's antiderivatives); F is smallest at t = g (the receiver's
+            // plane), so ends below g keep F(g)
+            const V te = gv < nlim ? nlim : (gv > lim ? lim : gv);
+            const V re = one / sqrtv(one + te * te), se = te * re;
+            stv(F + X0, half * (se * se) - gv * (half * (atanv(te) + se * re)));
         }
-        castGroup<V, NV, Mode>(hTab, rTab, steps, nAny, Y, X0, in, cosPhi, sinPhi, sc.moments.data(), sc.list.data(),
-                               sc.nlp.data(), pad);
+        for (int p = 0; p < 3 * nMo; ++p) stv(A + static_cast<std::size_t>(p) * pad + X0, zero);
     }
+    const V hMax = splv<V>(in.hMax);
+    for (int i = 0; i < nMax && nActive > 0; ++i) {
+        const ScanStep& st = hTab[i];
+        const std::ptrdiff_t o = Y * st.rowStep;
+        const float* a = st.field + (o + st.offA);
+        const float* b = st.field + (o + st.offB);
+        const V wa = splv<V>(st.w[0][0]), wb = splv<V>(st.w[1][0]), inv = splv<V>(st.w[2][0]);
+        const float* ra[3];
+        const float* rb[3];
+        V rwa[3], rwb[3];
+        for (int c = 0; c < 3; ++c) {
+            const ScanStep& rs = rTab[c][i];
+            const std::ptrdiff_t ro = Y * rs.rowStep;
+            ra[c] = rs.field + (ro + rs.offA);
+            rb[c] = rs.field + (ro + rs.offB);
+            rwa[c] = splv<V>(rs.w[0][0]);
+            rwb[c] = splv<V>(rs.w[1][0]);
+        }
+        const I iv = I{} + i;
+        int kept = 0;
+        for (int q = 0; q < nActive; ++q) {
+            const int G = active[q];
+            const int X0 = G * L;
+            I stp;
+            std::memcpy(&stp, steps + X0, sizeof stp);
+            const V h0 = ldv<V>(in.h0 + X0);
+            const V t = (((wa * ldv<V>(a + X0) + wb * ldv<V>(b + X0)) - h0) - ldv<V>(in.margin + X0)) * inv;
+            V m = ldv<V>(M + X0);
+            const I nw = (iv < stp) & (t > m);  // Eq. 17: above every earlier sample
+            if (laneBits(nw) == 0) {
+                // past the point where even the field's highest height would not
+                // beat any lane's running maximum, no new member can come: the
+                // group is done (lanes whose ray has left the domain are done too)
+                const I done = (iv >= stp) | (m >= (hMax - h0) * inv);
+                if (laneBits(~done) != 0) active[kept++] = G;
+                continue;
+            }
+            active[kept++] = G;
+            m = nw ? t : m;
+            stv(M + X0, m);
+            // the segment [c_(i-1), c_i] clamped to [omega_min, pi/2]
+            const V gl = ldv<V>(gLow + X0);
+            V tc = t < gl ? gl : t;
+            tc = tc < nlim ? nlim : (tc > lim ? lim : tc);
+            const V r = one / sqrtv(one + tc * tc), sNew = tc * r;  // cos, sin of the end
+            V mo[nMo];
+            if constexpr (Sh) {
+                const V p = ldv<V>(q1 + X0);
+                const V sv = nw ? sNew : p;  // no new member: an empty segment (exactly 0)
+                const V p2 = p * p, s2 = sv * sv;
+                mo[0] = sv - p;
+                mo[1] = s2 - p2;
+                mo[2] = s2 * sv - p2 * p;
+                mo[3] = s2 * s2 - p2 * p2;
+                stv(q1 + X0, sv);
+            }
+            if constexpr (Exact) {
+                const V gv = ldv<V>(g + X0), f = ldv<V>(F + X0);
+                const V fNew = half * (sNew * sNew) - gv * (half * (atanv(tc) + sNew * r));
+                const V fv = nw & (tc >= gv) ? fNew : f;  // below the receiver's plane: nothing
+                mo[e5] = fv - f;
+                stv(F + X0, fv);
+            }
+            // moments x radiance (lanes without a new member have zero moments;
+            // the radiance read there is finite: inside the field's padding and guard)
+            for (int c = 0; c < 3; ++c) {
+                const V u = rwa[c] * ldv<V>(ra[c] + X0) + rwb[c] * ldv<V>(rb[c] + X0);
+                for (int p = 0; p < nMo; ++p) {
+                    float* acc = A + static_cast<std::size_t>(c * nMo + p) * pad + X0;
+                    stv(acc, ldv<V>(acc) + u * mo[p]);
+                }
+            }
+        }
+        nActive = kept;
+    }
+    // Eq. 10's closed form as a polynomial in s
+    const V k0 = splv<V>(0.70710678118654752440f), k1 = splv<V>(0.61237243569579452455f);
+    const V k2 = splv<V>(0.79056941504209483300f), k3 = splv<V>(0.23385358667337133659f);
+    float* nlp = sc.nlp.data();
+    for (int c = 0; c < 3; ++c)
+        for (int X0 = 0; X0 < pad; X0 += L) {
+            V Ac[nMo];
+            for (int p = 0; p < nMo; ++p) Ac[p] = ldv<V>(A + static_cast<std::size_t>(c * nMo + p) * pad + X0);
+            if constexpr (Exact) stv(nlp + static_cast<std::size_t>(12 + c) * pad + X0, Ac[e5]);
+            if constexpr (!Sh) continue;
+            float* base = nlp + static_cast<std::size_t>(c) * 4 * pad + X0;
+            stv(base, k0 * Ac[0]);
+            stv(base + pad, k1 * Ac[1]);
+            stv(base + 2 * pad, k2 * (Ac[2] - Ac[0]));
+            stv(base + 3 * pad, k3 * (splv<V>(5.0f) * Ac[3] - splv<V>(6.0f) * Ac[1]));
+        }
 }
 
 template <int Mode>
@@ -357,8 +361,9 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
             b.lowSlope.resize(static_cast<std::size_t>(pad));
         }
         b.nlp.resize(static_cast<std::size_t>(15) * pad);
-        b.moments.resize(static_cast<std::size_t>(std::max(nSteps, 1)) * kGroup * 5 + 4);  // nSteps x kGroup / 4 vectors x 5 moments x 4 lanes
-        b.list.resize(static_cast<std::size_t>(std::max(nSteps, 1)));
+        b.state.resize(static_cast<std::size_t>(5 + 3 * 5) * pad);
+        b.groupSteps.resize(static_cast<std::size_t>(pad));
+        b.active.resize(static_cast<std::size_t>(pad));
     }
     // shading: U of channel c lights channel c only (identity product matrix)
     for (int c = 0; c < 3; ++c) {

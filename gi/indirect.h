@@ -113,8 +113,8 @@ struct IndirectScratch {
     std::vector<float> exact;               // ExactAtReceivers: rows x 3 channels x padded row, E sums
     std::vector<float> lowSlope;            // ExactAtReceivers: padded row, the lowered footprint slope of one azimuth
     std::vector<float> nlp;                 // 3 channels x 4 NLP (+ 3 exact) x padded row, one row and azimuth
-    std::vector<float> moments;             // casting-set moments of one group (pass 1 -> pass 2)
-    std::vector<int> list;                  // steps with a new casting-set member in the group
+    std::vector<float> state;               // the row's running values: 5 + 3 x 5 planes of pad floats
+    std::vector<int> groupSteps, active;    // per lane the valid prefix; the groups still walking
 };
 
 struct IndirectState {
