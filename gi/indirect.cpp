@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <type_traits>
 
 #include "gi/nlp.h"
 #include "gi/sh.h"
@@ -294,6 +295,53 @@ template <class V>
 void accumulateSse(const RowSums& r) { accumulateImpl<F4>(r); }
 [[gnu::target("avx2"), gnu::flatten]] void accumulateAvx2(const RowSums& r) { accumulateImpl<F8>(r); }
 
+// ExactAtReceivers: the shade at the receiver's normal, lam(N) . U (as
+// gi/shading evaluates it there), becomes E / pi through band 0; one row.
+struct ShiftRow {
+    const float *gx, *gy;  // the row's receiver gradients
+    const float* exact;    // 3 channels x pad E sums
+    int pad, nxr;
+    float eScale;          // (2 pi / m) / pi
+    float c[5];            // c0, c1, c4, c6, c8: the Lambert zonal factors x SH constants
+    float* u[3];           // U plane 0 of each channel at the row
+    std::size_t planeR;
+};
+
+template <class T>
+[[gnu::always_inline]] inline void exactShiftAt(const ShiftRow& r, T gx, T gy, const T* e, float* const* u0) {
+    constexpr auto sp = splv<T>;
+    const T one = sp(1.0f);
+    const T inv = one / sqrtv(one + gx * gx + gy * gy);
+    const T Xn = -gx * inv, Yn = -gy * inv, Z = inv;
+    const T c0 = sp(r.c[0]), c1 = sp(r.c[1]), c4 = sp(r.c[2]), c6 = sp(r.c[3]), c8 = sp(r.c[4]);
+    const T lam[9] = {c0, c1 * Yn, c1 * Z, c1 * Xn, c4 * Xn * Yn, c4 * Yn * Z, c6 * (sp(3.0f) * Z * Z - one), c4 * Xn * Z,
+                      c8 * (Xn * Xn - Yn * Yn)};
+    for (int c = 0; c < 3; ++c) {
+        T shade = sp(0.0f);
+        for (int i = 0; i < 9; ++i) shade += lam[i] * ldv<T>(u0[c] + static_cast<std::size_t>(i) * r.planeR);
+        const T ev = sp(r.eScale) * inv * e[c];
+        stv(u0[c], ldv<T>(u0[c]) + (ev - shade) / c0);
+    }
+}
+
+template <class V>
+[[gnu::always_inline]] inline void exactShiftImpl(const ShiftRow& r) {
+    constexpr int L = LaneTraits<V>::n;
+    const int nv = r.nxr / L * L;
+    for (int X = 0; X < nv; X += L) {
+        const V e[3] = {ldv<V>(r.exact + X), ldv<V>(r.exact + r.pad + X), ldv<V>(r.exact + 2 * r.pad + X)};
+        float* const u0[3] = {r.u[0] + X, r.u[1] + X, r.u[2] + X};
+        exactShiftAt<V>(r, ldv<V>(r.gx + X), ldv<V>(r.gy + X), e, u0);
+    }
+    for (int X = nv; X < r.nxr; ++X) {
+        const float e[3] = {r.exact[X], r.exact[r.pad + X], r.exact[2 * r.pad + X]};
+        float* const u0[3] = {r.u[0] + X, r.u[1] + X, r.u[2] + X};
+        exactShiftAt<float>(r, r.gx[X], r.gy[X], e, u0);
+    }
+}
+void exactShiftSse(const ShiftRow& r) { exactShiftImpl<F4>(r); }
+[[gnu::target("avx2"), gnu::flatten]] void exactShiftAvx2(const ShiftRow& r) { exactShiftImpl<F8>(r); }
+
 }  // namespace
 
 void validateIndirectSettings(const IndirectSettings& s) {
@@ -341,7 +389,14 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
         VisibilityField& u = st.u[static_cast<std::size_t>(c)];
         u.nxr = nxr;
         u.nyr = nyr;
+        if (u.sh.size() != planeR * kShCount) st.uZeroFrom = kShCount;  // contents unknown
         u.sh.resize(planeR * kShCount);
+    }
+    // the planes shading does not read (Lambert: bands 0..2) stay 0; each scan
+    // row clears only the planes it fills
+    if (st.uZeroFrom > nRows) {
+        for (VisibilityField& u : st.u) std::fill(u.sh.begin() + static_cast<std::ptrdiff_t>(planeR) * nRows, u.sh.end(), 0.0f);
+        st.uZeroFrom = nRows;
     }
     st.bounceMean.resize(static_cast<std::size_t>(settings.bounces));
 
@@ -426,6 +481,7 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
         const int P = op.patternSize();
         const CastRowFn castRow = castRowFor(mode);
         void (*const accumulate)(const RowSums&) = simd::wideEnabled() ? accumulateAvx2 : accumulateSse;
+        void (*const exactShift)(const ShiftRow&) = simd::wideEnabled() ? exactShiftAvx2 : exactShiftSse;
         parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
             for (int block = b0; block < b1; ++block) {
                 IndirectScratch& sc = st.blocks[static_cast<std::size_t>(block)];
@@ -459,7 +515,7 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
                         std::fill(sc.exact.data() + 3 * ro, sc.exact.data() + 3 * ro + 3 * static_cast<std::size_t>(pad), 0.0f);
                     }
                     for (int c = 0; c < 3; ++c)
-                        for (int i = 0; i < kShCount; ++i) {
+                        for (int i = 0; i < nRows; ++i) {
                             float* u = st.u[static_cast<std::size_t>(c)].plane(i) + static_cast<std::size_t>(Y) * nxr;
                             std::fill(u, u + nxr, 0.0f);
                         }
@@ -514,23 +570,11 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
                 const float c4 = lam2 * 1.0925484305920792f, c6 = lam2 * 0.31539156525252005f, c8 = lam2 * 0.54627421529603959f;
                 const float eScale = 2.0f / static_cast<float>(m);  // (2 pi / m) / pi
                 for (int r = 0; r < rows; ++r) {
-                    const int Y = yBegin + r;
                     const std::size_t ro = static_cast<std::size_t>(r) * pad;
-                    for (int X = 0; X < nxr; ++X) {
-                        const float gx = sc.gx[ro + static_cast<std::size_t>(X)], gy = sc.gy[ro + static_cast<std::size_t>(X)];
-                        const float inv = 1.0f / std::sqrt(1.0f + gx * gx + gy * gy);
-                        const float Xn = -gx * inv, Yn = -gy * inv, Z = inv;
-                        const float lam[9] = {c0, c1 * Yn, c1 * Z, c1 * Xn, c4 * Xn * Yn, c4 * Yn * Z, c6 * (3.0f * Z * Z - 1.0f), c4 * Xn * Z,
-                                              c8 * (Xn * Xn - Yn * Yn)};
-                        const std::size_t at = static_cast<std::size_t>(Y) * nxr + static_cast<std::size_t>(X);
-                        for (int c = 0; c < 3; ++c) {
-                            VisibilityField& u = st.u[static_cast<std::size_t>(c)];
-                            float shade = 0.0f;
-                            for (int i = 0; i < 9; ++i) shade += lam[i] * u.plane(i)[at];
-                            const float e = eScale * inv * sc.exact[3 * ro + static_cast<std::size_t>(c) * pad + static_cast<std::size_t>(X)];
-                            u.plane(0)[at] += (e - shade) / c0;
-                        }
-                    }
+                    const std::size_t at = static_cast<std::size_t>(yBegin + r) * nxr;
+                    exactShift({sc.gx.data() + ro, sc.gy.data() + ro, sc.exact.data() + 3 * ro, pad, nxr, eScale,
+                                {c0, c1, c4, c6, c8},
+                                {st.u[0].sh.data() + at, st.u[1].sh.data() + at, st.u[2].sh.data() + at}, planeR});
                 }
             }
         });

@@ -124,6 +124,7 @@ struct IndirectState {
     std::vector<int> stepsPerColumn, stepsPerRow;
     std::vector<IndirectScratch> blocks;
     std::array<VisibilityField, 3> u;    // U per channel (16 SH planes at the receivers)
+    int uZeroFrom = kShCount;            // U's planes from this one on are known to be 0
     std::array<ShadingLight, 3> lights;
     std::array<ShadeMaps, 2> bounceShade;  // exit radiance of the current / previous bounce
     std::array<Grid, 3> indirect;  // sum of bounces 1..B, full resolution

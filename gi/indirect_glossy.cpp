@@ -359,6 +359,7 @@ void computeGlossyIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstG
         u.nxr = nxr;
         u.nyr = nyr;
         u.sh.resize(planeR * kShCount);
+        st.uZeroFrom = kShCount;  // every plane is written here
     }
     st.bounceMean.resize(static_cast<std::size_t>(settings.bounces));
     // shading of U: channel c lights channel c only (identity product matrix)

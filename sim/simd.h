@@ -61,6 +61,7 @@ template <class V>
 [[gnu::always_inline]] inline V splv(float x) {
     return V{} + x;
 }
+[[gnu::always_inline]] inline float sqrtv(float x) { return std::sqrt(x); }
 [[gnu::always_inline]] inline F4 sqrtv(F4 x) { return __builtin_ia32_sqrtps(x); }
 [[gnu::target("avx")]] inline F8 sqrtv(F8 x) { return __builtin_ia32_sqrtps256(x); }
 /// One bit per lane: the lane's sign bit (a comparison mask's "true").
