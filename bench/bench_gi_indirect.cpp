@@ -3,7 +3,7 @@
 // bounces, with and without amortisation) on this machine.
 //
 //   bench_gi_indirect [--data DIR] [--out DIR] [--runs N] [--quick] [--diagnose] [--sh-kernel] [--indirect-azimuths N]
-//                     [--accuracy-only] [--probe N]
+//                     [--radiance-k N] [--radiance-o N] [--accuracy-only] [--probe N]
 //
 // Writes bench/results/gi_indirect_accuracy.{md,csv} and gi_indirect_timing.{md,csv}.
 #include <algorithm>
@@ -35,6 +35,8 @@ int gRuns = 5;
 bool gQuick = false;
 bool gShKernel = false;     // --sh-kernel: the engine settings with the paper's SH Lambert kernel and receiver planes
 int gIndirectAzimuths = 0;  // --indirect-azimuths N
+int gRadianceK = 0;         // --radiance-k N: the engine's radiance pyramid k_u
+int gRadianceO = -1;        // --radiance-o N: the engine's radiance pyramid o_u
 bool gAccuracyOnly = false;  // --accuracy-only: no Table 1
 int gProbe = 0;             // --probe N: only the frame time of an N^2 erosion frame, 2x, one bounce (stderr)
 bool gDiagnose = false;
@@ -177,6 +179,8 @@ GiSettings settingsFor(int s, int bounces, bool paper) {
     g.subsample = s;
     g.indirect.bounces = bounces;
     if (gIndirectAzimuths > 0) g.indirect.azimuths = gIndirectAzimuths;
+    if (!paper && gRadianceK > 0) g.indirect.radiance.levelsPerOctave = gRadianceK;
+    if (!paper && gRadianceO >= 0) g.indirect.radiance.levelOffset = gRadianceO;
     if (!paper && gShKernel) {
         g.indirect.lambert = LambertIndirect::ShKernel;
         g.visibility.footprintTangent = false;
@@ -278,8 +282,10 @@ int main(int argc, char** argv) {
         else if (a == "--accuracy-only") gAccuracyOnly = true;
         else if (a == "--probe" && i + 1 < argc) gProbe = std::atoi(argv[++i]);
         else if (a == "--indirect-azimuths" && i + 1 < argc) gIndirectAzimuths = std::atoi(argv[++i]);
+        else if (a == "--radiance-k" && i + 1 < argc) gRadianceK = std::atoi(argv[++i]);
+        else if (a == "--radiance-o" && i + 1 < argc) gRadianceO = std::atoi(argv[++i]);
         else {
-            std::fprintf(stderr, "usage: bench_gi_indirect [--data DIR] [--out DIR] [--runs N] [--quick] [--diagnose] [--sh-kernel] [--indirect-azimuths N] [--accuracy-only] [--probe N]\n");
+            std::fprintf(stderr, "usage: bench_gi_indirect [--data DIR] [--out DIR] [--runs N] [--quick] [--diagnose] [--sh-kernel] [--indirect-azimuths N] [--radiance-k N] [--radiance-o N] [--accuracy-only] [--probe N]\n");
             return 2;
         }
     }

@@ -319,7 +319,7 @@ Runner addGiCommand(CLI::App& app) {
     sub->add_option("--albedo", o->albedo, "Albedo R,G,B in [0, 1] or an sRGB PNG of the field's size");
     sub->add_flag("--amortise", o->amortise, "With --frames on static geometry: alternate direct and indirect updates");
     sub->add_option("--out-indirect", o->outIndirect, "Indirect light alone, RGB (.npy float32 (rows, columns, 3), or .exr)");
-    sub->add_option("--radiance-levels-per-octave", o->radianceLevelsPerOctave, "Radiance pyramid k_u (default 4)");
+    sub->add_option("--radiance-levels-per-octave", o->radianceLevelsPerOctave, "Radiance pyramid k_u (engine default 2, paper 4)");
     sub->add_option("--radiance-level-offset", o->radianceLevelOffset, "Radiance pyramid level offset o_u (engine default 3, paper 2)");
     sub->add_option("--indirect-azimuths", o->indirectAzimuths, "Azimuths of the indirect scan (0 = --azimuths)");
     sub->add_option("--indirect-kernel", o->indirectKernel,
