@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "sim/parallel.h"
+
 namespace terrain::gi {
 
 namespace {
@@ -34,18 +36,23 @@ void buildOne(ConstGridView field, const HeightPyramid& heights, const RadianceP
 void buildRadiancePyramid(const std::array<Grid, 3>& radiance, const HeightPyramid& heights,
                           const RadiancePyramidSettings& settings, RadiancePyramid& out) {
     out.fields.resize(3);
-    for (int c = 0; c < 3; ++c)
-        buildOne(radiance[static_cast<std::size_t>(c)].cview(), heights, settings, out.fields[static_cast<std::size_t>(c)]);
+    // the channels side by side (each build's own row loops are parallel too)
+    parallelFor(0, 3, 1, [&](int c0, int c1) {
+        for (int c = c0; c < c1; ++c)
+            buildOne(radiance[static_cast<std::size_t>(c)].cview(), heights, settings, out.fields[static_cast<std::size_t>(c)]);
+    });
 }
 
 void buildScalarPyramids(const float* fields, int count, const HeightPyramid& heights,
                          const RadiancePyramidSettings& settings, RadiancePyramid& out) {
     out.fields.resize(static_cast<std::size_t>(count));
     const std::size_t n = static_cast<std::size_t>(heights.nx) * heights.ny;
-    for (int c = 0; c < count; ++c) {
-        const ConstGridView v(fields + n * static_cast<std::size_t>(c), heights.nx, heights.ny, heights.nx);
-        buildOne(v, heights, settings, out.fields[static_cast<std::size_t>(c)]);
-    }
+    parallelFor(0, count, 1, [&](int c0, int c1) {
+        for (int c = c0; c < c1; ++c) {
+            const ConstGridView v(fields + n * static_cast<std::size_t>(c), heights.nx, heights.ny, heights.nx);
+            buildOne(v, heights, settings, out.fields[static_cast<std::size_t>(c)]);
+        }
+    });
 }
 
 }  // namespace terrain::gi
