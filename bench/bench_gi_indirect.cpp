@@ -17,10 +17,12 @@
 
 #include "bench/bench_common.h"
 #include "bench/bench_gi_common.h"
+#include "sim/simd.h"
 #include "gi/frame.h"
 #include "gi/reference_gi.h"
 #include "sim/io.h"
 #include "sim/parallel.h"
+#include "sim/simd.h"
 #include "sim/scene.h"
 
 using namespace terrain;
@@ -189,6 +191,21 @@ GiSettings settingsFor(int s, int bounces, bool paper) {
 }
 
 
+// The engine settings as the tables print them.
+std::string engineSummary() {
+    const GiSettings g = settingsFor(2, 1, false);
+    char b[400];
+    std::snprintf(b, sizeof b,
+                  "m %d, k_v %d, o_v %d, peak blend %.2f, k_u %d, o_u %d, %d indirect azimuths, %s, footprint tangent planes %s; "
+                  "%s kernels",
+                  g.visibility.azimuths, g.pyramid.levelsPerOctave, g.pyramid.levelOffset, g.pyramid.peakBlend,
+                  g.indirect.radiance.levelsPerOctave, g.indirect.radiance.levelOffset,
+                  g.indirect.azimuths > 0 ? g.indirect.azimuths : g.visibility.azimuths,
+                  g.indirect.lambert == LambertIndirect::ExactAtReceivers ? "exact cosine at the receivers" : "SH kernel",
+                  g.visibility.footprintTangent ? "on" : "off", simd::wideEnabled() ? "8-wide AVX2" : "4-wide SSE2");
+    return b;
+}
+
 // ---- error breakdown (--diagnose) ---------------------------------------------------
 std::string fmtErr(const char* what, double e, double b) {
     char line[256];
@@ -339,7 +356,7 @@ int main(int argc, char** argv) {
              "integrated as an exact cap by the reference), albedo " + std::to_string(albedo).substr(0, 3) +
              " everywhere, Lambert. Reference: exact direct light (256 azimuths) and " + std::to_string(refDirections) +
              " fixed gathering directions per texel, march step 0.5 cell. Relative RMSE over all three channels on the interior "
-             "(10 % border excluded); bias = mean difference / RMS of the reference.\n\n";
+             "(10 % border excluded); bias = mean difference / RMS of the reference. Engine settings: " + engineSummary() + ".\n\n";
     std::string accCsv = "dem,settings,subsample,bounces,total_rel_rmse,total_bias,indirect_rel_rmse,indirect_bias,frame_ms\n";
     std::vector<Reference> refs;
     for (const Dem& d : dems) {
@@ -411,8 +428,7 @@ int main(int argc, char** argv) {
     // ---- Table 1: frame time -----------------------------------------------------------
     std::string tMd = "# GI with indirect light: frame time (the paper's Table 1 on this machine)\n\n";
     tMd += "Machine: " + bench::machineDescription() + ", 2 threads. Scene: builtinScene(\"erosion\", N, 1) initial ground; engine "
-           "settings (m 16, k_v 4, o_v 3, peak blend 0.25, k_u 4, o_u 3, 8 indirect azimuths, exact cosine at the receivers, footprint "
-           "tangent planes), sun-and-sky environment + one key light, albedo 0.6, Lambert. Median of " +
+           "settings (" + engineSummary() + "), sun-and-sky environment + one key light, albedo 0.6, Lambert. Median of " +
            std::to_string(gRuns) + " frames after one warm-up, best of 3 repeats (shared virtual machine); amortised = static geometry, frames alternate direct and indirect "
            "updates; the amortised figure is the mean over an even number of frames (as many cheap as expensive). Memory: every buffer of the frame (inputs and intermediates, float32). Error: indirect / "
            "total relative RMSE at 256^2 against the reference of the accuracy table's erosion frame (at " + std::to_string(accSize) +
