@@ -30,27 +30,6 @@ inline F4 ld(const float* p) { return simd::load<F4>(p); }
 inline F4 spl(float x) { return simd::splat<F4>(x); }
 inline bool anyLane(I4 m) { return (m[0] | m[1] | m[2] | m[3]) != 0; }
 
-// Order-4 SH basis (gi/sh.h conventions) at a unit direction, for float or F4 lanes.
-template <class T>
-inline void shBasis(T x, T y, T z, T* o) {
-    o[0] = simd::splat<T>(0.28209479177387814f);
-    o[1] = 0.48860251190291992f * y;
-    o[2] = 0.48860251190291992f * z;
-    o[3] = 0.48860251190291992f * x;
-    o[4] = 1.0925484305920792f * x * y;
-    o[5] = 1.0925484305920792f * y * z;
-    o[6] = 0.31539156525252005f * (3.0f * z * z - 1.0f);
-    o[7] = 1.0925484305920792f * x * z;
-    o[8] = 0.54627421529603959f * (x * x - y * y);
-    o[9] = 0.59004358992664352f * y * (3.0f * x * x - y * y);
-    o[10] = 2.8906114426405538f * x * y * z;
-    o[11] = 0.45704579946446572f * y * (5.0f * z * z - 1.0f);
-    o[12] = 0.37317633259011546f * (5.0f * z * z * z - 3.0f * z);
-    o[13] = 0.45704579946446572f * x * (5.0f * z * z - 1.0f);
-    o[14] = 1.4453057213202769f * z * (x * x - y * y);
-    o[15] = 0.59004358992664352f * x * (x * x - 3.0f * y * y);
-}
-
 // ---- the reflection Rot_N(pi) in SH, per band -------------------------------
 // Band l of h(w) = f(R_N w) is fixed by its values at 2l+1 directions d_j:
 // E_l = B_l^-1 h_l(d), B_l[j][m] = Y_lm(d_j), d_0..d_(2l) the first 2l+1 of
@@ -119,7 +98,7 @@ void exitVectors(const MirrorTables& mt, const float (*I)[kShCount], float nx, f
     for (int j = 0; j < 7; ++j) {
         const float* d = mt.dir[j];
         const float dn = 2.0f * (nx * d[0] + ny * d[1] + nz * d[2]);
-        shBasis<float>(dn * nx - d[0], dn * ny - d[1], dn * nz - d[2], yr[j]);
+        shBasisLanes<float>(dn * nx - d[0], dn * ny - d[1], dn * nz - d[2], yr[j]);
     }
     const float sqrt4pi = 3.5449077018110318f;
     for (int c = 0; c < 3; ++c) {
@@ -202,7 +181,7 @@ void castGroupGlossy(const ScanStep* hTab, const ScanStep* rGeo, const float* co
             tm = nw[k] ? tm : zero;
             const F4 ic = one / simd::vsqrt(one + tm * tm);
             F4 y[kShCount];
-            shBasis<F4>(cp * ic, sp * ic, -(tm * ic), y);
+            shBasisLanes<F4>(cp * ic, sp * ic, -(tm * ic), y);
             for (int f = 0; f < kShCount; ++f) ba[kShCount * k + f] = nw[k] ? y[f] : zero;
         }
     }
@@ -317,7 +296,7 @@ void glossyExitRadiance(ConstGridView gradX, ConstGridView gradY, int s, int nxr
                     // what the shade holds beside the lobe towards the viewer: the diffuse part
                     const float nv = nxv * vx + nyv * vy + nzv * vz;
                     float yv[kShCount];
-                    shBasis<float>(2.0f * nv * nxv - vx, 2.0f * nv * nyv - vy, 2.0f * nv * nzv - vz, yv);
+                    shBasisLanes<float>(2.0f * nv * nxv - vx, 2.0f * nv * nyv - vy, 2.0f * nv * nzv - vz, yv);
                     float diffuse[3];
                     for (int c = 0; c < 3; ++c) {
                         float sp = 0.0f;

@@ -65,4 +65,28 @@ ShMatrix shProductMatrix(const ShVector& light);
 /// Gauss-Legendre nodes/weights on [-1, 1] (n <= 128), double precision.
 void gaussLegendre(int n, double* nodes, double* weights);
 
+/// The order-4 real SH basis (the conventions above) at a unit direction in
+/// float arithmetic, for T = float or a float vector (one direction per lane);
+/// only the first `count` (9 or 16) values are written.
+template <class T>
+inline void shBasisLanes(T x, T y, T z, T* o, int count = kShCount) {
+    o[0] = T{} + 0.28209479177387814f;
+    o[1] = 0.48860251190291992f * y;
+    o[2] = 0.48860251190291992f * z;
+    o[3] = 0.48860251190291992f * x;
+    o[4] = 1.0925484305920792f * x * y;
+    o[5] = 1.0925484305920792f * y * z;
+    o[6] = 0.31539156525252005f * (3.0f * z * z - 1.0f);
+    o[7] = 1.0925484305920792f * x * z;
+    o[8] = 0.54627421529603959f * (x * x - y * y);
+    if (count <= 9) return;
+    o[9] = 0.59004358992664352f * y * (3.0f * x * x - y * y);
+    o[10] = 2.8906114426405538f * x * y * z;
+    o[11] = 0.45704579946446572f * y * (5.0f * z * z - 1.0f);
+    o[12] = 0.37317633259011546f * (5.0f * z * z * z - 3.0f * z);
+    o[13] = 0.45704579946446572f * x * (5.0f * z * z - 1.0f);
+    o[14] = 1.4453057213202769f * z * (x * x - y * y);
+    o[15] = 0.59004358992664352f * x * (x * x - 3.0f * y * y);
+}
+
 }  // namespace terrain::gi

@@ -47,27 +47,6 @@ using simd::stv;
 
 constexpr int kMaxShadingLights = 8;  // lights per incident pass (more are folded in several passes)
 
-// SH basis in float at a unit direction (bands 0..3; only `count` filled).
-inline void shBasisFloat(float x, float y, float z, float* o, int count) {
-    o[0] = 0.28209479177387814f;
-    o[1] = 0.48860251190291992f * y;
-    o[2] = 0.48860251190291992f * z;
-    o[3] = 0.48860251190291992f * x;
-    o[4] = 1.0925484305920792f * x * y;
-    o[5] = 1.0925484305920792f * y * z;
-    o[6] = 0.31539156525252005f * (3.0f * z * z - 1.0f);
-    o[7] = 1.0925484305920792f * x * z;
-    o[8] = 0.54627421529603959f * (x * x - y * y);
-    if (count <= 9) return;
-    o[9] = 0.59004358992664352f * y * (3.0f * x * x - y * y);
-    o[10] = 2.8906114426405538f * x * y * z;
-    o[11] = 0.45704579946446572f * y * (5.0f * z * z - 1.0f);
-    o[12] = 0.37317633259011546f * (5.0f * z * z * z - 3.0f * z);
-    o[13] = 0.45704579946446572f * x * (5.0f * z * z - 1.0f);
-    o[14] = 1.4453057213202769f * z * (x * x - y * y);
-    o[15] = 0.59004358992664352f * x * (x * x - 3.0f * y * y);
-}
-
 // ---- algorithm: horizontal SH interpolation (Fig. 7), L texels x .. x+L-1 ----
 // Texel x = s X + k reads v[X] + (k / s) (v[X + 1] - v[X]), as the scalar code.
 template <class V, int S>
@@ -443,7 +422,7 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
                             float ph[kShOrder];  // the texel's exponent (AlbedoMap::phongExponent) or the uniform one
                             texelPhongLobe(albedo, static_cast<std::size_t>(y) * nx + x, phUniform, ph);
                             float yb[kShCount];
-                            shBasisFloat(2.0f * nv * nxv - vx, 2.0f * nv * nyv - vy, 2.0f * nv * nzv - vz, yb, kShCount);
+                            shBasisLanes(2.0f * nv * nxv - vx, 2.0f * nv * nyv - vy, 2.0f * nv * nzv - vz, yb, kShCount);
                             float sp = 0.0f;
                             for (int i = 0; i < kShCount; ++i) sp += ph[shBand(i)] * yb[i] * up[static_cast<std::size_t>(ch * nCoef + i) * nx + x];
                             o[x] += specWeight * sp;
