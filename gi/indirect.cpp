@@ -22,16 +22,13 @@ using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 constexpr int kIndirectRows = 8;  // receiver rows per block
-constexpr int kGroup = 8;  // receivers per kernel call (2 x 4 or 1 x 8 lanes); rows are padded to it
-constexpr float kMarginRel = 1.0f / 1048576.0f;  // 2^-20 |h0|: height differences below it are rounding
+constexpr int kGroup = 8;  // rows are padded to a multiple of the widest lane group
 
 inline int padGroup(int n) { return (n + kGroup - 1) / kGroup * kGroup; }
 
 // The kernel is written once over a lane type V: F4 (SSE2, the baseline) or
 // F8 (AVX2, chosen at run time where the processor has it): sim/simd.h.
 using simd::F8;
-using simd::I4;
-using simd::I8;
 using simd::LaneTraits;
 using simd::laneBits;
 using simd::ldv;
@@ -58,14 +55,12 @@ template <class V>
     return t < zero ? -r : r;
 }
 
-// ---- algorithm: the casting set and Eq. 12 for 4 NV receivers of row Y ------
-// Pass 1 walks the height steps (Eq. 17) and, at each step where some lane
-// has a new casting-set member, stores the clamped segment's moments
-// Delta(s^p), p = 1..4 (0 in the other lanes) and the step index. Pass 2
-// multiplies them with the radiance samples at those steps, one channel at a
-// time (few live registers; each lane's sums run in step order).
-// hTab: the height steps of this azimuth; rTab[c]: channel c's radiance steps;
-// moments: scratch of nSteps x NV x 5 vectors; list: nSteps ints.
+// ---- algorithm: the casting set and Eq. 12 for one row of receivers --------
+// The walk over the height steps (Eq. 17): at each step where some lane has a
+// new casting-set member, the clamped segment's moments Delta(s^p), p = 1..4
+// (0 in the other lanes) are multiplied with the radiance samples there and
+// summed per channel (each lane's sums in step order).
+// hTab: the height steps of this azimuth; rTab[c]: channel c's radiance steps.
 // Out: 3 channels x 4 NLP coefficients, written at nlp[(c * 4 + l) * pad + X].
 // Exact (LambertIndirect::ExactAtReceivers): a fifth moment per segment, the
 // exact clamped-cosine irradiance at the receiver's own normal up to
@@ -302,7 +297,7 @@ struct ShiftRow {
     const float* exact;    // 3 channels x pad E sums
     int pad, nxr;
     float eScale;          // (2 pi / m) / pi
-    float c[5];            // c0, c1, c4, c6, c8: the Lambert zonal factors x SH constants
+    LambertFactors lf;
     float* u[3];           // U plane 0 of each channel at the row
     std::size_t planeR;
 };
@@ -313,14 +308,13 @@ template <class T>
     const T one = sp(1.0f);
     const T inv = one / sqrtv(one + gx * gx + gy * gy);
     const T Xn = -gx * inv, Yn = -gy * inv, Z = inv;
-    const T c0 = sp(r.c[0]), c1 = sp(r.c[1]), c4 = sp(r.c[2]), c6 = sp(r.c[3]), c8 = sp(r.c[4]);
-    const T lam[9] = {c0, c1 * Yn, c1 * Z, c1 * Xn, c4 * Xn * Yn, c4 * Yn * Z, c6 * (sp(3.0f) * Z * Z - one), c4 * Xn * Z,
-                      c8 * (Xn * Xn - Yn * Yn)};
+    T lam[9];
+    lambertAtNormal(r.lf, Xn, Yn, Z, lam);
     for (int c = 0; c < 3; ++c) {
         T shade = sp(0.0f);
         for (int i = 0; i < 9; ++i) shade += lam[i] * ldv<T>(u0[c] + static_cast<std::size_t>(i) * r.planeR);
         const T ev = sp(r.eScale) * inv * e[c];
-        stv(u0[c], ldv<T>(u0[c]) + (ev - shade) / c0);
+        stv(u0[c], ldv<T>(u0[c]) + (ev - shade) / lam[0]);
     }
 }
 
@@ -343,6 +337,20 @@ void exactShiftSse(const ShiftRow& r) { exactShiftImpl<F4>(r); }
 [[gnu::target("avx2"), gnu::flatten]] void exactShiftAvx2(const ShiftRow& r) { exactShiftImpl<F8>(r); }
 
 }  // namespace
+
+void loadReceiverRow(const HeightPyramid& pyr, ConstGridView gradX, ConstGridView gradY, int Y, int pad, float* gx, float* gy,
+                     float* h0, float* margin) {
+    constexpr float kMarginRel = 1.0f / 1048576.0f;  // 2^-20 |h0|: height differences below it are rounding
+    const int s = pyr.subsample, nxr = pyr.nxr;
+    const float* hRow = pyr.rawPhaseRow(0, s * Y);
+    for (int X = 0; X < pad; ++X) {
+        const bool in = X < nxr;
+        gx[X] = in ? gradX(s * X, s * Y) : 0.0f;
+        gy[X] = in ? gradY(s * X, s * Y) : 0.0f;
+        h0[X] = in ? hRow[X] : 0.0f;
+        margin[X] = std::fabs(h0[X]) * kMarginRel;
+    }
+}
 
 void validateIndirectSettings(const IndirectSettings& s) {
     if (s.bounces < 0 || s.bounces > 16) throw InputError("bounces must be in [0, 16]");
@@ -480,6 +488,7 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
         // ---- scan: casting sets, Eq. 12, U through the folded wedge operator ----------
         const int P = op.patternSize();
         const CastRowFn castRow = castRowFor(mode);
+        const LambertFactors lambert = lambertFactors();
         void (*const accumulate)(const RowSums&) = simd::wideEnabled() ? accumulateAvx2 : accumulateSse;
         void (*const exactShift)(const ShiftRow&) = simd::wideEnabled() ? exactShiftAvx2 : exactShiftSse;
         parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
@@ -491,15 +500,8 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
                 for (int r = 0; r < rows; ++r) {
                     const int Y = yBegin + r;
                     const std::size_t ro = static_cast<std::size_t>(r) * pad;
-                    const float* hRow = pyr.rawPhaseRow(0, s * Y);
-                    for (int X = 0; X < pad; ++X) {
-                        const bool in = X < nxr;
-                        const std::size_t xi = ro + static_cast<std::size_t>(X);
-                        sc.gx[xi] = in ? gradX(s * X, s * Y) : 0.0f;
-                        sc.gy[xi] = in ? gradY(s * X, s * Y) : 0.0f;
-                        sc.h0[xi] = in ? hRow[X] : 0.0f;
-                        sc.margin[xi] = std::fabs(sc.h0[xi]) * kMarginRel;
-                    }
+                    loadReceiverRow(pyr, gradX, gradY, Y, pad, sc.gx.data() + ro, sc.gy.data() + ro, sc.h0.data() + ro,
+                                    sc.margin.data() + ro);
                     if (exact) {
                         // the footprint box's rows (FootprintBox), padded
                         if (mode == kShAndExact) {
@@ -563,17 +565,12 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
                 if (!exact) continue;
                 // ExactAtReceivers: the shade at the receiver's normal, lam(N) . U
                 // (as gi/shading evaluates it there), becomes E / pi through band 0
-                const float lam0 = static_cast<float>(std::sqrt(4.0 * kPi) * lambertZonal()[0] / kPi);
-                const float lam1 = static_cast<float>(std::sqrt(4.0 * kPi / 3.0) * lambertZonal()[1] / kPi);
-                const float lam2 = static_cast<float>(std::sqrt(4.0 * kPi / 5.0) * lambertZonal()[2] / kPi);
-                const float c0 = lam0 * 0.28209479177387814f, c1 = lam1 * 0.48860251190291992f;
-                const float c4 = lam2 * 1.0925484305920792f, c6 = lam2 * 0.31539156525252005f, c8 = lam2 * 0.54627421529603959f;
                 const float eScale = 2.0f / static_cast<float>(m);  // (2 pi / m) / pi
                 for (int r = 0; r < rows; ++r) {
                     const std::size_t ro = static_cast<std::size_t>(r) * pad;
                     const std::size_t at = static_cast<std::size_t>(yBegin + r) * nxr;
                     exactShift({sc.gx.data() + ro, sc.gy.data() + ro, sc.exact.data() + 3 * ro, pad, nxr, eScale,
-                                {c0, c1, c4, c6, c8},
+                                lambert,
                                 {st.u[0].sh.data() + at, st.u[1].sh.data() + at, st.u[2].sh.data() + at}, planeR});
                 }
             }

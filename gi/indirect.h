@@ -33,12 +33,13 @@
 // only when it rises above the receiver's height by more than 2^-20 |h0|
 // (a few ulp), which is subtracted from every height difference.
 //
-// Speed: a group of 8 receivers stops walking once the field's highest
-// height, seen from each lane's receiver at the current distance, can no
-// longer beat that lane's running maximum (no member can follow; results
-// unchanged), and pass 1 prefetches the radiance of each new member for pass 2
-// (its radiance reads were the kernel's hot spot). With ExactAtReceivers at 1x
-// only the exact moment is computed (every texel is a receiver).
+// Speed: the kernel runs over 8 (AVX2) or 4 (SSE2) lanes, bit-identically
+// (sim/simd.h), one receiver row at a time, step by step (each step's reads
+// sweep one stretch of its field). A group of lanes stops walking once the
+// field's highest height, seen from each lane's receiver at the current
+// distance, can no longer beat that lane's running maximum (no member can
+// follow; results unchanged). With ExactAtReceivers at 1x only the exact
+// moment is computed (every texel is a receiver).
 //
 // Schedule: like gi/visibility: a per-bounce step table, fixed blocks of
 // kIndirectRows receiver rows in parallel; within a block azimuth by azimuth,
@@ -150,5 +151,12 @@ void computeIndirect(const HeightPyramid& heights, ConstGridView gradX, ConstGri
 
 /// Throws InputError when a setting is out of range.
 void validateIndirectSettings(const IndirectSettings& s);
+
+/// The scan inputs of receiver row Y (Lambert and glossy scans), pad floats
+/// each (0 past the row): the height gradients, the receiver height h0, and
+/// the margin 2^-20 |h0| below which a height difference is rounding (a
+/// flat plane stays exactly dark).
+void loadReceiverRow(const HeightPyramid& pyr, ConstGridView gradX, ConstGridView gradY, int Y, int pad, float* gx, float* gy,
+                     float* h0, float* margin);
 
 }  // namespace terrain::gi

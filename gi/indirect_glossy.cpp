@@ -23,7 +23,6 @@ double msSince(Clock::time_point t0) { return std::chrono::duration<double, std:
 constexpr int kMaxBlocks = 64;
 constexpr int kGroup = 8;   // receivers per kernel call (2 x 4 lanes)
 constexpr int kNV = kGroup / 4;
-constexpr float kMarginRel = 1.0f / 1048576.0f;  // 2^-20 |h0|, as gi/indirect: flat stays exactly dark
 
 inline int padGroup(int n) { return (n + kGroup - 1) / kGroup * kGroup; }
 inline F4 ld(const float* p) { return simd::load<F4>(p); }
@@ -415,14 +414,7 @@ void computeGlossyIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstG
                 const int yBegin = static_cast<int>(static_cast<long long>(nyr) * block / nBlocks);
                 const int yEnd = static_cast<int>(static_cast<long long>(nyr) * (block + 1) / nBlocks);
                 for (int Y = yBegin; Y < yEnd; ++Y) {
-                    const float* hRow = pyr.rawPhaseRow(0, s * Y);
-                    for (int X = 0; X < pad; ++X) {
-                        const bool in = X < nxr;
-                        gxs[X] = in ? gradX(s * X, s * Y) : 0.0f;
-                        gys[X] = in ? gradY(s * X, s * Y) : 0.0f;
-                        h0s[X] = in ? hRow[X] : 0.0f;
-                        mgs[X] = std::fabs(h0s[X]) * kMarginRel;
-                    }
+                    loadReceiverRow(pyr, gradX, gradY, Y, pad, gxs, gys, h0s, mgs);  // the margin as gi/indirect
                     float* uRows[3][kShCount];
                     for (int c = 0; c < 3; ++c)
                         for (int i = 0; i < kShCount; ++i) {

@@ -12,6 +12,14 @@
 
 namespace terrain::gi {
 
+LambertFactors lambertFactors() {
+    double lamZh[3];
+    for (int l = 0; l < 3; ++l) lamZh[l] = std::sqrt(4.0 * kPi / (2.0 * l + 1.0)) * lambertZonal()[l] / kPi;
+    const float lam0 = static_cast<float>(lamZh[0]), lam1 = static_cast<float>(lamZh[1]), lam2 = static_cast<float>(lamZh[2]);
+    return {lam0 * 0.28209479177387814f, lam1 * 0.48860251190291992f, lam2 * 1.0925484305920792f,
+            lam2 * 0.31539156525252005f, lam2 * 0.54627421529603959f};
+}
+
 void phongLobeFactors(double exponent, float ph[kShOrder]) {
     double zh[kShOrder];
     phongZonal(exponent, zh);
@@ -77,7 +85,7 @@ template <class V, int S>
 // map, with lam the clamped-cosine zonal vector turned to the texel's normal.
 template <class V, int S>
 [[gnu::always_inline]] inline void lambertRowS(const float* vert, int nxrS, int nxr, int nCoef, const float* gxr, const float* gyr, const int* colIndex,
-                 const float* colFrac, float lam0, float lam1, float lam2, float diffuseWeight, const AlbedoMap* albedo, int y,
+                 const float* colFrac, const LambertFactors& lf, float diffuseWeight, const AlbedoMap* albedo, int y,
                  int nx, ShadeMaps& out) {
     float* amb = out.ambient.empty() ? nullptr : out.ambient.data() + static_cast<std::size_t>(y) * nx;
     float* rgb[3];
@@ -87,8 +95,6 @@ template <class V, int S>
         const Grid* a = albedo && !albedo->channel[static_cast<std::size_t>(ch)].empty() ? &albedo->channel[static_cast<std::size_t>(ch)] : nullptr;
         alb[ch] = a ? a->data() + static_cast<std::size_t>(y) * nx : nullptr;
     }
-    const float c0 = lam0 * 0.28209479177387814f, c1 = lam1 * 0.48860251190291992f;
-    const float c4 = lam2 * 1.0925484305920792f, c6 = lam2 * 0.31539156525252005f, c8 = lam2 * 0.54627421529603959f;
     // texels [0, xVec) take the vector path: all of x .. x+L-1 below s (nxr - 1)
     using I = typename LaneTraits<V>::I;
     constexpr int L = LaneTraits<V>::n;
@@ -100,8 +106,8 @@ template <class V, int S>
         const V gx = ldv<V>(gxr + x), gy = ldv<V>(gyr + x);
         const V inv = splat(1.0f) / sqrtv(splat(1.0f) + gx * gx + gy * gy);
         const V X = -gx * inv, Yn = -gy * inv, Z = inv;
-        const V lam[9] = {splat(c0), splat(c1) * Yn, splat(c1) * Z, splat(c1) * X, splat(c4) * X * Yn, splat(c4) * Yn * Z,
-                           splat(c6) * (3.0f * Z * Z - 1.0f), splat(c4) * X * Z, splat(c8) * (X * X - Yn * Yn)};
+        V lam[9];
+        lambertAtNormal(lf, X, Yn, Z, lam);
         // the four dot products interleaved: independent addition chains
         V acc = splat(0.0f), oc[3] = {splat(0.0f), splat(0.0f), splat(0.0f)};
         for (int i = 0; i < 9; ++i) {
@@ -124,8 +130,8 @@ template <class V, int S>
         const float gx = gxr[x], gy = gyr[x];
         const float inv = 1.0f / std::sqrt(1.0f + gx * gx + gy * gy);
         const float X = -gx * inv, Yn = -gy * inv, Z = inv;
-        const float lam[9] = {c0, c1 * Yn, c1 * Z, c1 * X, c4 * X * Yn, c4 * Yn * Z, c6 * (3.0f * Z * Z - 1.0f), c4 * X * Z,
-                              c8 * (X * X - Yn * Yn)};
+        float lam[9];
+        lambertAtNormal(lf, X, Yn, Z, lam);
         auto u = [&](int plane) {
             const float* v = vert + static_cast<std::size_t>(plane) * nxrS;
             return S == 1 ? v[x] : v[X0] + f * (v[X1] - v[X0]);
@@ -153,7 +159,8 @@ struct LambertRowJob {
     int nxr, nyr, nxrS, s, nCoef, nx;
     const int* colIndex;
     const float* colFrac;
-    float lam0, lam1, lam2, diffuseWeight;
+    LambertFactors lf;
+    float diffuseWeight;
     const AlbedoMap* albedo;
     ShadeMaps* out;
 };
@@ -180,7 +187,7 @@ template <class V>
     }
     auto row = [&](auto sTag) {
         constexpr int S = decltype(sTag)::value;
-        lambertRowS<V, S>(vert, j.nxrS, j.nxr, j.nCoef, gxr, gyr, j.colIndex, j.colFrac, j.lam0, j.lam1, j.lam2,
+        lambertRowS<V, S>(vert, j.nxrS, j.nxr, j.nCoef, gxr, gyr, j.colIndex, j.colFrac, j.lf,
                           j.diffuseWeight, j.albedo, y, j.nx, *j.out);
     };
     if (j.s == 1) row(std::integral_constant<int, 1>{});
@@ -320,16 +327,14 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
         out.colFrac[static_cast<std::size_t>(x)] = r.f;
     }
 
-    double lamZh[kShOrder];
-    for (int l = 0; l < kShOrder; ++l) lamZh[l] = std::sqrt(4.0 * kPi / (2.0 * l + 1.0)) * lambertZonal()[l] / kPi;
-    const float lam0 = static_cast<float>(lamZh[0]), lam1 = static_cast<float>(lamZh[1]), lam2 = static_cast<float>(lamZh[2]);
+    const LambertFactors lf = lambertFactors();
     float phUniform[kShOrder];
     phongLobeFactors(settings.phongExponent, phUniform);
     const float diffuseWeight = settings.brdf == Brdf::Phong ? 0.0f : 1.0f;
     const float specWeight = specularWeightOf(settings);
     const float vx = settings.viewDir[0], vy = settings.viewDir[1], vz = settings.viewDir[2];
     const LambertRowJob lambertJob{out.incident.data(), ambient ? &env : nullptr, planeR, nxr, nyr, nxrS, s, nCoef, nx,
-                                   out.colIndex.data(), out.colFrac.data(), lam0, lam1, lam2, diffuseWeight, albedo, &out};
+                                   out.colIndex.data(), out.colFrac.data(), lf, diffuseWeight, albedo, &out};
     const auto lambertShadeRow = wide ? lambertShadeRowAvx2 : lambertShadeRowSse;
 
     // ---- schedule: fixed row blocks, each with its own scratch ---------------
@@ -382,15 +387,9 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
                     const float gx = gxr[x], gy = gyr[x];
                     const float inv = 1.0f / std::sqrt(1.0f + gx * gx + gy * gy);
                     const float X = -gx * inv, Yn = -gy * inv, Z = inv;
-                    lamRow[0 * nx + x] = lam0 * 0.28209479177387814f;
-                    lamRow[1 * nx + x] = lam1 * 0.48860251190291992f * Yn;
-                    lamRow[2 * nx + x] = lam1 * 0.48860251190291992f * Z;
-                    lamRow[3 * nx + x] = lam1 * 0.48860251190291992f * X;
-                    lamRow[4 * nx + x] = lam2 * 1.0925484305920792f * X * Yn;
-                    lamRow[5 * nx + x] = lam2 * 1.0925484305920792f * Yn * Z;
-                    lamRow[6 * nx + x] = lam2 * 0.31539156525252005f * (3.0f * Z * Z - 1.0f);
-                    lamRow[7 * nx + x] = lam2 * 1.0925484305920792f * X * Z;
-                    lamRow[8 * nx + x] = lam2 * 0.54627421529603959f * (X * X - Yn * Yn);
+                    float lam[9];
+                    lambertAtNormal(lf, X, Yn, Z, lam);
+                    for (int i = 0; i < 9; ++i) lamRow[static_cast<std::size_t>(i) * nx + x] = lam[i];
                 }
                 float* __restrict amb = ambient ? out.ambient.data() + static_cast<std::size_t>(y) * nx : nullptr;
                 if (amb)

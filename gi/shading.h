@@ -72,6 +72,30 @@ inline float specularWeightOf(const ShadingSettings& s) {
 /// Where full-resolution texel x reads the receiver grid (receiver X at s X,
 /// n receivers; Fig. 7): between receivers i0 and i1 = min(i0 + 1, n - 1) at
 /// fraction f, clamped past the last receiver.
+/// The Lambert (clamped-cosine) zonal factors with the real SH constants of
+/// bands 0..2 folded in: lam(N)_i = c(i) Y_i-polynomial(N), c = c0; c1 x 3;
+/// c4, c4, c6, c4, c8 (see lambertAtNormal).
+struct LambertFactors {
+    float c0, c1, c4, c6, c8;
+};
+LambertFactors lambertFactors();
+
+/// lam(N): the clamped-cosine zonal vector (divided by pi) turned to the unit
+/// normal (X, Y, Z), bands 0..2, for T = float or a float vector; the shade
+/// of an SH radiance vector U at that normal is lam . U.
+template <class T>
+inline void lambertAtNormal(const LambertFactors& f, T X, T Y, T Z, T* lam) {
+    lam[0] = T{} + f.c0;
+    lam[1] = f.c1 * Y;
+    lam[2] = f.c1 * Z;
+    lam[3] = f.c1 * X;
+    lam[4] = f.c4 * X * Y;
+    lam[5] = f.c4 * Y * Z;
+    lam[6] = f.c6 * (3.0f * Z * Z - 1.0f);
+    lam[7] = f.c4 * X * Z;
+    lam[8] = f.c8 * (X * X - Y * Y);
+}
+
 struct ReceiverLerp {
     int i0 = 0, i1 = 0;
     float f = 0.0f;

@@ -360,7 +360,6 @@ template <class V>
         }
         e = e1;
     }
-    (void)nxrPad;
 }
 
 // One row's azimuth batch (1 or 2 azimuths from j0): the scans, their maximum
