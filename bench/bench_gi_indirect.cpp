@@ -2,7 +2,7 @@
 // gi/reference_gi, and the paper's Table 1 (frame time x size x sub-sampling x
 // bounces, with and without amortisation) on this machine.
 //
-//   bench_gi_indirect [--data DIR] [--out DIR] [--runs N] [--quick] [--diagnose] [--sh-kernel] [--indirect-azimuths N]
+//   bench_gi_indirect [--data DIR] [--out DIR] [--runs N] [--quick] [--diagnose] [--sh-kernel] [--exact-kernel] [--indirect-azimuths N]
 //                     [--radiance-k N] [--radiance-o N] [--accuracy-only] [--probe N]
 //
 // Writes bench/results/gi_indirect_accuracy.{md,csv} and gi_indirect_timing.{md,csv}.
@@ -36,6 +36,7 @@ std::string gOutDir = "bench/results";
 int gRuns = 5;
 bool gQuick = false;
 bool gShKernel = false;     // --sh-kernel: the engine settings with the paper's SH Lambert kernel and receiver planes
+bool gExactKernel = false;  // --exact-kernel: the engine settings with U's normal detail between the receivers
 int gIndirectAzimuths = 0;  // --indirect-azimuths N
 int gRadianceK = 0;         // --radiance-k N: the engine's radiance pyramid k_u
 int gRadianceO = -1;        // --radiance-o N: the engine's radiance pyramid o_u
@@ -183,6 +184,7 @@ GiSettings settingsFor(int s, int bounces, bool paper) {
     if (gIndirectAzimuths > 0) g.indirect.azimuths = gIndirectAzimuths;
     if (!paper && gRadianceK > 0) g.indirect.radiance.levelsPerOctave = gRadianceK;
     if (!paper && gRadianceO >= 0) g.indirect.radiance.levelOffset = gRadianceO;
+    if (!paper && gExactKernel) g.indirect.lambert = LambertIndirect::ExactAtReceivers;
     if (!paper && gShKernel) {
         g.indirect.lambert = LambertIndirect::ShKernel;
         g.visibility.footprintTangent = false;
@@ -194,14 +196,16 @@ GiSettings settingsFor(int s, int bounces, bool paper) {
 // The engine settings as the tables print them.
 std::string engineSummary() {
     const GiSettings g = settingsFor(2, 1, false);
-    char b[400];
+    char b[512];
     std::snprintf(b, sizeof b,
                   "m %d, k_v %d, o_v %d, peak blend %.2f, k_u %d, o_u %d, %d indirect azimuths, %s, footprint tangent planes %s; "
                   "%s kernels",
                   g.visibility.azimuths, g.pyramid.levelsPerOctave, g.pyramid.levelOffset, g.pyramid.peakBlend,
                   g.indirect.radiance.levelsPerOctave, g.indirect.radiance.levelOffset,
                   g.indirect.azimuths > 0 ? g.indirect.azimuths : g.visibility.azimuths,
-                  g.indirect.lambert == LambertIndirect::ExactAtReceivers ? "exact cosine at the receivers" : "SH kernel",
+                  g.indirect.lambert == LambertIndirect::BlockerRadiance    ? "exact cosine at the receivers, blocker radiance x occlusion between them"
+                  : g.indirect.lambert == LambertIndirect::ExactAtReceivers ? "exact cosine at the receivers, U's normal detail between them"
+                                                                            : "SH kernel",
                   g.visibility.footprintTangent ? "on" : "off", simd::wideEnabled() ? "8-wide AVX2" : "4-wide SSE2");
     return b;
 }
@@ -296,13 +300,14 @@ int main(int argc, char** argv) {
         else if (a == "--quick") gQuick = true;
         else if (a == "--diagnose") gDiagnose = true;
         else if (a == "--sh-kernel") gShKernel = true;
+        else if (a == "--exact-kernel") gExactKernel = true;
         else if (a == "--accuracy-only") gAccuracyOnly = true;
         else if (a == "--probe" && i + 1 < argc) gProbe = std::atoi(argv[++i]);
         else if (a == "--indirect-azimuths" && i + 1 < argc) gIndirectAzimuths = std::atoi(argv[++i]);
         else if (a == "--radiance-k" && i + 1 < argc) gRadianceK = std::atoi(argv[++i]);
         else if (a == "--radiance-o" && i + 1 < argc) gRadianceO = std::atoi(argv[++i]);
         else {
-            std::fprintf(stderr, "usage: bench_gi_indirect [--data DIR] [--out DIR] [--runs N] [--quick] [--diagnose] [--sh-kernel] [--indirect-azimuths N] [--radiance-k N] [--radiance-o N] [--accuracy-only] [--probe N]\n");
+            std::fprintf(stderr, "usage: bench_gi_indirect [--data DIR] [--out DIR] [--runs N] [--quick] [--diagnose] [--sh-kernel] [--exact-kernel] [--indirect-azimuths N] [--radiance-k N] [--radiance-o N] [--accuracy-only] [--probe N]\n");
             return 2;
         }
     }
@@ -373,7 +378,7 @@ int main(int argc, char** argv) {
                     GiState st;
                     withThreads(2, [&] { runGiFrame(d.heights.cview(), d.cell, light, settingsFor(s, b, paper), st, &a); });
                     const Errors e = errorsOf(st, ref, b);
-                    const char* name = paper ? "paper (m 32, k 4, o 2, SH kernel)" : "engine (m 16 / 8 indirect, o 3, exact at receivers)";
+                    const char* name = paper ? "paper (m 32, k 4, o 2, SH kernel)" : "engine (m 16 / 8 indirect, o 3, blocker radiance)";
                     char line[512];
                     std::snprintf(line, sizeof line, "| %s | %dx | %d | %.4f | %+.4f | %.4f | %+.4f |\n", name, s, b, e.total, e.totalBias,
                                   e.indirect, e.indirectBias);

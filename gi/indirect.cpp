@@ -35,25 +35,7 @@ using simd::ldv;
 using simd::splv;
 using simd::sqrtv;
 using simd::stv;
-
-// Deterministic float atan (Cephes atanf: range reduction to |x| <= tan(pi/8),
-// then a degree-9 odd minimax polynomial; ~1e-7 relative): a pure function of
-// its argument, so bit-identical for any thread count.
-template <class V>
-[[gnu::always_inline]] inline V atanv(V t) {
-    const V zero = splv<V>(0.0f), one = splv<V>(1.0f);
-    const V x = t < zero ? -t : t;
-    const auto big = x > splv<V>(2.414213562373095f);
-    const auto mid = (x > splv<V>(0.4142135623730950f)) & ~big;
-    // one division: -1 / x, (x - 1) / (x + 1) or x / 1
-    const V xr = (big ? -one : (mid ? x - one : x)) / (big ? x : (mid ? x + one : one));
-    const V y0 = big ? splv<V>(1.5707963267948966f) : (mid ? splv<V>(0.7853981633974483f) : zero);
-    const V z = xr * xr;
-    const V p = ((((splv<V>(8.05374449538e-2f) * z - splv<V>(1.38776856032e-1f)) * z + splv<V>(1.99777106478e-1f)) * z -
-                  splv<V>(3.33329491539e-1f)) * z) * xr + xr;
-    const V r = y0 + p;
-    return t < zero ? -r : r;
-}
+using simd::atanv;
 
 // ---- algorithm: the casting set and Eq. 12 for one row of receivers --------
 // The walk over the height steps (Eq. 17): at each step where some lane has a
@@ -381,8 +363,11 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
     const int nSteps = static_cast<int>(pyr.steps.size());
     const std::size_t planeR = static_cast<std::size_t>(nxr) * nyr;
     const int nRows = shading.brdf == Brdf::Lambert ? 9 : kShCount;  // Lambert reads bands 0..2 only
-    const bool exact = settings.lambert == LambertIndirect::ExactAtReceivers && shading.brdf == Brdf::Lambert;
-    const int mode = !exact ? kShOnly : (s == 1 ? kExactOnly : kShAndExact);
+    const bool lambertBrdf = shading.brdf == Brdf::Lambert;
+    // BlockerRadiance: only E and the horizons at the receivers, no U
+    const bool ratio = lambertBrdf && settings.lambert == LambertIndirect::BlockerRadiance;
+    const bool exact = lambertBrdf && (settings.lambert == LambertIndirect::ExactAtReceivers || ratio);
+    const int mode = !exact ? kShOnly : (s == 1 || ratio ? kExactOnly : kShAndExact);
     const FootprintBox* box = footprint;
     if (mode == kShAndExact && (!box || box->nxr != nxr || box->nyr != nyr || box->subsample != s)) {
         computeFootprintBox(gradX, gradY, s, st.footprint);
@@ -394,6 +379,9 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
         Grid& g = st.indirect[static_cast<std::size_t>(c)];
         if (g.nx != nx || g.ny != ny) g.resize(nx, ny);
         std::fill(g.v.begin(), g.v.end(), 0.0f);
+    }
+    if (ratio) prepareBlockerRadiance(pyr, m, st.blocker);
+    for (int c = 0; c < 3 && !ratio; ++c) {
         VisibilityField& u = st.u[static_cast<std::size_t>(c)];
         u.nxr = nxr;
         u.nyr = nyr;
@@ -402,7 +390,7 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
     }
     // the planes shading does not read (Lambert: bands 0..2) stay 0; each scan
     // row clears only the planes it fills
-    if (st.uZeroFrom > nRows) {
+    if (!ratio && st.uZeroFrom > nRows) {
         for (VisibilityField& u : st.u) std::fill(u.sh.begin() + static_cast<std::ptrdiff_t>(planeR) * nRows, u.sh.end(), 0.0f);
         st.uZeroFrom = nRows;
     }
@@ -516,7 +504,7 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
                         }
                         std::fill(sc.exact.data() + 3 * ro, sc.exact.data() + 3 * ro + 3 * static_cast<std::size_t>(pad), 0.0f);
                     }
-                    for (int c = 0; c < 3; ++c)
+                    for (int c = 0; c < 3 && !ratio; ++c)
                         for (int i = 0; i < nRows; ++i) {
                             float* u = st.u[static_cast<std::size_t>(c)].plane(i) + static_cast<std::size_t>(Y) * nxr;
                             std::fill(u, u + nxr, 0.0f);
@@ -554,6 +542,15 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
                                                                  st.stepsPerColumn.data() + static_cast<std::size_t>(j) * pad,
                                                                  st.stepsPerRow[static_cast<std::size_t>(j) * nyr + static_cast<std::size_t>(Y)], Y,
                                                                  in, cosPhi, sinPhi, sc, pad);
+                        if (ratio) {
+                            // the receivers' horizon along this azimuth (the walk's running maximum)
+                            if (b == 1 && s > 1)
+                                std::copy(sc.state.data(), sc.state.data() + nxr,
+                                          st.blocker.farSlope.data() + static_cast<std::size_t>(j) * planeR + static_cast<std::size_t>(Y) * nxr);
+                            accumulate({sc.nlp.data(), pad, nxr, sc.exact.data() + 3 * ro, 0, nullptr, nullptr, vals, 0,
+                                        {nullptr, nullptr, nullptr}, planeR});
+                            continue;
+                        }
                         accumulate({sc.nlp.data(), pad, nxr, exact ? sc.exact.data() + 3 * ro : nullptr,
                                     mode == kExactOnly ? 0 : P, op.patternRow.data(), op.patternNlp.data(), vals, nRows,
                                     {st.u[0].plane(0) + static_cast<std::size_t>(Y) * nxr,
@@ -563,9 +560,24 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
                     }
                 }
                 if (!exact) continue;
+                const float eScale = 2.0f / static_cast<float>(m);  // (2 pi / m) / pi
+                if (ratio) {
+                    // E / pi at the receivers
+                    for (int r = 0; r < rows; ++r) {
+                        const std::size_t ro = static_cast<std::size_t>(r) * pad;
+                        const std::size_t at = static_cast<std::size_t>(yBegin + r) * nxr;
+                        const float* gx = sc.gx.data() + ro;
+                        const float* gy = sc.gy.data() + ro;
+                        for (int c = 0; c < 3; ++c) {
+                            const float* e = sc.exact.data() + 3 * ro + static_cast<std::size_t>(c) * pad;
+                            float* out = st.blocker.receiverShade[static_cast<std::size_t>(c)].data() + at;
+                            for (int X = 0; X < nxr; ++X) out[X] = eScale / std::sqrt(1.0f + gx[X] * gx[X] + gy[X] * gy[X]) * e[X];
+                        }
+                    }
+                    continue;
+                }
                 // ExactAtReceivers: the shade at the receiver's normal, lam(N) . U
                 // (as gi/shading evaluates it there), becomes E / pi through band 0
-                const float eScale = 2.0f / static_cast<float>(m);  // (2 pi / m) / pi
                 for (int r = 0; r < rows; ++r) {
                     const std::size_t ro = static_cast<std::size_t>(r) * pad;
                     const std::size_t at = static_cast<std::size_t>(yBegin + r) * nxr;
@@ -580,7 +592,12 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
         // ---- shading of U at full-resolution normals: L_b ------------------------------
         t = Clock::now();
         ShadeMaps& out = st.bounceShade[static_cast<std::size_t>(b & 1)];
-        shadeTexels(gradX, gradY, s, envVisibility, st.lights.data(), 3, albedo, shading, out, false);
+        if (ratio) {
+            if (b == 1 && s > 1) computeTexelOcclusion(pyr, gradX, gradY, op.phi, st.blocker);
+            shadeBlockerRadiance(st.blocker, albedo, out.rgb);
+        } else {
+            shadeTexels(gradX, gradY, s, envVisibility, st.lights.data(), 3, albedo, shading, out, false);
+        }
         double sum = 0.0;
         for (int c = 0; c < 3; ++c) {
             Grid& acc = st.indirect[static_cast<std::size_t>(c)];

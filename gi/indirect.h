@@ -50,6 +50,7 @@
 #include <array>
 #include <vector>
 
+#include "gi/blocker_radiance.h"
 #include "gi/indirect_glossy.h"
 #include "gi/pyramid.h"
 #include "gi/radiance_pyramid.h"
@@ -80,6 +81,12 @@ enum class LambertIndirect {
     // With sub-sampling U's segments reach below the receiver's tangent plane
     // (see footprintDrop), so that texels of other normals find their light.
     ExactAtReceivers,
+    // The exact E at the receivers (as ExactAtReceivers); between them the
+    // blockers' mean radiance E / O interpolated and multiplied by each
+    // texel's own occlusion O (gi/blocker_radiance.h). No U: the scan keeps
+    // the exact moment and the horizon only. Lambert BRDF; others fall back
+    // to ExactAtReceivers.
+    BlockerRadiance,
 };
 
 struct IndirectSettings {
@@ -133,6 +140,7 @@ struct IndirectState {
     std::vector<double> bounceMean;  // mean exit radiance (RGB average) of each bounce
     IndirectTimings timings;
     GlossyIndirectState glossy;    // vector-pyramid buffers (GlossyIndirect::VectorPyramid)
+    BlockerRadianceState blocker;  // LambertIndirect::BlockerRadiance: horizons, occlusion, receivers' E
     FootprintBox footprint;        // when the caller passes none
 };
 

@@ -166,6 +166,9 @@ void FramePipeline::light() {
     const float uScale = static_cast<float>(1.0 / std::sqrt(4.0 * gi::kPi));
     const auto& u = gi_.indirect.u;
     const bool hasU = indirect && u[0].nxr == v.nxr && u[0].nyr == v.nyr && !u[0].sh.empty();
+    // LambertIndirect::BlockerRadiance keeps no U: its receivers' irradiance / pi instead
+    const auto& eRecv = gi_.indirect.blocker.receiverShade;
+    const bool hasE = indirect && !hasU && eRecv[0].size() == static_cast<std::size_t>(v.nxr) * v.nyr;
     for (int y = 0; y < v.nyr; ++y)
         for (int x = 0; x < v.nxr; ++x) {
             const std::size_t i = static_cast<std::size_t>(y) * v.nxr + x;
@@ -177,8 +180,9 @@ void FramePipeline::light() {
             }
             f.receiver[4 * i + 1] = level;
             f.receiver[4 * i + 2] =
-                hasU ? uScale * (0.2126f * u[0].plane(0)[i] + 0.7152f * u[1].plane(0)[i] + 0.0722f * u[2].plane(0)[i])
-                     : 0.0f;
+                hasU   ? uScale * (0.2126f * u[0].plane(0)[i] + 0.7152f * u[1].plane(0)[i] + 0.0722f * u[2].plane(0)[i])
+                : hasE ? 0.2126f * eRecv[0][i] + 0.7152f * eRecv[1][i] + 0.0722f * eRecv[2][i]
+                       : 0.0f;
             f.receiver[4 * i + 3] = 0.0f;
         }
     const double packMs = msSince(t);

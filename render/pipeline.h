@@ -15,7 +15,7 @@
 //   ambient    gi/ ambient map (normal-weighted sky-view factor)
 //   and at the receiver resolution: the sky visibility fraction (V's
 //   constant term), one height-pyramid level and the mean incident indirect
-//   radiance (U's constant term), for debug views.
+//   radiance (U's constant term, or E / pi with the blocker-radiance kernel), for debug views.
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -71,7 +71,7 @@ struct FrameData {
     std::vector<float> key;               // 4 per texel: key RGB, ambient
     int nxr = 0, nyr = 0, subsample = 1;  // receiver grid
     std::vector<float> receiver;          // 4 per receiver: sky visibility fraction, pyramid level height,
-                                          // mean incident indirect radiance (U's constant term; 0 without bounces), 0
+                                          // mean incident indirect radiance (U's constant term, or the irradiance E / pi where the kernel keeps no U; 0 without bounces), 0
     int pyramidLevel = -1;                // level in `receiver` (-1: none built)
     SceneLights lights;
     LightingMode lighting = LightingMode::Direct;

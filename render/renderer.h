@@ -32,7 +32,7 @@ enum class DebugView {
     Normals,        // full-resolution normals
     PyramidLevel,   // one height-pyramid level, receiver grid
     ShadeMap,       // gi/ RGB shade map (sky + key, white albedo)
-    IndirectRadiance,  // U: mean incident indirect radiance (U's constant term), receiver grid
+    IndirectRadiance,  // U: mean incident indirect radiance (U's constant term, or E / pi without U), receiver grid
 };
 
 struct OrbitCamera {

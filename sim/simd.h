@@ -98,6 +98,25 @@ inline T vmin(T a, T b) {
 }
 inline float vsqrt(float x) { return std::sqrt(x); }
 
+// Deterministic float atan (Cephes atanf: range reduction to |x| <= tan(pi/8),
+// then a degree-9 odd minimax polynomial; ~1e-7 relative): a pure function of
+// its argument, so bit-identical for any thread count.
+template <class V>
+[[gnu::always_inline]] inline V atanv(V t) {
+    const V zero = splv<V>(0.0f), one = splv<V>(1.0f);
+    const V x = t < zero ? -t : t;
+    const auto big = x > splv<V>(2.414213562373095f);
+    const auto mid = (x > splv<V>(0.4142135623730950f)) & ~big;
+    // one division: -1 / x, (x - 1) / (x + 1) or x / 1
+    const V xr = (big ? -one : (mid ? x - one : x)) / (big ? x : (mid ? x + one : one));
+    const V y0 = big ? splv<V>(1.5707963267948966f) : (mid ? splv<V>(0.7853981633974483f) : zero);
+    const V z = xr * xr;
+    const V p = ((((splv<V>(8.05374449538e-2f) * z - splv<V>(1.38776856032e-1f)) * z + splv<V>(1.99777106478e-1f)) * z -
+                  splv<V>(3.33329491539e-1f)) * z) * xr + xr;
+    const V r = y0 + p;
+    return t < zero ? -r : r;
+}
+
 /// Kernels with an 8-wide AVX2 variant (gi/indirect.cpp) use it when the
 /// processor has AVX2 and it is enabled (the default). The variants give
 /// bit-identical results (no fused multiply-add in either); tests and

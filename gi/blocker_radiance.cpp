@@ -1,0 +1,242 @@
+#include "gi/blocker_radiance.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "gi/visibility.h"
+#include "sim/parallel.h"
+#include "sim/simd.h"
+
+namespace terrain::gi {
+
+namespace {
+
+using simd::atanv;
+using simd::F4;
+using simd::F8;
+using simd::LaneTraits;
+using simd::ldv;
+using simd::splv;
+using simd::stv;
+
+constexpr int kRowsPerBlock = 8;
+constexpr int kLanePad = 8;                // rows padded to the widest lane group
+constexpr float kOutside = -1.0e30f;       // height outside the domain: a sample there blocks nothing
+constexpr float kMarginRel = 1.0f / 1048576.0f;  // as the scan: height differences below 2^-20 |h0| are rounding
+
+inline int padLanes(int n) { return (n + kLanePad - 1) / kLanePad * kLanePad; }
+
+// One row of texels: inputs and the occlusion sum.
+struct OcclusionRow {
+    const float* h;          // padded heights of this row at column 0 (taps reach s cells around)
+    std::ptrdiff_t stride;   // of the padded heights
+    const float *gx, *gy;    // padded rows of the gradient
+    float* far;              // padded row: the receivers' horizon of this azimuth, interpolated
+    float* sum;              // padded row: running sum of F(horizon) - F(plane)
+    int n;                   // padded length
+};
+
+// Adds one azimuth's clamped-cosine integral below the texels' horizons:
+// horizon = max(near samples, far), F(t) = f2 - g f1 (t = tan of the
+// elevation, f1 = (w + sin w cos w) / 2, f2 = sin^2 w / 2; with sin^2 w =
+// t^2 / (1 + t^2), sin w cos w = t / (1 + t^2)), clamped to the texel's
+// plane g (as the indirect scan's exact moment).
+template <class V>
+[[gnu::always_inline]] inline void occlusionAzimuthImpl(const OcclusionRow& r, const NearTap* taps, int nTaps, float cosPhi,
+                                                        float sinPhi) {
+    constexpr int L = LaneTraits<V>::n;
+    const V one = splv<V>(1.0f), half = splv<V>(0.5f), lim = splv<V>(1e6f), nlim = splv<V>(-1e6f);
+    for (int x = 0; x < r.n; x += L) {
+        const V h0 = ldv<V>(r.h + x);
+        const V margin = (h0 < splv<V>(0.0f) ? -h0 : h0) * splv<V>(kMarginRel);
+        V hor = ldv<V>(r.far + x);
+        for (int k = 0; k < nTaps; ++k) {
+            const NearTap& t = taps[k];
+            const float* a = r.h + t.dy * r.stride + t.dx + x;
+            const float* b = a + r.stride;
+            const V v = (splv<V>(t.w00) * ldv<V>(a) + splv<V>(t.w10) * ldv<V>(a + 1)) +
+                        (splv<V>(t.w01) * ldv<V>(b) + splv<V>(t.w11) * ldv<V>(b + 1));
+            const V slope = ((v - h0) - margin) * splv<V>(t.invDist);
+            hor = slope > hor ? slope : hor;
+        }
+        const V g = ldv<V>(r.gx + x) * splv<V>(cosPhi) + ldv<V>(r.gy + x) * splv<V>(sinPhi);
+        const V gc = g < nlim ? nlim : (g > lim ? lim : g);
+        V tc = hor < gc ? gc : hor;
+        tc = tc > lim ? lim : tc;
+        // F(t) = (t (t - g) / (1 + t^2) - g atan t) / 2, so F(g) = -g atan(g) / 2
+        const V f = half * (tc * (tc - g) / (one + tc * tc) - g * (atanv(tc) - atanv(gc)));
+        // below the plane nothing: exactly 0
+        stv(r.sum + x, ldv<V>(r.sum + x) + (tc > gc ? f : splv<V>(0.0f)));
+    }
+}
+void occlusionAzimuthSse(const OcclusionRow& r, const NearTap* taps, int nTaps, float c, float s) {
+    occlusionAzimuthImpl<F4>(r, taps, nTaps, c, s);
+}
+[[gnu::target("avx2"), gnu::flatten]] void occlusionAzimuthAvx2(const OcclusionRow& r, const NearTap* taps, int nTaps, float c,
+                                                                float s) {
+    occlusionAzimuthImpl<F8>(r, taps, nTaps, c, s);
+}
+
+}  // namespace
+
+void prepareBlockerRadiance(const HeightPyramid& pyr, int azimuths, BlockerRadianceState& st) {
+    st.nx = pyr.nx;
+    st.ny = pyr.ny;
+    st.nxr = pyr.nxr;
+    st.nyr = pyr.nyr;
+    st.subsample = pyr.subsample;
+    st.azimuths = azimuths;
+    const std::size_t planeR = static_cast<std::size_t>(pyr.nxr) * pyr.nyr;
+    for (std::vector<float>& v : st.receiverShade) v.resize(planeR);
+    if (pyr.subsample == 1) return;  // every texel a receiver: E alone
+    st.farSlope.resize(planeR * static_cast<std::size_t>(azimuths));
+    st.receiverOcclusion.resize(planeR);
+    if (st.occlusion.nx != pyr.nx || st.occlusion.ny != pyr.ny) st.occlusion.resize(pyr.nx, pyr.ny);
+}
+
+void computeTexelOcclusion(const HeightPyramid& pyr, ConstGridView gradX, ConstGridView gradY, const std::vector<double>& phi,
+                           BlockerRadianceState& st) {
+    const int nx = pyr.nx, ny = pyr.ny, s = pyr.subsample, nxr = pyr.nxr, nyr = pyr.nyr;
+    const int m = static_cast<int>(phi.size());
+    const int B = s;  // border: the near samples reach s - 0.5 cells, their taps s cells
+    const int pad = padLanes(nx);
+    const std::ptrdiff_t stride = pad + 2 * B + kLanePad;
+    // full-resolution heights (column x is column x / s of phase plane x % s)
+    st.heights.assign(static_cast<std::size_t>(stride) * (ny + 2 * B + 1), kOutside);
+    parallelForRows(ny, nx, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y) {
+            float* row = st.heights.data() + (y + B) * stride + B;
+            for (int q = 0; q < s; ++q) {
+                const float* src = pyr.rawPhaseRow(q, y);
+                for (int x = q; x < nx; x += s) row[x] = src[x / s];
+            }
+        }
+    });
+    // the near samples of every azimuth: t = 0.5, 1, ..., s - 0.5 cells
+    const int nTaps = 2 * s - 1;
+    std::vector<NearTap>& taps = st.taps;
+    std::vector<float>& cosPhi = st.cosPhi;
+    std::vector<float>& sinPhi = st.sinPhi;
+    taps.resize(static_cast<std::size_t>(m) * nTaps);
+    cosPhi.resize(static_cast<std::size_t>(m));
+    sinPhi.resize(static_cast<std::size_t>(m));
+    for (int j = 0; j < m; ++j) {
+        const double c = std::cos(phi[static_cast<std::size_t>(j)]), sn = std::sin(phi[static_cast<std::size_t>(j)]);
+        cosPhi[static_cast<std::size_t>(j)] = static_cast<float>(c);
+        sinPhi[static_cast<std::size_t>(j)] = static_cast<float>(sn);
+        for (int k = 0; k < nTaps; ++k) {
+            const double t = 0.5 * (k + 1), ox = t * c, oy = t * sn;
+            const double fx0 = std::floor(ox), fy0 = std::floor(oy), fx = ox - fx0, fy = oy - fy0;
+            NearTap& tp = taps[static_cast<std::size_t>(j) * nTaps + k];
+            tp.dx = static_cast<int>(fx0);
+            tp.dy = static_cast<int>(fy0);
+            tp.w00 = static_cast<float>((1.0 - fx) * (1.0 - fy));
+            tp.w10 = static_cast<float>(fx * (1.0 - fy));
+            tp.w01 = static_cast<float>((1.0 - fx) * fy);
+            tp.w11 = static_cast<float>(fx * fy);
+            tp.invDist = static_cast<float>(1.0 / (t * pyr.cellSize));
+        }
+    }
+    // per full-resolution column: the receivers it interpolates
+    std::vector<ReceiverLerp>& cols = st.cols;
+    cols.resize(static_cast<std::size_t>(nx));
+    for (int x = 0; x < nx; ++x) cols[static_cast<std::size_t>(x)] = receiverLerp(x, s, nxr);
+    const int nBlocks = (ny + kRowsPerBlock - 1) / kRowsPerBlock;
+    const std::size_t perBlock = static_cast<std::size_t>(5) * pad;  // gx, gy, far, sum, receivers' row
+    st.scratch.resize(perBlock * nBlocks);
+    const float scale = 2.0f / static_cast<float>(m);  // (2 pi / m) / pi
+    void (*const azimuth)(const OcclusionRow&, const NearTap*, int, float, float) =
+        simd::wideEnabled() ? occlusionAzimuthAvx2 : occlusionAzimuthSse;
+    parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
+        for (int block = b0; block < b1; ++block) {
+            float* gx = st.scratch.data() + perBlock * block;
+            float* gy = gx + pad;
+            float* far = gy + pad;
+            float* sum = far + pad;
+            float* recv = sum + pad;
+            for (int y = block * kRowsPerBlock; y < std::min(ny, (block + 1) * kRowsPerBlock); ++y) {
+                for (int x = 0; x < pad; ++x) {
+                    gx[x] = x < nx ? gradX(x, y) : 0.0f;
+                    gy[x] = x < nx ? gradY(x, y) : 0.0f;
+                    sum[x] = 0.0f;
+                }
+                const ReceiverLerp ry = receiverLerp(y, s, nyr);
+                OcclusionRow row{st.heights.data() + (y + B) * stride + B, stride, gx, gy, far, sum, pad};
+                for (int j = 0; j < m; ++j) {
+                    // the receivers' horizons: between rows, then along the row
+                    const float* fs = st.farSlope.data() + static_cast<std::size_t>(j) * nxr * nyr;
+                    const float* f0 = fs + static_cast<std::size_t>(ry.i0) * nxr;
+                    const float* f1 = fs + static_cast<std::size_t>(ry.i1) * nxr;
+                    for (int X = 0; X < nxr; ++X) recv[X] = f0[X] + ry.f * (f1[X] - f0[X]);
+                    for (int x = 0; x < nx; ++x) {
+                        const ReceiverLerp& rx = cols[static_cast<std::size_t>(x)];
+                        far[x] = recv[rx.i0] + rx.f * (recv[rx.i1] - recv[rx.i0]);
+                    }
+                    for (int x = nx; x < pad; ++x) far[x] = kNoBlocker;
+                    azimuth(row, taps.data() + static_cast<std::size_t>(j) * nTaps, nTaps, cosPhi[static_cast<std::size_t>(j)],
+                            sinPhi[static_cast<std::size_t>(j)]);
+                }
+                float* out = st.occlusion.data() + static_cast<std::size_t>(y) * nx;
+                for (int x = 0; x < nx; ++x) out[x] = scale * sum[x] / std::sqrt(1.0f + gx[x] * gx[x] + gy[x] * gy[x]);
+            }
+        }
+    });
+    for (int Y = 0; Y < nyr; ++Y)
+        for (int X = 0; X < nxr; ++X)
+            st.receiverOcclusion[static_cast<std::size_t>(Y) * nxr + X] = st.occlusion(std::min(s * X, nx - 1), std::min(s * Y, ny - 1));
+}
+
+void shadeBlockerRadiance(BlockerRadianceState& st, const AlbedoMap* albedo, std::array<Grid, 3>& rgb) {
+    const int nx = st.nx, ny = st.ny, s = st.subsample, nxr = st.nxr, nyr = st.nyr;
+    for (Grid& g : rgb)
+        if (g.nx != nx || g.ny != ny) g.resize(nx, ny);
+    const float* alb[3];
+    for (int c = 0; c < 3; ++c)
+        alb[c] = albedo && !albedo->channel[static_cast<std::size_t>(c)].empty() ? albedo->channel[static_cast<std::size_t>(c)].data()
+                                                                                 : nullptr;
+    if (s == 1) {  // every texel a receiver
+        parallelForRows(ny, nx, [&](int y0, int y1) {
+            for (int c = 0; c < 3; ++c) {
+                const std::size_t a = static_cast<std::size_t>(y0) * nx, e = static_cast<std::size_t>(y1) * nx;
+                const float* in = st.receiverShade[static_cast<std::size_t>(c)].data();
+                float* out = rgb[static_cast<std::size_t>(c)].data();
+                for (std::size_t i = a; i < e; ++i) out[i] = (alb[c] ? alb[c][i] : 1.0f) * in[i];
+            }
+        });
+        return;
+    }
+    const int nBlocks = (ny + kRowsPerBlock - 1) / kRowsPerBlock;
+    const std::size_t perBlock = static_cast<std::size_t>(4) * nxr;  // O, E x 3 of a row, between receiver rows
+    if (st.scratch.size() < perBlock * nBlocks) st.scratch.resize(perBlock * nBlocks);
+    parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
+        for (int block = b0; block < b1; ++block) {
+            float* oRow = st.scratch.data() + perBlock * block;
+            float* eRow[3] = {oRow + nxr, oRow + 2 * nxr, oRow + 3 * nxr};
+            for (int y = block * kRowsPerBlock; y < std::min(ny, (block + 1) * kRowsPerBlock); ++y) {
+                const ReceiverLerp ry = receiverLerp(y, s, nyr);
+                const std::size_t r0 = static_cast<std::size_t>(ry.i0) * nxr, r1 = static_cast<std::size_t>(ry.i1) * nxr;
+                const float* o = st.receiverOcclusion.data();
+                for (int X = 0; X < nxr; ++X) oRow[X] = o[r0 + X] + ry.f * (o[r1 + X] - o[r0 + X]);
+                for (int c = 0; c < 3; ++c) {
+                    const float* e = st.receiverShade[static_cast<std::size_t>(c)].data();
+                    for (int X = 0; X < nxr; ++X) eRow[c][X] = e[r0 + X] + ry.f * (e[r1 + X] - e[r0 + X]);
+                }
+                const std::size_t at = static_cast<std::size_t>(y) * nx;
+                const float* occ = st.occlusion.data() + at;
+                for (int x = 0; x < nx; ++x) {
+                    const ReceiverLerp& rx = st.cols[static_cast<std::size_t>(x)];
+                    const float den = oRow[rx.i0] + rx.f * (oRow[rx.i1] - oRow[rx.i0]);
+                    // the blockers' mean radiance (E / O, interpolated) times this texel's occlusion
+                    const float k = den > 0.0f ? occ[x] / den : 0.0f;
+                    for (int c = 0; c < 3; ++c) {
+                        const float* e = eRow[c];
+                        const float num = e[rx.i0] + rx.f * (e[rx.i1] - e[rx.i0]);
+                        rgb[static_cast<std::size_t>(c)].v[at + static_cast<std::size_t>(x)] = (alb[c] ? alb[c][at + x] : 1.0f) * (k * num);
+                    }
+                }
+            }
+        }
+    });
+}
+
+}  // namespace terrain::gi
