@@ -102,6 +102,10 @@ double frameMemoryMB(const Grid& heights, const GiState& st) {
     for (const VisibilityField& v : in.u) b += bytesOf(v.sh);
     for (const ShadeMaps& s : in.bounceShade) b += bytesOf(s);
     for (int c = 0; c < 3; ++c) b += bytesOf(in.indirect[static_cast<std::size_t>(c)]) + bytesOf(in.total[static_cast<std::size_t>(c)]);
+    const BlockerRadianceState& br = in.blocker;
+    b += bytesOf(br.farSlope) + bytesOf(br.heights) + bytesOf(br.occlusion) + bytesOf(br.receiverOcclusion) + bytesOf(br.scratch) +
+         bytesOf(br.taps) + bytesOf(br.cols);
+    for (const std::vector<float>& e : br.receiverShade) b += bytesOf(e);
     for (const IndirectScratch& s : in.blocks)
         b += bytesOf(s.nlp) + bytesOf(s.state) + 4 * bytesOf(s.gx) + bytesOf(s.footGx) + bytesOf(s.footGy) + bytesOf(s.exact) +
              bytesOf(s.lowSlope) + bytesOf(s.groupSteps) + bytesOf(s.active);
