@@ -18,7 +18,10 @@
 // environment visibility (Eqs. 19-21). The incident radiance is U itself; it is
 // shaded like direct light (gi/shading.h: SH vectors interpolated from the
 // receiver grid, dotted with the BRDF rotated to each full-resolution normal),
-// giving the bounce's exit radiance L_b. Bounce b + 1 builds its radiance
+// giving the bounce's exit radiance L_b (the engine's Lambert default,
+// LambertIndirect::BlockerRadiance, keeps no U: the exact irradiance at the
+// receivers, and between them the blockers' mean radiance times each texel's
+// occlusion, gi/blocker_radiance.h). Bounce b + 1 builds its radiance
 // pyramid from L_b (Section 7); the result accumulates L_1 + ... + L_B.
 //
 // Glossy surfaces (IndirectSettings::glossy): ScalarPyramid forwards the
