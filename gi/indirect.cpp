@@ -405,10 +405,10 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
         b.gy.resize(rowFloats);
         b.h0.resize(rowFloats);
         b.margin.resize(rowFloats);
-        if (exact) {
+        if (exact) b.exact.resize(rowFloats * 3);
+        if (mode == kShAndExact) {
             b.footGx.resize(rowFloats * 2);
             b.footGy.resize(rowFloats * 2);
-            b.exact.resize(rowFloats * 3);
             b.lowSlope.resize(static_cast<std::size_t>(pad));
         }
         b.nlp.resize(static_cast<std::size_t>(15) * pad);
@@ -542,21 +542,16 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
                                                                  st.stepsPerColumn.data() + static_cast<std::size_t>(j) * pad,
                                                                  st.stepsPerRow[static_cast<std::size_t>(j) * nyr + static_cast<std::size_t>(Y)], Y,
                                                                  in, cosPhi, sinPhi, sc, pad);
-                        if (ratio) {
-                            // the receivers' horizon along this azimuth (the walk's running maximum)
-                            if (b == 1 && s > 1)
-                                std::copy(sc.state.data(), sc.state.data() + nxr,
-                                          st.blocker.farSlope.data() + static_cast<std::size_t>(j) * planeR + static_cast<std::size_t>(Y) * nxr);
-                            accumulate({sc.nlp.data(), pad, nxr, sc.exact.data() + 3 * ro, 0, nullptr, nullptr, vals, 0,
-                                        {nullptr, nullptr, nullptr}, planeR});
-                            continue;
-                        }
+                        // BlockerRadiance: the receivers' horizon along this azimuth (the walk's running maximum)
+                        if (ratio && b == 1 && s > 1)
+                            std::copy(sc.state.data(), sc.state.data() + nxr,
+                                      st.blocker.farSlope.data() + static_cast<std::size_t>(j) * planeR + static_cast<std::size_t>(Y) * nxr);
+                        float* uRow[3] = {nullptr, nullptr, nullptr};  // no U with BlockerRadiance
+                        for (int c = 0; c < 3 && !ratio; ++c)
+                            uRow[c] = st.u[static_cast<std::size_t>(c)].plane(0) + static_cast<std::size_t>(Y) * nxr;
                         accumulate({sc.nlp.data(), pad, nxr, exact ? sc.exact.data() + 3 * ro : nullptr,
                                     mode == kExactOnly ? 0 : P, op.patternRow.data(), op.patternNlp.data(), vals, nRows,
-                                    {st.u[0].plane(0) + static_cast<std::size_t>(Y) * nxr,
-                                     st.u[1].plane(0) + static_cast<std::size_t>(Y) * nxr,
-                                     st.u[2].plane(0) + static_cast<std::size_t>(Y) * nxr},
-                                    planeR});
+                                    {uRow[0], uRow[1], uRow[2]}, planeR});
                     }
                 }
                 if (!exact) continue;
