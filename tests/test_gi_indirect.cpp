@@ -183,7 +183,18 @@ TEST_CASE("gi.indirect: hard cases stay finite") {
     }
     cases.emplace_back("1x1", Grid(1, 1, 5.0f));
     cases.emplace_back("2x2", hills(2, 3.0f));
-    cases.emplace_back("non-power-of-two 37x19", hills(37, 5.0f));
+    cases.emplace_back("non-power-of-two 37x37", hills(37, 5.0f));
+    {
+        Grid g(37, 19, 0.0f);  // not square: a ramp with a ridge across it
+        for (int y = 0; y < 19; ++y)
+            for (int x = 0; x < 37; ++x) g(x, y) = 0.3f * static_cast<float>(x) + (y == 9 ? 6.0f : 0.0f);
+        cases.emplace_back("37x19 ramp and ridge", g);
+    }
+    {
+        Grid g(1, 9, 0.0f);  // one column
+        for (int y = 0; y < 9; ++y) g(0, y) = static_cast<float>((y * 7) % 5);
+        cases.emplace_back("1x9", g);
+    }
     for (auto& [name, g] : cases)
         for (int s : {1, 2, 4}) {
             GiState st;
