@@ -181,9 +181,41 @@ void computeTexelOcclusion(const HeightPyramid& pyr, ConstGridView gradX, ConstG
             }
         }
     });
-    for (int Y = 0; Y < nyr; ++Y)
-        for (int X = 0; X < nxr; ++X)
-            st.receiverOcclusion[static_cast<std::size_t>(Y) * nxr + X] = st.occlusion(std::min(s * X, nx - 1), std::min(s * Y, ny - 1));
+    // O_k at the receivers below the scan's horizons alone, the blockers E_k
+    // saw (no near samples: the scan starts s cells away), so that E_k / O_k
+    // is their mean radiance; at a receiver's own texel the near field then
+    // adds O(x) / O_k at that radiance
+    const int padR = padLanes(nxr);
+    const int nBlocksR = (nyr + kRowsPerBlock - 1) / kRowsPerBlock;
+    const std::size_t perBlockR = static_cast<std::size_t>(4) * padR;  // gx, gy, horizon, sum
+    if (st.scratch.size() < perBlockR * nBlocksR) st.scratch.resize(perBlockR * nBlocksR);
+    parallelFor(0, nBlocksR, 1, [&](int b0, int b1) {
+        for (int block = b0; block < b1; ++block) {
+            float* gx = st.scratch.data() + perBlockR * block;
+            float* gy = gx + padR;
+            float* far = gy + padR;
+            float* sum = far + padR;
+            for (int Y = block * kRowsPerBlock; Y < std::min(nyr, (block + 1) * kRowsPerBlock); ++Y) {
+                const int y = std::min(s * Y, ny - 1);
+                for (int X = 0; X < padR; ++X) {
+                    const int x = std::min(s * X, nx - 1);
+                    gx[X] = X < nxr ? gradX(x, y) : 0.0f;
+                    gy[X] = X < nxr ? gradY(x, y) : 0.0f;
+                    sum[X] = 0.0f;
+                }
+                // no near samples: the heights are not read
+                OcclusionRow row{far, 0, gx, gy, far, sum, padR};
+                for (int j = 0; j < m; ++j) {
+                    const float* fs = st.farSlope.data() + static_cast<std::size_t>(j) * nxr * nyr + static_cast<std::size_t>(Y) * nxr;
+                    std::copy(fs, fs + nxr, far);
+                    std::fill(far + nxr, far + padR, kNoBlocker);
+                    azimuth(row, nullptr, 0, cosPhi[static_cast<std::size_t>(j)], sinPhi[static_cast<std::size_t>(j)]);
+                }
+                float* out = st.receiverOcclusion.data() + static_cast<std::size_t>(Y) * nxr;
+                for (int X = 0; X < nxr; ++X) out[X] = scale * sum[X] / std::sqrt(1.0f + gx[X] * gx[X] + gy[X] * gy[X]);
+            }
+        }
+    });
 }
 
 void shadeBlockerRadiance(BlockerRadianceState& st, const AlbedoMap* albedo, std::array<Grid, 3>& rgb) {

@@ -18,9 +18,14 @@
 // indirect scan, per azimuth, box weights) below the texel's horizon
 // max(near(x), far(x)): near(x) from the full-resolution heights at 0.5,
 // 1, ..., s - 0.5 cells (closer than the scan's first step), far(x) the
-// receivers' horizons interpolated bilinearly; O_k is the same estimate at
-// the receivers. A texel with no blocker above its plane gets exactly 0 (a
-// flat plane stays dark).
+// receivers' horizons interpolated bilinearly. O_k is taken below the
+// receiver's scan horizons alone, the blockers its E_k saw (the scan starts
+// s cells away), so that E_k / O_k is their mean radiance; a receiver's own
+// texel then gets E_k O(x) / O_k: its near field at that radiance. (With the
+// near field in O_k too, i.e. the same estimate as the texels', the blockers'
+// radiance came out low: 2x / 4x indirect rel. RMSE on the eroded 256^2 frame
+// 8.3 / 11.4 % instead of 7.9 / 9.0 %.) A texel with no blocker above its
+// plane gets exactly 0 (a flat plane stays dark).
 //
 // Why: at 2x most of the indirect error was between the receivers, and most
 // of that in the most concave and most convex tenths of the texels (a
