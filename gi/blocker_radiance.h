@@ -34,7 +34,7 @@
 // cannot see a height difference. Measured on 256^2 crops, one bounce
 // (bench/results/gi_indirect_accuracy.md), indirect rel. RMSE against the
 // reference, U's normal detail (ExactAtReceivers) -> this: 2x alps 9.9 ->
-// 9.4 %, eroded frame 11.3 -> 8.3 %; 4x 13.1 -> 13.1 %, 14.8 -> 11.4 %
+// 9.4 %, eroded frame 11.3 -> 7.9 %; 4x 13.1 -> 12.7 %, 14.8 -> 9.0 %
 // (1x unchanged: every texel is a receiver). Without U the scan keeps one
 // moment instead of five and nothing is shaded from SH: 512^2 2x scan 23 ->
 // 14 ms, plus 5-6 ms for the occlusion and this shading.

@@ -137,7 +137,7 @@ GiSettings engineGiSettings() {
     // indirect light: the exact clamped cosine at the receivers (no SH-kernel
     // bias); between them the blockers' mean radiance times each texel's own
     // occlusion (gi/blocker_radiance.h; 256^2 crops at 2x, indirect rel. RMSE
-    // alps 9.9 -> 9.4 %, eroded frame 11.3 -> 8.3 % against U's normal
+    // alps 9.9 -> 9.4 %, eroded frame 11.3 -> 7.9 % against U's normal
     // detail, and no U to scan or shade: 512^2 2x scan 23 -> 15 ms); direct
     // light: the footprint's lowest tangent plane (bench/results/gi_indirect_accuracy.md)
     s.indirect.lambert = LambertIndirect::BlockerRadiance;
