@@ -77,6 +77,44 @@ void occlusionAzimuthSse(const OcclusionRow& r, const NearTap* taps, int nTaps, 
     occlusionAzimuthImpl<F8>(r, taps, nTaps, c, s);
 }
 
+using AzimuthFn = void (*)(const OcclusionRow&, const NearTap*, int, float, float);
+
+// A block's row buffers: gradients, horizons, the occlusion sum (pad floats each).
+struct RowScratch {
+    float *gx, *gy, *far, *sum;
+    static RowScratch at(float* p, int pad) { return {p, p + pad, p + 2 * pad, p + 3 * pad}; }
+};
+
+// A row of points: full-resolution row y, columns step * i (i < n; rows padded to pad).
+struct PointRow {
+    int y, step, n, pad;
+    const float* heights;    // the padded heights at (0, y), for the near samples (null: none)
+    std::ptrdiff_t stride;
+    int nTaps;
+};
+
+// O / pi of one row of points: per azimuth fillFar(j, far) sets the horizons
+// of the n points, then the kernel adds the azimuth's integral.
+template <class FillFar>
+void occlusionOfRow(ConstGridView gradX, ConstGridView gradY, const PointRow& p, const RowScratch& r, const NearTap* taps,
+                    const float* cosPhi, const float* sinPhi, int m, float scale, AzimuthFn azimuth, FillFar&& fillFar,
+                    float* out) {
+    for (int i = 0; i < p.pad; ++i) {
+        const int x = std::min(p.step * i, gradX.nx - 1);
+        r.gx[i] = i < p.n ? gradX(x, p.y) : 0.0f;
+        r.gy[i] = i < p.n ? gradY(x, p.y) : 0.0f;
+        r.sum[i] = 0.0f;
+    }
+    // without near samples the heights are not read
+    const OcclusionRow row{p.heights ? p.heights : r.far, p.stride, r.gx, r.gy, r.far, r.sum, p.pad};
+    for (int j = 0; j < m; ++j) {
+        fillFar(j, r.far);
+        std::fill(r.far + p.n, r.far + p.pad, kNoBlocker);
+        azimuth(row, taps ? taps + static_cast<std::size_t>(j) * p.nTaps : nullptr, p.nTaps, cosPhi[j], sinPhi[j]);
+    }
+    for (int i = 0; i < p.n; ++i) out[i] = scale * r.sum[i] / std::sqrt(1.0f + r.gx[i] * r.gx[i] + r.gy[i] * r.gy[i]);
+}
+
 }  // namespace
 
 void prepareBlockerRadiance(const HeightPyramid& pyr, int azimuths, BlockerRadianceState& st) {
@@ -141,43 +179,31 @@ void computeTexelOcclusion(const HeightPyramid& pyr, ConstGridView gradX, ConstG
     std::vector<ReceiverLerp>& cols = st.cols;
     cols.resize(static_cast<std::size_t>(nx));
     for (int x = 0; x < nx; ++x) cols[static_cast<std::size_t>(x)] = receiverLerp(x, s, nxr);
+    const float scale = 2.0f / static_cast<float>(m);  // (2 pi / m) / pi
+    const AzimuthFn azimuth = simd::wideEnabled() ? occlusionAzimuthAvx2 : occlusionAzimuthSse;
+    // texels: the receivers' horizons between rows, then along the row
     const int nBlocks = (ny + kRowsPerBlock - 1) / kRowsPerBlock;
     const std::size_t perBlock = static_cast<std::size_t>(5) * pad;  // gx, gy, far, sum, receivers' row
     st.scratch.resize(perBlock * nBlocks);
-    const float scale = 2.0f / static_cast<float>(m);  // (2 pi / m) / pi
-    void (*const azimuth)(const OcclusionRow&, const NearTap*, int, float, float) =
-        simd::wideEnabled() ? occlusionAzimuthAvx2 : occlusionAzimuthSse;
     parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
         for (int block = b0; block < b1; ++block) {
-            float* gx = st.scratch.data() + perBlock * block;
-            float* gy = gx + pad;
-            float* far = gy + pad;
-            float* sum = far + pad;
-            float* recv = sum + pad;
+            const RowScratch r = RowScratch::at(st.scratch.data() + perBlock * block, pad);
+            float* recv = r.sum + pad;
             for (int y = block * kRowsPerBlock; y < std::min(ny, (block + 1) * kRowsPerBlock); ++y) {
-                for (int x = 0; x < pad; ++x) {
-                    gx[x] = x < nx ? gradX(x, y) : 0.0f;
-                    gy[x] = x < nx ? gradY(x, y) : 0.0f;
-                    sum[x] = 0.0f;
-                }
                 const ReceiverLerp ry = receiverLerp(y, s, nyr);
-                OcclusionRow row{st.heights.data() + (y + B) * stride + B, stride, gx, gy, far, sum, pad};
-                for (int j = 0; j < m; ++j) {
-                    // the receivers' horizons: between rows, then along the row
-                    const float* fs = st.farSlope.data() + static_cast<std::size_t>(j) * nxr * nyr;
-                    const float* f0 = fs + static_cast<std::size_t>(ry.i0) * nxr;
-                    const float* f1 = fs + static_cast<std::size_t>(ry.i1) * nxr;
-                    for (int X = 0; X < nxr; ++X) recv[X] = f0[X] + ry.f * (f1[X] - f0[X]);
-                    for (int x = 0; x < nx; ++x) {
-                        const ReceiverLerp& rx = cols[static_cast<std::size_t>(x)];
-                        far[x] = recv[rx.i0] + rx.f * (recv[rx.i1] - recv[rx.i0]);
-                    }
-                    for (int x = nx; x < pad; ++x) far[x] = kNoBlocker;
-                    azimuth(row, taps.data() + static_cast<std::size_t>(j) * nTaps, nTaps, cosPhi[static_cast<std::size_t>(j)],
-                            sinPhi[static_cast<std::size_t>(j)]);
-                }
-                float* out = st.occlusion.data() + static_cast<std::size_t>(y) * nx;
-                for (int x = 0; x < nx; ++x) out[x] = scale * sum[x] / std::sqrt(1.0f + gx[x] * gx[x] + gy[x] * gy[x]);
+                const PointRow pts{y, 1, nx, pad, st.heights.data() + (y + B) * stride + B, stride, nTaps};
+                occlusionOfRow(gradX, gradY, pts, r, taps.data(), cosPhi.data(), sinPhi.data(), m, scale, azimuth,
+                               [&](int j, float* far) {
+                                   const float* fs = st.farSlope.data() + static_cast<std::size_t>(j) * nxr * nyr;
+                                   const float* f0 = fs + static_cast<std::size_t>(ry.i0) * nxr;
+                                   const float* f1 = fs + static_cast<std::size_t>(ry.i1) * nxr;
+                                   for (int X = 0; X < nxr; ++X) recv[X] = f0[X] + ry.f * (f1[X] - f0[X]);
+                                   for (int x = 0; x < nx; ++x) {
+                                       const ReceiverLerp& rx = cols[static_cast<std::size_t>(x)];
+                                       far[x] = recv[rx.i0] + rx.f * (recv[rx.i1] - recv[rx.i0]);
+                                   }
+                               },
+                               st.occlusion.data() + static_cast<std::size_t>(y) * nx);
             }
         }
     });
@@ -187,32 +213,20 @@ void computeTexelOcclusion(const HeightPyramid& pyr, ConstGridView gradX, ConstG
     // adds O(x) / O_k at that radiance
     const int padR = padLanes(nxr);
     const int nBlocksR = (nyr + kRowsPerBlock - 1) / kRowsPerBlock;
-    const std::size_t perBlockR = static_cast<std::size_t>(4) * padR;  // gx, gy, horizon, sum
+    const std::size_t perBlockR = static_cast<std::size_t>(4) * padR;  // gx, gy, far, sum
     if (st.scratch.size() < perBlockR * nBlocksR) st.scratch.resize(perBlockR * nBlocksR);
     parallelFor(0, nBlocksR, 1, [&](int b0, int b1) {
         for (int block = b0; block < b1; ++block) {
-            float* gx = st.scratch.data() + perBlockR * block;
-            float* gy = gx + padR;
-            float* far = gy + padR;
-            float* sum = far + padR;
+            const RowScratch r = RowScratch::at(st.scratch.data() + perBlockR * block, padR);
             for (int Y = block * kRowsPerBlock; Y < std::min(nyr, (block + 1) * kRowsPerBlock); ++Y) {
-                const int y = std::min(s * Y, ny - 1);
-                for (int X = 0; X < padR; ++X) {
-                    const int x = std::min(s * X, nx - 1);
-                    gx[X] = X < nxr ? gradX(x, y) : 0.0f;
-                    gy[X] = X < nxr ? gradY(x, y) : 0.0f;
-                    sum[X] = 0.0f;
-                }
-                // no near samples: the heights are not read
-                OcclusionRow row{far, 0, gx, gy, far, sum, padR};
-                for (int j = 0; j < m; ++j) {
-                    const float* fs = st.farSlope.data() + static_cast<std::size_t>(j) * nxr * nyr + static_cast<std::size_t>(Y) * nxr;
-                    std::copy(fs, fs + nxr, far);
-                    std::fill(far + nxr, far + padR, kNoBlocker);
-                    azimuth(row, nullptr, 0, cosPhi[static_cast<std::size_t>(j)], sinPhi[static_cast<std::size_t>(j)]);
-                }
-                float* out = st.receiverOcclusion.data() + static_cast<std::size_t>(Y) * nxr;
-                for (int X = 0; X < nxr; ++X) out[X] = scale * sum[X] / std::sqrt(1.0f + gx[X] * gx[X] + gy[X] * gy[X]);
+                const PointRow pts{std::min(s * Y, ny - 1), s, nxr, padR, nullptr, 0, 0};
+                occlusionOfRow(gradX, gradY, pts, r, nullptr, cosPhi.data(), sinPhi.data(), m, scale, azimuth,
+                               [&](int j, float* far) {
+                                   const float* fs = st.farSlope.data() + static_cast<std::size_t>(j) * nxr * nyr +
+                                                     static_cast<std::size_t>(Y) * nxr;
+                                   std::copy(fs, fs + nxr, far);
+                               },
+                               st.receiverOcclusion.data() + static_cast<std::size_t>(Y) * nxr);
             }
         }
     });
