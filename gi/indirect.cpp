@@ -334,6 +334,30 @@ void loadReceiverRow(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
     }
 }
 
+void buildIndirectStepTable(const HeightPyramid& pyr, const std::vector<double>& phi, int pad, std::vector<ScanStep>& heightSteps,
+                            std::vector<int>& stepsPerColumn, std::vector<int>& stepsPerRow, const RadianceStepFn& radiance) {
+    const int m = static_cast<int>(phi.size()), nSteps = static_cast<int>(pyr.steps.size());
+    const int nxr = pyr.nxr, nyr = pyr.nyr;
+    parallelFor(0, m, 1, [&](int j0, int j1) {
+        for (int j = j0; j < j1; ++j) {
+            const double c = std::cos(phi[static_cast<std::size_t>(j)]);
+            const double sn = std::sin(phi[static_cast<std::size_t>(j)]);
+            const std::size_t base = static_cast<std::size_t>(j) * nSteps;
+            // a receiver's sequence is its prefix of steps inside the domain
+            // (for the heights and the radiance samples alike)
+            ValidPrefix prefix(nxr, nyr, pad, stepsPerColumn.data() + static_cast<std::size_t>(j) * pad,
+                               stepsPerRow.data() + static_cast<std::size_t>(j) * nyr);
+            for (int i = 0; i < nSteps; ++i) {
+                const ScanStepInfo h = scanStepInfo(pyr, i, c, sn);
+                heightSteps[base + static_cast<std::size_t>(i)] = h.step;
+                prefix.narrow(h);
+                radiance(i, c, sn, base + static_cast<std::size_t>(i), prefix);
+                prefix.commit(i);
+            }
+        }
+    });
+}
+
 void validateIndirectSettings(const IndirectSettings& s) {
     if (s.bounces < 0 || s.bounces > 16) throw InputError("bounces must be in [0, 16]");
     if (s.radiance.levelsPerOctave < 1 || s.radiance.levelsPerOctave > 64)
@@ -450,28 +474,14 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
 
         // ---- step table: height and radiance steps, valid prefixes --------------------
         t = Clock::now();
-        parallelFor(0, m, 1, [&](int j0, int j1) {
-            for (int j = j0; j < j1; ++j) {
-                const double c = std::cos(op.phi[static_cast<std::size_t>(j)]);
-                const double sn = std::sin(op.phi[static_cast<std::size_t>(j)]);
-                const std::size_t base = static_cast<std::size_t>(j) * nSteps;
-                // a receiver's sequence is its prefix of steps inside the domain
-                // (for the heights and the radiance sample alike)
-                ValidPrefix prefix(nxr, nyr, pad, st.stepsPerColumn.data() + static_cast<std::size_t>(j) * pad,
-                                   st.stepsPerRow.data() + static_cast<std::size_t>(j) * nyr);
-                for (int i = 0; i < nSteps; ++i) {
-                    const ScanStepInfo h = scanStepInfo(pyr, i, c, sn);
-                    st.heightSteps[base + static_cast<std::size_t>(i)] = h.step;
-                    prefix.narrow(h);
-                    for (int ch = 0; ch < 3; ++ch) {
-                        const ScanStepInfo r = scanStepInfo(st.radiance.fields[static_cast<std::size_t>(ch)], i, c, sn);
-                        st.radianceSteps[static_cast<std::size_t>(ch) * tableSize + base + static_cast<std::size_t>(i)] = r.step;
-                        prefix.narrow(r);
-                    }
-                    prefix.commit(i);
-                }
-            }
-        });
+        buildIndirectStepTable(pyr, op.phi, pad, st.heightSteps, st.stepsPerColumn, st.stepsPerRow,
+                               [&](int i, double c, double sn, std::size_t at, ValidPrefix& prefix) {
+                                   for (int ch = 0; ch < 3; ++ch) {
+                                       const ScanStepInfo r = scanStepInfo(st.radiance.fields[static_cast<std::size_t>(ch)], i, c, sn);
+                                       st.radianceSteps[static_cast<std::size_t>(ch) * tableSize + at] = r.step;
+                                       prefix.narrow(r);
+                                   }
+                               });
 
         // ---- scan: casting sets, Eq. 12, U through the folded wedge operator ----------
         const int P = op.patternSize();

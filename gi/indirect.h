@@ -51,6 +51,7 @@
 // block: bit-identical for any thread count; no allocation after the first
 // frame of a given size and settings.
 #include <array>
+#include <functional>
 #include <vector>
 
 #include "gi/blocker_radiance.h"
@@ -169,5 +170,14 @@ void validateIndirectSettings(const IndirectSettings& s);
 /// flat plane stays exactly dark).
 void loadReceiverRow(const HeightPyramid& pyr, ConstGridView gradX, ConstGridView gradY, int Y, int pad, float* gx, float* gy,
                      float* h0, float* margin);
+
+/// The step tables of an indirect scan, per azimuth phi[j] (in parallel):
+/// heightSteps[j * steps + i] and each receiver's valid prefix (steps inside
+/// the domain: stepsPerColumn, azimuths x pad; stepsPerRow, azimuths x nyr);
+/// radiance(i, cos, sin, j * steps + i, prefix) records the radiance steps of
+/// step i (Lambert: 3 channels; glossy: the SH planes) and narrows the prefix.
+using RadianceStepFn = std::function<void(int, double, double, std::size_t, ValidPrefix&)>;
+void buildIndirectStepTable(const HeightPyramid& pyr, const std::vector<double>& phi, int pad, std::vector<ScanStep>& heightSteps,
+                            std::vector<int>& stepsPerColumn, std::vector<int>& stepsPerRow, const RadianceStepFn& radiance);
 
 }  // namespace terrain::gi

@@ -373,30 +373,19 @@ void computeGlossyIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstG
 
         // ---- step table: heights, E geometry (identical for the 48 planes), valid prefixes
         t = Clock::now();
-        parallelFor(0, m, 1, [&](int j0, int j1) {
-            for (int j = j0; j < j1; ++j) {
-                const double c = std::cos(op.phi[static_cast<std::size_t>(j)]);
-                const double sn = std::sin(op.phi[static_cast<std::size_t>(j)]);
-                const std::size_t base = static_cast<std::size_t>(j) * nSteps;
-                ValidPrefix prefix(nxr, nyr, pad, st.stepsPerColumn.data() + static_cast<std::size_t>(j) * pad,
-                                   st.stepsPerRow.data() + static_cast<std::size_t>(j) * nyr);
-                for (int i = 0; i < nSteps; ++i) {
-                    const ScanStepInfo h = scanStepInfo(pyr, i, c, sn);
-                    st.heightSteps[base + static_cast<std::size_t>(i)] = h.step;
-                    const ScanStepInfo r = scanStepInfo(gs.pyramid.fields[0], i, c, sn);
-                    gs.steps[base + static_cast<std::size_t>(i)] = r.step;
-                    const float** fp = gs.fields.data() + (base + static_cast<std::size_t>(i)) * kGlossyFields;
-                    for (int f = 0; f < kGlossyFields; ++f) {
-                        // same layout in every plane's pyramid: only the base pointer differs
-                        const ScanStep rf = f == 0 ? r.step : scanStepInfo(gs.pyramid.fields[static_cast<std::size_t>(f)], i, c, sn).step;
-                        fp[f] = rf.field + rf.offA;
-                    }
-                    prefix.narrow(h);
-                    prefix.narrow(r);
-                    prefix.commit(i);
-                }
-            }
-        });
+        buildIndirectStepTable(pyr, op.phi, pad, st.heightSteps, st.stepsPerColumn, st.stepsPerRow,
+                               [&](int i, double c, double sn, std::size_t at, ValidPrefix& prefix) {
+                                   const ScanStepInfo r = scanStepInfo(gs.pyramid.fields[0], i, c, sn);
+                                   gs.steps[at] = r.step;
+                                   const float** fp = gs.fields.data() + at * kGlossyFields;
+                                   for (int f = 0; f < kGlossyFields; ++f) {
+                                       // same layout in every plane's pyramid: only the base pointer differs
+                                       const ScanStep rf =
+                                           f == 0 ? r.step : scanStepInfo(gs.pyramid.fields[static_cast<std::size_t>(f)], i, c, sn).step;
+                                       fp[f] = rf.field + rf.offA;
+                                   }
+                                   prefix.narrow(r);
+                               });
 
         // ---- scan: casting sets, u = Ebar . Y(-d), Eq. 12, U through the folded wedge operator
         const int P = op.patternSize();
