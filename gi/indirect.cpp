@@ -358,6 +358,19 @@ void buildIndirectStepTable(const HeightPyramid& pyr, const std::vector<double>&
     });
 }
 
+void setUShadingLights(IndirectState& st) {
+    for (int c = 0; c < 3; ++c) {
+        ShadingLight& L = st.lights[static_cast<std::size_t>(c)];
+        L.visibility = &st.u[static_cast<std::size_t>(c)];
+        for (int ch = 0; ch < 3; ++ch) {
+            ShMatrix& mtx = L.product[static_cast<std::size_t>(ch)];
+            mtx.fill(0.0);
+            if (ch == c)
+                for (int i = 0; i < kShCount; ++i) mtx[static_cast<std::size_t>(i * kShCount + i)] = 1.0;
+        }
+    }
+}
+
 void validateIndirectSettings(const IndirectSettings& s) {
     if (s.bounces < 0 || s.bounces > 16) throw InputError("bounces must be in [0, 16]");
     if (s.radiance.levelsPerOctave < 1 || s.radiance.levelsPerOctave > 64)
@@ -440,17 +453,7 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
         b.groupSteps.resize(static_cast<std::size_t>(pad));
         b.active.resize(static_cast<std::size_t>(pad));
     }
-    // shading: U of channel c lights channel c only (identity product matrix)
-    for (int c = 0; c < 3; ++c) {
-        ShadingLight& L = st.lights[static_cast<std::size_t>(c)];
-        L.visibility = &st.u[static_cast<std::size_t>(c)];
-        for (int ch = 0; ch < 3; ++ch) {
-            ShMatrix& mtx = L.product[static_cast<std::size_t>(ch)];
-            mtx.fill(0.0);
-            if (ch == c)
-                for (int i = 0; i < kShCount; ++i) mtx[static_cast<std::size_t>(i * kShCount + i)] = 1.0;
-        }
-    }
+    if (!ratio) setUShadingLights(st);
 
     // the field's highest height (the raw heights; the pyramid levels are
     // filters of it and so stay below it, up to float rounding: 1e-6 relative slack)

@@ -171,6 +171,10 @@ void validateIndirectSettings(const IndirectSettings& s);
 void loadReceiverRow(const HeightPyramid& pyr, ConstGridView gradX, ConstGridView gradY, int Y, int pad, float* gx, float* gy,
                      float* h0, float* margin);
 
+/// The shading lights of U: channel c lights channel c only (identity
+/// product matrices over st.u).
+void setUShadingLights(IndirectState& st);
+
 /// The step tables of an indirect scan, per azimuth phi[j] (in parallel):
 /// heightSteps[j * steps + i] and each receiver's valid prefix (steps inside
 /// the domain: stepsPerColumn, azimuths x pad; stepsPerRow, azimuths x nyr);

@@ -340,17 +340,7 @@ void computeGlossyIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstG
         st.uZeroFrom = kShCount;  // every plane is written here
     }
     st.bounceMean.resize(static_cast<std::size_t>(settings.bounces));
-    // shading of U: channel c lights channel c only (identity product matrix)
-    for (int c = 0; c < 3; ++c) {
-        ShadingLight& L = st.lights[static_cast<std::size_t>(c)];
-        L.visibility = &st.u[static_cast<std::size_t>(c)];
-        for (int ch = 0; ch < 3; ++ch) {
-            ShMatrix& mtx = L.product[static_cast<std::size_t>(ch)];
-            mtx.fill(0.0);
-            if (ch == c)
-                for (int i = 0; i < kShCount; ++i) mtx[static_cast<std::size_t>(i * kShCount + i)] = 1.0;
-        }
-    }
+    setUShadingLights(st);
     const int nBlocks = std::max(1, std::min(nyr, kMaxBlocks));
     const BlockLayout lay(pad, nSteps);
     gs.blockScratch.resize(static_cast<std::size_t>(nBlocks) * lay.total);
