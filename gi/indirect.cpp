@@ -358,6 +358,29 @@ void buildIndirectStepTable(const HeightPyramid& pyr, const std::vector<double>&
     });
 }
 
+void accumulateBounce(const std::array<Grid, 3>& exit, int b, IndirectState& st) {
+    double sum = 0.0;
+    for (int c = 0; c < 3; ++c) {
+        Grid& acc = st.indirect[static_cast<std::size_t>(c)];
+        const Grid& add = exit[static_cast<std::size_t>(c)];
+        for (std::size_t i = 0; i < acc.v.size(); ++i) {
+            acc.v[i] += add.v[i];
+            sum += add.v[i];
+        }
+    }
+    st.bounceMean[static_cast<std::size_t>(b - 1)] = sum / (3.0 * std::max<std::size_t>(1, st.indirect[0].v.size()));
+}
+
+void sumDirectAndIndirect(const std::array<Grid, 3>& direct, IndirectState& st) {
+    for (int c = 0; c < 3; ++c) {
+        Grid& tot = st.total[static_cast<std::size_t>(c)];
+        const Grid& ind = st.indirect[static_cast<std::size_t>(c)];
+        if (tot.nx != ind.nx || tot.ny != ind.ny) tot.resize(ind.nx, ind.ny);
+        const Grid& d = direct[static_cast<std::size_t>(c)];
+        for (std::size_t i = 0; i < tot.v.size(); ++i) tot.v[i] = d.v[i] + ind.v[i];
+    }
+}
+
 void setUShadingLights(IndirectState& st) {
     for (int c = 0; c < 3; ++c) {
         ShadingLight& L = st.lights[static_cast<std::size_t>(c)];
@@ -606,26 +629,11 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
         } else {
             shadeTexels(gradX, gradY, s, envVisibility, st.lights.data(), 3, albedo, shading, out, false);
         }
-        double sum = 0.0;
-        for (int c = 0; c < 3; ++c) {
-            Grid& acc = st.indirect[static_cast<std::size_t>(c)];
-            const Grid& add = out.rgb[static_cast<std::size_t>(c)];
-            for (std::size_t i = 0; i < acc.v.size(); ++i) {
-                acc.v[i] += add.v[i];
-                sum += add.v[i];
-            }
-        }
-        st.bounceMean[static_cast<std::size_t>(b - 1)] = sum / (3.0 * std::max<std::size_t>(1, static_cast<std::size_t>(nx) * ny));
+        accumulateBounce(out.rgb, b, st);
         source = &out.rgb;
         st.timings.shading += msSince(t);
     }
-    for (int c = 0; c < 3; ++c) {
-        Grid& tot = st.total[static_cast<std::size_t>(c)];
-        if (tot.nx != nx || tot.ny != ny) tot.resize(nx, ny);
-        const Grid& d = direct[static_cast<std::size_t>(c)];
-        const Grid& ind = st.indirect[static_cast<std::size_t>(c)];
-        for (std::size_t i = 0; i < tot.v.size(); ++i) tot.v[i] = d.v[i] + ind.v[i];
-    }
+    sumDirectAndIndirect(direct, st);
     st.timings.total = msSince(t0);
 }
 

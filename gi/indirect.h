@@ -171,6 +171,13 @@ void validateIndirectSettings(const IndirectSettings& s);
 void loadReceiverRow(const HeightPyramid& pyr, ConstGridView gradX, ConstGridView gradY, int Y, int pad, float* gx, float* gy,
                      float* h0, float* margin);
 
+/// Adds bounce b's exit radiance to st.indirect and records its mean
+/// (st.bounceMean[b - 1], RGB average).
+void accumulateBounce(const std::array<Grid, 3>& exit, int b, IndirectState& st);
+
+/// st.total = direct + st.indirect.
+void sumDirectAndIndirect(const std::array<Grid, 3>& direct, IndirectState& st);
+
 /// The shading lights of U: channel c lights channel c only (identity
 /// product matrices over st.u).
 void setUShadingLights(IndirectState& st);

@@ -442,26 +442,11 @@ void computeGlossyIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstG
         t = Clock::now();
         ShadeMaps& out = st.bounceShade[static_cast<std::size_t>(b & 1)];
         shadeTexels(gradX, gradY, s, envVisibility, st.lights.data(), 3, surface, shading, out, false);
-        double sum = 0.0;
-        for (int c = 0; c < 3; ++c) {
-            Grid& acc = st.indirect[static_cast<std::size_t>(c)];
-            const Grid& add = out.rgb[static_cast<std::size_t>(c)];
-            for (std::size_t i = 0; i < acc.v.size(); ++i) {
-                acc.v[i] += add.v[i];
-                sum += add.v[i];
-            }
-        }
-        st.bounceMean[static_cast<std::size_t>(b - 1)] = sum / (3.0 * std::max<std::size_t>(1, plane));
+        accumulateBounce(out.rgb, b, st);
         prev = &out;
         st.timings.shading += msSince(t);
     }
-    for (int c = 0; c < 3; ++c) {
-        Grid& tot = st.total[static_cast<std::size_t>(c)];
-        if (tot.nx != nx || tot.ny != ny) tot.resize(nx, ny);
-        const Grid& d = directShade.rgb[static_cast<std::size_t>(c)];
-        const Grid& ind = st.indirect[static_cast<std::size_t>(c)];
-        for (std::size_t i = 0; i < tot.v.size(); ++i) tot.v[i] = d.v[i] + ind.v[i];
-    }
+    sumDirectAndIndirect(directShade.rgb, st);
     st.timings.total = msSince(t0);
 }
 
