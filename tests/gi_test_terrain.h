@@ -27,4 +27,12 @@ inline Grid hills(int n, float amp) {
     return g;
 }
 
+/// Mean of g over columns [x0, x1) and rows [y0, y1).
+inline double meanOver(const Grid& g, int x0, int x1, int y0, int y1) {
+    double sum = 0.0;
+    for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) sum += g(x, y);
+    return sum / ((x1 - x0) * (y1 - y0));
+}
+
 }  // namespace terrain::gi_test

@@ -19,6 +19,7 @@
 using namespace terrain;
 using namespace terrain::gi;
 using gi_test::hills;
+using gi_test::meanOver;
 using gi_test::valley;
 
 namespace {
@@ -33,13 +34,6 @@ GiSettings glossySettings(Brdf brdf, float exponent, int bounces, GlossyIndirect
     s.indirect.bounces = bounces;
     s.indirect.glossy = mode;
     return s;
-}
-
-double meanOver(const Grid& g, int x0, int x1, int y0, int y1) {
-    double sum = 0.0;
-    for (int y = y0; y < y1; ++y)
-        for (int x = x0; x < x1; ++x) sum += g(x, y);
-    return sum / ((x1 - x0) * (y1 - y0));
 }
 
 std::vector<float> allChannels(const std::array<Grid, 3>& g) {

@@ -15,6 +15,7 @@
 using namespace terrain;
 using namespace terrain::gi;
 using gi_test::hills;
+using gi_test::meanOver;
 using gi_test::valley;
 
 namespace {
@@ -25,13 +26,6 @@ GiSettings indirectSettings(int bounces, int subsample = 1) {
     s.subsample = subsample;
     s.indirect.bounces = bounces;
     return s;
-}
-
-double meanOver(const Grid& g, int x0, int x1, int y0, int y1) {
-    double sum = 0.0;
-    for (int y = y0; y < y1; ++y)
-        for (int x = x0; x < x1; ++x) sum += g(x, y);
-    return sum / ((x1 - x0) * (y1 - y0));
 }
 
 // Relative RMSE of a against b over the interior (border fraction excluded).
