@@ -22,7 +22,6 @@ using simd::stv;
 constexpr int kRowsPerBlock = 8;
 constexpr int kLanePad = 8;                // rows padded to the widest lane group
 constexpr float kOutside = -1.0e30f;       // height outside the domain: a sample there blocks nothing
-constexpr float kMarginRel = 1.0f / 1048576.0f;  // as the scan: height differences below 2^-20 |h0| are rounding
 
 inline int padLanes(int n) { return (n + kLanePad - 1) / kLanePad * kLanePad; }
 
@@ -48,7 +47,7 @@ template <class V>
     const V one = splv<V>(1.0f), half = splv<V>(0.5f), lim = splv<V>(1e6f), nlim = splv<V>(-1e6f);
     for (int x = 0; x < r.n; x += L) {
         const V h0 = ldv<V>(r.h + x);
-        const V margin = (h0 < splv<V>(0.0f) ? -h0 : h0) * splv<V>(kMarginRel);
+        const V margin = (h0 < splv<V>(0.0f) ? -h0 : h0) * splv<V>(kHeightMarginRel);
         V hor = ldv<V>(r.far + x);
         for (int k = 0; k < nTaps; ++k) {
             const NearTap& t = taps[k];

@@ -322,7 +322,6 @@ void exactShiftSse(const ShiftRow& r) { exactShiftImpl<F4>(r); }
 
 void loadReceiverRow(const HeightPyramid& pyr, ConstGridView gradX, ConstGridView gradY, int Y, int pad, float* gx, float* gy,
                      float* h0, float* margin) {
-    constexpr float kMarginRel = 1.0f / 1048576.0f;  // 2^-20 |h0|: height differences below it are rounding
     const int s = pyr.subsample, nxr = pyr.nxr;
     const float* hRow = pyr.rawPhaseRow(0, s * Y);
     for (int X = 0; X < pad; ++X) {
@@ -330,7 +329,7 @@ void loadReceiverRow(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
         gx[X] = in ? gradX(s * X, s * Y) : 0.0f;
         gy[X] = in ? gradY(s * X, s * Y) : 0.0f;
         h0[X] = in ? hRow[X] : 0.0f;
-        margin[X] = std::fabs(h0[X]) * kMarginRel;
+        margin[X] = std::fabs(h0[X]) * kHeightMarginRel;
     }
 }
 

@@ -172,6 +172,9 @@ private:
 
 /// Lowest slope used for "nothing blocks in this direction".
 inline constexpr float kNoBlocker = -1.0e6f;
+/// Indirect scans: a height difference below kHeightMarginRel |h0| is float
+/// rounding, not a blocker (a flat plane gets exactly no indirect light).
+inline constexpr float kHeightMarginRel = 1.0f / 1048576.0f;  // 2^-20
 
 /// Computes V for every receiver of the pyramid. gradX/gradY are full
 /// resolution height derivatives (metres per metre).
