@@ -22,8 +22,9 @@
 
 #include "gi/frame.h"
 #include "gi/reference.h"
-#include "sim/io.h"
-#include "sim/parallel.h"
+#include "core/file_io.h"
+#include "core/png_io.h"
+#include "core/parallel.h"
 
 using namespace terrain;
 using namespace terrain::gi;

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <string>
 
-#include "sim/grid.h"
-#include "sim/io.h"
+#include "core/grid.h"
+#include "core/png_io.h"
 
 namespace terrain::bench {
 

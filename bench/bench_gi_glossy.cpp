@@ -17,8 +17,8 @@
 #include "bench/bench_gi_common.h"
 #include "gi/frame.h"
 #include "gi/reference_gi.h"
-#include "sim/io.h"
-#include "sim/parallel.h"
+
+#include "core/parallel.h"
 
 using namespace terrain;
 using namespace terrain::gi;

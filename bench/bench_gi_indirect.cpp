@@ -17,12 +17,12 @@
 
 #include "bench/bench_common.h"
 #include "bench/bench_gi_common.h"
-#include "sim/simd.h"
+#include "core/simd.h"
 #include "gi/frame.h"
 #include "gi/reference_gi.h"
-#include "sim/io.h"
-#include "sim/parallel.h"
-#include "sim/simd.h"
+
+#include "core/parallel.h"
+#include "core/simd.h"
 #include "sim/scene.h"
 
 using namespace terrain;

@@ -23,14 +23,15 @@
 #include "bench/bench_common.h"
 #include "render/context.h"
 #include "render/gl.h"
-#include "render/pipeline.h"
+#include "engine/pipeline.h"
 #include "render/renderer.h"
-#include "sim/io.h"
+#include "core/file_io.h"
 #include "sim/scene.h"
 
 using namespace terrain;
 using terrain::bench::median;
 using namespace terrain::render;
+using namespace terrain::engine;
 
 namespace {
 using Clock = std::chrono::steady_clock;

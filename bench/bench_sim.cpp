@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "bench/bench_common.h"
-#include "sim/parallel.h"
+#include "core/parallel.h"
 #include "sim/scene.h"
 
 using namespace terrain;

@@ -1,7 +1,5 @@
 #include "gi/albedo_io.h"
 
-#include "gi/image_io.h"
-
 #include <png.h>
 
 #include <algorithm>
@@ -11,8 +9,9 @@
 #include <sstream>
 #include <vector>
 
-#include "sim/error.h"
-#include "sim/io.h"
+#include "core/error.h"
+#include "core/parse.h"
+#include "core/png_io.h"
 
 namespace terrain::gi {
 
@@ -22,22 +21,6 @@ float srgbToLinear(std::uint8_t v) {
     return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
 }
 }  // namespace
-
-std::vector<float> parseNumberList(const std::string& text, const std::string& option) {
-    std::vector<float> v;
-    std::stringstream ss(text);
-    std::string item;
-    while (std::getline(ss, item, ',')) {
-        try {
-            std::size_t used = 0;
-            v.push_back(std::stof(item, &used));
-            if (used != item.size()) throw std::invalid_argument(item);
-        } catch (const std::exception&) {
-            throw InputError(option + " '" + text + "': '" + item + "' is not a number");
-        }
-    }
-    return v;
-}
 
 AlbedoMap loadAlbedo(const std::string& spec, int nx, int ny) {
     AlbedoMap m;
@@ -84,14 +67,6 @@ void loadPhongExponentMap(const std::string& file, int nx, int ny, float lo, flo
         s.v[i] = static_cast<float>(std::clamp(e, static_cast<double>(lo), static_cast<double>(hi)));
     }
     setPhongExponentMap(map, s);
-}
-
-void writeNpyRgb(const std::string& file, const std::array<Grid, 3>& rgb) {
-    const Grid& g0 = rgb[0];
-    std::vector<float> interleaved(g0.size() * 3);
-    for (std::size_t i = 0; i < g0.size(); ++i)
-        for (std::size_t c = 0; c < 3; ++c) interleaved[3 * i + c] = rgb[c].v[i];
-    writeNpyArray(file, {static_cast<std::size_t>(g0.ny), static_cast<std::size_t>(g0.nx), 3}, interleaved.data());
 }
 
 }  // namespace terrain::gi

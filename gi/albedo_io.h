@@ -8,10 +8,6 @@
 
 namespace terrain::gi {
 
-/// Parses a comma-separated list of numbers ("1,0.5,2"); throws InputError
-/// naming `option` and the offending item when one is not a number.
-std::vector<float> parseNumberList(const std::string& text, const std::string& option);
-
 /// Parses "R,G,B" (each in [0, 1]) or reads a PNG of exactly nx x ny pixels.
 /// Throws InputError (bad text, values out of range, size mismatch) or
 /// IoError (unreadable file).
@@ -24,8 +20,5 @@ AlbedoMap loadAlbedo(const std::string& spec, int nx, int ny);
 /// map with setPhongExponentMap. Throws InputError (size mismatch, bad range)
 /// or IoError (unreadable file).
 void loadPhongExponentMap(const std::string& file, int nx, int ny, float lo, float hi, AlbedoMap& map);
-
-/// float32 .npy of an RGB map, shape (rows, columns, 3).
-void writeNpyRgb(const std::string& file, const std::array<Grid, 3>& rgb);
 
 }  // namespace terrain::gi

@@ -4,8 +4,8 @@
 #include <cmath>
 
 #include "gi/visibility.h"
-#include "sim/parallel.h"
-#include "sim/simd.h"
+#include "core/parallel.h"
+#include "core/simd.h"
 
 namespace terrain::gi {
 

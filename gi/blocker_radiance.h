@@ -46,7 +46,7 @@
 
 #include "gi/pyramid.h"
 #include "gi/shading.h"
-#include "sim/grid.h"
+#include "core/grid.h"
 
 namespace terrain::gi {
 

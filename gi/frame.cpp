@@ -5,8 +5,8 @@
 #include <cmath>
 #include <string>
 
-#include "sim/error.h"
-#include "sim/parallel.h"
+#include "core/error.h"
+#include "core/parallel.h"
 
 namespace terrain::gi {
 

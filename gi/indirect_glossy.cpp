@@ -7,9 +7,9 @@
 
 #include "gi/indirect.h"
 #include "gi/sh.h"
-#include "sim/error.h"
-#include "sim/parallel.h"
-#include "sim/simd.h"
+#include "core/error.h"
+#include "core/parallel.h"
+#include "core/simd.h"
 
 namespace terrain::gi {
 

@@ -57,7 +57,7 @@
 #include "gi/shading.h"
 #include "gi/visibility.h"
 #include "gi/wedge.h"
-#include "sim/grid.h"
+#include "core/grid.h"
 
 namespace terrain::gi {
 

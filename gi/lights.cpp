@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "sim/error.h"
+#include "core/error.h"
 
 namespace terrain::gi {
 

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "sim/parallel.h"
+#include "core/parallel.h"
 
 namespace terrain::gi {
 

@@ -26,7 +26,7 @@
 // counters the filtered pyramid's lowering of distant peaks.
 #include <vector>
 
-#include "sim/grid.h"
+#include "core/grid.h"
 
 namespace terrain::gi {
 

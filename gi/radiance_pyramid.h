@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "gi/pyramid.h"
-#include "sim/grid.h"
+#include "core/grid.h"
 
 namespace terrain::gi {
 

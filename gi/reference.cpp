@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "gi/visibility.h"
-#include "sim/parallel.h"
+#include "core/parallel.h"
 
 namespace terrain::gi {
 

@@ -22,7 +22,7 @@
 
 #include "gi/lights.h"
 #include "gi/shading.h"
-#include "sim/grid.h"
+#include "core/grid.h"
 
 namespace terrain::gi {
 

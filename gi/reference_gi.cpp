@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "gi/frame.h"
-#include "sim/error.h"
-#include "sim/parallel.h"
+#include "core/error.h"
+#include "core/parallel.h"
 
 namespace terrain::gi {
 namespace {

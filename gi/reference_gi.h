@@ -19,7 +19,7 @@
 #include "gi/lights.h"
 #include "gi/reference.h"
 #include "gi/shading.h"
-#include "sim/grid.h"
+#include "core/grid.h"
 
 namespace terrain::gi {
 

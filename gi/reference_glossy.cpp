@@ -8,8 +8,8 @@
 
 #include "gi/frame.h"
 #include "gi/reference_gi.h"
-#include "sim/error.h"
-#include "sim/parallel.h"
+#include "core/error.h"
+#include "core/parallel.h"
 
 namespace terrain::gi {
 

@@ -19,7 +19,7 @@
 
 #include "gi/sh.h"
 #include "gi/visibility.h"
-#include "sim/grid.h"
+#include "core/grid.h"
 
 namespace terrain::gi {
 

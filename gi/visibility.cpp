@@ -6,8 +6,8 @@
 #include <cstdlib>
 
 #include "gi/nlp.h"
-#include "sim/parallel.h"
-#include "sim/simd.h"
+#include "core/parallel.h"
+#include "core/simd.h"
 
 namespace terrain::gi {
 

@@ -51,7 +51,7 @@
 
 #include "gi/pyramid.h"
 #include "gi/wedge.h"
-#include "sim/grid.h"
+#include "core/grid.h"
 
 namespace terrain::gi {
 

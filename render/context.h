@@ -6,7 +6,7 @@
 #include <memory>
 #include <string>
 
-#include "sim/error.h"
+#include "core/error.h"
 
 namespace terrain::render {
 

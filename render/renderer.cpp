@@ -119,7 +119,7 @@ void Renderer::ensureTexture(GLuint& tex, int& w, int& h, int nw, int nh, GLenum
     h = nh;
 }
 
-void Renderer::upload(const FrameData& f) {
+void Renderer::upload(const engine::FrameData& f) {
     gl_.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
     ensureTexture(heightTex_, heightW_, heightH_, f.nx, f.ny, GL_RG32F, GL_RG, true);
     gl_.BindTexture(GL_TEXTURE_2D, heightTex_);
@@ -241,7 +241,7 @@ void Renderer::draw(const RenderSettings& s, int width, int height, GLuint frame
     if (width < 1 || height < 1 || width > 16384 || height > 16384)
         throw InputError("image size must be 1..16384 pixels per side");
     if (!heightTex_) throw ContextError("renderer: draw before upload");
-    const FrameData& f = meta_;
+    const engine::FrameData& f = meta_;
     const float exag = f.exaggeration;
     const float extent = static_cast<float>(std::max(f.nx, f.ny) - 1) * f.cellSize;
     const glm::vec3 centre(0.5f * (f.nx - 1) * f.cellSize, 0.5f * (f.ny - 1) * f.cellSize,
@@ -324,7 +324,7 @@ void Renderer::draw(const RenderSettings& s, int width, int height, GLuint frame
         u.v3("uEye", eye);
         u.v3("uKeyDir", keyDir);
         u.v3("uKeyRgb", glm::vec3(f.lights.key.rgb[0], f.lights.key.rgb[1], f.lights.key.rgb[2]));
-        u.i("uLighting", f.lighting == LightingMode::KeyOnly ? 0 : (f.lighting == LightingMode::Direct ? 1 : 2));
+        u.i("uLighting", f.lighting == engine::LightingMode::KeyOnly ? 0 : (f.lighting == engine::LightingMode::Direct ? 1 : 2));
         u.i("uShadowMode", s.shadow == ShadowMode::SoftVisibility ? 0 : (wantShadowMap ? 1 : 2));
         u.i("uSpecular", s.specular ? 1 : 0);
         u.i("uDebug", static_cast<int>(s.debug));

@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "render/gl.h"
-#include "render/pipeline.h"
+#include "engine/frame_data.h"
 
 namespace terrain::render {
 
@@ -61,7 +61,7 @@ public:
     Renderer& operator=(const Renderer&) = delete;
 
     /// Streams the frame's heights and GI textures to the GPU.
-    void upload(const FrameData& frame);
+    void upload(const engine::FrameData& frame);
     /// Draws the last uploaded frame into `framebuffer` (0: the window) of size w x h.
     void draw(const RenderSettings& settings, int width, int height, GLuint framebuffer);
     /// Headless: draws into an own 8-bit target and reads it back as RGB, row 0 at the top.
@@ -85,7 +85,7 @@ private:
     int heightW_ = 0, heightH_ = 0, shadeW_ = 0, shadeH_ = 0, keyW_ = 0, keyH_ = 0, recvW_ = 0, recvH_ = 0, envW_ = 0,
         envH_ = 0;
     Target hdr_, ldr_, shadow_;
-    FrameData meta_;  // the uploaded frame's sizes, lights and modes (no per-texel arrays)
+    engine::FrameData meta_;  // the uploaded frame's sizes, lights and modes (no per-texel arrays)
     std::vector<float> envPixels_;
 };
 

@@ -2,8 +2,8 @@
 
 #include <cmath>
 
-#include "sim/error.h"
-#include "sim/parallel.h"
+#include "core/error.h"
+#include "core/parallel.h"
 #include "sim/terrain.h"
 
 namespace terrain {

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <string>
 
-#include "sim/grid.h"
+#include "core/grid.h"
 
 namespace terrain {
 

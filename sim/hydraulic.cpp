@@ -8,8 +8,8 @@
 
 #include <immintrin.h>
 
-#include "sim/parallel.h"
-#include "sim/simd.h"
+#include "core/parallel.h"
+#include "core/simd.h"
 
 // Hydraulic erosion, virtual-pipe model (Mei, Decaudin & Hu 2007), written as
 // two gather passes over the grid:

@@ -5,9 +5,9 @@
 #include <cstdlib>
 #include <filesystem>
 
-#include "sim/error.h"
-#include "sim/io.h"
-#include "sim/parallel.h"
+#include "core/error.h"
+#include "sim/heightmap_io.h"
+#include "core/parallel.h"
 
 #ifndef TERRAIN_DATA_DIR
 #define TERRAIN_DATA_DIR "../shared/data"

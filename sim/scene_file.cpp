@@ -20,7 +20,7 @@
 #include <filesystem>
 #include <set>
 
-#include "sim/error.h"
+#include "core/error.h"
 #include "sim/scene.h"
 
 namespace terrain {

@@ -4,8 +4,8 @@
 #include <cstdio>
 #include <cstring>
 
-#include "sim/error.h"
-#include "sim/parallel.h"
+#include "core/error.h"
+#include "core/parallel.h"
 
 namespace terrain {
 

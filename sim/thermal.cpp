@@ -6,8 +6,8 @@
 #include <cstring>
 #include <type_traits>
 
-#include "sim/parallel.h"
-#include "sim/simd.h"
+#include "core/parallel.h"
+#include "core/simd.h"
 
 // Thermal erosion (talus relaxation) in the 8-neighbourhood, with the real
 // distance to each neighbour (c along the axes, c * sqrt(2) on the

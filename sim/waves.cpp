@@ -6,9 +6,9 @@
 #include <string>
 #include <type_traits>
 
-#include "sim/error.h"
-#include "sim/parallel.h"
-#include "sim/simd.h"
+#include "core/error.h"
+#include "core/parallel.h"
+#include "core/simd.h"
 
 // ---------------------------------------------------------------------------
 // The algorithm

@@ -2,7 +2,7 @@
 // Small analytic terrains shared by the GI tests.
 #include <cmath>
 
-#include "sim/grid.h"
+#include "core/grid.h"
 
 namespace terrain::gi_test {
 

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "sim/hydraulic.h"
-#include "sim/parallel.h"
+#include "core/parallel.h"
 #include "sim/terrain.h"
 #include "sim/thermal.h"
 

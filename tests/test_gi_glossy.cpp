@@ -13,8 +13,8 @@
 #include "tests/gi_test_terrain.h"
 #include "gi/indirect_glossy.h"
 #include "gi/reference_gi.h"
-#include "sim/error.h"
-#include "sim/parallel.h"
+#include "core/error.h"
+#include "core/parallel.h"
 
 using namespace terrain;
 using namespace terrain::gi;

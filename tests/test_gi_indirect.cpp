@@ -10,7 +10,7 @@
 #include "gi/frame.h"
 #include "tests/gi_test_terrain.h"
 #include "gi/reference_gi.h"
-#include "sim/parallel.h"
+#include "core/parallel.h"
 
 using namespace terrain;
 using namespace terrain::gi;

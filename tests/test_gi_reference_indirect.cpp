@@ -6,7 +6,7 @@
 
 #include "gi/reference_gi.h"
 #include "tests/gi_test_terrain.h"
-#include "sim/parallel.h"
+#include "core/parallel.h"
 
 using namespace terrain;
 using namespace terrain::gi;

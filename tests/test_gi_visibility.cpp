@@ -9,8 +9,8 @@
 
 #include "gi/frame.h"
 #include "gi/reference.h"
-#include "sim/error.h"
-#include "sim/parallel.h"
+#include "core/error.h"
+#include "core/parallel.h"
 
 using namespace terrain;
 using namespace terrain::gi;

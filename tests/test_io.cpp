@@ -10,9 +10,11 @@
 #include <string>
 #include <unistd.h>
 
-#include "sim/error.h"
+#include "core/error.h"
 #include "sim/generators.h"
-#include "sim/io.h"
+#include "core/png_io.h"
+#include "sim/vdb_io.h"
+#include "sim/heightmap_io.h"
 #include "sim/terrain.h"
 
 using namespace terrain;

@@ -4,8 +4,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "sim/error.h"
-#include "sim/parallel.h"
+#include "core/error.h"
+#include "core/parallel.h"
 #include "sim/terrain.h"
 
 using namespace terrain;

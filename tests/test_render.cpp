@@ -12,13 +12,14 @@
 
 #include "render/context.h"
 #include "render/gl.h"
-#include "render/pipeline.h"
+#include "engine/pipeline.h"
 #include "render/renderer.h"
-#include "sim/parallel.h"
+#include "core/parallel.h"
 #include "sim/scene.h"
 
 using namespace terrain;
 using namespace terrain::render;
+using namespace terrain::engine;
 
 namespace {
 

@@ -9,8 +9,8 @@
 #include <string>
 #include <unistd.h>
 
-#include "sim/error.h"
-#include "sim/parallel.h"
+#include "core/error.h"
+#include "core/parallel.h"
 #include "sim/scene.h"
 
 using namespace terrain;

@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "gi/frame.h"
-#include "sim/parallel.h"
-#include "sim/simd.h"
+#include "core/parallel.h"
+#include "core/simd.h"
 #include "tests/gi_test_terrain.h"
 
 using namespace terrain;

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/parallel.h"
+#include "core/parallel.h"
 #include "sim/terrain.h"
 #include "sim/waves.h"
 

@@ -12,15 +12,17 @@
 
 #include <unistd.h>
 
-#include "render/app/commands.h"
-#include "render/app/progress.h"
+#include "app/commands.h"
+#include "app/render_options.h"
+#include "app/progress.h"
 #include "render/context.h"
 #include "render/gl.h"
-#include "render/pipeline.h"
+#include "engine/pipeline.h"
 #include "render/renderer.h"
-#include "sim/error.h"
-#include "sim/io.h"
-#include "sim/parallel.h"
+#include "core/error.h"
+#include "core/file_io.h"
+#include "core/png_io.h"
+#include "core/parallel.h"
 #include "sim/scene.h"
 
 namespace terrain::app {
@@ -87,8 +89,9 @@ void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize) {
     sub->add_flag("--quiet", o.quiet, "Print only errors");
 }
 
-void toSettings(const RenderOptions& o, render::PipelineSettings& p, render::RenderSettings& r) {
+void toSettings(const RenderOptions& o, engine::PipelineSettings& p, render::RenderSettings& r) {
     using namespace render;
+    using namespace engine;
     if (o.frames < 1 || o.frames > 100000) throw InputError("--frames must be 1..100000");
     if (o.width < 16 || o.height < 16 || o.width > 8192 || o.height > 8192)
         throw InputError("--width and --height must be 16..8192 pixels");
@@ -134,7 +137,7 @@ void toSettings(const RenderOptions& o, render::PipelineSettings& p, render::Ren
 }
 
 int runHeadlessRender(const RenderOptions& o, const char* label) {
-    render::PipelineSettings ps;
+    engine::PipelineSettings ps;
     render::RenderSettings rs;
     toSettings(o, ps, rs);
     if (!o.video.empty() && std::filesystem::path(o.video).extension() != ".mp4")
@@ -147,7 +150,7 @@ int runHeadlessRender(const RenderOptions& o, const char* label) {
         render::Gl gl;
         render::loadGl(gl, context->procAddress());
         render::Renderer renderer(gl);
-        render::FramePipeline pipeline(scene, ps);
+        engine::FramePipeline pipeline(scene, ps);
         const TerrainState& st = pipeline.simulation().state();
         if (!o.quiet) {
             std::printf("%s: scene %s, %d x %d cells of %.3g m, ground %.0f..%.0f m, %d frames of %d ticks, %d x %d pixels, %s\n",
@@ -170,7 +173,7 @@ int runHeadlessRender(const RenderOptions& o, const char* label) {
             std::snprintf(name, sizeof name, "frame_%04d.png", f);
             writePngRgb((std::filesystem::path(o.out) / name).string(), o.width, o.height, rgb);
             const double writeMs = msSince(t);
-            const render::StageTimings& tm = pipeline.timings();
+            const engine::StageTimings& tm = pipeline.timings();
             const double values[7] = {tm.sim, tm.pyramids, tm.scan, tm.integrate, tm.shade, renderMs, writeMs};
             for (int i = 0; i < 7; ++i) stage[static_cast<std::size_t>(i)].push_back(values[i]);
             progress.update(f + 1);

@@ -11,13 +11,15 @@
 
 #include "gi/albedo_io.h"
 #include "gi/frame.h"
-#include "gi/image_io.h"
+#include "core/image_io.h"
 #include "gi/reference.h"
 #include "gi/reference_gi.h"
-#include "render/app/commands.h"
-#include "sim/error.h"
-#include "sim/io.h"
-#include "sim/parallel.h"
+#include "app/commands.h"
+#include "core/error.h"
+#include "core/parse.h"
+#include "core/png_io.h"
+#include "sim/heightmap_io.h"
+#include "core/parallel.h"
 
 namespace terrain::app {
 namespace {
@@ -86,8 +88,8 @@ void writeIndirect(const std::string& file, const std::array<Grid, 3>& rgb) {
     const std::string e = file.size() >= 4 ? file.substr(file.size() - 4) : "";
     std::string ext = e;
     for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (ext == ".npy") gi::writeNpyRgb(file, rgb);
-    else if (ext == ".exr") gi::writeExr(file, {&rgb[0], &rgb[1], &rgb[2]});
+    if (ext == ".npy") writeNpyRgb(file, rgb);
+    else if (ext == ".exr") writeExr(file, {&rgb[0], &rgb[1], &rgb[2]});
     else throw InputError("--out-indirect must end in .npy or .exr (got '" + file + "')");
 }
 
@@ -99,7 +101,7 @@ std::string extensionOf(const std::string& f) {
 }
 
 gi::KeyLight parseKey(const std::string& text) {
-    const std::vector<float> v = gi::parseNumberList(text, "--key");
+    const std::vector<float> v = parseNumberList(text, "--key");
     if (v.size() != 6) throw InputError("--key '" + text + "': expected AZ_DEG,EL_DEG,RADIUS_DEG,R,G,B");
     gi::KeyLight k;
     k.azimuthDeg = v[0];
@@ -118,7 +120,7 @@ gi::ShRgb parseLight(const std::string& light) {
     if (light.rfind("env:", 0) == 0) {
         const std::string file = light.substr(4);
         int w = 0, h = 0;
-        const std::vector<float> rgb = gi::readEquirect(file, w, h);
+        const std::vector<float> rgb = readEquirect(file, w, h);
         try {
             return gi::projectEquirect(rgb, w, h);
         } catch (const InputError& e) {
@@ -131,7 +133,7 @@ gi::ShRgb parseLight(const std::string& light) {
 void writeShade(const std::string& file, const std::array<Grid, 3>& rgb) {
     const std::string ext = extensionOf(file);
     if (ext == ".exr") {
-        gi::writeExr(file, {&rgb[0], &rgb[1], &rgb[2]});
+        writeExr(file, {&rgb[0], &rgb[1], &rgb[2]});
         return;
     }
     if (ext != ".png") throw InputError("--out-shade must end in .png or .exr (got '" + file + "')");
@@ -149,8 +151,8 @@ void writeShade(const std::string& file, const std::array<Grid, 3>& rgb) {
 
 void writeAmbient(const std::string& file, const Grid& ambient) {
     const std::string ext = extensionOf(file);
-    if (ext == ".npy") gi::writeNpy(file, ambient);
-    else if (ext == ".exr") gi::writeExr(file, {&ambient});
+    if (ext == ".npy") writeNpy(file, ambient);
+    else if (ext == ".exr") writeExr(file, {&ambient});
     else throw InputError("--out-ambient must end in .npy or .exr (got '" + file + "')");
 }
 
@@ -181,13 +183,13 @@ int runGi(const GiOptions& o) {
     if (!o.phongExponent.empty()) {
         const bool numeric = o.phongExponent.find_first_not_of("0123456789.eE+-") == std::string::npos;
         if (numeric) {
-            const std::vector<float> v = gi::parseNumberList(o.phongExponent, "--phong-exponent");
+            const std::vector<float> v = parseNumberList(o.phongExponent, "--phong-exponent");
             if (v.size() != 1 || !(v[0] >= gi::kMinPhongExponent && v[0] <= gi::kMaxPhongExponent))
                 throw InputError("--phong-exponent: a constant must be one number in [0.01, 10000] (got '" + o.phongExponent + "')");
             settings.shading.phongExponent = v[0];
         } else {
             exponentFile = true;
-            const std::vector<float> r = gi::parseNumberList(o.phongExponentRange, "--phong-exponent-range");
+            const std::vector<float> r = parseNumberList(o.phongExponentRange, "--phong-exponent-range");
             if (r.size() != 2) throw InputError("--phong-exponent-range: expected MIN,MAX (got '" + o.phongExponentRange + "')");
             exponentLo = r[0];
             exponentHi = r[1];

@@ -4,11 +4,12 @@
 #include <filesystem>
 #include <string>
 
-#include "render/app/commands.h"
-#include "render/app/progress.h"
-#include "sim/error.h"
-#include "sim/io.h"
-#include "sim/parallel.h"
+#include "app/commands.h"
+#include "app/progress.h"
+#include "core/error.h"
+#include "core/png_io.h"
+#include "sim/vdb_io.h"
+#include "core/parallel.h"
 #include "sim/scene.h"
 
 namespace terrain::app {

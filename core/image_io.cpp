@@ -1,4 +1,4 @@
-#include "gi/image_io.h"
+#include "core/image_io.h"
 
 // OpenEXR's C interface: its C++ headers need Imath include paths that the
 // build does not export, and half-float RGBA/Y is all an image viewer needs
@@ -13,10 +13,10 @@
 #include <fstream>
 #include <iterator>
 
-#include "sim/error.h"
-#include "sim/io.h"
+#include "core/error.h"
+#include "core/file_io.h"
 
-namespace terrain::gi {
+namespace terrain {
 
 namespace {
 
@@ -58,6 +58,14 @@ void writeNpyArray(const std::string& file, const std::vector<std::size_t>& shap
 
 void writeNpy(const std::string& file, const Grid& g) {
     writeNpyArray(file, {static_cast<std::size_t>(g.ny), static_cast<std::size_t>(g.nx)}, g.data());
+}
+
+void writeNpyRgb(const std::string& file, const std::array<Grid, 3>& rgb) {
+    const Grid& g0 = rgb[0];
+    std::vector<float> interleaved(g0.size() * 3);
+    for (std::size_t i = 0; i < g0.size(); ++i)
+        for (std::size_t c = 0; c < 3; ++c) interleaved[3 * i + c] = rgb[c].v[i];
+    writeNpyArray(file, {static_cast<std::size_t>(g0.ny), static_cast<std::size_t>(g0.nx), 3}, interleaved.data());
 }
 
 void writeExr(const std::string& file, const std::vector<const Grid*>& channels) {
@@ -185,4 +193,4 @@ std::vector<float> readEquirect(const std::string& file, int& width, int& height
     throw IoError(file, "environment map must be .exr or .hdr");
 }
 
-}  // namespace terrain::gi
+}  // namespace terrain

@@ -1,48 +1,19 @@
-// PNG and file helpers. The OpenVDB part lives in io_vdb.cpp so its heavy
-// headers are compiled once, in one translation unit (GUIDE 5).
+// PNG reading and writing through libpng.
+#include "core/png_io.h"
+
 #include <png.h>
 
 #include <algorithm>
-#include <atomic>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
 #include <memory>
 #include <string>
-#include <unistd.h>
 
-#include "sim/error.h"
-#include "sim/io.h"
+#include "core/error.h"
+#include "core/file_io.h"
 
 namespace terrain {
-
-std::string temporaryNameFor(const std::string& file) {
-    static std::atomic<unsigned> counter{0};
-    return file + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
-}
-
-void commitTemporary(const std::string& tmp, const std::string& file) {
-    if (std::rename(tmp.c_str(), file.c_str()) != 0) {
-        const std::string why = std::strerror(errno);
-        std::remove(tmp.c_str());
-        throw IoError(file, "cannot move the finished file into place: " + why);
-    }
-}
-
-void writeFileAtomic(const std::string& file, const std::string& bytes) {
-    const std::string tmp = temporaryNameFor(file);
-    std::FILE* f = std::fopen(tmp.c_str(), "wb");
-    if (!f) throw IoError(file, std::string("cannot open for writing: ") + std::strerror(errno));
-    const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
-    const bool closed = std::fclose(f) == 0;
-    if (!ok || !closed) {
-        std::remove(tmp.c_str());
-        throw IoError(file, "write failed (disk full?)");
-    }
-    commitTemporary(tmp, file);
-}
 
 // ---------------------------------------------------------------------------
 // PNG reading
@@ -232,22 +203,6 @@ void writePngHeightmap(const std::string& file, const Grid& height, float zScale
         samples[i] = static_cast<std::uint16_t>(std::clamp(q, 0.0, 65535.0));
     }
     writePng(file, height.nx, height.ny, 1, 16, samples.data());
-}
-
-Grid readHeightmap(const std::string& file, float zScale, float zOffset, float* cellSizeOut) {
-    const std::string ext = std::filesystem::path(file).extension().string();
-    std::string lower = ext;
-    std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
-    if (lower == ".png") return readPngHeightmap(file, zScale, zOffset);
-    if (lower == ".vdb") {
-        TerrainState s;
-        readVdb(file, s, LayerSet{});
-        if (cellSizeOut) *cellSizeOut = s.cellSize;
-        Grid g;
-        s.groundHeight(g);
-        return g;
-    }
-    throw IoError(file, "unknown heightmap format '" + ext + "' (use .png or .vdb)");
 }
 
 }  // namespace terrain

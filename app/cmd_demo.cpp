@@ -5,13 +5,14 @@
 #include <memory>
 #include <string>
 
-#include "render/app/commands.h"
+#include "app/commands.h"
+#include "app/render_options.h"
 #include "render/context.h"
-#include "render/demo_window.h"
+#include "app/demo_window.h"
 #include "render/gl.h"
-#include "render/pipeline.h"
-#include "sim/error.h"
-#include "sim/parallel.h"
+#include "engine/pipeline.h"
+#include "core/error.h"
+#include "core/parallel.h"
 #include "sim/scene.h"
 
 namespace terrain::app {
@@ -25,7 +26,7 @@ struct DemoOptions {
 
 int runDemo(DemoOptions& d) {
     RenderOptions& o = d.render;
-    render::PipelineSettings ps;
+    engine::PipelineSettings ps;
     render::RenderSettings rs;
     toSettings(o, ps, rs);
     const SceneSettings scene = resolveScene(o.scene, o.size, static_cast<std::uint64_t>(o.seed));
@@ -46,10 +47,10 @@ int runDemo(DemoOptions& d) {
     return withThreads(o.threads, [&] {
         render::Gl gl;
         render::loadGl(gl, window->procAddress());
-        render::FramePipeline pipeline(scene, ps);
+        engine::FramePipeline pipeline(scene, ps);
         std::printf("demo: scene %s in a window (%s); drag to orbit, wheel to zoom\n", scene.name.c_str(),
                     render::glDescription(gl).c_str());
-        const int shown = render::runWindowDemo(*window, gl, pipeline, rs, d.frames->count() > 0 ? o.frames : 0);
+        const int shown = runWindowDemo(*window, gl, pipeline, rs, d.frames->count() > 0 ? o.frames : 0);
         std::printf("demo: %d frames shown\n", shown);
         return 0;
     });

@@ -1,4 +1,4 @@
-#include "render/app/progress.h"
+#include "app/progress.h"
 
 #include <chrono>
 #include <cstdlib>
@@ -6,8 +6,8 @@
 #include <system_error>
 #include <unistd.h>
 
-#include "sim/error.h"
-#include "sim/io.h"
+#include "core/error.h"
+#include "core/file_io.h"
 
 namespace terrain::app {
 namespace {

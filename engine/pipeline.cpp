@@ -1,13 +1,13 @@
-#include "render/pipeline.h"
+#include "engine/pipeline.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 
-#include "sim/error.h"
-#include "sim/parallel.h"
+#include "core/error.h"
+#include "core/parallel.h"
 
-namespace terrain::render {
+namespace terrain::engine {
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -199,4 +199,4 @@ void FramePipeline::light() {
     timings_.render = 0.0;
 }
 
-}  // namespace terrain::render
+}  // namespace terrain::engine

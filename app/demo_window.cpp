@@ -1,4 +1,4 @@
-#include "render/demo_window.h"
+#include "app/demo_window.h"
 
 #include <algorithm>
 #include <chrono>
@@ -8,7 +8,9 @@
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
 
-namespace terrain::render {
+namespace terrain::app {
+using namespace render;
+using namespace engine;
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -135,4 +137,4 @@ int runWindowDemo(WindowContext& window, const Gl& gl, FramePipeline& pipeline, 
     return frames;
 }
 
-}  // namespace terrain::render
+}  // namespace terrain::app

@@ -1,42 +1,18 @@
 #pragma once
 // One animated frame on the CPU: simulation ticks -> GI frame (gi/frame.h) ->
-// the per-texel data the renderer uploads. Shared by `terrain render`, the
-// window demo, the tests and the benchmark.
-//
-// What the renderer receives per texel (full resolution unless noted):
-//   heights    ground (bedrock + soil) and water depth, m
-//   skyShade   RGB radiance the environment (sky) gives a white Lambertian
-//              texel, with the engine's soft visibility (gi shade map minus
-//              the key light's share)
-//   keyShade   RGB radiance the key light gives it, with the engine's soft
-//              visibility V_key (gi/ shading of the key light alone)
-//   keyVisibility  keyShade / unshadowed key light (0..1): the key light's
-//              soft visibility, which also modulates the specular term
-//   ambient    gi/ ambient map (normal-weighted sky-view factor)
-//   and at the receiver resolution: the sky visibility fraction (V's
-//   constant term), one height-pyramid level and the mean incident indirect
-//   radiance (U's constant term, or E / pi with the blocker-radiance kernel), for debug views.
+// the per-texel data the renderer uploads (engine/frame_data.h). Shared by
+// `terrain render`, the window demo, the tests and the benchmark.
 #include <array>
 #include <cstdint>
 #include <vector>
 
+#include "engine/frame_data.h"
 #include "gi/frame.h"
 #include "sim/scene.h"
 
-namespace terrain::render {
-
-/// How the lighting is computed.
-enum class LightingMode {
-    KeyOnly,  // the key light only (with its visibility), no sky
-    Direct,   // sky + key light, each with the engine's soft visibility
-    Global,   // direct + `bounces` indirect bounces (gi/indirect.h)
-};
+namespace terrain::engine {
 
 /// Lights of the demo scenes.
-struct SceneLights {
-    gi::ShRgb sky;      // environment radiance (SH); also the water's reflection map
-    gi::KeyLight key;   // the sun
-};
 SceneLights defaultLights();
 
 struct PipelineSettings {
@@ -56,27 +32,6 @@ struct PipelineSettings {
 struct StageTimings {
     double sim = 0, pyramids = 0, scan = 0, integrate = 0, shade = 0, render = 0;
     double total() const { return sim + pyramids + scan + integrate + shade + render; }
-};
-
-/// Everything the renderer uploads for one frame.
-struct FrameData {
-    int nx = 0, ny = 0;
-    float cellSize = 1.0f;
-    float zMin = 0.0f, zMax = 1.0f;       // ground range of the first frame (fixed colour ramp)
-    bool hasWater = false;
-    float exaggeration = 1.0f;            // vertical exaggeration (applied by the renderer to the heights)
-    bool coast = false;                   // colour palette: coast (waves scenes) or mountains
-    std::vector<float> heights;           // 2 per texel: ground, water depth
-    std::vector<float> shade;             // 4 per texel: sky RGB, key visibility
-    std::vector<float> key;               // 4 per texel: key RGB, ambient
-    int nxr = 0, nyr = 0, subsample = 1;  // receiver grid
-    std::vector<float> receiver;          // 4 per receiver: sky visibility fraction, pyramid level height,
-                                          // mean incident indirect radiance (U's constant term, or the irradiance E / pi where the kernel keeps no U; 0 without bounces), 0
-    int pyramidLevel = -1;                // level in `receiver` (-1: none built)
-    SceneLights lights;
-    LightingMode lighting = LightingMode::Direct;
-    std::int64_t tick = 0;
-    double time = 0.0;                    // s, simulated
 };
 
 class FramePipeline {
@@ -118,4 +73,4 @@ private:
     StageTimings timings_;
 };
 
-}  // namespace terrain::render
+}  // namespace terrain::engine

@@ -3,8 +3,8 @@
 #include <exception>
 #include <vector>
 
-#include "render/app/commands.h"
-#include "sim/error.h"
+#include "app/commands.h"
+#include "core/error.h"
 
 int main(int argc, char** argv) {
     CLI::App app{"terrain: a dynamic terrain engine (erosion, waves, global illumination on height fields)"};

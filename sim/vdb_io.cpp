@@ -1,5 +1,5 @@
 // OpenVDB read/write of terrain layers, kept in one translation unit because
-// the OpenVDB headers are expensive to compile (GUIDE 5).
+// the OpenVDB headers are expensive to compile .
 //
 // Layout: each layer is a 2-D openvdb::FloatGrid, voxel (x, y, 0) = cell
 // (x, y), background 0, with a uniform linear transform whose voxel size is
@@ -12,8 +12,9 @@
 #include <filesystem>
 #include <mutex>
 
-#include "sim/error.h"
-#include "sim/io.h"
+#include "core/error.h"
+#include "core/file_io.h"
+#include "sim/vdb_io.h"
 
 namespace terrain {
 namespace {

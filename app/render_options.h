@@ -1,21 +1,14 @@
 #pragma once
-// Each subcommand of build/terrain registers itself on the CLI11 app and
-// returns the function that runs it once parsing succeeded.
-#include <functional>
+// Options shared by `terrain render` and `terrain demo` (its headless
+// fallback), and the headless render both run.
 #include <string>
 
 #include <CLI/CLI.hpp>
 
+#include "engine/pipeline.h"
 #include "render/renderer.h"
 
 namespace terrain::app {
-
-using Runner = std::function<int()>;
-
-Runner addSimCommand(CLI::App& app);
-Runner addGiCommand(CLI::App& app);
-Runner addRenderCommand(CLI::App& app);
-Runner addDemoCommand(CLI::App& app);
 
 /// Options shared by `terrain render` and the demo (its headless fallback).
 struct RenderOptions {
@@ -46,7 +39,7 @@ void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize);
 
 /// Checks the options and turns them into pipeline and renderer settings
 /// (throws InputError naming the bad option).
-void toSettings(const RenderOptions& o, render::PipelineSettings& pipeline, render::RenderSettings& renderer);
+void toSettings(const RenderOptions& o, engine::PipelineSettings& pipeline, render::RenderSettings& renderer);
 
 /// The headless render: PNG frames in o.out (atomic writes), a progress bar,
 /// the per-stage timing summary and, when asked, an mp4. Returns the exit code.

@@ -1,0 +1,27 @@
+// Small text parsers for command-line values.
+#include "core/parse.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "core/error.h"
+
+namespace terrain {
+
+std::vector<float> parseNumberList(const std::string& text, const std::string& option) {
+    std::vector<float> v;
+    std::stringstream ss(text);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+        try {
+            std::size_t used = 0;
+            v.push_back(std::stof(item, &used));
+            if (used != item.size()) throw std::invalid_argument(item);
+        } catch (const std::exception&) {
+            throw InputError(option + " '" + text + "': '" + item + "' is not a number");
+        }
+    }
+    return v;
+}
+
+}  // namespace terrain

@@ -1,0 +1,12 @@
+#pragma once
+// Small text parsers for command-line values.
+#include <string>
+#include <vector>
+
+namespace terrain {
+
+/// Parses a comma-separated list of numbers ("1,0.5,2"); throws InputError
+/// naming `option` and the offending item when one is not a number.
+std::vector<float> parseNumberList(const std::string& text, const std::string& option);
+
+}  // namespace terrain

@@ -1,0 +1,59 @@
+#pragma once
+// What the renderer uploads for one frame: plain per-texel arrays filled by
+// the frame pipeline (engine/pipeline.h). The OpenGL code sees only this.
+//
+// Per texel (full resolution unless noted):
+//   heights    ground (bedrock + soil) and water depth, m
+//   skyShade   RGB radiance the environment (sky) gives a white Lambertian
+//              texel, with the engine's soft visibility (gi shade map minus
+//              the key light's share)
+//   keyShade   RGB radiance the key light gives it, with the engine's soft
+//              visibility V_key (gi/ shading of the key light alone)
+//   keyVisibility  keyShade / unshadowed key light (0..1): the key light's
+//              soft visibility, which also modulates the specular term
+//   ambient    gi/ ambient map (normal-weighted sky-view factor)
+//   and at the receiver resolution: the sky visibility fraction (V's
+//   constant term), one height-pyramid level and the mean incident indirect
+//   radiance (U's constant term, or E / pi with the blocker-radiance kernel), for debug views.
+#include <cstdint>
+#include <vector>
+
+#include "gi/lights.h"
+
+namespace terrain::engine {
+
+/// How the lighting is computed.
+enum class LightingMode {
+    KeyOnly,  // the key light only (with its visibility), no sky
+    Direct,   // sky + key light, each with the engine's soft visibility
+    Global,   // direct + `bounces` indirect bounces (gi/indirect.h)
+};
+
+/// Lights of the demo scenes.
+struct SceneLights {
+    gi::ShRgb sky;      // environment radiance (SH); also the water's reflection map
+    gi::KeyLight key;   // the sun
+};
+
+/// Everything the renderer uploads for one frame.
+struct FrameData {
+    int nx = 0, ny = 0;
+    float cellSize = 1.0f;
+    float zMin = 0.0f, zMax = 1.0f;       // ground range of the first frame (fixed colour ramp)
+    bool hasWater = false;
+    float exaggeration = 1.0f;            // vertical exaggeration (applied by the renderer to the heights)
+    bool coast = false;                   // colour palette: coast (waves scenes) or mountains
+    std::vector<float> heights;           // 2 per texel: ground, water depth
+    std::vector<float> shade;             // 4 per texel: sky RGB, key visibility
+    std::vector<float> key;               // 4 per texel: key RGB, ambient
+    int nxr = 0, nyr = 0, subsample = 1;  // receiver grid
+    std::vector<float> receiver;          // 4 per receiver: sky visibility fraction, pyramid level height,
+                                          // mean incident indirect radiance (U's constant term, or the irradiance E / pi where the kernel keeps no U; 0 without bounces), 0
+    int pyramidLevel = -1;                // level in `receiver` (-1: none built)
+    SceneLights lights;
+    LightingMode lighting = LightingMode::Direct;
+    std::int64_t tick = 0;
+    double time = 0.0;                    // s, simulated
+};
+
+}  // namespace terrain::engine
