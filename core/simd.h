@@ -1,24 +1,25 @@
 #pragma once
-// 4-wide SIMD over GCC vector extensions, shared by the grid kernels.
+// SIMD lanes over GCC vector extensions: the one dialect every grid and GI
+// kernel is written in.
 //
-// A kernel is written once, templated on the lane type T (float or F4):
-// interior cells run four at a time, edge cells one at a time with the same
-// arithmetic. Every lane op is a correctly rounded IEEE-754 add/sub/mul/div/
-// sqrt or a select, so a cell's result does not depend on which path (or
-// thread) computed it. Explicit vectors rather than auto-vectorisation
-// because the build keeps -fmath-errno and -ftrapping-math (no fast-math, for
-// reproducible results), under which GCC will not vectorise sqrt, guarded
-// divisions or upwind selects by itself. Baseline x86-64 (SSE2) only.
+// Lane types: float (one cell), F4 (4 lanes, SSE2: the x86-64 baseline) and
+// F8 (8 lanes, AVX2). A kernel is written once, templated on the lane type:
+// the simulation's interior cells run four at a time and edge cells one at a
+// time with the same arithmetic; the GI's hot kernels are compiled for F4 and
+// again for F8 (see "width-generic kernels" below). Every lane op is a
+// correctly rounded IEEE-754 add/sub/mul/div/sqrt or a select, so a cell's
+// result does not depend on which path (or thread) computed it. Explicit
+// vectors rather than auto-vectorisation because the build keeps
+// -fmath-errno and -ftrapping-math (no fast-math, for reproducible results),
+// under which GCC will not vectorise sqrt, guarded divisions or upwind
+// selects by itself.
 #include <cmath>
 #include <cstring>
 #include <type_traits>
 
-#include <emmintrin.h>
-
 namespace terrain::simd {
 
 using F4 = float __attribute__((vector_size(16)));
-constexpr int kLanes = 4;
 
 // ---- width-generic kernels: F4 (SSE2) and F8 (AVX2) -------------------------
 // A hot kernel written once over V = F4 or F8 is compiled twice: as usual, and
@@ -38,6 +39,11 @@ using I8 = int __attribute__((vector_size(32)));
 template <class V>
 struct LaneTraits;
 template <>
+struct LaneTraits<float> {
+    using I = int;
+    static constexpr int n = 1;
+};
+template <>
 struct LaneTraits<F4> {
     using I = I4;
     static constexpr int n = 4;
@@ -47,20 +53,10 @@ struct LaneTraits<F8> {
     using I = I8;
     static constexpr int n = 8;
 };
+/// Lanes of a lane type: 1, 4 or 8.
 template <class V>
-[[gnu::always_inline]] inline V ldv(const float* p) {
-    V v;
-    std::memcpy(&v, p, sizeof v);
-    return v;
-}
-template <class V>
-[[gnu::always_inline]] inline void stv(float* p, V v) {
-    std::memcpy(p, &v, sizeof v);
-}
-template <class V>
-[[gnu::always_inline]] inline V splv(float x) {
-    return V{} + x;
-}
+inline constexpr int kLaneCount = LaneTraits<V>::n;
+
 [[gnu::always_inline]] inline float sqrtv(float x) { return std::sqrt(x); }
 [[gnu::always_inline]] inline F4 sqrtv(F4 x) { return __builtin_ia32_sqrtps(x); }
 [[gnu::target("avx")]] inline F8 sqrtv(F8 x) { return __builtin_ia32_sqrtps256(x); }
@@ -69,7 +65,7 @@ template <class V>
 [[gnu::target("avx")]] inline int laneBits(I8 m) { return __builtin_ia32_movmskps256(reinterpret_cast<F8>(m)); }
 
 template <class T>
-inline T load(const float* p) {
+[[gnu::always_inline]] inline T load(const float* p) {
     if constexpr (std::is_same_v<T, float>) {
         return *p;
     } else {
@@ -79,40 +75,39 @@ inline T load(const float* p) {
     }
 }
 template <class T>
-inline void store(float* p, T v) {
+[[gnu::always_inline]] inline void store(float* p, T v) {
     if constexpr (std::is_same_v<T, float>) *p = v;
     else std::memcpy(p, &v, sizeof v);
 }
 template <class T>
-inline T splat(float x) {
+[[gnu::always_inline]] inline T splat(float x) {
     if constexpr (std::is_same_v<T, float>) return x;
     else return T{} + x;
 }
 template <class T>
-inline T vmax(T a, T b) {
+[[gnu::always_inline]] inline T vmax(T a, T b) {
     return a > b ? a : b;
 }
 template <class T>
-inline T vmin(T a, T b) {
+[[gnu::always_inline]] inline T vmin(T a, T b) {
     return a < b ? a : b;
 }
-inline float vsqrt(float x) { return std::sqrt(x); }
 
 // Deterministic float atan (Cephes atanf: range reduction to |x| <= tan(pi/8),
 // then a degree-9 odd minimax polynomial; ~1e-7 relative): a pure function of
 // its argument, so bit-identical for any thread count.
 template <class V>
 [[gnu::always_inline]] inline V atanv(V t) {
-    const V zero = splv<V>(0.0f), one = splv<V>(1.0f);
+    const V zero = splat<V>(0.0f), one = splat<V>(1.0f);
     const V x = t < zero ? -t : t;
-    const auto big = x > splv<V>(2.414213562373095f);
-    const auto mid = (x > splv<V>(0.4142135623730950f)) & ~big;
+    const auto big = x > splat<V>(2.414213562373095f);
+    const auto mid = (x > splat<V>(0.4142135623730950f)) & ~big;
     // one division: -1 / x, (x - 1) / (x + 1) or x / 1
     const V xr = (big ? -one : (mid ? x - one : x)) / (big ? x : (mid ? x + one : one));
-    const V y0 = big ? splv<V>(1.5707963267948966f) : (mid ? splv<V>(0.7853981633974483f) : zero);
+    const V y0 = big ? splat<V>(1.5707963267948966f) : (mid ? splat<V>(0.7853981633974483f) : zero);
     const V z = xr * xr;
-    const V p = ((((splv<V>(8.05374449538e-2f) * z - splv<V>(1.38776856032e-1f)) * z + splv<V>(1.99777106478e-1f)) * z -
-                  splv<V>(3.33329491539e-1f)) * z) * xr + xr;
+    const V p = ((((splat<V>(8.05374449538e-2f) * z - splat<V>(1.38776856032e-1f)) * z + splat<V>(1.99777106478e-1f)) * z -
+                  splat<V>(3.33329491539e-1f)) * z) * xr + xr;
     const V r = y0 + p;
     return t < zero ? -r : r;
 }
@@ -131,6 +126,5 @@ inline bool setWideEnabled(bool on) {
     wideFlag() = on && __builtin_cpu_supports("avx2");
     return wideFlag();
 }
-inline F4 vsqrt(F4 x) { return reinterpret_cast<F4>(_mm_sqrt_ps(reinterpret_cast<__m128>(x))); }
 
 }  // namespace terrain::simd

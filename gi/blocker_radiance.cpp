@@ -11,13 +11,13 @@ namespace terrain::gi {
 
 namespace {
 
+using simd::load;
+using simd::splat;
+using simd::store;
 using simd::atanv;
 using simd::F4;
 using simd::F8;
 using simd::LaneTraits;
-using simd::ldv;
-using simd::splv;
-using simd::stv;
 
 constexpr int kRowsPerBlock = 8;
 constexpr int kLanePad = 8;                // rows padded to the widest lane group
@@ -44,28 +44,28 @@ template <class V>
 [[gnu::always_inline]] inline void occlusionAzimuthImpl(const OcclusionRow& r, const NearTap* taps, int nTaps, float cosPhi,
                                                         float sinPhi) {
     constexpr int L = LaneTraits<V>::n;
-    const V one = splv<V>(1.0f), half = splv<V>(0.5f), lim = splv<V>(1e6f), nlim = splv<V>(-1e6f);
+    const V one = splat<V>(1.0f), half = splat<V>(0.5f), lim = splat<V>(1e6f), nlim = splat<V>(-1e6f);
     for (int x = 0; x < r.n; x += L) {
-        const V h0 = ldv<V>(r.h + x);
-        const V margin = (h0 < splv<V>(0.0f) ? -h0 : h0) * splv<V>(kHeightMarginRel);
-        V hor = ldv<V>(r.far + x);
+        const V h0 = load<V>(r.h + x);
+        const V margin = (h0 < splat<V>(0.0f) ? -h0 : h0) * splat<V>(kHeightMarginRel);
+        V hor = load<V>(r.far + x);
         for (int k = 0; k < nTaps; ++k) {
             const NearTap& t = taps[k];
             const float* a = r.h + t.dy * r.stride + t.dx + x;
             const float* b = a + r.stride;
-            const V v = (splv<V>(t.w00) * ldv<V>(a) + splv<V>(t.w10) * ldv<V>(a + 1)) +
-                        (splv<V>(t.w01) * ldv<V>(b) + splv<V>(t.w11) * ldv<V>(b + 1));
-            const V slope = ((v - h0) - margin) * splv<V>(t.invDist);
+            const V v = (splat<V>(t.w00) * load<V>(a) + splat<V>(t.w10) * load<V>(a + 1)) +
+                        (splat<V>(t.w01) * load<V>(b) + splat<V>(t.w11) * load<V>(b + 1));
+            const V slope = ((v - h0) - margin) * splat<V>(t.invDist);
             hor = slope > hor ? slope : hor;
         }
-        const V g = ldv<V>(r.gx + x) * splv<V>(cosPhi) + ldv<V>(r.gy + x) * splv<V>(sinPhi);
+        const V g = load<V>(r.gx + x) * splat<V>(cosPhi) + load<V>(r.gy + x) * splat<V>(sinPhi);
         const V gc = g < nlim ? nlim : (g > lim ? lim : g);
         V tc = hor < gc ? gc : hor;
         tc = tc > lim ? lim : tc;
         // F(t) = (t (t - g) / (1 + t^2) - g atan t) / 2, so F(g) = -g atan(g) / 2
         const V f = half * (tc * (tc - g) / (one + tc * tc) - g * (atanv(tc) - atanv(gc)));
         // below the plane nothing: exactly 0
-        stv(r.sum + x, ldv<V>(r.sum + x) + (tc > gc ? f : splv<V>(0.0f)));
+        store(r.sum + x, load<V>(r.sum + x) + (tc > gc ? f : splat<V>(0.0f)));
     }
 }
 void occlusionAzimuthSse(const OcclusionRow& r, const NearTap* taps, int nTaps, float c, float s) {

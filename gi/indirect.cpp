@@ -17,6 +17,9 @@ namespace terrain::gi {
 
 namespace {
 
+using simd::load;
+using simd::splat;
+using simd::store;
 using simd::F4;
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
@@ -31,10 +34,7 @@ inline int padGroup(int n) { return (n + kGroup - 1) / kGroup * kGroup; }
 using simd::F8;
 using simd::LaneTraits;
 using simd::laneBits;
-using simd::ldv;
-using simd::splv;
 using simd::sqrtv;
-using simd::stv;
 using simd::atanv;
 
 // ---- algorithm: the casting set and Eq. 12 for one row of receivers --------
@@ -84,7 +84,7 @@ template <class V, int Mode>
     float *M = S, *g = S + pad, *gLow = S + 2 * pad, *q1 = S + 3 * pad, *F = S + 4 * pad, *A = S + 5 * pad;
     int* steps = sc.groupSteps.data();  // per lane: the valid prefix (row limit applied)
     int* active = sc.active.data();     // groups still walking
-    const V one = splv<V>(1.0f), half = splv<V>(0.5f), lim = splv<V>(1e6f), nlim = splv<V>(-1e6f), zero = splv<V>(0.0f);
+    const V one = splat<V>(1.0f), half = splat<V>(0.5f), lim = splat<V>(1e6f), nlim = splat<V>(-1e6f), zero = splat<V>(0.0f);
     const I rowLimit = I{} + rowSteps;
     int nActive = 0, nMax = 0;
     for (int G = 0; G < nGroups; ++G) {
@@ -97,33 +97,33 @@ template <class V, int Mode>
         for (int l = 0; l < L; ++l) nAny = std::max(nAny, static_cast<int>(c[l]));
         nMax = std::max(nMax, nAny);
         if (nAny > 0) active[nActive++] = G;
-        stv(M + X0, splv<V>(kNoBlocker));
+        store(M + X0, splat<V>(kNoBlocker));
         // omega_min: the tangent plane's slope along the azimuth (Section 3)
-        const V gv = ldv<V>(in.gx + X0) * splv<V>(cosPhi) + ldv<V>(in.gy + X0) * splv<V>(sinPhi);
+        const V gv = load<V>(in.gx + X0) * splat<V>(cosPhi) + load<V>(in.gy + X0) * splat<V>(sinPhi);
         V gl = gv;
-        if constexpr (Sh && Exact) gl = ldv<V>(in.lowSlope + X0);
-        stv(g + X0, gv);
-        stv(gLow + X0, gl);
+        if constexpr (Sh && Exact) gl = load<V>(in.lowSlope + X0);
+        store(g + X0, gv);
+        store(gLow + X0, gl);
         const V t = gl < nlim ? nlim : (gl > lim ? lim : gl);
         const V r = one / sqrtv(one + t * t);  // cos of the lower bound
-        stv(q1 + X0, t * r);
+        store(q1 + X0, t * r);
         if constexpr (Exact) {
             // F(t) = f2 - g f1 at the clamped segment end (f1, f2 the clamped
             // cosine's antiderivatives); F is smallest at t = g (the receiver's
             // plane), so ends below g keep F(g)
             const V te = gv < nlim ? nlim : (gv > lim ? lim : gv);
             const V re = one / sqrtv(one + te * te), se = te * re;
-            stv(F + X0, half * (se * se) - gv * (half * (atanv(te) + se * re)));
+            store(F + X0, half * (se * se) - gv * (half * (atanv(te) + se * re)));
         }
-        for (int p = 0; p < 3 * nMo; ++p) stv(A + static_cast<std::size_t>(p) * pad + X0, zero);
+        for (int p = 0; p < 3 * nMo; ++p) store(A + static_cast<std::size_t>(p) * pad + X0, zero);
     }
-    const V hMax = splv<V>(in.hMax);
+    const V hMax = splat<V>(in.hMax);
     for (int i = 0; i < nMax && nActive > 0; ++i) {
         const ScanStep& st = hTab[i];
         const std::ptrdiff_t o = Y * st.rowStep;
         const float* a = st.field + (o + st.offA);
         const float* b = st.field + (o + st.offB);
-        const V wa = splv<V>(st.w[0][0]), wb = splv<V>(st.w[1][0]), inv = splv<V>(st.w[2][0]);
+        const V wa = splat<V>(st.w[0][0]), wb = splat<V>(st.w[1][0]), inv = splat<V>(st.w[2][0]);
         const float* ra[3];
         const float* rb[3];
         V rwa[3], rwb[3];
@@ -132,8 +132,8 @@ template <class V, int Mode>
             const std::ptrdiff_t ro = Y * rs.rowStep;
             ra[c] = rs.field + (ro + rs.offA);
             rb[c] = rs.field + (ro + rs.offB);
-            rwa[c] = splv<V>(rs.w[0][0]);
-            rwb[c] = splv<V>(rs.w[1][0]);
+            rwa[c] = splat<V>(rs.w[0][0]);
+            rwb[c] = splat<V>(rs.w[1][0]);
         }
         const I iv = I{} + i;
         int kept = 0;
@@ -142,9 +142,9 @@ template <class V, int Mode>
             const int X0 = G * L;
             I stp;
             std::memcpy(&stp, steps + X0, sizeof stp);
-            const V h0 = ldv<V>(in.h0 + X0);
-            const V t = (((wa * ldv<V>(a + X0) + wb * ldv<V>(b + X0)) - h0) - ldv<V>(in.margin + X0)) * inv;
-            V m = ldv<V>(M + X0);
+            const V h0 = load<V>(in.h0 + X0);
+            const V t = (((wa * load<V>(a + X0) + wb * load<V>(b + X0)) - h0) - load<V>(in.margin + X0)) * inv;
+            V m = load<V>(M + X0);
             const I nw = (iv < stp) & (t > m);  // Eq. 17: above every earlier sample
             if (laneBits(nw) == 0) {
                 // past the point where even the field's highest height would not
@@ -156,57 +156,57 @@ template <class V, int Mode>
             }
             active[kept++] = G;
             m = nw ? t : m;
-            stv(M + X0, m);
+            store(M + X0, m);
             // the segment [c_(i-1), c_i] clamped to [omega_min, pi/2]
-            const V gl = ldv<V>(gLow + X0);
+            const V gl = load<V>(gLow + X0);
             V tc = t < gl ? gl : t;
             tc = tc < nlim ? nlim : (tc > lim ? lim : tc);
             const V r = one / sqrtv(one + tc * tc), sNew = tc * r;  // cos, sin of the end
             V mo[nMo];
             if constexpr (Sh) {
-                const V p = ldv<V>(q1 + X0);
+                const V p = load<V>(q1 + X0);
                 const V sv = nw ? sNew : p;  // no new member: an empty segment (exactly 0)
                 const V p2 = p * p, s2 = sv * sv;
                 mo[0] = sv - p;
                 mo[1] = s2 - p2;
                 mo[2] = s2 * sv - p2 * p;
                 mo[3] = s2 * s2 - p2 * p2;
-                stv(q1 + X0, sv);
+                store(q1 + X0, sv);
             }
             if constexpr (Exact) {
-                const V gv = ldv<V>(g + X0), f = ldv<V>(F + X0);
+                const V gv = load<V>(g + X0), f = load<V>(F + X0);
                 const V fNew = half * (sNew * sNew) - gv * (half * (atanv(tc) + sNew * r));
                 const V fv = nw & (tc >= gv) ? fNew : f;  // below the receiver's plane: nothing
                 mo[e5] = fv - f;
-                stv(F + X0, fv);
+                store(F + X0, fv);
             }
             // moments x radiance (lanes without a new member have zero moments;
             // the radiance read there is finite: inside the field's padding and guard)
             for (int c = 0; c < 3; ++c) {
-                const V u = rwa[c] * ldv<V>(ra[c] + X0) + rwb[c] * ldv<V>(rb[c] + X0);
+                const V u = rwa[c] * load<V>(ra[c] + X0) + rwb[c] * load<V>(rb[c] + X0);
                 for (int p = 0; p < nMo; ++p) {
                     float* acc = A + static_cast<std::size_t>(c * nMo + p) * pad + X0;
-                    stv(acc, ldv<V>(acc) + u * mo[p]);
+                    store(acc, load<V>(acc) + u * mo[p]);
                 }
             }
         }
         nActive = kept;
     }
     // Eq. 10's closed form as a polynomial in s
-    const V k0 = splv<V>(0.70710678118654752440f), k1 = splv<V>(0.61237243569579452455f);
-    const V k2 = splv<V>(0.79056941504209483300f), k3 = splv<V>(0.23385358667337133659f);
+    const V k0 = splat<V>(0.70710678118654752440f), k1 = splat<V>(0.61237243569579452455f);
+    const V k2 = splat<V>(0.79056941504209483300f), k3 = splat<V>(0.23385358667337133659f);
     float* nlp = sc.nlp.data();
     for (int c = 0; c < 3; ++c)
         for (int X0 = 0; X0 < pad; X0 += L) {
             V Ac[nMo];
-            for (int p = 0; p < nMo; ++p) Ac[p] = ldv<V>(A + static_cast<std::size_t>(c * nMo + p) * pad + X0);
-            if constexpr (Exact) stv(nlp + static_cast<std::size_t>(12 + c) * pad + X0, Ac[e5]);
+            for (int p = 0; p < nMo; ++p) Ac[p] = load<V>(A + static_cast<std::size_t>(c * nMo + p) * pad + X0);
+            if constexpr (Exact) store(nlp + static_cast<std::size_t>(12 + c) * pad + X0, Ac[e5]);
             if constexpr (!Sh) continue;
             float* base = nlp + static_cast<std::size_t>(c) * 4 * pad + X0;
-            stv(base, k0 * Ac[0]);
-            stv(base + pad, k1 * Ac[1]);
-            stv(base + 2 * pad, k2 * (Ac[2] - Ac[0]));
-            stv(base + 3 * pad, k3 * (splv<V>(5.0f) * Ac[3] - splv<V>(6.0f) * Ac[1]));
+            store(base, k0 * Ac[0]);
+            store(base + pad, k1 * Ac[1]);
+            store(base + 2 * pad, k2 * (Ac[2] - Ac[0]));
+            store(base + 3 * pad, k3 * (splat<V>(5.0f) * Ac[3] - splat<V>(6.0f) * Ac[1]));
         }
 }
 
@@ -250,15 +250,15 @@ template <class V>
     constexpr int L = LaneTraits<V>::n;
     const int nv = r.nxr / L * L;
     auto axpy = [&](float* __restrict dst, const float* __restrict w, float gval) {
-        const V g = splv<V>(gval);
-        for (int X = 0; X < nv; X += L) stv(dst + X, ldv<V>(dst + X) + g * ldv<V>(w + X));
+        const V g = splat<V>(gval);
+        for (int X = 0; X < nv; X += L) store(dst + X, load<V>(dst + X) + g * load<V>(w + X));
         for (int X = nv; X < r.nxr; ++X) dst[X] += gval * w[X];
     };
     if (r.exact)
         for (int c = 0; c < 3; ++c) {
             float* __restrict e = r.exact + static_cast<std::size_t>(c) * r.pad;
             const float* __restrict w = r.nlp + static_cast<std::size_t>(12 + c) * r.pad;
-            for (int X = 0; X < nv; X += L) stv(e + X, ldv<V>(e + X) + ldv<V>(w + X));
+            for (int X = 0; X < nv; X += L) store(e + X, load<V>(e + X) + load<V>(w + X));
             for (int X = nv; X < r.nxr; ++X) e[X] += w[X];
         }
     for (int e = 0; e < r.patSize; ++e) {
@@ -286,7 +286,7 @@ struct ShiftRow {
 
 template <class T>
 [[gnu::always_inline]] inline void exactShiftAt(const ShiftRow& r, T gx, T gy, const T* e, float* const* u0) {
-    constexpr auto sp = splv<T>;
+    constexpr auto sp = splat<T>;
     const T one = sp(1.0f);
     const T inv = one / sqrtv(one + gx * gx + gy * gy);
     const T Xn = -gx * inv, Yn = -gy * inv, Z = inv;
@@ -294,9 +294,9 @@ template <class T>
     lambertAtNormal(r.lf, Xn, Yn, Z, lam);
     for (int c = 0; c < 3; ++c) {
         T shade = sp(0.0f);
-        for (int i = 0; i < 9; ++i) shade += lam[i] * ldv<T>(u0[c] + static_cast<std::size_t>(i) * r.planeR);
+        for (int i = 0; i < 9; ++i) shade += lam[i] * load<T>(u0[c] + static_cast<std::size_t>(i) * r.planeR);
         const T ev = sp(r.eScale) * inv * e[c];
-        stv(u0[c], ldv<T>(u0[c]) + (ev - shade) / lam[0]);
+        store(u0[c], load<T>(u0[c]) + (ev - shade) / lam[0]);
     }
 }
 
@@ -305,9 +305,9 @@ template <class V>
     constexpr int L = LaneTraits<V>::n;
     const int nv = r.nxr / L * L;
     for (int X = 0; X < nv; X += L) {
-        const V e[3] = {ldv<V>(r.exact + X), ldv<V>(r.exact + r.pad + X), ldv<V>(r.exact + 2 * r.pad + X)};
+        const V e[3] = {load<V>(r.exact + X), load<V>(r.exact + r.pad + X), load<V>(r.exact + 2 * r.pad + X)};
         float* const u0[3] = {r.u[0] + X, r.u[1] + X, r.u[2] + X};
-        exactShiftAt<V>(r, ldv<V>(r.gx + X), ldv<V>(r.gy + X), e, u0);
+        exactShiftAt<V>(r, load<V>(r.gx + X), load<V>(r.gy + X), e, u0);
     }
     for (int X = nv; X < r.nxr; ++X) {
         const float e[3] = {r.exact[X], r.exact[r.pad + X], r.exact[2 * r.pad + X]};
@@ -560,16 +560,16 @@ void computeIndirect(const HeightPyramid& pyr, ConstGridView gradX, ConstGridVie
                             // U's segments start at the footprint's lowest tangent slope, lowered
                             // (by footprintDrop x the footprint's spread of slopes, at most footprintDropMax:
                             // 0 where the footprint is one plane)
-                            const F4 dropMax = splv<F4>(settings.footprintDropMax);
-                            const F4 c4 = splv<F4>(cosPhi), s4 = splv<F4>(sinPhi), drop = splv<F4>(settings.footprintDrop);
+                            const F4 dropMax = splat<F4>(settings.footprintDropMax);
+                            const F4 c4 = splat<F4>(cosPhi), s4 = splat<F4>(sinPhi), drop = splat<F4>(settings.footprintDrop);
                             // the box's lowest slope along (cos, sin): lo or hi per axis by the sign
                             const float* fx = sc.footGx.data() + 2 * ro + (cosPhi >= 0.0f ? 0 : pad);
                             const float* fy = sc.footGy.data() + 2 * ro + (sinPhi >= 0.0f ? 0 : pad);
                             for (int X = 0; X < pad; X += 4) {
-                                const F4 lo = ldv<F4>(fx + X) * c4 + ldv<F4>(fy + X) * s4;
-                                const F4 own = ldv<F4>(in.gx + X) * c4 + ldv<F4>(in.gy + X) * s4;
+                                const F4 lo = load<F4>(fx + X) * c4 + load<F4>(fy + X) * s4;
+                                const F4 own = load<F4>(in.gx + X) * c4 + load<F4>(in.gy + X) * s4;
                                 const F4 d = drop * (own - lo);
-                                stv(sc.lowSlope.data() + X, lo - (d < dropMax ? d : dropMax));
+                                store(sc.lowSlope.data() + X, lo - (d < dropMax ? d : dropMax));
                             }
                             in.lowSlope = sc.lowSlope.data();
                         }

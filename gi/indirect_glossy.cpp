@@ -15,6 +15,9 @@ namespace terrain::gi {
 
 namespace {
 
+using simd::load;
+using simd::splat;
+using simd::store;
 using simd::F4;
 typedef int I4 __attribute__((vector_size(16)));
 using Clock = std::chrono::steady_clock;
@@ -25,8 +28,6 @@ constexpr int kGroup = 8;   // receivers per kernel call (2 x 4 lanes)
 constexpr int kNV = kGroup / 4;
 
 inline int padGroup(int n) { return (n + kGroup - 1) / kGroup * kGroup; }
-inline F4 ld(const float* p) { return simd::load<F4>(p); }
-inline F4 spl(float x) { return simd::splat<F4>(x); }
 inline bool anyLane(I4 m) { return (m[0] | m[1] | m[2] | m[3]) != 0; }
 
 // ---- the reflection Rot_N(pi) in SH, per band -------------------------------
@@ -135,13 +136,13 @@ void castGroupGlossy(const ScanStep* hTab, const ScanStep* rGeo, const float* co
                      int Y, int X0, const float* h0, const float* margin, const float* gx, const float* gy, float cosPhi,
                      float sinPhi, F4* moments, F4* basis, int* list, float* nlp, int pad) {
     F4 M[kNV], g[kNV], q1[kNV];
-    const F4 one = spl(1.0f), lim = spl(1e6f), nlim = spl(-1e6f), zero = spl(0.0f);
-    const F4 cp = spl(-cosPhi), sp = spl(-sinPhi);
+    const F4 one = splat<F4>(1.0f), lim = splat<F4>(1e6f), nlim = splat<F4>(-1e6f), zero = splat<F4>(0.0f);
+    const F4 cp = splat<F4>(-cosPhi), sp = splat<F4>(-sinPhi);
     for (int k = 0; k < kNV; ++k) {
-        M[k] = spl(kNoBlocker);
-        g[k] = ld(gx + X0 + 4 * k) * spl(cosPhi) + ld(gy + X0 + 4 * k) * spl(sinPhi);  // omega_min (Section 3)
+        M[k] = splat<F4>(kNoBlocker);
+        g[k] = load<F4>(gx + X0 + 4 * k) * splat<F4>(cosPhi) + load<F4>(gy + X0 + 4 * k) * splat<F4>(sinPhi);  // omega_min (Section 3)
         const F4 t = g[k] < nlim ? nlim : (g[k] > lim ? lim : g[k]);
-        q1[k] = t / simd::vsqrt(one + t * t);
+        q1[k] = t / simd::sqrtv(one + t * t);
     }
     int n = 0;
     for (int i = 0; i < nAny; ++i) {
@@ -149,13 +150,13 @@ void castGroupGlossy(const ScanStep* hTab, const ScanStep* rGeo, const float* co
         const std::ptrdiff_t o = Y * st.rowStep + X0;
         const float* a = st.field + (o + st.offA);
         const float* b = st.field + (o + st.offB);
-        const F4 wa = ld(st.w[0]), wb = ld(st.w[1]), inv = ld(st.w[2]);
+        const F4 wa = load<F4>(st.w[0]), wb = load<F4>(st.w[1]), inv = load<F4>(st.w[2]);
         const I4 iv = {i, i, i, i};
         F4 t[kNV];
         I4 nw[kNV];
         I4 any = {0, 0, 0, 0};
         for (int k = 0; k < kNV; ++k) {
-            t[k] = (((wa * ld(a + 4 * k) + wb * ld(b + 4 * k)) - ld(h0 + X0 + 4 * k)) - ld(margin + X0 + 4 * k)) * inv;
+            t[k] = (((wa * load<F4>(a + 4 * k) + wb * load<F4>(b + 4 * k)) - load<F4>(h0 + X0 + 4 * k)) - load<F4>(margin + X0 + 4 * k)) * inv;
             nw[k] = (iv < steps[k]) & (t[k] > M[k]);  // Eq. 17
             any |= nw[k];
         }
@@ -167,7 +168,7 @@ void castGroupGlossy(const ScanStep* hTab, const ScanStep* rGeo, const float* co
             M[k] = nw[k] ? t[k] : M[k];
             F4 tc = t[k] < g[k] ? g[k] : t[k];
             tc = tc < nlim ? nlim : (tc > lim ? lim : tc);
-            const F4 sNew = tc / simd::vsqrt(one + tc * tc);
+            const F4 sNew = tc / simd::sqrtv(one + tc * tc);
             const F4 sv = nw[k] ? sNew : q1[k];  // no new member: an empty segment
             const F4 p = q1[k], p2 = p * p, s2 = sv * sv;
             mo[4 * k + 0] = sv - p;
@@ -178,14 +179,14 @@ void castGroupGlossy(const ScanStep* hTab, const ScanStep* rGeo, const float* co
             // the member's own direction (its unclamped elevation), reversed
             F4 tm = t[k] < nlim ? nlim : (t[k] > lim ? lim : t[k]);
             tm = nw[k] ? tm : zero;
-            const F4 ic = one / simd::vsqrt(one + tm * tm);
+            const F4 ic = one / simd::sqrtv(one + tm * tm);
             F4 y[kShCount];
             shBasisLanes<F4>(cp * ic, sp * ic, -(tm * ic), y);
             for (int f = 0; f < kShCount; ++f) ba[kShCount * k + f] = nw[k] ? y[f] : zero;
         }
     }
-    const F4 k0 = spl(0.70710678118654752440f), k1 = spl(0.61237243569579452455f);
-    const F4 k2 = spl(0.79056941504209483300f), k3 = spl(0.23385358667337133659f);
+    const F4 k0 = splat<F4>(0.70710678118654752440f), k1 = splat<F4>(0.61237243569579452455f);
+    const F4 k2 = splat<F4>(0.79056941504209483300f), k3 = splat<F4>(0.23385358667337133659f);
     for (int c = 0; c < 3; ++c) {
         F4 A[kNV][4];
         for (int k = 0; k < kNV; ++k)
@@ -194,7 +195,7 @@ void castGroupGlossy(const ScanStep* hTab, const ScanStep* rGeo, const float* co
             const int i = list[e];
             const ScanStep& rs = rGeo[i];
             const std::ptrdiff_t ro = Y * rs.rowStep + X0, dB = rs.offB - rs.offA;
-            const F4 rwa = ld(rs.w[0]), rwb = ld(rs.w[1]);
+            const F4 rwa = load<F4>(rs.w[0]), rwb = load<F4>(rs.w[1]);
             const float* const* fp = rFields + static_cast<std::size_t>(i) * kGlossyFields + c * kShCount;
             const F4* mo = moments + static_cast<std::size_t>(e) * kNV * 4;
             const F4* ba = basis + static_cast<std::size_t>(e) * kNV * kShCount;
@@ -204,7 +205,7 @@ void castGroupGlossy(const ScanStep* hTab, const ScanStep* rGeo, const float* co
                 const float* pa = fp[f] + ro;
                 for (int k = 0; k < kNV; ++k) {
                     // lanes without a new member have a zero basis; their samples are finite
-                    const F4 v = rwa * ld(pa + 4 * k) + rwb * ld(pa + dB + 4 * k);
+                    const F4 v = rwa * load<F4>(pa + 4 * k) + rwb * load<F4>(pa + dB + 4 * k);
                     u[k] += v * ba[kShCount * k + f];
                 }
             }
@@ -216,7 +217,7 @@ void castGroupGlossy(const ScanStep* hTab, const ScanStep* rGeo, const float* co
             simd::store(base, k0 * A[k][0]);
             simd::store(base + pad, k1 * A[k][1]);
             simd::store(base + 2 * pad, k2 * (A[k][2] - A[k][0]));
-            simd::store(base + 3 * pad, k3 * (spl(5.0f) * A[k][3] - spl(6.0f) * A[k][1]));
+            simd::store(base + 3 * pad, k3 * (splat<F4>(5.0f) * A[k][3] - splat<F4>(6.0f) * A[k][1]));
         }
     }
 }

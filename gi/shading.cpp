@@ -45,13 +45,13 @@ namespace {
 // Kernels over the lane type V: F4 (SSE2) or F8 (AVX2, chosen at run time),
 // sim/simd.h; lane-wise IEEE operations, so each texel gets exactly the
 // scalar result either way.
+using simd::load;
+using simd::splat;
+using simd::store;
 using simd::F4;
 using simd::F8;
 using simd::LaneTraits;
-using simd::ldv;
-using simd::splv;
 using simd::sqrtv;
-using simd::stv;
 
 constexpr int kMaxShadingLights = 8;  // lights per incident pass (more are folded in several passes)
 
@@ -62,7 +62,7 @@ template <class V, int S>
     using I = typename LaneTraits<V>::I;
     constexpr int L = LaneTraits<V>::n;
     if constexpr (S == 1) {
-        return ldv<V>(v + x);
+        return load<V>(v + x);
     } else {
         // lane l reads X0 + l / S and X0 + l / S + 1 with the weight (l % S) / S
         I lo{}, fr{};
@@ -72,7 +72,7 @@ template <class V, int S>
             fr[l] = l / S + 1;
             f[l] = static_cast<float>(l % S) / static_cast<float>(S);
         }
-        const V a = ldv<V>(v + x / S);
+        const V a = load<V>(v + x / S);
         const V vlo = __builtin_shuffle(a, lo), vhi = __builtin_shuffle(a, fr);
         return vlo + f * (vhi - vlo);
     }
@@ -100,26 +100,25 @@ template <class V, int S>
     constexpr int L = LaneTraits<V>::n;
     const int interior = S * std::max(nxr - 1, 0);
     const int xVec = nxr >= 3 ? std::max(0, interior - (S == 2 ? 2 : 0)) / L * L : 0;
-    const V fmax = splv<V>(3.40282347e38f);
-    auto splat = [](float x) { return splv<V>(x); };
+    const V fmax = splat<V>(3.40282347e38f);
     for (int x = 0; x < xVec; x += L) {
-        const V gx = ldv<V>(gxr + x), gy = ldv<V>(gyr + x);
-        const V inv = splat(1.0f) / sqrtv(splat(1.0f) + gx * gx + gy * gy);
+        const V gx = load<V>(gxr + x), gy = load<V>(gyr + x);
+        const V inv = splat<V>(1.0f) / sqrtv(splat<V>(1.0f) + gx * gx + gy * gy);
         const V X = -gx * inv, Yn = -gy * inv, Z = inv;
         V lam[9];
         lambertAtNormal(lf, X, Yn, Z, lam);
         // the four dot products interleaved: independent addition chains
-        V acc = splat(0.0f), oc[3] = {splat(0.0f), splat(0.0f), splat(0.0f)};
+        V acc = splat<V>(0.0f), oc[3] = {splat<V>(0.0f), splat<V>(0.0f), splat<V>(0.0f)};
         for (int i = 0; i < 9; ++i) {
             if (amb) acc += lam[i] * expandV<V, S>(vert + static_cast<std::size_t>(3 * nCoef + i) * nxrS, x);
             for (int ch = 0; ch < 3; ++ch) oc[ch] += lam[i] * expandV<V, S>(vert + static_cast<std::size_t>(ch * nCoef + i) * nxrS, x);
         }
-        if (amb) stv(amb + x, acc);
+        if (amb) store(amb + x, acc);
         for (int ch = 0; ch < 3; ++ch) {
             V o = oc[ch];
-            o *= diffuseWeight * (alb[ch] ? ldv<V>(alb[ch] + x) : splat(1.0f));
+            o *= diffuseWeight * (alb[ch] ? load<V>(alb[ch] + x) : splat<V>(1.0f));
             const I finite = (o < fmax) & (o > -fmax);  // false for NaN and +-Inf
-            stv(rgb[ch] + x, finite ? o : splat(0.0f));
+            store(rgb[ch] + x, finite ? o : splat<V>(0.0f));
         }
     }
     // remaining texels, scalar (same operations)
@@ -172,15 +171,15 @@ template <class V>
     const ReceiverLerp ry = receiverLerp(y, j.s, j.nyr);
     const int nPlanes = 3 * j.nCoef + (j.env ? 9 : 0);
     const int nv = j.nxr / L * L;
-    const V fy = splv<V>(ry.f);
+    const V fy = splat<V>(ry.f);
     for (int p = 0; p < nPlanes; ++p) {
         const float* plane = p < 3 * j.nCoef ? j.incident + static_cast<std::size_t>(p) * j.planeR : j.env->plane(p - 3 * j.nCoef);
         const float* __restrict ra = plane + static_cast<std::size_t>(ry.i0) * j.nxr;
         const float* __restrict rb = plane + static_cast<std::size_t>(ry.i1) * j.nxr;
         float* __restrict v = vert + static_cast<std::size_t>(p) * j.nxrS;
         for (int X = 0; X < nv; X += L) {
-            const V a = ldv<V>(ra + X);
-            stv(v + X, a + fy * (ldv<V>(rb + X) - a));
+            const V a = load<V>(ra + X);
+            store(v + X, a + fy * (load<V>(rb + X) - a));
         }
         for (int X = nv; X < j.nxr; ++X) v[X] = ra[X] + ry.f * (rb[X] - ra[X]);
         for (int X = j.nxr; X < j.nxrS; ++X) v[X] = 0.0f;
@@ -219,8 +218,8 @@ template <class V>
                 for (int k = 0; k < kShCount; ++k) {
                     const float* p = lights[Li].visibility->plane(k) + r0 + X;
                     for (int q = 0; q < NQ; ++q) {
-                        V a = splv<V>(0.0f);
-                        if (L * q + L <= n) a = ldv<V>(p + L * q);
+                        V a = splat<V>(0.0f);
+                        if (L * q + L <= n) a = load<V>(p + L * q);
                         else
                             for (int e = L * q; e < n; ++e) a[e - L * q] = p[e];
                         v[(Li - g0) * kShCount + k][q] = a;
@@ -229,18 +228,18 @@ template <class V>
             for (int c = 0; c < 3 * nCoef; ++c) {
                 float* o = out.incident.data() + static_cast<std::size_t>(c) * planeR + r0 + X;
                 V acc[NQ];
-                for (int q = 0; q < NQ; ++q) acc[q] = splv<V>(0.0f);
+                for (int q = 0; q < NQ; ++q) acc[q] = splat<V>(0.0f);
                 if (g0 > 0)
                     for (int e = 0; e < n; ++e) acc[e / L][e % L] = o[e];
                 for (int e = out.incidentTermStart[static_cast<std::size_t>(c)]; e < out.incidentTermStart[static_cast<std::size_t>(c + 1)]; ++e) {
                     const ShadeMaps::Term& term = out.incidentTerms[static_cast<std::size_t>(e)];
                     const int slot = term.index - g0 * kShCount;
                     if (slot < 0 || slot >= kMaxShadingLights * kShCount) continue;
-                    const V t = splv<V>(term.value);
+                    const V t = splat<V>(term.value);
                     for (int q = 0; q < NQ; ++q) acc[q] += t * v[slot][q];
                 }
                 for (int q = 0; q < NQ; ++q) {
-                    if (L * q + L <= n) stv(o + L * q, acc[q]);
+                    if (L * q + L <= n) store(o + L * q, acc[q]);
                     else
                         for (int e = L * q; e < n; ++e) o[e] = acc[q][e - L * q];
                 }

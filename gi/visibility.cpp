@@ -14,15 +14,15 @@ namespace terrain::gi {
 namespace {
 
 constexpr int kMaxBlocks = 64;
-constexpr int kLanes = 16;  // receivers per kernel call at most (4 x 4 or 2 x 8 lanes); rows are padded to it
+constexpr int kRowPad = 16;  // receivers per kernel call at most (4 x 4 or 2 x 8 lanes); rows are padded to it
 
+using simd::load;
+using simd::splat;
+using simd::store;
 using simd::LaneTraits;
-using simd::ldv;
-using simd::splv;
 using simd::sqrtv;
-using simd::stv;
 
-inline int padLanes(int n) { return (n + kLanes - 1) / kLanes * kLanes; }
+inline int padLanes(int n) { return (n + kRowPad - 1) / kRowPad * kRowPad; }
 
 // ---- algorithm: the step table (Eq. 14, level offset o_v) ---------------------
 // For azimuth (c, sn) and step i: where each receiver samples, with which
@@ -135,7 +135,7 @@ struct SampleMaxVisitor {
     using I = typename LaneTraits<V>::I;
     V m[NV];
     SampleMaxVisitor() {
-        for (int k = 0; k < NV; ++k) m[k] = splv<V>(kNoBlocker);
+        for (int k = 0; k < NV; ++k) m[k] = splat<V>(kNoBlocker);
     }
     // m = maxps(m, s): the larger; equal values are the same number (no -0 arises)
     void all(int, const V* s) {
@@ -145,7 +145,7 @@ struct SampleMaxVisitor {
         for (int k = 0; k < NV; ++k) m[k] = valid[k] & (s[k] > m[k]) ? s[k] : m[k];
     }
     void result(float* out) const {
-        for (int k = 0; k < NV; ++k) stv(out + LaneTraits<V>::n * k, m[k]);
+        for (int k = 0; k < NV; ++k) store(out + LaneTraits<V>::n * k, m[k]);
     }
 };
 
@@ -160,7 +160,7 @@ struct BsplineMaxVisitor {
     using I = typename LaneTraits<V>::I;
     V m[NV], p1[NV], p2[NV], p3[NV];
     BsplineMaxVisitor() {
-        for (int k = 0; k < NV; ++k) m[k] = p1[k] = p2[k] = p3[k] = splv<V>(kNoBlocker);
+        for (int k = 0; k < NV; ++k) m[k] = p1[k] = p2[k] = p3[k] = splat<V>(kNoBlocker);
     }
     static V mid(V sm, V s0, V s1, V s2) { return (9.0f * (s0 + s1) - (sm + s2)) * (1.0f / 16.0f); }
     void all(int i, const V* s) {
@@ -194,7 +194,7 @@ struct BsplineMaxVisitor {
         }
     }
     void result(float* out) const {
-        for (int k = 0; k < NV; ++k) stv(out + LaneTraits<V>::n * k, m[k]);
+        for (int k = 0; k < NV; ++k) store(out + LaneTraits<V>::n * k, m[k]);
     }
 };
 
@@ -207,13 +207,13 @@ template <class V, int NV, class Visitor>
     using I = typename LaneTraits<V>::I;
     constexpr int L = LaneTraits<V>::n;
     V h[NV];
-    for (int k = 0; k < NV; ++k) h[k] = ldv<V>(h0 + X0 + L * k);
+    for (int k = 0; k < NV; ++k) h[k] = load<V>(h0 + X0 + L * k);
     auto sample = [&](int i, V* s) {
         const ScanStep& st = table[i];
         const float* a = rowPtr[2 * i] + X0;
         const float* b = rowPtr[2 * i + 1] + X0;
-        const V wa = splv<V>(st.w[0][0]), wb = splv<V>(st.w[1][0]), inv = splv<V>(st.w[2][0]);
-        for (int k = 0; k < NV; ++k) s[k] = ((wa * ldv<V>(a + L * k) + wb * ldv<V>(b + L * k)) - h[k]) * inv;
+        const V wa = splat<V>(st.w[0][0]), wb = splat<V>(st.w[1][0]), inv = splat<V>(st.w[2][0]);
+        for (int k = 0; k < NV; ++k) s[k] = ((wa * load<V>(a + L * k) + wb * load<V>(b + L * k)) - h[k]) * inv;
     };
     for (int i = 0; i < nAll; ++i) {
         V s[NV];
@@ -230,7 +230,7 @@ template <class V, int NV, class Visitor>
         for (int k = 0; k < NV; ++k) valid[k] = iv < steps[k];
         if (i < nAny) sample(i, s);
         else
-            for (int k = 0; k < NV; ++k) s[k] = splv<V>(0.0f);
+            for (int k = 0; k < NV; ++k) s[k] = splat<V>(0.0f);
         visit.some(i, s, valid, steps);
     }
 }
@@ -280,15 +280,15 @@ template <class V>
                                           const float* __restrict gy, float cosPhi, float sinPhi,
                                           const VisibilityTarget& target, float* __restrict nlp, int nxrPad) {
     constexpr int L = LaneTraits<V>::n;
-    const V c = splv<V>(cosPhi), sn = splv<V>(sinPhi);
-    const V one = splv<V>(1.0f), lim = splv<V>(1e6f), nlim = splv<V>(-1e6f);
-    const V k0 = splv<V>(0.70710678118654752440f), k1 = splv<V>(0.61237243569579452455f);
-    const V k2 = splv<V>(0.79056941504209483300f), k3 = splv<V>(0.23385358667337133659f);
-    const V five = splv<V>(5.0f), four = splv<V>(4.0f);
-    const V sLow = splv<V>(target.sinLow), sHigh = splv<V>(target.sinHigh);
+    const V c = splat<V>(cosPhi), sn = splat<V>(sinPhi);
+    const V one = splat<V>(1.0f), lim = splat<V>(1e6f), nlim = splat<V>(-1e6f);
+    const V k0 = splat<V>(0.70710678118654752440f), k1 = splat<V>(0.61237243569579452455f);
+    const V k2 = splat<V>(0.79056941504209483300f), k3 = splat<V>(0.23385358667337133659f);
+    const V five = splat<V>(5.0f), four = splat<V>(4.0f);
+    const V sLow = splat<V>(target.sinLow), sHigh = splat<V>(target.sinHigh);
     for (int X = 0; X < nxrPad; X += L) {
-        const V tangent = ldv<V>(gx + X) * c + ldv<V>(gy + X) * sn;
-        const V ms = ldv<V>(maxSlope + X);
+        const V tangent = load<V>(gx + X) * c + load<V>(gy + X) * sn;
+        const V ms = load<V>(maxSlope + X);
         V t = ms < tangent ? tangent : ms;
         t = t < nlim ? nlim : (t > lim ? lim : t);  // sinFromSlope
         const V s = t / sqrtv(one + t * t);
@@ -310,10 +310,10 @@ template <class V>
             w2 = k2 * s * c2;
             w3 = (-k3) * c2 * (five * c2 - four);
         }
-        stv(nlp + X, w0);
-        stv(nlp + nxrPad + X, w1);
-        stv(nlp + 2 * nxrPad + X, w2);
-        stv(nlp + 3 * nxrPad + X, w3);
+        store(nlp + X, w0);
+        store(nlp + nxrPad + X, w1);
+        store(nlp + 2 * nxrPad + X, w2);
+        store(nlp + 3 * nxrPad + X, w3);
     }
 }
 
@@ -341,17 +341,17 @@ template <class V>
             for (int q = e; q < e1; ++q) {
                 w[nt] = nlp[a] + static_cast<std::size_t>(patNlp[q]) * nxrPad;
                 gs[nt] = opValues[a][q];
-                g[nt] = splv<V>(gs[nt]);
+                g[nt] = splat<V>(gs[nt]);
                 ++nt;
             }
         float* __restrict v = vRows[r];
         // 16 receivers at a time: independent addition chains
         for (int X = 0; X < n16; X += 16) {
             V acc[NA];
-            for (int k = 0; k < NA; ++k) acc[k] = ldv<V>(v + X + L * k);
+            for (int k = 0; k < NA; ++k) acc[k] = load<V>(v + X + L * k);
             for (int t = 0; t < nt; ++t)
-                for (int k = 0; k < NA; ++k) acc[k] += g[t] * ldv<V>(w[t] + X + L * k);
-            for (int k = 0; k < NA; ++k) stv(v + X + L * k, acc[k]);
+                for (int k = 0; k < NA; ++k) acc[k] += g[t] * load<V>(w[t] + X + L * k);
+            for (int k = 0; k < NA; ++k) store(v + X + L * k, acc[k]);
         }
         for (int X = n16; X < nxr; ++X) {
             float acc = v[X];

@@ -119,8 +119,8 @@ using simd::splat;
 using simd::store;
 using simd::vmax;
 using simd::vmin;
-using simd::vsqrt;
-constexpr int kLanes = simd::kLanes;
+using simd::sqrtv;
+constexpr int kLanes = simd::kLaneCount<simd::F4>;
 
 // ---------------------------------------------------------------------------
 // Pass A: outflow fluxes (Mei et al., "flow simulation": pipe acceleration and
@@ -235,7 +235,7 @@ inline void updateCell(const Fields F, const Coeffs& k, std::ptrdiff_t i, const 
 
     // Capacity C = Kc * sin(tilt) * |v| * min(d, dmax). |v| * d is the unit
     // discharge, which stays bounded for a thin film.
-    const T capacity = vsqrt(load<T>(F.sin2 + i) * (u * u + v * v)) * vmin(dbar, splat<T>(k.maxDepth)) * k.capacity;
+    const T capacity = sqrtv(load<T>(F.sin2 + i) * (u * u + v * v)) * vmin(dbar, splat<T>(k.maxDepth)) * k.capacity;
 
     // Dissolve a fraction of the deficit (soil first, then bedrock at the
     // reduced rate) or deposit a fraction of the excess.

@@ -72,7 +72,7 @@ using simd::splat;
 using simd::store;
 using simd::vmax;
 using simd::vmin;
-constexpr int kLanes = simd::kLanes;
+constexpr int kLanes = simd::kLaneCount<simd::F4>;
 
 // The eight neighbours in a fixed order: L, R, U, D, UL, UR, DL, DR. The
 // first four are at distance c, the last four at c * sqrt(2).

@@ -124,7 +124,7 @@ using simd::splat;
 using simd::store;
 using simd::vmax;
 using simd::vmin;
-constexpr int kVec = simd::kLanes;
+constexpr int kLanes = simd::kLaneCount<simd::F4>;
 
 // Hydrostatic reconstruction at a face (see above). bA, bB: grounds relative
 // to the step's reference level. Returns the pressure difference
@@ -223,9 +223,9 @@ void outflowRow(int nx, const float* u, const float* vS, const float* vN, const 
     F4 mh4 = splat<F4>(0.0f), mv4 = splat<F4>(0.0f);
     float mh = 0.0f, mv = std::fabs(u[nx]);
     int x = 0;
-    for (; x + kVec <= nx; x += kVec) outflowCell<F4>(x, u, vS, vN, h, o, invDx, mh4, mv4);
+    for (; x + kLanes <= nx; x += kLanes) outflowCell<F4>(x, u, vS, vN, h, o, invDx, mh4, mv4);
     for (; x < nx; ++x) outflowCell<float>(x, u, vS, vN, h, o, invDx, mh, mv);
-    for (int l = 0; l < kVec; ++l) {
+    for (int l = 0; l < kLanes; ++l) {
         mh = std::max(mh, mh4[l]);
         mv = std::max(mv, mv4[l]);
     }
@@ -268,7 +268,7 @@ void faceFluxes(int n, const float* hA, const float* hB, const float* bedA, cons
                 const float* soilB, const float* oA, const float* oB, const float* vel, float dt, float bref,
                 float* q) {
     int x = 0;
-    for (; x + kVec <= n; x += kVec) faceFlux<F4>(x, hA, hB, bedA, bedB, soilA, soilB, oA, oB, vel, dt, bref, q);
+    for (; x + kLanes <= n; x += kLanes) faceFlux<F4>(x, hA, hB, bedA, bedB, soilA, soilB, oA, oB, vel, dt, bref, q);
     for (; x < n; ++x) faceFlux<float>(x, hA, hB, bedA, bedB, soilA, soilB, oA, oB, vel, dt, bref, q);
 }
 
@@ -390,7 +390,7 @@ template <bool kAdvection, bool kFriction>
 void momentumRun(int n, const MomentumArrays& a, const StepConsts& c) {
     int i = 0;
     if constexpr (!kFriction)
-        for (; i + kVec <= n; i += kVec) momentumFace<F4, kAdvection, false>(i, a, c);
+        for (; i + kLanes <= n; i += kLanes) momentumFace<F4, kAdvection, false>(i, a, c);
     for (; i < n; ++i) momentumFace<float, kAdvection, kFriction>(i, a, c);
 }
 
