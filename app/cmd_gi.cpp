@@ -1,4 +1,4 @@
-// `terrain gi`: light a DEM with the GI fast path (paper 001) or the ground
+// `terrain gi`: light a DEM with the GI fast path (Nowrouzezahrai & Snyder 2009) or the ground
 // truth, write the shade and ambient maps, time the stages.
 #include <algorithm>
 #include <chrono>
@@ -41,7 +41,7 @@ struct GiOptions {
     std::string outShade, outAmbient;
     int frames = 1;
     bool time = false;
-    // indirect light (issue 4)
+    // indirect light
     int bounces = 0;
     std::string brdf = "lambert";
     std::string albedo;

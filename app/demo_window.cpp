@@ -83,8 +83,8 @@ int runWindowDemo(WindowContext& window, const Gl& gl, FramePipeline& pipeline, 
         ImGui::Checkbox("pause simulation", &paused);
         int lighting = static_cast<int>(ps.lighting);
         if (ImGui::Combo("lighting", &lighting, lightingNames, 3)) ps.lighting = static_cast<LightingMode>(lighting);
-        ImGui::SliderInt("bounces", &ps.bounces, 0, 3);
-        ImGui::Checkbox("amortise shading", &ps.amortise);
+        ImGui::SliderInt("bounces", &ps.gi.indirect.bounces, 0, 3);
+        ImGui::Checkbox("amortise shading", &ps.gi.indirect.amortise);
         int sub = ps.gi.subsample == 1 ? 0 : (ps.gi.subsample == 2 ? 1 : 2);
         ImGui::Text("sub-sampling");
         ImGui::SameLine();

@@ -75,7 +75,7 @@ int main(int argc, char** argv) {
                 PipelineSettings ps;
                 ps.gi.subsample = 2;
                 ps.lighting = LightingMode::Global;
-                ps.bounces = 1;
+                ps.gi.indirect.bounces = 1;
                 FramePipeline pipeline(resolveScene(scene, size, 1), ps);
                 std::vector<std::vector<double>> t(7);
                 for (int f = 0; f <= runs; ++f) {

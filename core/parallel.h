@@ -60,7 +60,8 @@ T deterministicReduce(int begin, int end, int chunk, T init, Map&& map, Combine&
 }
 
 /// Runs fn with exactly `threads` worker threads (0 = all hardware threads).
-/// Only mains, tests and benchmarks call this (GUIDE 2).
+/// Only mains, tests and benchmarks call this: libraries never fix the
+/// thread count of their caller.
 template <class Fn>
 auto withThreads(int threads, Fn&& fn) -> decltype(fn()) {
     if (threads <= 0) return fn();

@@ -38,9 +38,15 @@ SceneLights defaultLights() {
     return l;
 }
 
+gi::GiSettings defaultPipelineGi() {
+    gi::GiSettings s = gi::engineGiSettings();
+    s.indirect.bounces = 1;
+    return s;
+}
+
 FramePipeline::FramePipeline(const SceneSettings& scene, const PipelineSettings& settings, const SceneLights& lights)
     : sim_(scene), settings_(settings), lights_(lights) {
-    if (settings_.bounces < 0 || settings_.bounces > 3) throw InputError("bounces must be 0..3");
+    gi::validateIndirectSettings(settings_.gi.indirect);
     if (settings_.ticksPerFrame < 0) throw InputError("ticks per frame must be >= 0");
     ticksPerFrame_ = settings_.ticksPerFrame;
     if (ticksPerFrame_ == 0) {
@@ -80,7 +86,6 @@ void FramePipeline::advance() {
 }
 
 void FramePipeline::light() {
-    if (settings_.bounces < 0 || settings_.bounces > 3) throw InputError("bounces must be 0..3");
     if (!(settings_.verticalExaggeration >= 0.0f && settings_.verticalExaggeration <= 100.0f))
         throw InputError("vertical exaggeration must be in [0, 100] (0 = automatic)");
     const float exag = settings_.verticalExaggeration > 0.0f ? settings_.verticalExaggeration : autoExaggeration_;
@@ -96,12 +101,12 @@ void FramePipeline::light() {
     gi::GiLighting lighting;
     lighting.environment = lights_.sky;
     lighting.keys = {lights_.key};
-    // Global lighting adds `bounces` indirect bounces (gi/indirect.h); the
-    // simulator's change report says whether the lit surface moved, which
-    // drives the shading amortisation (Section 7) when it is on.
+    // Global lighting adds gi.indirect.bounces indirect bounces (gi/indirect.h);
+    // the other modes none. The simulator's change report says whether the
+    // lit surface moved, which drives the shading amortisation
+    // (Nowrouzezahrai & Snyder 2009, Section 7) when it is on.
     gi::GiSettings gs = settings_.gi;
-    gs.indirect.bounces = settings_.lighting == LightingMode::Global ? settings_.bounces : 0;
-    gs.indirect.amortise = settings_.amortise;
+    if (settings_.lighting != LightingMode::Global) gs.indirect.bounces = 0;
     const ChangeReport& ch = sim_.changes();
     gi_.geometryChanged = exag != lastExaggeration_ || ch.maxGroundChange > 0.0f || ch.maxWaterChange > 0.0f;
     lastExaggeration_ = exag;
@@ -194,7 +199,7 @@ void FramePipeline::light() {
     const bool indirectRan = gs.indirect.bounces > 0 && g.indirect > 0.0;
     timings_.pyramids = g.gradient + g.pyramid + (indirectRan ? ind.pyramid : 0.0);
     timings_.scan = g.visibility + g.keyVisibility + (indirectRan ? ind.scan : 0.0);
-    timings_.integrate = 0.0;  // gi/ fuses the wedge integration into the scan (part 1)
+    timings_.integrate = 0.0;  // gi/ fuses the wedge integration into the scan
     timings_.shade = g.shading + (indirectRan ? ind.shading : 0.0) + packMs + (surfaceMs - g.total);
     timings_.render = 0.0;
 }

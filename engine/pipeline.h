@@ -15,11 +15,14 @@ namespace terrain::engine {
 /// Lights of the demo scenes.
 SceneLights defaultLights();
 
+/// The engine's GI settings with one indirect bounce.
+gi::GiSettings defaultPipelineGi();
+
 struct PipelineSettings {
-    gi::GiSettings gi = gi::engineGiSettings();  // sub-sampling lives here (1, 2, 4)
+    // Sub-sampling, bounces (used by LightingMode::Global only) and shading
+    // amortisation live here; one indirect bounce by default.
+    gi::GiSettings gi = defaultPipelineGi();
     LightingMode lighting = LightingMode::Direct;
-    int bounces = 1;         // 0..3 indirect bounces in LightingMode::Global
-    bool amortise = false;   // Section 7: on static geometry alternate direct / indirect updates
     int pyramidLevel = 4;    // pyramid level exposed to the debug view
     int ticksPerFrame = 0;   // 0 = the scene's default pacing
     // Vertical exaggeration of what is lit and drawn (GI, shadow map and mesh

@@ -1,5 +1,5 @@
 #pragma once
-// Albedo maps for the GI command line (issue 4): a uniform R,G,B or an 8-bit
+// Albedo maps for the GI command line: a uniform R,G,B or an 8-bit
 // sRGB PNG (decoded to linear reflectance) of the height field's size.
 #include <string>
 #include <vector>

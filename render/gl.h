@@ -1,5 +1,5 @@
 #pragma once
-// The OpenGL function table (GUIDE 5). Every entry point the renderer uses is
+// The OpenGL function table. Every entry point the renderer uses is
 // loaded once through a get-proc-address callback (glfwGetProcAddress or
 // OSMesaGetProcAddress) into one struct typed with the PFN typedefs of
 // <GL/glcorearb.h>; both platforms share it. Nothing here links against libGL.

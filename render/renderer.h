@@ -7,10 +7,10 @@
 // triangles per quad) into an HDR target; draw water as a second surface
 // (ground + depth) blended over the lit terrain; tone map and encode sRGB.
 //
-// Materials (paper 002): Torrance-Sparrow specular for the key light
+// Materials (Heidrich & Seidel 1999): Torrance-Sparrow specular for the key light
 // (Beckmann distribution, Smith geometry term, Schlick's Fresnel), modulated
 // by the key light's visibility (the engine's soft visibility, or a classic
-// shadow map, paper 004); water reflects a prefiltered environment map (the
+// shadow map); water reflects a prefiltered environment map (the
 // sky's order-4 SH, a band-limited hence prefiltered map, baked to a small
 // equirectangular texture) weighted by Fresnel: L = F L_m + (1 - F) L_d
 // (Section 4.4), L_d the water body and the lit terrain seen through it.

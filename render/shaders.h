@@ -84,7 +84,7 @@ vec3 environment(vec3 d) {
     return texture(uEnv, vec2(u, v)).rgb;
 }
 
-// Torrance-Sparrow (paper 002, Eq. 1): f = F D G / (4 (n.l) (n.v)), returned
+// Torrance-Sparrow (Heidrich & Seidel 1999, Eq. 1): f = F D G / (4 (n.l) (n.v)), returned
 // as f * pi * (n.l), so that uKeyRgb * result is the reflected radiance (the
 // key light's irradiance is pi * uKeyRgb * (n.l)).
 float beckmann(float nh, float m) {
@@ -108,7 +108,7 @@ float torranceSparrow(vec3 n, vec3 v, vec3 l, float m, float f0) {
     return schlick(vh, f0) * beckmann(nh, m) * smithG1(nl, m) * smithG1(nv, m) * PI / (4.0 * nv);
 }
 
-// Classic shadow map (paper 004) with 3x3 percentage-closer filtering.
+// Classic shadow map (Williams 1978) with 3x3 percentage-closer filtering.
 float shadowMapVisibility(vec3 world) {
     vec4 p = uLightViewProj * vec4(world, 1.0);
     vec3 q = p.xyz / p.w * 0.5 + 0.5;

@@ -65,7 +65,9 @@ SceneSettings loadSceneFile(const std::string& file);
 /// A built-in name, or a path to a .toml scene file.
 SceneSettings resolveScene(const std::string& nameOrFile, int size, std::uint64_t seed);
 
-/// What changed in the last tick, for later stages (GI rebuilds only dirty tiles).
+/// What changed in the last tick: per change tile whether the ground moved,
+/// and the largest ground and water change. The frame pipeline reads only
+/// the maxima today (engine/pipeline.cpp: "did anything move?").
 struct ChangeReport {
     int tileSize = 32;
     int tilesX = 0;

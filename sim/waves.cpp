@@ -22,7 +22,7 @@
 // on an Arakawa C grid: h at cell centres, u on vertical faces (faceU,
 // (nx+1) x ny), v on horizontal faces (faceV, nx x (ny+1)). Gravity waves on
 // this grid have the semi-discrete speed c sin(k dx/2) / (k dx/2) with
-// c = sqrt(g h), i.e. sqrt(g h) up to O((k dx)^2) (GUIDE 3).
+// c = sqrt(g h), i.e. sqrt(g h) up to O((k dx)^2).
 //
 // One step is forward-backward (symplectic Euler), as in Stelling &
 // Duinmeijer 2003 ("A staggered conservative scheme for every Froude number

@@ -1,7 +1,7 @@
 #pragma once
 // Height-field water that carries real waves: the shallow-water equations on
 // a staggered grid (depth at cell centres, velocities on faces), so waves
-// travel at sqrt(g h) (the plain pipe model does not: GUIDE 3). Wet/dry
+// travel at sqrt(g h) (the plain pipe model of Mei, Decaudin & Hu 2007 does not: its waves travel at a speed set by the pipe area). Wet/dry
 // fronts, and well balanced: water at rest over any bottom stays at rest.
 //
 // Scheme (details and equations in waves.cpp): semi-discrete staggered

@@ -1,4 +1,4 @@
-// Glossy indirect light (issue 4): the SH radiance-vector pyramid
+// Glossy indirect light: the SH radiance-vector pyramid
 // (gi/indirect_glossy), the per-texel Phong exponent map and the glossy
 // reference (gi/reference_glossy).
 #include <doctest/doctest.h>

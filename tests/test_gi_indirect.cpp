@@ -1,4 +1,4 @@
-// Indirect light on the fast path (issue 4): gi/indirect, gi/radiance_pyramid
+// Indirect light on the fast path: gi/indirect, gi/radiance_pyramid
 // and the amortised frame, checked against gi/reference_gi.
 #include <doctest/doctest.h>
 

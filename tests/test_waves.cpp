@@ -1,4 +1,4 @@
-// Shallow-water waves (sim/waves.h) against the analytic cases of GUIDE 4:
+// Shallow-water waves (sim/waves.h) against analytic cases:
 // lake at rest, wave speed sqrt(g H), Ritter's dam break, the first seiche
 // mode, mass conservation, hard cases, determinism across thread counts,
 // swell and drops.
