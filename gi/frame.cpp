@@ -187,14 +187,7 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
     // ---- validate inputs (boundary of the stage) --------------------------------
     if (heights.nx < 1 || heights.ny < 1 || !heights.data) throw InputError("heights: empty grid");
     if (!std::isfinite(cellSize) || cellSize <= 0.0f) throw InputError("cell size must be positive and finite");
-    if (settings.subsample != 1 && settings.subsample != 2 && settings.subsample != 4)
-        throw InputError("subsample must be 1, 2 or 4");
-    if (settings.visibility.azimuths < 3 || settings.visibility.azimuths > 4096) throw InputError("azimuths must be in [3, 4096]");
-    if (settings.pyramid.levelsPerOctave < 1 || settings.pyramid.levelsPerOctave > 64)
-        throw InputError("levels per octave must be in [1, 64]");
-    if (settings.pyramid.levelOffset < 0 || settings.pyramid.levelOffset > 32) throw InputError("level offset must be in [0, 32]");
-    if (settings.keyLightAzimuths < 2 || settings.keyLightAzimuths > 256) throw InputError("key light azimuths must be in [2, 256]");
-    if (!(settings.pyramid.peakBlend >= 0.0f && settings.pyramid.peakBlend <= 1.0f)) throw InputError("peak blend must be in [0, 1]");
+    validateGiSettings(settings);
     for (const KeyLight& k : lighting.keys) validateKeyLight(k);
     for (const ShVector& c : lighting.environment.c)
         for (double v : c)
@@ -207,8 +200,6 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
         for (const Grid& g : albedo->phongLobe)
             if (!g.empty() && (g.nx != heights.nx || g.ny != heights.ny))
                 throw InputError("Phong exponent map size differs from the heights");
-
-    validateIndirectSettings(settings.indirect);
 
     // ---- amortisation (Section 7): on static geometry alternate direct / indirect --
     const std::array<int, 7> key = {heights.nx, heights.ny, settings.subsample, settings.indirect.bounces,

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "gi/indirect.h"
+#include "gi/settings.h"
 #include "gi/lights.h"
 #include "gi/pyramid.h"
 #include "gi/shading.h"
@@ -14,21 +15,6 @@
 #include "core/grid.h"
 
 namespace terrain::gi {
-
-struct GiSettings {
-    int subsample = 1;          // 1, 2 or 4: visibility on the (N/s)^2 receiver grid (Fig. 7)
-    PyramidSettings pyramid;    // k_v = 4, o_v = 2
-    VisibilitySettings visibility;  // m = 32, linear wedges, B-spline maximum (Eq. 16)
-    int keyLightAzimuths = 3;   // azimuth samples per key light (Section 9)
-    // Key lights shaded with the exact cosine: albedo RGB f max(0, N . l), f the
-    // visible fraction of the light's region (V_key's band-0 coefficient times
-    // sqrt(4 pi) over the region's solid angle), instead of V_key dotted with
-    // the order-4 SH clamped cosine (whose band-2 truncation is off by up to
-    // +-6 % for a small light: bench/results/gi_indirect_accuracy.md).
-    bool keyLightExactCosine = false;
-    ShadingSettings shading;
-    IndirectSettings indirect;  // bounces, radiance pyramid (k_u = 4, o_u = 2), amortisation (issue 4)
-};
 
 struct GiLighting {
     ShRgb environment = uniformSkyLight(1.0f);

@@ -1,0 +1,40 @@
+#pragma once
+// The settings of a GI frame. GiSettings{} is the engine's choice, measured
+// on real DEMs against the exact references (bench/results/gi_accuracy.md,
+// gi_indirect_accuracy.md, gi_convergence.md); paperGiSettings() gives the
+// settings of Nowrouzezahrai & Snyder 2009 for comparison. Every numeric
+// range is declared once in gi/settings_ranges.h and checked by
+// validateGiSettings, which the frame, the pipeline and the command line call.
+#include "gi/indirect.h"
+#include "gi/pyramid.h"
+#include "gi/settings_ranges.h"
+#include "gi/shading.h"
+#include "gi/visibility.h"
+
+namespace terrain::gi {
+
+struct GiSettings {
+    int subsample = 1;          // 1, 2 or 4: visibility on the (N/s)^2 receiver grid (Fig. 7)
+    PyramidSettings pyramid;
+    VisibilitySettings visibility;
+    int keyLightAzimuths = 3;   // azimuth samples per key light (Nowrouzezahrai & Snyder 2009, Section 9)
+    // Key lights shaded with the exact cosine: albedo RGB f max(0, N . l), f the
+    // visible fraction of the light's region (V_key's band-0 coefficient times
+    // sqrt(4 pi) over the region's solid angle), instead of V_key dotted with
+    // the order-4 SH clamped cosine (whose band-2 truncation is off for a
+    // small light: measured in bench/results/gi_indirect_accuracy.md).
+    bool keyLightExactCosine = false;
+    ShadingSettings shading;
+    IndirectSettings indirect;  // bounces, radiance pyramid, amortisation
+};
+
+/// The paper's settings: m = 32 azimuths, k_v = 4, o_v = 2, a mean height
+/// pyramid, the B-spline maximum of Eq. 16, the receiver's own tangent plane,
+/// key lights through the SH clamped cosine, k_u = 4, o_u = 2 and the order-4
+/// SH kernel for indirect light (Eq. 12 and the wedge operators).
+GiSettings paperGiSettings();
+
+/// Throws InputError naming the first setting outside its range.
+void validateGiSettings(const GiSettings& s);
+
+}  // namespace terrain::gi
