@@ -31,9 +31,9 @@ struct GiOptions {
     double zOffset = 0.0;
     std::string light = "uniform";
     std::vector<std::string> keys;
-    int subsample = 1;
-    int azimuths = 0, levelsPerOctave = 0, levelOffset = -1;
-    int indirectAzimuths = -1;
+    // The numeric settings bind straight into the engine's settings: their
+    // defaults and ranges are the engine's own (gi/settings.h).
+    gi::GiSettings settings = gi::engineGiSettings();
     std::string indirectKernel;
     std::string interp;
     int threads = 0;
@@ -42,12 +42,9 @@ struct GiOptions {
     int frames = 1;
     bool time = false;
     // indirect light
-    int bounces = 0;
     std::string brdf = "lambert";
     std::string albedo;
-    bool amortise = false;
     std::string outIndirect;
-    int radianceLevelsPerOctave = 0, radianceLevelOffset = -1;
     int referenceDirections = 2048;
     std::string glossy;          // vector | scalar (glossy indirect light)
     std::string phongExponent;   // VALUE or a 16-bit PNG
@@ -156,143 +153,174 @@ void writeAmbient(const std::string& file, const Grid& ambient) {
     else throw InputError("--out-ambient must end in .npy or .exr (got '" + file + "')");
 }
 
-int runGi(const GiOptions& o) {
-    // ---- validate everything before the work starts --------------------------
-    if (o.threads < 0 || o.threads > 256) throw InputError("--threads must be 0 (all) .. 256");
-    if (o.frames < 1 || o.frames > 100000) throw InputError("--frames must be >= 1");
-    if (o.subsample != 1 && o.subsample != 2 && o.subsample != 4) throw InputError("--subsample must be 1, 2 or 4");
-    if (!std::isfinite(o.zScale) || !std::isfinite(o.zOffset)) throw InputError("--z-scale and --z-offset must be finite");
-    if (!o.outShade.empty() && extensionOf(o.outShade) != ".png" && extensionOf(o.outShade) != ".exr")
-        throw InputError("--out-shade must end in .png or .exr (got '" + o.outShade + "')");
-    if (!o.outAmbient.empty() && extensionOf(o.outAmbient) != ".npy" && extensionOf(o.outAmbient) != ".exr")
-        throw InputError("--out-ambient must end in .npy or .exr (got '" + o.outAmbient + "')");
-    if (o.bounces < 0 || o.bounces > 16) throw InputError("--bounces must be 0 .. 16");
-    if (!o.outIndirect.empty() && extensionOf(o.outIndirect) != ".npy" && extensionOf(o.outIndirect) != ".exr")
-        throw InputError("--out-indirect must end in .npy or .exr (got '" + o.outIndirect + "')");
-    if (o.referenceDirections < 16 || o.referenceDirections > (1 << 20)) throw InputError("--reference-directions must be 16 .. 2^20");
-    gi::GiSettings settings = gi::engineGiSettings();
-    settings.subsample = o.subsample;
+// The phong exponent option: a constant, or a 16-bit PNG mapped to a range.
+struct ExponentSource {
+    bool fromFile = false;
+    float lo = 1.0f, hi = 1000.0f;
+};
+
+ExponentSource parsePhongExponent(const GiOptions& o, gi::GiSettings& settings) {
+    ExponentSource e;
+    if (o.phongExponent.empty()) return e;
+    const bool numeric = o.phongExponent.find_first_not_of("0123456789.eE+-") == std::string::npos;
+    if (numeric) {
+        const std::vector<float> v = parseNumberList(o.phongExponent, "--phong-exponent");
+        if (v.size() != 1 || !gi::ranges::kPhongExponent.contains(v[0]))
+            throw InputError("--phong-exponent: a constant must be one number, " + gi::describe(gi::ranges::kPhongExponent) +
+                             " (got '" + o.phongExponent + "')");
+        settings.shading.phongExponent = v[0];
+        return e;
+    }
+    e.fromFile = true;
+    const std::vector<float> r = parseNumberList(o.phongExponentRange, "--phong-exponent-range");
+    if (r.size() != 2) throw InputError("--phong-exponent-range: expected MIN,MAX (got '" + o.phongExponentRange + "')");
+    e.lo = r[0];
+    e.hi = r[1];
+    if (!(gi::ranges::kPhongExponent.contains(e.lo) && gi::ranges::kPhongExponent.contains(e.hi) && e.lo <= e.hi))
+        throw InputError("--phong-exponent-range: need MIN <= MAX, both in " + gi::describe(gi::ranges::kPhongExponent) +
+                         " (got '" + o.phongExponentRange + "')");
+    return e;
+}
+
+// The frame's settings from the options: the modes named by strings, then
+// one range check of everything (gi/settings.h).
+gi::GiSettings settingsFrom(const GiOptions& o, ExponentSource& exponent) {
+    gi::GiSettings settings = o.settings;
     parseBrdf(o.brdf, settings.shading);
     if (!o.glossy.empty()) {
         if (o.glossy == "vector") settings.indirect.glossy = gi::GlossyIndirect::VectorPyramid;
         else if (o.glossy == "scalar") settings.indirect.glossy = gi::GlossyIndirect::ScalarPyramid;
         else throw InputError("--glossy must be vector or scalar (got '" + o.glossy + "')");
     }
-    bool exponentFile = false;
-    float exponentLo = 1.0f, exponentHi = 1000.0f;
-    if (!o.phongExponent.empty()) {
-        const bool numeric = o.phongExponent.find_first_not_of("0123456789.eE+-") == std::string::npos;
-        if (numeric) {
-            const std::vector<float> v = parseNumberList(o.phongExponent, "--phong-exponent");
-            if (v.size() != 1 || !(v[0] >= gi::kMinPhongExponent && v[0] <= gi::kMaxPhongExponent))
-                throw InputError("--phong-exponent: a constant must be one number in [0.01, 10000] (got '" + o.phongExponent + "')");
-            settings.shading.phongExponent = v[0];
-        } else {
-            exponentFile = true;
-            const std::vector<float> r = parseNumberList(o.phongExponentRange, "--phong-exponent-range");
-            if (r.size() != 2) throw InputError("--phong-exponent-range: expected MIN,MAX (got '" + o.phongExponentRange + "')");
-            exponentLo = r[0];
-            exponentHi = r[1];
-            if (!(exponentLo >= gi::kMinPhongExponent && exponentHi <= gi::kMaxPhongExponent && exponentLo <= exponentHi))
-                throw InputError("--phong-exponent-range: need 0.01 <= MIN <= MAX <= 10000 (got '" + o.phongExponentRange + "')");
-        }
-    }
-    settings.indirect.bounces = o.bounces;
-    settings.indirect.amortise = o.amortise;
-    if (o.radianceLevelsPerOctave != 0) settings.indirect.radiance.levelsPerOctave = o.radianceLevelsPerOctave;
-    if (o.radianceLevelOffset >= 0) settings.indirect.radiance.levelOffset = o.radianceLevelOffset;
-    if (o.indirectAzimuths >= 0) settings.indirect.azimuths = o.indirectAzimuths;
+    exponent = parsePhongExponent(o, settings);
     if (!o.indirectKernel.empty()) {
         if (o.indirectKernel == "sh") settings.indirect.lambert = gi::LambertIndirect::ShKernel;
-        else if (o.indirectKernel == "exact") settings.indirect.lambert = gi::LambertIndirect::ExactAtReceivers;
         else if (o.indirectKernel == "blocker") settings.indirect.lambert = gi::LambertIndirect::BlockerRadiance;
-        else throw InputError("--indirect-kernel must be blocker, exact or sh (got '" + o.indirectKernel + "')");
+        else throw InputError("--indirect-kernel must be blocker or sh (got '" + o.indirectKernel + "')");
     }
-    gi::validateIndirectSettings(settings.indirect);
-    if (o.azimuths != 0) settings.visibility.azimuths = o.azimuths;
-    if (o.levelsPerOctave != 0) settings.pyramid.levelsPerOctave = o.levelsPerOctave;
-    if (o.levelOffset >= 0) settings.pyramid.levelOffset = o.levelOffset;
     if (!o.interp.empty()) {
         if (o.interp == "linear") settings.visibility.interp = gi::AzimuthInterp::Linear;
         else if (o.interp == "bspline") settings.visibility.interp = gi::AzimuthInterp::Bspline;
         else throw InputError("--interp must be linear or bspline (got '" + o.interp + "')");
     }
-    gi::GiLighting lighting;
-    for (const std::string& k : o.keys) lighting.keys.push_back(parseKey(k));
-    lighting.environment = parseLight(o.light);
+    gi::validateGiSettings(settings);
+    return settings;
+}
 
-    float cellFromFile = 0.0f;
-    const Grid heights = readHeightmap(o.heightmap, static_cast<float>(o.zScale), static_cast<float>(o.zOffset), &cellFromFile);
-    double cell = o.cellSize;
-    if (cell <= 0.0) cell = cellFromFile;
-    if (!(cell > 0.0) || !std::isfinite(cell)) throw InputError("--cell-size must be > 0 (metres between grid points)");
+// Everything about the options that can be wrong, before any work starts.
+void checkOptions(const GiOptions& o) {
+    if (o.threads < 0 || o.threads > 256) throw InputError("--threads must be 0 (all) .. 256");
+    if (o.frames < 1 || o.frames > 100000) throw InputError("--frames must be >= 1");
+    if (!std::isfinite(o.zScale) || !std::isfinite(o.zOffset)) throw InputError("--z-scale and --z-offset must be finite");
+    if (!o.outShade.empty() && extensionOf(o.outShade) != ".png" && extensionOf(o.outShade) != ".exr")
+        throw InputError("--out-shade must end in .png or .exr (got '" + o.outShade + "')");
+    if (!o.outAmbient.empty() && extensionOf(o.outAmbient) != ".npy" && extensionOf(o.outAmbient) != ".exr")
+        throw InputError("--out-ambient must end in .npy or .exr (got '" + o.outAmbient + "')");
+    if (!o.outIndirect.empty() && extensionOf(o.outIndirect) != ".npy" && extensionOf(o.outIndirect) != ".exr")
+        throw InputError("--out-indirect must end in .npy or .exr (got '" + o.outIndirect + "')");
+    if (!o.outIndirect.empty() && o.settings.indirect.bounces == 0 && !o.reference)
+        throw InputError("--out-indirect needs --bounces >= 1");
+    if (o.referenceDirections < 16 || o.referenceDirections > (1 << 20)) throw InputError("--reference-directions must be 16 .. 2^20");
+}
+
+// What a frame lights: the heights, their cell size and the albedo maps.
+struct GiInputs {
+    Grid heights;
+    double cell = 0.0;
     gi::AlbedoMap albedoMap;
-    if (!o.albedo.empty()) albedoMap = gi::loadAlbedo(o.albedo, heights.nx, heights.ny);
-    if (exponentFile) gi::loadPhongExponentMap(o.phongExponent, heights.nx, heights.ny, exponentLo, exponentHi, albedoMap);
-    const gi::AlbedoMap* albedo = o.albedo.empty() && !exponentFile ? nullptr : &albedoMap;
-    // after every input is read: a bad input gives one error line on stderr
-    std::fprintf(stderr, "terrain gi: %s, %d x %d cells of %.4g m\n", o.heightmap.c_str(), heights.nx, heights.ny, cell);
+    const gi::AlbedoMap* albedo = nullptr;
+    gi::GiLighting lighting;
+};
 
-    return withThreads(o.threads, [&] {
-        using Clock = std::chrono::steady_clock;
-        if (o.reference) {
-            gi::ReferenceSettings rs;
-            rs.progress = true;
-            gi::ReferenceResult rr;
-            // key lights enter the ground truth as exact caps (gi/reference_gi.h), not as SH
-            const gi::ShRgb& total = lighting.environment;
-            const auto t0 = Clock::now();
-            if (o.bounces > 0 || !o.outIndirect.empty() || !lighting.keys.empty() || settings.shading.brdf != gi::Brdf::Lambert) {
-                // with indirect light: bounce b gathers bounce b - 1 (gi/reference_gi.h)
-                gi::ReferenceGiSettings gs;
-                gs.bounces = o.bounces;
-                gs.directions = o.referenceDirections;
-                gs.progress = true;
-                gs.keys = lighting.keys;
-                gs.shading = settings.shading;  // Lambert, Phong or mixture (glossy reference: gi/reference_gi.h)
-                gi::ReferenceGiResult gr;
-                gi::renderReferenceGi(heights.cview(), static_cast<float>(cell), total, albedo, gs, gr);
-                const double gms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-                if (o.time) std::printf("reference: %.1f ms\n", gms);
-                if (!o.outShade.empty()) writeShade(o.outShade, gr.total);
-                if (!o.outAmbient.empty()) writeAmbient(o.outAmbient, gr.ambient);
-                if (!o.outIndirect.empty()) writeIndirect(o.outIndirect, gr.indirect);
-                return 0;
-            }
-            gi::renderReference(heights.cview(), static_cast<float>(cell), &total, albedo, rs, rr);
-            const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-            if (o.time) std::printf("reference: %.1f ms\n", ms);
-            if (!o.outShade.empty()) writeShade(o.outShade, rr.rgb);
-            if (!o.outAmbient.empty()) writeAmbient(o.outAmbient, rr.ambient);
-            return 0;
-        }
-        gi::GiState state;
-        std::vector<double> totals;
-        for (int f = 0; f < o.frames; ++f) {
-            state.geometryChanged = f == 0;  // the same field every frame: static geometry after the first
-            gi::runGiFrame(heights.cview(), static_cast<float>(cell), lighting, settings, state, albedo);
-            const gi::GiTimings& t = state.timings;
-            if (o.time)
-                std::printf("frame %d: gradient %.2f ms, pyramid %.2f ms, visibility %.2f ms, key lights %.2f ms, shading %.2f ms, indirect %.2f ms, total %.2f ms%s\n",
-                            f, t.gradient, t.pyramid, t.visibility, t.keyVisibility, t.shading, t.indirect, t.total,
-                            f == 0 && o.frames > 1 ? " (warm-up)" : "");
-            if (o.time && o.bounces > 0)
-                std::printf("  indirect: radiance pyramids %.2f ms, scans %.2f ms, shading %.2f ms\n", state.indirect.timings.pyramid,
-                            state.indirect.timings.scan, state.indirect.timings.shading);
-            if (f > 0 || o.frames == 1) totals.push_back(t.total);
-        }
-        if (o.time) {
-            std::sort(totals.begin(), totals.end());
-            std::printf("%.2f ms per frame\n", totals[totals.size() / 2]);
-        }
-        if (!o.outShade.empty()) writeShade(o.outShade, o.bounces > 0 ? state.indirect.total : state.shade.rgb);
-        if (!o.outAmbient.empty()) writeAmbient(o.outAmbient, state.shade.ambient);
-        if (!o.outIndirect.empty()) {
-            if (o.bounces == 0) throw InputError("--out-indirect needs --bounces >= 1");
-            writeIndirect(o.outIndirect, state.indirect.indirect);
-        }
+GiInputs readInputs(const GiOptions& o, const ExponentSource& exponent) {
+    GiInputs in;
+    for (const std::string& k : o.keys) in.lighting.keys.push_back(parseKey(k));
+    in.lighting.environment = parseLight(o.light);
+    float cellFromFile = 0.0f;
+    in.heights = readHeightmap(o.heightmap, static_cast<float>(o.zScale), static_cast<float>(o.zOffset), &cellFromFile);
+    in.cell = o.cellSize > 0.0 ? o.cellSize : cellFromFile;
+    if (!(in.cell > 0.0) || !std::isfinite(in.cell)) throw InputError("--cell-size must be > 0 (metres between grid points)");
+    if (!o.albedo.empty()) in.albedoMap = gi::loadAlbedo(o.albedo, in.heights.nx, in.heights.ny);
+    if (exponent.fromFile)
+        gi::loadPhongExponentMap(o.phongExponent, in.heights.nx, in.heights.ny, exponent.lo, exponent.hi, in.albedoMap);
+    in.albedo = o.albedo.empty() && !exponent.fromFile ? nullptr : &in.albedoMap;
+    return in;
+}
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+// The ground truth: the direct-light reference, or with bounces, key lights,
+// indirect output or a glossy BRDF the gathering reference (gi/reference_gi.h).
+int runReference(const GiOptions& o, const gi::GiSettings& settings, const GiInputs& in) {
+    const int bounces = settings.indirect.bounces;
+    const auto t0 = Clock::now();
+    if (bounces > 0 || !o.outIndirect.empty() || !in.lighting.keys.empty() || settings.shading.brdf != gi::Brdf::Lambert) {
+        gi::ReferenceGiSettings gs;
+        gs.bounces = bounces;
+        gs.directions = o.referenceDirections;
+        gs.progress = true;
+        gs.keys = in.lighting.keys;  // key lights enter the ground truth as exact caps, not as SH
+        gs.shading = settings.shading;
+        gi::ReferenceGiResult gr;
+        gi::renderReferenceGi(in.heights.cview(), static_cast<float>(in.cell), in.lighting.environment, in.albedo, gs, gr);
+        if (o.time) std::printf("reference: %.1f ms\n", msSince(t0));
+        if (!o.outShade.empty()) writeShade(o.outShade, gr.total);
+        if (!o.outAmbient.empty()) writeAmbient(o.outAmbient, gr.ambient);
+        if (!o.outIndirect.empty()) writeIndirect(o.outIndirect, gr.indirect);
         return 0;
-    });
+    }
+    gi::ReferenceSettings rs;
+    rs.progress = true;
+    gi::ReferenceResult rr;
+    gi::renderReference(in.heights.cview(), static_cast<float>(in.cell), &in.lighting.environment, in.albedo, rs, rr);
+    if (o.time) std::printf("reference: %.1f ms\n", msSince(t0));
+    if (!o.outShade.empty()) writeShade(o.outShade, rr.rgb);
+    if (!o.outAmbient.empty()) writeAmbient(o.outAmbient, rr.ambient);
+    return 0;
+}
+
+void printFrameTimes(int f, int frames, const gi::GiState& state, int bounces) {
+    const gi::GiTimings& t = state.timings;
+    std::printf("frame %d: gradient %.2f ms, pyramid %.2f ms, visibility %.2f ms, key lights %.2f ms, shading %.2f ms, "
+                "indirect %.2f ms, total %.2f ms%s\n",
+                f, t.gradient, t.pyramid, t.visibility, t.keyVisibility, t.shading, t.indirect, t.total,
+                f == 0 && frames > 1 ? " (warm-up)" : "");
+    if (bounces > 0)
+        std::printf("  indirect: radiance pyramids %.2f ms, scans %.2f ms, shading %.2f ms\n", state.indirect.timings.pyramid,
+                    state.indirect.timings.scan, state.indirect.timings.shading);
+}
+
+// The fast path, o.frames times on the same field (the first a warm-up).
+int runFastPath(const GiOptions& o, const gi::GiSettings& settings, const GiInputs& in) {
+    gi::GiState state;
+    std::vector<double> totals;
+    const int bounces = settings.indirect.bounces;
+    for (int f = 0; f < o.frames; ++f) {
+        state.geometryChanged = f == 0;  // the same field every frame: static geometry after the first
+        gi::runGiFrame(in.heights.cview(), static_cast<float>(in.cell), in.lighting, settings, state, in.albedo);
+        if (o.time) printFrameTimes(f, o.frames, state, bounces);
+        if (f > 0 || o.frames == 1) totals.push_back(state.timings.total);
+    }
+    if (o.time) {
+        std::sort(totals.begin(), totals.end());
+        std::printf("%.2f ms per frame\n", totals[totals.size() / 2]);
+    }
+    if (!o.outShade.empty()) writeShade(o.outShade, bounces > 0 ? state.indirect.total : state.shade.rgb);
+    if (!o.outAmbient.empty()) writeAmbient(o.outAmbient, state.shade.ambient);
+    if (!o.outIndirect.empty()) writeIndirect(o.outIndirect, state.indirect.indirect);
+    return 0;
+}
+
+int runGi(const GiOptions& o) {
+    checkOptions(o);
+    ExponentSource exponent;
+    const gi::GiSettings settings = settingsFrom(o, exponent);
+    const GiInputs in = readInputs(o, exponent);
+    // after every input is read: a bad input gives one error line on stderr
+    std::fprintf(stderr, "terrain gi: %s, %d x %d cells of %.4g m\n", o.heightmap.c_str(), in.heights.nx, in.heights.ny,
+                 in.cell);
+    return withThreads(o.threads, [&] { return o.reference ? runReference(o, settings, in) : runFastPath(o, settings, in); });
 }
 
 }  // namespace
@@ -306,10 +334,14 @@ Runner addGiCommand(CLI::App& app) {
     sub->add_option("--z-offset", o->zOffset, "Height of PNG value 0 in metres (O)");
     sub->add_option("--light", o->light, "uniform | sunsky | env:FILE (.exr/.hdr equirectangular)");
     sub->add_option("--key", o->keys, "Key light AZ_DEG,EL_DEG,RADIUS_DEG,R,G,B (repeatable)");
-    sub->add_option("--subsample", o->subsample, "Visibility sub-sampling: 1, 2 or 4");
-    sub->add_option("--azimuths", o->azimuths, "Azimuth samples m (engine default 16, paper 32)");
-    sub->add_option("--levels-per-octave", o->levelsPerOctave, "Pyramid levels per octave k_v (default 4)");
-    sub->add_option("--level-offset", o->levelOffset, "Pyramid level offset o_v in octaves (engine default 3, paper 2)");
+    gi::GiSettings& gs = o->settings;
+    namespace r = gi::ranges;
+    sub->add_option("--subsample", gs.subsample, gi::describe(r::kSubsample))->capture_default_str();
+    sub->add_option("--azimuths", gs.visibility.azimuths, gi::describe(r::kAzimuths) + " (paper 32)")->capture_default_str();
+    sub->add_option("--levels-per-octave", gs.pyramid.levelsPerOctave, gi::describe(r::kLevelsPerOctave))
+        ->capture_default_str();
+    sub->add_option("--level-offset", gs.pyramid.levelOffset, gi::describe(r::kLevelOffset) + " (paper 2)")
+        ->capture_default_str();
     sub->add_option("--interp", o->interp, "Azimuthal interpolation: linear | bspline");
     sub->add_option("--threads", o->threads, "Worker threads (0 = all)");
     sub->add_flag("--reference", o->reference, "Ground truth instead of the fast path (slow)");
@@ -317,18 +349,21 @@ Runner addGiCommand(CLI::App& app) {
     sub->add_option("--out-ambient", o->outAmbient, "Ambient (sky-view) map (.npy float32, or .exr)");
     sub->add_option("--frames", o->frames, "Run the frame N times on the same field (first = warm-up)");
     sub->add_flag("--time", o->time, "Print the time of each stage and the median ms per frame");
-    sub->add_option("--bounces", o->bounces, "Indirect light bounces (0 = direct only)");
+    sub->add_option("--bounces", gs.indirect.bounces, gi::describe(r::kBounces))->capture_default_str();
     sub->add_option("--brdf", o->brdf, "lambert | phong:EXP | mix:W[,EXP] (Lambert + W x Phong)");
     sub->add_option("--albedo", o->albedo, "Albedo R,G,B in [0, 1] or an sRGB PNG of the field's size");
-    sub->add_flag("--amortise", o->amortise, "With --frames on static geometry: alternate direct and indirect updates");
+    sub->add_flag("--amortise", gs.indirect.amortise, "With --frames on static geometry: alternate direct and indirect updates");
     sub->add_option("--out-indirect", o->outIndirect, "Indirect light alone, RGB (.npy float32 (rows, columns, 3), or .exr)");
-    sub->add_option("--radiance-levels-per-octave", o->radianceLevelsPerOctave, "Radiance pyramid k_u (engine default 2, paper 4)");
-    sub->add_option("--radiance-level-offset", o->radianceLevelOffset, "Radiance pyramid level offset o_u (engine default 3, paper 2)");
-    sub->add_option("--indirect-azimuths", o->indirectAzimuths, "Azimuths of the indirect scan (0 = --azimuths)");
+    sub->add_option("--radiance-levels-per-octave", gs.indirect.radiance.levelsPerOctave,
+                    gi::describe(r::kRadianceLevelsPerOctave) + " (paper 4)")
+        ->capture_default_str();
+    sub->add_option("--radiance-level-offset", gs.indirect.radiance.levelOffset,
+                    gi::describe(r::kRadianceLevelOffset) + " (paper 2)")
+        ->capture_default_str();
+    sub->add_option("--indirect-azimuths", gs.indirect.azimuths, gi::describe(r::kIndirectAzimuths))->capture_default_str();
     sub->add_option("--indirect-kernel", o->indirectKernel,
-                    "Lambert indirect light: blocker (exact cosine at the receivers, between them the blockers' mean radiance times "
-                    "each texel's occlusion, engine default) | exact (exact cosine at the receivers, U's normal detail between them) | "
-                    "sh (order-4 SH kernel, paper)");
+                    "Lambert indirect light: blocker (exact cosine at the receivers, between them the blockers' mean radiance "
+                    "times each texel's occlusion, engine default) | sh (order-4 SH kernel, paper)");
     sub->add_option("--reference-directions", o->referenceDirections, "Directions of the indirect reference (default 2048)");
     sub->add_option("--glossy", o->glossy,
                     "Glossy indirect light (phong/mix BRDFs): vector (SH radiance-vector pyramid, Fig. 5 middle) | scalar (shade pyramid, Fig. 5 right)");

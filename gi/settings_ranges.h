@@ -32,23 +32,23 @@ void checkRange(const SettingRange<float>& r, float v);
 namespace ranges {
 
 // Sub-sampling is further restricted to 1, 2 or 4 (validateGiSettings).
-inline constexpr SettingRange<int> kSubsample{"subsample", 1, 4, "receivers every s cells: 1, 2 or 4"};
-inline constexpr SettingRange<int> kAzimuths{"azimuths", 3, 4096, "azimuths m of the visibility scan"};
-inline constexpr SettingRange<int> kLevelsPerOctave{"levels per octave", 1, 64, "height pyramid levels per octave k_v"};
-inline constexpr SettingRange<int> kLevelOffset{"level offset", 0, 32, "height pyramid level offset o_v, octaves"};
+inline constexpr SettingRange<int> kSubsample{"subsample", 1, 4, "Receivers every s cells (1, 2 or 4)"};
+inline constexpr SettingRange<int> kAzimuths{"azimuths", 3, 4096, "Azimuths m of the visibility scan"};
+inline constexpr SettingRange<int> kLevelsPerOctave{"levels per octave", 1, 64, "Height pyramid levels per octave k_v"};
+inline constexpr SettingRange<int> kLevelOffset{"level offset", 0, 32, "Height pyramid level offset o_v, octaves"};
 inline constexpr SettingRange<float> kPeakBlend{"peak blend", 0.0f, 1.0f,
-                                                "share of max-decimated octaves in the height pyramid"};
-inline constexpr SettingRange<int> kKeyLightAzimuths{"key light azimuths", 2, 256, "azimuths over a key light's extent"};
+                                                "Share of max-decimated octaves in the height pyramid"};
+inline constexpr SettingRange<int> kKeyLightAzimuths{"key light azimuths", 2, 256, "Azimuths over a key light's extent"};
 inline constexpr SettingRange<float> kPhongExponent{"Phong exponent", 0.01f, 10000.0f, "Phong exponent S"};
 inline constexpr SettingRange<float> kSpecularWeight{"specular weight", 0.0f, 1.0f,
-                                                     "weight of the Phong lobe in the Lambert + Phong mixture"};
-inline constexpr SettingRange<int> kBounces{"bounces", 0, 16, "indirect light bounces (0: direct light only)"};
+                                                     "Weight of the Phong lobe in the Lambert + Phong mixture"};
+inline constexpr SettingRange<int> kBounces{"bounces", 0, 16, "Indirect light bounces (0: direct light only)"};
 inline constexpr SettingRange<int> kRadianceLevelsPerOctave{"radiance levels per octave", 1, 64,
-                                                            "radiance pyramid levels per octave k_u"};
+                                                            "Radiance pyramid levels per octave k_u"};
 inline constexpr SettingRange<int> kRadianceLevelOffset{"radiance level offset", 0, 32,
-                                                        "radiance pyramid level offset o_u, octaves"};
+                                                        "Radiance pyramid level offset o_u, octaves"};
 inline constexpr SettingRange<int> kIndirectAzimuths{"indirect azimuths", 3, 4096,
-                                                     "azimuths of the indirect scan (0: the visibility's)", true};
+                                                     "Azimuths of the indirect scan (0: the visibility's)", true};
 
 }  // namespace ranges
 }  // namespace terrain::gi
