@@ -71,7 +71,9 @@ double lerpReceivers(const Setup& b, int x, int y, const std::function<double(in
     return (1.0 - fy) * ((1.0 - fx) * v(X0, Y0) + fx * v(X1, Y0)) + fy * ((1.0 - fx) * v(X0, Y1) + fx * v(X1, Y1));
 }
 
-double sin2OfSlope(double t) { return t * t / (1.0 + t * t); }
+double sin2OfSlope(double t) {
+    return t * t / (1.0 + t * t);
+}
 
 Grid bumpy(int nx, int ny) {
     return gridOf(nx, ny, [](int x, int y) {
@@ -92,12 +94,18 @@ AlbedoMap patternAlbedo(int nx, int ny) {
     return a;
 }
 
+double albedoAt(const AlbedoMap& a, std::size_t ch, int x, int y) {
+    return a.channel[ch].empty() ? 1.0 : a.channel[ch](x, y);
+}
+
 }  // namespace
 
-TEST_CASE("gi.blocker: a flat or tilted plane with no blocker above it has occlusion exactly 0 and gets exactly no light") {
+TEST_CASE(
+    "gi.blocker: a flat or tilted plane with no blocker above it has occlusion exactly 0 and gets exactly no light") {
     const int nx = 45, ny = 38, m = 8;
     const Grid flat(nx, ny, 57.5f);
-    const Grid tilted = gridOf(nx, ny, [](int x, int y) { return 100.0f + 0.3f * static_cast<float>(x) - 0.2f * static_cast<float>(y); });
+    const Grid tilted = gridOf(
+        nx, ny, [](int x, int y) { return 100.0f + 0.3f * static_cast<float>(x) - 0.2f * static_cast<float>(y); });
     for (int s : {2, 4})
         for (int shape = 0; shape < 2; ++shape)
             for (float far : {kNoBlocker, 0.0f}) {
@@ -111,14 +119,18 @@ TEST_CASE("gi.blocker: a flat or tilted plane with no blocker above it has occlu
                 const AlbedoMap a = patternAlbedo(nx, ny);
                 shadeBlockerRadiance(b.st, &a, rgb);
                 INFO("s " << s << (shape == 0 ? " flat" : " tilted") << ", far horizon " << far);
-                CHECK(std::count(b.st.occlusion.v.begin(), b.st.occlusion.v.end(), 0.0f) == static_cast<long>(b.st.occlusion.size()));
+                CHECK(std::count(b.st.occlusion.v.begin(), b.st.occlusion.v.end(), 0.0f) ==
+                      static_cast<long>(b.st.occlusion.size()));
                 CHECK(std::count(b.st.receiverOcclusion.begin(), b.st.receiverOcclusion.end(), 0.0f) ==
                       static_cast<long>(b.st.receiverOcclusion.size()));
-                for (const Grid& g : rgb) CHECK(std::count(g.v.begin(), g.v.end(), 0.0f) == static_cast<long>(g.size()));
+                for (const Grid& g : rgb)
+                    CHECK(std::count(g.v.begin(), g.v.end(), 0.0f) == static_cast<long>(g.size()));
             }
 }
 
-TEST_CASE("gi.blocker: circular pit: O / pi at the centre is sin^2(atan(d / r)), and every floor texel matches its receivers' horizons") {
+TEST_CASE(
+    "gi.blocker: circular pit: O / pi at the centre is sin^2(atan(d / r)), and every floor texel matches its "
+    "receivers' horizons") {
     // Pit of radius r = 12 cells (cell 2 m), depth d, receivers horizontal; the
     // far horizons are the exact wall slopes d / D, D the distance to the rim
     // along the azimuth. O / pi = (1/m) sum_j sin^2 h_j: the cosine-weighted
@@ -132,16 +144,20 @@ TEST_CASE("gi.blocker: circular pit: O / pi at the centre is sin^2(atan(d / r)),
     const double cell = 2.0, rCells = 12.0, r = rCells * cell;
     for (double d : {0.5 * r, r, 2.0 * r})
         for (int s : {2, 4}) {
-            const Grid h = gridOf(n, n, [&](int x, int y) { return std::hypot(x - c, y - c) < rCells ? static_cast<float>(-d) : 0.0f; });
+            const Grid h = gridOf(
+                n, n, [&](int x, int y) { return std::hypot(x - c, y - c) < rCells ? static_cast<float>(-d) : 0.0f; });
             Setup b;
             prepare(h, static_cast<float>(cell), s, m, true, b);
             auto wallSlope = [&](int j, double px, double py) {  // px, py: metres from the centre
-                const double ux = std::cos(b.phi[static_cast<std::size_t>(j)]), uy = std::sin(b.phi[static_cast<std::size_t>(j)]);
+                const double ux = std::cos(b.phi[static_cast<std::size_t>(j)]),
+                             uy = std::sin(b.phi[static_cast<std::size_t>(j)]);
                 const double pu = px * ux + py * uy, pp = px * px + py * py;
                 if (pp >= r * r) return static_cast<double>(kNoBlocker);
                 return d / (-pu + std::sqrt(r * r - pp + pu * pu));
             };
-            fillFar(b, [&](int j, int X, int Y) { return static_cast<float>(wallSlope(j, (s * X - c) * cell, (s * Y - c) * cell)); });
+            fillFar(b, [&](int j, int X, int Y) {
+                return static_cast<float>(wallSlope(j, (s * X - c) * cell, (s * Y - c) * cell));
+            });
             computeTexelOcclusion(b.pyr, b.gx.cview(), b.gy.cview(), b.phi, b.st);
             INFO("d / r = " << d / r << ", s " << s);
             const double exact = d * d / (r * r + d * d);
@@ -159,7 +175,8 @@ TEST_CASE("gi.blocker: circular pit: O / pi at the centre is sin^2(atan(d / r)),
                     ++texels;
                     if (x % s == 0 && y % s == 0) {  // a receiver: against the exact horizons
                         double exactSum = 0.0;
-                        for (int j = 0; j < m; ++j) exactSum += sin2OfSlope(wallSlope(j, (x - c) * cell, (y - c) * cell));
+                        for (int j = 0; j < m; ++j)
+                            exactSum += sin2OfSlope(wallSlope(j, (x - c) * cell, (y - c) * cell));
                         worstReceiver = std::max(worstReceiver, std::fabs(b.st.occlusion(x, y) - exactSum / m));
                     }
                 }
@@ -187,63 +204,69 @@ TEST_CASE("gi.blocker: shading gives O(x) sum w E_k / sum w O_k; E_k = c O_k giv
         // every receiver sees a blocker: along phi or phi + pi its own plane is not above 0.05
         for (float o : b.st.receiverOcclusion) REQUIRE(o > 0.0f);
         // proportional: E_k = c O_k
-        for (int ch = 0; ch < 3; ++ch)
+        for (std::size_t ch = 0; ch < 3; ++ch)
             for (std::size_t i = 0; i < b.st.receiverOcclusion.size(); ++i)
-                b.st.receiverShade[static_cast<std::size_t>(ch)][i] = k[ch] * b.st.receiverOcclusion[i];
+                b.st.receiverShade[ch][i] = k[ch] * b.st.receiverOcclusion[i];
         std::array<Grid, 3> rgb;
         shadeBlockerRadiance(b.st, &a, rgb);
         double worst = 0.0;
         int positive = 0;
-        for (int ch = 0; ch < 3; ++ch)
+        for (std::size_t ch = 0; ch < 3; ++ch)
             for (int y = 0; y < ny; ++y)
                 for (int x = 0; x < nx; ++x) {
-                    const double alb = a.channel[static_cast<std::size_t>(ch)].empty() ? 1.0 : a.channel[static_cast<std::size_t>(ch)](x, y);
-                    const double want = alb * k[ch] * b.st.occlusion(x, y);
-                    worst = std::max(worst, std::fabs(rgb[static_cast<std::size_t>(ch)](x, y) - want) / (want + 1e-12));
+                    const double want = albedoAt(a, ch, x, y) * k[ch] * b.st.occlusion(x, y);
+                    worst = std::max(worst, std::fabs(rgb[ch](x, y) - want) / (want + 1e-12));
                     positive += want > 0.0;
                 }
         CHECK(positive > nx * ny);  // most texels lit: the check is not of zeros
         CHECK(worst < 2e-6);
         // any E_k: the quotient of the interpolations, computed here in double
-        for (int ch = 0; ch < 3; ++ch)
+        for (std::size_t ch = 0; ch < 3; ++ch)
             for (int Y = 0; Y < b.st.nyr; ++Y)
                 for (int X = 0; X < b.st.nxr; ++X)
-                    b.st.receiverShade[static_cast<std::size_t>(ch)][static_cast<std::size_t>(Y) * b.st.nxr + X] =
-                        0.1f + 0.02f * static_cast<float>((X * 5 + Y * 3 + ch) % 9);
+                    b.st.receiverShade[ch][static_cast<std::size_t>(Y) * b.st.nxr + X] =
+                        0.1f + 0.02f * static_cast<float>((X * 5 + Y * 3 + static_cast<int>(ch)) % 9);
         shadeBlockerRadiance(b.st, &a, rgb);
         worst = 0.0;
-        for (int ch = 0; ch < 3; ++ch)
+        auto receivers = [&](const std::vector<float>& v) {
+            return
+                [&v, &b](int X, int Y) { return static_cast<double>(v[static_cast<std::size_t>(Y) * b.st.nxr + X]); };
+        };
+        for (std::size_t ch = 0; ch < 3; ++ch)
             for (int y = 0; y < ny; ++y)
                 for (int x = 0; x < nx; ++x) {
-                    auto at = [&](const std::vector<float>& v) {
-                        return [&v, &b](int X, int Y) { return static_cast<double>(v[static_cast<std::size_t>(Y) * b.st.nxr + X]); };
-                    };
-                    const double num = lerpReceivers(b, x, y, at(b.st.receiverShade[static_cast<std::size_t>(ch)]));
-                    const double den = lerpReceivers(b, x, y, at(b.st.receiverOcclusion));
-                    const double alb = a.channel[static_cast<std::size_t>(ch)].empty() ? 1.0 : a.channel[static_cast<std::size_t>(ch)](x, y);
-                    const double want = alb * b.st.occlusion(x, y) * num / den;
-                    worst = std::max(worst, std::fabs(rgb[static_cast<std::size_t>(ch)](x, y) - want) / (want + 1e-12));
+                    const double num = lerpReceivers(b, x, y, receivers(b.st.receiverShade[ch]));
+                    const double den = lerpReceivers(b, x, y, receivers(b.st.receiverOcclusion));
+                    const double want = albedoAt(a, ch, x, y) * b.st.occlusion(x, y) * num / den;
+                    worst = std::max(worst, std::fabs(rgb[ch](x, y) - want) / (want + 1e-12));
                 }
         CHECK(worst < 2e-6);
     }
-    // s = 1: every texel is a receiver, its exit radiance albedo E / pi (float product, exact)
+}
+
+TEST_CASE("gi.blocker: at 1x every texel is a receiver and gets albedo E / pi exactly") {
+    const int nx = 45, ny = 38;
+    const Grid h = bumpy(nx, ny);
+    const AlbedoMap a = patternAlbedo(nx, ny);
     Setup b;
-    prepare(h, 1.0f, 1, m, false, b);
-    for (int ch = 0; ch < 3; ++ch)
-        for (std::size_t i = 0; i < b.st.receiverShade[static_cast<std::size_t>(ch)].size(); ++i)
-            b.st.receiverShade[static_cast<std::size_t>(ch)][i] = 0.01f * static_cast<float>(i % 37 + ch);
+    prepare(h, 1.0f, 1, 8, false, b);
+    for (std::size_t ch = 0; ch < 3; ++ch)
+        for (std::size_t i = 0; i < b.st.receiverShade[ch].size(); ++i)
+            b.st.receiverShade[ch][i] = 0.01f * static_cast<float>(i % 37 + ch);
     std::array<Grid, 3> rgb;
     shadeBlockerRadiance(b.st, &a, rgb);
     long off = 0;
-    for (int ch = 0; ch < 3; ++ch)
-        for (std::size_t i = 0; i < rgb[static_cast<std::size_t>(ch)].size(); ++i) {
-            const float alb = a.channel[static_cast<std::size_t>(ch)].empty() ? 1.0f : a.channel[static_cast<std::size_t>(ch)].v[i];
-            off += rgb[static_cast<std::size_t>(ch)].v[i] != alb * b.st.receiverShade[static_cast<std::size_t>(ch)][i];
-        }
+    for (std::size_t ch = 0; ch < 3; ++ch)
+        for (int y = 0; y < ny; ++y)
+            for (int x = 0; x < nx; ++x) {
+                const std::size_t i = static_cast<std::size_t>(y) * nx + x;
+                off += rgb[ch].v[i] != static_cast<float>(albedoAt(a, ch, x, y)) * b.st.receiverShade[ch][i];
+            }
     CHECK(off == 0);
 }
 
-TEST_CASE("gi.blocker: occlusion and shading are bit-identical for 1, 2 and 3 threads and for the SSE2 and AVX2 kernels") {
+TEST_CASE(
+    "gi.blocker: occlusion and shading are bit-identical for 1, 2 and 3 threads and for the SSE2 and AVX2 kernels") {
     const int nx = 61, ny = 70, m = 8;
     const Grid h = bumpy(nx, ny);
     const AlbedoMap a = patternAlbedo(nx, ny);
@@ -258,9 +281,10 @@ TEST_CASE("gi.blocker: occlusion and shading are bit-identical for 1, 2 and 3 th
             prepare(h, 1.25f, s, m, false, b);
             fillFar(b, patternSlope);
             computeTexelOcclusion(b.pyr, b.gx.cview(), b.gy.cview(), b.phi, b.st);
-            for (int ch = 0; ch < 3; ++ch)
+            for (std::size_t ch = 0; ch < 3; ++ch)
                 for (std::size_t i = 0; i < b.st.receiverOcclusion.size(); ++i)
-                    b.st.receiverShade[static_cast<std::size_t>(ch)][i] = (0.2f + 0.1f * static_cast<float>(ch + i % 5)) * b.st.receiverOcclusion[i];
+                    b.st.receiverShade[ch][i] = (0.2f + 0.1f * static_cast<float>(ch + i % 5)) *  // E_k ~ O_k
+                                                b.st.receiverOcclusion[i];
             Out o;
             shadeBlockerRadiance(b.st, &a, o.rgb);
             o.occlusion = b.st.occlusion;
@@ -270,7 +294,7 @@ TEST_CASE("gi.blocker: occlusion and shading are bit-identical for 1, 2 and 3 th
         const Out one = withThreads(1, run);
         auto same = [&](const Out& o) {
             bool ok = sameBits(o.occlusion.v, one.occlusion.v) && sameBits(o.receiverOcclusion, one.receiverOcclusion);
-            for (int ch = 0; ch < 3; ++ch) ok = ok && sameBits(o.rgb[static_cast<std::size_t>(ch)].v, one.rgb[static_cast<std::size_t>(ch)].v);
+            for (std::size_t ch = 0; ch < 3; ++ch) ok = ok && sameBits(o.rgb[ch].v, one.rgb[ch].v);
             return ok;
         };
         for (int t : {2, 3}) CHECK_MESSAGE(same(withThreads(t, run)), "s " << s << ", " << t << " threads");
