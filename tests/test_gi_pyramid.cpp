@@ -46,7 +46,7 @@ LevelBlend levelBlend(int l, int kv, int nOctaves) {
     return {l / kv, static_cast<double>(l % kv) / kv};
 }
 
-// Largest |level - expected(x, y)| over receivers whose cell lies in [lo, hi) on both axes' ranges.
+// Largest |level l - expected(x, y)| over the receivers at cells x in [x0, x1), y in [y0, y1).
 template <class Expected>
 double worstLevelError(const HeightPyramid& p, int l, int x0, int x1, int y0, int y1, Expected&& expected) {
     double worst = 0.0;
@@ -85,8 +85,11 @@ TEST_CASE("gi.pyramid: steps grow as 2^(i / k_v) from one receiver spacing to th
         int nx, ny, kv, ov, s;
         float cell;
     };
-    const Case cases[] = {{64, 64, 4, 2, 1, 1.0f}, {37, 23, 4, 2, 2, 2.5f}, {200, 136, 3, 1, 4, 0.5f},
-                          {129, 65, 16, 6, 1, 3.0f}, {50, 7, 1, 0, 2, 10.0f}};
+    const Case cases[] = {{64, 64, 4, 2, 1, 1.0f},
+                          {37, 23, 4, 2, 2, 2.5f},
+                          {200, 136, 3, 1, 4, 0.5f},
+                          {129, 65, 16, 6, 1, 3.0f},
+                          {50, 7, 1, 0, 2, 10.0f}};
     for (const Case& c : cases) {
         const Grid g(c.nx, c.ny, 1.0f);
         HeightPyramid p;
@@ -97,7 +100,8 @@ TEST_CASE("gi.pyramid: steps grow as 2^(i / k_v) from one receiver spacing to th
         // the first step is one receiver spacing; each next one 2^(1 / k_v) longer
         CHECK(p.steps[0].tauCells == doctest::Approx(c.s).epsilon(1e-12));
         for (std::size_t i = 1; i < p.steps.size(); ++i)
-            CHECK(p.steps[i].tauCells / p.steps[i - 1].tauCells == doctest::Approx(std::exp2(1.0 / c.kv)).epsilon(1e-12));
+            CHECK(p.steps[i].tauCells / p.steps[i - 1].tauCells ==
+                  doctest::Approx(std::exp2(1.0 / c.kv)).epsilon(1e-12));
         // the last step reaches the diagonal, the one before does not
         CHECK(p.steps.back().tauCells >= diag * (1.0 - 1e-12));
         CHECK(p.steps[p.steps.size() - 2].tauCells < diag);
@@ -175,9 +179,8 @@ TEST_CASE("gi.pyramid: a linear ramp stays the ramp away from the borders; max o
                 const int margin = 4 << top;  // taps reach 2 texels, and the odd edges replicate
                 if (2 * margin >= ny - 1) continue;
                 const double lift = blend * ((1.0 - lb.q) * drift(lb.o) + lb.q * drift(lb.o + 1));
-                const double err = worstLevelError(p, l, margin, nx - margin, margin, ny - margin, [&](int x, int y) {
-                    return c0 + a * x + b * y + lift;
-                });
+                const double err = worstLevelError(p, l, margin, nx - margin, margin, ny - margin,
+                                                   [&](int x, int y) { return c0 + a * x + b * y + lift; });
                 INFO("s " << s << " peakBlend " << blend << " level " << l);
                 CHECK(err < 2e-4);
                 ++checked;
@@ -245,7 +248,8 @@ TEST_CASE("gi.pyramid: a single spike: mean octaves divide it by 4^o, max octave
         }
     // monotone in the blend at every filtered level
     for (std::size_t k = 1; k < peaks.size(); ++k)
-        for (std::size_t l = static_cast<std::size_t>(kv); l < peaks[k].size(); ++l) CHECK(peaks[k][l] > peaks[k - 1][l]);
+        for (std::size_t l = static_cast<std::size_t>(kv); l < peaks[k].size(); ++l)
+            CHECK(peaks[k][l] > peaks[k - 1][l]);
     CHECK(peaks.back()[4 * kv] > 100.0 * peaks.front()[4 * kv]);  // 4^4 lower without the max octaves
 }
 
@@ -253,7 +257,9 @@ TEST_CASE("gi.pyramid: sizes of non-square, non-power-of-two and tiny fields at 
     const std::pair<int, int> sizes[] = {{37, 23}, {64, 48}, {33, 65}, {5, 1}, {1, 7}, {2, 2}, {1, 1}};
     for (auto [nx, ny] : sizes)
         for (int s : {1, 2, 4}) {
-            const Grid g = gridOf(nx, ny, [](int x, int y) { return static_cast<float>(3 * x - 2 * y) + 0.25f * static_cast<float>(x * y % 7); });
+            const Grid g = gridOf(nx, ny, [](int x, int y) {
+                return static_cast<float>(3 * x - 2 * y) + 0.25f * static_cast<float>(x * y % 7);
+            });
             HeightPyramid p;
             buildHeightPyramid(g.cview(), 2.0f, s, pyramidSettings(4, 0, 0.5f), p);
             INFO(nx << "x" << ny << " s " << s);
