@@ -1,6 +1,8 @@
 #pragma once
 // Small analytic terrains shared by the GI tests.
 #include <cmath>
+#include <cstddef>
+#include <cstring>
 
 #include "core/grid.h"
 
@@ -33,6 +35,21 @@ inline double meanOver(const Grid& g, int x0, int x1, int y0, int y1) {
     for (int y = y0; y < y1; ++y)
         for (int x = x0; x < x1; ++x) sum += g(x, y);
     return sum / ((x1 - x0) * (y1 - y0));
+}
+
+/// A grid filled with f(x, y).
+template <class F>
+Grid gridOf(int nx, int ny, F&& f) {
+    Grid g(nx, ny);
+    for (int y = 0; y < ny; ++y)
+        for (int x = 0; x < nx; ++x) g(x, y) = f(x, y);
+    return g;
+}
+
+/// True when a and b hold the same floats bit for bit (sizes included).
+template <class A, class B>
+bool sameBits(const A& a, const B& b) {
+    return a.size() == b.size() && (a.size() == 0 || std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0);
 }
 
 }  // namespace terrain::gi_test
