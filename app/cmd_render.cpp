@@ -69,10 +69,11 @@ void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize) {
     sub->add_option("--ticks-per-frame", o.ticksPerFrame, "Simulation ticks between frames (0 = scene default)");
     sub->add_option("--seed", o.seed, "Seed for the scene generator")->capture_default_str();
     sub->add_option("--threads", o.threads, "Worker threads (0 = all cores)")->capture_default_str();
-    sub->add_option("--subsample", o.subsample, "GI visibility sub-sampling: 1, 2 or 4")->capture_default_str();
+    sub->add_option("--subsample", o.subsample, gi::describe(gi::ranges::kSubsample))->capture_default_str();
     sub->add_option("--lighting", o.lighting, "key (key light only) | direct (sky + key) | global (direct + bounces)")
         ->capture_default_str();
-    sub->add_option("--bounces", o.bounces, "Indirect bounces for --lighting global")->capture_default_str();
+    sub->add_option("--bounces", o.bounces, gi::describe(gi::ranges::kBounces) + ", with --lighting global")
+        ->capture_default_str();
     sub->add_flag("--amortise", o.amortise,
                   "Shading amortisation: on static geometry update direct and indirect light on alternate frames");
     sub->add_option("--shadow", o.shadow, "Key light shadow: soft (engine visibility) | map (shadow map) | none")
@@ -97,7 +98,6 @@ void toSettings(const RenderOptions& o, engine::PipelineSettings& p, render::Ren
         throw InputError("--width and --height must be 16..8192 pixels");
     if (o.threads < 0 || o.threads > 256) throw InputError("--threads must be 0 (all) .. 256");
     if (o.ticksPerFrame < 0) throw InputError("--ticks-per-frame must be >= 0");
-    if (o.subsample != 1 && o.subsample != 2 && o.subsample != 4) throw InputError("--subsample must be 1, 2 or 4");
     if (!(o.exposure > 0.0f && o.exposure < 1000.0f)) throw InputError("--exposure must be > 0");
     if (!(o.exaggeration >= 0.0f && o.exaggeration <= 100.0f)) throw InputError("--exaggeration must be in [0, 100]");
     if (!(o.distance > 0.05f && o.distance < 100.0f)) throw InputError("--distance must be in (0.05, 100)");
@@ -106,7 +106,7 @@ void toSettings(const RenderOptions& o, engine::PipelineSettings& p, render::Ren
     p.gi.subsample = o.subsample;
     p.gi.indirect.bounces = o.bounces;
     p.gi.indirect.amortise = o.amortise;
-    gi::validateIndirectSettings(p.gi.indirect);
+    gi::validateGiSettings(p.gi);
     p.ticksPerFrame = o.ticksPerFrame;
     p.pyramidLevel = o.pyramidLevel;
     if (o.lighting == "key") p.lighting = LightingMode::KeyOnly;

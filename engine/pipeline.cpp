@@ -46,7 +46,7 @@ gi::GiSettings defaultPipelineGi() {
 
 FramePipeline::FramePipeline(const SceneSettings& scene, const PipelineSettings& settings, const SceneLights& lights)
     : sim_(scene), settings_(settings), lights_(lights) {
-    gi::validateIndirectSettings(settings_.gi.indirect);
+    gi::validateGiSettings(settings_.gi);
     if (settings_.ticksPerFrame < 0) throw InputError("ticks per frame must be >= 0");
     ticksPerFrame_ = settings_.ticksPerFrame;
     if (ticksPerFrame_ == 0) {
