@@ -1,10 +1,12 @@
 #pragma once
 // Order-4 normalised Legendre polynomial (NLP) basis on z = cos(theta) in
-// [-1, 1] (Section 4) and the closed-form occlusion vector (Eq. 10).
+// [-1, 1] (Nowrouzezahrai & Snyder 2009, Section 4) and the closed-form
+// occlusion vector (Eq. 10).
 //
 // NLP_l(z) = sqrt((2l+1)/2) P_l(z), from Rodrigues' formula. (The vector
 // printed in Section 4 has wrong constants for l = 2, 3; the closed form of
-// v^-(sigma) printed below it is right: papers/README.md, GUIDE 3.)
+// v^-(sigma) printed below it is right; tests/test_gi_sh.cpp checks the
+// basis for orthonormality.)
 //
 // Elevation functions are parameterised by the blocking angle omega from the
 // horizon up, z = sin(omega). Kernels never call atan: they carry the slope

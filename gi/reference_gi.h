@@ -1,7 +1,7 @@
 #pragma once
-// Ground truth with indirect light (issue "GI part 2"; paper 000's first-hit
-// gathering with the Method of Dependent Tests: one fixed direction set shared
-// by every texel).
+// Ground truth with indirect light (the first-hit gathering of Heidrich,
+// Daubert, Kautz & Seidel 2000 with their Method of Dependent Tests: one fixed
+// direction set shared by every texel).
 //
 // Bounce 0 is the direct exit radiance of the exact reference (gi/reference.h:
 // exact visibility, exact elevation integrals, the same order-4 SH lighting).
