@@ -80,7 +80,10 @@ struct ReferenceAzimuths {
     std::vector<double> cosA, sinA;
     std::vector<std::array<double, kShCount>> azim;
     explicit ReferenceAzimuths(int count)
-        : M(count), cosA(static_cast<std::size_t>(M)), sinA(static_cast<std::size_t>(M)), azim(static_cast<std::size_t>(M)) {
+        : M(count),
+          cosA(static_cast<std::size_t>(M)),
+          sinA(static_cast<std::size_t>(M)),
+          azim(static_cast<std::size_t>(M)) {
         for (int a = 0; a < M; ++a) {
             const double phi = 2.0 * kPi * (a + 0.5) / M;
             cosA[static_cast<std::size_t>(a)] = std::cos(phi);
@@ -128,7 +131,8 @@ void shadeReferenceTexel(const ReferenceTexels& t, int x, int y) {
             double P[kShCount], Q[kShCount];
             t.tables->lookup(lo, P, Q);
             const auto& az = t.az.azim[static_cast<std::size_t>(a)];
-            for (int i = 0; i < kShCount; ++i) transfer[i] += az[static_cast<std::size_t>(i)] * (horiz * P[i] + nzv * Q[i]);
+            for (int i = 0; i < kShCount; ++i)
+                transfer[i] += az[static_cast<std::size_t>(i)] * (horiz * P[i] + nzv * Q[i]);
         }
     }
     t.out.ambient(x, y) = static_cast<float>(amb * t.dphi / kPi);

@@ -1,5 +1,6 @@
 // The glossy ground truth (gi/reference_gi.h, renderReferenceGlossy): exact
 // visibility and first hits, the fast path's BRDFs and order-4 SH lighting.
+// Sections: Nowrouzezahrai & Snyder 2009.
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -18,8 +19,8 @@ namespace {
 // PP_ij(lo) = int_lo^{pi/2} A_i(sin w) A_j(sin w) cos w dw over lo in
 // [-pi/2, pi/2] (A_i the z part of Y_i, gi/sh.h): the elevation integral of a
 // product of two harmonics over the visible part of an azimuth. Tabulated
-// once (8-point Gauss-Legendre per interval, linear interpolation:
-// error < 1e-6 for kN = 2048).
+// once (8-point Gauss-Legendre per interval), interpolated linearly between
+// the kN + 1 tabulated angles.
 struct PairTables {
     static constexpr int kN = 2048;
     std::vector<double> t;  // (kN + 1) x 256
@@ -112,7 +113,8 @@ struct GlossySurface {
         for (int l = 0; l < kShOrder; ++l) phUniform[l] = f[l];
     }
     float albedoAt(int c, std::size_t i) const {
-        return surface && !surface->channel[static_cast<std::size_t>(c)].empty() ? surface->channel[static_cast<std::size_t>(c)].v[i] : 1.0f;
+        const std::size_t ch = static_cast<std::size_t>(c);
+        return surface && !surface->channel[ch].empty() ? surface->channel[ch].v[i] : 1.0f;
     }
     void lobeAt(std::size_t i, double ph[kShOrder]) const {
         for (int l = 0; l < kShOrder; ++l)
@@ -175,7 +177,8 @@ void towardsViewer(const GlossySurface& surf, const double view[3], double ws, c
                 basis(r[0], r[1], r[2], yR);
                 surf.lobeAt(i, ph);
                 for (int c = 0; c < 3; ++c) {
-                    const double v = D[c].v[i] + ws * phongTowards(ph, yR, I.data() + static_cast<std::size_t>(c * kShCount) * plane + i, plane);
+                    const float* Ic = I.data() + static_cast<std::size_t>(c * kShCount) * plane + i;
+                    const double v = D[c].v[i] + ws * phongTowards(ph, yR, Ic, plane);
                     dst[c].v[i] = static_cast<float>(add ? dst[c].v[i] + v : v);
                 }
             }
@@ -237,7 +240,8 @@ void gatherTexel(const GlossyGather& g, const std::array<Grid, 3>& prevD, const 
         const double cosine = n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2];
         if (cosine <= 0.0) continue;
         float qx, qy;
-        if (!referenceFirstHit(g.heights.data(), nx, ny, g.hMax, g.cellSize, x, y, dir, g.s.marchStep, qx, qy)) continue;
+        if (!referenceFirstHit(g.heights.data(), nx, ny, g.hMax, g.cellSize, x, y, dir, g.s.marchStep, qx, qy))
+            continue;
         double L[3];
         radianceFromHit(g, Bilinear(nx, ny, qx, qy), dir, prevD, prevI, L);
         const double* yw = &g.dirBasis[k * kShCount];

@@ -375,7 +375,8 @@ void addPhongLobe(const PhongRowJob& j, const float* __restrict gxr, const float
         float yb[kShCount];
         shBasisLanes(2.0f * nv * nxv - vx, 2.0f * nv * nyv - vy, 2.0f * nv * nzv - vz, yb, kShCount);
         float sp = 0.0f;
-        for (int i = 0; i < kShCount; ++i) sp += ph[shBand(i)] * yb[i] * up[static_cast<std::size_t>(ch * nCoef + i) * nx + x];
+        for (int i = 0; i < kShCount; ++i)
+            sp += ph[shBand(i)] * yb[i] * up[static_cast<std::size_t>(ch * nCoef + i) * nx + x];
         o[x] += j.specWeight * sp;
     }
 }

@@ -126,7 +126,7 @@ inline float sampleSlope(const ScanStep& st, std::ptrdiff_t index, float h0) {
 // `valid` are (the others' rays have left the domain; their s is garbage); the
 // kernel calls some() once more at i = (longest sequence) with no lane valid,
 // so a visitor can close what is still open. steps: each lane's sequence length.
-// Lane type V: F4 (SSE2) or F8 (AVX2), sim/simd.h; the same lane-wise
+// Lane type V: F4 (SSE2) or F8 (AVX2), core/simd.h; the same lane-wise
 // operations either way.
 
 // Plain maximum over the samples.
@@ -468,8 +468,9 @@ void buildStepTables(const HeightPyramid& pyr, const FoldedWedgeOperator& op, in
 
     state.cosSin.resize(2 * static_cast<std::size_t>(m));
     for (int j = 0; j < m; ++j) {
-        state.cosSin[2 * static_cast<std::size_t>(j)] = static_cast<float>(std::cos(op.phi[static_cast<std::size_t>(j)]));
-        state.cosSin[2 * static_cast<std::size_t>(j) + 1] = static_cast<float>(std::sin(op.phi[static_cast<std::size_t>(j)]));
+        const double phi = op.phi[static_cast<std::size_t>(j)];
+        state.cosSin[2 * static_cast<std::size_t>(j)] = static_cast<float>(std::cos(phi));
+        state.cosSin[2 * static_cast<std::size_t>(j) + 1] = static_cast<float>(std::sin(phi));
     }
 }
 
