@@ -63,27 +63,16 @@ void synthesisTaps(int receivers, int subsample, int octave, int octaveSize, int
     }
 }
 
-}  // namespace
-
-void buildHeightPyramid(ConstGridView heights, float cellSize, int subsample, const PyramidSettings& settings,
-                        HeightPyramid& p) {
-    const int nx = heights.nx, ny = heights.ny, s = subsample;
-    const int kv = std::max(1, settings.levelsPerOctave);
-    p.nx = nx;
-    p.ny = ny;
-    p.subsample = s;
-    p.nxr = receiverCount(nx, s);
-    p.nyr = receiverCount(ny, s);
-    p.cellSize = cellSize;
-    p.settings = settings;
-
-    // ---- steps (Eq. 14) and the level each reads (level offset o_v) ------
-    // Sub-sampling: the stack lives at the receiver grid (Section 9), so the
-    // first step is one receiver spacing, tau_0 = s cells (steps shorter than
-    // the receiver spacing would sample relief that the interpolated SH
-    // vectors cannot carry: measured on alps at 2x/4x they add error).
+// ---- steps (Eq. 14) and the level each reads (level offset o_v) ------
+// Sub-sampling: the stack lives at the receiver grid (Nowrouzezahrai & Snyder
+// 2009, Section 9), so the first step is one receiver spacing, tau_0 = s cells
+// (steps shorter than the receiver spacing would sample relief that the
+// interpolated SH vectors cannot carry). Returns the highest level read
+// (-1: none).
+int buildSteps(HeightPyramid& p, int kv, float cellSize) {
+    const int s = p.subsample;
     const int i0 = kv * (s == 4 ? 2 : (s == 2 ? 1 : 0));
-    const int nSteps = std::max(1, pyramidStepCount(nx, ny, kv) - i0);
+    const int nSteps = std::max(1, pyramidStepCount(p.nx, p.ny, kv) - i0);
     p.steps.resize(static_cast<std::size_t>(nSteps));
     int maxLevel = -1;
     for (int ii = 0; ii < nSteps; ++ii) {
@@ -91,12 +80,16 @@ void buildHeightPyramid(ConstGridView heights, float cellSize, int subsample, co
         PyramidStep& st = p.steps[static_cast<std::size_t>(ii)];
         st.tauCells = std::exp2(static_cast<double>(i) / kv);
         st.invTauWorld = static_cast<float>(1.0 / (st.tauCells * cellSize));
-        st.level = i - kv * settings.levelOffset;
+        st.level = i - kv * p.settings.levelOffset;
         if (st.level < 0) st.level = -1;
         maxLevel = std::max(maxLevel, st.level);
     }
+    return maxLevel;
+}
 
-    // ---- raw heights, split by column phase --------------------------------
+// ---- raw heights, split by column phase --------------------------------
+void splitRawPhases(ConstGridView heights, HeightPyramid& p) {
+    const int nx = p.nx, ny = p.ny, s = p.subsample;
     const int wp = nx / s + 1;
     p.rawPhaseWidth = wp;
     p.rawPhasePlane = static_cast<std::ptrdiff_t>(wp) * (ny + 1);
@@ -110,26 +103,23 @@ void buildHeightPyramid(ConstGridView heights, float cellSize, int subsample, co
             }
         }
     });
+}
 
-    const int nLevels = maxLevel + 1;
-    if (nLevels <= 0) {
-        p.levels.resize(0);
-        return;
+// Octaves needed for nLevels levels: up to floor((nLevels - 1) / kv) + 1,
+// stopping at 1x1.
+int octaveCount(int nx, int ny, int nLevels, int kv) {
+    const int wanted = (nLevels - 1) / kv + 2;
+    int w = nx, h = ny, count = 1;
+    while (count < wanted && (w > 1 || h > 1)) {
+        w = (w + 1) / 2;
+        h = (h + 1) / 2;
+        ++count;
     }
+    return count;
+}
 
-    // ---- octave images B_o (2x2 decimation) ---------------------------------
-    // Octaves needed: up to floor((nLevels - 1) / kv) + 1, stopping at 1x1.
-    int nOctaves = (nLevels - 1) / kv + 2;
-    {
-        int w = nx, h = ny, count = 1;
-        while (count < nOctaves && (w > 1 || h > 1)) {
-            w = (w + 1) / 2;
-            h = (h + 1) / 2;
-            ++count;
-        }
-        nOctaves = count;
-    }
-    const bool withMax = settings.peakBlend > 0.0f;
+// ---- octave images B_o (2x2 decimation) ---------------------------------
+void decimateOctaves(ConstGridView heights, int nOctaves, bool withMax, HeightPyramid& p) {
     p.meanOctaves.resize(static_cast<std::size_t>(nOctaves - 1));
     p.maxOctaves.resize(withMax ? static_cast<std::size_t>(nOctaves - 1) : 0u);
     for (int pass = 0; pass < (withMax ? 2 : 1); ++pass) {
@@ -143,10 +133,69 @@ void buildHeightPyramid(ConstGridView heights, float cellSize, int subsample, co
             src = dst.cview();
         }
     }
+}
 
-    // ---- B-spline synthesis of each octave at the receiver grid ---------------
-    // Separable: rows of B_o to receiver columns (rowTmp), then columns to
-    // receiver rows. Mean and (optionally) max syntheses are blended here.
+// S_0: level 0 is the height field itself (Nowrouzezahrai & Snyder 2009,
+// Section 5.2: level i is reduced by 2^(i / k_v), so f_0 = f, unfiltered),
+// taken at the receivers. (A B-spline synthesis of octave 0 would smooth it
+// by (1, 4, 1) / 6 per axis and lower the near blockers.)
+void receiverHeights(ConstGridView heights, int s, PaddedField& out) {
+    const int nxr = out.nx, nyr = out.ny;
+    parallelForRows(nyr, nxr, [&](int y0, int y1) {
+        for (int Y = y0; Y < y1; ++Y) {
+            const float* src = heights.row(s * Y);
+            float* d = out.row(Y);
+            for (int X = 0; X < nxr; ++X) d[X] = src[s * X];
+        }
+    });
+    out.padEdges();
+}
+
+// One pass (0: the mean octave, 1: the max octave) of the B-spline synthesis
+// of octave o >= 1 at the receiver grid, weighted by `blend`: pass 0 writes
+// out, pass 1 adds to it. Separable: rows of B_o to receiver columns
+// (rowTmp), then columns to receiver rows.
+void synthesisePass(ConstGridView src, int o, int pass, float blend, HeightPyramid& p, PaddedField& out) {
+    const int nxr = p.nxr, nyr = p.nyr, s = p.subsample;
+    int* ix = p.tapIndex.data();
+    int* iy = ix + 4 * nxr;
+    float* wx = p.tapWeight.data();
+    float* wy = wx + 4 * nxr;
+    synthesisTaps(nxr, s, o, src.nx, ix, wx);
+    synthesisTaps(nyr, s, o, src.ny, iy, wy);
+    p.rowTmp.resize(static_cast<std::size_t>(src.ny) * nxr);
+    float* tmp = p.rowTmp.data();
+    parallelForRows(src.ny, nxr, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y) {
+            const float* in = src.row(y);
+            float* t = tmp + static_cast<std::size_t>(y) * nxr;
+            for (int X = 0; X < nxr; ++X) {
+                const int* k = ix + 4 * X;
+                const float* w = wx + 4 * X;
+                t[X] = (w[0] * in[k[0]] + w[1] * in[k[1]]) + (w[2] * in[k[2]] + w[3] * in[k[3]]);
+            }
+        }
+    });
+    parallelForRows(nyr, nxr, [&](int y0, int y1) {
+        for (int Y = y0; Y < y1; ++Y) {
+            const int* k = iy + 4 * Y;
+            const float* w = wy + 4 * Y;
+            const float* r0 = tmp + static_cast<std::size_t>(k[0]) * nxr;
+            const float* r1 = tmp + static_cast<std::size_t>(k[1]) * nxr;
+            const float* r2 = tmp + static_cast<std::size_t>(k[2]) * nxr;
+            const float* r3 = tmp + static_cast<std::size_t>(k[3]) * nxr;
+            float* d = out.row(Y);
+            for (int X = 0; X < nxr; ++X) {
+                const float v = (w[0] * r0[X] + w[1] * r1[X]) + (w[2] * r2[X] + w[3] * r3[X]);
+                d[X] = pass == 0 ? blend * v : d[X] + blend * v;
+            }
+        }
+    });
+}
+
+// ---- B-spline synthesis of each octave at the receiver grid ---------------
+// S_o; mean and (optionally) max syntheses are blended here.
+void synthesiseOctaves(ConstGridView heights, int nOctaves, bool withMax, HeightPyramid& p) {
     const int nxr = p.nxr, nyr = p.nyr;
     p.synth.resize(static_cast<std::size_t>(nOctaves));
     p.tapIndex.resize(static_cast<std::size_t>(4 * (nxr + nyr)));
@@ -155,64 +204,21 @@ void buildHeightPyramid(ConstGridView heights, float cellSize, int subsample, co
         PaddedField& out = p.synth[static_cast<std::size_t>(o)];
         out.resize(nxr, nyr);
         if (o == 0) {
-            // Level 0 is the height field itself (Section 5.2: level i is reduced
-            // by 2^(i / k_v), so f_0 = f, unfiltered), taken at the receivers.
-            // (A B-spline synthesis of octave 0 would smooth it by (1, 4, 1) / 6
-            // per axis; measured on alps that lowers near blockers: paper-settings
-            // RMSE 0.0151 -> 0.0148 without it.)
-            parallelForRows(nyr, nxr, [&](int y0, int y1) {
-                for (int Y = y0; Y < y1; ++Y) {
-                    const float* src = heights.row(s * Y);
-                    float* d = out.row(Y);
-                    for (int X = 0; X < nxr; ++X) d[X] = src[s * X];
-                }
-            });
-            out.padEdges();
+            receiverHeights(heights, p.subsample, out);
             continue;
         }
         for (int pass = 0; pass < (withMax ? 2 : 1); ++pass) {
-            ConstGridView src = o == 0 ? heights
-                                       : (pass == 0 ? p.meanOctaves : p.maxOctaves)[static_cast<std::size_t>(o - 1)].cview();
-            int* ix = p.tapIndex.data();
-            int* iy = ix + 4 * nxr;
-            float* wx = p.tapWeight.data();
-            float* wy = wx + 4 * nxr;
-            synthesisTaps(nxr, s, o, src.nx, ix, wx);
-            synthesisTaps(nyr, s, o, src.ny, iy, wy);
-            p.rowTmp.resize(static_cast<std::size_t>(src.ny) * nxr);
-            float* tmp = p.rowTmp.data();
-            parallelForRows(src.ny, nxr, [&](int y0, int y1) {
-                for (int y = y0; y < y1; ++y) {
-                    const float* in = src.row(y);
-                    float* t = tmp + static_cast<std::size_t>(y) * nxr;
-                    for (int X = 0; X < nxr; ++X) {
-                        const int* k = ix + 4 * X;
-                        const float* w = wx + 4 * X;
-                        t[X] = (w[0] * in[k[0]] + w[1] * in[k[1]]) + (w[2] * in[k[2]] + w[3] * in[k[3]]);
-                    }
-                }
-            });
-            const float blend = withMax ? (pass == 0 ? 1.0f - settings.peakBlend : settings.peakBlend) : 1.0f;
-            parallelForRows(nyr, nxr, [&](int y0, int y1) {
-                for (int Y = y0; Y < y1; ++Y) {
-                    const int* k = iy + 4 * Y;
-                    const float* w = wy + 4 * Y;
-                    const float* r0 = tmp + static_cast<std::size_t>(k[0]) * nxr;
-                    const float* r1 = tmp + static_cast<std::size_t>(k[1]) * nxr;
-                    const float* r2 = tmp + static_cast<std::size_t>(k[2]) * nxr;
-                    const float* r3 = tmp + static_cast<std::size_t>(k[3]) * nxr;
-                    float* d = out.row(Y);
-                    for (int X = 0; X < nxr; ++X) {
-                        const float v = (w[0] * r0[X] + w[1] * r1[X]) + (w[2] * r2[X] + w[3] * r3[X]);
-                        d[X] = pass == 0 ? blend * v : d[X] + blend * v;
-                    }
-                }
-            });
+            ConstGridView src = (pass == 0 ? p.meanOctaves : p.maxOctaves)[static_cast<std::size_t>(o - 1)].cview();
+            const float blend = withMax ? (pass == 0 ? 1.0f - p.settings.peakBlend : p.settings.peakBlend) : 1.0f;
+            synthesisePass(src, o, pass, blend, p, out);
         }
         out.padEdges();
     }
+}
 
-    // ---- levels between octaves: f_l = (1 - q) S_o + q S_(o+1) -----------------
+// ---- levels between octaves: f_l = (1 - q) S_o + q S_(o+1) -----------------
+void blendLevels(int nLevels, int nOctaves, int kv, HeightPyramid& p) {
+    const int nxr = p.nxr, nyr = p.nyr;
     p.levels.resize(static_cast<std::size_t>(nLevels));
     for (int l = 0; l < nLevels; ++l) {
         int o = l / kv;
@@ -235,6 +241,34 @@ void buildHeightPyramid(ConstGridView heights, float cellSize, int subsample, co
             }
         });
     }
+}
+
+}  // namespace
+
+void buildHeightPyramid(ConstGridView heights, float cellSize, int subsample, const PyramidSettings& settings,
+                        HeightPyramid& p) {
+    const int nx = heights.nx, ny = heights.ny, s = subsample;
+    const int kv = std::max(1, settings.levelsPerOctave);
+    p.nx = nx;
+    p.ny = ny;
+    p.subsample = s;
+    p.nxr = receiverCount(nx, s);
+    p.nyr = receiverCount(ny, s);
+    p.cellSize = cellSize;
+    p.settings = settings;
+
+    const int maxLevel = buildSteps(p, kv, cellSize);
+    splitRawPhases(heights, p);
+    const int nLevels = maxLevel + 1;
+    if (nLevels <= 0) {
+        p.levels.resize(0);
+        return;
+    }
+    const int nOctaves = octaveCount(nx, ny, nLevels, kv);
+    const bool withMax = settings.peakBlend > 0.0f;
+    decimateOctaves(heights, nOctaves, withMax, p);
+    synthesiseOctaves(heights, nOctaves, withMax, p);
+    blendLevels(nLevels, nOctaves, kv, p);
 }
 
 }  // namespace terrain::gi

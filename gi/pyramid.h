@@ -1,5 +1,6 @@
 #pragma once
-// Height pyramid with B-spline filtering (Section 5.2, Eqs. 14-16).
+// Height pyramid with B-spline filtering (Nowrouzezahrai & Snyder 2009,
+// Section 5.2, Eqs. 14-16).
 //
 // Steps along every ray grow exponentially (Eq. 14): tau_i = 2^(i / k_v)
 // cells, i = i_0..n_v-1, n_v chosen so the last step reaches the domain
@@ -14,9 +15,10 @@
 // Level l is filtered at a scale of 2^(l / k_v) cells: octave images B_o are
 // repeated 2x2 box ("bilinear") decimations of the heights; each octave o >= 1
 // is synthesised at the receiver grid by cubic B-spline reconstruction (as the
-// paper's GPU version does with [SH05]), S_o; S_0 is the height field itself
-// at the receivers (level 0 is unfiltered, f_0 = f); a level between octaves
-// blends the two neighbouring ones: f_l = (1 - q) S_o + q S_(o+1), o + q = l / k_v.
+// paper's GPU version does, after Sigg & Hadwiger 2005), S_o; S_0 is the
+// height field itself at the receivers (level 0 is unfiltered, f_0 = f); a
+// level between octaves blends the two neighbouring ones:
+// f_l = (1 - q) S_o + q S_(o+1), o + q = l / k_v.
 // Like the paper we keep the stack "blown out" to the receiver resolution,
 // so for a fixed azimuth and step every receiver reads its level at the same
 // fractional offset: the scan streams rows with constant bilinear weights.

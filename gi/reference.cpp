@@ -1,12 +1,14 @@
 #include "gi/reference.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <mutex>
 #include <vector>
 
+#include "gi/frame.h"
 #include "gi/visibility.h"
 #include "core/parallel.h"
 
@@ -72,6 +74,100 @@ const ElevationTables& elevationTables() {
     return t;
 }
 
+// The M azimuths phi_a = 2 pi (a + 0.5) / M: cos, sin and T_i(phi_a).
+struct ReferenceAzimuths {
+    int M;
+    std::vector<double> cosA, sinA;
+    std::vector<std::array<double, kShCount>> azim;
+    explicit ReferenceAzimuths(int count)
+        : M(count),
+          cosA(static_cast<std::size_t>(M)),
+          sinA(static_cast<std::size_t>(M)),
+          azim(static_cast<std::size_t>(M)) {
+        for (int a = 0; a < M; ++a) {
+            const double phi = 2.0 * kPi * (a + 0.5) / M;
+            cosA[static_cast<std::size_t>(a)] = std::cos(phi);
+            sinA[static_cast<std::size_t>(a)] = std::sin(phi);
+            for (int i = 0; i < kShCount; ++i)
+                azim[static_cast<std::size_t>(a)][static_cast<std::size_t>(i)] = shAzimuthal(i, phi);
+        }
+    }
+};
+
+// What every texel of renderReference reads and writes.
+struct ReferenceTexels {
+    ConstGridView heights;
+    float cellSize;
+    const Grid& gx;
+    const Grid& gy;
+    double heightMax;
+    const ReferenceAzimuths& az;
+    const ElevationTables* tables;  // null: ambient only
+    const ShRgb* lighting;
+    const AlbedoMap* albedo;
+    double dphi;  // 2 pi / M
+    ReferenceResult& out;
+};
+
+// The ambient (and, with lighting, the Lambert shade) of texel (x, y): per
+// azimuth the exact blocking slope, then the elevation integrals above
+// lo = max(omega_max, tangent plane).
+void shadeReferenceTexel(const ReferenceTexels& t, int x, int y) {
+    const int M = t.az.M;
+    const double gxv = t.gx(x, y), gyv = t.gy(x, y);
+    const double inv = 1.0 / std::sqrt(1.0 + gxv * gxv + gyv * gyv);
+    const double nxv = -gxv * inv, nyv = -gyv * inv, nzv = inv;
+    double amb = 0.0;
+    double transfer[kShCount] = {};
+    for (int a = 0; a < M; ++a) {
+        const double c = t.az.cosA[static_cast<std::size_t>(a)], s = t.az.sinA[static_cast<std::size_t>(a)];
+        const double slope = referenceMaxSlope(t.heights, t.cellSize, x, y, c, s, t.heightMax);
+        const double tangent = gxv * c + gyv * s;
+        const double lo = std::atan(std::max(slope, tangent));
+        const double horiz = nxv * c + nyv * s;
+        const double sl = std::sin(lo), cl = std::cos(lo);
+        amb += horiz * (0.5 * kPi - lo - sl * cl) * 0.5 + nzv * cl * cl * 0.5;
+        if (t.tables) {
+            double P[kShCount], Q[kShCount];
+            t.tables->lookup(lo, P, Q);
+            const auto& az = t.az.azim[static_cast<std::size_t>(a)];
+            for (int i = 0; i < kShCount; ++i)
+                transfer[i] += az[static_cast<std::size_t>(i)] * (horiz * P[i] + nzv * Q[i]);
+        }
+    }
+    t.out.ambient(x, y) = static_cast<float>(amb * t.dphi / kPi);
+    if (t.tables)
+        for (int ch = 0; ch < 3; ++ch) {
+            double e = 0.0;
+            for (int i = 0; i < kShCount; ++i)
+                e += t.lighting->c[static_cast<std::size_t>(ch)][static_cast<std::size_t>(i)] * transfer[i];
+            const float alb = t.albedo && !t.albedo->channel[static_cast<std::size_t>(ch)].empty()
+                                  ? t.albedo->channel[static_cast<std::size_t>(ch)](x, y)
+                                  : 1.0f;
+            t.out.rgb[static_cast<std::size_t>(ch)](x, y) = static_cast<float>(alb * e * t.dphi / kPi);
+        }
+}
+
+// Prints "reference: N%" to stderr every 5 % of the rows.
+class RowProgress {
+public:
+    explicit RowProgress(int rowsTotal) : rowsTotal_(rowsTotal) {}
+    void rowDone() {
+        const int done = ++rowsDone_;
+        const int pct = static_cast<int>(100LL * done / std::max(rowsTotal_, 1));
+        const int prevPct = static_cast<int>(100LL * (done - 1) / std::max(rowsTotal_, 1));
+        if (pct / 5 != prevPct / 5) {
+            std::lock_guard<std::mutex> lock(printMutex_);
+            std::fprintf(stderr, "reference: %d%%\n", pct);
+        }
+    }
+
+private:
+    int rowsTotal_;
+    std::atomic<int> rowsDone_{0};
+    std::mutex printMutex_;
+};
+
 }  // namespace
 
 double referenceMaxSlope(ConstGridView h, float cellSize, int x, int y, double c, double s, double heightMax) {
@@ -113,89 +209,23 @@ void renderReference(ConstGridView heights, float cellSize, const ShRgb* lightin
     if (lighting)
         for (Grid& g : out.rgb) g.resize(nx, ny, 0.0f);
     Grid gx, gy;
-    // same central differences as the fast path
-    {
-        const float inv2 = 0.5f / cellSize, inv1 = 1.0f / cellSize;
-        gx.resize(nx, ny);
-        gy.resize(nx, ny);
-        for (int y = 0; y < ny; ++y)
-            for (int x = 0; x < nx; ++x) {
-                float dx = 0.0f, dy = 0.0f;
-                if (nx > 1) dx = x == 0 ? (heights(1, y) - heights(0, y)) * inv1
-                                : (x == nx - 1 ? (heights(x, y) - heights(x - 1, y)) * inv1
-                                               : (heights(x + 1, y) - heights(x - 1, y)) * inv2);
-                if (ny > 1) dy = y == 0 ? (heights(x, 1) - heights(x, 0)) * inv1
-                                : (y == ny - 1 ? (heights(x, y) - heights(x, y - 1)) * inv1
-                                               : (heights(x, y + 1) - heights(x, y - 1)) * inv2);
-                gx(x, y) = dx;
-                gy(x, y) = dy;
-            }
-    }
+    computeGradient(heights, cellSize, gx, gy);  // the fast path's normals
     double heightMax = -std::numeric_limits<double>::infinity();
     for (int y = 0; y < ny; ++y)
         for (int x = 0; x < nx; ++x) heightMax = std::max(heightMax, static_cast<double>(heights(x, y)));
-    std::vector<double> cosA(static_cast<std::size_t>(M)), sinA(static_cast<std::size_t>(M));
-    std::vector<std::array<double, kShCount>> azim(static_cast<std::size_t>(M));
-    for (int a = 0; a < M; ++a) {
-        const double phi = 2.0 * kPi * (a + 0.5) / M;
-        cosA[static_cast<std::size_t>(a)] = std::cos(phi);
-        sinA[static_cast<std::size_t>(a)] = std::sin(phi);
-        for (int i = 0; i < kShCount; ++i) azim[static_cast<std::size_t>(a)][static_cast<std::size_t>(i)] = shAzimuthal(i, phi);
-    }
-    const ElevationTables* tables = lighting ? &elevationTables() : nullptr;
-    const double dphi = 2.0 * kPi / M;
+    const ReferenceAzimuths azimuths(M);
+    const ReferenceTexels texels{heights, cellSize, gx, gy, heightMax, azimuths,
+                                 lighting ? &elevationTables() : nullptr, lighting, albedo, 2.0 * kPi / M, out};
     const int stride = std::max(rs.stride, 1);
     const int yBegin = rs.border, yEnd = ny - rs.border;
-    std::atomic<int> rowsDone{0};
-    std::mutex printMutex;
     const int rowsTotal = std::max(0, (yEnd - yBegin + stride - 1) / stride);
+    RowProgress progress(rowsTotal);
 
     parallelFor(0, rowsTotal, 1, [&](int r0, int r1) {
         for (int r = r0; r < r1; ++r) {
             const int y = yBegin + r * stride;
-            for (int x = rs.border; x < nx - rs.border; x += stride) {
-                const double gxv = gx(x, y), gyv = gy(x, y);
-                const double inv = 1.0 / std::sqrt(1.0 + gxv * gxv + gyv * gyv);
-                const double nxv = -gxv * inv, nyv = -gyv * inv, nzv = inv;
-                double amb = 0.0;
-                double transfer[kShCount] = {};
-                for (int a = 0; a < M; ++a) {
-                    const double c = cosA[static_cast<std::size_t>(a)], s = sinA[static_cast<std::size_t>(a)];
-                    const double slope = referenceMaxSlope(heights, cellSize, x, y, c, s, heightMax);
-                    const double tangent = gxv * c + gyv * s;
-                    const double lo = std::atan(std::max(slope, tangent));
-                    const double horiz = nxv * c + nyv * s;
-                    const double sl = std::sin(lo), cl = std::cos(lo);
-                    amb += horiz * (0.5 * kPi - lo - sl * cl) * 0.5 + nzv * cl * cl * 0.5;
-                    if (tables) {
-                        double P[kShCount], Q[kShCount];
-                        tables->lookup(lo, P, Q);
-                        const auto& az = azim[static_cast<std::size_t>(a)];
-                        for (int i = 0; i < kShCount; ++i)
-                            transfer[i] += az[static_cast<std::size_t>(i)] * (horiz * P[i] + nzv * Q[i]);
-                    }
-                }
-                out.ambient(x, y) = static_cast<float>(amb * dphi / kPi);
-                if (tables)
-                    for (int ch = 0; ch < 3; ++ch) {
-                        double e = 0.0;
-                        for (int i = 0; i < kShCount; ++i)
-                            e += lighting->c[static_cast<std::size_t>(ch)][static_cast<std::size_t>(i)] * transfer[i];
-                        const float alb = albedo && !albedo->channel[static_cast<std::size_t>(ch)].empty()
-                                              ? albedo->channel[static_cast<std::size_t>(ch)](x, y)
-                                              : 1.0f;
-                        out.rgb[static_cast<std::size_t>(ch)](x, y) = static_cast<float>(alb * e * dphi / kPi);
-                    }
-            }
-            if (rs.progress) {
-                const int done = ++rowsDone;
-                const int pct = static_cast<int>(100LL * done / std::max(rowsTotal, 1));
-                const int prevPct = static_cast<int>(100LL * (done - 1) / std::max(rowsTotal, 1));
-                if (pct / 5 != prevPct / 5) {
-                    std::lock_guard<std::mutex> lock(printMutex);
-                    std::fprintf(stderr, "reference: %d%%\n", pct);
-                }
-            }
+            for (int x = rs.border; x < nx - rs.border; x += stride) shadeReferenceTexel(texels, x, y);
+            if (rs.progress) progress.rowDone();
         }
     });
 }

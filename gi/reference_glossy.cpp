@@ -1,5 +1,6 @@
 // The glossy ground truth (gi/reference_gi.h, renderReferenceGlossy): exact
 // visibility and first hits, the fast path's BRDFs and order-4 SH lighting.
+// Sections: Nowrouzezahrai & Snyder 2009.
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -18,8 +19,8 @@ namespace {
 // PP_ij(lo) = int_lo^{pi/2} A_i(sin w) A_j(sin w) cos w dw over lo in
 // [-pi/2, pi/2] (A_i the z part of Y_i, gi/sh.h): the elevation integral of a
 // product of two harmonics over the visible part of an azimuth. Tabulated
-// once (8-point Gauss-Legendre per interval, linear interpolation:
-// error < 1e-6 for kN = 2048).
+// once (8-point Gauss-Legendre per interval), interpolated linearly between
+// the kN + 1 tabulated angles.
 struct PairTables {
     static constexpr int kN = 2048;
     std::vector<double> t;  // (kN + 1) x 256
@@ -97,6 +98,165 @@ void reflect(const double n[3], const double w[3], double r[3]) {
     for (int a = 0; a < 3; ++a) r[a] = d * n[a] - w[a];
 }
 
+// The surface as the glossy reference reads it at a texel: normal from the
+// gradients, albedo and Phong lobe factors (uniform where the maps are empty).
+struct GlossySurface {
+    const Grid& gx;
+    const Grid& gy;
+    const AlbedoMap* surface;
+    double phUniform[kShOrder];
+    bool lobeMap;
+    GlossySurface(const Grid& gradX, const Grid& gradY, const AlbedoMap* map, const ShadingSettings& sh)
+        : gx(gradX), gy(gradY), surface(map), lobeMap(map && !map->phongLobe[0].empty()) {
+        float f[kShOrder];
+        phongLobeFactors(sh.phongExponent, f);
+        for (int l = 0; l < kShOrder; ++l) phUniform[l] = f[l];
+    }
+    float albedoAt(int c, std::size_t i) const {
+        const std::size_t ch = static_cast<std::size_t>(c);
+        return surface && !surface->channel[ch].empty() ? surface->channel[ch].v[i] : 1.0f;
+    }
+    void lobeAt(std::size_t i, double ph[kShOrder]) const {
+        for (int l = 0; l < kShOrder; ++l)
+            ph[l] = l > 0 && lobeMap ? surface->phongLobe[static_cast<std::size_t>(l - 1)].v[i] : phUniform[l];
+    }
+    // the lobe factors at a bilinear sample (a first hit)
+    void lobeAt(const Bilinear& bl, double ph[kShOrder]) const {
+        for (int l = 0; l < kShOrder; ++l)
+            ph[l] = l > 0 && lobeMap ? bl(surface->phongLobe[static_cast<std::size_t>(l - 1)].data()) : phUniform[l];
+    }
+    void normalAt(std::size_t i, double n[3]) const {
+        const double ddx = gx.v[i], ddy = gy.v[i];
+        const double inv = 1.0 / std::sqrt(1.0 + ddx * ddx + ddy * ddy);
+        n[0] = -ddx * inv;
+        n[1] = -ddy * inv;
+        n[2] = inv;
+    }
+};
+
+// Bounce 0: the exact Lambert part and the exact-cap key lights (D_0) and the
+// exact SH incident radiance (I_0); out.ambient from the direct reference,
+// out.direct / indirect sized (indirect zeroed).
+void directBounce(ConstGridView heights, float cellSize, const ShRgb& lighting, const AlbedoMap* surface,
+                  const ReferenceGiSettings& s, double wd, ReferenceGiResult& out, std::array<Grid, 3>& prevD,
+                  std::vector<float>& prevI) {
+    const int nx = heights.nx, ny = heights.ny;
+    const std::size_t plane = static_cast<std::size_t>(nx) * ny;
+    ReferenceSettings rs;
+    rs.azimuths = s.azimuths;
+    rs.progress = s.progress;
+    ReferenceResult d;
+    renderReference(heights, cellSize, &lighting, surface, rs, d);
+    out.ambient = d.ambient;
+    std::array<Grid, 3> keys;
+    for (Grid& g : keys) g.resize(nx, ny, 0.0f);
+    for (const KeyLight& k : s.keys) addReferenceKeyLight(heights, cellSize, k, surface, s.keyAzimuths, keys);
+    referenceIncidentSh(heights, cellSize, lighting, s.azimuths, prevI);
+    for (int c = 0; c < 3; ++c) {
+        prevD[c].resize(nx, ny);
+        out.direct[c].resize(nx, ny);
+        out.indirect[c].resize(nx, ny, 0.0f);
+        for (std::size_t i = 0; i < plane; ++i)
+            prevD[c].v[i] = static_cast<float>(wd * d.rgb[c].v[i] + keys[c].v[i]);
+    }
+}
+
+// Exit radiance towards the viewer of (D, I) at every texel, written to dst
+// (add: added to it).
+void towardsViewer(const GlossySurface& surf, const double view[3], double ws, const std::array<Grid, 3>& D,
+                   const std::vector<float>& I, std::array<Grid, 3>& dst, bool add) {
+    const int nx = surf.gx.nx, ny = surf.gx.ny;
+    const std::size_t plane = static_cast<std::size_t>(nx) * ny;
+    parallelFor(0, ny, 1, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < nx; ++x) {
+                const std::size_t i = static_cast<std::size_t>(y) * nx + x;
+                double n[3], r[3], ph[kShOrder], yR[kShCount];
+                surf.normalAt(i, n);
+                reflect(n, view, r);
+                basis(r[0], r[1], r[2], yR);
+                surf.lobeAt(i, ph);
+                for (int c = 0; c < 3; ++c) {
+                    const float* Ic = I.data() + static_cast<std::size_t>(c * kShCount) * plane + i;
+                    const double v = D[c].v[i] + ws * phongTowards(ph, yR, Ic, plane);
+                    dst[c].v[i] = static_cast<float>(add ? dst[c].v[i] + v : v);
+                }
+            }
+    });
+}
+
+// What one gathering bounce reads: the surface, the height field for the
+// first hits, the fixed directions and their SH basis, weights.
+struct GlossyGather {
+    const GlossySurface& surf;
+    const Grid& heights;
+    float hMax;
+    float cellSize;
+    const ReferenceGiSettings& s;
+    const std::vector<std::array<float, 3>>& dirs;
+    const std::vector<double>& dirBasis;  // Y(dirs[k]), kShCount each
+    double weight;                        // 4 pi / directions
+    double ws, wd;                        // specular and diffuse weights
+};
+
+// Radiance L[c] leaving the first hit `bl` towards the texel (direction -dir)
+// under the previous bounce (prevD, prevI).
+void radianceFromHit(const GlossyGather& g, const Bilinear& bl, const std::array<float, 3>& dir,
+                     const std::array<Grid, 3>& prevD, const std::vector<float>& prevI, double L[3]) {
+    const std::size_t plane = static_cast<std::size_t>(g.heights.nx) * g.heights.ny;
+    // q's normal, lobe and radiance towards p (direction -w)
+    const double ddx = bl(g.surf.gx.data()), ddy = bl(g.surf.gy.data());
+    const double inv = 1.0 / std::sqrt(1.0 + ddx * ddx + ddy * ddy);
+    const double nq[3] = {-ddx * inv, -ddy * inv, inv};
+    const double back[3] = {-dir[0], -dir[1], -dir[2]};
+    double r[3], yR[kShCount], ph[kShOrder];
+    reflect(nq, back, r);
+    basis(r[0], r[1], r[2], yR);
+    g.surf.lobeAt(bl, ph);
+    for (int c = 0; c < 3; ++c) {
+        L[c] = bl(prevD[c].data());
+        if (g.ws != 0.0) {
+            double sp = 0.0;
+            for (int j = 0; j < kShCount; ++j)
+                sp += ph[shBand(j)] * yR[j] * bl(prevI.data() + static_cast<std::size_t>(c * kShCount + j) * plane);
+            L[c] += g.ws * sp;
+        }
+    }
+}
+
+// One gathering bounce at texel (x, y): the previous bounce's radiance from
+// the first hits of the fixed directions, projected to SH (nextI) and
+// integrated against the cosine (the Lambert part, nextD).
+void gatherTexel(const GlossyGather& g, const std::array<Grid, 3>& prevD, const std::vector<float>& prevI, int x, int y,
+                 std::array<Grid, 3>& nextD, std::vector<float>& nextI) {
+    const int nx = g.heights.nx, ny = g.heights.ny;
+    const std::size_t plane = static_cast<std::size_t>(nx) * ny;
+    const std::size_t i = static_cast<std::size_t>(y) * nx + x;
+    double n[3];
+    g.surf.normalAt(i, n);
+    double I[3][kShCount] = {}, E[3] = {};
+    for (std::size_t k = 0; k < g.dirs.size(); ++k) {
+        const auto& dir = g.dirs[k];
+        const double cosine = n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2];
+        if (cosine <= 0.0) continue;
+        float qx, qy;
+        if (!referenceFirstHit(g.heights.data(), nx, ny, g.hMax, g.cellSize, x, y, dir, g.s.marchStep, qx, qy))
+            continue;
+        double L[3];
+        radianceFromHit(g, Bilinear(nx, ny, qx, qy), dir, prevD, prevI, L);
+        const double* yw = &g.dirBasis[k * kShCount];
+        for (int c = 0; c < 3; ++c) {
+            for (int j = 0; j < kShCount; ++j) I[c][j] += L[c] * yw[j];
+            E[c] += L[c] * cosine;
+        }
+    }
+    for (int c = 0; c < 3; ++c) {
+        for (int j = 0; j < kShCount; ++j)
+            nextI[static_cast<std::size_t>(c * kShCount + j) * plane + i] = static_cast<float>(g.weight * I[c][j]);
+        nextD[c].v[i] = static_cast<float>(g.wd * g.surf.albedoAt(c, i) / kPi * g.weight * E[c]);
+    }
+}
+
 }  // namespace
 
 void referenceIncidentSh(ConstGridView heights, float cellSize, const ShRgb& lighting, int azimuths, std::vector<float>& out) {
@@ -170,68 +330,14 @@ void renderReferenceGlossy(ConstGridView heights, float cellSize, const ShRgb& l
     const double view[3] = {sh.viewDir[0], sh.viewDir[1], sh.viewDir[2]};
     Grid gx, gy;
     computeGradient(heights, cellSize, gx, gy);
-    auto albedoAt = [&](int c, std::size_t i) {
-        return surface && !surface->channel[static_cast<std::size_t>(c)].empty() ? surface->channel[static_cast<std::size_t>(c)].v[i] : 1.0f;
-    };
-    double phUniform[kShOrder];
-    {
-        float f[kShOrder];
-        phongLobeFactors(sh.phongExponent, f);
-        for (int l = 0; l < kShOrder; ++l) phUniform[l] = f[l];
-    }
-    const bool lobeMap = surface && !surface->phongLobe[0].empty();
-    auto lobeAt = [&](std::size_t i, double ph[kShOrder]) {
-        for (int l = 0; l < kShOrder; ++l)
-            ph[l] = l > 0 && lobeMap ? surface->phongLobe[static_cast<std::size_t>(l - 1)].v[i] : phUniform[l];
-    };
-    auto normalAt = [&](std::size_t i, double n[3]) {
-        const double ddx = gx.v[i], ddy = gy.v[i];
-        const double inv = 1.0 / std::sqrt(1.0 + ddx * ddx + ddy * ddy);
-        n[0] = -ddx * inv;
-        n[1] = -ddy * inv;
-        n[2] = inv;
-    };
+    const GlossySurface surf(gx, gy, surface, sh);
 
     // ---- bounce 0: exact Lambert part + exact-cap keys (D_0), exact SH incident (I_0)
-    ReferenceSettings rs;
-    rs.azimuths = s.azimuths;
-    rs.progress = s.progress;
-    ReferenceResult d;
-    renderReference(heights, cellSize, &lighting, surface, rs, d);
-    out.ambient = d.ambient;
-    std::array<Grid, 3> keys;
-    for (Grid& g : keys) g.resize(nx, ny, 0.0f);
-    for (const KeyLight& k : s.keys) addReferenceKeyLight(heights, cellSize, k, surface, s.keyAzimuths, keys);
     std::vector<float> prevI, nextI(plane * 3 * kShCount);
-    referenceIncidentSh(heights, cellSize, lighting, s.azimuths, prevI);
     std::array<Grid, 3> prevD, nextD;
-    for (int c = 0; c < 3; ++c) {
-        prevD[c].resize(nx, ny);
-        out.direct[c].resize(nx, ny);
-        out.indirect[c].resize(nx, ny, 0.0f);
-        nextD[c].resize(nx, ny);
-        for (std::size_t i = 0; i < plane; ++i)
-            prevD[c].v[i] = static_cast<float>(wd * d.rgb[c].v[i] + keys[c].v[i]);
-    }
-    // exit radiance towards the viewer of (D, I) at texel i
-    auto towardsViewer = [&](const std::array<Grid, 3>& D, const std::vector<float>& I, std::array<Grid, 3>& dst, bool add) {
-        parallelFor(0, ny, 1, [&](int y0, int y1) {
-            for (int y = y0; y < y1; ++y)
-                for (int x = 0; x < nx; ++x) {
-                    const std::size_t i = static_cast<std::size_t>(y) * nx + x;
-                    double n[3], r[3], ph[kShOrder], yR[kShCount];
-                    normalAt(i, n);
-                    reflect(n, view, r);
-                    basis(r[0], r[1], r[2], yR);
-                    lobeAt(i, ph);
-                    for (int c = 0; c < 3; ++c) {
-                        const double v = D[c].v[i] + ws * phongTowards(ph, yR, I.data() + static_cast<std::size_t>(c * kShCount) * plane + i, plane);
-                        dst[c].v[i] = static_cast<float>(add ? dst[c].v[i] + v : v);
-                    }
-                }
-        });
-    };
-    towardsViewer(prevD, prevI, out.direct, false);
+    directBounce(heights, cellSize, lighting, surface, s, wd, out, prevD, prevI);
+    for (int c = 0; c < 3; ++c) nextD[c].resize(nx, ny);
+    towardsViewer(surf, view, ws, prevD, prevI, out.direct, false);
 
     // ---- bounces 1..B: gather (D, I) of the previous bounce at the first hits
     if (nx >= 2 && ny >= 2 && s.bounces > 0) {
@@ -243,54 +349,14 @@ void renderReferenceGlossy(ConstGridView heights, float cellSize, const ShRgb& l
         referenceDirections(s.directions, dirs);
         std::vector<double> dirBasis(dirs.size() * kShCount);
         for (std::size_t k = 0; k < dirs.size(); ++k) basis(dirs[k][0], dirs[k][1], dirs[k][2], &dirBasis[k * kShCount]);
-        const double weight = 4.0 * kPi / s.directions;
+        const GlossyGather gather{surf, hCopy, hMax, cellSize, s, dirs, dirBasis, 4.0 * kPi / s.directions, ws, wd};
         for (int b = 1; b <= s.bounces; ++b) {
             if (s.progress) std::fprintf(stderr, "glossy reference: bounce %d of %d\n", b, s.bounces);
             parallelFor(0, ny, 1, [&](int y0, int y1) {
                 for (int y = y0; y < y1; ++y)
-                    for (int x = 0; x < nx; ++x) {
-                        const std::size_t i = static_cast<std::size_t>(y) * nx + x;
-                        double n[3];
-                        normalAt(i, n);
-                        double I[3][kShCount] = {}, E[3] = {};
-                        for (std::size_t k = 0; k < dirs.size(); ++k) {
-                            const auto& dir = dirs[k];
-                            const double cosine = n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2];
-                            if (cosine <= 0.0) continue;
-                            float qx, qy;
-                            if (!referenceFirstHit(hCopy.data(), nx, ny, hMax, cellSize, x, y, dir, s.marchStep, qx, qy)) continue;
-                            const Bilinear bl(nx, ny, qx, qy);
-                            // q's normal, lobe and radiance towards p (direction -w)
-                            const double ddx = bl(gx.data()), ddy = bl(gy.data());
-                            const double inv = 1.0 / std::sqrt(1.0 + ddx * ddx + ddy * ddy);
-                            const double nq[3] = {-ddx * inv, -ddy * inv, inv};
-                            const double back[3] = {-dir[0], -dir[1], -dir[2]};
-                            double r[3], yR[kShCount], ph[kShOrder];
-                            reflect(nq, back, r);
-                            basis(r[0], r[1], r[2], yR);
-                            for (int l = 0; l < kShOrder; ++l)
-                                ph[l] = l > 0 && lobeMap ? bl(surface->phongLobe[static_cast<std::size_t>(l - 1)].data()) : phUniform[l];
-                            const double* yw = &dirBasis[k * kShCount];
-                            for (int c = 0; c < 3; ++c) {
-                                double L = bl(prevD[c].data());
-                                if (ws != 0.0) {
-                                    double sp = 0.0;
-                                    for (int j = 0; j < kShCount; ++j)
-                                        sp += ph[shBand(j)] * yR[j] * bl(prevI.data() + static_cast<std::size_t>(c * kShCount + j) * plane);
-                                    L += ws * sp;
-                                }
-                                for (int j = 0; j < kShCount; ++j) I[c][j] += L * yw[j];
-                                E[c] += L * cosine;
-                            }
-                        }
-                        for (int c = 0; c < 3; ++c) {
-                            for (int j = 0; j < kShCount; ++j)
-                                nextI[static_cast<std::size_t>(c * kShCount + j) * plane + i] = static_cast<float>(weight * I[c][j]);
-                            nextD[c].v[i] = static_cast<float>(wd * albedoAt(c, i) / kPi * weight * E[c]);
-                        }
-                    }
+                    for (int x = 0; x < nx; ++x) gatherTexel(gather, prevD, prevI, x, y, nextD, nextI);
             });
-            towardsViewer(nextD, nextI, out.indirect, true);
+            towardsViewer(surf, view, ws, nextD, nextI, out.indirect, true);
             std::swap(prevI, nextI);
             std::swap(prevD, nextD);
         }

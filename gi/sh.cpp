@@ -113,32 +113,36 @@ void phongZonal(double exponent, double zh[kShOrder]) {
         zh[l] = std::exp(-static_cast<double>(l * l) / (2.0 * exponent)) / std::sqrt(4.0 * kPi / (2.0 * l + 1.0));
 }
 
+namespace {
+
+// P_n(x) by the three-term recurrence k P_k = (2k - 1) x P_{k-1} - (k - 1) P_{k-2},
+// and its derivative P_n'(x) = n (x P_n - P_{n-1}) / (x^2 - 1).
+struct LegendreAt {
+    double p, dp;
+};
+LegendreAt legendreAt(int n, double x) {
+    double p0 = 1.0, p1 = x;
+    for (int k = 2; k <= n; ++k) {
+        const double p2 = ((2.0 * k - 1.0) * x * p1 - (k - 1.0) * p0) / k;
+        p0 = p1;
+        p1 = p2;
+    }
+    return {p1, n * (x * p1 - p0) / (x * x - 1.0)};
+}
+
+}  // namespace
+
 void gaussLegendre(int n, double* nodes, double* weights) {
     // Newton iteration on P_n from Chebyshev starting points.
     for (int i = 0; i < n; ++i) {
         double x = std::cos(kPi * (i + 0.75) / (n + 0.5));
-        double dp = 1.0;
         for (int it = 0; it < 100; ++it) {
-            double p0 = 1.0, p1 = x;
-            for (int k = 2; k <= n; ++k) {
-                const double p2 = ((2.0 * k - 1.0) * x * p1 - (k - 1.0) * p0) / k;
-                p0 = p1;
-                p1 = p2;
-            }
-            if (n == 1) { p1 = x; p0 = 1.0; }
-            dp = n * (x * p1 - p0) / (x * x - 1.0);
-            const double dx = p1 / dp;
+            const LegendreAt l = legendreAt(n, x);
+            const double dx = l.p / l.dp;
             x -= dx;
             if (std::abs(dx) < 1e-16) break;
         }
-        double p0 = 1.0, p1 = x;
-        for (int k = 2; k <= n; ++k) {
-            const double p2 = ((2.0 * k - 1.0) * x * p1 - (k - 1.0) * p0) / k;
-            p0 = p1;
-            p1 = p2;
-        }
-        if (n == 1) { p1 = x; p0 = 1.0; }
-        dp = n * (x * p1 - p0) / (x * x - 1.0);
+        const double dp = legendreAt(n, x).dp;
         nodes[i] = x;
         weights[i] = 2.0 / ((1.0 - x * x) * dp * dp);
     }

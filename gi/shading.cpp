@@ -43,7 +43,7 @@ void setPhongExponentMap(AlbedoMap& map, const Grid& exponent) {
 namespace {
 
 // Kernels over the lane type V: F4 (SSE2) or F8 (AVX2, chosen at run time),
-// sim/simd.h; lane-wise IEEE operations, so each texel gets exactly the
+// core/simd.h; lane-wise IEEE operations, so each texel gets exactly the
 // scalar result either way.
 using simd::load;
 using simd::splat;
@@ -255,40 +255,25 @@ void incidentRowSse(const ShadingLight* lights, int nl, int nCoef, int nxr, std:
     incidentRowImpl<F8>(lights, nl, nCoef, nxr, planeR, out, Y);
 }
 
-}  // namespace
-
-AlbedoMap uniformAlbedo(int nx, int ny, float albedo) {
-    AlbedoMap m;
-    for (Grid& c : m.channel) c.resize(nx, ny, albedo);
-    return m;
-}
-
-void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const VisibilityField& env,
-                 const ShadingLight* lights, int lightCount, const AlbedoMap* albedo, const ShadingSettings& settings,
-                 ShadeMaps& out, bool ambient) {
-    const int nx = gradX.nx, ny = gradX.ny;
-    const int nxr = env.nxr, nyr = env.nyr;
-    const std::size_t planeR = static_cast<std::size_t>(nxr) * nyr;
-    const bool phong = settings.brdf != Brdf::Lambert;
-    const int nCoef = phong ? kShCount : 9;
+// ---- setup ----------------------------------------------------------------------
+void sizeShadeMaps(int nx, int ny, std::size_t incidentSize, bool ambient, std::size_t rowScratchSize,
+                   std::size_t basisScratchSize, ShadeMaps& out) {
     out.nx = nx;
     out.ny = ny;
     for (Grid& g : out.rgb)
         if (g.nx != nx || g.ny != ny) g.resize(nx, ny);
     if (!ambient) out.ambient = Grid{};
     else if (out.ambient.nx != nx || out.ambient.ny != ny) out.ambient.resize(nx, ny);
-    out.incident.resize(planeR * 3 * nCoef);
-    const int nPlanes = 3 * nCoef + (ambient ? 9 : 0);  // incident radiance + V_env bands 0..2 (ambient)
-    const int nBlocks = std::max(1, std::min(ny, 64));
-    const int nxrS = nxr + 8;  // vertical scratch rows padded for 8-wide reads
-    out.rowScratch.resize(static_cast<std::size_t>(nBlocks) * nPlanes * (nxrS + nx));
-    out.basisScratch.resize(static_cast<std::size_t>(nBlocks) * 24 * nx);
-
+    out.incident.resize(incidentSize);
+    out.rowScratch.resize(rowScratchSize);
+    out.basisScratch.resize(basisScratchSize);
     out.colIndex.resize(static_cast<std::size_t>(nx));
     out.colFrac.resize(static_cast<std::size_t>(nx));
+}
 
-    // lighting matrices in float
-    const int nl = lightCount;
+// The lights' lighting matrices in float, and for each output coefficient of
+// I_c = sum_L T_{L,c} V_L its non-zero matrix entries (incidentRowImpl).
+void buildIncidentTerms(const ShadingLight* lights, int nl, int nCoef, ShadeMaps& out) {
     out.lightMatrices.resize(static_cast<std::size_t>(nl) * 3 * kShCount * kShCount);
     for (int L = 0; L < nl; ++L)
         for (int ch = 0; ch < 3; ++ch)
@@ -296,8 +281,6 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
                 out.lightMatrices[(static_cast<std::size_t>(L) * 3 + ch) * kShCount * kShCount + e] =
                     static_cast<float>(lights[L].product[static_cast<std::size_t>(ch)][static_cast<std::size_t>(e)]);
 
-    // ---- algorithm, receivers: incident radiance I_c = sum_L T_{L,c} V_L ------
-    // (incidentRowImpl) over the non-zero matrix entries of each output coefficient
     out.incidentTerms.clear();
     out.incidentTermStart.assign(static_cast<std::size_t>(3 * nCoef + 1), 0);
     for (int ch = 0; ch < 3; ++ch)
@@ -314,9 +297,150 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
                 }
             out.incidentTermStart[static_cast<std::size_t>(ch * nCoef + i + 1)] = static_cast<int>(out.incidentTerms.size());
         }
+}
+
+// ---- Phong rows (Brdf::Phong, LambertPlusPhong) --------------------------------
+// One full-resolution row: the SH planes interpolated to the row
+// (interpolatePlanesToRow), the Lambert part at each texel's normal and the
+// Phong lobe about its reflection vector (phongShadeRow).
+struct PhongRowJob {
+    LambertRowJob base;          // planes, sizes, tables, Lambert factors, diffuse weight, albedo, out
+    float phUniform[kShOrder];   // the uniform lobe factors (phongLobeFactors of the settings)
+    float specWeight;
+    float view[3];               // unit vector towards the viewer
+};
+
+// ---- algorithm: SH vectors interpolated to row y (Fig. 7) ----
+// vert: each plane's row at the receivers (planes nxrS apart); up: the same
+// at every texel of the row (planes nx apart).
+void interpolatePlanesToRow(const LambertRowJob& j, int y, float* vert, float* up) {
+    const int nxr = j.nxr, nxrS = j.nxrS, s = j.s, nCoef = j.nCoef, nx = j.nx;
+    const int nPlanes = 3 * nCoef + (j.env ? 9 : 0);
+    const ReceiverLerp ry = receiverLerp(y, s, j.nyr);
+    const int Y0 = ry.i0, Y1 = ry.i1;
+    const float fy = ry.f;
+    for (int p = 0; p < nPlanes; ++p) {
+        const float* plane = p < 3 * nCoef ? j.incident + static_cast<std::size_t>(p) * j.planeR
+                                           : j.env->plane(p - 3 * nCoef);
+        const float* __restrict ra = plane + static_cast<std::size_t>(Y0) * nxr;
+        const float* __restrict rb = plane + static_cast<std::size_t>(Y1) * nxr;
+        float* __restrict v = vert + static_cast<std::size_t>(p) * nxrS;
+        for (int X = 0; X < nxr; ++X) v[X] = ra[X] + fy * (rb[X] - ra[X]);
+        for (int X = nxr; X < nxrS; ++X) v[X] = 0.0f;
+        float* __restrict u = up + static_cast<std::size_t>(p) * nx;
+        if (s == 1) {
+            std::copy(v, v + nx, u);
+        } else {
+            // texels s X + k share the weights k / s
+            for (int k = 0; k < s; ++k) {
+                const float fx = static_cast<float>(k) / static_cast<float>(s);
+                for (int X = 0; X + 1 < nxr && s * X + k < nx; ++X) u[s * X + k] = v[X] + fx * (v[X + 1] - v[X]);
+            }
+            for (int x = s * std::max(nxr - 1, 0); x < nx; ++x) {
+                const int X0 = j.colIndex[static_cast<std::size_t>(x)];
+                const int X1 = std::min(X0 + 1, nxr - 1);
+                const float fx = j.colFrac[static_cast<std::size_t>(x)];
+                u[x] = v[X0] + fx * (v[X1] - v[X0]);
+            }
+        }
+    }
+}
+
+// ---- algorithm: rotated BRDF at each full-resolution normal -----
+// lamRow: the clamped-cosine zonal vector turned to each texel's normal (9 x nx).
+void lambertBasisRow(const LambertFactors& lf, const float* __restrict gxr, const float* __restrict gyr, int nx,
+                     float* __restrict lamRow) {
+    for (int x = 0; x < nx; ++x) {
+        const float gx = gxr[x], gy = gyr[x];
+        const float inv = 1.0f / std::sqrt(1.0f + gx * gx + gy * gy);
+        const float X = -gx * inv, Yn = -gy * inv, Z = inv;
+        float lam[9];
+        lambertAtNormal(lf, X, Yn, Z, lam);
+        for (int i = 0; i < 9; ++i) lamRow[static_cast<std::size_t>(i) * nx + x] = lam[i];
+    }
+}
+
+// o[x] += specWeight * (Phong lobe about texel x's reflection vector) . I_ch (Section 7).
+void addPhongLobe(const PhongRowJob& j, const float* __restrict gxr, const float* __restrict gyr,
+                  const float* __restrict up, int ch, int y, float* __restrict o) {
+    const int nx = j.base.nx, nCoef = j.base.nCoef;
+    const float vx = j.view[0], vy = j.view[1], vz = j.view[2];
+    for (int x = 0; x < nx; ++x) {
+        const float gx = gxr[x], gy = gyr[x];
+        const float inv = 1.0f / std::sqrt(1.0f + gx * gx + gy * gy);
+        const float nxv = -gx * inv, nyv = -gy * inv, nzv = inv;
+        const float nv = nxv * vx + nyv * vy + nzv * vz;
+        float ph[kShOrder];  // the texel's exponent (AlbedoMap::phongExponent) or the uniform one
+        texelPhongLobe(j.base.albedo, static_cast<std::size_t>(y) * nx + x, j.phUniform, ph);
+        float yb[kShCount];
+        shBasisLanes(2.0f * nv * nxv - vx, 2.0f * nv * nyv - vy, 2.0f * nv * nzv - vz, yb, kShCount);
+        float sp = 0.0f;
+        for (int i = 0; i < kShCount; ++i)
+            sp += ph[shBand(i)] * yb[i] * up[static_cast<std::size_t>(ch * nCoef + i) * nx + x];
+        o[x] += j.specWeight * sp;
+    }
+}
+
+// Ambient and RGB of row y from the row's SH planes `up` and its Lambert basis
+// `lamRow` (lambertBasisRow).
+void phongShadeRow(const PhongRowJob& j, const float* __restrict gxr, const float* __restrict gyr,
+                   const float* __restrict lamRow, const float* __restrict up, int y) {
+    const int nx = j.base.nx, nCoef = j.base.nCoef;
+    ShadeMaps& out = *j.base.out;
+    const AlbedoMap* albedo = j.base.albedo;
+    float* __restrict amb = j.base.env ? out.ambient.data() + static_cast<std::size_t>(y) * nx : nullptr;
+    if (amb)
+        for (int x = 0; x < nx; ++x) amb[x] = 0.0f;
+    for (int i = 0; i < (amb ? 9 : 0); ++i) {
+        const float* __restrict l = lamRow + static_cast<std::size_t>(i) * nx;
+        const float* __restrict u = up + static_cast<std::size_t>(3 * nCoef + i) * nx;
+        for (int x = 0; x < nx; ++x) amb[x] += l[x] * u[x];
+    }
+    for (int ch = 0; ch < 3; ++ch) {
+        float* __restrict o = out.rgb[static_cast<std::size_t>(ch)].data() + static_cast<std::size_t>(y) * nx;
+        for (int x = 0; x < nx; ++x) o[x] = 0.0f;
+        for (int i = 0; i < 9; ++i) {
+            const float* __restrict l = lamRow + static_cast<std::size_t>(i) * nx;
+            const float* __restrict u = up + static_cast<std::size_t>(ch * nCoef + i) * nx;
+            for (int x = 0; x < nx; ++x) o[x] += l[x] * u[x];
+        }
+        const Grid* a = albedo && !albedo->channel[static_cast<std::size_t>(ch)].empty()
+                            ? &albedo->channel[static_cast<std::size_t>(ch)]
+                            : nullptr;
+        for (int x = 0; x < nx; ++x) o[x] *= j.base.diffuseWeight * (a ? (*a)(x, y) : 1.0f);
+        addPhongLobe(j, gxr, gyr, up, ch, y, o);
+        for (int x = 0; x < nx; ++x) o[x] = std::isfinite(o[x]) ? o[x] : 0.0f;
+    }
+}
+
+}  // namespace
+
+AlbedoMap uniformAlbedo(int nx, int ny, float albedo) {
+    AlbedoMap m;
+    for (Grid& c : m.channel) c.resize(nx, ny, albedo);
+    return m;
+}
+
+void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const VisibilityField& env,
+                 const ShadingLight* lights, int lightCount, const AlbedoMap* albedo, const ShadingSettings& settings,
+                 ShadeMaps& out, bool ambient) {
+    const int nx = gradX.nx, ny = gradX.ny;
+    const int nxr = env.nxr, nyr = env.nyr;
+    const std::size_t planeR = static_cast<std::size_t>(nxr) * nyr;
+    const bool phong = settings.brdf != Brdf::Lambert;
+    const int nCoef = phong ? kShCount : 9;
+    const int nPlanes = 3 * nCoef + (ambient ? 9 : 0);  // incident radiance + V_env bands 0..2 (ambient)
+    const int nBlocks = std::max(1, std::min(ny, 64));
+    const int nxrS = nxr + 8;  // vertical scratch rows padded for 8-wide reads
+    sizeShadeMaps(nx, ny, planeR * 3 * nCoef, ambient, static_cast<std::size_t>(nBlocks) * nPlanes * (nxrS + nx),
+                  static_cast<std::size_t>(nBlocks) * 24 * nx, out);
+
+    // ---- algorithm, receivers: incident radiance I_c = sum_L T_{L,c} V_L ------
+    buildIncidentTerms(lights, lightCount, nCoef, out);
     const bool wide = simd::wideEnabled();
     parallelForRows(nyr, nxr * 16, [&](int y0, int y1) {
-        for (int Y = y0; Y < y1; ++Y) (wide ? incidentRowAvx2 : incidentRowSse)(lights, nl, nCoef, nxr, planeR, out, Y);
+        for (int Y = y0; Y < y1; ++Y)
+            (wide ? incidentRowAvx2 : incidentRowSse)(lights, lightCount, nCoef, nxr, planeR, out, Y);
     });
 
     // ---- interpolation tables (receiver X sits at column s X) -----------------
@@ -327,14 +451,13 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
     }
 
     const LambertFactors lf = lambertFactors();
-    float phUniform[kShOrder];
-    phongLobeFactors(settings.phongExponent, phUniform);
     const float diffuseWeight = settings.brdf == Brdf::Phong ? 0.0f : 1.0f;
-    const float specWeight = specularWeightOf(settings);
-    const float vx = settings.viewDir[0], vy = settings.viewDir[1], vz = settings.viewDir[2];
     const LambertRowJob lambertJob{out.incident.data(), ambient ? &env : nullptr, planeR, nxr, nyr, nxrS, s, nCoef, nx,
                                    out.colIndex.data(), out.colFrac.data(), lf, diffuseWeight, albedo, &out};
     const auto lambertShadeRow = wide ? lambertShadeRowAvx2 : lambertShadeRowSse;
+    PhongRowJob phongJob{lambertJob, {}, specularWeightOf(settings),
+                         {settings.viewDir[0], settings.viewDir[1], settings.viewDir[2]}};
+    phongLobeFactors(settings.phongExponent, phongJob.phUniform);
 
     // ---- schedule: fixed row blocks, each with its own scratch ---------------
     parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
@@ -349,85 +472,9 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
                     lambertShadeRow(lambertJob, vert, gradX.row(y), gradY.row(y), y);
                     continue;
                 }
-                // ---- algorithm: SH vectors interpolated to this row (Fig. 7) ----
-                const ReceiverLerp ry = receiverLerp(y, s, nyr);
-                const int Y0 = ry.i0, Y1 = ry.i1;
-                const float fy = ry.f;
-                for (int p = 0; p < nPlanes; ++p) {
-                    const float* plane = p < 3 * nCoef ? out.incident.data() + static_cast<std::size_t>(p) * planeR
-                                                       : env.plane(p - 3 * nCoef);
-                    const float* __restrict ra = plane + static_cast<std::size_t>(Y0) * nxr;
-                    const float* __restrict rb = plane + static_cast<std::size_t>(Y1) * nxr;
-                    float* __restrict v = vert + static_cast<std::size_t>(p) * nxrS;
-                    for (int X = 0; X < nxr; ++X) v[X] = ra[X] + fy * (rb[X] - ra[X]);
-                    for (int X = nxr; X < nxrS; ++X) v[X] = 0.0f;
-                    float* __restrict u = up + static_cast<std::size_t>(p) * nx;
-                    if (s == 1) {
-                        std::copy(v, v + nx, u);
-                    } else {
-                        // texels s X + k share the weights k / s
-                        for (int k = 0; k < s; ++k) {
-                            const float fx = static_cast<float>(k) / static_cast<float>(s);
-                            for (int X = 0; X + 1 < nxr && s * X + k < nx; ++X) u[s * X + k] = v[X] + fx * (v[X + 1] - v[X]);
-                        }
-                        for (int x = s * std::max(nxr - 1, 0); x < nx; ++x) {
-                            const int X0 = out.colIndex[static_cast<std::size_t>(x)];
-                            const int X1 = std::min(X0 + 1, nxr - 1);
-                            const float fx = out.colFrac[static_cast<std::size_t>(x)];
-                            u[x] = v[X0] + fx * (v[X1] - v[X0]);
-                        }
-                    }
-                }
-                // ---- algorithm: rotated BRDF at each full-resolution normal -----
-                const float* __restrict gxr = gradX.row(y);
-                const float* __restrict gyr = gradY.row(y);
-                float* __restrict lamRow = basis;  // 9 x nx
-                for (int x = 0; x < nx; ++x) {
-                    const float gx = gxr[x], gy = gyr[x];
-                    const float inv = 1.0f / std::sqrt(1.0f + gx * gx + gy * gy);
-                    const float X = -gx * inv, Yn = -gy * inv, Z = inv;
-                    float lam[9];
-                    lambertAtNormal(lf, X, Yn, Z, lam);
-                    for (int i = 0; i < 9; ++i) lamRow[static_cast<std::size_t>(i) * nx + x] = lam[i];
-                }
-                float* __restrict amb = ambient ? out.ambient.data() + static_cast<std::size_t>(y) * nx : nullptr;
-                if (amb)
-                    for (int x = 0; x < nx; ++x) amb[x] = 0.0f;
-                for (int i = 0; i < (amb ? 9 : 0); ++i) {
-                    const float* __restrict l = lamRow + static_cast<std::size_t>(i) * nx;
-                    const float* __restrict u = up + static_cast<std::size_t>(3 * nCoef + i) * nx;
-                    for (int x = 0; x < nx; ++x) amb[x] += l[x] * u[x];
-                }
-                for (int ch = 0; ch < 3; ++ch) {
-                    float* __restrict o = out.rgb[static_cast<std::size_t>(ch)].data() + static_cast<std::size_t>(y) * nx;
-                    for (int x = 0; x < nx; ++x) o[x] = 0.0f;
-                    for (int i = 0; i < 9; ++i) {
-                        const float* __restrict l = lamRow + static_cast<std::size_t>(i) * nx;
-                        const float* __restrict u = up + static_cast<std::size_t>(ch * nCoef + i) * nx;
-                        for (int x = 0; x < nx; ++x) o[x] += l[x] * u[x];
-                    }
-                    const Grid* a = albedo && !albedo->channel[static_cast<std::size_t>(ch)].empty()
-                                        ? &albedo->channel[static_cast<std::size_t>(ch)]
-                                        : nullptr;
-                    for (int x = 0; x < nx; ++x) o[x] *= diffuseWeight * (a ? (*a)(x, y) : 1.0f);
-                    if (phong) {
-                        // Phong lobe about the reflection vector (Section 7)
-                        for (int x = 0; x < nx; ++x) {
-                            const float gx = gxr[x], gy = gyr[x];
-                            const float inv = 1.0f / std::sqrt(1.0f + gx * gx + gy * gy);
-                            const float nxv = -gx * inv, nyv = -gy * inv, nzv = inv;
-                            const float nv = nxv * vx + nyv * vy + nzv * vz;
-                            float ph[kShOrder];  // the texel's exponent (AlbedoMap::phongExponent) or the uniform one
-                            texelPhongLobe(albedo, static_cast<std::size_t>(y) * nx + x, phUniform, ph);
-                            float yb[kShCount];
-                            shBasisLanes(2.0f * nv * nxv - vx, 2.0f * nv * nyv - vy, 2.0f * nv * nzv - vz, yb, kShCount);
-                            float sp = 0.0f;
-                            for (int i = 0; i < kShCount; ++i) sp += ph[shBand(i)] * yb[i] * up[static_cast<std::size_t>(ch * nCoef + i) * nx + x];
-                            o[x] += specWeight * sp;
-                        }
-                    }
-                    for (int x = 0; x < nx; ++x) o[x] = std::isfinite(o[x]) ? o[x] : 0.0f;
-                }
+                interpolatePlanesToRow(phongJob.base, y, vert, up);
+                lambertBasisRow(lf, gradX.row(y), gradY.row(y), nx, basis);
+                phongShadeRow(phongJob, gradX.row(y), gradY.row(y), basis, up, y);
             }
         }
     });

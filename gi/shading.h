@@ -1,5 +1,6 @@
 #pragma once
-// Shading in SH (Section 7) with sub-sampling (Fig. 7).
+// Shading in SH (Nowrouzezahrai & Snyder 2009, Section 7) with sub-sampling
+// (Fig. 7).
 //
 // Direct light: the incident radiance of a light is the SH product of its
 // radiance L and the visibility V it sees (a triple product; the 16 x 16
@@ -47,7 +48,7 @@ struct AlbedoMap {
 
 /// The Phong lobe's per-band factors as shading applies them:
 /// ph[l] = float(sqrt(4 pi / (2l+1)) zh_l) with zh = phongZonal(exponent),
-/// i.e. e^{-l^2 / (2 S)} (Section 7, [RH02]).
+/// i.e. e^{-l^2 / (2 S)} (Section 7; Ramamoorthi & Hanrahan 2002).
 void phongLobeFactors(double exponent, float ph[kShOrder]);
 
 /// Sets the per-texel Phong exponent map (and its lobe factors). Throws

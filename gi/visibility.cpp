@@ -126,7 +126,7 @@ inline float sampleSlope(const ScanStep& st, std::ptrdiff_t index, float h0) {
 // `valid` are (the others' rays have left the domain; their s is garbage); the
 // kernel calls some() once more at i = (longest sequence) with no lane valid,
 // so a visitor can close what is still open. steps: each lane's sequence length.
-// Lane type V: F4 (SSE2) or F8 (AVX2), sim/simd.h; the same lane-wise
+// Lane type V: F4 (SSE2) or F8 (AVX2), core/simd.h; the same lane-wise
 // operations either way.
 
 // Plain maximum over the samples.
@@ -415,6 +415,134 @@ template <class V>
 void rowBatchSse(const RowBatch& r) { rowBatchImpl<simd::F4>(r); }
 [[gnu::target("avx2"), gnu::flatten]] void rowBatchAvx2(const RowBatch& r) { rowBatchImpl<simd::F8>(r); }
 
+// ---- per frame: the step table and the valid-prefix lengths -----------------
+// Step table of azimuth j (cos c, sin sn) and the valid-prefix length of each
+// receiver column and row.
+void buildAzimuthSteps(const HeightPyramid& pyr, int j, double c, double sn, int nxrPad, VisibilityState& state) {
+    const int nxr = pyr.nxr, nyr = pyr.nyr;
+    const int nSteps = static_cast<int>(pyr.steps.size());
+    const std::size_t base = static_cast<std::size_t>(j) * nSteps;
+    int* vc = state.validColumns.data() + 2 * base;
+    int* vr = state.validRows.data() + 2 * base;
+    for (int i = 0; i < nSteps; ++i) {
+        const StepGeometry g = makeStep(pyr, i, c, sn);
+        state.steps[base + static_cast<std::size_t>(i)] = g.step;
+        vc[2 * i] = g.xFirst;
+        vc[2 * i + 1] = g.xLast;
+        vr[2 * i] = g.yFirst;
+        vr[2 * i + 1] = g.yLast;
+    }
+    // a receiver's sequence is the prefix of steps before its first invalid one
+    int* colSteps = state.stepsPerColumn.data() + static_cast<std::size_t>(j) * nxrPad;
+    for (int X = 0; X < nxrPad; ++X) {
+        int n = 0;
+        if (X < nxr)
+            while (n < nSteps && vc[2 * n] <= X && X <= vc[2 * n + 1]) ++n;
+        colSteps[X] = n;
+    }
+    int* rowSteps = state.stepsPerRow.data() + static_cast<std::size_t>(j) * nyr;
+    for (int Y = 0; Y < nyr; ++Y) {
+        int n = 0;
+        while (n < nSteps && vr[2 * n] <= Y && Y <= vr[2 * n + 1]) ++n;
+        rowSteps[Y] = n;
+    }
+}
+
+// The step tables of every azimuth of op, and each azimuth's cos and sin in float.
+void buildStepTables(const HeightPyramid& pyr, const FoldedWedgeOperator& op, int nxrPad, VisibilityState& state) {
+    const int m = op.azimuths, nyr = pyr.nyr;
+    const int nSteps = static_cast<int>(pyr.steps.size());
+    const std::size_t tableSize = static_cast<std::size_t>(m) * nSteps;
+    state.steps.resize(tableSize);
+    state.validColumns.resize(2 * tableSize);
+    state.validRows.resize(2 * tableSize);
+    state.stepsPerColumn.resize(static_cast<std::size_t>(m) * nxrPad);
+    state.stepsPerRow.resize(static_cast<std::size_t>(m) * nyr);
+    parallelFor(0, m, 1, [&](int j0, int j1) {
+        for (int j = j0; j < j1; ++j) {
+            const double c = std::cos(op.phi[static_cast<std::size_t>(j)]);
+            const double sn = std::sin(op.phi[static_cast<std::size_t>(j)]);
+            buildAzimuthSteps(pyr, j, c, sn, nxrPad, state);
+        }
+    });
+
+    state.cosSin.resize(2 * static_cast<std::size_t>(m));
+    for (int j = 0; j < m; ++j) {
+        const double phi = op.phi[static_cast<std::size_t>(j)];
+        state.cosSin[2 * static_cast<std::size_t>(j)] = static_cast<float>(std::cos(phi));
+        state.cosSin[2 * static_cast<std::size_t>(j) + 1] = static_cast<float>(std::sin(phi));
+    }
+}
+
+void resizeBlockScratch(int nBlocks, int nxrPad, int nSteps, VisibilityState& state) {
+    state.blocks.resize(static_cast<std::size_t>(nBlocks));
+    for (VisibilityScratch& b : state.blocks) {
+        b.maxRow.resize(static_cast<std::size_t>(nxrPad));
+        b.gradX.resize(static_cast<std::size_t>(3) * nxrPad);  // receiver, footprint lo, hi
+        b.gradY.resize(static_cast<std::size_t>(3) * nxrPad);
+        b.h0.resize(static_cast<std::size_t>(nxrPad));
+        b.nlp.resize(static_cast<std::size_t>(8) * nxrPad);
+        b.rowPtr.resize(2 * static_cast<std::size_t>(nSteps));
+    }
+}
+
+// ---- per receiver row ----------------------------------------------------------
+// What every receiver row of one computeVisibility call reads and writes.
+struct VisibilityRows {
+    const HeightPyramid& pyr;
+    ConstGridView gradX, gradY;
+    const VisibilitySettings& settings;
+    const VisibilityTarget& target;
+    const FootprintBox* box;  // footprint box (sub-sampling) or null: the receiver's own tangent plane
+    VisibilityState& state;
+    VisibilityField& out;
+    int nxrPad, nSteps;
+    void (*rowBatch)(const RowBatch&);  // rowBatchSse or rowBatchAvx2
+};
+
+// h0 and the height gradients of receiver row Y into the block's scratch
+// (padding lanes: 0), and the footprint box rows, padded the same way.
+void loadReceiverRow(const VisibilityRows& r, int Y, VisibilityScratch& sc) {
+    const int nxr = r.pyr.nxr, s = r.pyr.subsample, nxrPad = r.nxrPad;
+    const float* hRow = r.pyr.rawPhaseRow(0, s * Y);
+    for (int X = 0; X < nxrPad; ++X) {
+        const bool in = X < nxr;
+        sc.gradX[static_cast<std::size_t>(X)] = in ? r.gradX(s * X, s * Y) : 0.0f;
+        sc.gradY[static_cast<std::size_t>(X)] = in ? r.gradY(s * X, s * Y) : 0.0f;
+    }
+    for (int X = 0; X < nxrPad; ++X) sc.h0[static_cast<std::size_t>(X)] = X < nxr ? hRow[X] : 0.0f;
+    if (r.box) {
+        const FootprintBox* box = r.box;
+        const std::size_t at = static_cast<std::size_t>(Y) * nxr;
+        float* loX = sc.gradX.data() + nxrPad;
+        float* loY = sc.gradY.data() + nxrPad;
+        std::copy(box->loX.begin() + at, box->loX.begin() + at + nxr, loX);
+        std::copy(box->hiX.begin() + at, box->hiX.begin() + at + nxr, loX + nxrPad);
+        std::copy(box->loY.begin() + at, box->loY.begin() + at + nxr, loY);
+        std::copy(box->hiY.begin() + at, box->hiY.begin() + at + nxr, loY + nxrPad);
+        for (int X = nxr; X < nxrPad; ++X) loX[X] = loX[nxrPad + X] = loY[X] = loY[nxrPad + X] = 0.0f;
+    }
+}
+
+// V of receiver row Y (loaded by loadReceiverRow): every azimuth, two at a time.
+void visibilityOfRow(const VisibilityRows& r, int Y, VisibilityScratch& sc) {
+    const int nxr = r.pyr.nxr, nyr = r.pyr.nyr, m = r.target.op->azimuths;
+    VisibilityState& state = r.state;
+    float* vRows[kShCount];
+    for (int i = 0; i < kShCount; ++i) {
+        vRows[i] = r.out.plane(i) + static_cast<std::size_t>(Y) * nxr;
+        std::fill(vRows[i], vRows[i] + nxr, 0.0f);
+    }
+    for (int j0 = 0; j0 < m; j0 += 2) {
+        const RowBatch rb{state.steps.data(), r.nSteps, nxr, nyr, r.nxrPad, Y, j0, std::min(2, m - j0),
+                          state.stepsPerColumn.data(), state.stepsPerRow.data(), state.cosSin.data(),
+                          sc.h0.data(), sc.gradX.data(), sc.gradY.data(), r.box != nullptr,
+                          r.settings.blockingMax, &r.target, r.target.op, sc.maxRow.data(), sc.nlp.data(),
+                          sc.rowPtr.data(), r.out.maxSlope.data(), vRows};
+        r.rowBatch(rb);
+    }
+}
+
 }  // namespace
 
 void computeFootprintBox(ConstGridView gradX, ConstGridView gradY, int s, FootprintBox& out) {
@@ -523,62 +651,14 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
     out.sh.resize(planeSize * kShCount);
     out.maxSlope.resize(planeSize * m);
 
-    // ---- per frame: the step table and the valid-prefix lengths ----------------
-    const std::size_t tableSize = static_cast<std::size_t>(m) * nSteps;
-    state.steps.resize(tableSize);
-    state.validColumns.resize(2 * tableSize);
-    state.validRows.resize(2 * tableSize);
-    state.stepsPerColumn.resize(static_cast<std::size_t>(m) * nxrPad);
-    state.stepsPerRow.resize(static_cast<std::size_t>(m) * nyr);
-    parallelFor(0, m, 1, [&](int j0, int j1) {
-        for (int j = j0; j < j1; ++j) {
-            const double c = std::cos(op.phi[static_cast<std::size_t>(j)]);
-            const double sn = std::sin(op.phi[static_cast<std::size_t>(j)]);
-            const std::size_t base = static_cast<std::size_t>(j) * nSteps;
-            int* vc = state.validColumns.data() + 2 * base;
-            int* vr = state.validRows.data() + 2 * base;
-            for (int i = 0; i < nSteps; ++i) {
-                const StepGeometry g = makeStep(pyr, i, c, sn);
-                state.steps[base + static_cast<std::size_t>(i)] = g.step;
-                vc[2 * i] = g.xFirst;
-                vc[2 * i + 1] = g.xLast;
-                vr[2 * i] = g.yFirst;
-                vr[2 * i + 1] = g.yLast;
-            }
-            // a receiver's sequence is the prefix of steps before its first invalid one
-            int* colSteps = state.stepsPerColumn.data() + static_cast<std::size_t>(j) * nxrPad;
-            for (int X = 0; X < nxrPad; ++X) {
-                int n = 0;
-                if (X < nxr)
-                    while (n < nSteps && vc[2 * n] <= X && X <= vc[2 * n + 1]) ++n;
-                colSteps[X] = n;
-            }
-            int* rowSteps = state.stepsPerRow.data() + static_cast<std::size_t>(j) * nyr;
-            for (int Y = 0; Y < nyr; ++Y) {
-                int n = 0;
-                while (n < nSteps && vr[2 * n] <= Y && Y <= vr[2 * n + 1]) ++n;
-                rowSteps[Y] = n;
-            }
-        }
-    });
-
-    state.cosSin.resize(2 * static_cast<std::size_t>(m));
-    for (int j = 0; j < m; ++j) {
-        state.cosSin[2 * static_cast<std::size_t>(j)] = static_cast<float>(std::cos(op.phi[static_cast<std::size_t>(j)]));
-        state.cosSin[2 * static_cast<std::size_t>(j) + 1] = static_cast<float>(std::sin(op.phi[static_cast<std::size_t>(j)]));
-    }
-    void (*const rowBatch)(const RowBatch&) = simd::wideEnabled() ? rowBatchAvx2 : rowBatchSse;
-
+    buildStepTables(pyr, op, nxrPad, state);
     const int nBlocks = std::max(1, std::min(nyr, kMaxBlocks));
-    state.blocks.resize(static_cast<std::size_t>(nBlocks));
-    for (VisibilityScratch& b : state.blocks) {
-        b.maxRow.resize(static_cast<std::size_t>(nxrPad));
-        b.gradX.resize(static_cast<std::size_t>(3) * nxrPad);  // receiver, footprint lo, hi
-        b.gradY.resize(static_cast<std::size_t>(3) * nxrPad);
-        b.h0.resize(static_cast<std::size_t>(nxrPad));
-        b.nlp.resize(static_cast<std::size_t>(8) * nxrPad);
-        b.rowPtr.resize(2 * static_cast<std::size_t>(nSteps));
-    }
+    resizeBlockScratch(nBlocks, nxrPad, nSteps, state);
+    // footprint box rows (sub-sampling), when the box is this grid's
+    const FootprintBox* box = target.footprint && s > 1 && target.footprint->nxr == nxr && target.footprint->nyr == nyr
+                                  ? target.footprint : nullptr;
+    const VisibilityRows rows{pyr, gradX, gradY, settings, target, box, state, out, nxrPad, nSteps,
+                              simd::wideEnabled() ? rowBatchAvx2 : rowBatchSse};
     // ---- schedule: fixed row blocks in parallel, rows serially within a block,
     // every azimuth of a row before the next row (the row's h0 / tau table is
     // built once for all azimuths).
@@ -588,40 +668,8 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
             const int yBegin = static_cast<int>(static_cast<long long>(nyr) * block / nBlocks);
             const int yEnd = static_cast<int>(static_cast<long long>(nyr) * (block + 1) / nBlocks);
             for (int Y = yBegin; Y < yEnd; ++Y) {
-                // h0 / tau per step and height gradients of this row (padding lanes: 0)
-                const float* hRow = pyr.rawPhaseRow(0, s * Y);
-                for (int X = 0; X < nxrPad; ++X) {
-                    const bool in = X < nxr;
-                    sc.gradX[static_cast<std::size_t>(X)] = in ? gradX(s * X, s * Y) : 0.0f;
-                    sc.gradY[static_cast<std::size_t>(X)] = in ? gradY(s * X, s * Y) : 0.0f;
-                }
-                for (int X = 0; X < nxrPad; ++X) sc.h0[static_cast<std::size_t>(X)] = X < nxr ? hRow[X] : 0.0f;
-                // footprint box rows (sub-sampling), padded like the receiver row
-                const FootprintBox* box = target.footprint && s > 1 && target.footprint->nxr == nxr && target.footprint->nyr == nyr
-                                              ? target.footprint : nullptr;
-                const bool foot = box != nullptr;
-                if (foot) {
-                    const std::size_t at = static_cast<std::size_t>(Y) * nxr;
-                    float* loX = sc.gradX.data() + nxrPad;
-                    float* loY = sc.gradY.data() + nxrPad;
-                    std::copy(box->loX.begin() + at, box->loX.begin() + at + nxr, loX);
-                    std::copy(box->hiX.begin() + at, box->hiX.begin() + at + nxr, loX + nxrPad);
-                    std::copy(box->loY.begin() + at, box->loY.begin() + at + nxr, loY);
-                    std::copy(box->hiY.begin() + at, box->hiY.begin() + at + nxr, loY + nxrPad);
-                    for (int X = nxr; X < nxrPad; ++X) loX[X] = loX[nxrPad + X] = loY[X] = loY[nxrPad + X] = 0.0f;
-                }
-                float* vRows[kShCount];
-                for (int i = 0; i < kShCount; ++i) {
-                    vRows[i] = out.plane(i) + static_cast<std::size_t>(Y) * nxr;
-                    std::fill(vRows[i], vRows[i] + nxr, 0.0f);
-                }
-                for (int j0 = 0; j0 < m; j0 += 2) {
-                    const RowBatch rb{state.steps.data(), nSteps, nxr, nyr, nxrPad, Y, j0, std::min(2, m - j0),
-                                      state.stepsPerColumn.data(), state.stepsPerRow.data(), state.cosSin.data(),
-                                      sc.h0.data(), sc.gradX.data(), sc.gradY.data(), foot, settings.blockingMax, &target,
-                                      &op, sc.maxRow.data(), sc.nlp.data(), sc.rowPtr.data(), out.maxSlope.data(), vRows};
-                    rowBatch(rb);
-                }
+                loadReceiverRow(rows, Y, sc);
+                visibilityOfRow(rows, Y, sc);
             }
         }
     });

@@ -1,10 +1,11 @@
 #pragma once
-// Per-receiver visibility (Sections 3, 5.2, 6; Eqs. 4, 11, 14-16, 20-21).
+// Per-receiver visibility (Nowrouzezahrai & Snyder 2009, Sections 3, 5.2, 6;
+// Eqs. 4, 11, 14-16, 20-21).
 //
 // For every receiver and every azimuth phi_j the scan walks the exponential
 // steps of the height pyramid (Eq. 14) and records the blocking slope
 // tan(omega_i) = (f_l(p + tau_i d) - f(p)) / tau_i of each step (Eq. 15, as a
-// slope: atan is monotonic, GUIDE 3). Each sample is moved along the ray to the
+// slope: atan is monotonic). Each sample is moved along the ray to the
 // nearest crossing of the field's grid lines across the ray's major axis (at
 // most half a texel along that axis), where the bilinear field is linear
 // between two texels, as in the reference march; tau_i is the moved distance.
@@ -20,15 +21,15 @@
 // folded wedge operator turns the m vectors into the SH visibility V (Eqs.
 // 20-21). Directions below z = 0 are kept: on slopes omega_min < 0.
 //
-// Design for part 2 (indirect light): the scan is one row kernel templated
-// on a per-step visitor (gi/visibility.cpp, scanLanes): for 16 receivers at a
-// time (8 for Eq. 16) it walks the steps of one azimuth and hands the visitor the slope
+// Design: the scan is one row kernel templated on a per-step visitor
+// (gi/visibility.cpp, scanLanes): for 16 receivers at a time (8 for Eq. 16)
+// it walks the steps of one azimuth and hands the visitor the slope
 // sequence, step by step, with the steps each receiver's ray still has inside
-// the domain. The maximum rules (samples, Eq. 16) are two such visitors; the
-// casting set of Eq. 17 (the steps whose slope beats every earlier one) and
-// the Eq. 12 accumulation over it are a third that can read a radiance
-// pyramid at the same step positions without a second scan. maxSlope (per
-// azimuth, per receiver) is kept for the same reason.
+// the domain. The maximum rules (samples, Eq. 16) are two such visitors. The
+// indirect scan (gi/indirect.h: the casting set of Eq. 17 and the Eq. 12
+// accumulation over it) walks the same steps with its own kernel
+// (scanStepInfo, ValidPrefix). maxSlope (per azimuth, per receiver) is kept so
+// that the scan can be checked against its scalar twin (scanReceiverScalar).
 //
 // Sequence semantics: a receiver's sequence is its valid prefix, the steps
 // whose sample lies inside the domain (the ray leaves a convex domain once
@@ -41,10 +42,11 @@
 // (azimuth, step), with the number of valid steps per receiver column and
 // row. Receiver rows are split into a fixed number of blocks; each block owns
 // a scratch buffer and runs its rows serially; blocks run in parallel. Within
-// a row, for each azimuth, 16 receivers at a time run all their steps with 4-wide
-// SIMD (each receiver's arithmetic is exactly the scalar one), then the NLP
-// vectors of two azimuths at a time and the folded wedge operator update the
-// 16 SH planes of the row.
+// a row, azimuths two at a time: for each, groups of 16 receivers (8 for
+// Eq. 16) run all their steps with 4- or 8-wide SIMD (F4 or F8, core/simd.h;
+// each receiver's arithmetic is exactly the scalar one), then the NLP vectors
+// of both azimuths and the folded wedge operator update the 16 SH planes of
+// the row.
 // Every receiver is written by exactly one block (gather only), so the result
 // is bit-identical for any thread count.
 #include <vector>
@@ -69,9 +71,8 @@ struct VisibilitySettings {
     // {-s/2, 0, s/2}^2 cells, FootprintBox; gi/frame passes it in the
     // VisibilityTarget) instead of the receiver's own (paper). V is shaded at every texel's own
     // normal (Fig. 7); sky between the receiver's plane and a neighbour's
-    // lower one is visible to that neighbour. Measured on 96^2 crops, total
-    // shade rel. RMSE with indirect light, alps / erosion: 2x 4.3 -> 3.2 % /
-    // 2.0 -> 1.7 %, 4x 7.8 -> 5.4 % / 2.3 -> 1.5 %; 1x unchanged.
+    // lower one is visible to that neighbour. Its effect on accuracy:
+    // README.md, "Footprint tangent planes"; at 1x it changes nothing.
     bool footprintTangent = false;
 };
 
@@ -183,7 +184,7 @@ void computeVisibility(const HeightPyramid& pyramid, ConstGridView gradX, ConstG
                        VisibilityField& out);
 
 /// Eq. 16 over one receiver's valid slope sequence (scalar twin of the scan's
-/// visitors, for tests and for part 2's casting-set work).
+/// visitors; scanReceiverScalar uses it).
 float maxBlockingSlopeOfSequence(const float* slopes, int count, BlockingMax rule);
 
 /// Scalar twin of the scan for one receiver and azimuth phi: walks the same

@@ -77,7 +77,7 @@ void addRotatedBlock(FoldedWedgeOperator& op, const std::vector<double>& m, int 
 
 double wedgeTapWeight(AzimuthInterp interp, int k, double a) {
     if (interp == AzimuthInterp::Linear) return k == 0 ? 1.0 - a : a;
-    // Uniform cubic B-spline on samples j-1, j, j+1, j+2 (Appendix A).
+    // Uniform cubic B-spline on samples j-1, j, j+1, j+2 (Nowrouzezahrai & Snyder 2009, Appendix A).
     switch (k) {
         case 0: return (1.0 - a) * (1.0 - a) * (1.0 - a) / 6.0;
         case 1: return (3.0 * a * a * a - 6.0 * a * a + 4.0) / 6.0;

@@ -3,12 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
-#include <cstring>
-#include <type_traits>
-
-#include <immintrin.h>
 
 #include "core/parallel.h"
+#include "core/row_driver.h"
 #include "core/simd.h"
 
 // Hydraulic erosion, virtual-pipe model (Mei, Decaudin & Hu 2007), written as
@@ -120,7 +117,6 @@ using simd::store;
 using simd::vmax;
 using simd::vmin;
 using simd::sqrtv;
-constexpr int kLanes = simd::kLaneCount<simd::F4>;
 
 // ---------------------------------------------------------------------------
 // Pass A: outflow fluxes (Mei et al., "flow simulation": pipe acceleration and
@@ -260,27 +256,21 @@ inline void updateCell(const Fields F, const Coeffs& k, std::ptrdiff_t i, const 
     store(F.velY + i, v);
 }
 
-/// One row of a pass: edge cells on the scalar path, interior cells four at
-/// a time, the interior remainder one at a time.
+/// One row of a pass (core/row_driver.h): edge cells on the scalar path,
+/// interior cells four at a time, the interior remainder one at a time.
 template <class Kernel>
 void runRow(const Fields& F, const Coeffs& k, int y) {
     const int nx = F.nx, ny = F.ny;
     const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(y) * nx;
-    if (y == 0 || y == ny - 1 || nx < 3) {
-        for (int x = 0; x < nx; ++x) Kernel::template run<float, true>(F, k, row + x, edgeNeighbours(x, y, nx, ny, k.invCell));
-        return;
-    }
-    Kernel::template run<float, true>(F, k, row, edgeNeighbours(0, y, nx, ny, k.invCell));
-    int x = 1;
-    for (; x + kLanes <= nx - 1; x += kLanes) {
+    forEachCellOfRow<F4>(y, nx, ny, [&](auto path, int x) {
+        using Path = decltype(path);
         const std::ptrdiff_t i = row + x;
-        Kernel::template run<F4, false>(F, k, i, Nbr{i - 1, i + 1, i - nx, i + nx, true, true, true, true, 0, 0});
-    }
-    for (; x < nx - 1; ++x) {
-        const std::ptrdiff_t i = row + x;
-        Kernel::template run<float, false>(F, k, i, Nbr{i - 1, i + 1, i - nx, i + nx, true, true, true, true, 0, 0});
-    }
-    Kernel::template run<float, true>(F, k, row + nx - 1, edgeNeighbours(nx - 1, y, nx, ny, k.invCell));
+        if constexpr (Path::edge)
+            Kernel::template run<float, true>(F, k, i, edgeNeighbours(x, y, nx, ny, k.invCell));
+        else
+            Kernel::template run<typename Path::Lanes, false>(
+                F, k, i, Nbr{i - 1, i + 1, i - nx, i + nx, true, true, true, true, 0, 0});
+    });
 }
 
 struct PipePass {
@@ -306,17 +296,17 @@ void ensureScratch(Grid& g, int nx, int ny) {
 //
 // Linearise the pipe update around a lake at rest. Per step (symplectic
 // Euler: fluxes first, then depths with the new fluxes)
-//     f   += dt * g * A / l * (h_i - h_j)          (Eq. 2)
-//     h_i -= dt / c^2 * sum_j f_ij                 (Eq. 6)
+//     f   += dt * g * A / l * (h_i - h_j)          (Mei et al. Eq. 2)
+//     h_i -= dt / c^2 * sum_j f_ij                 (Mei et al. Eq. 6)
 // which is a discrete wave equation h'' = (g A / (l c^2)) * L h with L the
 // un-normalised 5-point Laplacian (eigenvalues in [-8, 0]). Symplectic Euler
 // on h'' = -w^2 h is stable iff dt * w <= 2; with w^2 = 8 g A / (l c^2) and
 // A = a c^2, l = c:
 //     dt <= 2 / sqrt(8 g a / c) = sqrt(c / (2 g a)).
 // The water depth does not enter: in the pipe model the "wave speed" is
-// sqrt(g A / l) = sqrt(g a c), set by the pipe, not sqrt(g d) (GUIDE 3).
-// Depth enters only through the K-scaling (Eq. 5), which caps the volume a
-// cell sends in one step at the water it holds. That cap keeps depths
+// sqrt(g A / l) = sqrt(g a c), set by the pipe, not sqrt(g d). Depth enters
+// only through the K-scaling (Mei et al. Eq. 5), which caps the volume a cell
+// sends in one step at the water it holds. That cap keeps depths
 // non-negative for any dt, but once it is active the update is no longer the
 // linear scheme above (a shallow film on a slope drains every step), so we
 // keep half of the linear limit as margin. The state argument is unused

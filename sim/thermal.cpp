@@ -3,10 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
-#include <cstring>
-#include <type_traits>
 
 #include "core/parallel.h"
+#include "core/row_driver.h"
 #include "core/simd.h"
 
 // Thermal erosion (talus relaxation) in the 8-neighbourhood, with the real
@@ -72,7 +71,6 @@ using simd::splat;
 using simd::store;
 using simd::vmax;
 using simd::vmin;
-constexpr int kLanes = simd::kLaneCount<simd::F4>;
 
 // The eight neighbours in a fixed order: L, R, U, D, UL, UR, DL, DR. The
 // first four are at distance c, the last four at c * sqrt(2).
@@ -168,21 +166,20 @@ inline void settleCell(const Fields F, const Coeffs& k, std::ptrdiff_t i, const 
     store(F.soil + i, soil1);
 }
 
+// One pass over the grid, rows in parallel, each row by core/row_driver.h.
 template <class Kernel>
 void forEachCell8(const Fields& F, const Coeffs& k) {
     const int nx = F.nx, ny = F.ny;
     parallelForRows(ny, nx, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
             const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(y) * nx;
-            if (y == 0 || y == ny - 1 || nx < 3) {
-                for (int x = 0; x < nx; ++x) Kernel::template run<float, true>(F, k, row + x, edgeNeighbours(x, y, nx, ny));
-                continue;
-            }
-            Kernel::template run<float, true>(F, k, row, edgeNeighbours(0, y, nx, ny));
-            int x = 1;
-            for (; x + kLanes <= nx - 1; x += kLanes) Kernel::template run<F4, false>(F, k, row + x, interiorNeighbours(row + x, nx));
-            for (; x < nx - 1; ++x) Kernel::template run<float, false>(F, k, row + x, interiorNeighbours(row + x, nx));
-            Kernel::template run<float, true>(F, k, row + nx - 1, edgeNeighbours(nx - 1, y, nx, ny));
+            forEachCellOfRow<F4>(y, nx, ny, [&](auto path, int x) {
+                using Path = decltype(path);
+                if constexpr (Path::edge)
+                    Kernel::template run<float, true>(F, k, row + x, edgeNeighbours(x, y, nx, ny));
+                else
+                    Kernel::template run<typename Path::Lanes, false>(F, k, row + x, interiorNeighbours(row + x, nx));
+            });
         }
     });
 }
