@@ -1,36 +1,69 @@
 #pragma once
-// Helpers shared by the benchmark mains: medians and the machine description
-// every results file starts with.
-#include <algorithm>
-#include <fstream>
+// Helpers shared by the suites of build/terrain_bench: where the DEMs and the
+// results live, a scratch folder, the machine description every results file
+// starts with, medians, the real DEMs at true scale and relative errors.
+#include <array>
 #include <string>
-#include <sys/utsname.h>
-#include <thread>
 #include <vector>
+
+#include "core/grid.h"
 
 namespace terrain::bench {
 
-inline double median(std::vector<double> v) {
-    if (v.empty()) return 0.0;
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+/// What every suite takes from the command line.
+struct BenchContext {
+    std::string dataDir;  // the real DEMs (alps-montblanc.png, mtperdu_20m.png)
+    std::string outDir;   // results files (bench/results of the source tree by default)
+    std::string command;  // "build/terrain_bench <arguments>", as results files quote it
+};
 
-inline std::string cpuName() {
-    std::ifstream f("/proc/cpuinfo");
-    std::string line;
-    while (std::getline(f, line))
-        if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-    return "unknown CPU";
-}
+/// A fresh folder under the system's temporary directory, removed with
+/// everything in it when the object goes.
+class ScratchDir {
+public:
+    ScratchDir();
+    ~ScratchDir();
+    ScratchDir(const ScratchDir&) = delete;
+    ScratchDir& operator=(const ScratchDir&) = delete;
+    const std::string& path() const { return path_; }
+
+private:
+    std::string path_;
+};
+
+/// Writes outDir/name atomically (creating outDir) and says so on stderr.
+void writeResult(const std::string& outDir, const std::string& name, const std::string& text);
+
+/// Median; the mean of the two middle values for an even count, 0 for none.
+double median(std::vector<double> v);
+
+/// "<cpu>, <n> hardware threads".
+std::string cpuAndThreads();
 
 /// "<cpu>, <n> hardware threads, <kernel>": the machine line of a results file.
-inline std::string machineDescription() {
-    utsname u{};
-    uname(&u);
-    return cpuName() + ", " + std::to_string(std::thread::hardware_concurrency()) + " hardware threads, " +
-           u.sysname + " " + u.release;
-}
+std::string machineDescription();
+
+/// A height field at true scale: heights and cell size in metres.
+struct Dem {
+    std::string name, note;
+    Grid heights;
+    float cell = 1.0f;
+};
+
+/// alps-montblanc.png at true scale: 647^2, cell 60000 / 647 m, heights 454 + v (4810 - 454) / 65535.
+Dem loadAlps(const std::string& dataDir);
+
+/// mtperdu_20m.png at true scale: cell 20 m, heights v / 10.
+Dem loadPerdu(const std::string& dataDir);
+
+/// The central size^2 texels of g.
+Grid centreCrop(const Grid& g, int size);
+
+/// The central size^2 crop of alps-montblanc at true scale; sets cell.
+Grid alpsCentreCrop(const std::string& dataDir, int size, float& cell);
+
+/// Relative RMSE of a against b over the interior (10 % border left out), all
+/// three channels; bias = mean difference / RMS of b.
+double relRmse(const std::array<Grid, 3>& a, const std::array<Grid, 3>& b, double& bias);
 
 }  // namespace terrain::bench

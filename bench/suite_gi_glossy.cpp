@@ -1,39 +1,32 @@
-// bench_gi_glossy: glossy indirect light (issue 4) - the SH radiance-vector
-// pyramid (GlossyIndirect::VectorPyramid, Fig. 5 middle) and the scalar
-// shade pyramid (ScalarPyramid, Fig. 5 right) against the glossy reference
-// (gi/reference_glossy), and the frame time of the glossy bounce.
-//
-//   bench_gi_glossy [--data DIR] [--out DIR] [--runs N] [--size N] [--directions K]
-//
-// Writes bench/results/gi_glossy.md.
+// `terrain_bench gi-glossy`: glossy indirect light - the SH radiance-vector
+// pyramid (GlossyIndirect::VectorPyramid, Fig. 5 middle) and the scalar shade
+// pyramid (ScalarPyramid, Fig. 5 right) against the glossy reference
+// (gi/reference_glossy), and the frame time of the glossy bounce. Writes
+// gi_glossy.md.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
+#include <memory>
 #include <string>
 #include <vector>
 
-#include "bench/bench_common.h"
-#include "bench/bench_gi_common.h"
+#include "bench/suites.h"
+#include "core/parallel.h"
 #include "gi/frame.h"
 #include "gi/reference_gi.h"
 
-#include "core/parallel.h"
-
-using namespace terrain;
-using namespace terrain::gi;
-
+namespace terrain::bench {
 namespace {
-
+using namespace terrain::gi;
 using Clock = std::chrono::steady_clock;
-std::string gDataDir = "/work/shared/data";
-std::string gOutDir = "bench/results";
-int gRuns = 5;
-int gSize = 96;
-int gDirections = 2048;
 
-Grid alpsCrop(int size, float& cell) { return bench::alpsCentreCrop(gDataDir, size, cell); }
-using bench::relRmse;
+struct GlossyOptions {
+    int runs = 5;
+    int size = 96;          // side of the accuracy crop
+    int directions = 2048;  // directions of the reference
+};
+
+constexpr float albedo = 0.6f;
 
 GiSettings settingsFor(Brdf brdf, float exponent, int s, int bounces, GlossyIndirect mode) {
     GiSettings g = engineGiSettings();
@@ -48,36 +41,22 @@ GiSettings settingsFor(Brdf brdf, float exponent, int s, int bounces, GlossyIndi
 
 const char* brdfName(Brdf b) { return b == Brdf::Phong ? "phong" : (b == Brdf::LambertPlusPhong ? "mix 0.5" : "lambert"); }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        if (a == "--data" && i + 1 < argc) gDataDir = argv[++i];
-        else if (a == "--out" && i + 1 < argc) gOutDir = argv[++i];
-        else if (a == "--runs" && i + 1 < argc) gRuns = std::max(1, std::atoi(argv[++i]));
-        else if (a == "--size" && i + 1 < argc) gSize = std::max(16, std::atoi(argv[++i]));
-        else if (a == "--directions" && i + 1 < argc) gDirections = std::max(64, std::atoi(argv[++i]));
-        else {
-            std::fprintf(stderr, "usage: bench_gi_glossy [--data DIR] [--out DIR] [--runs N] [--size N] [--directions K]\n");
-            return 2;
-        }
-    }
-    const float albedo = 0.6f;
-    std::string md = "# Glossy indirect light: vector vs scalar pyramid\n\n";
-    md += "Machine: " + bench::machineDescription() +
-          " (shared with another engineer's builds and benchmarks while this ran: timings are indicative).\n\n";
-    md += "Lighting: sun-and-sky SH environment (`sunSkyLight()`), viewer overhead, albedo " + std::to_string(albedo).substr(0, 3) +
-          " (diffuse part), engine settings (`engineGiSettings()`: m = 16, o_v = o_u = 3), 1 bounce.\n\n";
-
-    // ---- accuracy against the glossy reference -----------------------------------
-    float cell = 1.0f;
-    const Grid h = alpsCrop(gSize, cell);
-    const AlbedoMap a = uniformAlbedo(gSize, gSize, albedo);
+// The lighting of every row: the sun-and-sky SH environment alone.
+GiLighting sunSkyLighting() {
     GiLighting light;
     light.environment = sunSkyLight();
-    md += "## Accuracy: alps-montblanc, central " + std::to_string(gSize) + "^2 crop at true scale (cell 92.74 m)\n\n";
-    md += "Reference: `renderReferenceGlossy` (" + std::to_string(gDirections) +
+    return light;
+}
+
+// Accuracy against the glossy reference on the central o.size^2 crop of Mont Blanc.
+std::string accuracySection(const GlossyOptions& o, const BenchContext& ctx) {
+    std::string md;
+    float cell = 1.0f;
+    const Grid h = alpsCentreCrop(ctx.dataDir, o.size, cell);
+    const AlbedoMap a = uniformAlbedo(o.size, o.size, albedo);
+    const GiLighting light = sunSkyLighting();
+    md += "## Accuracy: alps-montblanc, central " + std::to_string(o.size) + "^2 crop at true scale (cell 92.74 m)\n\n";
+    md += "Reference: `renderReferenceGlossy` (" + std::to_string(o.directions) +
           " fixed directions, 256 azimuths for bounce 0; the same Phong lobe in order-4 SH, exact visibility and first hits). "
           "Relative RMSE and bias of the indirect light (bounce 1, RGB, 10 % border left out).\n\n";
     md += "| BRDF | S | sub-sampling | vector pyramid RMSE | bias | scalar pyramid RMSE | bias | reference mean indirect | reference time (s) |\n";
@@ -86,7 +65,7 @@ int main(int argc, char** argv) {
         for (float S : {8.0f, 64.0f}) {
             if (brdf == Brdf::LambertPlusPhong && S != 64.0f) continue;
             ReferenceGiSettings rs;
-            rs.directions = gDirections;
+            rs.directions = o.directions;
             rs.bounces = 1;
             rs.shading = settingsFor(brdf, S, 1, 1, GlossyIndirect::VectorPyramid).shading;
             ReferenceGiResult ref;
@@ -96,7 +75,7 @@ int main(int argc, char** argv) {
             double refMean = 0.0;
             for (const Grid& g : ref.indirect)
                 for (float v : g.v) refMean += v;
-            refMean /= 3.0 * gSize * gSize;
+            refMean /= 3.0 * o.size * o.size;
             for (int s : {1, 2}) {
                 double e[2], b[2];
                 for (int k = 0; k < 2; ++k) {
@@ -112,15 +91,20 @@ int main(int argc, char** argv) {
                 md += line;
             }
         }
+    return md;
+}
 
-    // ---- frame time -----------------------------------------------------------
-    md += "\n## Frame time, alps-montblanc central crops, 2x sub-sampling, 1 bounce, 2 threads (median of " + std::to_string(gRuns) +
-          " frames after a warm-up)\n\n";
+// Frame time of the glossy bounce at 256^2 and 512^2.
+std::string frameTimeSection(const GlossyOptions& o, const BenchContext& ctx) {
+    const GiLighting light = sunSkyLighting();
+    std::string md;
+    md += "\n## Frame time, alps-montblanc central crops, 2x sub-sampling, 1 bounce, 2 threads (median of " +
+          std::to_string(o.runs) + " frames after a warm-up)\n\n";
     md += "| size | BRDF / glossy mode | frame (ms) | indirect (ms) | E + pyramids (ms) | scan (ms) | shading (ms) |\n";
     md += "|---|---|---|---|---|---|---|\n";
     for (int size : {256, 512}) {
         float c2 = 1.0f;
-        const Grid hs = alpsCrop(size, c2);
+        const Grid hs = alpsCentreCrop(ctx.dataDir, size, c2);
         const AlbedoMap as = uniformAlbedo(size, size, albedo);
         struct Case {
             const char* name;
@@ -135,7 +119,7 @@ int main(int argc, char** argv) {
             std::vector<double> frame, ind, pyr, scan, shade;
             withThreads(2, [&] {
                 runGiFrame(hs.cview(), c2, light, g, st, &as);  // warm-up (allocations)
-                for (int r = 0; r < gRuns; ++r) {
+                for (int r = 0; r < o.runs; ++r) {
                     st.geometryChanged = true;
                     runGiFrame(hs.cview(), c2, light, g, st, &as);
                     frame.push_back(st.timings.total);
@@ -146,13 +130,39 @@ int main(int argc, char** argv) {
                 }
             });
             char line[512];
-            std::snprintf(line, sizeof line, "| %d^2 | %s | %.1f | %.1f | %.1f | %.1f | %.1f |\n", size, cs.name, bench::median(frame),
-                          bench::median(ind), bench::median(pyr), bench::median(scan), bench::median(shade));
+            std::snprintf(line, sizeof line, "| %d^2 | %s | %.1f | %.1f | %.1f | %.1f | %.1f |\n", size, cs.name,
+                          median(frame), median(ind), median(pyr), median(scan), median(shade));
             std::fprintf(stderr, "%s", line);
             md += line;
         }
     }
-    std::ofstream(gOutDir + "/gi_glossy.md") << md;
-    std::fprintf(stderr, "wrote %s/gi_glossy.md\n", gOutDir.c_str());
+    return md;
+}
+
+int runGlossy(const GlossyOptions& o, const BenchContext& ctx) {
+    std::string md = "# Glossy indirect light: vector vs scalar pyramid\n\n";
+    md += "Machine: " + machineDescription() +
+          " (shared with another engineer's builds and benchmarks while this ran: timings are indicative).\n\n";
+    md += "Lighting: sun-and-sky SH environment (`sunSkyLight()`), viewer overhead, albedo " + std::to_string(albedo).substr(0, 3) +
+          " (diffuse part), engine settings (`engineGiSettings()`: m = 16, o_v = o_u = 3), 1 bounce.\n\n";
+    md += accuracySection(o, ctx);
+    md += frameTimeSection(o, ctx);
+    writeResult(ctx.outDir, "gi_glossy.md", md);
     return 0;
 }
+
+}  // namespace
+
+Runner addGiGlossySuite(CLI::App& app, const BenchContext& ctx) {
+    auto o = std::make_shared<GlossyOptions>();
+    CLI::App* sub =
+        app.add_subcommand("gi-glossy", "Glossy indirect light: vector vs scalar pyramid, accuracy and frame time");
+    addRunsOption(*sub, o->runs, "Frames per timing (the median is reported)");
+    sub->add_option("--size", o->size, "Side of the accuracy crop")->check(CLI::Range(16, 4096))->capture_default_str();
+    sub->add_option("--directions", o->directions, "Directions of the glossy reference")
+        ->check(CLI::Range(64, 1 << 20))
+        ->capture_default_str();
+    return [o, &ctx] { return runGlossy(*o, ctx); };
+}
+
+}  // namespace terrain::bench

@@ -1,0 +1,121 @@
+#include "bench/bench_common.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sys/utsname.h>
+#include <system_error>
+#include <thread>
+#include <unistd.h>
+
+#include "core/error.h"
+#include "core/file_io.h"
+#include "core/png_io.h"
+
+namespace terrain::bench {
+
+ScratchDir::ScratchDir() {
+    namespace fs = std::filesystem;
+    std::random_device rd;
+    for (int attempt = 0; attempt < 100; ++attempt) {
+        char name[64];
+        std::snprintf(name, sizeof name, "terrain_bench-%ld-%08x", static_cast<long>(getpid()), rd());
+        const fs::path p = fs::temp_directory_path() / name;
+        if (fs::create_directory(p)) {
+            path_ = p.string();
+            return;
+        }
+    }
+    throw IoError(fs::temp_directory_path().string(), "cannot create a scratch folder there");
+}
+
+ScratchDir::~ScratchDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+}
+
+void writeResult(const std::string& outDir, const std::string& name, const std::string& text) {
+    std::filesystem::create_directories(outDir);
+    const std::string path = outDir + "/" + name;
+    writeFileAtomic(path, text);
+    std::fprintf(stderr, "wrote %s\n", path.c_str());
+}
+
+double median(std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+namespace {
+std::string cpuName() {
+    std::ifstream f("/proc/cpuinfo");
+    std::string line;
+    while (std::getline(f, line))
+        if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
+    return "unknown CPU";
+}
+}  // namespace
+
+std::string cpuAndThreads() {
+    return cpuName() + ", " + std::to_string(std::thread::hardware_concurrency()) + " hardware threads";
+}
+
+std::string machineDescription() {
+    utsname u{};
+    uname(&u);
+    return cpuAndThreads() + ", " + u.sysname + " " + u.release;
+}
+
+Dem loadAlps(const std::string& dataDir) {
+    Dem d;
+    d.name = "alps-montblanc";
+    d.heights = readPngHeightmap(dataDir + "/alps-montblanc.png", (4810.0f - 454.0f) / 65535.0f, 454.0f);
+    d.cell = 60000.0f / 647.0f;
+    return d;
+}
+
+Dem loadPerdu(const std::string& dataDir) {
+    Dem d;
+    d.name = "mtperdu_20m";
+    d.heights = readPngHeightmap(dataDir + "/mtperdu_20m.png", 0.1f, 0.0f);
+    d.cell = 20.0f;
+    return d;
+}
+
+Grid centreCrop(const Grid& g, int size) {
+    Grid c(size, size);
+    const int x0 = (g.nx - size) / 2, y0 = (g.ny - size) / 2;
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) c(x, y) = g(x0 + x, y0 + y);
+    return c;
+}
+
+Grid alpsCentreCrop(const std::string& dataDir, int size, float& cell) {
+    const Dem full = loadAlps(dataDir);
+    cell = full.cell;
+    return centreCrop(full.heights, size);
+}
+
+double relRmse(const std::array<Grid, 3>& a, const std::array<Grid, 3>& b, double& bias) {
+    const int bx = a[0].nx / 10, by = a[0].ny / 10;
+    double se = 0.0, sr = 0.0, sd = 0.0;
+    long n = 0;
+    for (std::size_t c = 0; c < 3; ++c)
+        for (int y = by; y < a[0].ny - by; ++y)
+            for (int x = bx; x < a[0].nx - bx; ++x) {
+                const double d = a[c](x, y) - b[c](x, y);
+                se += d * d;
+                sd += d;
+                sr += static_cast<double>(b[c](x, y)) * b[c](x, y);
+                ++n;
+            }
+    bias = sd / n / std::sqrt(sr / n);
+    return std::sqrt(se / n) / std::sqrt(sr / n);
+}
+
+}  // namespace terrain::bench
