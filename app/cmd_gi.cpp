@@ -204,9 +204,8 @@ int runGi(const GiOptions& o) {
     if (o.indirectAzimuths >= 0) settings.indirect.azimuths = o.indirectAzimuths;
     if (!o.indirectKernel.empty()) {
         if (o.indirectKernel == "sh") settings.indirect.lambert = gi::LambertIndirect::ShKernel;
-        else if (o.indirectKernel == "exact") settings.indirect.lambert = gi::LambertIndirect::ExactAtReceivers;
         else if (o.indirectKernel == "blocker") settings.indirect.lambert = gi::LambertIndirect::BlockerRadiance;
-        else throw InputError("--indirect-kernel must be blocker, exact or sh (got '" + o.indirectKernel + "')");
+        else throw InputError("--indirect-kernel must be blocker or sh (got '" + o.indirectKernel + "')");
     }
     gi::validateIndirectSettings(settings.indirect);
     if (o.azimuths != 0) settings.visibility.azimuths = o.azimuths;
@@ -327,8 +326,7 @@ Runner addGiCommand(CLI::App& app) {
     sub->add_option("--indirect-azimuths", o->indirectAzimuths, "Azimuths of the indirect scan (0 = --azimuths)");
     sub->add_option("--indirect-kernel", o->indirectKernel,
                     "Lambert indirect light: blocker (exact cosine at the receivers, between them the blockers' mean radiance times "
-                    "each texel's occlusion, engine default) | exact (exact cosine at the receivers, U's normal detail between them) | "
-                    "sh (order-4 SH kernel, paper)");
+                    "each texel's occlusion, engine default) | sh (order-4 SH kernel, paper)");
     sub->add_option("--reference-directions", o->referenceDirections, "Directions of the indirect reference (default 2048)");
     sub->add_option("--glossy", o->glossy,
                     "Glossy indirect light (phong/mix BRDFs): vector (SH radiance-vector pyramid, Fig. 5 middle) | scalar (shade pyramid, Fig. 5 right)");

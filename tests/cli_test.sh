@@ -83,11 +83,12 @@ expect_error "bad exponent range" "phong-exponent-range" "$T" gi --heightmap "$h
   --phong-exponent-range 100,10
 expect_error "bad glossy mode" "glossy" "$T" gi --heightmap "$hm24" --cell-size 10 --glossy shiny
 # the indirect kernel and azimuths: both kernels run, bad values are one error line
-for k in sh exact; do
+for k in sh blocker; do
   "$T" gi --heightmap "$hm24" --cell-size 10 --subsample 2 --bounces 1 --indirect-kernel $k --indirect-azimuths 12 \
     --out-indirect "$tmp/ik_$k.npy" >/dev/null 2>&1 && [ -s "$tmp/ik_$k.npy" ] && ok || bad "gi --indirect-kernel $k"
 done
 expect_error "bad indirect kernel" "indirect-kernel" "$T" gi --heightmap "$hm24" --cell-size 10 --bounces 1 --indirect-kernel cosine
+expect_error "retired indirect kernel" "indirect-kernel" "$T" gi --heightmap "$hm24" --cell-size 10 --bounces 1 --indirect-kernel exact
 expect_error "bad indirect azimuths" "indirect azimuths" "$T" gi --heightmap "$hm24" --cell-size 10 --bounces 1 --indirect-azimuths 2
 
 echo "cli: $pass passed, $fail failed"
