@@ -28,7 +28,6 @@ struct IndirectOptions {
     bool quick = false;         // 96^2 accuracy crops, Table 1 at 128^2 only
     bool diagnose = false;      // the error breakdown instead of the tables
     bool shKernel = false;      // the engine settings with the paper's SH Lambert kernel and receiver planes
-    bool exactKernel = false;   // the engine settings with U's normal detail between the receivers
     int indirectAzimuths = 0;   // azimuths of the indirect scan (0: the settings' own)
     int radianceK = 0;          // the engine's radiance pyramid k_u (0: the engine default)
     int radianceO = -1;         // the engine's radiance pyramid o_u (-1: the engine default)
@@ -92,8 +91,8 @@ double frameMemoryMB(const Grid& heights, const GiState& st) {
          bytesOf(br.taps) + bytesOf(br.cols);
     for (const std::vector<float>& e : br.receiverShade) b += bytesOf(e);
     for (const IndirectScratch& s : in.blocks)
-        b += bytesOf(s.nlp) + bytesOf(s.state) + 4 * bytesOf(s.gx) + bytesOf(s.footGx) + bytesOf(s.footGy) + bytesOf(s.exact) +
-             bytesOf(s.lowSlope) + bytesOf(s.groupSteps) + bytesOf(s.active);
+        b += bytesOf(s.result) + bytesOf(s.irradiance) + bytesOf(s.state) + 4 * bytesOf(s.gx) + bytesOf(s.groupSteps) +
+             bytesOf(s.active);
     return static_cast<double>(b) / (1024.0 * 1024.0);
 }
 
@@ -233,8 +232,9 @@ std::string diagnose(const Dem& d, const GiLighting& light, float albedo) {
                 is.radiance.levelsPerOctave = ku;
                 IndirectState ist;
                 withThreads(2, [&] {
-                    computeIndirect(st.pyramid, st.gradX.cview(), st.gradY.cview(), st.envOperator, st.envVisibility, capRef.direct, &a,
-                                    g.shading, is, ist);
+                    const IndirectInputs in{st.pyramid, st.gradX.cview(), st.gradY.cview(), st.envOperator,
+                                            st.envVisibility, capRef.direct, nullptr, &a, g.shading};
+                    computeIndirect(in, is, ist);
                 });
                 const std::string name = "(b,c) " + tag + " indirect from ref. direct, o_u " + std::to_string(ou) + ", k_u " +
                                          std::to_string(ku);
@@ -321,7 +321,6 @@ private:
         if (o_.indirectAzimuths > 0) g.indirect.azimuths = o_.indirectAzimuths;
         if (!paper && o_.radianceK > 0) g.indirect.radiance.levelsPerOctave = o_.radianceK;
         if (!paper && o_.radianceO >= 0) g.indirect.radiance.levelOffset = o_.radianceO;
-        if (!paper && o_.exactKernel) g.indirect.lambert = LambertIndirect::ExactAtReceivers;
         if (!paper && o_.shKernel) {
             g.indirect.lambert = LambertIndirect::ShKernel;
             g.visibility.footprintTangent = false;
@@ -339,9 +338,9 @@ private:
                       g.visibility.azimuths, g.pyramid.levelsPerOctave, g.pyramid.levelOffset, g.pyramid.peakBlend,
                       g.indirect.radiance.levelsPerOctave, g.indirect.radiance.levelOffset,
                       g.indirect.azimuths > 0 ? g.indirect.azimuths : g.visibility.azimuths,
-                      g.indirect.lambert == LambertIndirect::BlockerRadiance    ? "exact cosine at the receivers, blocker radiance x occlusion between them"
-                      : g.indirect.lambert == LambertIndirect::ExactAtReceivers ? "exact cosine at the receivers, U's normal detail between them"
-                                                                                : "SH kernel",
+                      g.indirect.lambert == LambertIndirect::BlockerRadiance
+                          ? "exact cosine at the receivers, blocker radiance x occlusion between them"
+                          : "SH kernel",
                       g.visibility.footprintTangent ? "on" : "off", simd::wideEnabled() ? "8-wide AVX2" : "4-wide SSE2");
         return b;
     }
@@ -554,7 +553,6 @@ Runner addGiIndirectSuite(CLI::App& app, const BenchContext& ctx) {
     sub->add_flag("--quick", o->quick, "96^2 accuracy crops, fewer erosion ticks, Table 1 at 128^2 only");
     sub->add_flag("--diagnose", o->diagnose, "Error breakdown instead of the tables (gi_indirect_diagnosis.md)");
     sub->add_flag("--sh-kernel", o->shKernel, "Engine settings with the paper's SH Lambert kernel and receiver planes");
-    sub->add_flag("--exact-kernel", o->exactKernel, "Engine settings with U's normal detail between the receivers");
     sub->add_option("--indirect-azimuths", o->indirectAzimuths, "Azimuths of the indirect scan (0: the settings' own)");
     sub->add_option("--radiance-k", o->radianceK, "The engine's radiance pyramid k_u (0: the engine default)");
     sub->add_option("--radiance-o", o->radianceO, "The engine's radiance pyramid o_u (-1: the engine default)");

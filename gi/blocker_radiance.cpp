@@ -41,8 +41,8 @@ struct OcclusionRow {
 // t^2 / (1 + t^2), sin w cos w = t / (1 + t^2)), clamped to the texel's
 // plane g (as the indirect scan's exact moment).
 template <class V>
-[[gnu::always_inline]] inline void occlusionAzimuthImpl(const OcclusionRow& r, const NearTap* taps, int nTaps, float cosPhi,
-                                                        float sinPhi) {
+[[gnu::always_inline]] inline void occlusionAzimuthImpl(const OcclusionRow& r, const NearTap* taps, int nTaps,
+                                                        float cosPhi, float sinPhi) {
     constexpr int L = LaneTraits<V>::n;
     const V one = splat<V>(1.0f), half = splat<V>(0.5f), lim = splat<V>(1e6f), nlim = splat<V>(-1e6f);
     for (int x = 0; x < r.n; x += L) {
@@ -71,8 +71,8 @@ template <class V>
 void occlusionAzimuthSse(const OcclusionRow& r, const NearTap* taps, int nTaps, float c, float s) {
     occlusionAzimuthImpl<F4>(r, taps, nTaps, c, s);
 }
-[[gnu::target("avx2"), gnu::flatten]] void occlusionAzimuthAvx2(const OcclusionRow& r, const NearTap* taps, int nTaps, float c,
-                                                                float s) {
+[[gnu::target("avx2"), gnu::flatten]] void occlusionAzimuthAvx2(const OcclusionRow& r, const NearTap* taps, int nTaps,
+                                                                float c, float s) {
     occlusionAzimuthImpl<F8>(r, taps, nTaps, c, s);
 }
 
@@ -95,9 +95,9 @@ struct PointRow {
 // O / pi of one row of points: per azimuth fillFar(j, far) sets the horizons
 // of the n points, then the kernel adds the azimuth's integral.
 template <class FillFar>
-void occlusionOfRow(ConstGridView gradX, ConstGridView gradY, const PointRow& p, const RowScratch& r, const NearTap* taps,
-                    const float* cosPhi, const float* sinPhi, int m, float scale, AzimuthFn azimuth, FillFar&& fillFar,
-                    float* out) {
+void occlusionOfRow(ConstGridView gradX, ConstGridView gradY, const PointRow& p, const RowScratch& r,
+                    const NearTap* taps, const float* cosPhi, const float* sinPhi, int m, float scale,
+                    AzimuthFn azimuth, FillFar&& fillFar, float* out) {
     for (int i = 0; i < p.pad; ++i) {
         const int x = std::min(p.step * i, gradX.nx - 1);
         r.gx[i] = i < p.n ? gradX(x, p.y) : 0.0f;
@@ -114,31 +114,10 @@ void occlusionOfRow(ConstGridView gradX, ConstGridView gradY, const PointRow& p,
     for (int i = 0; i < p.n; ++i) out[i] = scale * r.sum[i] / std::sqrt(1.0f + r.gx[i] * r.gx[i] + r.gy[i] * r.gy[i]);
 }
 
-}  // namespace
-
-void prepareBlockerRadiance(const HeightPyramid& pyr, int azimuths, BlockerRadianceState& st) {
-    st.nx = pyr.nx;
-    st.ny = pyr.ny;
-    st.nxr = pyr.nxr;
-    st.nyr = pyr.nyr;
-    st.subsample = pyr.subsample;
-    st.azimuths = azimuths;
-    const std::size_t planeR = static_cast<std::size_t>(pyr.nxr) * pyr.nyr;
-    for (std::vector<float>& v : st.receiverShade) v.resize(planeR);
-    if (pyr.subsample == 1) return;  // every texel a receiver: E alone
-    st.farSlope.resize(planeR * static_cast<std::size_t>(azimuths));
-    st.receiverOcclusion.resize(planeR);
-    if (st.occlusion.nx != pyr.nx || st.occlusion.ny != pyr.ny) st.occlusion.resize(pyr.nx, pyr.ny);
-}
-
-void computeTexelOcclusion(const HeightPyramid& pyr, ConstGridView gradX, ConstGridView gradY, const std::vector<double>& phi,
-                           BlockerRadianceState& st) {
-    const int nx = pyr.nx, ny = pyr.ny, s = pyr.subsample, nxr = pyr.nxr, nyr = pyr.nyr;
-    const int m = static_cast<int>(phi.size());
-    const int B = s;  // border: the near samples reach s - 0.5 cells, their taps s cells
-    const int pad = padLanes(nx);
-    const std::ptrdiff_t stride = pad + 2 * B + kLanePad;
-    // full-resolution heights (column x is column x / s of phase plane x % s)
+// Full-resolution heights with a border of B cells (kOutside there), rows of
+// `stride` floats (column x is column x / s of phase plane x % s).
+void fillBorderedHeights(const HeightPyramid& pyr, int B, std::ptrdiff_t stride, BlockerRadianceState& st) {
+    const int nx = pyr.nx, ny = pyr.ny, s = pyr.subsample;
     st.heights.assign(static_cast<std::size_t>(stride) * (ny + 2 * B + 1), kOutside);
     parallelForRows(ny, nx, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
@@ -149,8 +128,12 @@ void computeTexelOcclusion(const HeightPyramid& pyr, ConstGridView gradX, ConstG
             }
         }
     });
-    // the near samples of every azimuth: t = 0.5, 1, ..., s - 0.5 cells
-    const int nTaps = 2 * s - 1;
+}
+
+// The near samples of every azimuth (t = 0.5, 1, ..., s - 0.5 cells; nTaps
+// each) and the azimuths' cos, sin.
+void buildNearTaps(const HeightPyramid& pyr, const std::vector<double>& phi, int nTaps, BlockerRadianceState& st) {
+    const int m = static_cast<int>(phi.size());
     std::vector<NearTap>& taps = st.taps;
     std::vector<float>& cosPhi = st.cosPhi;
     std::vector<float>& sinPhi = st.sinPhi;
@@ -174,13 +157,21 @@ void computeTexelOcclusion(const HeightPyramid& pyr, ConstGridView gradX, ConstG
             tp.invDist = static_cast<float>(1.0 / (t * pyr.cellSize));
         }
     }
-    // per full-resolution column: the receivers it interpolates
-    std::vector<ReceiverLerp>& cols = st.cols;
-    cols.resize(static_cast<std::size_t>(nx));
-    for (int x = 0; x < nx; ++x) cols[static_cast<std::size_t>(x)] = receiverLerp(x, s, nxr);
-    const float scale = 2.0f / static_cast<float>(m);  // (2 pi / m) / pi
-    const AzimuthFn azimuth = simd::wideEnabled() ? occlusionAzimuthAvx2 : occlusionAzimuthSse;
-    // texels: the receivers' horizons between rows, then along the row
+}
+
+// What both occlusion passes share: the azimuth kernel and its scale.
+struct OcclusionPass {
+    int m;
+    float scale;  // (2 pi / m) / pi
+    AzimuthFn azimuth;
+};
+
+// O / pi at every texel: the receivers' horizons interpolated between rows,
+// then along the row, and the near samples from the bordered heights.
+void occlusionAtTexels(const HeightPyramid& pyr, ConstGridView gradX, ConstGridView gradY, int B, std::ptrdiff_t stride,
+                       int nTaps, const OcclusionPass& pass, BlockerRadianceState& st) {
+    const int nx = pyr.nx, ny = pyr.ny, s = pyr.subsample, nxr = pyr.nxr, nyr = pyr.nyr;
+    const int pad = padLanes(nx);
     const int nBlocks = (ny + kRowsPerBlock - 1) / kRowsPerBlock;
     const std::size_t perBlock = static_cast<std::size_t>(5) * pad;  // gx, gy, far, sum, receivers' row
     st.scratch.resize(perBlock * nBlocks);
@@ -191,25 +182,30 @@ void computeTexelOcclusion(const HeightPyramid& pyr, ConstGridView gradX, ConstG
             for (int y = block * kRowsPerBlock; y < std::min(ny, (block + 1) * kRowsPerBlock); ++y) {
                 const ReceiverLerp ry = receiverLerp(y, s, nyr);
                 const PointRow pts{y, 1, nx, pad, st.heights.data() + (y + B) * stride + B, stride, nTaps};
-                occlusionOfRow(gradX, gradY, pts, r, taps.data(), cosPhi.data(), sinPhi.data(), m, scale, azimuth,
-                               [&](int j, float* far) {
-                                   const float* fs = st.farSlope.data() + static_cast<std::size_t>(j) * nxr * nyr;
-                                   const float* f0 = fs + static_cast<std::size_t>(ry.i0) * nxr;
-                                   const float* f1 = fs + static_cast<std::size_t>(ry.i1) * nxr;
-                                   for (int X = 0; X < nxr; ++X) recv[X] = f0[X] + ry.f * (f1[X] - f0[X]);
-                                   for (int x = 0; x < nx; ++x) {
-                                       const ReceiverLerp& rx = cols[static_cast<std::size_t>(x)];
-                                       far[x] = recv[rx.i0] + rx.f * (recv[rx.i1] - recv[rx.i0]);
-                                   }
-                               },
-                               st.occlusion.data() + static_cast<std::size_t>(y) * nx);
+                const auto fillFar = [&](int j, float* far) {
+                    const float* fs = st.farSlope.data() + static_cast<std::size_t>(j) * nxr * nyr;
+                    const float* f0 = fs + static_cast<std::size_t>(ry.i0) * nxr;
+                    const float* f1 = fs + static_cast<std::size_t>(ry.i1) * nxr;
+                    for (int X = 0; X < nxr; ++X) recv[X] = f0[X] + ry.f * (f1[X] - f0[X]);
+                    for (int x = 0; x < nx; ++x) {
+                        const ReceiverLerp& rx = st.cols[static_cast<std::size_t>(x)];
+                        far[x] = recv[rx.i0] + rx.f * (recv[rx.i1] - recv[rx.i0]);
+                    }
+                };
+                occlusionOfRow(gradX, gradY, pts, r, st.taps.data(), st.cosPhi.data(), st.sinPhi.data(), pass.m,
+                               pass.scale, pass.azimuth, fillFar, st.occlusion.data() + static_cast<std::size_t>(y) * nx);
             }
         }
     });
-    // O_k at the receivers below the scan's horizons alone, the blockers E_k
-    // saw (no near samples: the scan starts s cells away), so that E_k / O_k
-    // is their mean radiance; at a receiver's own texel the near field then
-    // adds O(x) / O_k at that radiance
+}
+
+// O_k at the receivers below the scan's horizons alone, the blockers E_k
+// saw (no near samples: the scan starts s cells away), so that E_k / O_k
+// is their mean radiance; at a receiver's own texel the near field then
+// adds O(x) / O_k at that radiance
+void occlusionAtReceivers(const HeightPyramid& pyr, ConstGridView gradX, ConstGridView gradY, const OcclusionPass& pass,
+                          BlockerRadianceState& st) {
+    const int ny = pyr.ny, s = pyr.subsample, nxr = pyr.nxr, nyr = pyr.nyr;
     const int padR = padLanes(nxr);
     const int nBlocksR = (nyr + kRowsPerBlock - 1) / kRowsPerBlock;
     const std::size_t perBlockR = static_cast<std::size_t>(4) * padR;  // gx, gy, far, sum
@@ -219,16 +215,52 @@ void computeTexelOcclusion(const HeightPyramid& pyr, ConstGridView gradX, ConstG
             const RowScratch r = RowScratch::at(st.scratch.data() + perBlockR * block, padR);
             for (int Y = block * kRowsPerBlock; Y < std::min(nyr, (block + 1) * kRowsPerBlock); ++Y) {
                 const PointRow pts{std::min(s * Y, ny - 1), s, nxr, padR, nullptr, 0, 0};
-                occlusionOfRow(gradX, gradY, pts, r, nullptr, cosPhi.data(), sinPhi.data(), m, scale, azimuth,
-                               [&](int j, float* far) {
-                                   const float* fs = st.farSlope.data() + static_cast<std::size_t>(j) * nxr * nyr +
-                                                     static_cast<std::size_t>(Y) * nxr;
-                                   std::copy(fs, fs + nxr, far);
-                               },
-                               st.receiverOcclusion.data() + static_cast<std::size_t>(Y) * nxr);
+                const auto fillFar = [&](int j, float* far) {
+                    const float* fs =
+                        st.farSlope.data() + static_cast<std::size_t>(j) * nxr * nyr + static_cast<std::size_t>(Y) * nxr;
+                    std::copy(fs, fs + nxr, far);
+                };
+                occlusionOfRow(gradX, gradY, pts, r, nullptr, st.cosPhi.data(), st.sinPhi.data(), pass.m, pass.scale,
+                               pass.azimuth, fillFar, st.receiverOcclusion.data() + static_cast<std::size_t>(Y) * nxr);
             }
         }
     });
+}
+
+}  // namespace
+
+void prepareBlockerRadiance(const HeightPyramid& pyr, int azimuths, BlockerRadianceState& st) {
+    st.nx = pyr.nx;
+    st.ny = pyr.ny;
+    st.nxr = pyr.nxr;
+    st.nyr = pyr.nyr;
+    st.subsample = pyr.subsample;
+    st.azimuths = azimuths;
+    const std::size_t planeR = static_cast<std::size_t>(pyr.nxr) * pyr.nyr;
+    for (std::vector<float>& v : st.receiverShade) v.resize(planeR);
+    if (pyr.subsample == 1) return;  // every texel a receiver: E alone
+    st.farSlope.resize(planeR * static_cast<std::size_t>(azimuths));
+    st.receiverOcclusion.resize(planeR);
+    if (st.occlusion.nx != pyr.nx || st.occlusion.ny != pyr.ny) st.occlusion.resize(pyr.nx, pyr.ny);
+}
+
+void computeTexelOcclusion(const HeightPyramid& pyr, ConstGridView gradX, ConstGridView gradY,
+                           const std::vector<double>& phi, BlockerRadianceState& st) {
+    const int nx = pyr.nx, s = pyr.subsample, nxr = pyr.nxr;
+    const int m = static_cast<int>(phi.size());
+    const int B = s;  // border: the near samples reach s - 0.5 cells, their taps s cells
+    const int pad = padLanes(nx);
+    const std::ptrdiff_t stride = pad + 2 * B + kLanePad;
+    fillBorderedHeights(pyr, B, stride, st);
+    const int nTaps = 2 * s - 1;
+    buildNearTaps(pyr, phi, nTaps, st);
+    // per full-resolution column: the receivers it interpolates
+    st.cols.resize(static_cast<std::size_t>(nx));
+    for (int x = 0; x < nx; ++x) st.cols[static_cast<std::size_t>(x)] = receiverLerp(x, s, nxr);
+    const OcclusionPass pass{m, 2.0f / static_cast<float>(m),
+                             simd::wideEnabled() ? occlusionAzimuthAvx2 : occlusionAzimuthSse};
+    occlusionAtTexels(pyr, gradX, gradY, B, stride, nTaps, pass, st);
+    occlusionAtReceivers(pyr, gradX, gradY, pass, st);
 }
 
 void shadeBlockerRadiance(BlockerRadianceState& st, const AlbedoMap* albedo, std::array<Grid, 3>& rgb) {
@@ -237,8 +269,9 @@ void shadeBlockerRadiance(BlockerRadianceState& st, const AlbedoMap* albedo, std
         if (g.nx != nx || g.ny != ny) g.resize(nx, ny);
     const float* alb[3];
     for (int c = 0; c < 3; ++c)
-        alb[c] = albedo && !albedo->channel[static_cast<std::size_t>(c)].empty() ? albedo->channel[static_cast<std::size_t>(c)].data()
-                                                                                 : nullptr;
+        alb[c] = albedo && !albedo->channel[static_cast<std::size_t>(c)].empty()
+                     ? albedo->channel[static_cast<std::size_t>(c)].data()
+                     : nullptr;
     if (s == 1) {  // every texel a receiver
         parallelForRows(ny, nx, [&](int y0, int y1) {
             for (int c = 0; c < 3; ++c) {
@@ -259,7 +292,8 @@ void shadeBlockerRadiance(BlockerRadianceState& st, const AlbedoMap* albedo, std
             float* eRow[3] = {oRow + nxr, oRow + 2 * nxr, oRow + 3 * nxr};
             for (int y = block * kRowsPerBlock; y < std::min(ny, (block + 1) * kRowsPerBlock); ++y) {
                 const ReceiverLerp ry = receiverLerp(y, s, nyr);
-                const std::size_t r0 = static_cast<std::size_t>(ry.i0) * nxr, r1 = static_cast<std::size_t>(ry.i1) * nxr;
+                const std::size_t r0 = static_cast<std::size_t>(ry.i0) * nxr,
+                                  r1 = static_cast<std::size_t>(ry.i1) * nxr;
                 const float* o = st.receiverOcclusion.data();
                 for (int X = 0; X < nxr; ++X) oRow[X] = o[r0 + X] + ry.f * (o[r1 + X] - o[r0 + X]);
                 for (int c = 0; c < 3; ++c) {
@@ -276,7 +310,8 @@ void shadeBlockerRadiance(BlockerRadianceState& st, const AlbedoMap* albedo, std
                     for (int c = 0; c < 3; ++c) {
                         const float* e = eRow[c];
                         const float num = e[rx.i0] + rx.f * (e[rx.i1] - e[rx.i0]);
-                        rgb[static_cast<std::size_t>(c)].v[at + static_cast<std::size_t>(x)] = (alb[c] ? alb[c][at + x] : 1.0f) * (k * num);
+                        rgb[static_cast<std::size_t>(c)].v[at + static_cast<std::size_t>(x)] =
+                            (alb[c] ? alb[c][at + x] : 1.0f) * (k * num);
                     }
                 }
             }

@@ -1,18 +1,18 @@
 #pragma once
 // Lambert indirect light between sub-sampled receivers
-// (LambertIndirect::BlockerRadiance).
+// (LambertIndirect::BlockerRadiance, gi/indirect_blocker_radiance.h).
 //
 // A receiver's casting sets give its exact clamped-cosine irradiance E
-// (gi/indirect.h) and, from the same walk, its horizon along every indirect
-// azimuth (the highest blocking slope over the scan's steps, which start one
-// receiver spacing away). Indirect irradiance is the blockers' radiance times
-// the cosine-weighted solid angle they cover, E = Lbar O. Of the two factors
-// the blockers' mean radiance Lbar = E / O is smooth (it is the filtered exit
-// radiance of the terrain around), while the occlusion O changes from texel
-// to texel (a channel's floor is enclosed by its walls, the rim beside it is
-// not). So between receivers the engine interpolates Lbar, as the ratio of
-// the bilinearly interpolated E and O, and multiplies it by each texel's own
-// O:
+// (gi/casting_set_scan.h, CastingMoments::Irradiance) and, from the same walk,
+// its horizon along every indirect azimuth (the highest blocking slope over
+// the scan's steps, which start one receiver spacing away). Indirect
+// irradiance is the blockers' radiance times the cosine-weighted solid angle
+// they cover, E = Lbar O. Of the two factors the blockers' mean radiance
+// Lbar = E / O is smooth (it is the filtered exit radiance of the terrain
+// around), while the occlusion O changes from texel to texel (a channel's
+// floor is enclosed by its walls, the rim beside it is not). So between
+// receivers the engine interpolates Lbar, as the ratio of the bilinearly
+// interpolated E and O, and multiplies it by each texel's own O:
 //   E(x) = O(x) sum_k w_k E_k / sum_k w_k O_k,
 // where O(x) is the clamped-cosine integral (the exact F = f2 - g f1 of the
 // indirect scan, per azimuth, box weights) below the texel's horizon
@@ -23,21 +23,16 @@
 // s cells away), so that E_k / O_k is their mean radiance; a receiver's own
 // texel then gets E_k O(x) / O_k: its near field at that radiance. (With the
 // near field in O_k too, i.e. the same estimate as the texels', the blockers'
-// radiance came out low: 2x / 4x indirect rel. RMSE on the eroded 256^2 frame
-// 8.3 / 11.4 % instead of 7.9 / 9.0 %.) A texel with no blocker above its
-// plane gets exactly 0 (a flat plane stays dark).
+// radiance came out low.) A texel with no blocker above its plane gets
+// exactly 0 (a flat plane stays dark).
 //
-// Why: at 2x most of the indirect error was between the receivers, and most
-// of that in the most concave and most convex tenths of the texels (a
-// channel's floor below its interpolated neighbours got too little light, a
-// crest too much); interpolating U and shading it at each texel's normal
-// cannot see a height difference. Measured on 256^2 crops, one bounce
-// (bench/results/gi_indirect_accuracy.md), indirect rel. RMSE against the
-// reference, U's normal detail (ExactAtReceivers) -> this: 2x alps 9.9 ->
-// 9.4 %, eroded frame 11.3 -> 7.9 %; 4x 13.1 -> 12.7 %, 14.8 -> 9.0 %
-// (1x unchanged: every texel is a receiver). Without U the scan keeps one
-// moment instead of five and nothing is shaded from SH: 512^2 2x scan 23 ->
-// 14 ms, plus 5-6 ms for the occlusion and this shading.
+// Why: with sub-sampling most of the indirect error was between the
+// receivers, and most of that in the most concave and most convex tenths of
+// the texels (a channel's floor below its interpolated neighbours got too
+// little light, a crest too much); interpolating an SH radiance vector U and
+// shading it at each texel's normal cannot see a height difference. Accuracy
+// and cost are measured in bench/results/gi_indirect_accuracy.md (1x is
+// unchanged: every texel is a receiver).
 //
 // Deterministic: fixed blocks of rows, per texel a pure function of its
 // inputs; the 4- and 8-wide kernels use the same lane-wise IEEE operations.

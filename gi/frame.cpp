@@ -15,7 +15,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
-// Indirect bounces over the last computed direct shade (issue 4).
+// Indirect bounces over the last computed direct shade.
 void runIndirectStage(const GiSettings& settings, GiState& st, const AlbedoMap* albedo) {
     const auto t = Clock::now();
     const int m = settings.indirect.azimuths;
@@ -28,9 +28,16 @@ void runIndirectStage(const GiSettings& settings, GiState& st, const AlbedoMap* 
         }
         op = &st.indirectOperator;
     }
-    computeIndirect(st.pyramid, st.gradX.cview(), st.gradY.cview(), *op, st.envVisibility, st.shade.rgb, albedo,
-                    settings.shading, settings.indirect, st.indirect, &st.shade,
-                    st.footprint.nxr == st.pyramid.nxr && st.footprint.subsample == settings.subsample ? &st.footprint : nullptr);
+    const IndirectInputs in{.heights = st.pyramid,
+                            .gradX = st.gradX.cview(),
+                            .gradY = st.gradY.cview(),
+                            .op = *op,
+                            .envVisibility = st.envVisibility,
+                            .direct = st.shade.rgb,
+                            .directShade = &st.shade,
+                            .albedo = albedo,
+                            .shading = settings.shading};
+    computeIndirect(in, settings.indirect, st.indirect);
     st.timings.indirect = msSince(t);
 }
 
@@ -236,12 +243,10 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
         st.envOperatorAzimuths = settings.visibility.azimuths;
         st.envOperatorInterp = settings.visibility.interp;
     }
-    // the receivers' footprint boxes (sub-sampling): direct omega_min and the indirect U
-    const bool footprint = settings.subsample > 1 &&
-                           (settings.visibility.footprintTangent || settings.indirect.lambert == LambertIndirect::ExactAtReceivers);
+    // the receivers' footprint boxes (sub-sampling): omega_min of the direct light
+    const bool footprint = settings.subsample > 1 && settings.visibility.footprintTangent;
     if (footprint) computeFootprintBox(st.gradX.cview(), st.gradY.cview(), settings.subsample, st.footprint);
-    else st.footprint.nxr = 0;
-    const FootprintBox* box = settings.subsample > 1 && settings.visibility.footprintTangent ? &st.footprint : nullptr;
+    const FootprintBox* box = footprint ? &st.footprint : nullptr;
     VisibilityTarget envTarget;
     envTarget.op = &st.envOperator;
     envTarget.footprint = box;

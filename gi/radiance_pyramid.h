@@ -15,8 +15,7 @@
 // the step index minus k_u o_u, as in the paper).
 //
 // Glossy surfaces (vector pyramid): the same pyramid over each coefficient of
-// an SH radiance vector field (RGB x `coefficients` planes), see
-// buildShRadiancePyramid.
+// an SH radiance vector field (RGB x SH planes), see buildScalarPyramids.
 #include <array>
 #include <vector>
 

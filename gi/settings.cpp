@@ -33,10 +33,7 @@ void validateGiSettings(const GiSettings& s) {
     checkRange(ranges::kKeyLightAzimuths, s.keyLightAzimuths);
     checkRange(ranges::kPhongExponent, s.shading.phongExponent);
     checkRange(ranges::kSpecularWeight, s.shading.specularWeight);
-    checkRange(ranges::kBounces, s.indirect.bounces);
-    checkRange(ranges::kRadianceLevelsPerOctave, s.indirect.radiance.levelsPerOctave);
-    checkRange(ranges::kRadianceLevelOffset, s.indirect.radiance.levelOffset);
-    checkRange(ranges::kIndirectAzimuths, s.indirect.azimuths);
+    validateIndirectSettings(s.indirect);
 }
 
 }  // namespace terrain::gi

@@ -88,6 +88,7 @@ for k in sh blocker; do
     --out-indirect "$tmp/ik_$k.npy" >/dev/null 2>&1 && [ -s "$tmp/ik_$k.npy" ] && ok || bad "gi --indirect-kernel $k"
 done
 expect_error "bad indirect kernel" "indirect-kernel" "$T" gi --heightmap "$hm24" --cell-size 10 --bounces 1 --indirect-kernel cosine
+expect_error "retired indirect kernel" "indirect-kernel" "$T" gi --heightmap "$hm24" --cell-size 10 --bounces 1 --indirect-kernel exact
 expect_error "bad indirect azimuths" "indirect azimuths" "$T" gi --heightmap "$hm24" --cell-size 10 --bounces 1 --indirect-azimuths 2
 
 echo "cli: $pass passed, $fail failed"

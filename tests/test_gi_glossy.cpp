@@ -11,7 +11,7 @@
 
 #include "gi/frame.h"
 #include "tests/gi_test_terrain.h"
-#include "gi/indirect_glossy.h"
+#include "gi/glossy_exit_radiance.h"
 #include "gi/reference_gi.h"
 #include "core/error.h"
 #include "core/parallel.h"

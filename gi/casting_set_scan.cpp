@@ -1,0 +1,271 @@
+#include "gi/casting_set_scan.h"
+
+#include <algorithm>
+#include <cstring>
+
+#include "core/simd.h"
+
+namespace terrain::gi {
+
+namespace {
+
+// The kernel is written once over a lane type V: F4 (SSE2, the baseline) or
+// F8 (AVX2, chosen at run time where the processor has it): core/simd.h.
+using simd::load;
+using simd::splat;
+using simd::store;
+using simd::F4;
+using simd::F8;
+using simd::LaneTraits;
+using simd::laneBits;
+using simd::sqrtv;
+using simd::atanv;
+
+constexpr int kMaxMoments = 4;  // moments per segment and channel (Nlp)
+
+// Step i's taps: the two height samples of the receivers' row and each
+// channel's two radiance samples, with their weights.
+template <class V>
+struct StepTaps {
+    const float *a, *b;
+    V wa, wb, inv;
+    const float* ra[3];
+    const float* rb[3];
+    V rwa[3], rwb[3];
+};
+
+template <class V>
+[[gnu::always_inline]] inline StepTaps<V> stepTaps(const AzimuthSteps& az, int i, int Y) {
+    StepTaps<V> tp;
+    const ScanStep& st = az.heights[i];
+    const std::ptrdiff_t o = Y * st.rowStep;
+    tp.a = st.field + (o + st.offA);
+    tp.b = st.field + (o + st.offB);
+    tp.wa = splat<V>(st.w[0][0]);
+    tp.wb = splat<V>(st.w[1][0]);
+    tp.inv = splat<V>(st.w[2][0]);
+    for (int c = 0; c < 3; ++c) {
+        const ScanStep& rs = az.radiance[c][i];
+        const std::ptrdiff_t ro = Y * rs.rowStep;
+        tp.ra[c] = rs.field + (ro + rs.offA);
+        tp.rb[c] = rs.field + (ro + rs.offB);
+        tp.rwa[c] = splat<V>(rs.w[0][0]);
+        tp.rwb[c] = splat<V>(rs.w[1][0]);
+    }
+    return tp;
+}
+
+// ---- algorithm: the casting set and Eq. 12 for one row of receivers --------
+// The walk over the height steps (Eq. 17): at each step where some lane has a
+// new casting-set member, the clamped segment's moments (0 in the other
+// lanes) are multiplied with the radiance samples there and summed per
+// channel (each lane's sums in step order).
+//
+// The row is walked step by step: at step i every group of L receivers still
+// walking reads its 2 height taps and, where some lane has a new casting-set
+// member, the 3 channels' radiance taps: each step's reads sweep one
+// contiguous stretch of its field (hardware prefetch follows them), and the
+// groups' running values live in the row scratch (IndirectScratch::state).
+// Per lane the same operations in the same order as walking each group alone
+// (step order; lanes without a new member add exactly 0), so the result does
+// not depend on the schedule.
+template <class V, CastingMoments K>
+struct CastingRow {
+    using I = typename LaneTraits<V>::I;
+    static constexpr int L = LaneTraits<V>::n;
+    static constexpr bool Exact = K == CastingMoments::Irradiance;
+    static constexpr int nMo = Exact ? 1 : kMaxMoments;  // moments per segment
+
+    const ReceiverRow& in;
+    int pad;
+    // state planes (pad floats each): M the running maximum, g the tangent
+    // slope, q1 (Nlp) the sin of the last segment end, F (Irradiance) F at the
+    // last segment end, then 3 x nMo sums A
+    float *M, *g, *q1, *F, *A;
+    int* steps;   // per lane: the valid prefix (row limit applied)
+    int* active;  // groups still walking
+    const V one = splat<V>(1.0f), half = splat<V>(0.5f), zero = splat<V>(0.0f);
+    const V lim = splat<V>(1e6f), nlim = splat<V>(-1e6f);
+
+    CastingRow(const ReceiverRow& r, IndirectScratch& sc, int p)
+        : in(r),
+          pad(p),
+          M(sc.state.data()),
+          g(M + p),
+          q1(M + 2 * p),
+          F(M + 3 * p),
+          A(M + 4 * p),
+          steps(sc.groupSteps.data()),
+          active(sc.active.data()) {}
+
+    // Group G's running values before the first step; returns its longest valid prefix.
+    [[gnu::always_inline]] int startGroup(int G, const AzimuthSteps& az, I rowLimit) {
+        const int X0 = G * L;
+        I c;
+        std::memcpy(&c, az.stepsPerColumn + X0, sizeof c);
+        c = c < rowLimit ? c : rowLimit;
+        std::memcpy(steps + X0, &c, sizeof c);
+        int nAny = 0;
+        for (int l = 0; l < L; ++l) nAny = std::max(nAny, static_cast<int>(c[l]));
+        store(M + X0, splat<V>(kNoBlocker));
+        // omega_min: the tangent plane's slope along the azimuth (Section 3)
+        const V gv = load<V>(in.gx + X0) * splat<V>(az.cosPhi) + load<V>(in.gy + X0) * splat<V>(az.sinPhi);
+        store(g + X0, gv);
+        if constexpr (!Exact) {
+            const V t = gv < nlim ? nlim : (gv > lim ? lim : gv);
+            const V r = one / sqrtv(one + t * t);  // cos of the lower bound
+            store(q1 + X0, t * r);
+        } else {
+            // F(t) = f2 - g f1 at the clamped segment end (f1, f2 the clamped
+            // cosine's antiderivatives); F is smallest at t = g (the receiver's
+            // plane), so ends below g keep F(g)
+            const V te = gv < nlim ? nlim : (gv > lim ? lim : gv);
+            const V re = one / sqrtv(one + te * te), se = te * re;
+            store(F + X0, half * (se * se) - gv * (half * (atanv(te) + se * re)));
+        }
+        for (int p = 0; p < 3 * nMo; ++p) store(A + static_cast<std::size_t>(p) * pad + X0, zero);
+        return nAny;
+    }
+
+    // The new members' segments [c_(i-1), c_i] clamped to [omega_min, pi/2]:
+    // their moments times the radiance samples, into the sums A.
+    [[gnu::always_inline]] void addSegments(const StepTaps<V>& tp, I nw, V t, int X0) {
+        const V gl = load<V>(g + X0);
+        V tc = t < gl ? gl : t;
+        tc = tc < nlim ? nlim : (tc > lim ? lim : tc);
+        const V r = one / sqrtv(one + tc * tc), sNew = tc * r;  // cos, sin of the end
+        V mo[nMo];
+        if constexpr (!Exact) {
+            const V p = load<V>(q1 + X0);
+            const V sv = nw ? sNew : p;  // no new member: an empty segment (exactly 0)
+            const V p2 = p * p, s2 = sv * sv;
+            mo[0] = sv - p;
+            mo[1] = s2 - p2;
+            mo[2] = s2 * sv - p2 * p;
+            mo[3] = s2 * s2 - p2 * p2;
+            store(q1 + X0, sv);
+        } else {
+            const V f = load<V>(F + X0);
+            const V fNew = half * (sNew * sNew) - gl * (half * (atanv(tc) + sNew * r));
+            const V fv = nw & (tc >= gl) ? fNew : f;  // below the receiver's plane: nothing
+            mo[0] = fv - f;
+            store(F + X0, fv);
+        }
+        // moments x radiance (lanes without a new member have zero moments;
+        // the radiance read there is finite: inside the field's padding and guard)
+        for (int c = 0; c < 3; ++c) {
+            const V u = tp.rwa[c] * load<V>(tp.ra[c] + X0) + tp.rwb[c] * load<V>(tp.rb[c] + X0);
+            for (int p = 0; p < nMo; ++p) {
+                float* acc = A + static_cast<std::size_t>(c * nMo + p) * pad + X0;
+                store(acc, load<V>(acc) + u * mo[p]);
+            }
+        }
+    }
+
+    // Step i (iv) for the group at X0; false once the group is done.
+    [[gnu::always_inline]] bool stepGroup(const StepTaps<V>& tp, I iv, V hMax, int X0) {
+        I stp;
+        std::memcpy(&stp, steps + X0, sizeof stp);
+        const V h0 = load<V>(in.h0 + X0);
+        const V t =
+            (((tp.wa * load<V>(tp.a + X0) + tp.wb * load<V>(tp.b + X0)) - h0) - load<V>(in.margin + X0)) * tp.inv;
+        V m = load<V>(M + X0);
+        const I nw = (iv < stp) & (t > m);  // Eq. 17: above every earlier sample
+        if (laneBits(nw) == 0) {
+            // past the point where even the field's highest height would not
+            // beat any lane's running maximum, no new member can come: the
+            // group is done (lanes whose ray has left the domain are done too)
+            const I done = (iv >= stp) | (m >= (hMax - h0) * tp.inv);
+            return laneBits(~done) != 0;
+        }
+        m = nw ? t : m;
+        store(M + X0, m);
+        addSegments(tp, nw, t, X0);
+        return true;
+    }
+
+    // The walk: steps in order, the groups still walking at each.
+    [[gnu::always_inline]] void walk(const AzimuthSteps& az) {
+        const I rowLimit = I{} + in.steps;
+        int nActive = 0, nMax = 0;
+        for (int G = 0; G < pad / L; ++G) {
+            const int nAny = startGroup(G, az, rowLimit);
+            nMax = std::max(nMax, nAny);
+            if (nAny > 0) active[nActive++] = G;
+        }
+        const V hMax = splat<V>(in.hMax);
+        for (int i = 0; i < nMax && nActive > 0; ++i) {
+            const StepTaps<V> tp = stepTaps<V>(az, i, in.Y);
+            const I iv = I{} + i;
+            int kept = 0;
+            for (int q = 0; q < nActive; ++q) {
+                const int G = active[q];
+                if (stepGroup(tp, iv, hMax, G * L)) active[kept++] = G;
+            }
+            nActive = kept;
+        }
+    }
+
+    // The sums per channel into out: the exact moment (Irradiance), or the
+    // NLP coefficients by Eq. 10's closed form as a polynomial in s (Nlp).
+    [[gnu::always_inline]] void finish(float* out) const {
+        const V k0 = splat<V>(0.70710678118654752440f), k1 = splat<V>(0.61237243569579452455f);
+        const V k2 = splat<V>(0.79056941504209483300f), k3 = splat<V>(0.23385358667337133659f);
+        for (int c = 0; c < 3; ++c)
+            for (int X0 = 0; X0 < pad; X0 += L) {
+                V Ac[nMo];
+                for (int p = 0; p < nMo; ++p) Ac[p] = load<V>(A + static_cast<std::size_t>(c * nMo + p) * pad + X0);
+                if constexpr (Exact) {
+                    store(out + static_cast<std::size_t>(c) * pad + X0, Ac[0]);
+                } else {
+                    float* base = out + static_cast<std::size_t>(c) * 4 * pad + X0;
+                    store(base, k0 * Ac[0]);
+                    store(base + pad, k1 * Ac[1]);
+                    store(base + 2 * pad, k2 * (Ac[2] - Ac[0]));
+                    store(base + 3 * pad, k3 * (splat<V>(5.0f) * Ac[3] - splat<V>(6.0f) * Ac[1]));
+                }
+            }
+    }
+};
+
+template <class V, CastingMoments K>
+[[gnu::always_inline]] inline void castRowImpl(const AzimuthSteps& az, const ReceiverRow& in, IndirectScratch& sc,
+                                               int pad) {
+    CastingRow<V, K> row(in, sc, pad);
+    row.walk(az);
+    row.finish(sc.result.data());
+}
+
+template <CastingMoments K>
+void castRowSse(const AzimuthSteps& az, const ReceiverRow& in, IndirectScratch& sc, int pad) {
+    castRowImpl<F4, K>(az, in, sc, pad);
+}
+template <CastingMoments K>
+[[gnu::target("avx2"), gnu::flatten]] void castRowAvx2(const AzimuthSteps& az, const ReceiverRow& in,
+                                                       IndirectScratch& sc, int pad) {
+    castRowImpl<F8, K>(az, in, sc, pad);
+}
+
+}  // namespace
+
+void sizeIndirectScratch(IndirectScratch& sc, int rows, int pad, bool irradiance) {
+    const std::size_t rowFloats = static_cast<std::size_t>(rows) * pad;
+    sc.gx.resize(rowFloats);
+    sc.gy.resize(rowFloats);
+    sc.h0.resize(rowFloats);
+    sc.margin.resize(rowFloats);
+    if (irradiance) sc.irradiance.resize(rowFloats * 3);
+    sc.result.resize(static_cast<std::size_t>(3 * kMaxMoments) * pad);
+    sc.state.resize(static_cast<std::size_t>(4 + 3 * kMaxMoments) * pad);
+    sc.groupSteps.resize(static_cast<std::size_t>(pad));
+    sc.active.resize(static_cast<std::size_t>(pad));
+}
+
+CastRowFn castRowFor(CastingMoments moments) {
+    const bool wide = simd::wideEnabled();
+    if (moments == CastingMoments::Nlp)
+        return wide ? castRowAvx2<CastingMoments::Nlp> : castRowSse<CastingMoments::Nlp>;
+    return wide ? castRowAvx2<CastingMoments::Irradiance> : castRowSse<CastingMoments::Irradiance>;
+}
+
+}  // namespace terrain::gi

@@ -1,0 +1,117 @@
+#include "gi/indirect_blocker_radiance.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "gi/blocker_radiance.h"
+#include "core/parallel.h"
+#include "core/simd.h"
+
+namespace terrain::gi {
+
+namespace {
+
+using simd::load;
+using simd::store;
+using simd::F4;
+using simd::F8;
+using simd::LaneTraits;
+
+// One row and azimuth's exact moments into the row's E sums, per channel
+// (pad floats each): sums[c] += result[c].
+template <class V>
+[[gnu::always_inline]] inline void accumulateIrradianceImpl(const float* result, float* sums, int pad, int nxr) {
+    constexpr int L = LaneTraits<V>::n;
+    const int nv = nxr / L * L;
+    for (int c = 0; c < 3; ++c) {
+        float* __restrict e = sums + static_cast<std::size_t>(c) * pad;
+        const float* __restrict w = result + static_cast<std::size_t>(c) * pad;
+        for (int X = 0; X < nv; X += L) store(e + X, load<V>(e + X) + load<V>(w + X));
+        for (int X = nv; X < nxr; ++X) e[X] += w[X];
+    }
+}
+void accumulateIrradianceSse(const float* result, float* sums, int pad, int nxr) {
+    accumulateIrradianceImpl<F4>(result, sums, pad, nxr);
+}
+[[gnu::target("avx2"), gnu::flatten]] void accumulateIrradianceAvx2(const float* result, float* sums, int pad,
+                                                                    int nxr) {
+    accumulateIrradianceImpl<F8>(result, sums, pad, nxr);
+}
+
+}  // namespace
+
+BlockerRadianceIndirect::BlockerRadianceIndirect(const IndirectInputs& in, const IndirectSettings& settings,
+                                                 IndirectState& st)
+    : in_(in), settings_(settings), st_(st), scan_(in, CastingMoments::Irradiance, st) {}
+
+void BlockerRadianceIndirect::beginFrame() {
+    prepareBlockerRadiance(in_.heights, in_.op.azimuths, st_.blocker);
+    scan_.beginFrame();
+}
+
+void BlockerRadianceIndirect::buildPyramid(const BounceSource& previous) {
+    scan_.buildPyramid(*previous.rgb, settings_.radiance);
+}
+
+void BlockerRadianceIndirect::scan(int b) {
+    scan_.buildStepTable();
+    // the receivers' horizons do not change between bounces
+    const bool horizons = b == 1 && in_.heights.subsample > 1;
+    parallelFor(0, scan_.blockCount(), 1, [&](int b0, int b1) {
+        for (int block = b0; block < b1; ++block) scanBlock(block, horizons);
+    });
+}
+
+// Casting sets and the exact irradiance at one block of receiver rows
+// (horizons: and the receivers' horizons, BlockerRadianceState::farSlope).
+void BlockerRadianceIndirect::scanBlock(int block, bool horizons) {
+    const int nxr = in_.heights.nxr, nyr = in_.heights.nyr, pad = scan_.pad();
+    const std::size_t planeR = static_cast<std::size_t>(nxr) * nyr;
+    void (*const accumulate)(const float*, float*, int, int) =
+        simd::wideEnabled() ? accumulateIrradianceAvx2 : accumulateIrradianceSse;
+    IndirectScratch& sc = st_.blocks[static_cast<std::size_t>(block)];
+    const RowBlock rb = scan_.rowBlock(block);
+    // the rows' receiver heights and gradients; E sums zeroed
+    scan_.loadRows(rb, sc);
+    std::fill(sc.irradiance.data(), sc.irradiance.data() + 3 * static_cast<std::size_t>(rb.rows) * pad, 0.0f);
+    for (int j = 0; j < in_.op.azimuths; ++j) {
+        const AzimuthSteps az = scan_.azimuth(j);
+        for (int r = 0; r < rb.rows; ++r) {
+            const int Y = rb.yBegin + r;
+            scan_.castRow(az, j, Y, r, sc);
+            // the receivers' horizon along this azimuth (the walk's running maximum)
+            if (horizons)
+                std::copy(sc.state.data(), sc.state.data() + nxr,
+                          st_.blocker.farSlope.data() + static_cast<std::size_t>(j) * planeR +
+                              static_cast<std::size_t>(Y) * nxr);
+            accumulate(sc.result.data(), sc.irradiance.data() + 3 * static_cast<std::size_t>(r) * pad, pad, nxr);
+        }
+    }
+    receiverIrradiance(rb, sc);
+}
+
+// E / pi at the block's receivers (BlockerRadianceState::receiverShade):
+// box weights (2 pi / m) / pi over the azimuths, over |n|.
+void BlockerRadianceIndirect::receiverIrradiance(const RowBlock& rb, const IndirectScratch& sc) {
+    const int nxr = in_.heights.nxr, pad = scan_.pad();
+    const float eScale = 2.0f / static_cast<float>(in_.op.azimuths);  // (2 pi / m) / pi
+    for (int r = 0; r < rb.rows; ++r) {
+        const std::size_t ro = static_cast<std::size_t>(r) * pad;
+        const std::size_t at = static_cast<std::size_t>(rb.yBegin + r) * nxr;
+        const float* gx = sc.gx.data() + ro;
+        const float* gy = sc.gy.data() + ro;
+        for (int c = 0; c < 3; ++c) {
+            const float* e = sc.irradiance.data() + 3 * ro + static_cast<std::size_t>(c) * pad;
+            float* out = st_.blocker.receiverShade[static_cast<std::size_t>(c)].data() + at;
+            for (int X = 0; X < nxr; ++X) out[X] = eScale / std::sqrt(1.0f + gx[X] * gx[X] + gy[X] * gy[X]) * e[X];
+        }
+    }
+}
+
+void BlockerRadianceIndirect::shade(int b, ShadeMaps& out) {
+    if (b == 1 && in_.heights.subsample > 1)
+        computeTexelOcclusion(in_.heights, in_.gradX, in_.gradY, in_.op.phi, st_.blocker);
+    shadeBlockerRadiance(st_.blocker, in_.albedo, out.rgb);
+}
+
+}  // namespace terrain::gi

@@ -1,0 +1,91 @@
+#include "gi/indirect_bounces.h"
+
+#include <algorithm>
+#include <chrono>
+
+namespace terrain::gi {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+// Zeroes the sum of the bounces (full resolution) and sizes the bounce means.
+void clearIndirect(int nx, int ny, int bounces, IndirectState& st) {
+    for (int c = 0; c < 3; ++c) {
+        Grid& g = st.indirect[static_cast<std::size_t>(c)];
+        if (g.nx != nx || g.ny != ny) g.resize(nx, ny);
+        std::fill(g.v.begin(), g.v.end(), 0.0f);
+    }
+    st.bounceMean.resize(static_cast<std::size_t>(bounces));
+}
+
+}  // namespace
+
+void runBounces(const IndirectInputs& in, const IndirectSettings& settings, IndirectStrategy& strategy,
+                IndirectState& st) {
+    const auto t0 = Clock::now();
+    st.timings = IndirectTimings{};
+    strategy.beginFrame();
+    clearIndirect(in.heights.nx, in.heights.ny, settings.bounces, st);
+    BounceSource source{&in.direct, in.directShade};
+    for (int b = 1; b <= settings.bounces; ++b) {
+        // ---- pyramid of bounce b - 1 (Section 5.3) ------------------------------------
+        auto t = Clock::now();
+        strategy.buildPyramid(source);
+        st.timings.pyramid += msSince(t);
+
+        // ---- step table and casting-set scan --------------------------------------------
+        t = Clock::now();
+        strategy.scan(b);
+        st.timings.scan += msSince(t);
+
+        // ---- shading at full-resolution normals: L_b ---------------------------------
+        t = Clock::now();
+        ShadeMaps& out = st.bounceShade[static_cast<std::size_t>(b & 1)];
+        strategy.shade(b, out);
+        accumulateBounce(out.rgb, b, st);
+        source = {&out.rgb, &out};
+        st.timings.shading += msSince(t);
+    }
+    sumDirectAndIndirect(in.direct, st);
+    st.timings.total = msSince(t0);
+}
+
+void accumulateBounce(const std::array<Grid, 3>& exit, int b, IndirectState& st) {
+    double sum = 0.0;
+    for (int c = 0; c < 3; ++c) {
+        Grid& acc = st.indirect[static_cast<std::size_t>(c)];
+        const Grid& add = exit[static_cast<std::size_t>(c)];
+        for (std::size_t i = 0; i < acc.v.size(); ++i) {
+            acc.v[i] += add.v[i];
+            sum += add.v[i];
+        }
+    }
+    st.bounceMean[static_cast<std::size_t>(b - 1)] = sum / (3.0 * std::max<std::size_t>(1, st.indirect[0].v.size()));
+}
+
+void sumDirectAndIndirect(const std::array<Grid, 3>& direct, IndirectState& st) {
+    for (int c = 0; c < 3; ++c) {
+        Grid& tot = st.total[static_cast<std::size_t>(c)];
+        const Grid& ind = st.indirect[static_cast<std::size_t>(c)];
+        if (tot.nx != ind.nx || tot.ny != ind.ny) tot.resize(ind.nx, ind.ny);
+        const Grid& d = direct[static_cast<std::size_t>(c)];
+        for (std::size_t i = 0; i < tot.v.size(); ++i) tot.v[i] = d.v[i] + ind.v[i];
+    }
+}
+
+void setUShadingLights(IndirectState& st) {
+    for (int c = 0; c < 3; ++c) {
+        ShadingLight& L = st.lights[static_cast<std::size_t>(c)];
+        L.visibility = &st.u[static_cast<std::size_t>(c)];
+        for (int ch = 0; ch < 3; ++ch) {
+            ShMatrix& mtx = L.product[static_cast<std::size_t>(ch)];
+            mtx.fill(0.0);
+            if (ch == c)
+                for (int i = 0; i < kShCount; ++i) mtx[static_cast<std::size_t>(i * kShCount + i)] = 1.0;
+        }
+    }
+}
+
+}  // namespace terrain::gi

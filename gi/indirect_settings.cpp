@@ -1,0 +1,14 @@
+#include "gi/indirect_settings.h"
+
+#include "gi/settings_ranges.h"
+
+namespace terrain::gi {
+
+void validateIndirectSettings(const IndirectSettings& s) {
+    checkRange(ranges::kBounces, s.bounces);
+    checkRange(ranges::kRadianceLevelsPerOctave, s.radiance.levelsPerOctave);
+    checkRange(ranges::kRadianceLevelOffset, s.radiance.levelOffset);
+    checkRange(ranges::kIndirectAzimuths, s.azimuths);
+}
+
+}  // namespace terrain::gi

@@ -1,0 +1,47 @@
+#pragma once
+// Settings of the indirect light (gi/indirect.h): the number of bounces, the
+// radiance pyramid, and which strategy turns the casting sets into light.
+#include "gi/radiance_pyramid.h"
+
+namespace terrain::gi {
+
+// Glossy BRDFs (Phong, Lambert + Phong).
+enum class GlossyIndirect {
+    // One RGB pyramid of the scalar shade (diffuse + glossy towards the
+    // viewer), Fig. 5 right: the SH kernel's scan, shaded with the BRDF
+    // (gi/indirect_sh_kernel.h).
+    ScalarPyramid,
+    // A pyramid of SH exit-radiance vectors, evaluated towards each receiver
+    // (Fig. 5 middle; gi/indirect_glossy.h).
+    VectorPyramid,
+};
+
+// How Lambert receivers turn their casting sets into irradiance.
+enum class LambertIndirect {
+    // Eq. 12 + the folded wedge operator + the order-4 SH clamped cosine (the
+    // paper; gi/indirect_sh_kernel.h). The SH kernel over-weights light near
+    // the horizon (k(0) = 0.094): the indirect light comes out biased high
+    // (bench/results/gi_indirect_diagnosis.md).
+    ShKernel,
+    // The exact clamped-cosine irradiance E at the receivers; between them
+    // the blockers' mean radiance E / O interpolated and multiplied by each
+    // texel's own occlusion O (gi/indirect_blocker_radiance.h). No U: the
+    // scan keeps the exact moment and the horizon only. Lambert BRDF; with
+    // another BRDF the SH kernel runs.
+    BlockerRadiance,
+};
+
+struct IndirectSettings {
+    int bounces = 0;                   // 0: direct light only
+    RadiancePyramidSettings radiance;  // k_u = 4, o_u = 2
+    bool amortise = false;             // Section 7: alternate direct / indirect on static geometry
+    GlossyIndirect glossy = GlossyIndirect::ScalarPyramid;
+    LambertIndirect lambert = LambertIndirect::ShKernel;
+    // Azimuths of the indirect scan (0: the visibility's m).
+    int azimuths = 0;
+};
+
+/// Throws InputError when a setting is out of range.
+void validateIndirectSettings(const IndirectSettings& s);
+
+}  // namespace terrain::gi

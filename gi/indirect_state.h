@@ -1,0 +1,50 @@
+#pragma once
+// Results and reusable buffers of the indirect light (gi/indirect.h): the
+// bounces' sums, U, and each strategy's scratch. Sized on the first frame of
+// a given size and settings; no allocation after it.
+#include <array>
+#include <vector>
+
+#include "gi/blocker_radiance.h"
+#include "gi/casting_set_scan.h"
+#include "gi/radiance_pyramid.h"
+#include "gi/shading.h"
+#include "gi/visibility.h"
+#include "core/grid.h"
+
+namespace terrain::gi {
+
+struct IndirectTimings {
+    double pyramid = 0.0, scan = 0.0, shading = 0.0, total = 0.0;
+};
+
+/// Buffers of the vector-pyramid bounce (GlossyIndirect::VectorPyramid, gi/indirect_glossy.h).
+struct GlossyIndirectState {
+    std::vector<float> exitSh;  // 3 x 16 planes of nx * ny: E at full resolution (plane c * 16 + k)
+    RadiancePyramid pyramid;    // one field per plane of exitSh
+    std::vector<ScanStep> steps;        // azimuths x steps: geometry and weights (field 0)
+    std::vector<const float*> fields;   // azimuths x steps x 48: field + offA of each plane
+    std::vector<float> blockScratch;    // per row block: scan scratch (moments, basis, NLP)
+    std::vector<int> blockList;         // per row block: steps with a new member
+    std::vector<float> rowScratch;      // per row block: interpolated incident SH of one row
+};
+
+struct IndirectState {
+    RadiancePyramid radiance;             // Lambert strategies: the previous bounce's RGB radiance pyramid
+    std::vector<ScanStep> heightSteps;    // azimuths x steps
+    std::vector<ScanStep> radianceSteps;  // Lambert strategies: channels x azimuths x steps
+    std::vector<int> stepsPerColumn, stepsPerRow;
+    std::vector<IndirectScratch> blocks;  // Lambert strategies: per block of receiver rows
+    std::array<VisibilityField, 3> u;     // U per channel (16 SH planes at the receivers; not with BlockerRadiance)
+    int uZeroFrom = kShCount;             // U's planes from this one on are known to be 0
+    std::array<ShadingLight, 3> lights;   // the shading lights of U
+    std::array<ShadeMaps, 2> bounceShade;  // exit radiance of the current / previous bounce
+    std::array<Grid, 3> indirect;  // sum of bounces 1..B, full resolution
+    std::array<Grid, 3> total;     // direct + indirect
+    std::vector<double> bounceMean;  // mean exit radiance (RGB average) of each bounce
+    IndirectTimings timings;
+    GlossyIndirectState glossy;    // GlossyIndirect::VectorPyramid
+    BlockerRadianceState blocker;  // LambertIndirect::BlockerRadiance: horizons, occlusion, receivers' E
+};
+
+}  // namespace terrain::gi

@@ -1,0 +1,65 @@
+#pragma once
+// The scan of the Lambert strategies (gi/indirect_sh_kernel.h,
+// gi/indirect_blocker_radiance.h): per bounce the previous bounce's RGB
+// radiance pyramid, the step table of heights and the 3 channels' radiance,
+// and the casting-set kernel (gi/casting_set_scan.h) row by row.
+//
+// Schedule: like gi/visibility: a per-bounce step table, fixed blocks of
+// kRowsPerBlock receiver rows in parallel; within a block azimuth by azimuth,
+// the block's rows one after the other (consecutive rows read neighbouring
+// rows of every level, which stay in cache), every receiver written by one
+// block: bit-identical for any thread count; no allocation after the first
+// frame of a given size and settings.
+#include <array>
+#include <cstddef>
+
+#include "gi/casting_set_scan.h"
+#include "gi/indirect_inputs.h"
+#include "gi/indirect_state.h"
+#include "gi/radiance_pyramid.h"
+#include "core/grid.h"
+
+namespace terrain::gi {
+
+/// The receiver rows of one block: [yBegin, yBegin + rows).
+struct RowBlock {
+    int yBegin, rows;
+};
+
+class LambertScan {
+public:
+    static constexpr int kRowsPerBlock = 8;
+
+    /// A scan that sums `moments` over the casting sets, in st's buffers.
+    LambertScan(const IndirectInputs& in, CastingMoments moments, IndirectState& st);
+
+    /// Sizes the step tables and the blocks' scratch (IndirectScratch::irradiance
+    /// with CastingMoments::Irradiance) and finds the field's highest height.
+    void beginFrame();
+    /// The RGB radiance pyramid of the previous bounce's exit radiance (Section 5.3).
+    void buildPyramid(const std::array<Grid, 3>& exit, const RadiancePyramidSettings& settings);
+    /// The bounce's step table: height and radiance steps, valid prefixes.
+    void buildStepTable();
+
+    int blockCount() const { return nBlocks_; }
+    RowBlock rowBlock(int block) const;
+    /// The block's receiver rows (loadReceiverRow) into its scratch.
+    void loadRows(const RowBlock& rb, IndirectScratch& sc) const;
+    /// Azimuth j's step tables.
+    AzimuthSteps azimuth(int j) const;
+    /// Scans receiver row Y, row r of its block, along azimuth j: sc.result.
+    void castRow(const AzimuthSteps& az, int j, int Y, int r, IndirectScratch& sc) const;
+
+    int pad() const { return pad_; }
+
+private:
+    const IndirectInputs& in_;
+    IndirectState& st_;
+    CastingMoments moments_;
+    CastRowFn castRow_;
+    int pad_, nSteps_, nBlocks_;
+    std::size_t tableSize_;  // azimuths x steps
+    float hMax_ = 0.0f;
+};
+
+}  // namespace terrain::gi
