@@ -33,7 +33,7 @@ struct GiOptions {
     std::vector<std::string> keys;
     // The numeric settings bind straight into the engine's settings: their
     // defaults and ranges are the engine's own (gi/settings.h).
-    gi::GiSettings settings = gi::engineGiSettings();
+    gi::GiSettings settings = gi::GiSettings{};
     std::string indirectKernel;
     std::string interp;
     int threads = 0;

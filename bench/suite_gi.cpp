@@ -96,9 +96,9 @@ std::string settingsName(const GiSettings& s) {
     return buf;
 }
 
-GiSettings paperSettings() { return GiSettings{}; }
+GiSettings paperSettings() { return paperGiSettings(); }
 
-GiSettings engineDefaults() { return engineGiSettings(); }
+GiSettings engineDefaults() { return GiSettings{}; }
 
 std::string buildFlags() {
     return std::string("GCC ") + __VERSION__ +
@@ -108,7 +108,7 @@ std::string buildFlags() {
 
 struct Row {
     std::string label;
-    GiSettings s;
+    GiSettings s = paperGiSettings();
     ErrorStats e;
     Timing t;
 };
@@ -251,7 +251,7 @@ void GiSuite::quickAccuracy() const {
     const Grid ref = referenceAmbient(alps, 1, border);
     for (const char* which : {"paper", "engine"})
         for (int s : {1, 2, 4}) {
-            GiSettings set = std::string(which) == "paper" ? GiSettings{} : engineGiSettings();
+            GiSettings set = std::string(which) == "paper" ? paperGiSettings() : GiSettings{};
             set.subsample = s;
             GiState st;
             withThreads(2, [&] {
@@ -312,7 +312,7 @@ void GiSuite::explore() const {
     for (int o : {2, 3, 4})
         for (float peak : {0.0f, 0.25f, 0.5f})
             for (BlockingMax bm : {BlockingMax::BsplineKnotsAndMidpoints, BlockingMax::Samples}) {
-                GiSettings s;
+                GiSettings s = paperGiSettings();
                 s.pyramid.levelOffset = o;
                 s.pyramid.peakBlend = peak;
                 s.visibility.blockingMax = bm;
@@ -341,7 +341,7 @@ void GiSuite::convergence() const {
     const Grid ref = referenceAmbient(small, 1, border);
     std::vector<Row> rows;
     auto base = [] {
-        GiSettings s;
+        GiSettings s = paperGiSettings();
         s.visibility.blockingMax = BlockingMax::Samples;
         return s;
     };

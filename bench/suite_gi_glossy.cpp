@@ -29,7 +29,7 @@ struct GlossyOptions {
 constexpr float albedo = 0.6f;
 
 GiSettings settingsFor(Brdf brdf, float exponent, int s, int bounces, GlossyIndirect mode) {
-    GiSettings g = engineGiSettings();
+    GiSettings g = GiSettings{};
     g.subsample = s;
     g.shading.brdf = brdf;
     g.shading.phongExponent = exponent;
@@ -144,7 +144,7 @@ int runGlossy(const GlossyOptions& o, const BenchContext& ctx) {
     md += "Machine: " + machineDescription() +
           " (shared with another engineer's builds and benchmarks while this ran: timings are indicative).\n\n";
     md += "Lighting: sun-and-sky SH environment (`sunSkyLight()`), viewer overhead, albedo " + std::to_string(albedo).substr(0, 3) +
-          " (diffuse part), engine settings (`engineGiSettings()`: m = 16, o_v = o_u = 3), 1 bounce.\n\n";
+          " (diffuse part), engine settings (`GiSettings{}`: m = 16, o_v = o_u = 3), 1 bounce.\n\n";
     md += accuracySection(o, ctx);
     md += frameTimeSection(o, ctx);
     writeResult(ctx.outDir, "gi_glossy.md", md);

@@ -39,7 +39,7 @@ SceneLights defaultLights() {
 }
 
 gi::GiSettings defaultPipelineGi() {
-    gi::GiSettings s = gi::engineGiSettings();
+    gi::GiSettings s = gi::GiSettings{};
     s.indirect.bounces = 1;
     return s;
 }

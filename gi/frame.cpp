@@ -108,55 +108,6 @@ bool sameLight(const KeyLight& a, const KeyLight& b) {
 
 }  // namespace
 
-GiSettings engineGiSettings() {
-    // Measured on alps-montblanc at true scale against gi/reference
-    // (bench/results/gi_accuracy.md, gi_explore.csv): a level offset of 3, a
-    // pyramid that blends max-decimated octaves into the mean ones (keeps
-    // distant peaks that the mean filter lowers) and the plain maximum over the
-    // step samples remove the pyramid's positive bias at the same cost. The
-    // blend is 50 %: 25 % gave the best ambient (RMSE 0.0073, bias -0.0012 vs
-    // 0.0076, -0.0042 at 50 %), but the casting sets need the peaks too: with
-    // 25 % the indirect light is 5 % low (lowered occluders end the casting
-    // sets early); 256^2 crops, 2x indirect rel. RMSE alps 10.8 -> 9.8 %,
-    // erosion 12.1 -> 11.3 %, 1x 9.4 -> 8.0 %, 8.1 -> 6.8 %.
-    GiSettings s;
-    s.pyramid.levelOffset = 3;
-    s.pyramid.peakBlend = 0.5f;
-    s.visibility.blockingMax = BlockingMax::Samples;
-    // 16 azimuths instead of the paper's 32: with the engine's pyramid the
-    // ambient error is the same to 1e-4 (alps, true scale, 1x: RMSE 0.0073 at
-    // m = 16, 20, 32; order-4 SH truncation is the floor) and the sun-and-sky
-    // shade within 0.1 % (3.15 % vs 3.06 % relative RMSE at 1x), at about 0.7x
-    // the frame time (512^2 2x: 13.7 vs 19.7 ms, 2 threads).
-    s.visibility.azimuths = 16;
-    s.keyLightExactCosine = true;
-    // radiance pyramid offset 3 like the heights' (bench/results/gi_indirect_accuracy.md:
-    // alps crop indirect 9.6 -> 8.1 % at 1x, 13.8 -> 13.0 % at 2x, from the reference's direct light)
-    s.indirect.radiance.levelOffset = 3;
-    // 2 radiance levels per octave instead of 4: the casting-set members read
-    // the nearest level, and the filtered radiance is smooth enough that the
-    // finer level spacing does not show (96^2 quick crops, bench_gi_indirect
-    // --quick --accuracy-only --radiance-k 2 vs 4: 2x indirect rel. RMSE alps
-    // 12.34 vs 12.25 %, erosion 14.27 vs 14.27 %; 1x identical to 0.01 %),
-    // with half the radiance levels to build and to keep in cache (512^2 2x
-    // frame, best of 4 runs: 41.0 vs 46.5 ms).
-    s.indirect.radiance.levelsPerOctave = 2;
-    // indirect light: the exact clamped cosine at the receivers (no SH-kernel
-    // bias); between them the blockers' mean radiance times each texel's own
-    // occlusion (gi/blocker_radiance.h; 256^2 crops at 2x, indirect rel. RMSE
-    // alps 9.9 -> 9.4 %, eroded frame 11.3 -> 7.9 % against U's normal
-    // detail, and no U to scan or shade: 512^2 2x scan 23 -> 15 ms); direct
-    // light: the footprint's lowest tangent plane (bench/results/gi_indirect_accuracy.md)
-    s.indirect.lambert = LambertIndirect::BlockerRadiance;
-    // 8 azimuths for the indirect scan: 256^2 crops at 2x, indirect rel. RMSE
-    // alps 10.1 -> 10.9 %, erosion 12.3 -> 12.5 % (total 2.7 / 1.9 % either
-    // way) at about 0.55x the scan time of 16 (erosion 512^2 2x frame
-    // 125 -> 76 ms, 2 threads)
-    s.indirect.azimuths = 8;
-    s.visibility.footprintTangent = true;
-    return s;
-}
-
 void checkHeightsFinite(ConstGridView h) {
     for (int y = 0; y < h.ny; ++y)
         for (int x = 0; x < h.nx; ++x)

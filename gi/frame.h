@@ -59,10 +59,6 @@ struct GiState {
     bool directUpdated = false, indirectUpdated = false;  // what the last frame recomputed
 };
 
-/// The engine's default settings (chosen from measurements on real DEMs,
-/// bench/results/gi_accuracy.md); GiSettings{} holds the paper's values.
-GiSettings engineGiSettings();
-
 /// Runs one frame. Throws InputError when heights contain NaN/Inf, the cell
 /// size is not positive and finite, or a setting is out of range.
 void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lighting, const GiSettings& settings,

@@ -31,14 +31,18 @@ enum class LambertIndirect {
     BlockerRadiance,
 };
 
+// Defaults: the engine's (gi/settings.h): blocker radiance (no SH-kernel
+// bias near the horizon) and 8 azimuths for the indirect scan, whose light is
+// smooth in azimuth, at about half the scan time of 16
+// (bench/results/gi_indirect_accuracy.md).
 struct IndirectSettings {
     int bounces = 0;                   // 0: direct light only
-    RadiancePyramidSettings radiance;  // k_u = 4, o_u = 2
+    RadiancePyramidSettings radiance;
     bool amortise = false;             // Section 7: alternate direct / indirect on static geometry
     GlossyIndirect glossy = GlossyIndirect::ScalarPyramid;
-    LambertIndirect lambert = LambertIndirect::ShKernel;
-    // Azimuths of the indirect scan (0: the visibility's m).
-    int azimuths = 0;
+    LambertIndirect lambert = LambertIndirect::BlockerRadiance;  // paper: ShKernel
+    // Azimuths of the indirect scan (0: the visibility's m; paper: 0).
+    int azimuths = 8;
 };
 
 /// Throws InputError when a setting is out of range.

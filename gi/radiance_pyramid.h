@@ -24,9 +24,13 @@
 
 namespace terrain::gi {
 
+// Defaults: the engine's (gi/settings.h). Offset 3 like the heights'; 2
+// levels per octave: a casting-set member reads the nearest level and the
+// filtered radiance is smooth enough that finer spacing does not show, with
+// half the levels to build and keep in cache (bench/results/gi_indirect_accuracy.md).
 struct RadiancePyramidSettings {
-    int levelsPerOctave = 4;  // k_u (paper: 4)
-    int levelOffset = 2;      // o_u in octaves (paper: 2)
+    int levelsPerOctave = 2;  // k_u (paper: 4)
+    int levelOffset = 3;      // o_u in octaves (paper: 2)
 };
 
 /// One pyramid per scalar field (3 for RGB radiance, 3 x n for SH vectors),

@@ -23,7 +23,7 @@ struct GiSettings {
     // sqrt(4 pi) over the region's solid angle), instead of V_key dotted with
     // the order-4 SH clamped cosine (whose band-2 truncation is off for a
     // small light: measured in bench/results/gi_indirect_accuracy.md).
-    bool keyLightExactCosine = false;
+    bool keyLightExactCosine = true;  // paper: false
     ShadingSettings shading;
     IndirectSettings indirect;  // bounces, radiance pyramid, amortisation
 };

@@ -62,10 +62,16 @@ enum class BlockingMax {
     Samples,                   // plain maximum over the step samples
 };
 
+// Defaults: the engine's (gi/settings.h). 16 azimuths instead of the
+// paper's 32: with the engine's pyramid the ambient error does not change
+// (the order-4 SH truncation of V is the floor) at about 0.7x the frame time
+// (bench/results/gi_convergence.md); the plain sample maximum instead of
+// Eq. 16's B-spline, which smooths the blocking-angle sequence and does not
+// converge to the exact horizon.
 struct VisibilitySettings {
-    int azimuths = 32;                                    // m (paper: 32)
+    int azimuths = 16;                                    // m (paper: 32)
     AzimuthInterp interp = AzimuthInterp::Linear;         // M_lin (paper's main operator)
-    BlockingMax blockingMax = BlockingMax::BsplineKnotsAndMidpoints;
+    BlockingMax blockingMax = BlockingMax::Samples;       // paper: BsplineKnotsAndMidpoints
     // Sub-sampling: omega_min from the lowest tangent plane of the box of
     // gradients of the texels that interpolate the receiver's V (offsets
     // {-s/2, 0, s/2}^2 cells, FootprintBox; gi/frame passes it in the
@@ -73,7 +79,7 @@ struct VisibilitySettings {
     // normal (Fig. 7); sky between the receiver's plane and a neighbour's
     // lower one is visible to that neighbour. Its effect on accuracy:
     // README.md, "Footprint tangent planes"; at 1x it changes nothing.
-    bool footprintTangent = false;
+    bool footprintTangent = true;  // paper: false
 };
 
 /// Per-block scratch of the scan (one per fixed row block), rows padded to a

@@ -36,7 +36,7 @@ struct Setup {
 // zeroGradient: receivers and texels taken horizontal (the analytic pit);
 // otherwise the frame's central differences.
 void prepare(const Grid& h, float cell, int s, int m, bool zeroGradient, Setup& b) {
-    buildHeightPyramid(h.cview(), cell, s, PyramidSettings{}, b.pyr);
+    buildHeightPyramid(h.cview(), cell, s, paperGiSettings().pyramid, b.pyr);
     if (zeroGradient) {
         b.gx = Grid(h.nx, h.ny, 0.0f);
         b.gy = Grid(h.nx, h.ny, 0.0f);

@@ -68,7 +68,7 @@ TEST_CASE("gi.frame: a flat plane under a uniform unit sky: ambient and shade 1 
     for (int settingsKind = 0; settingsKind < 2; ++settingsKind)
         for (int s : {1, 2, 4})
             for (auto [nx, ny] : {std::pair{64, 64}, std::pair{37, 29}}) {
-                const GiSettings settings = withBounces(settingsKind == 0 ? GiSettings{} : engineGiSettings(), s, 1);
+                const GiSettings settings = withBounces(settingsKind == 0 ? paperGiSettings() : GiSettings{}, s, 1);
                 const Grid h(nx, ny, 312.5f);
                 const AlbedoMap a = uniformAlbedo(nx, ny, 0.6f);
                 for (const AlbedoMap* albedo : {static_cast<const AlbedoMap*>(nullptr), &a}) {
@@ -92,7 +92,7 @@ TEST_CASE(
     "gi.frame: state reuse: a repeated frame is bit-identical, a new size or sub-sampling matches a fresh state") {
     const Grid a = bumpy(64, 64), b = bumpy(48, 80);
     const GiLighting light = sunSkyAndKey();
-    const GiSettings s2 = withBounces(engineGiSettings(), 2, 1), s4 = withBounces(engineGiSettings(), 4, 1);
+    const GiSettings s2 = withBounces(GiSettings{}, 2, 1), s4 = withBounces(GiSettings{}, 4, 1);
     const AlbedoMap albA = uniformAlbedo(64, 64, 0.7f), albB = uniformAlbedo(48, 80, 0.7f);
     auto fresh = [&](const Grid& h, const GiSettings& s, const AlbedoMap& alb) {
         GiState st;
@@ -116,7 +116,7 @@ TEST_CASE(
 
 TEST_CASE("gi.frame: NaN/Inf heights, a bad cell size or sub-sampling throw InputError and leave the state usable") {
     const Grid h = bumpy(24, 20);
-    const GiSettings ok = withBounces(engineGiSettings(), 2, 1);
+    const GiSettings ok = withBounces(GiSettings{}, 2, 1);
     GiState st;
     for (float bad : {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
                       -std::numeric_limits<float>::infinity()}) {
@@ -149,7 +149,7 @@ TEST_CASE(
     const Grid h = bumpy(48, 40);
     const AlbedoMap alb = uniformAlbedo(48, 40, 0.65f);
     const GiLighting light = sunSkyAndKey();
-    const GiSettings full = withBounces(engineGiSettings(), 2, 1);
+    const GiSettings full = withBounces(GiSettings{}, 2, 1);
     GiSettings amort = full;
     amort.indirect.amortise = true;
     GiState ref;
@@ -202,7 +202,7 @@ TEST_CASE("gi.frame: shade, ambient and indirect are bit-identical for 1, 2 and 
     const GiLighting light = sunSkyAndKey();
     for (int s : {1, 2})
         for (int kind = 0; kind < 2; ++kind) {
-            const GiSettings settings = withBounces(kind == 0 ? engineGiSettings() : GiSettings{}, s, 2);
+            const GiSettings settings = withBounces(kind == 0 ? GiSettings{} : paperGiSettings(), s, 2);
             auto run = [&] {
                 GiState st;
                 runGiFrame(h.cview(), 1.5f, light, settings, st, &alb);

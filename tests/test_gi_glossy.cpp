@@ -26,7 +26,7 @@ namespace {
 
 
 GiSettings glossySettings(Brdf brdf, float exponent, int bounces, GlossyIndirect mode, int subsample = 1) {
-    GiSettings s = engineGiSettings();
+    GiSettings s = GiSettings{};
     s.subsample = subsample;
     s.shading.brdf = brdf;
     s.shading.phongExponent = exponent;

@@ -22,7 +22,7 @@ namespace {
 
 
 GiSettings indirectSettings(int bounces, int subsample = 1) {
-    GiSettings s = engineGiSettings();
+    GiSettings s = GiSettings{};
     s.subsample = subsample;
     s.indirect.bounces = bounces;
     return s;

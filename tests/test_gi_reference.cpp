@@ -75,7 +75,7 @@ TEST_CASE("gi.reference: the fast path converges to the ground truth as m, k_v a
     const Setting sweep[] = {{8, 2, 0}, {16, 4, 1}, {32, 4, 2}, {64, 8, 4}, {128, 16, 6}};
     double previous = 1e9;
     for (const Setting& s : sweep) {
-        GiSettings settings;
+        GiSettings settings = paperGiSettings();
         settings.visibility.azimuths = s.m;
         settings.pyramid.levelsPerOctave = s.kv;
         settings.pyramid.levelOffset = s.ov;

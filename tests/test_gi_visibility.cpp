@@ -72,7 +72,7 @@ TEST_CASE("gi.visibility: flat plane has ambient 1 within 1e-4 at 1x, 2x, 4x") {
     for (int s : {1, 2, 4})
         for (auto dims : {std::pair{64, 64}, std::pair{37, 29}}) {
             const Grid g(dims.first, dims.second, 123.0f);
-            GiSettings settings;
+            GiSettings settings = paperGiSettings();
             settings.subsample = s;
             for (AzimuthInterp interp : {AzimuthInterp::Linear, AzimuthInterp::Bspline}) {
                 settings.visibility.interp = interp;
@@ -106,7 +106,7 @@ TEST_CASE("gi.visibility: circular pit floor centre against r^2 / (r^2 + d^2)") 
             const double dist = std::hypot(x - 36.0, y - 36.0) * cell;
             return dist < r ? static_cast<float>(-d) : 0.0f;
         });
-        GiSettings settings;
+        GiSettings settings = paperGiSettings();
         settings.visibility.azimuths = 64;
         settings.pyramid.levelOffset = 6;
         settings.pyramid.levelsPerOctave = 16;
@@ -126,7 +126,7 @@ TEST_CASE("gi.visibility: circular pit floor centre against r^2 / (r^2 + d^2)") 
         CHECK(std::abs(fast - order4PitAmbient(s)) < 0.015);
         CHECK(std::abs(fast - exact) < 0.04);
         // paper settings for the record (filtered rim: positive bias)
-        GiSettings paper;
+        GiSettings paper = paperGiSettings();
         GiState st2;
         runGiFrame(g.cview(), static_cast<float>(cell), GiLighting{}, paper, st2);
         MESSAGE("   paper settings (m=32, k_v=4, o_v=2): " << st2.shade.ambient(36, 36));
@@ -145,7 +145,7 @@ TEST_CASE("gi.visibility: a wall shades the side away from the key light") {
         k.radiusDeg = 5.0f;
         light.keys.push_back(k);
         for (int s : {1, 2}) {
-            GiSettings settings;
+            GiSettings settings = paperGiSettings();
             settings.subsample = s;
             GiState st;
             runGiFrame(g.cview(), 1.0f, light, settings, st);
@@ -180,7 +180,7 @@ TEST_CASE("gi.visibility: hard cases give finite output") {
     light.keys.push_back(k);
     for (auto& [name, g] : cases)
         for (int s : {1, 2, 4}) {
-            GiSettings settings;
+            GiSettings settings = paperGiSettings();
             settings.subsample = s;
             GiState st;
             runGiFrame(g.cview(), 1.0f, light, settings, st);
@@ -194,18 +194,18 @@ TEST_CASE("gi.visibility: NaN/Inf heights and bad settings are rejected") {
     Grid g(8, 8, 0.0f);
     g(3, 4) = std::nanf("");
     GiState st;
-    CHECK_THROWS_AS(runGiFrame(g.cview(), 1.0f, GiLighting{}, GiSettings{}, st), InputError);
+    CHECK_THROWS_AS(runGiFrame(g.cview(), 1.0f, GiLighting{}, paperGiSettings(), st), InputError);
     g(3, 4) = INFINITY;
-    CHECK_THROWS_AS(runGiFrame(g.cview(), 1.0f, GiLighting{}, GiSettings{}, st), InputError);
+    CHECK_THROWS_AS(runGiFrame(g.cview(), 1.0f, GiLighting{}, paperGiSettings(), st), InputError);
     g(3, 4) = 0.0f;
-    CHECK_THROWS_AS(runGiFrame(g.cview(), 0.0f, GiLighting{}, GiSettings{}, st), InputError);
-    GiSettings bad;
+    CHECK_THROWS_AS(runGiFrame(g.cview(), 0.0f, GiLighting{}, paperGiSettings(), st), InputError);
+    GiSettings bad = paperGiSettings();
     bad.subsample = 3;
     CHECK_THROWS_AS(runGiFrame(g.cview(), 1.0f, GiLighting{}, bad, st), InputError);
     GiLighting badKey;
     badKey.keys.push_back(KeyLight{});
     badKey.keys[0].radiusDeg = 0.0f;
-    CHECK_THROWS_AS(runGiFrame(g.cview(), 1.0f, badKey, GiSettings{}, st), InputError);
+    CHECK_THROWS_AS(runGiFrame(g.cview(), 1.0f, badKey, paperGiSettings(), st), InputError);
 }
 
 TEST_CASE("gi.visibility: outputs are bit-identical for 1, 2, 3 and 8 threads") {
@@ -217,7 +217,7 @@ TEST_CASE("gi.visibility: outputs are bit-identical for 1, 2, 3 and 8 threads") 
     k.elevationDeg = 20.0f;
     light.keys.push_back(k);
     for (int s : {1, 2}) {
-        GiSettings settings;
+        GiSettings settings = paperGiSettings();
         settings.subsample = s;
         settings.visibility.interp = s == 1 ? AzimuthInterp::Linear : AzimuthInterp::Bspline;
         settings.pyramid.peakBlend = s == 1 ? 0.0f : 0.5f;
@@ -235,7 +235,7 @@ TEST_CASE("gi.visibility: a second frame on a changed field reuses every buffer"
     Grid g = hills(64, 48, 20.0f);
     GiLighting light;
     light.keys.push_back(KeyLight{});
-    GiSettings settings;
+    GiSettings settings = paperGiSettings();
     settings.subsample = 2;
     GiState st;
     runGiFrame(g.cview(), 1.0f, light, settings, st);
@@ -261,7 +261,7 @@ TEST_CASE("gi.visibility: the SIMD scan matches its scalar twin bit for bit (eve
     const Grid g = hills(61, 47, 30.0f);
     for (int s : {1, 2, 4})
         for (BlockingMax rule : {BlockingMax::Samples, BlockingMax::BsplineKnotsAndMidpoints}) {
-            GiSettings settings;
+            GiSettings settings = paperGiSettings();
             settings.subsample = s;
             settings.visibility.azimuths = 7;
             settings.visibility.blockingMax = rule;

@@ -46,7 +46,7 @@ TEST_CASE("simd: the AVX2 and SSE2 kernels give bit-identical GI frames") {
         for (int x = 0; x < 77; ++x) a.channel[0](x, y) = 0.3f + 0.5f * static_cast<float>((x * 5 + y * 3) % 13) / 13.0f;
     for (int sub : {1, 2, 4})
         for (LambertIndirect lam : {LambertIndirect::BlockerRadiance, LambertIndirect::ShKernel}) {
-            GiSettings s = engineGiSettings();
+            GiSettings s = GiSettings{};
             s.subsample = sub;
             s.indirect.bounces = 2;
             s.indirect.lambert = lam;

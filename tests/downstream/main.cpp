@@ -47,7 +47,7 @@ int main() {
         gi::GiLighting lighting;
         lighting.environment = gi::uniformSkyLight(1.0f);
         gi::GiState state;
-        gi::runGiFrame(heights.cview(), kCellSize, lighting, gi::engineGiSettings(), state);
+        gi::runGiFrame(heights.cview(), kCellSize, lighting, gi::GiSettings{}, state);
 
         const terrain::Grid& ambient = state.shade.ambient;
         if (ambient.nx != kSize || ambient.ny != kSize) return fail("ambient map size", static_cast<float>(ambient.nx));
