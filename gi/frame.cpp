@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "gi/indirect_bounces.h"
 
 namespace terrain::gi {
 
@@ -140,9 +141,11 @@ void computeGradient(ConstGridView h, float cellSize, Grid& gx, Grid& gy) {
     });
 }
 
-void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lighting, const GiSettings& settings,
-                GiState& st, const AlbedoMap* albedo) {
-    // ---- validate inputs (boundary of the stage) --------------------------------
+namespace {
+
+// The stage's boundary: every input and setting checked before any work.
+void validateFrameInputs(ConstGridView heights, float cellSize, const GiLighting& lighting, const GiSettings& settings,
+                         const AlbedoMap* albedo) {
     if (heights.nx < 1 || heights.ny < 1 || !heights.data) throw InputError("heights: empty grid");
     if (!std::isfinite(cellSize) || cellSize <= 0.0f) throw InputError("cell size must be positive and finite");
     validateGiSettings(settings);
@@ -151,17 +154,26 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
         for (double v : c)
             if (!std::isfinite(v)) throw InputError("environment light: NaN or Inf coefficient");
     checkHeightsFinite(heights);
-    if (albedo)
-        for (const Grid& g : albedo->channel)
-            if (!g.empty() && (g.nx != heights.nx || g.ny != heights.ny)) throw InputError("albedo map size differs from the heights");
-    if (albedo)
-        for (const Grid& g : albedo->phongLobe)
-            if (!g.empty() && (g.nx != heights.nx || g.ny != heights.ny))
-                throw InputError("Phong exponent map size differs from the heights");
+    if (!albedo) return;
+    for (const Grid& g : albedo->channel)
+        if (!g.empty() && (g.nx != heights.nx || g.ny != heights.ny))
+            throw InputError("albedo map size differs from the heights");
+    for (const Grid& g : albedo->phongLobe)
+        if (!g.empty() && (g.nx != heights.nx || g.ny != heights.ny))
+            throw InputError("Phong exponent map size differs from the heights");
+}
 
-    // ---- amortisation (Section 7): on static geometry alternate direct / indirect --
-    const std::array<int, 7> key = {heights.nx, heights.ny, settings.subsample, settings.indirect.bounces,
-                                    settings.visibility.azimuths, static_cast<int>(settings.shading.brdf), settings.indirect.azimuths};
+// Shading amortisation (Nowrouzezahrai & Snyder 2009, Section 7): on static
+// geometry, frames with the same key alternate between updating the direct
+// and the indirect light. Sets st.directUpdated / st.indirectUpdated.
+void planAmortisation(ConstGridView heights, const GiSettings& settings, GiState& st) {
+    const std::array<int, 7> key = {heights.nx,
+                                    heights.ny,
+                                    settings.subsample,
+                                    settings.indirect.bounces,
+                                    settings.visibility.azimuths,
+                                    static_cast<int>(settings.shading.brdf),
+                                    settings.indirect.azimuths};
     const bool amortised = settings.indirect.amortise && settings.indirect.bounces > 0 && !st.geometryChanged &&
                            st.amortiseReady && st.amortiseKey == key;
     st.directUpdated = !amortised || st.amortisePhase == 0;
@@ -169,48 +181,33 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
     st.amortisePhase = amortised ? 1 - st.amortisePhase : 0;
     st.amortiseReady = true;
     st.amortiseKey = key;
-    st.timings.indirect = 0.0;
-    if (!st.directUpdated) {
-        // indirect only: geometry, pyramid, visibility and direct shade are the last frame's
-        const auto ti = Clock::now();
-        runIndirectStage(settings, st, albedo);
-        st.timings.total = msSince(ti);
-        return;
-    }
+}
 
-    const auto t0 = Clock::now();
-    auto t = t0;
-    computeGradient(heights, cellSize, st.gradX, st.gradY);
-    st.timings.gradient = msSince(t);
-
-    t = Clock::now();
-    buildHeightPyramid(heights, cellSize, settings.subsample, settings.pyramid, st.pyramid);
-    st.timings.pyramid = msSince(t);
-
-    // ---- environment visibility ---------------------------------------------------
-    t = Clock::now();
+// The environment's visibility V at the receivers; with sub-sampling and
+// footprint tangent planes, omega_min from each receiver's footprint box.
+void environmentVisibility(const GiSettings& settings, GiState& st) {
     if (st.envOperatorAzimuths != settings.visibility.azimuths || st.envOperatorInterp != settings.visibility.interp) {
         st.envOperator = foldFullCircle(settings.visibility.azimuths, settings.visibility.interp);
         st.envOperatorAzimuths = settings.visibility.azimuths;
         st.envOperatorInterp = settings.visibility.interp;
     }
-    // the receivers' footprint boxes (sub-sampling): omega_min of the direct light
     const bool footprint = settings.subsample > 1 && settings.visibility.footprintTangent;
     if (footprint) computeFootprintBox(st.gradX.cview(), st.gradY.cview(), settings.subsample, st.footprint);
-    const FootprintBox* box = footprint ? &st.footprint : nullptr;
     VisibilityTarget envTarget;
     envTarget.op = &st.envOperator;
-    envTarget.footprint = box;
+    envTarget.footprint = footprint ? &st.footprint : nullptr;
     computeVisibility(st.pyramid, st.gradX.cview(), st.gradY.cview(), settings.visibility, envTarget, st.visibilityState,
                       st.envVisibility);
-    st.timings.visibility = msSince(t);
+}
 
-    // ---- key lights: own visibility over their extent (Section 6) -------------------
-    t = Clock::now();
+// Each key light's own visibility over its azimuthal extent and elevation
+// interval (Section 6); operators cached per light.
+void keyLightVisibility(const GiLighting& lighting, const GiSettings& settings, GiState& st) {
     const std::size_t nKeys = lighting.keys.size();
     st.keyOperators.resize(nKeys);
     st.keyOperatorLights.resize(nKeys);
     st.keyVisibility.resize(nKeys);
+    const bool footprint = settings.subsample > 1 && settings.visibility.footprintTangent;
     for (std::size_t k = 0; k < nKeys; ++k) {
         const KeyLight& light = lighting.keys[k];
         const KeyLightExtent ext = keyLightExtent(light);
@@ -223,44 +220,67 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
         target.window = true;
         target.sinLow = ext.sinLow;
         target.sinHigh = ext.sinHigh;
-        target.footprint = box;
+        target.footprint = footprint ? &st.footprint : nullptr;
         VisibilitySettings ks = settings.visibility;
         ks.azimuths = settings.keyLightAzimuths;
         computeVisibility(st.pyramid, st.gradX.cview(), st.gradY.cview(), ks, target, st.visibilityState,
                           st.keyVisibility[k]);
     }
-    st.timings.keyVisibility = msSince(t);
+}
 
-    // ---- shading: lighting matrices once per frame, then every texel ------------------
-    t = Clock::now();
+// Direct light at every texel: the lighting's SH product matrices once per
+// frame, then the shading (Section 7); key lights through the SH clamped
+// cosine, or with the exact cosine (GiSettings::keyLightExactCosine).
+void directShading(const GiLighting& lighting, const GiSettings& settings, const AlbedoMap* albedo, GiState& st) {
+    const std::size_t nKeys = lighting.keys.size();
     const bool exactKeys = settings.keyLightExactCosine;
     st.shadingLights.resize(1 + (exactKeys ? 0 : nKeys));
     st.shadingLights[0].visibility = &st.envVisibility;
     for (int ch = 0; ch < 3; ++ch)
-        st.shadingLights[0].product[static_cast<std::size_t>(ch)] = shProductMatrix(lighting.environment.c[static_cast<std::size_t>(ch)]);
-    for (std::size_t k = 0; k < (exactKeys ? 0 : nKeys); ++k) {
-        // Section 6: the key light's visibility is already restricted to the
-        // light's azimuthal extent and elevation interval, so V_key is the SH
-        // projection of "visible part of the light's region". Its incident
-        // radiance is that region's radiance times V_key: the product matrix
-        // is a scalar. The region's radiance gives the cap's irradiance at
-        // normal incidence, pi * RGB, over the region's solid angle.
+        st.shadingLights[0].product[static_cast<std::size_t>(ch)] =
+            shProductMatrix(lighting.environment.c[static_cast<std::size_t>(ch)]);
+    for (std::size_t k = 0; k < (exactKeys ? 0 : nKeys); ++k)
         st.shadingLights[k + 1] = keyShadingLight(lighting.keys[k], st.keyVisibility[k]);
-    }
     shadeTexels(st.gradX.cview(), st.gradY.cview(), settings.subsample, st.envVisibility, st.shadingLights.data(),
                 static_cast<int>(st.shadingLights.size()), albedo, settings.shading, st.shade);
     if (exactKeys)
-        for (std::size_t k = 0; k < nKeys; ++k) addKeyLightExactCosine(lighting.keys[k], st.keyVisibility[k], settings.subsample, albedo, st,
-                                   st.shade.rgb);
+        for (std::size_t k = 0; k < nKeys; ++k)
+            addKeyLightExactCosine(lighting.keys[k], st.keyVisibility[k], settings.subsample, albedo, st, st.shade.rgb);
+}
+
+}  // namespace
+
+void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lighting, const GiSettings& settings,
+                GiState& st, const AlbedoMap* albedo) {
+    validateFrameInputs(heights, cellSize, lighting, settings, albedo);
+    planAmortisation(heights, settings, st);
+    st.timings.indirect = 0.0;
+    if (!st.directUpdated) {
+        // indirect only: geometry, pyramid, visibility and direct shade are the last frame's
+        const auto ti = Clock::now();
+        runIndirectStage(settings, st, albedo);
+        st.timings.total = msSince(ti);
+        return;
+    }
+    const auto t0 = Clock::now();
+    auto t = t0;
+    computeGradient(heights, cellSize, st.gradX, st.gradY);
+    st.timings.gradient = msSince(t);
+    t = Clock::now();
+    buildHeightPyramid(heights, cellSize, settings.subsample, settings.pyramid, st.pyramid);
+    st.timings.pyramid = msSince(t);
+    t = Clock::now();
+    environmentVisibility(settings, st);
+    st.timings.visibility = msSince(t);
+    t = Clock::now();
+    keyLightVisibility(lighting, settings, st);
+    st.timings.keyVisibility = msSince(t);
+    t = Clock::now();
+    directShading(lighting, settings, albedo, st);
     st.timings.shading = msSince(t);
     if (st.indirectUpdated) runIndirectStage(settings, st, albedo);
     else if (settings.indirect.bounces > 0)
-        for (int c = 0; c < 3; ++c) {  // direct only: the last indirect light on the new direct shade
-            Grid& tot = st.indirect.total[static_cast<std::size_t>(c)];
-            const Grid& d = st.shade.rgb[static_cast<std::size_t>(c)];
-            const Grid& ind = st.indirect.indirect[static_cast<std::size_t>(c)];
-            for (std::size_t i = 0; i < tot.v.size(); ++i) tot.v[i] = d.v[i] + ind.v[i];
-        }
+        sumDirectAndIndirect(st.shade.rgb, st.indirect);  // the last indirect light on the new direct shade
     st.timings.total = msSince(t0);
 }
 
