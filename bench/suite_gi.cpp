@@ -100,6 +100,16 @@ GiSettings paperSettings() { return paperGiSettings(); }
 
 GiSettings engineDefaults() { return GiSettings{}; }
 
+// The direct-light settings a table compares, printed from the settings
+// themselves so that the text cannot drift from what ran.
+std::string directSettingsText(const GiSettings& s) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "m %d, k_v %d, o_v %d, %.0f %% max-decimated octaves in the pyramid, %s",
+                  s.visibility.azimuths, s.pyramid.levelsPerOctave, s.pyramid.levelOffset, 100.0 * s.pyramid.peakBlend,
+                  s.visibility.blockingMax == BlockingMax::Samples ? "sample maximum" : "Eq. 16 B-spline maximum");
+    return buf;
+}
+
 std::string buildFlags() {
     return std::string("GCC ") + __VERSION__ +
            ", CMAKE_BUILD_TYPE=Release (-O3 -DNDEBUG), -ffp-contract=off -fno-fast-math, baseline x86-64 (SSE2, no -march), "
@@ -379,8 +389,8 @@ void GiSuite::convergence() const {
           "of the bilinear field, exact elevation integrals). The m / k_v / o_v sweeps use the plain sample maximum (the "
           "B-spline maximum of Eq. 16 smooths the blocking-angle sequence and does not converge to the exact horizon); "
           "what remains at large m, k_v, o_v is the order-4 SH truncation of visibility (and m = 128 azimuth interpolation). "
-          "Sub-sampling rows: the paper settings (m = 32, k_v = 4, o_v = 2, Eq. 16 maximum) and the engine defaults "
-          "(o_v = 3, 25 % peak-keeping pyramid, sample maximum), 4x -> 2x -> 1x. Times: whole frame (uniform sky, no key "
+          "Sub-sampling rows: the paper settings (" + directSettingsText(paperSettings()) + ") and the engine defaults (" +
+          directSettingsText(engineDefaults()) + "), 4x -> 2x -> 1x. Times: whole frame (uniform sky, no key "
           "light), 2 threads, median of " + std::to_string(o_.runs) + ".\n\n" + provenance();
     md += "| sweep | settings | RMSE | bias | max abs | ms/frame |\n|---|---|---|---|---|---|\n";
     std::string csv = "sweep,azimuths,levels_per_octave,level_offset,blocking_max,peak_blend,subsample,rmse,bias,max_abs,ms\n";
@@ -447,8 +457,8 @@ void GiSuite::timing() const {
           "Error: ambient map (normal-weighted sky-view factor) RMSE / bias against gi/reference (256 azimuths, exact march) "
           "over the interior (10 % border left out); at 1024^2 over every 4th texel in x and y of the interior (the "
           "reference is computed and cached only there). The error does not depend on the thread count.\n\n"
-          "Settings: paper = m 32, k_v 4, o_v 2, Eq. 16 B-spline maximum; engine = the engine defaults (o_v 3, 25 % "
-          "peak-keeping pyramid, sample maximum). pyramid = gradient + pyramid.\n\nThe machine is shared with other work (2 vCPUs): "
+          "Settings: paper = " + directSettingsText(paperSettings()) + "; engine = the engine defaults (" +
+          directSettingsText(engineDefaults()) + "). pyramid = gradient + pyramid.\n\nThe machine is shared with other work (2 vCPUs): "
           "each row is measured 3 times (median of " + std::to_string(o_.runs) +
           " frames each) and the lowest of the 3 medians is "
           "reported with its stage medians; a repeat during which other processes used more than 5 % of a core is discarded "

@@ -15,7 +15,7 @@
 // integral of (N . d) cos(omega) is closed-form for the ambient map, and for
 // SH lighting the separable Y_i = A_i(sin omega) T_i(phi) reduces it to two
 // 1-D functions of lo per coefficient, tabulated once by Gauss-Legendre
-// quadrature (table error < 1e-7).
+// quadrature.
 // Normals are the same central-difference normals as the fast path uses.
 #include <array>
 #include <atomic>
