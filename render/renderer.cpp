@@ -237,17 +237,21 @@ void Renderer::releaseTarget(Target& t) {
     t = {};
 }
 
-void Renderer::draw(const RenderSettings& s, int width, int height, GLuint framebuffer) {
-    if (width < 1 || height < 1 || width > 16384 || height > 16384)
-        throw InputError("image size must be 1..16384 pixels per side");
-    if (!heightTex_) throw ContextError("renderer: draw before upload");
+// Where the camera and the key light's shadow map look from.
+struct Renderer::FrameViews {
+    glm::vec3 eye;
+    glm::mat4 viewProj;
+    glm::vec3 keyDir;
+    glm::mat4 lightViewProj;  // orthographic, covering the terrain
+};
+
+Renderer::FrameViews Renderer::frameViews(const OrbitCamera& cam, int width, int height) const {
     const engine::FrameData& f = meta_;
     const float exag = f.exaggeration;
     const float extent = static_cast<float>(std::max(f.nx, f.ny) - 1) * f.cellSize;
     const glm::vec3 centre(0.5f * (f.nx - 1) * f.cellSize, 0.5f * (f.ny - 1) * f.cellSize,
                            0.5f * (f.zMin + f.zMax) * exag);
     // ---- camera ------------------------------------------------------------------
-    const OrbitCamera& cam = s.camera;
     const float cp = std::cos(cam.pitchDeg * kDeg);
     const glm::vec3 eye = centre + extent * cam.distance *
                                        glm::vec3(cp * std::cos(cam.yawDeg * kDeg), cp * std::sin(cam.yawDeg * kDeg),
@@ -263,40 +267,67 @@ void Renderer::draw(const RenderSettings& s, int width, int height, GLuint frame
     const glm::vec3 up = std::abs(keyDir.z) > 0.99f ? glm::vec3(0, 1, 0) : glm::vec3(0, 0, 1);
     const glm::mat4 lightViewProj = glm::ortho(-radius, radius, -radius, radius, 0.0f, 4.0f * radius) *
                                     glm::lookAt(centre + keyDir * (2.0f * radius), centre, up);
+    return {eye, viewProj, keyDir, lightViewProj};
+}
+
+namespace {
+
+// The uniforms every mesh program reads: heights, grid, exaggeration, view.
+void meshUniforms(const Gl& gl, const engine::FrameData& f, GLuint p, const glm::mat4& vp, int water) {
+    Uniforms u{gl, p};
+    u.i("uHeight", 0);
+    u.i2("uGrid", f.nx, f.ny);
+    u.f("uCell", f.cellSize);
+    u.f("uExag", f.exaggeration);
+    u.m4("uViewProj", vp);
+    u.i("uWater", water);
+}
+
+}  // namespace
+
+void Renderer::draw(const RenderSettings& s, int width, int height, GLuint framebuffer) {
+    if (width < 1 || height < 1 || width > 16384 || height > 16384)
+        throw InputError("image size must be 1..16384 pixels per side");
+    if (!heightTex_) throw ContextError("renderer: draw before upload");
+    const FrameViews v = frameViews(s.camera, width, height);
     const bool debug = s.debug != DebugView::None;
     gl_.BindVertexArray(vao_);
-    const GLsizei indexCount = static_cast<GLsizei>(indexCount_);
-    auto meshUniforms = [&](GLuint p, const glm::mat4& vp, int water) {
-        Uniforms u{gl_, p};
-        u.i("uHeight", 0);
-        u.i2("uGrid", f.nx, f.ny);
-        u.f("uCell", f.cellSize);
-        u.f("uExag", exag);
-        u.m4("uViewProj", vp);
-        u.i("uWater", water);
-    };
     const bool wantShadowMap = s.shadow == ShadowMode::ShadowMap && !debug;
     // Targets first: creating one binds its textures to the active unit.
-    if (wantShadowMap) ensureTarget(shadow_, std::clamp(s.shadowMapSize, 256, 8192), std::clamp(s.shadowMapSize, 256, 8192), 0, true);
+    const int shadowSide = std::clamp(s.shadowMapSize, 256, 8192);
+    if (wantShadowMap) ensureTarget(shadow_, shadowSide, shadowSide, 0, true);
     ensureTarget(hdr_, width, height, GL_RGBA16F, true);
     gl_.ActiveTexture(GL_TEXTURE0);
     gl_.BindTexture(GL_TEXTURE_2D, heightTex_);
-    if (wantShadowMap) {
-        const int side = shadow_.w;
-        gl_.BindFramebuffer(GL_FRAMEBUFFER, shadow_.fbo);
-        gl_.Viewport(0, 0, side, side);
-        gl_.ClearDepth(1.0);
-        gl_.Clear(GL_DEPTH_BUFFER_BIT);
-        gl_.Enable(GL_DEPTH_TEST);
-        gl_.DepthFunc(GL_LESS);
-        gl_.Enable(GL_POLYGON_OFFSET_FILL);
-        gl_.PolygonOffset(1.5f, 2.0f);
-        gl_.UseProgram(shadowProgram_);
-        meshUniforms(shadowProgram_, lightViewProj, 0);
-        gl_.DrawElements(GL_TRIANGLES, indexCount, GL_UNSIGNED_INT, nullptr);
-        gl_.Disable(GL_POLYGON_OFFSET_FILL);
-    }
-    // ---- terrain and water into the HDR target ------------------------------------
+    if (wantShadowMap) drawShadowMap(v);
+    drawSurfaces(s, v, width, height, wantShadowMap);
+    drawPost(s, v, width, height, framebuffer);
+    gl_.BindVertexArray(0);
+    gl_.ActiveTexture(GL_TEXTURE0);
+    checkGlError(gl_, "draw");
+}
+
+// ---- key light shadow map -----------------------------------------------------------
+void Renderer::drawShadowMap(const FrameViews& v) {
+    const int side = shadow_.w;
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, shadow_.fbo);
+    gl_.Viewport(0, 0, side, side);
+    gl_.ClearDepth(1.0);
+    gl_.Clear(GL_DEPTH_BUFFER_BIT);
+    gl_.Enable(GL_DEPTH_TEST);
+    gl_.DepthFunc(GL_LESS);
+    gl_.Enable(GL_POLYGON_OFFSET_FILL);
+    gl_.PolygonOffset(1.5f, 2.0f);
+    gl_.UseProgram(shadowProgram_);
+    meshUniforms(gl_, meta_, shadowProgram_, v.lightViewProj, 0);
+    gl_.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(indexCount_), GL_UNSIGNED_INT, nullptr);
+    gl_.Disable(GL_POLYGON_OFFSET_FILL);
+}
+
+// ---- terrain and water into the HDR target ------------------------------------------
+void Renderer::drawSurfaces(const RenderSettings& s, const FrameViews& v, int width, int height, bool wantShadowMap) {
+    const engine::FrameData& f = meta_;
+    const GLsizei indexCount = static_cast<GLsizei>(indexCount_);
     gl_.BindFramebuffer(GL_FRAMEBUFFER, hdr_.fbo);
     gl_.Viewport(0, 0, width, height);
     gl_.ClearColor(0, 0, 0, 0);
@@ -310,33 +341,10 @@ void Renderer::draw(const RenderSettings& s, int width, int height, GLuint frame
         gl_.ActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + i));
         gl_.BindTexture(GL_TEXTURE_2D, textures[i]);
     }
-    auto surfaceUniforms = [&](GLuint p, int water) {
-        gl_.UseProgram(p);
-        meshUniforms(p, viewProj, water);
-        Uniforms u{gl_, p};
-        u.i("uShade", 1);
-        u.i("uKey", 2);
-        u.i("uReceiver", 3);
-        u.i("uEnv", 4);
-        u.i("uShadowMap", 5);
-        u.i2("uReceiverGrid", f.nxr, f.nyr);
-        u.i("uSubsample", f.subsample);
-        u.v3("uEye", eye);
-        u.v3("uKeyDir", keyDir);
-        u.v3("uKeyRgb", glm::vec3(f.lights.key.rgb[0], f.lights.key.rgb[1], f.lights.key.rgb[2]));
-        u.i("uLighting", f.lighting == engine::LightingMode::KeyOnly ? 0 : (f.lighting == engine::LightingMode::Direct ? 1 : 2));
-        u.i("uShadowMode", s.shadow == ShadowMode::SoftVisibility ? 0 : (wantShadowMap ? 1 : 2));
-        u.i("uSpecular", s.specular ? 1 : 0);
-        u.i("uDebug", static_cast<int>(s.debug));
-        u.f2("uZRange", f.zMin, f.zMax);
-        u.i("uPalette", f.coast ? 1 : 0);
-        u.m4("uLightViewProj", lightViewProj);
-        u.f("uShadowTexel", shadow_.w > 0 ? 1.0f / static_cast<float>(shadow_.w) : 0.0f);
-    };
-    surfaceUniforms(terrainProgram_, 0);
+    surfaceUniforms(terrainProgram_, 0, s, v, wantShadowMap);
     gl_.DrawElements(GL_TRIANGLES, indexCount, GL_UNSIGNED_INT, nullptr);
-    if (s.water && f.hasWater && !debug) {
-        surfaceUniforms(waterProgram_, 1);
+    if (s.water && f.hasWater && s.debug == DebugView::None) {
+        surfaceUniforms(waterProgram_, 1, s, v, wantShadowMap);
         gl_.Enable(GL_BLEND);
         gl_.BlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
         gl_.DepthMask(GL_FALSE);
@@ -344,7 +352,36 @@ void Renderer::draw(const RenderSettings& s, int width, int height, GLuint frame
         gl_.DepthMask(GL_TRUE);
         gl_.Disable(GL_BLEND);
     }
-    // ---- tone mapping + sRGB into the output --------------------------------------
+}
+
+void Renderer::surfaceUniforms(GLuint p, int water, const RenderSettings& s, const FrameViews& v, bool wantShadowMap) {
+    const engine::FrameData& f = meta_;
+    gl_.UseProgram(p);
+    meshUniforms(gl_, f, p, v.viewProj, water);
+    Uniforms u{gl_, p};
+    u.i("uShade", 1);
+    u.i("uKey", 2);
+    u.i("uReceiver", 3);
+    u.i("uEnv", 4);
+    u.i("uShadowMap", 5);
+    u.i2("uReceiverGrid", f.nxr, f.nyr);
+    u.i("uSubsample", f.subsample);
+    u.v3("uEye", v.eye);
+    u.v3("uKeyDir", v.keyDir);
+    u.v3("uKeyRgb", glm::vec3(f.lights.key.rgb[0], f.lights.key.rgb[1], f.lights.key.rgb[2]));
+    u.i("uLighting",
+        f.lighting == engine::LightingMode::KeyOnly ? 0 : (f.lighting == engine::LightingMode::Direct ? 1 : 2));
+    u.i("uShadowMode", s.shadow == ShadowMode::SoftVisibility ? 0 : (wantShadowMap ? 1 : 2));
+    u.i("uSpecular", s.specular ? 1 : 0);
+    u.i("uDebug", static_cast<int>(s.debug));
+    u.f2("uZRange", f.zMin, f.zMax);
+    u.i("uPalette", f.coast ? 1 : 0);
+    u.m4("uLightViewProj", v.lightViewProj);
+    u.f("uShadowTexel", shadow_.w > 0 ? 1.0f / static_cast<float>(shadow_.w) : 0.0f);
+}
+
+// ---- tone mapping + sRGB into the output --------------------------------------------
+void Renderer::drawPost(const RenderSettings& s, const FrameViews& v, int width, int height, GLuint framebuffer) {
     gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffer);
     gl_.Viewport(0, 0, width, height);
     gl_.Disable(GL_DEPTH_TEST);
@@ -356,15 +393,12 @@ void Renderer::draw(const RenderSettings& s, int width, int height, GLuint frame
     Uniforms u{gl_, postProgram_};
     u.i("uHdr", 0);
     u.i("uEnv", 1);
-    u.m4("uInvViewProj", glm::inverse(viewProj));
-    u.v3("uEye", eye);
+    u.m4("uInvViewProj", glm::inverse(v.viewProj));
+    u.v3("uEye", v.eye);
     u.f2("uSize", static_cast<float>(width), static_cast<float>(height));
     u.f("uExposure", s.exposure);
-    u.i("uTonemap", debug ? 0 : 1);
+    u.i("uTonemap", s.debug != DebugView::None ? 0 : 1);
     gl_.DrawArrays(GL_TRIANGLES, 0, 3);
-    gl_.BindVertexArray(0);
-    gl_.ActiveTexture(GL_TEXTURE0);
-    checkGlError(gl_, "draw");
 }
 
 void Renderer::drawToImage(const RenderSettings& s, int width, int height, std::vector<std::uint8_t>& rgb) {
