@@ -18,7 +18,7 @@ constexpr float kDeg = 0.017453292519943295f;
 // The light sees the surface: ground, and water where there is water.
 void exaggeratedSurface(const TerrainState& s, float exag, Grid& surface) {
     const int nx = s.nx, ny = s.ny;
-    if (surface.nx != nx || surface.ny != ny) surface.resize(nx, ny);
+    surface.ensureSize(nx, ny);
     parallelForRows(ny, nx, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y)
             for (int x = 0; x < nx; ++x)

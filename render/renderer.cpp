@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include <glm/glm.hpp>
@@ -16,17 +17,26 @@ namespace {
 
 constexpr float kDeg = 0.017453292519943295f;
 
+// When the shader or program `object` failed (its `status` is false): deletes
+// it and returns its info log; otherwise nothing. Shaders and programs have
+// entry points of the same types (glGetShaderiv / glGetProgramiv, ...).
+std::optional<std::string> failureLog(PFNGLGETSHADERIVPROC getiv, PFNGLGETSHADERINFOLOGPROC getInfoLog,
+                                      PFNGLDELETESHADERPROC del, GLuint object, GLenum status) {
+    GLint ok = 0;
+    getiv(object, status, &ok);
+    if (ok) return std::nullopt;
+    char log[2048] = {};
+    getInfoLog(object, sizeof log, nullptr, log);
+    del(object);
+    return std::string(log);
+}
+
 GLuint compile(const Gl& gl, GLenum type, const std::vector<const char*>& sources, const char* name) {
     const GLuint s = gl.CreateShader(type);
     gl.ShaderSource(s, static_cast<GLsizei>(sources.size()), sources.data(), nullptr);
     gl.CompileShader(s);
-    GLint ok = 0;
-    gl.GetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char log[2048] = {};
-        gl.GetShaderInfoLog(s, sizeof log, nullptr, log);
-        gl.DeleteShader(s);
-        std::string line(log);
+    if (const auto log = failureLog(gl.GetShaderiv, gl.GetShaderInfoLog, gl.DeleteShader, s, GL_COMPILE_STATUS)) {
+        std::string line(*log);
         for (char& c : line)
             if (c == '\n') c = ' ';
         throw ContextError(std::string("shader ") + name + " does not compile: " + line);
@@ -43,15 +53,18 @@ GLuint link(const Gl& gl, const std::vector<const char*>& vs, const std::vector<
     gl.LinkProgram(p);
     gl.DeleteShader(v);
     gl.DeleteShader(f);
-    GLint ok = 0;
-    gl.GetProgramiv(p, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        char log[2048] = {};
-        gl.GetProgramInfoLog(p, sizeof log, nullptr, log);
-        gl.DeleteProgram(p);
-        throw ContextError(std::string("shader program ") + name + " does not link: " + log);
-    }
+    if (const auto log = failureLog(gl.GetProgramiv, gl.GetProgramInfoLog, gl.DeleteProgram, p, GL_LINK_STATUS))
+        throw ContextError(std::string("shader program ") + name + " does not link: " + *log);
     return p;
+}
+
+// Binds `tex` and gives it w x h texels of the `internal` format (contents
+// undefined) and one filter for minification and magnification.
+void defineTexture(const Gl& gl, GLuint tex, GLenum internal, int w, int h, GLenum format, GLenum type, GLint filter) {
+    gl.BindTexture(GL_TEXTURE_2D, tex);
+    gl.TexImage2D(GL_TEXTURE_2D, 0, static_cast<GLint>(internal), w, h, 0, format, type, nullptr);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
 }
 
 struct Uniforms {
@@ -108,31 +121,26 @@ Renderer::~Renderer() {
 void Renderer::ensureTexture(GLuint& tex, int& w, int& h, int nw, int nh, GLenum internal, GLenum format, bool linear) {
     if (tex && w == nw && h == nh) return;
     if (!tex) gl_.GenTextures(1, &tex);
-    gl_.BindTexture(GL_TEXTURE_2D, tex);
-    gl_.TexImage2D(GL_TEXTURE_2D, 0, static_cast<GLint>(internal), nw, nh, 0, format, GL_FLOAT, nullptr);
-    const GLint filter = linear ? GL_LINEAR : GL_NEAREST;
-    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
-    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
+    defineTexture(gl_, tex, internal, nw, nh, format, GL_FLOAT, linear ? GL_LINEAR : GL_NEAREST);
     gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     w = nw;
     h = nh;
 }
 
+void Renderer::streamTexture(GLuint& tex, int& w, int& h, int nw, int nh, GLenum internal, GLenum format,
+                             const float* data) {
+    ensureTexture(tex, w, h, nw, nh, internal, format, true);
+    gl_.BindTexture(GL_TEXTURE_2D, tex);
+    gl_.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, nw, nh, format, GL_FLOAT, data);
+}
+
 void Renderer::upload(const engine::FrameData& f) {
     gl_.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    ensureTexture(heightTex_, heightW_, heightH_, f.nx, f.ny, GL_RG32F, GL_RG, true);
-    gl_.BindTexture(GL_TEXTURE_2D, heightTex_);
-    gl_.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, f.nx, f.ny, GL_RG, GL_FLOAT, f.heights.data());
-    ensureTexture(shadeTex_, shadeW_, shadeH_, f.nx, f.ny, GL_RGBA32F, GL_RGBA, true);
-    gl_.BindTexture(GL_TEXTURE_2D, shadeTex_);
-    gl_.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, f.nx, f.ny, GL_RGBA, GL_FLOAT, f.shade.data());
-    ensureTexture(keyTex_, keyW_, keyH_, f.nx, f.ny, GL_RGBA32F, GL_RGBA, true);
-    gl_.BindTexture(GL_TEXTURE_2D, keyTex_);
-    gl_.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, f.nx, f.ny, GL_RGBA, GL_FLOAT, f.key.data());
-    ensureTexture(receiverTex_, recvW_, recvH_, f.nxr, f.nyr, GL_RGBA32F, GL_RGBA, true);
-    gl_.BindTexture(GL_TEXTURE_2D, receiverTex_);
-    gl_.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, f.nxr, f.nyr, GL_RGBA, GL_FLOAT, f.receiver.data());
+    streamTexture(heightTex_, heightW_, heightH_, f.nx, f.ny, GL_RG32F, GL_RG, f.heights.data());
+    streamTexture(shadeTex_, shadeW_, shadeH_, f.nx, f.ny, GL_RGBA32F, GL_RGBA, f.shade.data());
+    streamTexture(keyTex_, keyW_, keyH_, f.nx, f.ny, GL_RGBA32F, GL_RGBA, f.key.data());
+    streamTexture(receiverTex_, recvW_, recvH_, f.nxr, f.nyr, GL_RGBA32F, GL_RGBA, f.receiver.data());
 
     // The environment map: the sky's SH radiance baked to 64 x 32 texels
     // (order 4 is band-limited, i.e. already a prefiltered map).
@@ -198,19 +206,13 @@ void Renderer::ensureTarget(Target& t, int w, int h, GLenum colorFormat, bool de
     gl_.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
     if (colorFormat) {
         gl_.GenTextures(1, &t.color);
-        gl_.BindTexture(GL_TEXTURE_2D, t.color);
         const GLenum type = colorFormat == GL_RGBA8 ? GL_UNSIGNED_BYTE : GL_FLOAT;
-        gl_.TexImage2D(GL_TEXTURE_2D, 0, static_cast<GLint>(colorFormat), w, h, 0, GL_RGBA, type, nullptr);
-        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        defineTexture(gl_, t.color, colorFormat, w, h, GL_RGBA, type, GL_NEAREST);
         gl_.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, t.color, 0);
     }
     if (depth) {
         gl_.GenTextures(1, &t.depth);
-        gl_.BindTexture(GL_TEXTURE_2D, t.depth);
-        gl_.TexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, w, h, 0, GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
-        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        defineTexture(gl_, t.depth, GL_DEPTH_COMPONENT24, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, GL_LINEAR);
         gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
         gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
         const float border[4] = {1.0f, 1.0f, 1.0f, 1.0f};

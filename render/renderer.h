@@ -75,6 +75,8 @@ private:
     void ensureTarget(Target& t, int w, int h, GLenum colorFormat, bool depth);
     void releaseTarget(Target& t);
     void ensureTexture(GLuint& tex, int& w, int& h, int nw, int nh, GLenum internal, GLenum format, bool linear);
+    /// ensureTexture (linear) and the texels of `data` (nw x nh float texels of `format`).
+    void streamTexture(GLuint& tex, int& w, int& h, int nw, int nh, GLenum internal, GLenum format, const float* data);
     // The passes of draw().
     struct FrameViews;
     FrameViews frameViews(const OrbitCamera& camera, int width, int height) const;

@@ -118,12 +118,7 @@ namespace {
 // Explicit vectors because the build keeps -ftrapping-math, under which GCC
 // turns upwind selects of divisions/products back into branches and gives up.
 // ---------------------------------------------------------------------------
-using simd::F4;
-using simd::load;
-using simd::splat;
-using simd::store;
-using simd::vmax;
-using simd::vmin;
+using namespace simd;
 constexpr int kLanes = simd::kLaneCount<simd::F4>;
 
 // Hydrostatic reconstruction at a face (see above). bA, bB: grounds relative
@@ -174,6 +169,15 @@ struct Views {
     float* nv = nullptr;        // nextV
     std::size_t su() const { return static_cast<std::size_t>(nx) + 1; }
     std::size_t sc() const { return static_cast<std::size_t>(nx); }
+    // Row y of the cell-centred arrays: its offset r and depth, bedrock, soil.
+    struct CellRow {
+        std::size_t r;
+        const float *h, *bed, *soil;
+    };
+    CellRow cellRow(int y) const {
+        const std::size_t r = static_cast<std::size_t>(y) * sc();
+        return {r, h + r, bed + r, soil + r};
+    }
 };
 
 // eta_in(t): the incoming swell elevation, ramped in from t = 0.
@@ -276,10 +280,7 @@ void fluxRows(const Views& w, const StepConsts& c, int y0, int y1) {
     const std::size_t su = w.su(), sc = w.sc();
     const int nx = w.nx, ny = w.ny;
     for (int y = y0; y < y1; ++y) {
-        const std::size_t r = static_cast<std::size_t>(y) * sc;
-        const float* h = w.h + r;
-        const float* bed = w.bed + r;
-        const float* soil = w.soil + r;
+        const auto [r, h, bed, soil] = w.cellRow(y);
         const float* o = w.out + r;
         // x faces of row y: face x between cells x-1 and x.
         float* qu = w.qu + y * su;
@@ -399,10 +400,7 @@ void momentumRows(const Views& w, const StepConsts& c, int y0, int y1) {
     const std::size_t su = w.su(), sc = w.sc();
     const int nx = w.nx, ny = w.ny;
     for (int y = y0; y < y1; ++y) {
-        const std::size_t r = static_cast<std::size_t>(y) * sc;
-        const float* h = w.h + r;
-        const float* bed = w.bed + r;
-        const float* soil = w.soil + r;
+        const auto [r, h, bed, soil] = w.cellRow(y);
 
         // ---- u faces of row y: face x between cells x-1 and x, x in [1, nx) ----
         const float* u = w.u + y * su;
@@ -482,11 +480,6 @@ void applyDrop(TerrainState& s, const WaveDrop& d) {
     });
 }
 
-void ensure(Grid& g, int w, int h) {
-    if (g.nx != w || g.ny != h || g.v.size() != static_cast<std::size_t>(w) * static_cast<std::size_t>(h))
-        g.resize(w, h);
-}
-
 void checkLayers(const TerrainState& s) {
     if (s.water.nx != s.nx || s.water.ny != s.ny || s.faceU.nx != s.nx + 1 || s.faceU.ny != s.ny ||
         s.faceV.nx != s.nx || s.faceV.ny != s.ny + 1)
@@ -521,11 +514,11 @@ struct Maxima {
 constexpr int kMaxSubsteps = 64;
 
 void ensureScratch(WaveScratch& scratch, int nx, int ny) {
-    ensure(scratch.outflow, nx, ny);
-    ensure(scratch.fluxU, nx + 1, ny);
-    ensure(scratch.fluxV, nx, ny + 1);
-    ensure(scratch.nextU, nx + 1, ny);
-    ensure(scratch.nextV, nx, ny + 1);
+    scratch.outflow.ensureSize(nx, ny);
+    scratch.fluxU.ensureSize(nx + 1, ny);
+    scratch.fluxV.ensureSize(nx, ny + 1);
+    scratch.nextU.ensureSize(nx + 1, ny);
+    scratch.nextV.ensureSize(nx, ny + 1);
     if (scratch.rowMaxDepth.size() != static_cast<std::size_t>(ny)) {
         scratch.rowMaxDepth.assign(static_cast<std::size_t>(ny), 0.0f);
         scratch.rowMaxSpeed.assign(static_cast<std::size_t>(ny), 0.0f);
