@@ -37,6 +37,76 @@ struct ImGuiSession {
     ImGuiSession& operator=(const ImGuiSession&) = delete;
 };
 
+// Left drag orbits, the wheel zooms (unless ImGui wants the mouse).
+void steerCamera(OrbitCamera& camera) {
+    ImGuiIO& io = ImGui::GetIO();
+    if (!io.WantCaptureMouse) {
+        if (io.MouseDown[0]) {
+            camera.yawDeg -= io.MouseDelta.x * 0.3f;
+            camera.pitchDeg = std::clamp(camera.pitchDeg + io.MouseDelta.y * 0.3f, 2.0f, 89.0f);
+        }
+        if (io.MouseWheel != 0.0f)
+            camera.distance = std::clamp(camera.distance * (1.0f - 0.1f * io.MouseWheel), 0.2f, 6.0f);
+    }
+}
+
+// The control panel: what is shown, the frame's timings, and the settings it edits.
+void drawPanel(FramePipeline& pipeline, RenderSettings& rs, bool& paused, const StageTimings& avg, double fpsAvg) {
+    const char* lightingNames[] = {"key light only", "direct (sky + key)", "global (direct + bounces)"};
+    const char* shadowNames[] = {"engine soft visibility", "shadow map", "none"};
+    const char* debugNames[] = {"none",          "ambient",      "V (sky visibility)", "key visibility", "normals",
+                                "pyramid level", "GI shade map", "U (indirect, global)"};
+    PipelineSettings& ps = pipeline.settings();
+    SceneLights& lights = pipeline.lights();
+    ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
+    ImGui::Begin("terrain");
+    ImGui::Text("%s  %d x %d  tick %lld", pipeline.simulation().settings().name.c_str(), pipeline.frame().nx,
+                pipeline.frame().ny, static_cast<long long>(pipeline.frame().tick));
+    ImGui::Text("%.1f fps", fpsAvg > 0.0 ? 1000.0 / fpsAvg : 0.0);
+    ImGui::Text("ms: sim %.1f  pyramids %.1f  scan %.1f", avg.sim, avg.pyramids, avg.scan);
+    ImGui::Text("    integrate %.1f  shade %.1f  render %.1f", avg.integrate, avg.shade, avg.render);
+    ImGui::Separator();
+    ImGui::Checkbox("pause simulation", &paused);
+    int lighting = static_cast<int>(ps.lighting);
+    if (ImGui::Combo("lighting", &lighting, lightingNames, 3)) ps.lighting = static_cast<LightingMode>(lighting);
+    ImGui::SliderInt("bounces", &ps.gi.indirect.bounces, 0, 3);
+    ImGui::Checkbox("amortise shading", &ps.gi.indirect.amortise);
+    int sub = ps.gi.subsample == 1 ? 0 : (ps.gi.subsample == 2 ? 1 : 2);
+    ImGui::Text("sub-sampling");
+    ImGui::SameLine();
+    ImGui::RadioButton("1", &sub, 0);
+    ImGui::SameLine();
+    ImGui::RadioButton("2", &sub, 1);
+    ImGui::SameLine();
+    ImGui::RadioButton("4", &sub, 2);
+    ps.gi.subsample = sub == 0 ? 1 : (sub == 1 ? 2 : 4);
+    int shadow = static_cast<int>(rs.shadow);
+    if (ImGui::Combo("key shadow", &shadow, shadowNames, 3)) rs.shadow = static_cast<ShadowMode>(shadow);
+    int debug = static_cast<int>(rs.debug);
+    if (ImGui::Combo("view", &debug, debugNames, 8)) rs.debug = static_cast<DebugView>(debug);
+    ImGui::SliderInt("pyramid level", &ps.pyramidLevel, 0, 16);
+    ImGui::Checkbox("water", &rs.water);
+    ImGui::SameLine();
+    ImGui::Checkbox("specular", &rs.specular);
+    ImGui::SliderFloat("exposure", &rs.exposure, 0.1f, 4.0f);
+    ImGui::SliderFloat("exaggeration (0 = auto)", &ps.verticalExaggeration, 0.0f, 10.0f);
+    ImGui::Separator();
+    ImGui::SliderFloat("sun azimuth", &lights.key.azimuthDeg, 0.0f, 359.0f);
+    ImGui::SliderFloat("sun elevation", &lights.key.elevationDeg, 3.0f, 85.0f);
+    ImGui::SliderFloat("sun radius", &lights.key.radiusDeg, 0.5f, 15.0f);
+    ImGui::TextDisabled("drag: orbit, wheel: zoom");
+    ImGui::End();
+}
+
+void smoothTimings(StageTimings& avg, const StageTimings& tm) {
+    smooth(avg.sim, tm.sim);
+    smooth(avg.pyramids, tm.pyramids);
+    smooth(avg.scan, tm.scan);
+    smooth(avg.integrate, tm.integrate);
+    smooth(avg.shade, tm.shade);
+    smooth(avg.render, tm.render);
+}
+
 }  // namespace
 
 int runWindowDemo(WindowContext& window, const Gl& gl, FramePipeline& pipeline, RenderSettings& rs, int maxFrames) {
@@ -47,69 +117,18 @@ int runWindowDemo(WindowContext& window, const Gl& gl, FramePipeline& pipeline, 
     StageTimings avg;
     double fpsAvg = 0.0;
     auto last = Clock::now();
-    const char* lightingNames[] = {"key light only", "direct (sky + key)", "global (direct + bounces)"};
-    const char* shadowNames[] = {"engine soft visibility", "shadow map", "none"};
-    const char* debugNames[] = {"none",          "ambient",      "V (sky visibility)", "key visibility", "normals",
-                                "pyramid level", "GI shade map", "U (indirect, global)"};
     while (!window.shouldClose() && (maxFrames <= 0 || frames < maxFrames)) {
         window.pollEvents();
         // ---- simulation + GI ----------------------------------------------------------
         if (!paused) pipeline.advance();
         else pipeline.timings().sim = 0.0;
         pipeline.light();
-        // ---- camera: left drag orbits, wheel zooms (unless ImGui wants the mouse) -------
+        // ---- camera and panel -----------------------------------------------------------
         ImGui_ImplOpenGL3_NewFrame();
         ImGui_ImplGlfw_NewFrame();
         ImGui::NewFrame();
-        ImGuiIO& io = ImGui::GetIO();
-        if (!io.WantCaptureMouse) {
-            if (io.MouseDown[0]) {
-                rs.camera.yawDeg -= io.MouseDelta.x * 0.3f;
-                rs.camera.pitchDeg = std::clamp(rs.camera.pitchDeg + io.MouseDelta.y * 0.3f, 2.0f, 89.0f);
-            }
-            if (io.MouseWheel != 0.0f) rs.camera.distance = std::clamp(rs.camera.distance * (1.0f - 0.1f * io.MouseWheel), 0.2f, 6.0f);
-        }
-        // ---- panel ----------------------------------------------------------------------
-        PipelineSettings& ps = pipeline.settings();
-        SceneLights& lights = pipeline.lights();
-        ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
-        ImGui::Begin("terrain");
-        ImGui::Text("%s  %d x %d  tick %lld", pipeline.simulation().settings().name.c_str(), pipeline.frame().nx,
-                    pipeline.frame().ny, static_cast<long long>(pipeline.frame().tick));
-        ImGui::Text("%.1f fps", fpsAvg > 0.0 ? 1000.0 / fpsAvg : 0.0);
-        ImGui::Text("ms: sim %.1f  pyramids %.1f  scan %.1f", avg.sim, avg.pyramids, avg.scan);
-        ImGui::Text("    integrate %.1f  shade %.1f  render %.1f", avg.integrate, avg.shade, avg.render);
-        ImGui::Separator();
-        ImGui::Checkbox("pause simulation", &paused);
-        int lighting = static_cast<int>(ps.lighting);
-        if (ImGui::Combo("lighting", &lighting, lightingNames, 3)) ps.lighting = static_cast<LightingMode>(lighting);
-        ImGui::SliderInt("bounces", &ps.gi.indirect.bounces, 0, 3);
-        ImGui::Checkbox("amortise shading", &ps.gi.indirect.amortise);
-        int sub = ps.gi.subsample == 1 ? 0 : (ps.gi.subsample == 2 ? 1 : 2);
-        ImGui::Text("sub-sampling");
-        ImGui::SameLine();
-        ImGui::RadioButton("1", &sub, 0);
-        ImGui::SameLine();
-        ImGui::RadioButton("2", &sub, 1);
-        ImGui::SameLine();
-        ImGui::RadioButton("4", &sub, 2);
-        ps.gi.subsample = sub == 0 ? 1 : (sub == 1 ? 2 : 4);
-        int shadow = static_cast<int>(rs.shadow);
-        if (ImGui::Combo("key shadow", &shadow, shadowNames, 3)) rs.shadow = static_cast<ShadowMode>(shadow);
-        int debug = static_cast<int>(rs.debug);
-        if (ImGui::Combo("view", &debug, debugNames, 8)) rs.debug = static_cast<DebugView>(debug);
-        ImGui::SliderInt("pyramid level", &ps.pyramidLevel, 0, 16);
-        ImGui::Checkbox("water", &rs.water);
-        ImGui::SameLine();
-        ImGui::Checkbox("specular", &rs.specular);
-        ImGui::SliderFloat("exposure", &rs.exposure, 0.1f, 4.0f);
-        ImGui::SliderFloat("exaggeration (0 = auto)", &ps.verticalExaggeration, 0.0f, 10.0f);
-        ImGui::Separator();
-        ImGui::SliderFloat("sun azimuth", &lights.key.azimuthDeg, 0.0f, 359.0f);
-        ImGui::SliderFloat("sun elevation", &lights.key.elevationDeg, 3.0f, 85.0f);
-        ImGui::SliderFloat("sun radius", &lights.key.radiusDeg, 0.5f, 15.0f);
-        ImGui::TextDisabled("drag: orbit, wheel: zoom");
-        ImGui::End();
+        steerCamera(rs.camera);
+        drawPanel(pipeline, rs, paused, avg, fpsAvg);
         ImGui::Render();
         // ---- draw ------------------------------------------------------------------------
         int w = 0, h = 0;
@@ -123,13 +142,7 @@ int runWindowDemo(WindowContext& window, const Gl& gl, FramePipeline& pipeline, 
         gl.Finish();
         pipeline.timings().render = msSince(t);
         window.swapBuffers();
-        const StageTimings& tm = pipeline.timings();
-        smooth(avg.sim, tm.sim);
-        smooth(avg.pyramids, tm.pyramids);
-        smooth(avg.scan, tm.scan);
-        smooth(avg.integrate, tm.integrate);
-        smooth(avg.shade, tm.shade);
-        smooth(avg.render, tm.render);
+        smoothTimings(avg, pipeline.timings());
         smooth(fpsAvg, msSince(last));
         last = Clock::now();
         ++frames;

@@ -98,6 +98,11 @@ struct Grid {
         ny = h;
         v.assign(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), fill);
     }
+    /// Resizes (zero-filled) only when the size differs: buffers kept from
+    /// call to call keep their storage and contents.
+    void ensureSize(int w, int h) {
+        if (nx != w || ny != h || v.size() != static_cast<std::size_t>(w) * static_cast<std::size_t>(h)) resize(w, h);
+    }
     bool empty() const { return v.empty(); }
     std::size_t size() const { return v.size(); }
 

@@ -15,6 +15,115 @@ double msSince(Clock::time_point t0) { return std::chrono::duration<double, std:
 
 constexpr float kDeg = 0.017453292519943295f;
 
+// The light sees the surface: ground, and water where there is water.
+void exaggeratedSurface(const TerrainState& s, float exag, Grid& surface) {
+    const int nx = s.nx, ny = s.ny;
+    surface.ensureSize(nx, ny);
+    parallelForRows(ny, nx, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < nx; ++x)
+                surface(x, y) = exag * (s.ground(x, y) + (s.hasWater() ? s.water(x, y) : 0.0f));
+    });
+}
+
+gi::GiLighting giLighting(const SceneLights& lights) {
+    gi::GiLighting lighting;
+    lighting.environment = lights.sky;
+    lighting.keys = {lights.key};
+    return lighting;
+}
+
+// Per texel: ground and water depth; the shade without the key light and the
+// key light's own shade; the key light's soft visibility and the ambient map.
+void packTexels(const TerrainState& s, const gi::GiState& gi, const std::array<Grid, 3>& keyRgb,
+                const gi::KeyLight& k, bool indirect, FrameData& f) {
+    const int nx = s.nx, ny = s.ny;
+    const std::size_t n = static_cast<std::size_t>(nx) * ny;
+    f.heights.resize(2 * n);
+    f.shade.resize(4 * n);
+    f.key.resize(4 * n);
+    const float ce = std::cos(k.elevationDeg * kDeg);
+    const float lx = ce * std::cos(k.azimuthDeg * kDeg), ly = ce * std::sin(k.azimuthDeg * kDeg);
+    const float lz = std::sin(k.elevationDeg * kDeg);
+    const float keyLum = 0.2126f * k.rgb[0] + 0.7152f * k.rgb[1] + 0.0722f * k.rgb[2];
+    const auto& total = indirect ? gi.indirect.total : gi.shade.rgb;
+    parallelForRows(ny, nx, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < nx; ++x) {
+                const std::size_t i = static_cast<std::size_t>(y) * nx + x;
+                f.heights[2 * i] = s.ground(x, y);
+                f.heights[2 * i + 1] = s.hasWater() ? s.water(x, y) : 0.0f;
+                float keyC[3];
+                for (int c = 0; c < 3; ++c) {
+                    keyC[c] = std::max(0.0f, keyRgb[static_cast<std::size_t>(c)].v[i]);
+                    f.shade[4 * i + static_cast<std::size_t>(c)] = std::max(
+                        0.0f, total[static_cast<std::size_t>(c)].v[i] - keyRgb[static_cast<std::size_t>(c)].v[i]);
+                    f.key[4 * i + static_cast<std::size_t>(c)] = keyC[c];
+                }
+                // Soft visibility of the key light: its shade over the unshadowed N.L shade.
+                const float gx = gi.gradX.v[i], gy = gi.gradY.v[i];
+                const float nl = (-gx * lx - gy * ly + lz) / std::sqrt(gx * gx + gy * gy + 1.0f);
+                const float lum = 0.2126f * keyC[0] + 0.7152f * keyC[1] + 0.0722f * keyC[2];
+                const float vis = nl > 0.02f && keyLum > 0.0f ? std::clamp(lum / (keyLum * nl), 0.0f, 1.0f) : 0.0f;
+                f.shade[4 * i + 3] = vis;
+                f.key[4 * i + 3] = gi.shade.ambient.v[i];
+            }
+    });
+}
+
+// Receiver grid: sky visibility fraction (V_00 sqrt(4 pi) / 2 pi), one
+// pyramid level and the mean incident indirect radiance.
+void packReceivers(const gi::GiState& gi, const Grid& surface, const PipelineSettings& settings, float exag,
+                   bool indirect, FrameData& f) {
+    const int nx = surface.nx, ny = surface.ny;
+    const gi::VisibilityField& v = gi.envVisibility;
+    f.nxr = v.nxr;
+    f.nyr = v.nyr;
+    f.subsample = settings.gi.subsample;
+    f.receiver.resize(4 * static_cast<std::size_t>(v.nxr) * v.nyr);
+    const int levels = static_cast<int>(gi.pyramid.levels.size());
+    f.pyramidLevel = levels > 0 ? std::clamp(settings.pyramidLevel, 0, levels - 1) : -1;
+    const float vScale = static_cast<float>(std::sqrt(4.0 * gi::kPi) / (2.0 * gi::kPi));
+    // U's constant term: the mean incident indirect radiance U_00 / sqrt(4 pi) (luminance)
+    const float uScale = static_cast<float>(1.0 / std::sqrt(4.0 * gi::kPi));
+    const auto& u = gi.indirect.u;
+    const bool hasU = indirect && u[0].nxr == v.nxr && u[0].nyr == v.nyr && !u[0].sh.empty();
+    // LambertIndirect::BlockerRadiance keeps no U: its receivers' irradiance / pi instead
+    const auto& eRecv = gi.indirect.blocker.receiverShade;
+    const bool hasE = indirect && !hasU && eRecv[0].size() == static_cast<std::size_t>(v.nxr) * v.nyr;
+    for (int y = 0; y < v.nyr; ++y)
+        for (int x = 0; x < v.nxr; ++x) {
+            const std::size_t i = static_cast<std::size_t>(y) * v.nxr + x;
+            f.receiver[4 * i] = v.plane(0)[i] * vScale;
+            float level = surface(std::min(x * f.subsample, nx - 1), std::min(y * f.subsample, ny - 1)) / exag;
+            if (f.pyramidLevel >= 0) {
+                const gi::PaddedField& p = gi.pyramid.levels[static_cast<std::size_t>(f.pyramidLevel)];
+                if (x < p.nx && y < p.ny) level = p.row(y)[x] / exag;
+            }
+            f.receiver[4 * i + 1] = level;
+            f.receiver[4 * i + 2] =
+                hasU   ? uScale * (0.2126f * u[0].plane(0)[i] + 0.7152f * u[1].plane(0)[i] + 0.0722f * u[2].plane(0)[i])
+                : hasE ? 0.2126f * eRecv[0][i] + 0.7152f * eRecv[1][i] + 0.0722f * eRecv[2][i]
+                       : 0.0f;
+            f.receiver[4 * i + 3] = 0.0f;
+        }
+}
+
+// gi/'s timings of the frame in the pipeline's stages (sim and render are not gi/'s).
+void recordGiTimings(const gi::GiState& gi, const gi::GiSettings& gs, double surfaceMs, double packMs,
+                     StageTimings& timings) {
+    const gi::GiTimings& g = gi.timings;
+    // Indirect light's own radiance pyramids, casting-set scans and shading go
+    // into the matching stages (zero on frames that did not update it).
+    const gi::IndirectTimings& ind = gi.indirect.timings;
+    const bool indirectRan = gs.indirect.bounces > 0 && g.indirect > 0.0;
+    timings.pyramids = g.gradient + g.pyramid + (indirectRan ? ind.pyramid : 0.0);
+    timings.scan = g.visibility + g.keyVisibility + (indirectRan ? ind.scan : 0.0);
+    timings.integrate = 0.0;  // gi/ fuses the wedge integration into the scan
+    timings.shade = g.shading + (indirectRan ? ind.shading : 0.0) + packMs + (surfaceMs - g.total);
+    timings.render = 0.0;
+}
+
 }  // namespace
 
 SceneLights defaultLights() {
@@ -90,17 +199,9 @@ void FramePipeline::light() {
         throw InputError("vertical exaggeration must be in [0, 100] (0 = automatic)");
     const float exag = settings_.verticalExaggeration > 0.0f ? settings_.verticalExaggeration : autoExaggeration_;
     const TerrainState& s = sim_.state();
-    const int nx = s.nx, ny = s.ny;
     auto t = Clock::now();
-    // The light sees the surface: ground, and water where there is water.
-    if (surface_.nx != nx || surface_.ny != ny) surface_.resize(nx, ny);
-    parallelForRows(ny, nx, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y)
-            for (int x = 0; x < nx; ++x) surface_(x, y) = exag * (s.ground(x, y) + (s.hasWater() ? s.water(x, y) : 0.0f));
-    });
-    gi::GiLighting lighting;
-    lighting.environment = lights_.sky;
-    lighting.keys = {lights_.key};
+    exaggeratedSurface(s, exag, surface_);
+    const gi::GiLighting lighting = giLighting(lights_);
     // Global lighting adds gi.indirect.bounces indirect bounces (gi/indirect.h);
     // the other modes none. The simulator's change report says whether the
     // lit surface moved, which drives the shading amortisation
@@ -124,84 +225,11 @@ void FramePipeline::light() {
     f.lights = lights_;
     f.tick = s.tick;
     f.time = s.time;
-    const std::size_t n = static_cast<std::size_t>(nx) * ny;
-    f.heights.resize(2 * n);
-    f.shade.resize(4 * n);
-    f.key.resize(4 * n);
-    const gi::KeyLight& k = lights_.key;
-    const float ce = std::cos(k.elevationDeg * kDeg);
-    const float lx = ce * std::cos(k.azimuthDeg * kDeg), ly = ce * std::sin(k.azimuthDeg * kDeg);
-    const float lz = std::sin(k.elevationDeg * kDeg);
-    const float keyLum = 0.2126f * k.rgb[0] + 0.7152f * k.rgb[1] + 0.0722f * k.rgb[2];
     const bool indirect = gs.indirect.bounces > 0;
-    const auto& total = indirect ? gi_.indirect.total : gi_.shade.rgb;
-    const auto& keyRgb = keyOnly_;
-    parallelForRows(ny, nx, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y)
-            for (int x = 0; x < nx; ++x) {
-                const std::size_t i = static_cast<std::size_t>(y) * nx + x;
-                f.heights[2 * i] = s.ground(x, y);
-                f.heights[2 * i + 1] = s.hasWater() ? s.water(x, y) : 0.0f;
-                float keyC[3];
-                for (int c = 0; c < 3; ++c) {
-                    keyC[c] = std::max(0.0f, keyRgb[static_cast<std::size_t>(c)].v[i]);
-                    f.shade[4 * i + static_cast<std::size_t>(c)] =
-                        std::max(0.0f, total[static_cast<std::size_t>(c)].v[i] - keyRgb[static_cast<std::size_t>(c)].v[i]);
-                    f.key[4 * i + static_cast<std::size_t>(c)] = keyC[c];
-                }
-                // Soft visibility of the key light: its shade over the unshadowed N.L shade.
-                const float gx = gi_.gradX.v[i], gy = gi_.gradY.v[i];
-                const float nl = (-gx * lx - gy * ly + lz) / std::sqrt(gx * gx + gy * gy + 1.0f);
-                const float lum = 0.2126f * keyC[0] + 0.7152f * keyC[1] + 0.0722f * keyC[2];
-                const float vis = nl > 0.02f && keyLum > 0.0f ? std::clamp(lum / (keyLum * nl), 0.0f, 1.0f) : 0.0f;
-                f.shade[4 * i + 3] = vis;
-                f.key[4 * i + 3] = gi_.shade.ambient.v[i];
-            }
-    });
-    // Receiver grid: sky visibility fraction (V_00 sqrt(4 pi) / 2 pi) and one pyramid level.
-    const gi::VisibilityField& v = gi_.envVisibility;
-    f.nxr = v.nxr;
-    f.nyr = v.nyr;
-    f.subsample = settings_.gi.subsample;
-    f.receiver.resize(4 * static_cast<std::size_t>(v.nxr) * v.nyr);
-    const int levels = static_cast<int>(gi_.pyramid.levels.size());
-    f.pyramidLevel = levels > 0 ? std::clamp(settings_.pyramidLevel, 0, levels - 1) : -1;
-    const float vScale = static_cast<float>(std::sqrt(4.0 * gi::kPi) / (2.0 * gi::kPi));
-    // U's constant term: the mean incident indirect radiance U_00 / sqrt(4 pi) (luminance)
-    const float uScale = static_cast<float>(1.0 / std::sqrt(4.0 * gi::kPi));
-    const auto& u = gi_.indirect.u;
-    const bool hasU = indirect && u[0].nxr == v.nxr && u[0].nyr == v.nyr && !u[0].sh.empty();
-    // LambertIndirect::BlockerRadiance keeps no U: its receivers' irradiance / pi instead
-    const auto& eRecv = gi_.indirect.blocker.receiverShade;
-    const bool hasE = indirect && !hasU && eRecv[0].size() == static_cast<std::size_t>(v.nxr) * v.nyr;
-    for (int y = 0; y < v.nyr; ++y)
-        for (int x = 0; x < v.nxr; ++x) {
-            const std::size_t i = static_cast<std::size_t>(y) * v.nxr + x;
-            f.receiver[4 * i] = v.plane(0)[i] * vScale;
-            float level = surface_(std::min(x * f.subsample, nx - 1), std::min(y * f.subsample, ny - 1)) / exag;
-            if (f.pyramidLevel >= 0) {
-                const gi::PaddedField& p = gi_.pyramid.levels[static_cast<std::size_t>(f.pyramidLevel)];
-                if (x < p.nx && y < p.ny) level = p.row(y)[x] / exag;
-            }
-            f.receiver[4 * i + 1] = level;
-            f.receiver[4 * i + 2] =
-                hasU   ? uScale * (0.2126f * u[0].plane(0)[i] + 0.7152f * u[1].plane(0)[i] + 0.0722f * u[2].plane(0)[i])
-                : hasE ? 0.2126f * eRecv[0][i] + 0.7152f * eRecv[1][i] + 0.0722f * eRecv[2][i]
-                       : 0.0f;
-            f.receiver[4 * i + 3] = 0.0f;
-        }
+    packTexels(s, gi_, keyOnly_, lights_.key, indirect, f);
+    packReceivers(gi_, surface_, settings_, exag, indirect, f);
     const double packMs = msSince(t);
-
-    const gi::GiTimings& g = gi_.timings;
-    // Indirect light's own radiance pyramids, casting-set scans and shading go
-    // into the matching stages (zero on frames that did not update it).
-    const gi::IndirectTimings& ind = gi_.indirect.timings;
-    const bool indirectRan = gs.indirect.bounces > 0 && g.indirect > 0.0;
-    timings_.pyramids = g.gradient + g.pyramid + (indirectRan ? ind.pyramid : 0.0);
-    timings_.scan = g.visibility + g.keyVisibility + (indirectRan ? ind.scan : 0.0);
-    timings_.integrate = 0.0;  // gi/ fuses the wedge integration into the scan
-    timings_.shade = g.shading + (indirectRan ? ind.shading : 0.0) + packMs + (surfaceMs - g.total);
-    timings_.render = 0.0;
+    recordGiTimings(gi_, gs, surfaceMs, packMs, timings_);
 }
 
 }  // namespace terrain::engine

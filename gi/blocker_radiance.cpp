@@ -11,13 +11,7 @@ namespace terrain::gi {
 
 namespace {
 
-using simd::load;
-using simd::splat;
-using simd::store;
-using simd::atanv;
-using simd::F4;
-using simd::F8;
-using simd::LaneTraits;
+using namespace simd;
 
 constexpr int kRowsPerBlock = 8;
 constexpr int kLanePad = 8;                // rows padded to the widest lane group
@@ -241,7 +235,7 @@ void prepareBlockerRadiance(const HeightPyramid& pyr, int azimuths, BlockerRadia
     if (pyr.subsample == 1) return;  // every texel a receiver: E alone
     st.farSlope.resize(planeR * static_cast<std::size_t>(azimuths));
     st.receiverOcclusion.resize(planeR);
-    if (st.occlusion.nx != pyr.nx || st.occlusion.ny != pyr.ny) st.occlusion.resize(pyr.nx, pyr.ny);
+    st.occlusion.ensureSize(pyr.nx, pyr.ny);
 }
 
 void computeTexelOcclusion(const HeightPyramid& pyr, ConstGridView gradX, ConstGridView gradY,
@@ -265,8 +259,7 @@ void computeTexelOcclusion(const HeightPyramid& pyr, ConstGridView gradX, ConstG
 
 void shadeBlockerRadiance(BlockerRadianceState& st, const AlbedoMap* albedo, std::array<Grid, 3>& rgb) {
     const int nx = st.nx, ny = st.ny, s = st.subsample, nxr = st.nxr, nyr = st.nyr;
-    for (Grid& g : rgb)
-        if (g.nx != nx || g.ny != ny) g.resize(nx, ny);
+    for (Grid& g : rgb) g.ensureSize(nx, ny);
     const float* alb[3];
     for (int c = 0; c < 3; ++c)
         alb[c] = albedo && !albedo->channel[static_cast<std::size_t>(c)].empty()

@@ -11,15 +11,7 @@ namespace {
 
 // The kernel is written once over a lane type V: F4 (SSE2, the baseline) or
 // F8 (AVX2, chosen at run time where the processor has it): core/simd.h.
-using simd::load;
-using simd::splat;
-using simd::store;
-using simd::F4;
-using simd::F8;
-using simd::LaneTraits;
-using simd::laneBits;
-using simd::sqrtv;
-using simd::atanv;
+using namespace simd;
 
 constexpr int kMaxMoments = 4;  // moments per segment and channel (Nlp)
 

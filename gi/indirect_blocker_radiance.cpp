@@ -11,11 +11,7 @@ namespace terrain::gi {
 
 namespace {
 
-using simd::load;
-using simd::store;
-using simd::F4;
-using simd::F8;
-using simd::LaneTraits;
+using namespace simd;
 
 // One row and azimuth's exact moments into the row's E sums, per channel
 // (pad floats each): sums[c] += result[c].

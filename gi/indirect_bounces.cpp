@@ -14,7 +14,7 @@ double msSince(Clock::time_point t0) { return std::chrono::duration<double, std:
 void clearIndirect(int nx, int ny, int bounces, IndirectState& st) {
     for (int c = 0; c < 3; ++c) {
         Grid& g = st.indirect[static_cast<std::size_t>(c)];
-        if (g.nx != nx || g.ny != ny) g.resize(nx, ny);
+        g.ensureSize(nx, ny);
         std::fill(g.v.begin(), g.v.end(), 0.0f);
     }
     st.bounceMean.resize(static_cast<std::size_t>(bounces));
@@ -69,7 +69,7 @@ void sumDirectAndIndirect(const std::array<Grid, 3>& direct, IndirectState& st) 
     for (int c = 0; c < 3; ++c) {
         Grid& tot = st.total[static_cast<std::size_t>(c)];
         const Grid& ind = st.indirect[static_cast<std::size_t>(c)];
-        if (tot.nx != ind.nx || tot.ny != ind.ny) tot.resize(ind.nx, ind.ny);
+        tot.ensureSize(ind.nx, ind.ny);
         const Grid& d = direct[static_cast<std::size_t>(c)];
         for (std::size_t i = 0; i < tot.v.size(); ++i) tot.v[i] = d.v[i] + ind.v[i];
     }

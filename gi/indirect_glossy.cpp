@@ -14,10 +14,7 @@ namespace terrain::gi {
 
 namespace {
 
-using simd::load;
-using simd::splat;
-using simd::F4;
-typedef int I4 __attribute__((vector_size(16)));
+using namespace simd;
 
 constexpr int kMaxBlocks = 64;              // receiver rows split into at most this many fixed blocks
 constexpr int kGroup = kIndirectLaneGroup;  // receivers per kernel call (2 x 4 lanes)

@@ -11,12 +11,7 @@ namespace terrain::gi {
 
 namespace {
 
-using simd::load;
-using simd::splat;
-using simd::store;
-using simd::F4;
-using simd::F8;
-using simd::LaneTraits;
+using namespace simd;
 
 // One row and azimuth's NLP coefficients into U: U_c += G_j u_(c, j) over
 // the sparse pattern of the folded wedge operator (Eq. 21).

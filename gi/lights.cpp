@@ -1,6 +1,8 @@
 #include "gi/lights.h"
 
+#include <array>
 #include <cmath>
+#include <string>
 
 #include "core/error.h"
 
@@ -8,19 +10,14 @@ namespace terrain::gi {
 
 namespace {
 constexpr double kDeg = kPi / 180.0;
-}
 
-ShRgb uniformSkyLight(float radiance) {
+// SH projection of the radiance of every direction by the midpoint rule over
+// an nTheta x nPhi equirectangular grid (theta from +z, phi from +x towards
+// +y): radiance(a, b, x, y, z) is the RGB radiance of cell (a, b), direction
+// (x, y, z).
+template <class Radiance>
+ShRgb projectMidpoints(int nTheta, int nPhi, Radiance radiance) {
     ShRgb l;
-    for (auto& c : l.c) c[0] = std::sqrt(4.0 * kPi) * radiance;
-    return l;
-}
-
-ShRgb sunSkyLight(const SunSkySettings& s) {
-    ShRgb l;
-    const double sa = s.sunAzimuthDeg * kDeg, se = s.sunElevationDeg * kDeg;
-    const double sx = std::cos(se) * std::cos(sa), sy = std::cos(se) * std::sin(sa), sz = std::sin(se);
-    const int nTheta = 256, nPhi = 512;
     for (int a = 0; a < nTheta; ++a) {
         const double theta = kPi * (a + 0.5) / nTheta;
         const double z = std::cos(theta), r = std::sin(theta);
@@ -30,39 +27,53 @@ ShRgb sunSkyLight(const SunSkySettings& s) {
             const double x = r * std::cos(phi), y = r * std::sin(phi);
             double yv[kShCount];
             shEvaluate(x, y, z, yv);
-            const double lobe = std::exp(s.sunSharpness * (x * sx + y * sy + z * sz - 1.0));
-            for (int ch = 0; ch < 3; ++ch) {
-                double rad = z >= 0.0 ? s.horizon[ch] + (s.zenith[ch] - s.horizon[ch]) * z : s.ground[ch];
-                rad += s.sun[ch] * lobe;
-                for (int i = 0; i < kShCount; ++i) l.c[static_cast<std::size_t>(ch)][static_cast<std::size_t>(i)] += rad * yv[i] * dA;
-            }
+            const std::array<double, 3> rgb = radiance(a, b, x, y, z);
+            for (int ch = 0; ch < 3; ++ch)
+                for (int i = 0; i < kShCount; ++i)
+                    l.c[static_cast<std::size_t>(ch)][static_cast<std::size_t>(i)] +=
+                        rgb[static_cast<std::size_t>(ch)] * yv[i] * dA;
         }
     }
     return l;
 }
 
+}  // namespace
+
+ShRgb uniformSkyLight(float radiance) {
+    ShRgb l;
+    for (auto& c : l.c) c[0] = std::sqrt(4.0 * kPi) * radiance;
+    return l;
+}
+
+ShRgb sunSkyLight(const SunSkySettings& s) {
+    const double sa = s.sunAzimuthDeg * kDeg, se = s.sunElevationDeg * kDeg;
+    const double sx = std::cos(se) * std::cos(sa), sy = std::cos(se) * std::sin(sa), sz = std::sin(se);
+    return projectMidpoints(256, 512, [&](int, int, double x, double y, double z) {
+        const double lobe = std::exp(s.sunSharpness * (x * sx + y * sy + z * sz - 1.0));
+        std::array<double, 3> rgb;
+        for (int ch = 0; ch < 3; ++ch) {
+            double rad = z >= 0.0 ? s.horizon[ch] + (s.zenith[ch] - s.horizon[ch]) * z : s.ground[ch];
+            rad += s.sun[ch] * lobe;
+            rgb[static_cast<std::size_t>(ch)] = rad;
+        }
+        return rgb;
+    });
+}
+
 ShRgb projectEquirect(const std::vector<float>& rgb, int width, int height) {
     if (width <= 0 || height <= 0 || rgb.size() != static_cast<std::size_t>(width) * height * 3)
         throw InputError("environment map: bad size");
-    ShRgb l;
-    for (int v = 0; v < height; ++v) {
-        const double theta = kPi * (v + 0.5) / height;
-        const double z = std::cos(theta), r = std::sin(theta);
-        const double dA = (kPi / height) * (2.0 * kPi / width) * r;
-        for (int u = 0; u < width; ++u) {
-            const double phi = 2.0 * kPi * (u + 0.5) / width;
-            double yv[kShCount];
-            shEvaluate(r * std::cos(phi), r * std::sin(phi), z, yv);
-            for (int ch = 0; ch < 3; ++ch) {
-                const float p = rgb[(static_cast<std::size_t>(v) * width + u) * 3 + ch];
-                if (!std::isfinite(p) || p < 0.0f)
-                    throw InputError("environment map: pixel (" + std::to_string(u) + ", " + std::to_string(v) +
-                                     ") is negative, NaN or Inf");
-                for (int i = 0; i < kShCount; ++i) l.c[static_cast<std::size_t>(ch)][static_cast<std::size_t>(i)] += p * yv[i] * dA;
-            }
+    return projectMidpoints(height, width, [&](int v, int u, double, double, double) {
+        std::array<double, 3> pixel;
+        for (int ch = 0; ch < 3; ++ch) {
+            const float p = rgb[(static_cast<std::size_t>(v) * width + u) * 3 + ch];
+            if (!std::isfinite(p) || p < 0.0f)
+                throw InputError("environment map: pixel (" + std::to_string(u) + ", " + std::to_string(v) +
+                                 ") is negative, NaN or Inf");
+            pixel[static_cast<std::size_t>(ch)] = p;
         }
-    }
-    return l;
+        return pixel;
+    });
 }
 
 void validateKeyLight(const KeyLight& k) {

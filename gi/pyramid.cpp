@@ -128,7 +128,7 @@ void decimateOctaves(ConstGridView heights, int nOctaves, bool withMax, HeightPy
         for (int o = 1; o < nOctaves; ++o) {
             Grid& dst = oct[static_cast<std::size_t>(o - 1)];
             const int w = (src.nx + 1) / 2, h = (src.ny + 1) / 2;
-            if (dst.nx != w || dst.ny != h) dst.resize(w, h);
+            dst.ensureSize(w, h);
             parallelForRows(h, w, [&](int y0, int y1) { decimateRows(src, dst, pass == 1, y0, y1); });
             src = dst.cview();
         }

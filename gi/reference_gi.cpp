@@ -61,8 +61,7 @@ void addReferenceKeyLight(ConstGridView heights, float cellSize, const KeyLight&
                           int azimuths, std::array<Grid, 3>& rgb) {
     validateKeyLight(key);
     const int nx = heights.nx, ny = heights.ny;
-    for (Grid& g : rgb)
-        if (g.nx != nx || g.ny != ny) g.resize(nx, ny, 0.0f);
+    for (Grid& g : rgb) g.ensureSize(nx, ny);
     const int A = std::max(azimuths, 1);
     const KeyLightExtent ext = keyLightExtent(key);
     const double r = key.radiusDeg * kPi / 180.0, el = key.elevationDeg * kPi / 180.0, az = key.azimuthDeg * kPi / 180.0;
@@ -177,6 +176,14 @@ void gatherReferenceBounce(ConstGridView heights, float cellSize, const std::arr
     });
 }
 
+void renderDirectReference(ConstGridView heights, float cellSize, const ShRgb& lighting, const AlbedoMap* albedo,
+                           const ReferenceGiSettings& settings, ReferenceResult& out) {
+    ReferenceSettings direct;
+    direct.azimuths = settings.azimuths;
+    direct.progress = settings.progress;
+    renderReference(heights, cellSize, &lighting, albedo, direct, out);
+}
+
 void renderReferenceGi(ConstGridView heights, float cellSize, const ShRgb& lighting, const AlbedoMap* albedo,
                        const ReferenceGiSettings& s, ReferenceGiResult& out) {
     if (s.directions < 16 || s.directions > 1 << 20) throw InputError("reference: directions must be 16 .. 2^20");
@@ -189,11 +196,8 @@ void renderReferenceGi(ConstGridView heights, float cellSize, const ShRgb& light
     }
     const int nx = heights.nx, ny = heights.ny;
     // Bounce 0: the exact direct reference.
-    ReferenceSettings direct;
-    direct.azimuths = s.azimuths;
-    direct.progress = s.progress;
     ReferenceResult d;
-    renderReference(heights, cellSize, &lighting, albedo, direct, d);
+    renderDirectReference(heights, cellSize, lighting, albedo, s, d);
     out.ambient = d.ambient;
     for (const KeyLight& k : s.keys) addReferenceKeyLight(heights, cellSize, k, albedo, s.keyAzimuths, d.rgb);
     for (int c = 0; c < 3; ++c) {

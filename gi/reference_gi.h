@@ -91,6 +91,11 @@ void referenceIncidentSh(ConstGridView heights, float cellSize, const ShRgb& lig
 bool referenceFirstHit(const float* h, int nx, int ny, float hMax, float cellSize, int x, int y, const std::array<float, 3>& d,
                        float step, float& hx, float& hy);
 
+/// Bounce 0 of both references: the exact direct reference (gi/reference.h)
+/// of the SH `lighting` with settings.azimuths and settings.progress.
+void renderDirectReference(ConstGridView heights, float cellSize, const ShRgb& lighting, const AlbedoMap* albedo,
+                           const ReferenceGiSettings& settings, ReferenceResult& out);
+
 /// One gathering bounce: next(p) = albedo(p) / pi * sum_k prev(q_k) (N . w_k) 4 pi / K
 /// over the fixed direction set (the rays' first hits q_k). next is resized.
 void gatherReferenceBounce(ConstGridView heights, float cellSize, const std::array<Grid, 3>& prev,

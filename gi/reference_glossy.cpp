@@ -142,11 +142,8 @@ void directBounce(ConstGridView heights, float cellSize, const ShRgb& lighting, 
                   std::vector<float>& prevI) {
     const int nx = heights.nx, ny = heights.ny;
     const std::size_t plane = static_cast<std::size_t>(nx) * ny;
-    ReferenceSettings rs;
-    rs.azimuths = s.azimuths;
-    rs.progress = s.progress;
     ReferenceResult d;
-    renderReference(heights, cellSize, &lighting, surface, rs, d);
+    renderDirectReference(heights, cellSize, lighting, surface, s, d);
     out.ambient = d.ambient;
     std::array<Grid, 3> keys;
     for (Grid& g : keys) g.resize(nx, ny, 0.0f);

@@ -45,13 +45,7 @@ namespace {
 // Kernels over the lane type V: F4 (SSE2) or F8 (AVX2, chosen at run time),
 // core/simd.h; lane-wise IEEE operations, so each texel gets exactly the
 // scalar result either way.
-using simd::load;
-using simd::splat;
-using simd::store;
-using simd::F4;
-using simd::F8;
-using simd::LaneTraits;
-using simd::sqrtv;
+using namespace simd;
 
 constexpr int kMaxShadingLights = 8;  // lights per incident pass (more are folded in several passes)
 
@@ -260,10 +254,9 @@ void sizeShadeMaps(int nx, int ny, std::size_t incidentSize, bool ambient, std::
                    std::size_t basisScratchSize, ShadeMaps& out) {
     out.nx = nx;
     out.ny = ny;
-    for (Grid& g : out.rgb)
-        if (g.nx != nx || g.ny != ny) g.resize(nx, ny);
+    for (Grid& g : out.rgb) g.ensureSize(nx, ny);
     if (!ambient) out.ambient = Grid{};
-    else if (out.ambient.nx != nx || out.ambient.ny != ny) out.ambient.resize(nx, ny);
+    else out.ambient.ensureSize(nx, ny);
     out.incident.resize(incidentSize);
     out.rowScratch.resize(rowScratchSize);
     out.basisScratch.resize(basisScratchSize);

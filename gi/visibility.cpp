@@ -16,11 +16,7 @@ namespace {
 constexpr int kMaxBlocks = 64;
 constexpr int kRowPad = 16;  // receivers per kernel call at most (4 x 4 or 2 x 8 lanes); rows are padded to it
 
-using simd::load;
-using simd::splat;
-using simd::store;
-using simd::LaneTraits;
-using simd::sqrtv;
+using namespace simd;
 
 inline int padLanes(int n) { return (n + kRowPad - 1) / kRowPad * kRowPad; }
 

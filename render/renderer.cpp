@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include <glm/glm.hpp>
@@ -16,17 +17,26 @@ namespace {
 
 constexpr float kDeg = 0.017453292519943295f;
 
+// When the shader or program `object` failed (its `status` is false): deletes
+// it and returns its info log; otherwise nothing. Shaders and programs have
+// entry points of the same types (glGetShaderiv / glGetProgramiv, ...).
+std::optional<std::string> failureLog(PFNGLGETSHADERIVPROC getiv, PFNGLGETSHADERINFOLOGPROC getInfoLog,
+                                      PFNGLDELETESHADERPROC del, GLuint object, GLenum status) {
+    GLint ok = 0;
+    getiv(object, status, &ok);
+    if (ok) return std::nullopt;
+    char log[2048] = {};
+    getInfoLog(object, sizeof log, nullptr, log);
+    del(object);
+    return std::string(log);
+}
+
 GLuint compile(const Gl& gl, GLenum type, const std::vector<const char*>& sources, const char* name) {
     const GLuint s = gl.CreateShader(type);
     gl.ShaderSource(s, static_cast<GLsizei>(sources.size()), sources.data(), nullptr);
     gl.CompileShader(s);
-    GLint ok = 0;
-    gl.GetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char log[2048] = {};
-        gl.GetShaderInfoLog(s, sizeof log, nullptr, log);
-        gl.DeleteShader(s);
-        std::string line(log);
+    if (const auto log = failureLog(gl.GetShaderiv, gl.GetShaderInfoLog, gl.DeleteShader, s, GL_COMPILE_STATUS)) {
+        std::string line(*log);
         for (char& c : line)
             if (c == '\n') c = ' ';
         throw ContextError(std::string("shader ") + name + " does not compile: " + line);
@@ -43,15 +53,18 @@ GLuint link(const Gl& gl, const std::vector<const char*>& vs, const std::vector<
     gl.LinkProgram(p);
     gl.DeleteShader(v);
     gl.DeleteShader(f);
-    GLint ok = 0;
-    gl.GetProgramiv(p, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        char log[2048] = {};
-        gl.GetProgramInfoLog(p, sizeof log, nullptr, log);
-        gl.DeleteProgram(p);
-        throw ContextError(std::string("shader program ") + name + " does not link: " + log);
-    }
+    if (const auto log = failureLog(gl.GetProgramiv, gl.GetProgramInfoLog, gl.DeleteProgram, p, GL_LINK_STATUS))
+        throw ContextError(std::string("shader program ") + name + " does not link: " + *log);
     return p;
+}
+
+// Binds `tex` and gives it w x h texels of the `internal` format (contents
+// undefined) and one filter for minification and magnification.
+void defineTexture(const Gl& gl, GLuint tex, GLenum internal, int w, int h, GLenum format, GLenum type, GLint filter) {
+    gl.BindTexture(GL_TEXTURE_2D, tex);
+    gl.TexImage2D(GL_TEXTURE_2D, 0, static_cast<GLint>(internal), w, h, 0, format, type, nullptr);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
 }
 
 struct Uniforms {
@@ -108,31 +121,26 @@ Renderer::~Renderer() {
 void Renderer::ensureTexture(GLuint& tex, int& w, int& h, int nw, int nh, GLenum internal, GLenum format, bool linear) {
     if (tex && w == nw && h == nh) return;
     if (!tex) gl_.GenTextures(1, &tex);
-    gl_.BindTexture(GL_TEXTURE_2D, tex);
-    gl_.TexImage2D(GL_TEXTURE_2D, 0, static_cast<GLint>(internal), nw, nh, 0, format, GL_FLOAT, nullptr);
-    const GLint filter = linear ? GL_LINEAR : GL_NEAREST;
-    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
-    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
+    defineTexture(gl_, tex, internal, nw, nh, format, GL_FLOAT, linear ? GL_LINEAR : GL_NEAREST);
     gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     w = nw;
     h = nh;
 }
 
+void Renderer::streamTexture(GLuint& tex, int& w, int& h, int nw, int nh, GLenum internal, GLenum format,
+                             const float* data) {
+    ensureTexture(tex, w, h, nw, nh, internal, format, true);
+    gl_.BindTexture(GL_TEXTURE_2D, tex);
+    gl_.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, nw, nh, format, GL_FLOAT, data);
+}
+
 void Renderer::upload(const engine::FrameData& f) {
     gl_.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    ensureTexture(heightTex_, heightW_, heightH_, f.nx, f.ny, GL_RG32F, GL_RG, true);
-    gl_.BindTexture(GL_TEXTURE_2D, heightTex_);
-    gl_.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, f.nx, f.ny, GL_RG, GL_FLOAT, f.heights.data());
-    ensureTexture(shadeTex_, shadeW_, shadeH_, f.nx, f.ny, GL_RGBA32F, GL_RGBA, true);
-    gl_.BindTexture(GL_TEXTURE_2D, shadeTex_);
-    gl_.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, f.nx, f.ny, GL_RGBA, GL_FLOAT, f.shade.data());
-    ensureTexture(keyTex_, keyW_, keyH_, f.nx, f.ny, GL_RGBA32F, GL_RGBA, true);
-    gl_.BindTexture(GL_TEXTURE_2D, keyTex_);
-    gl_.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, f.nx, f.ny, GL_RGBA, GL_FLOAT, f.key.data());
-    ensureTexture(receiverTex_, recvW_, recvH_, f.nxr, f.nyr, GL_RGBA32F, GL_RGBA, true);
-    gl_.BindTexture(GL_TEXTURE_2D, receiverTex_);
-    gl_.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, f.nxr, f.nyr, GL_RGBA, GL_FLOAT, f.receiver.data());
+    streamTexture(heightTex_, heightW_, heightH_, f.nx, f.ny, GL_RG32F, GL_RG, f.heights.data());
+    streamTexture(shadeTex_, shadeW_, shadeH_, f.nx, f.ny, GL_RGBA32F, GL_RGBA, f.shade.data());
+    streamTexture(keyTex_, keyW_, keyH_, f.nx, f.ny, GL_RGBA32F, GL_RGBA, f.key.data());
+    streamTexture(receiverTex_, recvW_, recvH_, f.nxr, f.nyr, GL_RGBA32F, GL_RGBA, f.receiver.data());
 
     // The environment map: the sky's SH radiance baked to 64 x 32 texels
     // (order 4 is band-limited, i.e. already a prefiltered map).
@@ -198,19 +206,13 @@ void Renderer::ensureTarget(Target& t, int w, int h, GLenum colorFormat, bool de
     gl_.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
     if (colorFormat) {
         gl_.GenTextures(1, &t.color);
-        gl_.BindTexture(GL_TEXTURE_2D, t.color);
         const GLenum type = colorFormat == GL_RGBA8 ? GL_UNSIGNED_BYTE : GL_FLOAT;
-        gl_.TexImage2D(GL_TEXTURE_2D, 0, static_cast<GLint>(colorFormat), w, h, 0, GL_RGBA, type, nullptr);
-        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        defineTexture(gl_, t.color, colorFormat, w, h, GL_RGBA, type, GL_NEAREST);
         gl_.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, t.color, 0);
     }
     if (depth) {
         gl_.GenTextures(1, &t.depth);
-        gl_.BindTexture(GL_TEXTURE_2D, t.depth);
-        gl_.TexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, w, h, 0, GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
-        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        defineTexture(gl_, t.depth, GL_DEPTH_COMPONENT24, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, GL_LINEAR);
         gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
         gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
         const float border[4] = {1.0f, 1.0f, 1.0f, 1.0f};
@@ -237,17 +239,21 @@ void Renderer::releaseTarget(Target& t) {
     t = {};
 }
 
-void Renderer::draw(const RenderSettings& s, int width, int height, GLuint framebuffer) {
-    if (width < 1 || height < 1 || width > 16384 || height > 16384)
-        throw InputError("image size must be 1..16384 pixels per side");
-    if (!heightTex_) throw ContextError("renderer: draw before upload");
+// Where the camera and the key light's shadow map look from.
+struct Renderer::FrameViews {
+    glm::vec3 eye;
+    glm::mat4 viewProj;
+    glm::vec3 keyDir;
+    glm::mat4 lightViewProj;  // orthographic, covering the terrain
+};
+
+Renderer::FrameViews Renderer::frameViews(const OrbitCamera& cam, int width, int height) const {
     const engine::FrameData& f = meta_;
     const float exag = f.exaggeration;
     const float extent = static_cast<float>(std::max(f.nx, f.ny) - 1) * f.cellSize;
     const glm::vec3 centre(0.5f * (f.nx - 1) * f.cellSize, 0.5f * (f.ny - 1) * f.cellSize,
                            0.5f * (f.zMin + f.zMax) * exag);
     // ---- camera ------------------------------------------------------------------
-    const OrbitCamera& cam = s.camera;
     const float cp = std::cos(cam.pitchDeg * kDeg);
     const glm::vec3 eye = centre + extent * cam.distance *
                                        glm::vec3(cp * std::cos(cam.yawDeg * kDeg), cp * std::sin(cam.yawDeg * kDeg),
@@ -263,40 +269,67 @@ void Renderer::draw(const RenderSettings& s, int width, int height, GLuint frame
     const glm::vec3 up = std::abs(keyDir.z) > 0.99f ? glm::vec3(0, 1, 0) : glm::vec3(0, 0, 1);
     const glm::mat4 lightViewProj = glm::ortho(-radius, radius, -radius, radius, 0.0f, 4.0f * radius) *
                                     glm::lookAt(centre + keyDir * (2.0f * radius), centre, up);
+    return {eye, viewProj, keyDir, lightViewProj};
+}
+
+namespace {
+
+// The uniforms every mesh program reads: heights, grid, exaggeration, view.
+void meshUniforms(const Gl& gl, const engine::FrameData& f, GLuint p, const glm::mat4& vp, int water) {
+    Uniforms u{gl, p};
+    u.i("uHeight", 0);
+    u.i2("uGrid", f.nx, f.ny);
+    u.f("uCell", f.cellSize);
+    u.f("uExag", f.exaggeration);
+    u.m4("uViewProj", vp);
+    u.i("uWater", water);
+}
+
+}  // namespace
+
+void Renderer::draw(const RenderSettings& s, int width, int height, GLuint framebuffer) {
+    if (width < 1 || height < 1 || width > 16384 || height > 16384)
+        throw InputError("image size must be 1..16384 pixels per side");
+    if (!heightTex_) throw ContextError("renderer: draw before upload");
+    const FrameViews v = frameViews(s.camera, width, height);
     const bool debug = s.debug != DebugView::None;
     gl_.BindVertexArray(vao_);
-    const GLsizei indexCount = static_cast<GLsizei>(indexCount_);
-    auto meshUniforms = [&](GLuint p, const glm::mat4& vp, int water) {
-        Uniforms u{gl_, p};
-        u.i("uHeight", 0);
-        u.i2("uGrid", f.nx, f.ny);
-        u.f("uCell", f.cellSize);
-        u.f("uExag", exag);
-        u.m4("uViewProj", vp);
-        u.i("uWater", water);
-    };
     const bool wantShadowMap = s.shadow == ShadowMode::ShadowMap && !debug;
     // Targets first: creating one binds its textures to the active unit.
-    if (wantShadowMap) ensureTarget(shadow_, std::clamp(s.shadowMapSize, 256, 8192), std::clamp(s.shadowMapSize, 256, 8192), 0, true);
+    const int shadowSide = std::clamp(s.shadowMapSize, 256, 8192);
+    if (wantShadowMap) ensureTarget(shadow_, shadowSide, shadowSide, 0, true);
     ensureTarget(hdr_, width, height, GL_RGBA16F, true);
     gl_.ActiveTexture(GL_TEXTURE0);
     gl_.BindTexture(GL_TEXTURE_2D, heightTex_);
-    if (wantShadowMap) {
-        const int side = shadow_.w;
-        gl_.BindFramebuffer(GL_FRAMEBUFFER, shadow_.fbo);
-        gl_.Viewport(0, 0, side, side);
-        gl_.ClearDepth(1.0);
-        gl_.Clear(GL_DEPTH_BUFFER_BIT);
-        gl_.Enable(GL_DEPTH_TEST);
-        gl_.DepthFunc(GL_LESS);
-        gl_.Enable(GL_POLYGON_OFFSET_FILL);
-        gl_.PolygonOffset(1.5f, 2.0f);
-        gl_.UseProgram(shadowProgram_);
-        meshUniforms(shadowProgram_, lightViewProj, 0);
-        gl_.DrawElements(GL_TRIANGLES, indexCount, GL_UNSIGNED_INT, nullptr);
-        gl_.Disable(GL_POLYGON_OFFSET_FILL);
-    }
-    // ---- terrain and water into the HDR target ------------------------------------
+    if (wantShadowMap) drawShadowMap(v);
+    drawSurfaces(s, v, width, height, wantShadowMap);
+    drawPost(s, v, width, height, framebuffer);
+    gl_.BindVertexArray(0);
+    gl_.ActiveTexture(GL_TEXTURE0);
+    checkGlError(gl_, "draw");
+}
+
+// ---- key light shadow map -----------------------------------------------------------
+void Renderer::drawShadowMap(const FrameViews& v) {
+    const int side = shadow_.w;
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, shadow_.fbo);
+    gl_.Viewport(0, 0, side, side);
+    gl_.ClearDepth(1.0);
+    gl_.Clear(GL_DEPTH_BUFFER_BIT);
+    gl_.Enable(GL_DEPTH_TEST);
+    gl_.DepthFunc(GL_LESS);
+    gl_.Enable(GL_POLYGON_OFFSET_FILL);
+    gl_.PolygonOffset(1.5f, 2.0f);
+    gl_.UseProgram(shadowProgram_);
+    meshUniforms(gl_, meta_, shadowProgram_, v.lightViewProj, 0);
+    gl_.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(indexCount_), GL_UNSIGNED_INT, nullptr);
+    gl_.Disable(GL_POLYGON_OFFSET_FILL);
+}
+
+// ---- terrain and water into the HDR target ------------------------------------------
+void Renderer::drawSurfaces(const RenderSettings& s, const FrameViews& v, int width, int height, bool wantShadowMap) {
+    const engine::FrameData& f = meta_;
+    const GLsizei indexCount = static_cast<GLsizei>(indexCount_);
     gl_.BindFramebuffer(GL_FRAMEBUFFER, hdr_.fbo);
     gl_.Viewport(0, 0, width, height);
     gl_.ClearColor(0, 0, 0, 0);
@@ -310,33 +343,10 @@ void Renderer::draw(const RenderSettings& s, int width, int height, GLuint frame
         gl_.ActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + i));
         gl_.BindTexture(GL_TEXTURE_2D, textures[i]);
     }
-    auto surfaceUniforms = [&](GLuint p, int water) {
-        gl_.UseProgram(p);
-        meshUniforms(p, viewProj, water);
-        Uniforms u{gl_, p};
-        u.i("uShade", 1);
-        u.i("uKey", 2);
-        u.i("uReceiver", 3);
-        u.i("uEnv", 4);
-        u.i("uShadowMap", 5);
-        u.i2("uReceiverGrid", f.nxr, f.nyr);
-        u.i("uSubsample", f.subsample);
-        u.v3("uEye", eye);
-        u.v3("uKeyDir", keyDir);
-        u.v3("uKeyRgb", glm::vec3(f.lights.key.rgb[0], f.lights.key.rgb[1], f.lights.key.rgb[2]));
-        u.i("uLighting", f.lighting == engine::LightingMode::KeyOnly ? 0 : (f.lighting == engine::LightingMode::Direct ? 1 : 2));
-        u.i("uShadowMode", s.shadow == ShadowMode::SoftVisibility ? 0 : (wantShadowMap ? 1 : 2));
-        u.i("uSpecular", s.specular ? 1 : 0);
-        u.i("uDebug", static_cast<int>(s.debug));
-        u.f2("uZRange", f.zMin, f.zMax);
-        u.i("uPalette", f.coast ? 1 : 0);
-        u.m4("uLightViewProj", lightViewProj);
-        u.f("uShadowTexel", shadow_.w > 0 ? 1.0f / static_cast<float>(shadow_.w) : 0.0f);
-    };
-    surfaceUniforms(terrainProgram_, 0);
+    surfaceUniforms(terrainProgram_, 0, s, v, wantShadowMap);
     gl_.DrawElements(GL_TRIANGLES, indexCount, GL_UNSIGNED_INT, nullptr);
-    if (s.water && f.hasWater && !debug) {
-        surfaceUniforms(waterProgram_, 1);
+    if (s.water && f.hasWater && s.debug == DebugView::None) {
+        surfaceUniforms(waterProgram_, 1, s, v, wantShadowMap);
         gl_.Enable(GL_BLEND);
         gl_.BlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
         gl_.DepthMask(GL_FALSE);
@@ -344,7 +354,36 @@ void Renderer::draw(const RenderSettings& s, int width, int height, GLuint frame
         gl_.DepthMask(GL_TRUE);
         gl_.Disable(GL_BLEND);
     }
-    // ---- tone mapping + sRGB into the output --------------------------------------
+}
+
+void Renderer::surfaceUniforms(GLuint p, int water, const RenderSettings& s, const FrameViews& v, bool wantShadowMap) {
+    const engine::FrameData& f = meta_;
+    gl_.UseProgram(p);
+    meshUniforms(gl_, f, p, v.viewProj, water);
+    Uniforms u{gl_, p};
+    u.i("uShade", 1);
+    u.i("uKey", 2);
+    u.i("uReceiver", 3);
+    u.i("uEnv", 4);
+    u.i("uShadowMap", 5);
+    u.i2("uReceiverGrid", f.nxr, f.nyr);
+    u.i("uSubsample", f.subsample);
+    u.v3("uEye", v.eye);
+    u.v3("uKeyDir", v.keyDir);
+    u.v3("uKeyRgb", glm::vec3(f.lights.key.rgb[0], f.lights.key.rgb[1], f.lights.key.rgb[2]));
+    u.i("uLighting",
+        f.lighting == engine::LightingMode::KeyOnly ? 0 : (f.lighting == engine::LightingMode::Direct ? 1 : 2));
+    u.i("uShadowMode", s.shadow == ShadowMode::SoftVisibility ? 0 : (wantShadowMap ? 1 : 2));
+    u.i("uSpecular", s.specular ? 1 : 0);
+    u.i("uDebug", static_cast<int>(s.debug));
+    u.f2("uZRange", f.zMin, f.zMax);
+    u.i("uPalette", f.coast ? 1 : 0);
+    u.m4("uLightViewProj", v.lightViewProj);
+    u.f("uShadowTexel", shadow_.w > 0 ? 1.0f / static_cast<float>(shadow_.w) : 0.0f);
+}
+
+// ---- tone mapping + sRGB into the output --------------------------------------------
+void Renderer::drawPost(const RenderSettings& s, const FrameViews& v, int width, int height, GLuint framebuffer) {
     gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffer);
     gl_.Viewport(0, 0, width, height);
     gl_.Disable(GL_DEPTH_TEST);
@@ -356,15 +395,12 @@ void Renderer::draw(const RenderSettings& s, int width, int height, GLuint frame
     Uniforms u{gl_, postProgram_};
     u.i("uHdr", 0);
     u.i("uEnv", 1);
-    u.m4("uInvViewProj", glm::inverse(viewProj));
-    u.v3("uEye", eye);
+    u.m4("uInvViewProj", glm::inverse(v.viewProj));
+    u.v3("uEye", v.eye);
     u.f2("uSize", static_cast<float>(width), static_cast<float>(height));
     u.f("uExposure", s.exposure);
-    u.i("uTonemap", debug ? 0 : 1);
+    u.i("uTonemap", s.debug != DebugView::None ? 0 : 1);
     gl_.DrawArrays(GL_TRIANGLES, 0, 3);
-    gl_.BindVertexArray(0);
-    gl_.ActiveTexture(GL_TEXTURE0);
-    checkGlError(gl_, "draw");
 }
 
 void Renderer::drawToImage(const RenderSettings& s, int width, int height, std::vector<std::uint8_t>& rgb) {

@@ -75,6 +75,15 @@ private:
     void ensureTarget(Target& t, int w, int h, GLenum colorFormat, bool depth);
     void releaseTarget(Target& t);
     void ensureTexture(GLuint& tex, int& w, int& h, int nw, int nh, GLenum internal, GLenum format, bool linear);
+    /// ensureTexture (linear) and the texels of `data` (nw x nh float texels of `format`).
+    void streamTexture(GLuint& tex, int& w, int& h, int nw, int nh, GLenum internal, GLenum format, const float* data);
+    // The passes of draw().
+    struct FrameViews;
+    FrameViews frameViews(const OrbitCamera& camera, int width, int height) const;
+    void drawShadowMap(const FrameViews& v);
+    void drawSurfaces(const RenderSettings& s, const FrameViews& v, int width, int height, bool wantShadowMap);
+    void surfaceUniforms(GLuint p, int water, const RenderSettings& s, const FrameViews& v, bool wantShadowMap);
+    void drawPost(const RenderSettings& s, const FrameViews& v, int width, int height, GLuint framebuffer);
 
     const Gl& gl_;
     GLuint terrainProgram_ = 0, waterProgram_ = 0, shadowProgram_ = 0, postProgram_ = 0;

@@ -110,13 +110,7 @@ inline Nbr edgeNeighbours(int x, int y, int nx, int ny, float invCell) {
 // than auto-vectorisation) because the build keeps -fmath-errno and
 // -ftrapping-math, which stop GCC from vectorising sqrt and guarded divisions.
 // ---------------------------------------------------------------------------
-using simd::F4;
-using simd::load;
-using simd::splat;
-using simd::store;
-using simd::vmax;
-using simd::vmin;
-using simd::sqrtv;
+using namespace simd;
 
 // ---------------------------------------------------------------------------
 // Pass A: outflow fluxes (Mei et al., "flow simulation": pipe acceleration and
@@ -285,10 +279,6 @@ struct UpdatePass {
 /// Rows per block of the pipelined schedule: about 32k cells, at least 4 rows.
 int blockRows(int nx, int ny) { return std::clamp(32768 / std::max(nx, 1), 4, std::max(ny, 4)); }
 
-void ensureScratch(Grid& g, int nx, int ny) {
-    if (g.nx != nx || g.ny != ny) g.resize(nx, ny);
-}
-
 }  // namespace
 
 // ---------------------------------------------------------------------------
@@ -323,8 +313,8 @@ float hydraulicMaxDt(const TerrainState& s, const HydraulicSettings& settings) {
 void hydraulicStep(TerrainState& s, const HydraulicSettings& settings, float dt, HydraulicScratch& scratch) {
     const int nx = s.nx, ny = s.ny;
     if (nx <= 0 || ny <= 0 || !(dt > 0.0f)) return;
-    ensureScratch(scratch.conc, nx, ny);
-    ensureScratch(scratch.sin2, nx, ny);
+    scratch.conc.ensureSize(nx, ny);
+    scratch.sin2.ensureSize(nx, ny);
 
     const float c = s.cellSize;
     Coeffs k;

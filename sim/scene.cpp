@@ -46,6 +46,13 @@ Grid resampleBilinear(const Grid& in, int nx, int ny) {
     return out;
 }
 
+// Noise terrain `extent` metres across at any resolution.
+void noiseTerrain(SceneSettings& s, float extent, const NoiseSettings& noise) {
+    s.cellSize = extent / static_cast<float>(s.nx);
+    s.terrain.kind = TerrainSource::Kind::Noise;
+    s.terrain.noise = noise;
+}
+
 }  // namespace
 
 std::vector<std::string> builtinSceneNames() { return {"erosion", "waves", "dem"}; }
@@ -59,13 +66,7 @@ SceneSettings builtinScene(const std::string& name, int size, std::uint64_t seed
     if (name == "erosion") {
         // Noise mountains, 4 km across at any resolution, under rain:
         // hydraulic + thermal erosion carve valleys and fill basins.
-        const float extent = 4000.0f;
-        s.cellSize = extent / static_cast<float>(size);
-        s.terrain.kind = TerrainSource::Kind::Noise;
-        s.terrain.noise.amplitude = 500.0f;
-        s.terrain.noise.wavelength = 3000.0f;
-        s.terrain.noise.octaves = 9;
-        s.terrain.noise.ridged = true;
+        noiseTerrain(s, 4000.0f, {.amplitude = 500.0f, .wavelength = 3000.0f, .octaves = 9, .ridged = true});
         s.soilDepth = 2.0f;
         s.hydraulic = true;
         s.thermal = true;
@@ -82,12 +83,7 @@ SceneSettings builtinScene(const std::string& name, int size, std::uint64_t seed
         // rocky islands at +x; a swell rolls in through the -x edge and drops
         // fall into the bay.
         const float extent = 512.0f;
-        s.cellSize = extent / static_cast<float>(size);
-        s.terrain.kind = TerrainSource::Kind::Noise;
-        s.terrain.noise.amplitude = 6.0f;
-        s.terrain.noise.wavelength = 140.0f;
-        s.terrain.noise.octaves = 5;
-        s.terrain.noise.offset = -3.0f;
+        noiseTerrain(s, extent, {.amplitude = 6.0f, .wavelength = 140.0f, .octaves = 5, .offset = -3.0f});
         s.terrain.rampStart = -8.0f;
         s.terrain.rampEnd = 4.0f;
         s.hasWaterLevel = true;

@@ -41,7 +41,7 @@ void TerrainState::allocate(int w, int h, float cell, const LayerSet& layers) {
 }
 
 void TerrainState::groundHeight(Grid& out) const {
-    if (out.nx != nx || out.ny != ny) out.resize(nx, ny);
+    out.ensureSize(nx, ny);
     const float* b = bedrock.data();
     const float* s = soil.data();
     float* o = out.data();

@@ -65,12 +65,7 @@ struct Coeffs {
 // kernels are templated on the lane type, interior cells run four at a time,
 // edge cells one at a time with the same IEEE operations, so a cell's result
 // does not depend on the path.
-using simd::F4;
-using simd::load;
-using simd::splat;
-using simd::store;
-using simd::vmax;
-using simd::vmin;
+using namespace simd;
 
 // The eight neighbours in a fixed order: L, R, U, D, UL, UR, DL, DR. The
 // first four are at distance c, the last four at c * sqrt(2).
@@ -193,18 +188,14 @@ struct SettlePass {
     static void run(const Fields& F, const Coeffs& k, std::ptrdiff_t i, const Nbr8& n) { settleCell<T, kEdge>(F, k, i, n); }
 };
 
-void ensureScratch(Grid& g, int nx, int ny) {
-    if (g.nx != nx || g.ny != ny) g.resize(nx, ny);
-}
-
 }  // namespace
 
 void thermalStep(TerrainState& s, const ThermalSettings& settings, float dt, ThermalScratch& scratch) {
     const int nx = s.nx, ny = s.ny;
     if (nx <= 0 || ny <= 0 || !(dt > 0.0f) || !(settings.rate > 0.0f)) return;
-    ensureScratch(scratch.ground, nx, ny);
-    ensureScratch(scratch.out, nx, ny);
-    ensureScratch(scratch.share, nx, ny);
+    scratch.ground.ensureSize(nx, ny);
+    scratch.out.ensureSize(nx, ny);
+    scratch.share.ensureSize(nx, ny);
 
     constexpr float kDegToRad = 3.14159265358979f / 180.0f;
     const float talus = std::clamp(settings.talusAngleDeg, 0.0f, 89.9f) * kDegToRad;

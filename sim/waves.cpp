@@ -118,12 +118,7 @@ namespace {
 // Explicit vectors because the build keeps -ftrapping-math, under which GCC
 // turns upwind selects of divisions/products back into branches and gives up.
 // ---------------------------------------------------------------------------
-using simd::F4;
-using simd::load;
-using simd::splat;
-using simd::store;
-using simd::vmax;
-using simd::vmin;
+using namespace simd;
 constexpr int kLanes = simd::kLaneCount<simd::F4>;
 
 // Hydrostatic reconstruction at a face (see above). bA, bB: grounds relative
@@ -174,6 +169,15 @@ struct Views {
     float* nv = nullptr;        // nextV
     std::size_t su() const { return static_cast<std::size_t>(nx) + 1; }
     std::size_t sc() const { return static_cast<std::size_t>(nx); }
+    // Row y of the cell-centred arrays: its offset r and depth, bedrock, soil.
+    struct CellRow {
+        std::size_t r;
+        const float *h, *bed, *soil;
+    };
+    CellRow cellRow(int y) const {
+        const std::size_t r = static_cast<std::size_t>(y) * sc();
+        return {r, h + r, bed + r, soil + r};
+    }
 };
 
 // eta_in(t): the incoming swell elevation, ramped in from t = 0.
@@ -276,10 +280,7 @@ void fluxRows(const Views& w, const StepConsts& c, int y0, int y1) {
     const std::size_t su = w.su(), sc = w.sc();
     const int nx = w.nx, ny = w.ny;
     for (int y = y0; y < y1; ++y) {
-        const std::size_t r = static_cast<std::size_t>(y) * sc;
-        const float* h = w.h + r;
-        const float* bed = w.bed + r;
-        const float* soil = w.soil + r;
+        const auto [r, h, bed, soil] = w.cellRow(y);
         const float* o = w.out + r;
         // x faces of row y: face x between cells x-1 and x.
         float* qu = w.qu + y * su;
@@ -399,10 +400,7 @@ void momentumRows(const Views& w, const StepConsts& c, int y0, int y1) {
     const std::size_t su = w.su(), sc = w.sc();
     const int nx = w.nx, ny = w.ny;
     for (int y = y0; y < y1; ++y) {
-        const std::size_t r = static_cast<std::size_t>(y) * sc;
-        const float* h = w.h + r;
-        const float* bed = w.bed + r;
-        const float* soil = w.soil + r;
+        const auto [r, h, bed, soil] = w.cellRow(y);
 
         // ---- u faces of row y: face x between cells x-1 and x, x in [1, nx) ----
         const float* u = w.u + y * su;
@@ -482,11 +480,6 @@ void applyDrop(TerrainState& s, const WaveDrop& d) {
     });
 }
 
-void ensure(Grid& g, int w, int h) {
-    if (g.nx != w || g.ny != h || g.v.size() != static_cast<std::size_t>(w) * static_cast<std::size_t>(h))
-        g.resize(w, h);
-}
-
 void checkLayers(const TerrainState& s) {
     if (s.water.nx != s.nx || s.water.ny != s.ny || s.faceU.nx != s.nx + 1 || s.faceU.ny != s.ny ||
         s.faceV.nx != s.nx || s.faceV.ny != s.ny + 1)
@@ -516,6 +509,105 @@ struct Maxima {
     float depth = 0.0f;
     float speed = 0.0f;
 };
+
+// --- waveStep's parts: scratch, sub-step plan, constants, P4 dispatch -------
+constexpr int kMaxSubsteps = 64;
+
+void ensureScratch(WaveScratch& scratch, int nx, int ny) {
+    scratch.outflow.ensureSize(nx, ny);
+    scratch.fluxU.ensureSize(nx + 1, ny);
+    scratch.fluxV.ensureSize(nx, ny + 1);
+    scratch.nextU.ensureSize(nx + 1, ny);
+    scratch.nextV.ensureSize(nx, ny + 1);
+    if (scratch.rowMaxDepth.size() != static_cast<std::size_t>(ny)) {
+        scratch.rowMaxDepth.assign(static_cast<std::size_t>(ny), 0.0f);
+        scratch.rowMaxSpeed.assign(static_cast<std::size_t>(ny), 0.0f);
+    }
+}
+
+// The arrays of one sub-step (the face velocities are swapped after each).
+Views stepViews(TerrainState& s, WaveScratch& scratch) {
+    Views w;
+    w.nx = s.nx;
+    w.ny = s.ny;
+    w.h = s.water.data();
+    w.bed = s.bedrock.data();
+    w.soil = s.soil.data();
+    w.u = s.faceU.data();
+    w.v = s.faceV.data();
+    w.out = scratch.outflow.data();
+    w.qu = scratch.fluxU.data();
+    w.qv = scratch.fluxV.data();
+    w.nu = scratch.nextU.data();
+    w.nv = scratch.nextV.data();
+    return w;
+}
+
+struct Substep {
+    float hMax = 0.0f;  // deepest water at the start of the sub-step
+    int n = 1;          // sub-steps the rest of the call is cut into
+    double h = 0.0;     // s, this sub-step
+};
+
+// P1, and the CFL check on the state at the start of this sub-step.
+Substep planSubstep(const Views& w, WaveScratch& scratch, float dx, float g, float maxCourant, double remaining,
+                    int taken) {
+    const int nx = w.nx, ny = w.ny;
+    parallelForRows(ny, nx, [&](int y0, int y1) {
+        outflowRows(w, y0, y1, 1.0f / dx, scratch.rowMaxDepth.data(), scratch.rowMaxSpeed.data());
+    });
+    float hMax = 0.0f, vMax = 0.0f;
+    for (int y = 0; y < ny; ++y) {
+        hMax = std::max(hMax, scratch.rowMaxDepth[static_cast<std::size_t>(y)]);
+        vMax = std::max(vMax, scratch.rowMaxSpeed[static_cast<std::size_t>(y)]);
+    }
+    const double speed = std::sqrt(static_cast<double>(g) * hMax) + vMax;
+    const double stable = speed > 0.0 ? maxCourant * dx / speed : remaining;
+    int n = 1;
+    if (stable < remaining) n = static_cast<int>(std::min<double>(std::ceil(remaining / stable), kMaxSubsteps - taken));
+    n = std::max(n, 1);
+    const double h = n == 1 ? remaining : remaining / n;
+    return {hMax, n, h};
+}
+
+StepConsts stepConsts(const TerrainState& s, const WaveSettings& settings, const WaveScratch& scratch,
+                      float maxCourant, double t, const Substep& sub) {
+    const float dx = s.cellSize;
+    const float g = settings.gravity;
+    const double h = sub.h;
+    StepConsts c;
+    c.dt = static_cast<float>(h);
+    c.dx = dx;
+    c.invDx = 1.0f / dx;
+    c.k = c.dt / dx;
+    c.gk = g * c.dt / dx;
+    c.dry = settings.dryDepth;
+    c.vmax = maxCourant * dx / c.dt;
+    c.frictionK = c.dt * g * settings.friction * settings.friction;
+    c.advection = settings.advection;
+    c.swell = settings.swell.enabled && settings.swell.edge >= 0 && settings.swell.edge <= 3;
+    c.edge = settings.swell.edge;
+    c.etaInFlux = swellElevation(settings.swell, t);
+    c.etaIn = swellElevation(settings.swell, t + h);
+    c.seaLevel = settings.swell.seaLevel;
+    c.gravity = g;
+    c.bref = referenceLevel(s, scratch.rowMaxDepth, sub.hMax);
+    return c;
+}
+
+template <bool kAdvection, bool kFriction>
+void momentumPass(const Views& w, const StepConsts& c) {
+    parallelForRows(w.ny, w.nx, [&](int y0, int y1) { momentumRows<kAdvection, kFriction>(w, c, y0, y1); });
+}
+
+// P4, with the advection and friction terms compiled in only where they are on.
+void momentum(const Views& w, const StepConsts& c, const WaveSettings& settings) {
+    const bool friction = settings.friction > 0.0f;
+    if (settings.advection && friction) momentumPass<true, true>(w, c);
+    else if (settings.advection) momentumPass<true, false>(w, c);
+    else if (friction) momentumPass<false, true>(w, c);
+    else momentumPass<false, false>(w, c);
+}
 
 }  // namespace
 
@@ -559,94 +651,31 @@ void waveStep(TerrainState& s, const WaveSettings& settings, float dt, WaveScrat
     checkLayers(s);
     if (!(dt > 0.0f) || !std::isfinite(dt)) return;
     const int nx = s.nx, ny = s.ny;
-    ensure(scratch.outflow, nx, ny);
-    ensure(scratch.fluxU, nx + 1, ny);
-    ensure(scratch.fluxV, nx, ny + 1);
-    ensure(scratch.nextU, nx + 1, ny);
-    ensure(scratch.nextV, nx, ny + 1);
-    if (scratch.rowMaxDepth.size() != static_cast<std::size_t>(ny)) {
-        scratch.rowMaxDepth.assign(static_cast<std::size_t>(ny), 0.0f);
-        scratch.rowMaxSpeed.assign(static_cast<std::size_t>(ny), 0.0f);
-    }
+    ensureScratch(scratch, nx, ny);
 
     const float dx = s.cellSize;
     const float g = settings.gravity;
     const float maxCourant = std::clamp(settings.maxCourant, 0.05f, 1.0f);
-    constexpr int kMaxSubsteps = 64;
 
     double t = s.time;
     double remaining = dt;
     int taken = 0;
     while (remaining > 0.0) {
-        Views w;
-        w.nx = nx;
-        w.ny = ny;
-        w.h = s.water.data();
-        w.bed = s.bedrock.data();
-        w.soil = s.soil.data();
-        w.u = s.faceU.data();
-        w.v = s.faceV.data();
-        w.out = scratch.outflow.data();
-        w.qu = scratch.fluxU.data();
-        w.qv = scratch.fluxV.data();
-        w.nu = scratch.nextU.data();
-        w.nv = scratch.nextV.data();
-
-        // P1, and the CFL check on the state at the start of this sub-step.
-        parallelForRows(ny, nx, [&](int y0, int y1) {
-            outflowRows(w, y0, y1, 1.0f / dx, scratch.rowMaxDepth.data(), scratch.rowMaxSpeed.data());
-        });
-        float hMax = 0.0f, vMax = 0.0f;
-        for (int y = 0; y < ny; ++y) {
-            hMax = std::max(hMax, scratch.rowMaxDepth[static_cast<std::size_t>(y)]);
-            vMax = std::max(vMax, scratch.rowMaxSpeed[static_cast<std::size_t>(y)]);
-        }
-        const double speed = std::sqrt(static_cast<double>(g) * hMax) + vMax;
-        const double stable = speed > 0.0 ? maxCourant * dx / speed : remaining;
-        int n = 1;
-        if (stable < remaining) n = static_cast<int>(std::min<double>(std::ceil(remaining / stable), kMaxSubsteps - taken));
-        n = std::max(n, 1);
-        const double h = n == 1 ? remaining : remaining / n;
-
-        StepConsts c;
-        c.dt = static_cast<float>(h);
-        c.dx = dx;
-        c.invDx = 1.0f / dx;
-        c.k = c.dt / dx;
-        c.gk = g * c.dt / dx;
-        c.dry = settings.dryDepth;
-        c.vmax = maxCourant * dx / c.dt;
-        c.frictionK = c.dt * g * settings.friction * settings.friction;
-        c.advection = settings.advection;
-        c.swell = settings.swell.enabled && settings.swell.edge >= 0 && settings.swell.edge <= 3;
-        c.edge = settings.swell.edge;
-        c.etaInFlux = swellElevation(settings.swell, t);
-        c.etaIn = swellElevation(settings.swell, t + h);
-        c.seaLevel = settings.swell.seaLevel;
-        c.gravity = g;
-        c.bref = referenceLevel(s, scratch.rowMaxDepth, hMax);
-
+        const Views w = stepViews(s, scratch);
+        const Substep sub = planSubstep(w, scratch, dx, g, maxCourant, remaining, taken);  // P1
+        const double h = sub.h;
+        const StepConsts c = stepConsts(s, settings, scratch, maxCourant, t, sub);
         parallelForRows(ny, nx, [&](int y0, int y1) { fluxRows(w, c, y0, y1); });          // P2
         parallelForRows(ny, nx, [&](int y0, int y1) { continuityRows(w, c.k, y0, y1); });  // P3
         for (const WaveDrop& d : settings.drops)
             if (d.time >= t && d.time < t + h) applyDrop(s, d);
-        // P4
-        auto momentumPass = [&](auto advection, auto friction) {
-            parallelForRows(ny, nx, [&](int y0, int y1) {
-                momentumRows<decltype(advection)::value, decltype(friction)::value>(w, c, y0, y1);
-            });
-        };
-        const bool friction = settings.friction > 0.0f;
-        if (settings.advection && friction) momentumPass(std::true_type{}, std::true_type{});
-        else if (settings.advection) momentumPass(std::true_type{}, std::false_type{});
-        else if (friction) momentumPass(std::false_type{}, std::true_type{});
-        else momentumPass(std::false_type{}, std::false_type{});
+        momentum(w, c, settings);  // P4
         std::swap(s.faceU, scratch.nextU);
         std::swap(s.faceV, scratch.nextV);
 
         t += h;
         ++taken;
-        remaining = n == 1 ? 0.0 : remaining - h;
+        remaining = sub.n == 1 ? 0.0 : remaining - h;
     }
     scratch.lastSubsteps = taken;
 }
