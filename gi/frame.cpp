@@ -118,8 +118,8 @@ void checkHeightsFinite(ConstGridView h) {
 
 void computeGradient(ConstGridView h, float cellSize, Grid& gx, Grid& gy) {
     const int nx = h.nx, ny = h.ny;
-    if (gx.nx != nx || gx.ny != ny) gx.resize(nx, ny);
-    if (gy.nx != nx || gy.ny != ny) gy.resize(nx, ny);
+    gx.ensureSize(nx, ny);
+    gy.ensureSize(nx, ny);
     const float inv2 = 0.5f / cellSize, inv1 = 1.0f / cellSize;
     parallelForRows(ny, nx, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y)
