@@ -6,13 +6,13 @@
 #include <string>
 
 #include "app/commands.h"
-#include "app/render_options.h"
-#include "render/context.h"
 #include "app/demo_window.h"
-#include "render/gl.h"
-#include "engine/pipeline.h"
+#include "app/render_options.h"
 #include "core/error.h"
 #include "core/parallel.h"
+#include "engine/pipeline.h"
+#include "render/context.h"
+#include "render/gl.h"
 #include "sim/scene.h"
 
 namespace terrain::app {

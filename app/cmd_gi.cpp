@@ -9,17 +9,17 @@
 #include <string>
 #include <vector>
 
-#include "gi/albedo_io.h"
-#include "gi/frame.h"
-#include "core/image_io.h"
-#include "gi/reference.h"
-#include "gi/reference_gi.h"
 #include "app/commands.h"
 #include "core/error.h"
+#include "core/image_io.h"
+#include "core/parallel.h"
 #include "core/parse.h"
 #include "core/png_io.h"
+#include "gi/albedo_io.h"
+#include "gi/frame.h"
+#include "gi/reference.h"
+#include "gi/reference_gi.h"
 #include "sim/heightmap_io.h"
-#include "core/parallel.h"
 
 namespace terrain::app {
 namespace {
@@ -46,8 +46,8 @@ struct GiOptions {
     std::string albedo;
     std::string outIndirect;
     int referenceDirections = 2048;
-    std::string glossy;          // vector | scalar (glossy indirect light)
-    std::string phongExponent;   // VALUE or a 16-bit PNG
+    std::string glossy;         // vector | scalar (glossy indirect light)
+    std::string phongExponent;  // VALUE or a 16-bit PNG
     std::string phongExponentRange = "1,1000";
 };
 
@@ -74,20 +74,25 @@ void parseBrdf(const std::string& text, gi::ShadingSettings& s) {
         const auto comma = rest.find(',');
         s.specularWeight = number(rest.substr(0, comma));
         if (comma != std::string::npos) s.phongExponent = number(rest.substr(comma + 1));
-        if (!(s.specularWeight >= 0.0f && s.specularWeight <= 1.0f)) throw InputError("--brdf mix: weight must be in [0, 1]");
+        if (!(s.specularWeight >= 0.0f && s.specularWeight <= 1.0f))
+            throw InputError("--brdf mix: weight must be in [0, 1]");
     } else {
         throw InputError("--brdf must be lambert, phong:EXP or mix:W[,EXP] (got '" + text + "')");
     }
-    if (!(s.phongExponent >= 1.0f && s.phongExponent <= 10000.0f)) throw InputError("--brdf: Phong exponent must be in [1, 10000]");
+    if (!(s.phongExponent >= 1.0f && s.phongExponent <= 10000.0f))
+        throw InputError("--brdf: Phong exponent must be in [1, 10000]");
 }
 
 void writeIndirect(const std::string& file, const std::array<Grid, 3>& rgb) {
     const std::string e = file.size() >= 4 ? file.substr(file.size() - 4) : "";
     std::string ext = e;
     for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (ext == ".npy") writeNpyRgb(file, rgb);
-    else if (ext == ".exr") writeExr(file, {&rgb[0], &rgb[1], &rgb[2]});
-    else throw InputError("--out-indirect must end in .npy or .exr (got '" + file + "')");
+    if (ext == ".npy")
+        writeNpyRgb(file, rgb);
+    else if (ext == ".exr")
+        writeExr(file, {&rgb[0], &rgb[1], &rgb[2]});
+    else
+        throw InputError("--out-indirect must end in .npy or .exr (got '" + file + "')");
 }
 
 std::string extensionOf(const std::string& f) {
@@ -148,9 +153,12 @@ void writeShade(const std::string& file, const std::array<Grid, 3>& rgb) {
 
 void writeAmbient(const std::string& file, const Grid& ambient) {
     const std::string ext = extensionOf(file);
-    if (ext == ".npy") writeNpy(file, ambient);
-    else if (ext == ".exr") writeExr(file, {&ambient});
-    else throw InputError("--out-ambient must end in .npy or .exr (got '" + file + "')");
+    if (ext == ".npy")
+        writeNpy(file, ambient);
+    else if (ext == ".exr")
+        writeExr(file, {&ambient});
+    else
+        throw InputError("--out-ambient must end in .npy or .exr (got '" + file + "')");
 }
 
 // The phong exponent option: a constant, or a 16-bit PNG mapped to a range.
@@ -166,19 +174,20 @@ ExponentSource parsePhongExponent(const GiOptions& o, gi::GiSettings& settings) 
     if (numeric) {
         const std::vector<float> v = parseNumberList(o.phongExponent, "--phong-exponent");
         if (v.size() != 1 || !gi::ranges::kPhongExponent.contains(v[0]))
-            throw InputError("--phong-exponent: a constant must be one number, " + gi::describe(gi::ranges::kPhongExponent) +
-                             " (got '" + o.phongExponent + "')");
+            throw InputError("--phong-exponent: a constant must be one number, " +
+                             gi::describe(gi::ranges::kPhongExponent) + " (got '" + o.phongExponent + "')");
         settings.shading.phongExponent = v[0];
         return e;
     }
     e.fromFile = true;
     const std::vector<float> r = parseNumberList(o.phongExponentRange, "--phong-exponent-range");
-    if (r.size() != 2) throw InputError("--phong-exponent-range: expected MIN,MAX (got '" + o.phongExponentRange + "')");
+    if (r.size() != 2)
+        throw InputError("--phong-exponent-range: expected MIN,MAX (got '" + o.phongExponentRange + "')");
     e.lo = r[0];
     e.hi = r[1];
     if (!(gi::ranges::kPhongExponent.contains(e.lo) && gi::ranges::kPhongExponent.contains(e.hi) && e.lo <= e.hi))
-        throw InputError("--phong-exponent-range: need MIN <= MAX, both in " + gi::describe(gi::ranges::kPhongExponent) +
-                         " (got '" + o.phongExponentRange + "')");
+        throw InputError("--phong-exponent-range: need MIN <= MAX, both in " +
+                         gi::describe(gi::ranges::kPhongExponent) + " (got '" + o.phongExponentRange + "')");
     return e;
 }
 
@@ -188,20 +197,29 @@ gi::GiSettings settingsFrom(const GiOptions& o, ExponentSource& exponent) {
     gi::GiSettings settings = o.settings;
     parseBrdf(o.brdf, settings.shading);
     if (!o.glossy.empty()) {
-        if (o.glossy == "vector") settings.indirect.glossy = gi::GlossyIndirect::VectorPyramid;
-        else if (o.glossy == "scalar") settings.indirect.glossy = gi::GlossyIndirect::ScalarPyramid;
-        else throw InputError("--glossy must be vector or scalar (got '" + o.glossy + "')");
+        if (o.glossy == "vector")
+            settings.indirect.glossy = gi::GlossyIndirect::VectorPyramid;
+        else if (o.glossy == "scalar")
+            settings.indirect.glossy = gi::GlossyIndirect::ScalarPyramid;
+        else
+            throw InputError("--glossy must be vector or scalar (got '" + o.glossy + "')");
     }
     exponent = parsePhongExponent(o, settings);
     if (!o.indirectKernel.empty()) {
-        if (o.indirectKernel == "sh") settings.indirect.lambert = gi::LambertIndirect::ShKernel;
-        else if (o.indirectKernel == "blocker") settings.indirect.lambert = gi::LambertIndirect::BlockerRadiance;
-        else throw InputError("--indirect-kernel must be blocker or sh (got '" + o.indirectKernel + "')");
+        if (o.indirectKernel == "sh")
+            settings.indirect.lambert = gi::LambertIndirect::ShKernel;
+        else if (o.indirectKernel == "blocker")
+            settings.indirect.lambert = gi::LambertIndirect::BlockerRadiance;
+        else
+            throw InputError("--indirect-kernel must be blocker or sh (got '" + o.indirectKernel + "')");
     }
     if (!o.interp.empty()) {
-        if (o.interp == "linear") settings.visibility.interp = gi::AzimuthInterp::Linear;
-        else if (o.interp == "bspline") settings.visibility.interp = gi::AzimuthInterp::Bspline;
-        else throw InputError("--interp must be linear or bspline (got '" + o.interp + "')");
+        if (o.interp == "linear")
+            settings.visibility.interp = gi::AzimuthInterp::Linear;
+        else if (o.interp == "bspline")
+            settings.visibility.interp = gi::AzimuthInterp::Bspline;
+        else
+            throw InputError("--interp must be linear or bspline (got '" + o.interp + "')");
     }
     gi::validateGiSettings(settings);
     return settings;
@@ -211,7 +229,8 @@ gi::GiSettings settingsFrom(const GiOptions& o, ExponentSource& exponent) {
 void checkOptions(const GiOptions& o) {
     if (o.threads < 0 || o.threads > 256) throw InputError("--threads must be 0 (all) .. 256");
     if (o.frames < 1 || o.frames > 100000) throw InputError("--frames must be >= 1");
-    if (!std::isfinite(o.zScale) || !std::isfinite(o.zOffset)) throw InputError("--z-scale and --z-offset must be finite");
+    if (!std::isfinite(o.zScale) || !std::isfinite(o.zOffset))
+        throw InputError("--z-scale and --z-offset must be finite");
     if (!o.outShade.empty() && extensionOf(o.outShade) != ".png" && extensionOf(o.outShade) != ".exr")
         throw InputError("--out-shade must end in .png or .exr (got '" + o.outShade + "')");
     if (!o.outAmbient.empty() && extensionOf(o.outAmbient) != ".npy" && extensionOf(o.outAmbient) != ".exr")
@@ -220,7 +239,8 @@ void checkOptions(const GiOptions& o) {
         throw InputError("--out-indirect must end in .npy or .exr (got '" + o.outIndirect + "')");
     if (!o.outIndirect.empty() && o.settings.indirect.bounces == 0 && !o.reference)
         throw InputError("--out-indirect needs --bounces >= 1");
-    if (o.referenceDirections < 16 || o.referenceDirections > (1 << 20)) throw InputError("--reference-directions must be 16 .. 2^20");
+    if (o.referenceDirections < 16 || o.referenceDirections > (1 << 20))
+        throw InputError("--reference-directions must be 16 .. 2^20");
 }
 
 // What a frame lights: the heights, their cell size and the albedo maps.
@@ -239,7 +259,8 @@ GiInputs readInputs(const GiOptions& o, const ExponentSource& exponent) {
     float cellFromFile = 0.0f;
     in.heights = readHeightmap(o.heightmap, static_cast<float>(o.zScale), static_cast<float>(o.zOffset), &cellFromFile);
     in.cell = o.cellSize > 0.0 ? o.cellSize : cellFromFile;
-    if (!(in.cell > 0.0) || !std::isfinite(in.cell)) throw InputError("--cell-size must be > 0 (metres between grid points)");
+    if (!(in.cell > 0.0) || !std::isfinite(in.cell))
+        throw InputError("--cell-size must be > 0 (metres between grid points)");
     if (!o.albedo.empty()) in.albedoMap = gi::loadAlbedo(o.albedo, in.heights.nx, in.heights.ny);
     if (exponent.fromFile)
         gi::loadPhongExponentMap(o.phongExponent, in.heights.nx, in.heights.ny, exponent.lo, exponent.hi, in.albedoMap);
@@ -255,7 +276,8 @@ double msSince(Clock::time_point t0) { return std::chrono::duration<double, std:
 int runReference(const GiOptions& o, const gi::GiSettings& settings, const GiInputs& in) {
     const int bounces = settings.indirect.bounces;
     const auto t0 = Clock::now();
-    if (bounces > 0 || !o.outIndirect.empty() || !in.lighting.keys.empty() || settings.shading.brdf != gi::Brdf::Lambert) {
+    if (bounces > 0 || !o.outIndirect.empty() || !in.lighting.keys.empty() ||
+        settings.shading.brdf != gi::Brdf::Lambert) {
         gi::ReferenceGiSettings gs;
         gs.bounces = bounces;
         gs.directions = o.referenceDirections;
@@ -263,7 +285,8 @@ int runReference(const GiOptions& o, const gi::GiSettings& settings, const GiInp
         gs.keys = in.lighting.keys;  // key lights enter the ground truth as exact caps, not as SH
         gs.shading = settings.shading;
         gi::ReferenceGiResult gr;
-        gi::renderReferenceGi(in.heights.cview(), static_cast<float>(in.cell), in.lighting.environment, in.albedo, gs, gr);
+        gi::renderReferenceGi(in.heights.cview(), static_cast<float>(in.cell), in.lighting.environment, in.albedo, gs,
+                              gr);
         if (o.time) std::printf("reference: %.1f ms\n", msSince(t0));
         if (!o.outShade.empty()) writeShade(o.outShade, gr.total);
         if (!o.outAmbient.empty()) writeAmbient(o.outAmbient, gr.ambient);
@@ -282,13 +305,14 @@ int runReference(const GiOptions& o, const gi::GiSettings& settings, const GiInp
 
 void printFrameTimes(int f, int frames, const gi::GiState& state, int bounces) {
     const gi::GiTimings& t = state.timings;
-    std::printf("frame %d: gradient %.2f ms, pyramid %.2f ms, visibility %.2f ms, key lights %.2f ms, shading %.2f ms, "
-                "indirect %.2f ms, total %.2f ms%s\n",
-                f, t.gradient, t.pyramid, t.visibility, t.keyVisibility, t.shading, t.indirect, t.total,
-                f == 0 && frames > 1 ? " (warm-up)" : "");
+    std::printf(
+        "frame %d: gradient %.2f ms, pyramid %.2f ms, visibility %.2f ms, key lights %.2f ms, shading %.2f ms, "
+        "indirect %.2f ms, total %.2f ms%s\n",
+        f, t.gradient, t.pyramid, t.visibility, t.keyVisibility, t.shading, t.indirect, t.total,
+        f == 0 && frames > 1 ? " (warm-up)" : "");
     if (bounces > 0)
-        std::printf("  indirect: radiance pyramids %.2f ms, scans %.2f ms, shading %.2f ms\n", state.indirect.timings.pyramid,
-                    state.indirect.timings.scan, state.indirect.timings.shading);
+        std::printf("  indirect: radiance pyramids %.2f ms, scans %.2f ms, shading %.2f ms\n",
+                    state.indirect.timings.pyramid, state.indirect.timings.scan, state.indirect.timings.shading);
 }
 
 // The fast path, o.frames times on the same field (the first a warm-up).
@@ -320,14 +344,16 @@ int runGi(const GiOptions& o) {
     // after every input is read: a bad input gives one error line on stderr
     std::fprintf(stderr, "terrain gi: %s, %d x %d cells of %.4g m\n", o.heightmap.c_str(), in.heights.nx, in.heights.ny,
                  in.cell);
-    return withThreads(o.threads, [&] { return o.reference ? runReference(o, settings, in) : runFastPath(o, settings, in); });
+    return withThreads(o.threads,
+                       [&] { return o.reference ? runReference(o, settings, in) : runFastPath(o, settings, in); });
 }
 
 }  // namespace
 
 Runner addGiCommand(CLI::App& app) {
     auto o = std::make_shared<GiOptions>();
-    CLI::App* sub = app.add_subcommand("gi", "Global illumination of a height field: soft shadows from sky and key lights");
+    CLI::App* sub =
+        app.add_subcommand("gi", "Global illumination of a height field: soft shadows from sky and key lights");
     sub->add_option("--heightmap", o->heightmap, "16-bit PNG (height = O + S * value) or .vdb")->required();
     sub->add_option("--cell-size", o->cellSize, "Metres between grid points (required for PNG)");
     sub->add_option("--z-scale", o->zScale, "Metres per PNG unit (S)");
@@ -337,7 +363,8 @@ Runner addGiCommand(CLI::App& app) {
     gi::GiSettings& gs = o->settings;
     namespace r = gi::ranges;
     sub->add_option("--subsample", gs.subsample, gi::describe(r::kSubsample))->capture_default_str();
-    sub->add_option("--azimuths", gs.visibility.azimuths, gi::describe(r::kAzimuths) + " (paper 32)")->capture_default_str();
+    sub->add_option("--azimuths", gs.visibility.azimuths, gi::describe(r::kAzimuths) + " (paper 32)")
+        ->capture_default_str();
     sub->add_option("--levels-per-octave", gs.pyramid.levelsPerOctave, gi::describe(r::kLevelsPerOctave))
         ->capture_default_str();
     sub->add_option("--level-offset", gs.pyramid.levelOffset, gi::describe(r::kLevelOffset) + " (paper 2)")
@@ -352,24 +379,32 @@ Runner addGiCommand(CLI::App& app) {
     sub->add_option("--bounces", gs.indirect.bounces, gi::describe(r::kBounces))->capture_default_str();
     sub->add_option("--brdf", o->brdf, "lambert | phong:EXP | mix:W[,EXP] (Lambert + W x Phong)");
     sub->add_option("--albedo", o->albedo, "Albedo R,G,B in [0, 1] or an sRGB PNG of the field's size");
-    sub->add_flag("--amortise", gs.indirect.amortise, "With --frames on static geometry: alternate direct and indirect updates");
-    sub->add_option("--out-indirect", o->outIndirect, "Indirect light alone, RGB (.npy float32 (rows, columns, 3), or .exr)");
+    sub->add_flag("--amortise", gs.indirect.amortise,
+                  "With --frames on static geometry: alternate direct and indirect updates");
+    sub->add_option("--out-indirect", o->outIndirect,
+                    "Indirect light alone, RGB (.npy float32 (rows, columns, 3), or .exr)");
     sub->add_option("--radiance-levels-per-octave", gs.indirect.radiance.levelsPerOctave,
                     gi::describe(r::kRadianceLevelsPerOctave) + " (paper 4)")
         ->capture_default_str();
     sub->add_option("--radiance-level-offset", gs.indirect.radiance.levelOffset,
                     gi::describe(r::kRadianceLevelOffset) + " (paper 2)")
         ->capture_default_str();
-    sub->add_option("--indirect-azimuths", gs.indirect.azimuths, gi::describe(r::kIndirectAzimuths))->capture_default_str();
-    sub->add_option("--indirect-kernel", o->indirectKernel,
-                    "Lambert indirect light: blocker (exact cosine at the receivers, between them the blockers' mean radiance "
-                    "times each texel's occlusion, engine default) | sh (order-4 SH kernel, paper)");
-    sub->add_option("--reference-directions", o->referenceDirections, "Directions of the indirect reference (default 2048)");
+    sub->add_option("--indirect-azimuths", gs.indirect.azimuths, gi::describe(r::kIndirectAzimuths))
+        ->capture_default_str();
+    sub->add_option(
+        "--indirect-kernel", o->indirectKernel,
+        "Lambert indirect light: blocker (exact cosine at the receivers, between them the blockers' mean radiance "
+        "times each texel's occlusion, engine default) | sh (order-4 SH kernel, paper)");
+    sub->add_option("--reference-directions", o->referenceDirections,
+                    "Directions of the indirect reference (default 2048)");
     sub->add_option("--glossy", o->glossy,
-                    "Glossy indirect light (phong/mix BRDFs): vector (SH radiance-vector pyramid, Fig. 5 middle) | scalar (shade pyramid, Fig. 5 right)");
+                    "Glossy indirect light (phong/mix BRDFs): vector (SH radiance-vector pyramid, Fig. 5 middle) | "
+                    "scalar (shade pyramid, Fig. 5 right)");
     sub->add_option("--phong-exponent", o->phongExponent,
-                    "Phong exponent: a constant VALUE, or a 16-bit PNG of the field's size mapped log-uniformly to --phong-exponent-range");
-    sub->add_option("--phong-exponent-range", o->phongExponentRange, "MIN,MAX exponents of PNG values 0 and 65535 (default 1,1000)");
+                    "Phong exponent: a constant VALUE, or a 16-bit PNG of the field's size mapped log-uniformly to "
+                    "--phong-exponent-range");
+    sub->add_option("--phong-exponent-range", o->phongExponentRange,
+                    "MIN,MAX exponents of PNG values 0 and 65535 (default 1,1000)");
     return [o] { return runGi(*o); };
 }
 

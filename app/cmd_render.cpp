@@ -13,16 +13,16 @@
 #include <unistd.h>
 
 #include "app/commands.h"
-#include "app/render_options.h"
 #include "app/progress.h"
-#include "render/context.h"
-#include "render/gl.h"
-#include "engine/pipeline.h"
-#include "render/renderer.h"
+#include "app/render_options.h"
 #include "core/error.h"
 #include "core/file_io.h"
-#include "core/png_io.h"
 #include "core/parallel.h"
+#include "core/png_io.h"
+#include "engine/pipeline.h"
+#include "render/context.h"
+#include "render/gl.h"
+#include "render/renderer.h"
 #include "sim/scene.h"
 
 namespace terrain::app {
@@ -40,7 +40,8 @@ std::string findOnPath(const std::string& program) {
         const std::size_t end = std::min(p.find(':', start), p.size());
         const std::filesystem::path candidate = std::filesystem::path(p.substr(start, end - start)) / program;
         std::error_code ec;
-        if (std::filesystem::is_regular_file(candidate, ec) && access(candidate.c_str(), X_OK) == 0) return candidate.string();
+        if (std::filesystem::is_regular_file(candidate, ec) && access(candidate.c_str(), X_OK) == 0)
+            return candidate.string();
         start = end + 1;
     }
     return "";
@@ -78,11 +79,14 @@ void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize) {
                   "Shading amortisation: on static geometry update direct and indirect light on alternate frames");
     sub->add_option("--shadow", o.shadow, "Key light shadow: soft (engine visibility) | map (shadow map) | none")
         ->capture_default_str();
-    sub->add_option("--debug", o.debug, "Debug view: none | ambient | v | u (with --lighting global) | key | normals | pyramid | shade")
+    sub->add_option("--debug", o.debug,
+                    "Debug view: none | ambient | v | u (with --lighting global) | key | normals | pyramid | shade")
         ->capture_default_str();
-    sub->add_option("--pyramid-level", o.pyramidLevel, "Height-pyramid level for --debug pyramid")->capture_default_str();
+    sub->add_option("--pyramid-level", o.pyramidLevel, "Height-pyramid level for --debug pyramid")
+        ->capture_default_str();
     sub->add_option("--exposure", o.exposure, "Exposure before tone mapping")->capture_default_str();
-    sub->add_option("--exaggeration", o.exaggeration, "Vertical exaggeration (0 = automatic: relief >= 15% of the extent)")
+    sub->add_option("--exaggeration", o.exaggeration,
+                    "Vertical exaggeration (0 = automatic: relief >= 15% of the extent)")
         ->capture_default_str();
     sub->add_option("--yaw", o.yaw, "Camera azimuth in degrees")->capture_default_str();
     sub->add_option("--pitch", o.pitch, "Camera elevation in degrees")->capture_default_str();
@@ -109,24 +113,40 @@ void toSettings(const RenderOptions& o, engine::PipelineSettings& p, render::Ren
     gi::validateGiSettings(p.gi);
     p.ticksPerFrame = o.ticksPerFrame;
     p.pyramidLevel = o.pyramidLevel;
-    if (o.lighting == "key") p.lighting = LightingMode::KeyOnly;
-    else if (o.lighting == "direct") p.lighting = LightingMode::Direct;
-    else if (o.lighting == "global") p.lighting = LightingMode::Global;
-    else throw InputError("--lighting must be key, direct or global (got '" + o.lighting + "')");
-    if (o.shadow == "soft") r.shadow = ShadowMode::SoftVisibility;
-    else if (o.shadow == "map") r.shadow = ShadowMode::ShadowMap;
-    else if (o.shadow == "none") r.shadow = ShadowMode::None;
-    else throw InputError("--shadow must be soft, map or none (got '" + o.shadow + "')");
-    if (o.debug == "none") r.debug = DebugView::None;
-    else if (o.debug == "ambient") r.debug = DebugView::Ambient;
-    else if (o.debug == "v") r.debug = DebugView::SkyVisibility;
-    else if (o.debug == "key") r.debug = DebugView::KeyVisibility;
-    else if (o.debug == "normals") r.debug = DebugView::Normals;
-    else if (o.debug == "pyramid") r.debug = DebugView::PyramidLevel;
-    else if (o.debug == "shade") r.debug = DebugView::ShadeMap;
+    if (o.lighting == "key")
+        p.lighting = LightingMode::KeyOnly;
+    else if (o.lighting == "direct")
+        p.lighting = LightingMode::Direct;
+    else if (o.lighting == "global")
+        p.lighting = LightingMode::Global;
+    else
+        throw InputError("--lighting must be key, direct or global (got '" + o.lighting + "')");
+    if (o.shadow == "soft")
+        r.shadow = ShadowMode::SoftVisibility;
+    else if (o.shadow == "map")
+        r.shadow = ShadowMode::ShadowMap;
+    else if (o.shadow == "none")
+        r.shadow = ShadowMode::None;
+    else
+        throw InputError("--shadow must be soft, map or none (got '" + o.shadow + "')");
+    if (o.debug == "none")
+        r.debug = DebugView::None;
+    else if (o.debug == "ambient")
+        r.debug = DebugView::Ambient;
+    else if (o.debug == "v")
+        r.debug = DebugView::SkyVisibility;
+    else if (o.debug == "key")
+        r.debug = DebugView::KeyVisibility;
+    else if (o.debug == "normals")
+        r.debug = DebugView::Normals;
+    else if (o.debug == "pyramid")
+        r.debug = DebugView::PyramidLevel;
+    else if (o.debug == "shade")
+        r.debug = DebugView::ShadeMap;
     else if (o.debug == "u") {
         r.debug = DebugView::IndirectRadiance;
-        if (p.lighting != LightingMode::Global) throw InputError("--debug u needs --lighting global (U is the indirect light)");
+        if (p.lighting != LightingMode::Global)
+            throw InputError("--debug u needs --lighting global (U is the indirect light)");
     } else
         throw InputError("--debug must be none, ambient, v, u, key, normals, pyramid or shade (got '" + o.debug + "')");
     r.exposure = o.exposure;
@@ -153,10 +173,12 @@ int runHeadlessRender(const RenderOptions& o, const char* label) {
         engine::FramePipeline pipeline(scene, ps);
         const TerrainState& st = pipeline.simulation().state();
         if (!o.quiet) {
-            std::printf("%s: scene %s, %d x %d cells of %.3g m, ground %.0f..%.0f m, %d frames of %d ticks, %d x %d pixels, %s\n",
-                        label, scene.name.c_str(), st.nx, st.ny, static_cast<double>(st.cellSize),
-                        static_cast<double>(pipeline.frame().zMin), static_cast<double>(pipeline.frame().zMax), o.frames,
-                        pipeline.ticksPerFrame(), o.width, o.height, render::glDescription(gl).c_str());
+            std::printf(
+                "%s: scene %s, %d x %d cells of %.3g m, ground %.0f..%.0f m, %d frames of %d ticks, %d x %d pixels, "
+                "%s\n",
+                label, scene.name.c_str(), st.nx, st.ny, static_cast<double>(st.cellSize),
+                static_cast<double>(pipeline.frame().zMin), static_cast<double>(pipeline.frame().zMax), o.frames,
+                pipeline.ticksPerFrame(), o.width, o.height, render::glDescription(gl).c_str());
         }
         std::vector<std::vector<double>> stage(7);
         std::vector<std::uint8_t> rgb;
@@ -195,14 +217,16 @@ int runHeadlessRender(const RenderOptions& o, const char* label) {
         if (!o.video.empty()) {
             const std::string ffmpeg = findOnPath("ffmpeg");
             if (ffmpeg.empty()) {
-                std::printf("%s: ffmpeg is not installed, so no %s was made (the PNG frames are in %s; "
-                            "install ffmpeg, e.g. apt-get install ffmpeg, for video)\n",
-                            label, o.video.c_str(), dir.c_str());
+                std::printf(
+                    "%s: ffmpeg is not installed, so no %s was made (the PNG frames are in %s; "
+                    "install ffmpeg, e.g. apt-get install ffmpeg, for video)\n",
+                    label, o.video.c_str(), dir.c_str());
             } else {
                 const std::string tmp = temporaryNameFor(o.video) + ".mp4";
                 const std::string cmd = shellQuote(ffmpeg) + " -loglevel error -y -framerate 24 -i " +
                                         shellQuote((std::filesystem::path(o.out) / "frame_%04d.png").string()) +
-                                        " -c:v libx264 -pix_fmt yuv420p -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' " + shellQuote(tmp);
+                                        " -c:v libx264 -pix_fmt yuv420p -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' " +
+                                        shellQuote(tmp);
                 if (std::system(cmd.c_str()) != 0) {
                     std::error_code ec;
                     std::filesystem::remove(tmp, ec);
@@ -218,8 +242,10 @@ int runHeadlessRender(const RenderOptions& o, const char* label) {
 
 Runner addRenderCommand(CLI::App& app) {
     auto o = std::make_shared<RenderOptions>();
-    CLI::App* sub = app.add_subcommand("render", "Render an animated scene headless (OSMesa) to PNG frames, optionally an mp4");
-    sub->add_option("--scene", o->scene, "Built-in scene (erosion, waves, dem) or a .toml scene file")->capture_default_str();
+    CLI::App* sub =
+        app.add_subcommand("render", "Render an animated scene headless (OSMesa) to PNG frames, optionally an mp4");
+    sub->add_option("--scene", o->scene, "Built-in scene (erosion, waves, dem) or a .toml scene file")
+        ->capture_default_str();
     sub->add_option("--out", o->out, "Output folder for frame_NNNN.png")->capture_default_str();
     sub->add_option("--video", o->video, "Also encode the frames to this .mp4 (needs ffmpeg)");
     addRenderOptions(sub, *o, true);

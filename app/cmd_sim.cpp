@@ -7,10 +7,10 @@
 #include "app/commands.h"
 #include "app/progress.h"
 #include "core/error.h"
-#include "core/png_io.h"
-#include "sim/vdb_io.h"
 #include "core/parallel.h"
+#include "core/png_io.h"
 #include "sim/scene.h"
+#include "sim/vdb_io.h"
 
 namespace terrain::app {
 namespace {
@@ -29,8 +29,7 @@ struct SimOptions {
     bool quiet = false;
 };
 
-void writeFrame(const std::string& dir, const TerrainState& s, const std::string& format, float zScale,
-                float zOffset) {
+void writeFrame(const std::string& dir, const TerrainState& s, const std::string& format, float zScale, float zOffset) {
     char name[64];
     std::snprintf(name, sizeof name, "frame_%06lld", static_cast<long long>(s.tick));
     const std::filesystem::path base = std::filesystem::path(dir) / name;
@@ -58,10 +57,10 @@ int runSim(const SimOptions& o) {
                          o.dt, static_cast<double>(sim.dtLimit()));
         const TerrainState& s = sim.state();
         if (!o.quiet)
-            std::fprintf(stderr, "scene %s: %d x %d cells of %.4g m, dt %.4g s, stages:%s%s%s\n",
-                         settings.name.c_str(), s.nx, s.ny, static_cast<double>(s.cellSize),
-                         static_cast<double>(sim.dt()), settings.hydraulic ? " hydraulic" : "",
-                         settings.thermal ? " thermal" : "", settings.waves ? " waves" : "");
+            std::fprintf(stderr, "scene %s: %d x %d cells of %.4g m, dt %.4g s, stages:%s%s%s\n", settings.name.c_str(),
+                         s.nx, s.ny, static_cast<double>(s.cellSize), static_cast<double>(sim.dt()),
+                         settings.hydraulic ? " hydraulic" : "", settings.thermal ? " thermal" : "",
+                         settings.waves ? " waves" : "");
         // PNG frames share one height range (from the first frame, with margin)
         float zScale = 1.0f, zOffset = 0.0f;
         {

@@ -4,9 +4,9 @@
 #include <chrono>
 #include <cstdio>
 
-#include <imgui.h>
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
+#include <imgui.h>
 
 namespace terrain::app {
 using namespace render;
@@ -54,8 +54,8 @@ void steerCamera(OrbitCamera& camera) {
 void drawPanel(FramePipeline& pipeline, RenderSettings& rs, bool& paused, const StageTimings& avg, double fpsAvg) {
     const char* lightingNames[] = {"key light only", "direct (sky + key)", "global (direct + bounces)"};
     const char* shadowNames[] = {"engine soft visibility", "shadow map", "none"};
-    const char* debugNames[] = {"none",          "ambient",      "V (sky visibility)", "key visibility", "normals",
-                                "pyramid level", "GI shade map", "U (indirect, global)"};
+    const char* debugNames[] = {"none",    "ambient",       "V (sky visibility)", "key visibility",
+                                "normals", "pyramid level", "GI shade map",       "U (indirect, global)"};
     PipelineSettings& ps = pipeline.settings();
     SceneLights& lights = pipeline.lights();
     ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
@@ -120,8 +120,10 @@ int runWindowDemo(WindowContext& window, const Gl& gl, FramePipeline& pipeline, 
     while (!window.shouldClose() && (maxFrames <= 0 || frames < maxFrames)) {
         window.pollEvents();
         // ---- simulation + GI ----------------------------------------------------------
-        if (!paused) pipeline.advance();
-        else pipeline.timings().sim = 0.0;
+        if (!paused)
+            pipeline.advance();
+        else
+            pipeline.timings().sim = 0.0;
         pipeline.light();
         // ---- camera and panel -----------------------------------------------------------
         ImGui_ImplOpenGL3_NewFrame();

@@ -10,7 +10,7 @@ namespace terrain::app {
 
 /// Runs the window until it is closed, or for maxFrames frames (> 0).
 /// Returns the number of frames shown.
-int runWindowDemo(render::WindowContext& window, const render::Gl& gl, engine::FramePipeline& pipeline, render::RenderSettings& settings,
-                  int maxFrames);
+int runWindowDemo(render::WindowContext& window, const render::Gl& gl, engine::FramePipeline& pipeline,
+                  render::RenderSettings& settings, int maxFrames);
 
 }  // namespace terrain::app

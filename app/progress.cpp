@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <system_error>
+
 #include <unistd.h>
 
 #include "core/error.h"

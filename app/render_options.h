@@ -17,11 +17,11 @@ struct RenderOptions {
     int frames = 24;
     int width = 1280, height = 720;
     std::string out = "out/render";
-    std::string video;            // .mp4 through ffmpeg, when installed
+    std::string video;  // .mp4 through ffmpeg, when installed
     long long seed = 1;
     int threads = 0;
-    int ticksPerFrame = 0;        // 0 = the scene's pacing
-    int subsample = 2;            // GI receivers every 1, 2 or 4 cells
+    int ticksPerFrame = 0;            // 0 = the scene's pacing
+    int subsample = 2;                // GI receivers every 1, 2 or 4 cells
     std::string lighting = "global";  // key | direct | global (direct + `bounces` indirect bounces)
     int bounces = 1;
     bool amortise = false;
@@ -29,7 +29,7 @@ struct RenderOptions {
     std::string debug = "none";   // none | ambient | v | key | normals | pyramid | shade | u
     int pyramidLevel = 4;
     float exposure = 1.0f;
-    float exaggeration = 0.0f;    // 0 = automatic
+    float exaggeration = 0.0f;  // 0 = automatic
     float yaw = 235.0f, pitch = 34.0f, distance = 1.35f;
     bool quiet = false;
 };

@@ -6,9 +6,10 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
-#include <sys/utsname.h>
 #include <system_error>
 #include <thread>
+
+#include <sys/utsname.h>
 #include <unistd.h>
 
 #include "core/error.h"

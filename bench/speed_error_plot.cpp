@@ -23,7 +23,8 @@ struct Canvas {
         const int n = static_cast<int>(std::max(std::abs(x1 - x0), std::abs(y1 - y0))) + 1;
         for (int i = 0; i <= n; ++i) {
             const double t = static_cast<double>(i) / n;
-            const int x = static_cast<int>(std::lround(x0 + t * (x1 - x0))), y = static_cast<int>(std::lround(y0 + t * (y1 - y0)));
+            const int x = static_cast<int>(std::lround(x0 + t * (x1 - x0))),
+                      y = static_cast<int>(std::lround(y0 + t * (y1 - y0)));
             for (int dy = -(thick / 2); dy <= thick / 2; ++dy)
                 for (int dx = -(thick / 2); dx <= thick / 2; ++dx) set(x + dx, y + dy, c);
         }
@@ -31,11 +32,13 @@ struct Canvas {
     void dot(double x, double y, int r, const std::uint8_t c[3]) {
         for (int dy = -r; dy <= r; ++dy)
             for (int dx = -r; dx <= r; ++dx)
-                if (dx * dx + dy * dy <= r * r) set(static_cast<int>(std::lround(x)) + dx, static_cast<int>(std::lround(y)) + dy, c);
+                if (dx * dx + dy * dy <= r * r)
+                    set(static_cast<int>(std::lround(x)) + dx, static_cast<int>(std::lround(y)) + dy, c);
     }
     void square(double x, double y, int r, const std::uint8_t c[3]) {
         for (int dy = -r; dy <= r; ++dy)
-            for (int dx = -r; dx <= r; ++dx) set(static_cast<int>(std::lround(x)) + dx, static_cast<int>(std::lround(y)) + dy, c);
+            for (int dx = -r; dx <= r; ++dx)
+                set(static_cast<int>(std::lround(x)) + dx, static_cast<int>(std::lround(y)) + dy, c);
     }
     // 5x7 glyphs, each row a 5-bit mask (bit 4 = leftmost), scaled by `scale`
     void text(int x, int y, const std::string& str, const std::uint8_t c[3], int scale = 2) {
@@ -50,24 +53,27 @@ struct Canvas {
         }
     }
     static const std::uint8_t* glyph(char ch) {
-        static const struct { char c; std::uint8_t rows[7]; } font[] = {
-            {'0', {14, 17, 19, 21, 25, 17, 14}}, {'1', {4, 12, 4, 4, 4, 4, 14}},   {'2', {14, 17, 1, 2, 4, 8, 31}},
-            {'3', {30, 1, 1, 14, 1, 1, 30}},     {'4', {2, 6, 10, 18, 31, 2, 2}},  {'5', {31, 16, 30, 1, 1, 17, 14}},
-            {'6', {6, 8, 16, 30, 17, 17, 14}},   {'7', {31, 1, 2, 4, 8, 8, 8}},    {'8', {14, 17, 17, 14, 17, 17, 14}},
-            {'9', {14, 17, 17, 15, 1, 2, 12}},   {'.', {0, 0, 0, 0, 0, 12, 12}},   {'x', {0, 0, 17, 10, 4, 10, 17}},
-            {'m', {0, 0, 26, 21, 21, 21, 21}},   {'s', {0, 0, 15, 16, 14, 1, 30}}, {'R', {30, 17, 17, 30, 20, 18, 17}},
+        static const struct {
+            char c;
+            std::uint8_t rows[7];
+        } font[] = {
+            {'0', {14, 17, 19, 21, 25, 17, 14}}, {'1', {4, 12, 4, 4, 4, 4, 14}},    {'2', {14, 17, 1, 2, 4, 8, 31}},
+            {'3', {30, 1, 1, 14, 1, 1, 30}},     {'4', {2, 6, 10, 18, 31, 2, 2}},   {'5', {31, 16, 30, 1, 1, 17, 14}},
+            {'6', {6, 8, 16, 30, 17, 17, 14}},   {'7', {31, 1, 2, 4, 8, 8, 8}},     {'8', {14, 17, 17, 14, 17, 17, 14}},
+            {'9', {14, 17, 17, 15, 1, 2, 12}},   {'.', {0, 0, 0, 0, 0, 12, 12}},    {'x', {0, 0, 17, 10, 4, 10, 17}},
+            {'m', {0, 0, 26, 21, 21, 21, 21}},   {'s', {0, 0, 15, 16, 14, 1, 30}},  {'R', {30, 17, 17, 30, 20, 18, 17}},
             {'M', {17, 27, 21, 21, 17, 17, 17}}, {'S', {15, 16, 16, 14, 1, 1, 30}}, {'E', {31, 16, 16, 30, 16, 16, 31}},
-            {'p', {0, 0, 30, 17, 30, 16, 16}},   {'a', {0, 0, 14, 1, 15, 17, 15}}, {'e', {0, 0, 14, 17, 31, 16, 14}},
+            {'p', {0, 0, 30, 17, 30, 16, 16}},   {'a', {0, 0, 14, 1, 15, 17, 15}},  {'e', {0, 0, 14, 17, 31, 16, 14}},
             {'r', {0, 0, 22, 25, 16, 16, 16}},   {'n', {0, 0, 22, 25, 17, 17, 17}}, {'g', {0, 0, 15, 17, 15, 1, 14}},
             {'i', {4, 0, 12, 4, 4, 4, 14}},      {'o', {0, 0, 14, 17, 17, 17, 14}}, {'f', {6, 9, 8, 28, 8, 8, 8}},
-            {'t', {8, 8, 28, 8, 8, 9, 6}},       {'l', {12, 4, 4, 4, 4, 4, 14}},   {'h', {16, 16, 22, 25, 17, 17, 17}},
+            {'t', {8, 8, 28, 8, 8, 9, 6}},       {'l', {12, 4, 4, 4, 4, 4, 14}},    {'h', {16, 16, 22, 25, 17, 17, 17}},
             {'d', {1, 1, 13, 19, 17, 19, 13}},   {'c', {0, 0, 14, 16, 16, 17, 14}}, {'u', {0, 0, 17, 17, 17, 19, 13}},
             {'b', {16, 16, 22, 25, 17, 17, 30}}, {'v', {0, 0, 17, 17, 17, 10, 4}},  {'w', {0, 0, 17, 17, 21, 21, 10}},
             {'k', {16, 16, 18, 20, 24, 20, 18}}, {'y', {0, 0, 17, 17, 15, 1, 14}},  {'T', {31, 4, 4, 4, 4, 4, 4}},
-            {'(', {2, 4, 8, 8, 8, 4, 2}},        {')', {8, 4, 2, 2, 2, 4, 8}},     {',', {0, 0, 0, 0, 12, 4, 8}},
-            {'-', {0, 0, 0, 31, 0, 0, 0}},       {'=', {0, 0, 31, 0, 31, 0, 0}},   {'/', {1, 1, 2, 4, 8, 16, 16}},
-            {':', {0, 12, 12, 0, 12, 12, 0}},    {'^', {4, 10, 17, 0, 0, 0, 0}},   {' ', {0, 0, 0, 0, 0, 0, 0}},
-            {'G', {14, 17, 16, 23, 17, 17, 15}}, {'I', {14, 4, 4, 4, 4, 4, 14}},   {'q', {0, 0, 15, 17, 15, 1, 1}},
+            {'(', {2, 4, 8, 8, 8, 4, 2}},        {')', {8, 4, 2, 2, 2, 4, 8}},      {',', {0, 0, 0, 0, 12, 4, 8}},
+            {'-', {0, 0, 0, 31, 0, 0, 0}},       {'=', {0, 0, 31, 0, 31, 0, 0}},    {'/', {1, 1, 2, 4, 8, 16, 16}},
+            {':', {0, 12, 12, 0, 12, 12, 0}},    {'^', {4, 10, 17, 0, 0, 0, 0}},    {' ', {0, 0, 0, 0, 0, 0, 0}},
+            {'G', {14, 17, 16, 23, 17, 17, 15}}, {'I', {14, 4, 4, 4, 4, 4, 14}},    {'q', {0, 0, 15, 17, 15, 1, 1}},
         };
         static const std::uint8_t unknown[7] = {31, 17, 17, 17, 17, 17, 31};
         for (const auto& f : font)
@@ -128,20 +134,26 @@ void speedErrorPlot(const std::vector<PlotPoint>& pts, const std::string& file) 
             std::vector<const PlotPoint*> line;
             for (int sub : {4, 2, 1})
                 for (const PlotPoint& p : pts)
-                    if (p.threads == 2 && p.size == sizes[si] && p.settings == which && p.subsample == sub) line.push_back(&p);
+                    if (p.threads == 2 && p.size == sizes[si] && p.settings == which && p.subsample == sub)
+                        line.push_back(&p);
             const bool paper = std::string(which) == "paper";
             for (std::size_t i = 0; i + 1 < line.size(); ++i)
-                c.line(X(line[i]->ms), Y(line[i]->rmse), X(line[i + 1]->ms), Y(line[i + 1]->rmse), colours[si], paper ? 1 : 3);
+                c.line(X(line[i]->ms), Y(line[i]->rmse), X(line[i + 1]->ms), Y(line[i + 1]->rmse), colours[si],
+                       paper ? 1 : 3);
             for (const PlotPoint* p : line) {
-                if (paper) c.square(X(p->ms), Y(p->rmse), 4, colours[si]);
-                else c.dot(X(p->ms), Y(p->rmse), 5, colours[si]);
+                if (paper)
+                    c.square(X(p->ms), Y(p->rmse), 4, colours[si]);
+                else
+                    c.dot(X(p->ms), Y(p->rmse), 5, colours[si]);
                 char b[8];
                 std::snprintf(b, sizeof b, "%dx", p->subsample);
                 c.text(static_cast<int>(X(p->ms)) + 7, static_cast<int>(Y(p->rmse)) - 16, b, colours[si]);
             }
             const int lx = W - right + 20;
-            if (paper) c.square(lx + 6, legendY + 7, 4, colours[si]);
-            else c.dot(lx + 6, legendY + 7, 5, colours[si]);
+            if (paper)
+                c.square(lx + 6, legendY + 7, 4, colours[si]);
+            else
+                c.dot(lx + 6, legendY + 7, 5, colours[si]);
             c.text(lx + 20, legendY, std::to_string(sizes[si]) + "^2 " + which, colours[si]);
             legendY += 24;
         }

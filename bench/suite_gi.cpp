@@ -15,8 +15,9 @@
 #include <optional>
 #include <string>
 #include <thread>
-#include <unistd.h>
 #include <vector>
+
+#include <unistd.h>
 
 #include "bench/speed_error_plot.h"
 #include "bench/suites.h"
@@ -32,11 +33,11 @@ using Clock = std::chrono::steady_clock;
 
 struct GiOptions {
     int runs = 5;
-    bool useMin = false;    // the minimum over the frames instead of the median
-    std::string cacheDir;   // ground truths kept across runs; empty: a scratch folder for this run
-    int onlyCase = -1;      // stages, cpu: only this case (-1: all)
-    int threads = 2;        // stages: worker threads
-    std::string dump;       // stages: "write" the outputs to the cache folder, or "compare" against them
+    bool useMin = false;   // the minimum over the frames instead of the median
+    std::string cacheDir;  // ground truths kept across runs; empty: a scratch folder for this run
+    int onlyCase = -1;     // stages, cpu: only this case (-1: all)
+    int threads = 2;       // stages: worker threads
+    std::string dump;      // stages: "write" the outputs to the cache folder, or "compare" against them
 };
 
 struct ErrorStats {
@@ -89,8 +90,9 @@ double processCpuSeconds() {
 
 std::string settingsName(const GiSettings& s) {
     char buf[160];
-    std::snprintf(buf, sizeof buf, "m=%d k_v=%d o_v=%d %s %s peak=%.2f %dx", s.visibility.azimuths, s.pyramid.levelsPerOctave,
-                  s.pyramid.levelOffset, s.visibility.interp == AzimuthInterp::Linear ? "linear" : "bspline",
+    std::snprintf(buf, sizeof buf, "m=%d k_v=%d o_v=%d %s %s peak=%.2f %dx", s.visibility.azimuths,
+                  s.pyramid.levelsPerOctave, s.pyramid.levelOffset,
+                  s.visibility.interp == AzimuthInterp::Linear ? "linear" : "bspline",
                   s.visibility.blockingMax == BlockingMax::Samples ? "max=samples" : "max=bspline", s.pyramid.peakBlend,
                   s.subsample);
     return buf;
@@ -112,7 +114,8 @@ std::string directSettingsText(const GiSettings& s) {
 
 std::string buildFlags() {
     return std::string("GCC ") + __VERSION__ +
-           ", CMAKE_BUILD_TYPE=Release (-O3 -DNDEBUG), -ffp-contract=off -fno-fast-math, baseline x86-64 (SSE2, no -march), "
+           ", CMAKE_BUILD_TYPE=Release (-O3 -DNDEBUG), -ffp-contract=off -fno-fast-math, baseline x86-64 (SSE2, no "
+           "-march), "
            "4-wide GCC vector extensions in gi/";
 }
 
@@ -159,7 +162,8 @@ GiLighting sunSkyAndKey() {
 void storeOrCompare(const std::string& mode, const std::string& file, const std::vector<const Grid*>& grids) {
     if (mode == "write") {
         std::ofstream out(file, std::ios::binary);
-        for (const Grid* g : grids) out.write(reinterpret_cast<const char*>(g->data()), static_cast<std::streamsize>(g->size() * 4));
+        for (const Grid* g : grids)
+            out.write(reinterpret_cast<const char*>(g->data()), static_cast<std::streamsize>(g->size() * 4));
     } else {
         std::ifstream in(file, std::ios::binary);
         double maxd[4] = {}, sumd[4] = {};
@@ -173,7 +177,8 @@ void storeOrCompare(const std::string& mode, const std::string& file, const std:
             }
             sumd[k] /= static_cast<double>(old.size());
         }
-        std::printf("    vs stored: ambient max %.3g mean %.3g; rgb max %.3g %.3g %.3g\n", maxd[0], sumd[0], maxd[1], maxd[2], maxd[3]);
+        std::printf("    vs stored: ambient max %.3g mean %.3g; rgb max %.3g %.3g %.3g\n", maxd[0], sumd[0], maxd[1],
+                    maxd[2], maxd[3]);
     }
 }
 
@@ -211,12 +216,13 @@ private:
 
 // Reference ambient on the interior (10 % border left out), every `stride`-th texel, cached.
 Grid GiSuite::referenceAmbient(const Dem& d, int stride, int border) const {
-    const std::string cache = cacheDir_ + "/gi_reference_" + d.name + "_s" + std::to_string(stride) + "_b" +
-                              std::to_string(border) + ".bin";
+    const std::string cache =
+        cacheDir_ + "/gi_reference_" + d.name + "_s" + std::to_string(stride) + "_b" + std::to_string(border) + ".bin";
     Grid g(d.heights.nx, d.heights.ny);
     {
         std::ifstream in(cache, std::ios::binary);
-        if (in && in.read(reinterpret_cast<char*>(g.data()), static_cast<std::streamsize>(g.size() * sizeof(float)))) return g;
+        if (in && in.read(reinterpret_cast<char*>(g.data()), static_cast<std::streamsize>(g.size() * sizeof(float))))
+            return g;
     }
     std::fprintf(stderr, "reference for %s (stride %d) ...\n", d.name.c_str(), stride);
     const auto t0 = Clock::now();
@@ -229,7 +235,8 @@ Grid GiSuite::referenceAmbient(const Dem& d, int stride, int border) const {
     renderReference(d.heights.cview(), d.cell, nullptr, nullptr, rs, rr);
     std::fprintf(stderr, "reference: %.1f s\n", std::chrono::duration<double>(Clock::now() - t0).count());
     std::ofstream out(cache, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(rr.ambient.data()), static_cast<std::streamsize>(rr.ambient.size() * sizeof(float)));
+    out.write(reinterpret_cast<const char*>(rr.ambient.data()),
+              static_cast<std::streamsize>(rr.ambient.size() * sizeof(float)));
     return rr.ambient;
 }
 
@@ -281,8 +288,8 @@ void GiSuite::runSettingsRows(const Dem& d, const Grid& ref, int border, std::ve
             return 0;
         });
         r.e = compare(st.shade.ambient, ref, 1, border);
-        std::fprintf(stderr, "%-60s rmse %.4f bias %+.4f max %.3f  %.1f ms\n", (r.label + " " + settingsName(r.s)).c_str(),
-                     r.e.rmse, r.e.bias, r.e.maxAbs, r.t.median);
+        std::fprintf(stderr, "%-60s rmse %.4f bias %+.4f max %.3f  %.1f ms\n",
+                     (r.label + " " + settingsName(r.s)).c_str(), r.e.rmse, r.e.bias, r.e.maxAbs, r.t.median);
     }
 }
 
@@ -299,10 +306,13 @@ void GiSuite::accuracy() const {
     md += "Interior only: a 64-texel (10 %) border is left out (" + std::to_string(rows[0].e.count) + " texels). ";
     md += "Ground truth: gi/reference (256 azimuths, exact march of the bilinear field, exact elevation integrals). ";
     md += "Ambient = direct irradiance / pi under a uniform unit sky (normal-weighted sky-view factor). ";
-    md += "Time: whole frame (gradient, pyramid, visibility, shading; uniform sky, no key light) with 2 threads, median of " +
-          std::to_string(o_.runs) + " after a warm-up.\n\n" + provenance();
+    md +=
+        "Time: whole frame (gradient, pyramid, visibility, shading; uniform sky, no key light) with 2 threads, median "
+        "of " +
+        std::to_string(o_.runs) + " after a warm-up.\n\n" + provenance();
     md += "| settings | RMSE | bias | max abs | ms/frame |\n|---|---|---|---|---|\n";
-    std::string csv = "label,azimuths,levels_per_octave,level_offset,interp,blocking_max,peak_blend,subsample,rmse,bias,max_abs,ms\n";
+    std::string csv =
+        "label,azimuths,levels_per_octave,level_offset,interp,blocking_max,peak_blend,subsample,rmse,bias,max_abs,ms\n";
     for (const Row& r : rows) {
         md += "| " + r.label + ": " + settingsName(r.s) + " " + errorCells(r);
         csv += r.label + "," + settingsCsv(r, true);
@@ -336,7 +346,8 @@ void GiSuite::explore() const {
             rows.push_back({"explore", s, {}, {}});
         }
     runSettingsRows(alps, ref, border, rows, 2);
-    std::string csv = "azimuths,levels_per_octave,level_offset,interp,blocking_max,peak_blend,subsample,rmse,bias,max_abs,ms\n";
+    std::string csv =
+        "azimuths,levels_per_octave,level_offset,interp,blocking_max,peak_blend,subsample,rmse,bias,max_abs,ms\n";
     for (const Row& r : rows) csv += settingsCsv(r, true);
     writeResult(ctx_.outDir, "gi_explore.csv", csv);
 }
@@ -384,16 +395,23 @@ void GiSuite::convergence() const {
         }
     runSettingsRows(small, ref, border, rows, 2);
     std::string md = "# GI convergence to the ground truth (small terrain)\n\n";
-    md += "Terrain: alps-montblanc centre crop 256 x 256 at true scale (cell 92.74 m), interior only (25-texel border left out, " +
-          std::to_string(rows[0].e.count) + " texels). Ambient RMSE / bias against gi/reference (256 azimuths, exact march "
-          "of the bilinear field, exact elevation integrals). The m / k_v / o_v sweeps use the plain sample maximum (the "
-          "B-spline maximum of Eq. 16 smooths the blocking-angle sequence and does not converge to the exact horizon); "
-          "what remains at large m, k_v, o_v is the order-4 SH truncation of visibility (and m = 128 azimuth interpolation). "
-          "Sub-sampling rows: the paper settings (" + directSettingsText(paperSettings()) + ") and the engine defaults (" +
-          directSettingsText(engineDefaults()) + "), 4x -> 2x -> 1x. Times: whole frame (uniform sky, no key "
-          "light), 2 threads, median of " + std::to_string(o_.runs) + ".\n\n" + provenance();
+    md +=
+        "Terrain: alps-montblanc centre crop 256 x 256 at true scale (cell 92.74 m), interior only (25-texel border "
+        "left out, " +
+        std::to_string(rows[0].e.count) +
+        " texels). Ambient RMSE / bias against gi/reference (256 azimuths, exact march "
+        "of the bilinear field, exact elevation integrals). The m / k_v / o_v sweeps use the plain sample maximum (the "
+        "B-spline maximum of Eq. 16 smooths the blocking-angle sequence and does not converge to the exact horizon); "
+        "what remains at large m, k_v, o_v is the order-4 SH truncation of visibility (and m = 128 azimuth "
+        "interpolation). "
+        "Sub-sampling rows: the paper settings (" +
+        directSettingsText(paperSettings()) + ") and the engine defaults (" + directSettingsText(engineDefaults()) +
+        "), 4x -> 2x -> 1x. Times: whole frame (uniform sky, no key "
+        "light), 2 threads, median of " +
+        std::to_string(o_.runs) + ".\n\n" + provenance();
     md += "| sweep | settings | RMSE | bias | max abs | ms/frame |\n|---|---|---|---|---|---|\n";
-    std::string csv = "sweep,azimuths,levels_per_octave,level_offset,blocking_max,peak_blend,subsample,rmse,bias,max_abs,ms\n";
+    std::string csv =
+        "sweep,azimuths,levels_per_octave,level_offset,blocking_max,peak_blend,subsample,rmse,bias,max_abs,ms\n";
     for (const Row& r : rows) {
         md += "| " + r.label + " | " + settingsName(r.s) + " " + errorCells(r);
         csv += r.label + "," + settingsCsv(r, false);
@@ -441,33 +459,49 @@ Timing GiSuite::bestOfThree(const Dem& d, const GiSettings& set, const GiLightin
 void GiSuite::timing() const {
     const Dem alps = loadAlps(ctx_.dataDir);
     const Dem perdu = loadPerdu(ctx_.dataDir);
-    struct Size { Dem dem; std::string source; };
+    struct Size {
+        Dem dem;
+        std::string source;
+    };
     std::vector<Size> sizes;
     sizes.push_back({crop(alps, 256, "c256"), "alps c256"});
     sizes.push_back({crop(alps, 512, "c512"), "alps c512"});
     sizes.push_back({crop(perdu, 1024, "c1024"), "mtperdu c1024"});
     const GiLighting light = sunSkyAndKey();
     std::string md = "# GI time per frame\n\n";
-    md += "Frame = gradient + pyramid + environment visibility + key-light visibility + direct shading (Lambert, RGB + ambient "
-          "map), one sun-and-sky environment light (m azimuths) and one key light (3 azimuths over its extent), as "
-          "`terrain gi --frames N --time` runs it. Median of " + std::to_string(o_.runs) +
-          " frames after a warm-up (best of 3 repeats, below); stage columns are medians too (ms).\n\n"
-          "DEMs (centre crops at true scale, no resampling): 256^2 and 512^2 = ../shared/data/alps-montblanc.png (cell 92.74 m), "
-          "1024^2 = ../shared/data/mtperdu_20m.png (cell 20 m).\n\n"
-          "Error: ambient map (normal-weighted sky-view factor) RMSE / bias against gi/reference (256 azimuths, exact march) "
-          "over the interior (10 % border left out); at 1024^2 over every 4th texel in x and y of the interior (the "
-          "reference is computed and cached only there). The error does not depend on the thread count.\n\n"
-          "Settings: paper = " + directSettingsText(paperSettings()) + "; engine = the engine defaults (" +
-          directSettingsText(engineDefaults()) + "). pyramid = gradient + pyramid.\n\nThe machine is shared with other work (2 vCPUs): "
-          "each row is measured 3 times (median of " + std::to_string(o_.runs) +
-          " frames each) and the lowest of the 3 medians is "
-          "reported with its stage medians; a repeat during which other processes used more than 5 % of a core is discarded "
-          "and re-done (other load = other processes' CPU time over the kept repeat, from /proc/stat, in cores). Load on the "
-          "other vCPU of a shared physical core does not show in /proc/stat, so single rows can still be noisy.\n\n" +
-          provenance();
-    md += "| DEM | size | sub | settings | threads | ms/frame | pyramid | visibility | key light | shading | RMSE | bias | other load |\n";
+    md +=
+        "Frame = gradient + pyramid + environment visibility + key-light visibility + direct shading (Lambert, RGB + "
+        "ambient "
+        "map), one sun-and-sky environment light (m azimuths) and one key light (3 azimuths over its extent), as "
+        "`terrain gi --frames N --time` runs it. Median of " +
+        std::to_string(o_.runs) +
+        " frames after a warm-up (best of 3 repeats, below); stage columns are medians too (ms).\n\n"
+        "DEMs (centre crops at true scale, no resampling): 256^2 and 512^2 = ../shared/data/alps-montblanc.png (cell "
+        "92.74 m), "
+        "1024^2 = ../shared/data/mtperdu_20m.png (cell 20 m).\n\n"
+        "Error: ambient map (normal-weighted sky-view factor) RMSE / bias against gi/reference (256 azimuths, exact "
+        "march) "
+        "over the interior (10 % border left out); at 1024^2 over every 4th texel in x and y of the interior (the "
+        "reference is computed and cached only there). The error does not depend on the thread count.\n\n"
+        "Settings: paper = " +
+        directSettingsText(paperSettings()) + "; engine = the engine defaults (" +
+        directSettingsText(engineDefaults()) +
+        "). pyramid = gradient + pyramid.\n\nThe machine is shared with other work (2 vCPUs): "
+        "each row is measured 3 times (median of " +
+        std::to_string(o_.runs) +
+        " frames each) and the lowest of the 3 medians is "
+        "reported with its stage medians; a repeat during which other processes used more than 5 % of a core is "
+        "discarded "
+        "and re-done (other load = other processes' CPU time over the kept repeat, from /proc/stat, in cores). Load on "
+        "the "
+        "other vCPU of a shared physical core does not show in /proc/stat, so single rows can still be noisy.\n\n" +
+        provenance();
+    md +=
+        "| DEM | size | sub | settings | threads | ms/frame | pyramid | visibility | key light | shading | RMSE | bias "
+        "| other load |\n";
     md += "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
-    std::string csv = "dem,size,subsample,settings,threads,ms,pyramid_ms,visibility_ms,key_ms,shading_ms,rmse,bias,other_load\n";
+    std::string csv =
+        "dem,size,subsample,settings,threads,ms,pyramid_ms,visibility_ms,key_ms,shading_ms,rmse,bias,other_load\n";
     std::vector<PlotPoint> pts;
     for (const Size& sz : sizes) {
         const int n = sz.dem.heights.nx;
@@ -484,16 +518,19 @@ void GiSuite::timing() const {
                     const Timing t = bestOfThree(sz.dem, set, light, threads, st, otherLoad);
                     const ErrorStats e = compare(st.shade.ambient, ref, stride, border);
                     char buf[600];
-                    std::snprintf(buf, sizeof buf, "| %s | %d | %dx | %s | %d | %.1f | %.1f | %.1f | %.1f | %.1f | %.4f | %+.4f | %.2f |\n",
-                                  sz.source.c_str(), n, s, which, threads, t.median, t.pyramid, t.visibility, t.key, t.shading,
-                                  e.rmse, e.bias, otherLoad);
+                    std::snprintf(
+                        buf, sizeof buf,
+                        "| %s | %d | %dx | %s | %d | %.1f | %.1f | %.1f | %.1f | %.1f | %.4f | %+.4f | %.2f |\n",
+                        sz.source.c_str(), n, s, which, threads, t.median, t.pyramid, t.visibility, t.key, t.shading,
+                        e.rmse, e.bias, otherLoad);
                     md += buf;
-                    std::snprintf(buf, sizeof buf, "%s,%d,%d,%s,%d,%.2f,%.2f,%.2f,%.2f,%.2f,%.5f,%.5f,%.3f\n", sz.dem.name.c_str(), n, s,
-                                  which, threads, t.median, t.pyramid, t.visibility, t.key, t.shading, e.rmse, e.bias, otherLoad);
+                    std::snprintf(buf, sizeof buf, "%s,%d,%d,%s,%d,%.2f,%.2f,%.2f,%.2f,%.2f,%.5f,%.5f,%.3f\n",
+                                  sz.dem.name.c_str(), n, s, which, threads, t.median, t.pyramid, t.visibility, t.key,
+                                  t.shading, e.rmse, e.bias, otherLoad);
                     csv += buf;
                     pts.push_back({n, s, threads, which, t.median, e.rmse});
-                    std::fprintf(stderr, "%s %d %dx %s %dT: %.1f ms (rmse %.4f)\n", sz.dem.name.c_str(), n, s, which, threads,
-                                 t.median, e.rmse);
+                    std::fprintf(stderr, "%s %d %dx %s %dT: %.1f ms (rmse %.4f)\n", sz.dem.name.c_str(), n, s, which,
+                                 threads, t.median, e.rmse);
                 }
     }
     md += "\n![speed vs error](gi_speed_error.png)\n";
@@ -501,7 +538,6 @@ void GiSuite::timing() const {
     writeResult(ctx_.outDir, "gi_timing.csv", csv);
     speedErrorPlot(pts, ctx_.outDir + "/gi_speed_error.png");
 }
-
 
 // plot only, from an existing gi_timing.csv
 void GiSuite::plotFromCsv() const {
@@ -515,8 +551,8 @@ void GiSuite::plotFromCsv() const {
         for (std::size_t b; (b = line.find(',', a)) != std::string::npos; a = b + 1) f.push_back(line.substr(a, b - a));
         f.push_back(line.substr(a));
         if (f.size() < 12) continue;
-        pts.push_back({std::atoi(f[1].c_str()), std::atoi(f[2].c_str()), std::atoi(f[4].c_str()), f[3], std::atof(f[5].c_str()),
-                       std::atof(f[10].c_str())});
+        pts.push_back({std::atoi(f[1].c_str()), std::atoi(f[2].c_str()), std::atoi(f[4].c_str()), f[3],
+                       std::atof(f[5].c_str()), std::atof(f[10].c_str())});
     }
     speedErrorPlot(pts, ctx_.outDir + "/gi_speed_error.png");
 }
@@ -527,10 +563,15 @@ void GiSuite::plotFromCsv() const {
 void GiSuite::stages() const {
     const Dem alps = loadAlps(ctx_.dataDir);
     const GiLighting light = sunSkyAndKey();
-    struct Case { const Dem* dem; int s; const char* which; };
+    struct Case {
+        const Dem* dem;
+        int s;
+        const char* which;
+    };
     const Dem c512 = crop(alps, 512, "c512");
     int caseIndex = -1;
-    for (const Case& c : {Case{&c512, 2, "engine"}, Case{&c512, 2, "paper"}, Case{&alps, 1, "engine"}, Case{&alps, 1, "paper"}}) {
+    for (const Case& c :
+         {Case{&c512, 2, "engine"}, Case{&c512, 2, "paper"}, Case{&alps, 1, "engine"}, Case{&alps, 1, "paper"}}) {
         ++caseIndex;
         if (o_.onlyCase >= 0 && o_.onlyCase != caseIndex) continue;  // one case only
         GiSettings set = std::string(c.which) == "paper" ? paperSettings() : engineDefaults();
@@ -547,8 +588,9 @@ void GiSuite::stages() const {
             return 0;
         });
         const double cpu = (c1.tv_sec - c0.tv_sec) * 1e3 + (c1.tv_nsec - c0.tv_nsec) * 1e-6;
-        std::printf("%-22s %dx %-6s %dT: %6.1f ms, cpu %6.1f ms (pyramid+grad %.1f, visibility %.1f, key %.1f, shading %.1f)\n",
-                    c.dem->name.c_str(), c.s, c.which, threads, t.median, cpu, t.pyramid, t.visibility, t.key, t.shading);
+        std::printf(
+            "%-22s %dx %-6s %dT: %6.1f ms, cpu %6.1f ms (pyramid+grad %.1f, visibility %.1f, key %.1f, shading %.1f)\n",
+            c.dem->name.c_str(), c.s, c.which, threads, t.median, cpu, t.pyramid, t.visibility, t.key, t.shading);
         // --dump write stores the outputs, --dump compare reports the largest change against them
         if (!o_.dump.empty()) {
             const std::string file =
@@ -571,7 +613,11 @@ void GiSuite::cpuStages() const {
     const Dem alps = loadAlps(ctx_.dataDir);
     const Dem c512 = crop(alps, 512, "c512");
     const GiLighting light = sunSkyAndKey();
-    struct Case { const Dem* dem; int s; const char* which; };
+    struct Case {
+        const Dem* dem;
+        int s;
+        const char* which;
+    };
     int caseIndex = -1;
     for (const Case& c : {Case{&c512, 2, "engine"}, Case{&c512, 2, "paper"}, Case{&alps, 1, "engine"}}) {
         ++caseIndex;
@@ -589,7 +635,8 @@ void GiSuite::cpuStages() const {
                 double t1 = threadCpuMs();
                 VisibilityTarget env;
                 env.op = &st.envOperator;
-                computeVisibility(st.pyramid, st.gradX.cview(), st.gradY.cview(), set.visibility, env, st.visibilityState, st.envVisibility);
+                computeVisibility(st.pyramid, st.gradX.cview(), st.gradY.cview(), set.visibility, env,
+                                  st.visibilityState, st.envVisibility);
                 double t2 = threadCpuMs();
                 runGiFrame(c.dem->heights.cview(), c.dem->cell, light, set, st);
                 double t3 = threadCpuMs();
@@ -599,8 +646,10 @@ void GiSuite::cpuStages() const {
                 best[3] = std::min(best[3], st.timings.keyVisibility);
                 best[4] = std::min(best[4], st.timings.shading);
             }
-            std::printf("%-22s %dx %-6s cpu: grad+pyramid %.1f  env visibility %.1f  frame %.1f  (wall key %.1f shading %.1f)\n",
-                        c.dem->name.c_str(), c.s, c.which, best[0], best[1], best[2], best[3], best[4]);
+            std::printf(
+                "%-22s %dx %-6s cpu: grad+pyramid %.1f  env visibility %.1f  frame %.1f  (wall key %.1f shading "
+                "%.1f)\n",
+                c.dem->name.c_str(), c.s, c.which, best[0], best[1], best[2], best[3], best[4]);
             return 0;
         });
     }
@@ -646,8 +695,9 @@ int runGi(const CLI::App& sub, const GiOptions& o, const BenchContext& ctx) {
 
 Runner addGiSuite(CLI::App& app, const BenchContext& ctx) {
     auto o = std::make_shared<GiOptions>();
-    CLI::App* sub = app.add_subcommand("gi", "GI fast path vs ground truth: accuracy, convergence, time per frame "
-                                             "(default: accuracy convergence timing)");
+    CLI::App* sub = app.add_subcommand("gi",
+                                       "GI fast path vs ground truth: accuracy, convergence, time per frame "
+                                       "(default: accuracy convergence timing)");
     sub->require_subcommand(0, 0);  // any number of modes, run in the order given
     addRunsOption(*sub, o->runs, "Frames per timing after a warm-up");
     sub->add_flag("--min", o->useMin, "Report the fastest frame, not the median (a busy machine while developing)")

@@ -39,7 +39,9 @@ GiSettings settingsFor(Brdf brdf, float exponent, int s, int bounces, GlossyIndi
     return g;
 }
 
-const char* brdfName(Brdf b) { return b == Brdf::Phong ? "phong" : (b == Brdf::LambertPlusPhong ? "mix 0.5" : "lambert"); }
+const char* brdfName(Brdf b) {
+    return b == Brdf::Phong ? "phong" : (b == Brdf::LambertPlusPhong ? "mix 0.5" : "lambert");
+}
 
 // The lighting of every row: the sun-and-sky SH environment alone.
 GiLighting sunSkyLighting() {
@@ -57,9 +59,12 @@ std::string accuracySection(const GlossyOptions& o, const BenchContext& ctx) {
     const GiLighting light = sunSkyLighting();
     md += "## Accuracy: alps-montblanc, central " + std::to_string(o.size) + "^2 crop at true scale (cell 92.74 m)\n\n";
     md += "Reference: `renderReferenceGlossy` (" + std::to_string(o.directions) +
-          " fixed directions, 256 azimuths for bounce 0; the same Phong lobe in order-4 SH, exact visibility and first hits). "
+          " fixed directions, 256 azimuths for bounce 0; the same Phong lobe in order-4 SH, exact visibility and first "
+          "hits). "
           "Relative RMSE and bias of the indirect light (bounce 1, RGB, 10 % border left out).\n\n";
-    md += "| BRDF | S | sub-sampling | vector pyramid RMSE | bias | scalar pyramid RMSE | bias | reference mean indirect | reference time (s) |\n";
+    md +=
+        "| BRDF | S | sub-sampling | vector pyramid RMSE | bias | scalar pyramid RMSE | bias | reference mean indirect "
+        "| reference time (s) |\n";
     md += "|---|---|---|---|---|---|---|---|---|\n";
     for (Brdf brdf : {Brdf::Phong, Brdf::LambertPlusPhong})
         for (float S : {8.0f, 64.0f}) {
@@ -81,12 +86,13 @@ std::string accuracySection(const GlossyOptions& o, const BenchContext& ctx) {
                 for (int k = 0; k < 2; ++k) {
                     GiState st;
                     const GlossyIndirect mode = k == 0 ? GlossyIndirect::VectorPyramid : GlossyIndirect::ScalarPyramid;
-                    withThreads(2, [&] { runGiFrame(h.cview(), cell, light, settingsFor(brdf, S, s, 1, mode), st, &a); });
+                    withThreads(2,
+                                [&] { runGiFrame(h.cview(), cell, light, settingsFor(brdf, S, s, 1, mode), st, &a); });
                     e[k] = relRmse(st.indirect.indirect, ref.indirect, b[k]);
                 }
                 char line[512];
-                std::snprintf(line, sizeof line, "| %s | %g | %dx | %.4f | %+.4f | %.4f | %+.4f | %.4f | %.1f |\n", brdfName(brdf), S, s,
-                              e[0], b[0], e[1], b[1], refMean, refSeconds);
+                std::snprintf(line, sizeof line, "| %s | %g | %dx | %.4f | %+.4f | %.4f | %+.4f | %.4f | %.1f |\n",
+                              brdfName(brdf), S, s, e[0], b[0], e[1], b[1], refMean, refSeconds);
                 std::fprintf(stderr, "%s", line);
                 md += line;
             }
@@ -143,7 +149,8 @@ int runGlossy(const GlossyOptions& o, const BenchContext& ctx) {
     std::string md = "# Glossy indirect light: vector vs scalar pyramid\n\n";
     md += "Machine: " + machineDescription() +
           " (shared with another engineer's builds and benchmarks while this ran: timings are indicative).\n\n";
-    md += "Lighting: sun-and-sky SH environment (`sunSkyLight()`), viewer overhead, albedo " + std::to_string(albedo).substr(0, 3) +
+    md += "Lighting: sun-and-sky SH environment (`sunSkyLight()`), viewer overhead, albedo " +
+          std::to_string(albedo).substr(0, 3) +
           " (diffuse part), engine settings (`GiSettings{}`: m = 16, o_v = o_u = 3), 1 bounce.\n\n";
     md += accuracySection(o, ctx);
     md += frameTimeSection(o, ctx);

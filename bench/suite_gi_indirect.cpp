@@ -56,7 +56,6 @@ Dem erodedScene(int size, int ticks) {
     return d;
 }
 
-
 template <class T>
 std::size_t bytesOf(const std::vector<T>& v) {
     return v.capacity() * sizeof(T);
@@ -85,10 +84,11 @@ double frameMemoryMB(const Grid& heights, const GiState& st) {
     for (const HeightPyramid& p : in.radiance.fields) b += bytesOf(p);
     for (const VisibilityField& v : in.u) b += bytesOf(v.sh);
     for (const ShadeMaps& s : in.bounceShade) b += bytesOf(s);
-    for (int c = 0; c < 3; ++c) b += bytesOf(in.indirect[static_cast<std::size_t>(c)]) + bytesOf(in.total[static_cast<std::size_t>(c)]);
+    for (int c = 0; c < 3; ++c)
+        b += bytesOf(in.indirect[static_cast<std::size_t>(c)]) + bytesOf(in.total[static_cast<std::size_t>(c)]);
     const BlockerRadianceState& br = in.blocker;
-    b += bytesOf(br.farSlope) + bytesOf(br.heights) + bytesOf(br.occlusion) + bytesOf(br.receiverOcclusion) + bytesOf(br.scratch) +
-         bytesOf(br.taps) + bytesOf(br.cols);
+    b += bytesOf(br.farSlope) + bytesOf(br.heights) + bytesOf(br.occlusion) + bytesOf(br.receiverOcclusion) +
+         bytesOf(br.scratch) + bytesOf(br.taps) + bytesOf(br.cols);
     for (const std::vector<float>& e : br.receiverShade) b += bytesOf(e);
     for (const IndirectScratch& s : in.blocks)
         b += bytesOf(s.result) + bytesOf(s.irradiance) + bytesOf(s.state) + 4 * bytesOf(s.gx) + bytesOf(s.groupSteps) +
@@ -113,7 +113,9 @@ ShRgb foldKeys(const GiLighting& l) {
     for (const KeyLight& k : l.keys) {
         const ShRgb cap = keyLightSh(k);
         for (int c = 0; c < 3; ++c)
-            for (int i = 0; i < kShCount; ++i) total.c[static_cast<std::size_t>(c)][static_cast<std::size_t>(i)] += cap.c[static_cast<std::size_t>(c)][static_cast<std::size_t>(i)];
+            for (int i = 0; i < kShCount; ++i)
+                total.c[static_cast<std::size_t>(c)][static_cast<std::size_t>(i)] +=
+                    cap.c[static_cast<std::size_t>(c)][static_cast<std::size_t>(i)];
     }
     return total;
 }
@@ -140,7 +142,8 @@ Reference computeReference(const Dem& d, const GiLighting& light, const AlbedoMa
     for (int b = 1; b <= maxBounces; ++b) {
         gatherReferenceBounce(d.heights.cview(), d.cell, prev, &a, s, next);
         for (int c = 0; c < 3; ++c)
-            for (std::size_t i = 0; i < sum[static_cast<std::size_t>(c)].v.size(); ++i) sum[static_cast<std::size_t>(c)].v[i] += next[static_cast<std::size_t>(c)].v[i];
+            for (std::size_t i = 0; i < sum[static_cast<std::size_t>(c)].v.size(); ++i)
+                sum[static_cast<std::size_t>(c)].v[i] += next[static_cast<std::size_t>(c)].v[i];
         r.indirectUpTo.push_back(sum);
         std::swap(prev, next);
     }
@@ -154,17 +157,20 @@ struct Errors {
 
 Errors errorsOf(const GiState& st, const Reference& ref, int bounces) {
     Errors e;
-    e.total = relRmse(st.indirect.total, [&] {
-        std::array<Grid, 3> t = ref.direct;
-        for (int c = 0; c < 3; ++c)
-            for (std::size_t i = 0; i < t[static_cast<std::size_t>(c)].v.size(); ++i)
-                t[static_cast<std::size_t>(c)].v[i] += ref.indirectUpTo[static_cast<std::size_t>(bounces - 1)][static_cast<std::size_t>(c)].v[i];
-        return t;
-    }(), e.totalBias);
+    e.total = relRmse(
+        st.indirect.total,
+        [&] {
+            std::array<Grid, 3> t = ref.direct;
+            for (int c = 0; c < 3; ++c)
+                for (std::size_t i = 0; i < t[static_cast<std::size_t>(c)].v.size(); ++i)
+                    t[static_cast<std::size_t>(c)].v[i] +=
+                        ref.indirectUpTo[static_cast<std::size_t>(bounces - 1)][static_cast<std::size_t>(c)].v[i];
+            return t;
+        }(),
+        e.totalBias);
     e.indirect = relRmse(st.indirect.indirect, ref.indirectUpTo[static_cast<std::size_t>(bounces - 1)], e.indirectBias);
     return e;
 }
-
 
 // ---- error breakdown (--diagnose) ---------------------------------------------------
 std::string fmtErr(const char* what, double e, double b) {
@@ -232,12 +238,13 @@ std::string diagnose(const Dem& d, const GiLighting& light, float albedo) {
                 is.radiance.levelsPerOctave = ku;
                 IndirectState ist;
                 withThreads(2, [&] {
-                    const IndirectInputs in{st.pyramid, st.gradX.cview(), st.gradY.cview(), st.envOperator,
-                                            st.envVisibility, capRef.direct, nullptr, &a, g.shading};
+                    const IndirectInputs in{st.pyramid,       st.gradX.cview(), st.gradY.cview(), st.envOperator,
+                                            st.envVisibility, capRef.direct,    nullptr,          &a,
+                                            g.shading};
                     computeIndirect(in, is, ist);
                 });
-                const std::string name = "(b,c) " + tag + " indirect from ref. direct, o_u " + std::to_string(ou) + ", k_u " +
-                                         std::to_string(ku);
+                const std::string name = "(b,c) " + tag + " indirect from ref. direct, o_u " + std::to_string(ou) +
+                                         ", k_u " + std::to_string(ku);
                 e = relRmse(ist.indirect, ind, b);
                 md += fmtErr((name + " vs ref.").c_str(), e, b);
                 e = relRmse(ist.indirect, indSh, b);
@@ -260,13 +267,16 @@ std::string interpolationBound(const Reference& ref, int s) {
                 const int X1 = std::min(X0 + s, (r0.nx - 1) / s * s), Y1 = std::min(Y0 + s, (r0.ny - 1) / s * s);
                 const float fx = X1 > X0 ? float(x - X0) / s : 0.0f, fy = Y1 > Y0 ? float(y - Y0) / s : 0.0f;
                 const Grid& g = ref.indirectUpTo[0][c];
-                ip[c](x, y) = (1 - fy) * ((1 - fx) * g(X0, Y0) + fx * g(X1, Y0)) + fy * ((1 - fx) * g(X0, Y1) + fx * g(X1, Y1));
+                ip[c](x, y) =
+                    (1 - fy) * ((1 - fx) * g(X0, Y0) + fx * g(X1, Y0)) + fy * ((1 - fx) * g(X0, Y1) + fx * g(X1, Y1));
             }
     double b = 0.0;
     const double e = relRmse(ip, ref.indirectUpTo[0], b);
     char line[256];
-    std::snprintf(line, sizeof line, "Bound of interpolation: the reference's own indirect light sampled at the %dx receivers and "
-                  "interpolated bilinearly is off by %.4f rel. RMSE (bias %+.4f).\n\n", s, e, b);
+    std::snprintf(line, sizeof line,
+                  "Bound of interpolation: the reference's own indirect light sampled at the %dx receivers and "
+                  "interpolated bilinearly is off by %.4f rel. RMSE (bias %+.4f).\n\n",
+                  s, e, b);
     std::fprintf(stderr, "%s", line);
     return line;
 }
@@ -308,7 +318,8 @@ private:
     const BenchContext& ctx_;
     const int accSize = o_.quick ? 96 : 256;
     const int refDirections = 2048;
-    const int refDirections512 = 1024;  // Table 1's 512^2 error: half the directions (the reference's time grows 8x with the size)
+    const int refDirections512 =
+        1024;  // Table 1's 512^2 error: half the directions (the reference's time grows 8x with the size)
     const float albedo = 0.6f;
     GiLighting light;
     std::vector<Dem> dems;        // the accuracy terrains: Mont Blanc and an eroded frame
@@ -333,7 +344,8 @@ private:
         const GiSettings g = settingsFor(2, 1, false);
         char b[512];
         std::snprintf(b, sizeof b,
-                      "m %d, k_v %d, o_v %d, peak blend %.2f, k_u %d, o_u %d, %d indirect azimuths, %s, footprint tangent planes %s; "
+                      "m %d, k_v %d, o_v %d, peak blend %.2f, k_u %d, o_u %d, %d indirect azimuths, %s, footprint "
+                      "tangent planes %s; "
                       "%s kernels",
                       g.visibility.azimuths, g.pyramid.levelsPerOctave, g.pyramid.levelOffset, g.pyramid.peakBlend,
                       g.indirect.radiance.levelsPerOctave, g.indirect.radiance.levelOffset,
@@ -341,7 +353,8 @@ private:
                       g.indirect.lambert == LambertIndirect::BlockerRadiance
                           ? "exact cosine at the receivers, blocker radiance x occlusion between them"
                           : "SH kernel",
-                      g.visibility.footprintTangent ? "on" : "off", simd::wideEnabled() ? "8-wide AVX2" : "4-wide SSE2");
+                      g.visibility.footprintTangent ? "on" : "off",
+                      simd::wideEnabled() ? "8-wide AVX2" : "4-wide SSE2");
         return b;
     }
 
@@ -366,9 +379,9 @@ void IndirectSuite::probe() const {
             t.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
             ti.push_back(st.timings.indirect);
             ts.push_back(st.indirect.timings.scan);
-            const double v[9] = {st.timings.gradient, st.timings.pyramid, st.timings.visibility, st.timings.keyVisibility,
-                                 st.timings.shading, st.indirect.timings.pyramid, st.indirect.timings.scan,
-                                 st.indirect.timings.shading, st.indirect.timings.total};
+            const double v[9] = {st.timings.gradient,      st.timings.pyramid,          st.timings.visibility,
+                                 st.timings.keyVisibility, st.timings.shading,          st.indirect.timings.pyramid,
+                                 st.indirect.timings.scan, st.indirect.timings.shading, st.indirect.timings.total};
             for (int k = 0; k < 9; ++k) parts[k].push_back(v[k]);
         }
     });
@@ -377,9 +390,8 @@ void IndirectSuite::probe() const {
     std::fprintf(stderr,
                  "  gradient %.2f, height pyramid %.2f, env visibility %.2f, key visibility %.2f, direct shading %.2f; "
                  "indirect: radiance pyramid %.2f, scan %.2f, shading %.2f, total %.2f ms\n",
-                 median(parts[0]), median(parts[1]), median(parts[2]), median(parts[3]),
-                 median(parts[4]), median(parts[5]), median(parts[6]), median(parts[7]),
-                 median(parts[8]));
+                 median(parts[0]), median(parts[1]), median(parts[2]), median(parts[3]), median(parts[4]),
+                 median(parts[5]), median(parts[6]), median(parts[7]), median(parts[8]));
 }
 
 // The error table of one terrain: paper and engine settings at 1x/2x/4x, 1..3
@@ -394,18 +406,20 @@ std::string IndirectSuite::accuracyRows(const Dem& d, const AlbedoMap& a, const 
                 GiState st;
                 withThreads(2, [&] { runGiFrame(d.heights.cview(), d.cell, light, settingsFor(s, b, paper), st, &a); });
                 const Errors e = errorsOf(st, ref, b);
-                const char* name = paper ? "paper (m 32, k 4, o 2, SH kernel)" : "engine (m 16 / 8 indirect, o 3, blocker radiance)";
+                const char* name =
+                    paper ? "paper (m 32, k 4, o 2, SH kernel)" : "engine (m 16 / 8 indirect, o 3, blocker radiance)";
                 char line[512];
-                std::snprintf(line, sizeof line, "| %s | %dx | %d | %.4f | %+.4f | %.4f | %+.4f |\n", name, s, b, e.total, e.totalBias,
-                              e.indirect, e.indirectBias);
+                std::snprintf(line, sizeof line, "| %s | %dx | %d | %.4f | %+.4f | %.4f | %+.4f |\n", name, s, b,
+                              e.total, e.totalBias, e.indirect, e.indirectBias);
                 accMd += line;
                 if (b == 1 && (s == 2 || !paper)) {
-                    std::snprintf(line, sizeof line, "| %s | %s | %dx | %.1f %% | %.1f %% |\n", d.name.c_str(), paper ? "paper" : "engine", s,
-                                  100.0 * e.total, 100.0 * e.indirect);
+                    std::snprintf(line, sizeof line, "| %s | %s | %dx | %.1f %% | %.1f %% |\n", d.name.c_str(),
+                                  paper ? "paper" : "engine", s, 100.0 * e.total, 100.0 * e.indirect);
                     summary += line;
                 }
-                std::snprintf(line, sizeof line, "%s,%s,%d,%d,%.5f,%.5f,%.5f,%.5f,%.2f\n", d.name.c_str(), paper ? "paper" : "engine", s, b,
-                              e.total, e.totalBias, e.indirect, e.indirectBias, st.timings.total);
+                std::snprintf(line, sizeof line, "%s,%s,%d,%d,%.5f,%.5f,%.5f,%.5f,%.2f\n", d.name.c_str(),
+                              paper ? "paper" : "engine", s, b, e.total, e.totalBias, e.indirect, e.indirectBias,
+                              st.timings.total);
                 accCsv += line;
                 std::fprintf(stderr, "%s", line);
             }
@@ -417,26 +431,37 @@ void IndirectSuite::accuracy() {
     std::string summary;
     accMd += "Machine: " + machineDescription() +
              ". Lighting: sun-and-sky environment + one key light (az 135, el 35, r 5 deg; "
-             "integrated as an exact cap by the reference), albedo " + std::to_string(albedo).substr(0, 3) +
+             "integrated as an exact cap by the reference), albedo " +
+             std::to_string(albedo).substr(0, 3) +
              " everywhere, Lambert. Reference: exact direct light (256 azimuths) and " + std::to_string(refDirections) +
-             " fixed gathering directions per texel, march step 0.5 cell. Relative RMSE over all three channels on the interior "
-             "(10 % border excluded); bias = mean difference / RMS of the reference. Engine settings: " + engineSummary() + ".\n\n";
-    std::string accCsv = "dem,settings,subsample,bounces,total_rel_rmse,total_bias,indirect_rel_rmse,indirect_bias,frame_ms\n";
+             " fixed gathering directions per texel, march step 0.5 cell. Relative RMSE over all three channels on the "
+             "interior "
+             "(10 % border excluded); bias = mean difference / RMS of the reference. Engine settings: " +
+             engineSummary() + ".\n\n";
+    std::string accCsv =
+        "dem,settings,subsample,bounces,total_rel_rmse,total_bias,indirect_rel_rmse,indirect_bias,frame_ms\n";
     for (const Dem& d : dems) {
         const AlbedoMap a = uniformAlbedo(d.heights.nx, d.heights.ny, albedo);
         std::fprintf(stderr, "reference %s %dx%d ...\n", d.name.c_str(), d.heights.nx, d.heights.ny);
         Reference ref = withThreads(0, [&] { return computeReference(d, light, a, 3, refDirections); });
-        accMd += "## " + d.name + ": " + d.note + "\n\nReference: " + std::to_string(static_cast<int>(ref.seconds)) + " s (3 bounces).\n\n";
-        accMd += "| settings | sub-sampling | bounces | total rel. RMSE | total bias | indirect rel. RMSE | indirect bias |\n|---|---|---|---|---|---|---|\n";
+        accMd += "## " + d.name + ": " + d.note + "\n\nReference: " + std::to_string(static_cast<int>(ref.seconds)) +
+                 " s (3 bounces).\n\n";
+        accMd +=
+            "| settings | sub-sampling | bounces | total rel. RMSE | total bias | indirect rel. RMSE | indirect bias "
+            "|\n|---|---|---|---|---|---|---|\n";
         accMd += accuracyRows(d, a, ref, summary, accCsv);
         for (int s : {2, 4}) accMd += interpolationBound(ref, s);
         refs.push_back(std::move(ref));
     }
     const std::size_t head = accMd.find("\n\n") + 2;
-    accMd.insert(head, "## Summary (one bounce; targets: total <= 3 %, indirect <= 10 % relative RMSE at 2x)\n\n"
-                       "| terrain | settings | sub-sampling | total rel. RMSE | indirect rel. RMSE |\n|---|---|---|---|---|\n" + summary +
-                       "\nWhy the engine's indirect light differs from the paper's (exact cosine at the receivers, footprint tangent "
-                       "planes, 8 indirect azimuths): gi/indirect.h, gi/visibility.h and gi_indirect_diagnosis.md.\n\n");
+    accMd.insert(
+        head,
+        "## Summary (one bounce; targets: total <= 3 %, indirect <= 10 % relative RMSE at 2x)\n\n"
+        "| terrain | settings | sub-sampling | total rel. RMSE | indirect rel. RMSE |\n|---|---|---|---|---|\n" +
+            summary +
+            "\nWhy the engine's indirect light differs from the paper's (exact cosine at the receivers, footprint "
+            "tangent "
+            "planes, 8 indirect azimuths): gi/indirect.h, gi/visibility.h and gi_indirect_diagnosis.md.\n\n");
     writeResult(ctx_.outDir, "gi_indirect_accuracy.md", accMd);
     writeResult(ctx_.outDir, "gi_indirect_accuracy.csv", accCsv);
 }
@@ -473,8 +498,7 @@ FrameTime IndirectSuite::timeFrames(const Dem& d, const AlbedoMap& a, int n, int
                 double sum = 0.0;
                 for (double v : t) sum += v;
                 ft.msA = std::min(ft.msA, sum / static_cast<double>(t.size()));
-            }
-            else if (median(t) < ft.ms) {
+            } else if (median(t) < ft.ms) {
                 ft.ms = median(t);
                 ft.msInd = median(ti);
                 ft.mem = frameMemoryMB(d.heights, st);
@@ -488,16 +512,23 @@ void IndirectSuite::frameTimes() const {
     std::string tMd = "# GI with indirect light: frame time (the paper's Table 1 on this machine)\n\n";
     tMd += "Machine: " + machineDescription() +
            ", 2 threads. Scene: builtinScene(\"erosion\", N, 1) initial ground; engine "
-           "settings (" + engineSummary() + "), sun-and-sky environment + one key light, albedo 0.6, Lambert. Median of " +
+           "settings (" +
+           engineSummary() + "), sun-and-sky environment + one key light, albedo 0.6, Lambert. Median of " +
            std::to_string(o_.runs) +
            " frames after one warm-up, best of 3 repeats (shared virtual machine); amortised = static geometry, "
            "frames alternate direct and indirect "
-           "updates; the amortised figure is the mean over an even number of frames (as many cheap as expensive). Memory: every buffer of the frame (inputs and intermediates, float32). Error: indirect / "
-           "total relative RMSE against the reference of an eroded frame of the same size (builtinScene(\"erosion\", N, 1) after 2000 "
-           "ticks; at 256^2 the accuracy table's erosion frame; at 512^2 a reference of " + std::to_string(refDirections512) +
+           "updates; the amortised figure is the mean over an even number of frames (as many cheap as expensive). "
+           "Memory: every buffer of the frame (inputs and intermediates, float32). Error: indirect / "
+           "total relative RMSE against the reference of an eroded frame of the same size (builtinScene(\"erosion\", "
+           "N, 1) after 2000 "
+           "ticks; at 256^2 the accuracy table's erosion frame; at 512^2 a reference of " +
+           std::to_string(refDirections512) +
            " directions, about 10 minutes; not measured at 1024^2, where the reference would take hours).\n\n";
-    tMd += "| size | sub-sampling | bounces | ms / frame | ms amortised | indirect ms | memory MB | indirect rel. RMSE | total rel. RMSE |\n|---|---|---|---|---|---|---|---|---|\n";
-    std::string tCsv = "size,subsample,bounces,ms,ms_amortised,indirect_ms,memory_mb,indirect_rel_rmse,total_rel_rmse\n";
+    tMd +=
+        "| size | sub-sampling | bounces | ms / frame | ms amortised | indirect ms | memory MB | indirect rel. RMSE | "
+        "total rel. RMSE |\n|---|---|---|---|---|---|---|---|---|\n";
+    std::string tCsv =
+        "size,subsample,bounces,ms,ms_amortised,indirect_ms,memory_mb,indirect_rel_rmse,total_rel_rmse\n";
     const std::vector<int> sizes = o_.quick ? std::vector<int>{128} : std::vector<int>{256, 512, 1024};
     // the error beside each figure: an eroded frame of the size and its reference
     // (256^2: the accuracy table's; 512^2: computed here)
@@ -523,7 +554,8 @@ void IndirectSuite::frameTimes() const {
                     const Reference& re = n == 256 ? refs[1] : ref512;
                     GiState st;
                     const AlbedoMap a2 = uniformAlbedo(de.heights.nx, de.heights.ny, albedo);
-                    withThreads(2, [&] { runGiFrame(de.heights.cview(), de.cell, light, settingsFor(s, b, false), st, &a2); });
+                    withThreads(
+                        2, [&] { runGiFrame(de.heights.cview(), de.cell, light, settingsFor(s, b, false), st, &a2); });
                     const Errors e = errorsOf(st, re, b);
                     std::snprintf(line, sizeof line, "%.4f", e.indirect);
                     err = line;

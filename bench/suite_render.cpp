@@ -82,21 +82,21 @@ int runRender(int runs, const BenchContext& ctx) {
         for (int size : {256, 512}) {
             const SceneTimes st = measureScene(renderer, scene, size, runs, width, height);
             const double* m = st.m;
-            csv << scene << ',' << size << ",2," << width << ',' << height << ',' << st.ticksPerFrame << ','
-                << runs;
+            csv << scene << ',' << size << ",2," << width << ',' << height << ',' << st.ticksPerFrame << ',' << runs;
             for (double x : st.m) csv << ',' << x;
             csv << '\n';
             char line[512];
-            std::snprintf(line, sizeof line, "| %s | %d² | %d | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.2f |\n",
-                          scene, size, st.ticksPerFrame, m[0], m[1], m[2], m[3], m[4], m[5], m[6],
-                          1000.0 / m[6]);
+            std::snprintf(line, sizeof line,
+                          "| %s | %d² | %d | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.2f |\n", scene, size,
+                          st.ticksPerFrame, m[0], m[1], m[2], m[3], m[4], m[5], m[6], 1000.0 / m[6]);
             md << line;
             std::printf("%s", line);
             std::fflush(stdout);
         }
     md << "\n\"integrate\" is 0 because gi/ computes the wedge integration inside the visibility scan (reported "
           "under scan). \"render\" is the OpenGL share: texture upload, the draw of the mesh (one vertex "
-          "per grid point; soft-visibility mode, so no shadow-map pass) and water, tone mapping, and the read-back of the 1280 x 720 image; on llvmpipe it "
+          "per grid point; soft-visibility mode, so no shadow-map pass) and water, tone mapping, and the read-back of "
+          "the 1280 x 720 image; on llvmpipe it "
           "runs on the same 2 CPU cores as GI, so it is not small here as it would be on a GPU.\n";
     writeResult(ctx.outDir, "render.csv", csv.str());
     writeResult(ctx.outDir, "render.md", md.str());

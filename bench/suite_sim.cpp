@@ -66,8 +66,8 @@ void writeReport(const std::vector<Row>& rows, const SimOptions& o, const BenchC
     md << "# Simulation benchmark\n\n"
        << "Machine: " << machineDescription() << ". Release build (-O3, baseline x86-64, no fast-math).\n\n"
        << "Command: `build/terrain_bench sim --runs " << runs << " --ticks " << ticks
-       << "`. Each figure is the median of "
-       << runs << " runs of " << ticks << " ticks, after 10 warm-up ticks. *kernels*: the scene's simulation steps "
+       << "`. Each figure is the median of " << runs << " runs of " << ticks
+       << " ticks, after 10 warm-up ticks. *kernels*: the scene's simulation steps "
        << "alone (erosion: hydraulic + thermal; waves: shallow water); *tick*: `Simulation::tick` "
        << "(kernels + stability check + change tracking).\n\n"
        << "| scene | size | threads | kernels ms/tick | tick ms/tick | ticks/s | Mcell-updates/s |\n"

@@ -15,8 +15,7 @@ public:
 /// A file could not be read or written, or its contents are wrong.
 class IoError : public Error {
 public:
-    IoError(const std::string& file, const std::string& what)
-        : Error(file + ": " + what), file_(file) {}
+    IoError(const std::string& file, const std::string& what) : Error(file + ": " + what), file_(file) {}
     const std::string& file() const { return file_; }
 
 private:

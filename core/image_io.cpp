@@ -3,8 +3,6 @@
 // OpenEXR's C interface: its C++ headers need Imath include paths that the
 // build does not export, and half-float RGBA/Y is all an image viewer needs
 // (use .npy for exact float32 ambient values).
-#include <OpenEXR/ImfCRgbaFile.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -12,6 +10,8 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+
+#include <OpenEXR/ImfCRgbaFile.h>
 
 #include "core/error.h"
 #include "core/file_io.h"
@@ -36,8 +36,10 @@ void writeNpyArray(const std::string& file, const std::vector<std::size_t>& shap
         dims += std::to_string(d) + ", ";
         count *= d;
     }
-    if (shape.size() > 1) dims.erase(dims.size() - 2);  // "(ny, nx)"; a 1-tuple keeps its comma: "(n,)"
-    else if (!dims.empty()) dims.erase(dims.size() - 1);
+    if (shape.size() > 1)
+        dims.erase(dims.size() - 2);  // "(ny, nx)"; a 1-tuple keeps its comma: "(n,)"
+    else if (!dims.empty())
+        dims.erase(dims.size() - 1);
     std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': (" + dims + "), }";
     // magic (6) + version (2) + header length (2) + header, padded to 64 bytes, ending in '\n'
     const std::size_t total = 10 + header.size() + 1;
@@ -89,7 +91,8 @@ void writeExr(const std::string& file, const std::vector<const Grid*>& channels)
     ImfOutputFile* out = ImfOpenOutputFile(tmp.c_str(), header, channels.size() == 3 ? IMF_WRITE_RGB : IMF_WRITE_Y);
     ImfDeleteHeader(header);
     if (!out) throw IoError(file, std::string("cannot write EXR: ") + ImfErrorMessage());
-    const bool ok = ImfOutputSetFrameBuffer(out, px.data(), 1, static_cast<std::size_t>(w)) && ImfOutputWritePixels(out, h);
+    const bool ok =
+        ImfOutputSetFrameBuffer(out, px.data(), 1, static_cast<std::size_t>(w)) && ImfOutputWritePixels(out, h);
     const std::string err = ok ? "" : ImfErrorMessage();
     ImfCloseOutputFile(out);
     if (!ok) {
@@ -113,7 +116,8 @@ std::vector<float> readExrRgb(const std::string& file, int& w, int& h) {
         throw IoError(file, "bad EXR data window");
     }
     std::vector<ImfRgba> px(static_cast<std::size_t>(w) * h);
-    const bool ok = ImfInputSetFrameBuffer(in, px.data() - x0 - static_cast<std::ptrdiff_t>(y0) * w, 1, static_cast<std::size_t>(w)) &&
+    const bool ok = ImfInputSetFrameBuffer(in, px.data() - x0 - static_cast<std::ptrdiff_t>(y0) * w, 1,
+                                           static_cast<std::size_t>(w)) &&
                     ImfInputReadPixels(in, y0, y1);
     const std::string err = ok ? "" : ImfErrorMessage();
     ImfCloseInputFile(in);
@@ -140,8 +144,8 @@ std::vector<float> readHdr(const std::string& file, int& w, int& h) {
     if (!formatOk) throw IoError(file, "unsupported HDR format (need 32-bit_rle_rgbe)");
     if (!std::getline(in, line)) throw IoError(file, "missing resolution line");
     char ya[3] = {}, xa[3] = {};
-    if (std::sscanf(line.c_str(), "%2s %d %2s %d", ya, &h, xa, &w) != 4 || std::string(ya) != "-Y" || std::string(xa) != "+X" ||
-        w <= 0 || h <= 0 || w > 65536 || h > 65536)
+    if (std::sscanf(line.c_str(), "%2s %d %2s %d", ya, &h, xa, &w) != 4 || std::string(ya) != "-Y" ||
+        std::string(xa) != "+X" || w <= 0 || h <= 0 || w > 65536 || h > 65536)
         throw IoError(file, "unsupported resolution line '" + line + "' (need -Y H +X W)");
     std::vector<unsigned char> data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     std::size_t pos = 0;
@@ -168,7 +172,10 @@ std::vector<float> readHdr(const std::string& file, int& w, int& h) {
                     }
                 }
         } else {
-            scan[0] = b0; scan[1] = b1; scan[2] = b2; scan[3] = b3;
+            scan[0] = b0;
+            scan[1] = b1;
+            scan[2] = b2;
+            scan[3] = b3;
             for (int x = 1; x < w; ++x)
                 for (int c = 0; c < 4; ++c) scan[static_cast<std::size_t>(x) * 4 + c] = byte();
         }

@@ -1,14 +1,14 @@
 // PNG reading and writing through libpng.
 #include "core/png_io.h"
 
-#include <png.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <memory>
 #include <string>
+
+#include <png.h>
 
 #include "core/error.h"
 #include "core/file_io.h"
@@ -165,8 +165,8 @@ void writePng(const std::string& file, int width, int height, int channels, int 
     std::FILE* f = std::fopen(tmp.c_str(), "wb");
     if (!f) throw IoError(file, std::string("cannot open for writing: ") + std::strerror(errno));
     std::string message;
-    const bool ok = writePngRaw(f, width, height, channels, bitDepth, static_cast<const unsigned char*>(pixels),
-                                message);
+    const bool ok =
+        writePngRaw(f, width, height, channels, bitDepth, static_cast<const unsigned char*>(pixels), message);
     const bool closed = std::fclose(f) == 0;
     if (!ok || !closed) {
         std::remove(tmp.c_str());

@@ -76,13 +76,17 @@ template <class T>
 }
 template <class T>
 [[gnu::always_inline]] inline void store(float* p, T v) {
-    if constexpr (std::is_same_v<T, float>) *p = v;
-    else std::memcpy(p, &v, sizeof v);
+    if constexpr (std::is_same_v<T, float>)
+        *p = v;
+    else
+        std::memcpy(p, &v, sizeof v);
 }
 template <class T>
 [[gnu::always_inline]] inline T splat(float x) {
-    if constexpr (std::is_same_v<T, float>) return x;
-    else return T{} + x;
+    if constexpr (std::is_same_v<T, float>)
+        return x;
+    else
+        return T{} + x;
 }
 template <class T>
 [[gnu::always_inline]] inline T vmax(T a, T b) {
@@ -106,8 +110,12 @@ template <class V>
     const V xr = (big ? -one : (mid ? x - one : x)) / (big ? x : (mid ? x + one : one));
     const V y0 = big ? splat<V>(1.5707963267948966f) : (mid ? splat<V>(0.7853981633974483f) : zero);
     const V z = xr * xr;
-    const V p = ((((splat<V>(8.05374449538e-2f) * z - splat<V>(1.38776856032e-1f)) * z + splat<V>(1.99777106478e-1f)) * z -
-                  splat<V>(3.33329491539e-1f)) * z) * xr + xr;
+    const V p =
+        ((((splat<V>(8.05374449538e-2f) * z - splat<V>(1.38776856032e-1f)) * z + splat<V>(1.99777106478e-1f)) * z -
+          splat<V>(3.33329491539e-1f)) *
+         z) *
+            xr +
+        xr;
     const V r = y0 + p;
     return t < zero ? -r : r;
 }

@@ -31,15 +31,15 @@ enum class LightingMode {
 
 /// Lights of the demo scenes.
 struct SceneLights {
-    gi::ShRgb sky;      // environment radiance (SH); also the water's reflection map
-    gi::KeyLight key;   // the sun
+    gi::ShRgb sky;     // environment radiance (SH); also the water's reflection map
+    gi::KeyLight key;  // the sun
 };
 
 /// Everything the renderer uploads for one frame.
 struct FrameData {
     int nx = 0, ny = 0;
     float cellSize = 1.0f;
-    float zMin = 0.0f, zMax = 1.0f;       // ground range of the first frame (fixed colour ramp)
+    float zMin = 0.0f, zMax = 1.0f;  // ground range of the first frame (fixed colour ramp)
     bool hasWater = false;
     float exaggeration = 1.0f;            // vertical exaggeration (applied by the renderer to the heights)
     bool coast = false;                   // colour palette: coast (waves scenes) or mountains
@@ -48,12 +48,12 @@ struct FrameData {
     std::vector<float> key;               // 4 per texel: key RGB, ambient
     int nxr = 0, nyr = 0, subsample = 1;  // receiver grid
     std::vector<float> receiver;          // 4 per receiver: sky visibility fraction, pyramid level height,
-                                          // mean incident indirect radiance (U's constant term, or the irradiance E / pi where the kernel keeps no U; 0 without bounces), 0
-    int pyramidLevel = -1;                // level in `receiver` (-1: none built)
+        // mean incident indirect radiance (U's constant term, or the irradiance E / pi where the kernel keeps no U; 0 without bounces), 0
+    int pyramidLevel = -1;  // level in `receiver` (-1: none built)
     SceneLights lights;
     LightingMode lighting = LightingMode::Direct;
     std::int64_t tick = 0;
-    double time = 0.0;                    // s, simulated
+    double time = 0.0;  // s, simulated
 };
 
 }  // namespace terrain::engine

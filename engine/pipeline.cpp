@@ -35,8 +35,8 @@ gi::GiLighting giLighting(const SceneLights& lights) {
 
 // Per texel: ground and water depth; the shade without the key light and the
 // key light's own shade; the key light's soft visibility and the ambient map.
-void packTexels(const TerrainState& s, const gi::GiState& gi, const std::array<Grid, 3>& keyRgb,
-                const gi::KeyLight& k, bool indirect, FrameData& f) {
+void packTexels(const TerrainState& s, const gi::GiState& gi, const std::array<Grid, 3>& keyRgb, const gi::KeyLight& k,
+                bool indirect, FrameData& f) {
     const int nx = s.nx, ny = s.ny;
     const std::size_t n = static_cast<std::size_t>(nx) * ny;
     f.heights.resize(2 * n);
@@ -160,9 +160,12 @@ FramePipeline::FramePipeline(const SceneSettings& scene, const PipelineSettings&
     ticksPerFrame_ = settings_.ticksPerFrame;
     if (ticksPerFrame_ == 0) {
         // Erosion needs many ticks per frame to show change; waves ~0.25 s of water per frame.
-        if (scene.waves) ticksPerFrame_ = std::max(1, static_cast<int>(0.25f / sim_.dt()));
-        else if (scene.hydraulic || scene.thermal) ticksPerFrame_ = 60;
-        else ticksPerFrame_ = 1;
+        if (scene.waves)
+            ticksPerFrame_ = std::max(1, static_cast<int>(0.25f / sim_.dt()));
+        else if (scene.hydraulic || scene.thermal)
+            ticksPerFrame_ = 60;
+        else
+            ticksPerFrame_ = 1;
     }
     terrainReplaced();
 }

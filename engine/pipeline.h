@@ -23,8 +23,8 @@ struct PipelineSettings {
     // amortisation live here; one indirect bounce by default.
     gi::GiSettings gi = defaultPipelineGi();
     LightingMode lighting = LightingMode::Direct;
-    int pyramidLevel = 4;    // pyramid level exposed to the debug view
-    int ticksPerFrame = 0;   // 0 = the scene's default pacing
+    int pyramidLevel = 4;   // pyramid level exposed to the debug view
+    int ticksPerFrame = 0;  // 0 = the scene's default pacing
     // Vertical exaggeration of what is lit and drawn (GI, shadow map and mesh
     // all see the same surface); 0 = automatic: relief at least 15 % of the
     // extent (the waves bay is 512 m wide and 18 m deep).
@@ -39,7 +39,8 @@ struct StageTimings {
 
 class FramePipeline {
 public:
-    FramePipeline(const SceneSettings& scene, const PipelineSettings& settings, const SceneLights& lights = defaultLights());
+    FramePipeline(const SceneSettings& scene, const PipelineSettings& settings,
+                  const SceneLights& lights = defaultLights());
 
     /// Advances the simulation by one frame's ticks (none for the first frame).
     void advance();
@@ -68,10 +69,10 @@ private:
     float autoExaggeration_ = 1.0f;
     bool first_ = true;
     float lastExaggeration_ = -1.0f;  // exaggeration of the last lit frame (a change moves the surface)
-    Grid surface_;          // ground + water: what the light sees
+    Grid surface_;                    // ground + water: what the light sees
     gi::GiState gi_;
-    gi::ShadeMaps keyScratch_;           // buffers of the key light's own shading
-    std::array<Grid, 3> keyOnly_;        // the key light's shade alone (white albedo)
+    gi::ShadeMaps keyScratch_;     // buffers of the key light's own shading
+    std::array<Grid, 3> keyOnly_;  // the key light's shade alone (white albedo)
     FrameData frame_;
     StageTimings timings_;
 };

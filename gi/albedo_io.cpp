@@ -1,13 +1,13 @@
 #include "gi/albedo_io.h"
 
-#include <png.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <sstream>
 #include <vector>
+
+#include <png.h>
 
 #include "core/error.h"
 #include "core/parse.h"
@@ -31,13 +31,15 @@ AlbedoMap loadAlbedo(const std::string& spec, int nx, int ny) {
         if (v.size() != 3) throw InputError("--albedo '" + spec + "': expected R,G,B or a PNG file");
         for (float a : v)
             if (!(a >= 0.0f && a <= 1.0f)) throw InputError("--albedo '" + spec + "': each value must be in [0, 1]");
-        for (int c = 0; c < 3; ++c) m.channel[static_cast<std::size_t>(c)].resize(nx, ny, v[static_cast<std::size_t>(c)]);
+        for (int c = 0; c < 3; ++c)
+            m.channel[static_cast<std::size_t>(c)].resize(nx, ny, v[static_cast<std::size_t>(c)]);
         return m;
     }
     png_image img;
     std::memset(&img, 0, sizeof img);
     img.version = PNG_IMAGE_VERSION;
-    if (!png_image_begin_read_from_file(&img, spec.c_str())) throw IoError(spec, std::string("cannot read PNG: ") + img.message);
+    if (!png_image_begin_read_from_file(&img, spec.c_str()))
+        throw IoError(spec, std::string("cannot read PNG: ") + img.message);
     img.format = PNG_FORMAT_RGB;
     if (static_cast<int>(img.width) != nx || static_cast<int>(img.height) != ny) {
         png_image_free(&img);
@@ -45,17 +47,19 @@ AlbedoMap loadAlbedo(const std::string& spec, int nx, int ny) {
                          " pixels, the height field has " + std::to_string(nx) + " x " + std::to_string(ny));
     }
     std::vector<std::uint8_t> px(PNG_IMAGE_SIZE(img));
-    if (!png_image_finish_read(&img, nullptr, px.data(), 0, nullptr)) throw IoError(spec, std::string("cannot decode PNG: ") + img.message);
+    if (!png_image_finish_read(&img, nullptr, px.data(), 0, nullptr))
+        throw IoError(spec, std::string("cannot decode PNG: ") + img.message);
     for (int c = 0; c < 3; ++c) m.channel[static_cast<std::size_t>(c)].resize(nx, ny);
     for (std::size_t i = 0; i < static_cast<std::size_t>(nx) * ny; ++i)
-        for (int c = 0; c < 3; ++c) m.channel[static_cast<std::size_t>(c)].v[i] = srgbToLinear(px[3 * i + static_cast<std::size_t>(c)]);
+        for (int c = 0; c < 3; ++c)
+            m.channel[static_cast<std::size_t>(c)].v[i] = srgbToLinear(px[3 * i + static_cast<std::size_t>(c)]);
     return m;
 }
 
 void loadPhongExponentMap(const std::string& file, int nx, int ny, float lo, float hi, AlbedoMap& map) {
     if (!(lo >= kMinPhongExponent && hi <= kMaxPhongExponent && lo <= hi))
-        throw InputError("--phong-exponent-range: need " + std::to_string(kMinPhongExponent) + " <= MIN <= MAX <= " +
-                         std::to_string(kMaxPhongExponent));
+        throw InputError("--phong-exponent-range: need " + std::to_string(kMinPhongExponent) +
+                         " <= MIN <= MAX <= " + std::to_string(kMaxPhongExponent));
     const Grid raw = readPngHeightmap(file, 1.0f, 0.0f);
     if (raw.nx != nx || raw.ny != ny)
         throw InputError("--phong-exponent " + file + ": " + std::to_string(raw.nx) + " x " + std::to_string(raw.ny) +

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "gi/visibility.h"
 #include "core/parallel.h"
 #include "core/simd.h"
+#include "gi/visibility.h"
 
 namespace terrain::gi {
 
@@ -14,19 +14,19 @@ namespace {
 using namespace simd;
 
 constexpr int kRowsPerBlock = 8;
-constexpr int kLanePad = 8;                // rows padded to the widest lane group
-constexpr float kOutside = -1.0e30f;       // height outside the domain: a sample there blocks nothing
+constexpr int kLanePad = 8;           // rows padded to the widest lane group
+constexpr float kOutside = -1.0e30f;  // height outside the domain: a sample there blocks nothing
 
 inline int padLanes(int n) { return (n + kLanePad - 1) / kLanePad * kLanePad; }
 
 // One row of texels: inputs and the occlusion sum.
 struct OcclusionRow {
-    const float* h;          // padded heights of this row at column 0 (taps reach s cells around)
-    std::ptrdiff_t stride;   // of the padded heights
-    const float *gx, *gy;    // padded rows of the gradient
-    float* far;              // padded row: the receivers' horizon of this azimuth, interpolated
-    float* sum;              // padded row: running sum of F(horizon) - F(plane)
-    int n;                   // padded length
+    const float* h;         // padded heights of this row at column 0 (taps reach s cells around)
+    std::ptrdiff_t stride;  // of the padded heights
+    const float *gx, *gy;   // padded rows of the gradient
+    float* far;             // padded row: the receivers' horizon of this azimuth, interpolated
+    float* sum;             // padded row: running sum of F(horizon) - F(plane)
+    int n;                  // padded length
 };
 
 // Adds one azimuth's clamped-cosine integral below the texels' horizons:
@@ -81,7 +81,7 @@ struct RowScratch {
 // A row of points: full-resolution row y, columns step * i (i < n; rows padded to pad).
 struct PointRow {
     int y, step, n, pad;
-    const float* heights;    // the padded heights at (0, y), for the near samples (null: none)
+    const float* heights;  // the padded heights at (0, y), for the near samples (null: none)
     std::ptrdiff_t stride;
     int nTaps;
 };
@@ -187,7 +187,8 @@ void occlusionAtTexels(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
                     }
                 };
                 occlusionOfRow(gradX, gradY, pts, r, st.taps.data(), st.cosPhi.data(), st.sinPhi.data(), pass.m,
-                               pass.scale, pass.azimuth, fillFar, st.occlusion.data() + static_cast<std::size_t>(y) * nx);
+                               pass.scale, pass.azimuth, fillFar,
+                               st.occlusion.data() + static_cast<std::size_t>(y) * nx);
             }
         }
     });
@@ -210,8 +211,8 @@ void occlusionAtReceivers(const HeightPyramid& pyr, ConstGridView gradX, ConstGr
             for (int Y = block * kRowsPerBlock; Y < std::min(nyr, (block + 1) * kRowsPerBlock); ++Y) {
                 const PointRow pts{std::min(s * Y, ny - 1), s, nxr, padR, nullptr, 0, 0};
                 const auto fillFar = [&](int j, float* far) {
-                    const float* fs =
-                        st.farSlope.data() + static_cast<std::size_t>(j) * nxr * nyr + static_cast<std::size_t>(Y) * nxr;
+                    const float* fs = st.farSlope.data() + static_cast<std::size_t>(j) * nxr * nyr +
+                                      static_cast<std::size_t>(Y) * nxr;
                     std::copy(fs, fs + nxr, far);
                 };
                 occlusionOfRow(gradX, gradY, pts, r, nullptr, st.cosPhi.data(), st.sinPhi.data(), pass.m, pass.scale,

@@ -39,28 +39,28 @@
 #include <array>
 #include <vector>
 
+#include "core/grid.h"
 #include "gi/pyramid.h"
 #include "gi/shading.h"
-#include "core/grid.h"
 
 namespace terrain::gi {
 
 /// One near-field sample of an azimuth: the bilinear taps at a constant offset.
 struct NearTap {
-    int dx, dy;              // offset of the lower-left tap, cells
+    int dx, dy;  // offset of the lower-left tap, cells
     float w00, w10, w01, w11;
-    float invDist;           // 1 / (t cellSize)
+    float invDist;  // 1 / (t cellSize)
 };
 
 struct BlockerRadianceState {
     int nx = 0, ny = 0, nxr = 0, nyr = 0, subsample = 1, azimuths = 0;
-    std::vector<float> farSlope;    // azimuths planes of nxr * nyr: the receivers' horizons (tan), from the scan
-    std::vector<float> heights;     // full-resolution heights with a border of s cells (outside: no blocker)
-    Grid occlusion;                 // O / pi at every texel
-    std::vector<float> receiverOcclusion;            // O / pi at the receivers
+    std::vector<float> farSlope;           // azimuths planes of nxr * nyr: the receivers' horizons (tan), from the scan
+    std::vector<float> heights;            // full-resolution heights with a border of s cells (outside: no blocker)
+    Grid occlusion;                        // O / pi at every texel
+    std::vector<float> receiverOcclusion;  // O / pi at the receivers
     std::array<std::vector<float>, 3> receiverShade;  // E / pi at the receivers, per channel
-    std::vector<float> scratch;     // per block of rows: padded row buffers
-    std::vector<NearTap> taps;      // azimuths x near samples
+    std::vector<float> scratch;                       // per block of rows: padded row buffers
+    std::vector<NearTap> taps;                        // azimuths x near samples
     std::vector<float> cosPhi, sinPhi;
     std::vector<ReceiverLerp> cols;  // per full-resolution column: the receivers it reads
 };

@@ -52,7 +52,8 @@ void addKeyLightExactCosine(const KeyLight& light, const VisibilityField& v, int
     if (!(solidAngle > 0.0)) return;
     const float toFrac = static_cast<float>(std::sqrt(4.0 * kPi) / solidAngle);
     const double az = light.azimuthDeg * kPi / 180.0, el = light.elevationDeg * kPi / 180.0;
-    const float lx = static_cast<float>(std::cos(el) * std::cos(az)), ly = static_cast<float>(std::cos(el) * std::sin(az));
+    const float lx = static_cast<float>(std::cos(el) * std::cos(az)),
+                ly = static_cast<float>(std::cos(el) * std::sin(az));
     const float lz = static_cast<float>(std::sin(el));
     const int nx = st.gradX.nx, ny = st.gradX.ny, nxr = v.nxr, nyr = v.nyr;
     const float* v0 = v.plane(0);
@@ -126,14 +127,20 @@ void computeGradient(ConstGridView h, float cellSize, Grid& gx, Grid& gy) {
             for (int x = 0; x < nx; ++x) {
                 float dx = 0.0f, dy = 0.0f;
                 if (nx > 1) {
-                    if (x == 0) dx = (h(1, y) - h(0, y)) * inv1;
-                    else if (x == nx - 1) dx = (h(x, y) - h(x - 1, y)) * inv1;
-                    else dx = (h(x + 1, y) - h(x - 1, y)) * inv2;
+                    if (x == 0)
+                        dx = (h(1, y) - h(0, y)) * inv1;
+                    else if (x == nx - 1)
+                        dx = (h(x, y) - h(x - 1, y)) * inv1;
+                    else
+                        dx = (h(x + 1, y) - h(x - 1, y)) * inv2;
                 }
                 if (ny > 1) {
-                    if (y == 0) dy = (h(x, 1) - h(x, 0)) * inv1;
-                    else if (y == ny - 1) dy = (h(x, y) - h(x, y - 1)) * inv1;
-                    else dy = (h(x, y + 1) - h(x, y - 1)) * inv2;
+                    if (y == 0)
+                        dy = (h(x, 1) - h(x, 0)) * inv1;
+                    else if (y == ny - 1)
+                        dy = (h(x, y) - h(x, y - 1)) * inv1;
+                    else
+                        dy = (h(x, y + 1) - h(x, y - 1)) * inv2;
                 }
                 gx(x, y) = dx;
                 gy(x, y) = dy;
@@ -196,8 +203,8 @@ void environmentVisibility(const GiSettings& settings, GiState& st) {
     VisibilityTarget envTarget;
     envTarget.op = &st.envOperator;
     envTarget.footprint = footprint ? &st.footprint : nullptr;
-    computeVisibility(st.pyramid, st.gradX.cview(), st.gradY.cview(), settings.visibility, envTarget, st.visibilityState,
-                      st.envVisibility);
+    computeVisibility(st.pyramid, st.gradX.cview(), st.gradY.cview(), settings.visibility, envTarget,
+                      st.visibilityState, st.envVisibility);
 }
 
 // Each key light's own visibility over its azimuthal extent and elevation
@@ -278,14 +285,15 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
     t = Clock::now();
     directShading(lighting, settings, albedo, st);
     st.timings.shading = msSince(t);
-    if (st.indirectUpdated) runIndirectStage(settings, st, albedo);
+    if (st.indirectUpdated)
+        runIndirectStage(settings, st, albedo);
     else if (settings.indirect.bounces > 0)
         sumDirectAndIndirect(st.shade.rgb, st.indirect);  // the last indirect light on the new direct shade
     st.timings.total = msSince(t0);
 }
 
-void shadeKeyLight(const GiState& st, const GiSettings& settings, const GiLighting& lighting, int k,
-                   ShadeMaps& scratch, std::array<Grid, 3>& out) {
+void shadeKeyLight(const GiState& st, const GiSettings& settings, const GiLighting& lighting, int k, ShadeMaps& scratch,
+                   std::array<Grid, 3>& out) {
     if (k < 0 || k >= static_cast<int>(lighting.keys.size()) || k >= static_cast<int>(st.keyVisibility.size()))
         throw InputError("shadeKeyLight: no key light " + std::to_string(k) + " in the last frame");
     const KeyLight& light = lighting.keys[static_cast<std::size_t>(k)];

@@ -5,14 +5,14 @@
 // allocates nothing.
 #include <vector>
 
+#include "core/grid.h"
 #include "gi/indirect.h"
-#include "gi/settings.h"
 #include "gi/lights.h"
 #include "gi/pyramid.h"
+#include "gi/settings.h"
 #include "gi/shading.h"
 #include "gi/visibility.h"
 #include "gi/wedge.h"
-#include "core/grid.h"
 
 namespace terrain::gi {
 
@@ -28,7 +28,7 @@ struct GiTimings {
 };
 
 struct GiState {
-    Grid gradX, gradY;             // full resolution dh/dx, dh/dy (metres per metre)
+    Grid gradX, gradY;  // full resolution dh/dx, dh/dy (metres per metre)
     HeightPyramid pyramid;
     FoldedWedgeOperator envOperator;  // cached for (azimuths, interp)
     int envOperatorAzimuths = -1;
@@ -53,9 +53,9 @@ struct GiState {
     // simulator's change report); with settings.indirect.amortise such frames
     // update the direct and the indirect light alternately.
     bool geometryChanged = true;
-    int amortisePhase = 0;            // next static frame: 0 direct, 1 indirect
-    bool amortiseReady = false;       // a full frame with the current key ran before
-    std::array<int, 7> amortiseKey{}; // nx, ny, subsample, bounces, azimuths, brdf, indirect azimuths of that frame
+    int amortisePhase = 0;             // next static frame: 0 direct, 1 indirect
+    bool amortiseReady = false;        // a full frame with the current key ran before
+    std::array<int, 7> amortiseKey{};  // nx, ny, subsample, bounces, azimuths, brdf, indirect azimuths of that frame
     bool directUpdated = false, indirectUpdated = false;  // what the last frame recomputed
 };
 
@@ -74,7 +74,7 @@ void checkHeightsFinite(ConstGridView heights);
 /// The shade key light k alone gives every texel (white albedo) in the last
 /// frame run on `st`, the way that frame computed it (exact cosine times the
 /// visible fraction, or SH shading of its visibility). scratch is reused.
-void shadeKeyLight(const GiState& st, const GiSettings& settings, const GiLighting& lighting, int k,
-                   ShadeMaps& scratch, std::array<Grid, 3>& out);
+void shadeKeyLight(const GiState& st, const GiSettings& settings, const GiLighting& lighting, int k, ShadeMaps& scratch,
+                   std::array<Grid, 3>& out);
 
 }  // namespace terrain::gi

@@ -20,13 +20,11 @@ constexpr int kMaxBlocks = 64;
 // so float rounding of h costs ~1e-6 relative. The inverses are computed once
 // in double (Gauss-Jordan, partial pivoting).
 struct MirrorTables {
-    static constexpr float kDirs[7][3] = {{-0.784515631f, -0.552553248f, 0.281460715f},
-                                          {-0.971931924f, -0.041938494f, -0.231494056f},
-                                          {0.054143289f, -0.730243560f, -0.681038066f},
-                                          {0.772798188f, -0.028211642f, -0.634024498f},
-                                          {0.081702522f, -0.036083780f, -0.996003343f},
-                                          {0.005037122f, 0.998826450f, 0.048170015f},
-                                          {0.631249704f, 0.383672776f, -0.674031908f}};
+    static constexpr float kDirs[7][3] = {
+        {-0.784515631f, -0.552553248f, 0.281460715f}, {-0.971931924f, -0.041938494f, -0.231494056f},
+        {0.054143289f, -0.730243560f, -0.681038066f}, {0.772798188f, -0.028211642f, -0.634024498f},
+        {0.081702522f, -0.036083780f, -0.996003343f}, {0.005037122f, 0.998826450f, 0.048170015f},
+        {0.631249704f, 0.383672776f, -0.674031908f}};
     float dir[7][3];
     float inv[83];  // band l: (2l+1) x (2l+1) block at offset(l)
     static int offset(int l) { return l == 1 ? 0 : (l == 2 ? 9 : 34); }

@@ -36,9 +36,9 @@
 #include <array>
 #include <vector>
 
+#include "core/grid.h"
 #include "gi/sh.h"
 #include "gi/shading.h"
-#include "core/grid.h"
 
 namespace terrain::gi {
 

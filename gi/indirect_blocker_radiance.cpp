@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "gi/blocker_radiance.h"
 #include "core/parallel.h"
 #include "core/simd.h"
+#include "gi/blocker_radiance.h"
 
 namespace terrain::gi {
 

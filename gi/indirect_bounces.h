@@ -9,11 +9,11 @@
 // bounce; runBounces times them and keeps the sums.
 #include <array>
 
+#include "core/grid.h"
 #include "gi/indirect_inputs.h"
 #include "gi/indirect_settings.h"
 #include "gi/indirect_state.h"
 #include "gi/shading.h"
-#include "core/grid.h"
 
 namespace terrain::gi {
 

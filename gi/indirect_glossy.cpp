@@ -4,11 +4,11 @@
 #include <cmath>
 #include <cstring>
 
-#include "gi/glossy_exit_radiance.h"
-#include "gi/indirect_scan_tables.h"
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/simd.h"
+#include "gi/glossy_exit_radiance.h"
+#include "gi/indirect_scan_tables.h"
 
 namespace terrain::gi {
 

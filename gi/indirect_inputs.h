@@ -3,17 +3,17 @@
 // strategy gets, filled once by the caller (gi/frame.cpp).
 #include <array>
 
+#include "core/grid.h"
 #include "gi/pyramid.h"
 #include "gi/shading.h"
 #include "gi/visibility.h"
 #include "gi/wedge.h"
-#include "core/grid.h"
 
 namespace terrain::gi {
 
 struct IndirectInputs {
-    const HeightPyramid& heights;          // the frame's height pyramid (receiver grid, steps)
-    ConstGridView gradX, gradY;            // full-resolution height gradients
+    const HeightPyramid& heights;   // the frame's height pyramid (receiver grid, steps)
+    ConstGridView gradX, gradY;     // full-resolution height gradients
     const FoldedWedgeOperator& op;  // folded wedge operator of the indirect azimuths (IndirectSettings::azimuths)
     const VisibilityField& envVisibility;  // environment visibility (the shading's ambient map)
     const std::array<Grid, 3>& direct;     // bounce 0's exit radiance (full resolution, albedo applied)

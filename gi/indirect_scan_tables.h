@@ -18,9 +18,9 @@
 #include <functional>
 #include <vector>
 
+#include "core/grid.h"
 #include "gi/pyramid.h"
 #include "gi/visibility.h"
-#include "core/grid.h"
 
 namespace terrain::gi {
 

@@ -36,9 +36,9 @@ enum class LambertIndirect {
 // smooth in azimuth, at about half the scan time of 16
 // (bench/results/gi_indirect_accuracy.md).
 struct IndirectSettings {
-    int bounces = 0;                   // 0: direct light only
+    int bounces = 0;  // 0: direct light only
     RadiancePyramidSettings radiance;
-    bool amortise = false;             // Section 7: alternate direct / indirect on static geometry
+    bool amortise = false;  // Section 7: alternate direct / indirect on static geometry
     GlossyIndirect glossy = GlossyIndirect::ScalarPyramid;
     LambertIndirect lambert = LambertIndirect::BlockerRadiance;  // paper: ShKernel
     // Azimuths of the indirect scan (0: the visibility's m; paper: 0).

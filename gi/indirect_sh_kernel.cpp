@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cstdint>
 
-#include "gi/sh.h"
 #include "core/parallel.h"
 #include "core/simd.h"
+#include "gi/sh.h"
 
 namespace terrain::gi {
 
@@ -50,7 +50,10 @@ void accumulateUSse(const URowSums& r) { accumulateUImpl<F4>(r); }
 }  // namespace
 
 ShKernelIndirect::ShKernelIndirect(const IndirectInputs& in, const IndirectSettings& settings, IndirectState& st)
-    : in_(in), settings_(settings), st_(st), scan_(in, CastingMoments::Nlp, st),
+    : in_(in),
+      settings_(settings),
+      st_(st),
+      scan_(in, CastingMoments::Nlp, st),
       nRows_(in.shading.brdf == Brdf::Lambert ? 9 : kShCount) {}  // Lambert reads bands 0..2 only
 
 void ShKernelIndirect::beginFrame() {
@@ -112,8 +115,16 @@ void ShKernelIndirect::scanBlock(int block) {
             float* uRow[3];
             for (int c = 0; c < 3; ++c)
                 uRow[c] = st_.u[static_cast<std::size_t>(c)].plane(0) + static_cast<std::size_t>(Y) * nxr;
-            accumulate({sc.result.data(), pad, nxr, P, op.patternRow.data(), op.patternNlp.data(), vals, nRows_,
-                        {uRow[0], uRow[1], uRow[2]}, planeR});
+            accumulate({sc.result.data(),
+                        pad,
+                        nxr,
+                        P,
+                        op.patternRow.data(),
+                        op.patternNlp.data(),
+                        vals,
+                        nRows_,
+                        {uRow[0], uRow[1], uRow[2]},
+                        planeR});
         }
     }
 }

@@ -5,12 +5,12 @@
 #include <array>
 #include <vector>
 
+#include "core/grid.h"
 #include "gi/blocker_radiance.h"
 #include "gi/casting_set_scan.h"
 #include "gi/radiance_pyramid.h"
 #include "gi/shading.h"
 #include "gi/visibility.h"
-#include "core/grid.h"
 
 namespace terrain::gi {
 
@@ -20,13 +20,13 @@ struct IndirectTimings {
 
 /// Buffers of the vector-pyramid bounce (GlossyIndirect::VectorPyramid, gi/indirect_glossy.h).
 struct GlossyIndirectState {
-    std::vector<float> exitSh;  // 3 x 16 planes of nx * ny: E at full resolution (plane c * 16 + k)
-    RadiancePyramid pyramid;    // one field per plane of exitSh
-    std::vector<ScanStep> steps;        // azimuths x steps: geometry and weights (field 0)
-    std::vector<const float*> fields;   // azimuths x steps x 48: field + offA of each plane
-    std::vector<float> blockScratch;    // per row block: scan scratch (moments, basis, NLP)
-    std::vector<int> blockList;         // per row block: steps with a new member
-    std::vector<float> rowScratch;      // per row block: interpolated incident SH of one row
+    std::vector<float> exitSh;         // 3 x 16 planes of nx * ny: E at full resolution (plane c * 16 + k)
+    RadiancePyramid pyramid;           // one field per plane of exitSh
+    std::vector<ScanStep> steps;       // azimuths x steps: geometry and weights (field 0)
+    std::vector<const float*> fields;  // azimuths x steps x 48: field + offA of each plane
+    std::vector<float> blockScratch;   // per row block: scan scratch (moments, basis, NLP)
+    std::vector<int> blockList;        // per row block: steps with a new member
+    std::vector<float> rowScratch;     // per row block: interpolated incident SH of one row
 };
 
 struct IndirectState {
@@ -34,14 +34,14 @@ struct IndirectState {
     std::vector<ScanStep> heightSteps;    // azimuths x steps
     std::vector<ScanStep> radianceSteps;  // Lambert strategies: channels x azimuths x steps
     std::vector<int> stepsPerColumn, stepsPerRow;
-    std::vector<IndirectScratch> blocks;  // Lambert strategies: per block of receiver rows
-    std::array<VisibilityField, 3> u;     // U per channel (16 SH planes at the receivers; not with BlockerRadiance)
-    int uZeroFrom = kShCount;             // U's planes from this one on are known to be 0
-    std::array<ShadingLight, 3> lights;   // the shading lights of U
+    std::vector<IndirectScratch> blocks;   // Lambert strategies: per block of receiver rows
+    std::array<VisibilityField, 3> u;      // U per channel (16 SH planes at the receivers; not with BlockerRadiance)
+    int uZeroFrom = kShCount;              // U's planes from this one on are known to be 0
+    std::array<ShadingLight, 3> lights;    // the shading lights of U
     std::array<ShadeMaps, 2> bounceShade;  // exit radiance of the current / previous bounce
-    std::array<Grid, 3> indirect;  // sum of bounces 1..B, full resolution
-    std::array<Grid, 3> total;     // direct + indirect
-    std::vector<double> bounceMean;  // mean exit radiance (RGB average) of each bounce
+    std::array<Grid, 3> indirect;          // sum of bounces 1..B, full resolution
+    std::array<Grid, 3> total;             // direct + indirect
+    std::vector<double> bounceMean;        // mean exit radiance (RGB average) of each bounce
     IndirectTimings timings;
     GlossyIndirectState glossy;    // GlossyIndirect::VectorPyramid
     BlockerRadianceState blocker;  // LambertIndirect::BlockerRadiance: horizons, occlusion, receivers' E

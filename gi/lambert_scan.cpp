@@ -24,7 +24,11 @@ float fieldTopHeight(const HeightPyramid& pyr) {
 }  // namespace
 
 LambertScan::LambertScan(const IndirectInputs& in, CastingMoments moments, IndirectState& st)
-    : in_(in), st_(st), moments_(moments), castRow_(castRowFor(moments)), pad_(indirectRowPad(in.heights.nxr)),
+    : in_(in),
+      st_(st),
+      moments_(moments),
+      castRow_(castRowFor(moments)),
+      pad_(indirectRowPad(in.heights.nxr)),
       nSteps_(static_cast<int>(in.heights.steps.size())),
       nBlocks_(std::max(1, (in.heights.nyr + kRowsPerBlock - 1) / kRowsPerBlock)),
       tableSize_(static_cast<std::size_t>(in.op.azimuths) * nSteps_) {}

@@ -13,11 +13,11 @@
 #include <array>
 #include <cstddef>
 
+#include "core/grid.h"
 #include "gi/casting_set_scan.h"
 #include "gi/indirect_inputs.h"
 #include "gi/indirect_state.h"
 #include "gi/radiance_pyramid.h"
-#include "core/grid.h"
 
 namespace terrain::gi {
 

@@ -80,7 +80,8 @@ void validateKeyLight(const KeyLight& k) {
     auto bad = [](float v) { return !std::isfinite(v); };
     if (bad(k.azimuthDeg) || bad(k.elevationDeg) || bad(k.radiusDeg) || bad(k.rgb[0]) || bad(k.rgb[1]) || bad(k.rgb[2]))
         throw InputError("key light: values must be finite");
-    if (k.elevationDeg < -90.0f || k.elevationDeg > 90.0f) throw InputError("key light: elevation must be in [-90, 90] degrees");
+    if (k.elevationDeg < -90.0f || k.elevationDeg > 90.0f)
+        throw InputError("key light: elevation must be in [-90, 90] degrees");
     if (k.radiusDeg <= 0.0f || k.radiusDeg >= 90.0f) throw InputError("key light: radius must be in (0, 90) degrees");
     if (k.rgb[0] < 0.0f || k.rgb[1] < 0.0f || k.rgb[2] < 0.0f) throw InputError("key light: R,G,B must be >= 0");
 }

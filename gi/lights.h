@@ -38,7 +38,7 @@ struct SunSkySettings {
     float sunAzimuthDeg = 135.0f;
     float sunElevationDeg = 35.0f;
     float sun[3] = {3.0f, 2.8f, 2.5f};  // peak radiance of the sun lobe
-    float sunSharpness = 40.0f;          // lobe exp(k (cos - 1))
+    float sunSharpness = 40.0f;         // lobe exp(k (cos - 1))
 };
 /// Sky gradient (horizon to zenith, linear in sin(elevation)) plus a smooth
 /// sun lobe, projected by dense quadrature.
@@ -49,9 +49,9 @@ ShRgb sunSkyLight(const SunSkySettings& s = {});
 ShRgb projectEquirect(const std::vector<float>& rgb, int width, int height);
 
 struct KeyLight {
-    float azimuthDeg = 0.0f;    // from +x towards +y
-    float elevationDeg = 45.0f; // from the horizon up
-    float radiusDeg = 5.0f;     // angular radius of the cap (> 0, < 90)
+    float azimuthDeg = 0.0f;     // from +x towards +y
+    float elevationDeg = 45.0f;  // from the horizon up
+    float radiusDeg = 5.0f;      // angular radius of the cap (> 0, < 90)
     float rgb[3] = {1.0f, 1.0f, 1.0f};
 };
 
@@ -60,7 +60,7 @@ ShRgb keyLightSh(const KeyLight& k);
 
 /// Azimuthal extent and elevation interval of a key light (Section 6).
 struct KeyLightExtent {
-    double phiStart = 0.0, phiEnd = 0.0;  // radians
+    double phiStart = 0.0, phiEnd = 0.0;   // radians
     float sinLow = -1.0f, sinHigh = 1.0f;  // sines of the elevation interval
 };
 KeyLightExtent keyLightExtent(const KeyLight& k);

@@ -28,9 +28,9 @@ void nlpEvaluate(double z, double out[kNlpCount]);
 template <class T>
 inline void nlpOcclusion(T s, T out[kNlpCount]) {
     const T c2 = T(1) - s * s;
-    out[0] = (s + T(1)) * T(0.70710678118654752440);          // 1/sqrt2
-    out[1] = T(-0.61237243569579452455) * c2;                  // 3/(2 sqrt6)
-    out[2] = T(-0.79056941504209483300) * s * c2;              // 5/(2 sqrt10)
+    out[0] = (s + T(1)) * T(0.70710678118654752440);               // 1/sqrt2
+    out[1] = T(-0.61237243569579452455) * c2;                      // 3/(2 sqrt6)
+    out[2] = T(-0.79056941504209483300) * s * c2;                  // 5/(2 sqrt10)
     out[3] = T(0.23385358667337133659) * c2 * (T(5) * c2 - T(4));  // 7/(8 sqrt14)
 }
 

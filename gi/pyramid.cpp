@@ -58,8 +58,7 @@ void synthesisTaps(int receivers, int subsample, int octave, int octaveSize, int
         const double u = (subsample * X + 0.5) / scale - 0.5;
         const double k0 = std::floor(u);
         bsplineWeights(static_cast<float>(u - k0), weight + 4 * X);
-        for (int k = 0; k < 4; ++k)
-            index[4 * X + k] = std::clamp(static_cast<int>(k0) - 1 + k, 0, octaveSize - 1);
+        for (int k = 0; k < 4; ++k) index[4 * X + k] = std::clamp(static_cast<int>(k0) - 1 + k, 0, octaveSize - 1);
     }
 }
 

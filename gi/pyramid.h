@@ -53,7 +53,7 @@ inline constexpr std::ptrdiff_t kFieldGuard = 32;
 /// One sampled field: a row-major grid padded with one replicated column and
 /// row so bilinear reads at the last sample stay in bounds.
 struct PaddedField {
-    int nx = 0, ny = 0;        // logical size
+    int nx = 0, ny = 0;         // logical size
     std::ptrdiff_t stride = 0;  // nx + 1
     std::vector<float> v;       // guard + (nx + 1) * (ny + 1) + guard
     void resize(int w, int h);
@@ -65,17 +65,17 @@ struct PaddedField {
 };
 
 struct PyramidStep {
-    double tauCells = 1.0;   // distance in full-resolution cells (Eq. 14)
+    double tauCells = 1.0;     // distance in full-resolution cells (Eq. 14)
     float invTauWorld = 1.0f;  // 1 / (tau * cellSize)
-    int level = -1;          // -1: raw heights, else index into levels
+    int level = -1;            // -1: raw heights, else index into levels
 };
 
 struct HeightPyramid {
     // Geometry of this build.
-    int nx = 0, ny = 0;           // full resolution
-    int subsample = 1;            // receiver spacing in cells (1, 2, 4)
-    int nxr = 0, nyr = 0;         // receiver grid: receiver (X, Y) sits at cell (s X, s Y)
-    float cellSize = 1.0f;        // metres
+    int nx = 0, ny = 0;     // full resolution
+    int subsample = 1;      // receiver spacing in cells (1, 2, 4)
+    int nxr = 0, nyr = 0;   // receiver grid: receiver (X, Y) sits at cell (s X, s Y)
+    float cellSize = 1.0f;  // metres
     PyramidSettings settings;
     std::vector<PyramidStep> steps;  // n_v steps
 

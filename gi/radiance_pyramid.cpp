@@ -16,7 +16,8 @@ void matchSteps(const HeightPyramid& heights, const RadiancePyramidSettings& s, 
     p.steps.resize(heights.steps.size());
     for (std::size_t i = 0; i < heights.steps.size(); ++i) {
         PyramidStep st = heights.steps[i];
-        const int l = static_cast<int>(std::lround(s.levelsPerOctave * std::log2(st.tauCells))) - s.levelsPerOctave * s.levelOffset;
+        const int l = static_cast<int>(std::lround(s.levelsPerOctave * std::log2(st.tauCells))) -
+                      s.levelsPerOctave * s.levelOffset;
         st.level = l < 0 || nLevels == 0 ? -1 : std::min(l, nLevels - 1);
         p.steps[i] = st;
     }
@@ -39,7 +40,8 @@ void buildRadiancePyramid(const std::array<Grid, 3>& radiance, const HeightPyram
     // the channels side by side (each build's own row loops are parallel too)
     parallelFor(0, 3, 1, [&](int c0, int c1) {
         for (int c = c0; c < c1; ++c)
-            buildOne(radiance[static_cast<std::size_t>(c)].cview(), heights, settings, out.fields[static_cast<std::size_t>(c)]);
+            buildOne(radiance[static_cast<std::size_t>(c)].cview(), heights, settings,
+                     out.fields[static_cast<std::size_t>(c)]);
     });
 }
 

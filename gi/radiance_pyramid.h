@@ -19,8 +19,8 @@
 #include <array>
 #include <vector>
 
-#include "gi/pyramid.h"
 #include "core/grid.h"
+#include "gi/pyramid.h"
 
 namespace terrain::gi {
 

@@ -8,9 +8,9 @@
 #include <mutex>
 #include <vector>
 
+#include "core/parallel.h"
 #include "gi/frame.h"
 #include "gi/visibility.h"
-#include "core/parallel.h"
 
 namespace terrain::gi {
 
@@ -194,8 +194,10 @@ double referenceMaxSlope(ConstGridView h, float cellSize, int x, int y, double c
         // nothing farther can beat the current slope
         if (best > 0.0 && heightMax - h0 <= best * t * cellSize) return best;
         tPrev = t;
-        if (tx <= ty) tx += dtx;
-        else ty += dty;
+        if (tx <= ty)
+            tx += dtx;
+        else
+            ty += dty;
         if (t > 4.0 * (xmax + ymax + 2.0)) break;
     }
     return best;
@@ -214,8 +216,9 @@ void renderReference(ConstGridView heights, float cellSize, const ShRgb* lightin
     for (int y = 0; y < ny; ++y)
         for (int x = 0; x < nx; ++x) heightMax = std::max(heightMax, static_cast<double>(heights(x, y)));
     const ReferenceAzimuths azimuths(M);
-    const ReferenceTexels texels{heights, cellSize, gx, gy, heightMax, azimuths,
-                                 lighting ? &elevationTables() : nullptr, lighting, albedo, 2.0 * kPi / M, out};
+    const ReferenceTexels texels{
+        heights, cellSize,      gx, gy, heightMax, azimuths, lighting ? &elevationTables() : nullptr, lighting,
+        albedo,  2.0 * kPi / M, out};
     const int stride = std::max(rs.stride, 1);
     const int yBegin = rs.border, yEnd = ny - rs.border;
     const int rowsTotal = std::max(0, (yEnd - yBegin + stride - 1) / stride);

@@ -20,22 +20,22 @@
 #include <array>
 #include <atomic>
 
+#include "core/grid.h"
 #include "gi/lights.h"
 #include "gi/shading.h"
-#include "core/grid.h"
 
 namespace terrain::gi {
 
 struct ReferenceSettings {
-    int azimuths = 256;       // M (>= 256 for the accuracy claims)
-    int border = 0;           // texels left out at each border (their outputs are 0)
-    int stride = 1;           // compute every stride-th texel in x and y (others 0)
-    bool progress = false;    // print progress to stderr on long runs
+    int azimuths = 256;     // M (>= 256 for the accuracy claims)
+    int border = 0;         // texels left out at each border (their outputs are 0)
+    int stride = 1;         // compute every stride-th texel in x and y (others 0)
+    bool progress = false;  // print progress to stderr on long runs
 };
 
 struct ReferenceResult {
-    Grid ambient;               // normal-weighted sky-view factor (uniform unit sky)
-    std::array<Grid, 3> rgb;    // Lambert shade under `lighting` (when given)
+    Grid ambient;             // normal-weighted sky-view factor (uniform unit sky)
+    std::array<Grid, 3> rgb;  // Lambert shade under `lighting` (when given)
 };
 
 /// Renders the ground truth. `lighting` may be null (ambient only).

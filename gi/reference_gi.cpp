@@ -6,9 +6,9 @@
 #include <cstdio>
 #include <vector>
 
-#include "gi/frame.h"
 #include "core/error.h"
 #include "core/parallel.h"
+#include "gi/frame.h"
 
 namespace terrain::gi {
 namespace {
@@ -29,8 +29,8 @@ inline float bilinearF(const float* v, int nx, int ny, float px, float py) {
 
 }  // namespace
 
-bool referenceFirstHit(const float* h, int nx, int ny, float hMax, float cellSize, int x, int y, const std::array<float, 3>& d,
-              float step, float& hx, float& hy) {
+bool referenceFirstHit(const float* h, int nx, int ny, float hMax, float cellSize, int x, int y,
+                       const std::array<float, 3>& d, float step, float& hx, float& hy) {
     const float horiz = std::sqrt(d[0] * d[0] + d[1] * d[1]);
     if (horiz < 1e-6f) return d[2] < 0.0f ? (hx = static_cast<float>(x), hy = static_cast<float>(y), true) : false;
     const float dx = d[0] / horiz, dy = d[1] / horiz;
@@ -64,9 +64,11 @@ void addReferenceKeyLight(ConstGridView heights, float cellSize, const KeyLight&
     for (Grid& g : rgb) g.ensureSize(nx, ny);
     const int A = std::max(azimuths, 1);
     const KeyLightExtent ext = keyLightExtent(key);
-    const double r = key.radiusDeg * kPi / 180.0, el = key.elevationDeg * kPi / 180.0, az = key.azimuthDeg * kPi / 180.0;
+    const double r = key.radiusDeg * kPi / 180.0, el = key.elevationDeg * kPi / 180.0,
+                 az = key.azimuthDeg * kPi / 180.0;
     const double cosR = std::cos(r), sr = std::sin(r);
-    const double radianceScale = 1.0 / (sr * sr);  // cap radiance = RGB / sin^2(r): irradiance ~ pi RGB at normal incidence
+    const double radianceScale =
+        1.0 / (sr * sr);  // cap radiance = RGB / sin^2(r): irradiance ~ pi RGB at normal incidence
     // per azimuth: the cap's elevation chord [lo, hi] (A sin w + B cos w >= cos r)
     struct Az {
         double c, s, lo, hi;
@@ -128,8 +130,8 @@ void referenceDirections(int count, std::vector<std::array<float, 3>>& out) {
         const double z = 1.0 - (2.0 * k + 1.0) / count;
         const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
         const double phi = golden * k;
-        out[static_cast<std::size_t>(k)] = {static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)),
-                                            static_cast<float>(z)};
+        out[static_cast<std::size_t>(k)] = {static_cast<float>(r * std::cos(phi)),
+                                            static_cast<float>(r * std::sin(phi)), static_cast<float>(z)};
     }
 }
 
@@ -160,8 +162,10 @@ void gatherReferenceBounce(ConstGridView heights, float cellSize, const std::arr
                     const float cosine = n0 * dir[0] + n1 * dir[1] + n2 * dir[2];
                     if (cosine <= 0.0f) continue;
                     float qx, qy;
-                    if (!referenceFirstHit(hCopy.data(), nx, ny, hMax, cellSize, x, y, dir, s.marchStep, qx, qy)) continue;
-                    const float k = s.shLambert ? 0.25f + 0.5f * cosine + 0.15625f * (3.0f * cosine * cosine - 1.0f) : cosine;
+                    if (!referenceFirstHit(hCopy.data(), nx, ny, hMax, cellSize, x, y, dir, s.marchStep, qx, qy))
+                        continue;
+                    const float k =
+                        s.shLambert ? 0.25f + 0.5f * cosine + 0.15625f * (3.0f * cosine * cosine - 1.0f) : cosine;
                     for (int c = 0; c < 3; ++c) e[c] += k * bilinearF(prev[c].data(), nx, ny, qx, qy);
                 }
                 for (int c = 0; c < 3; ++c) {

@@ -16,19 +16,19 @@
 #include <array>
 #include <vector>
 
+#include "core/grid.h"
 #include "gi/lights.h"
 #include "gi/reference.h"
 #include "gi/shading.h"
-#include "core/grid.h"
 
 namespace terrain::gi {
 
 struct ReferenceGiSettings {
-    int directions = 2048;    // K: fixed set over the sphere (Fibonacci), shared by every texel
-    int bounces = 1;          // indirect bounces after the direct one
-    int azimuths = 256;       // of the direct (bounce 0) reference
-    float marchStep = 0.5f;   // march step along the ray, in cells
-    bool progress = false;    // progress on stderr
+    int directions = 2048;   // K: fixed set over the sphere (Fibonacci), shared by every texel
+    int bounces = 1;         // indirect bounces after the direct one
+    int azimuths = 256;      // of the direct (bounce 0) reference
+    float marchStep = 0.5f;  // march step along the ray, in cells
+    bool progress = false;   // progress on stderr
     // Key lights as exact spherical caps (radiance RGB / sin^2(radius) inside
     // the cap, 0 outside): exact visibility per azimuth across the cap's
     // azimuthal extent and the exact elevation integral of the cap's chord
@@ -41,7 +41,7 @@ struct ReferenceGiSettings {
     // still 0 below the tangent plane), instead of max(0, c): isolates the
     // order-4 SH truncation of indirect light (a floor for the fast path).
     bool shLambert = false;
-    int keyAzimuths = 48;     // midpoint azimuths across each cap's extent
+    int keyAzimuths = 48;  // midpoint azimuths across each cap's extent
     // BRDF of every texel. Lambert (default): the scalar gathering above.
     // Phong / LambertPlusPhong: the glossy reference (renderReferenceGlossy).
     ShadingSettings shading;
@@ -83,13 +83,14 @@ void renderReferenceGlossy(ConstGridView heights, float cellSize, const ShRgb& l
 /// I_0 of the glossy reference: per texel the exact incident radiance of the
 /// SH `lighting` through the exact visibility, projected to order-4 SH
 /// (out: 3 x 16 planes of nx * ny, plane c * 16 + i).
-void referenceIncidentSh(ConstGridView heights, float cellSize, const ShRgb& lighting, int azimuths, std::vector<float>& out);
+void referenceIncidentSh(ConstGridView heights, float cellSize, const ShRgb& lighting, int azimuths,
+                         std::vector<float>& out);
 
 /// First hit of the ray from grid point (x, y) (at its height) in direction d
 /// through the bilinear height field; false when it escapes. Positions in
 /// cells, heights in metres; hMax the field's maximum.
-bool referenceFirstHit(const float* h, int nx, int ny, float hMax, float cellSize, int x, int y, const std::array<float, 3>& d,
-                       float step, float& hx, float& hy);
+bool referenceFirstHit(const float* h, int nx, int ny, float hMax, float cellSize, int x, int y,
+                       const std::array<float, 3>& d, float step, float& hx, float& hy);
 
 /// Bounce 0 of both references: the exact direct reference (gi/reference.h)
 /// of the SH `lighting` with settings.azimuths and settings.progress.

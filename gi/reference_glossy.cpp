@@ -7,10 +7,10 @@
 #include <cstdio>
 #include <vector>
 
-#include "gi/frame.h"
-#include "gi/reference_gi.h"
 #include "core/error.h"
 #include "core/parallel.h"
+#include "gi/frame.h"
+#include "gi/reference_gi.h"
 
 namespace terrain::gi {
 
@@ -38,7 +38,8 @@ struct PairTables {
                     double A[kShCount];
                     for (int i = 0; i < kShCount; ++i) A[i] = shAssociated(i, sw);
                     for (int i = 0; i < kShCount; ++i)
-                        for (int j = 0; j < kShCount; ++j) acc[static_cast<std::size_t>(i * kShCount + j)] += wt * A[i] * A[j];
+                        for (int j = 0; j < kShCount; ++j)
+                            acc[static_cast<std::size_t>(i * kShCount + j)] += wt * A[i] * A[j];
                 }
             }
             std::copy(acc.begin(), acc.end(), t.begin() + static_cast<std::ptrdiff_t>(k) * kShCount * kShCount);
@@ -153,8 +154,7 @@ void directBounce(ConstGridView heights, float cellSize, const ShRgb& lighting, 
         prevD[c].resize(nx, ny);
         out.direct[c].resize(nx, ny);
         out.indirect[c].resize(nx, ny, 0.0f);
-        for (std::size_t i = 0; i < plane; ++i)
-            prevD[c].v[i] = static_cast<float>(wd * d.rgb[c].v[i] + keys[c].v[i]);
+        for (std::size_t i = 0; i < plane; ++i) prevD[c].v[i] = static_cast<float>(wd * d.rgb[c].v[i] + keys[c].v[i]);
     }
 }
 
@@ -256,7 +256,8 @@ void gatherTexel(const GlossyGather& g, const std::array<Grid, 3>& prevD, const 
 
 }  // namespace
 
-void referenceIncidentSh(ConstGridView heights, float cellSize, const ShRgb& lighting, int azimuths, std::vector<float>& out) {
+void referenceIncidentSh(ConstGridView heights, float cellSize, const ShRgb& lighting, int azimuths,
+                         std::vector<float>& out) {
     const int nx = heights.nx, ny = heights.ny, M = std::max(azimuths, 1);
     const std::size_t plane = static_cast<std::size_t>(nx) * ny;
     out.assign(plane * 3 * kShCount, 0.0f);
@@ -284,7 +285,8 @@ void referenceIncidentSh(ConstGridView heights, float cellSize, const ShRgb& lig
         for (int c = 0; c < 3; ++c)
             for (int q = 0; q < nj; ++q)
                 lam[(static_cast<std::size_t>(a) * 3 + c) * kShCount + q] =
-                    shAzimuthal(js[static_cast<std::size_t>(q)], phi) * lighting.c[static_cast<std::size_t>(c)][static_cast<std::size_t>(js[static_cast<std::size_t>(q)])];
+                    shAzimuthal(js[static_cast<std::size_t>(q)], phi) *
+                    lighting.c[static_cast<std::size_t>(c)][static_cast<std::size_t>(js[static_cast<std::size_t>(q)])];
     }
     const PairTables& tables = pairTables();
     const double dphi = 2.0 * kPi / M;
@@ -304,15 +306,16 @@ void referenceIncidentSh(ConstGridView heights, float cellSize, const ShRgb& lig
                         for (int ch = 0; ch < 3; ++ch) {
                             double acc = 0.0;
                             for (int q = 0; q < nj; ++q)
-                                acc += pp[static_cast<std::size_t>(i * kShCount + js[static_cast<std::size_t>(q)])] * la[ch * kShCount + q];
+                                acc += pp[static_cast<std::size_t>(i * kShCount + js[static_cast<std::size_t>(q)])] *
+                                       la[ch * kShCount + q];
                             I[ch][i] += ti * acc;
                         }
                     }
                 }
                 for (int ch = 0; ch < 3; ++ch)
                     for (int i = 0; i < kShCount; ++i)
-                        out[static_cast<std::size_t>(ch * kShCount + i) * plane + static_cast<std::size_t>(y) * nx + x] =
-                            static_cast<float>(I[ch][i]);
+                        out[static_cast<std::size_t>(ch * kShCount + i) * plane + static_cast<std::size_t>(y) * nx +
+                            x] = static_cast<float>(I[ch][i]);
             }
     });
 }
@@ -345,7 +348,8 @@ void renderReferenceGlossy(ConstGridView heights, float cellSize, const ShRgb& l
         std::vector<std::array<float, 3>> dirs;
         referenceDirections(s.directions, dirs);
         std::vector<double> dirBasis(dirs.size() * kShCount);
-        for (std::size_t k = 0; k < dirs.size(); ++k) basis(dirs[k][0], dirs[k][1], dirs[k][2], &dirBasis[k * kShCount]);
+        for (std::size_t k = 0; k < dirs.size(); ++k)
+            basis(dirs[k][0], dirs[k][1], dirs[k][2], &dirBasis[k * kShCount]);
         const GlossyGather gather{surf, hCopy, hMax, cellSize, s, dirs, dirBasis, 4.0 * kPi / s.directions, ws, wd};
         for (int b = 1; b <= s.bounces; ++b) {
             if (s.progress) std::fprintf(stderr, "glossy reference: bounce %d of %d\n", b, s.bounces);

@@ -14,10 +14,10 @@
 namespace terrain::gi {
 
 struct GiSettings {
-    int subsample = 1;          // 1, 2 or 4: visibility on the (N/s)^2 receiver grid (Fig. 7)
+    int subsample = 1;  // 1, 2 or 4: visibility on the (N/s)^2 receiver grid (Fig. 7)
     PyramidSettings pyramid;
     VisibilitySettings visibility;
-    int keyLightAzimuths = 3;   // azimuth samples per key light (Nowrouzezahrai & Snyder 2009, Section 9)
+    int keyLightAzimuths = 3;  // azimuth samples per key light (Nowrouzezahrai & Snyder 2009, Section 9)
     // Key lights shaded with the exact cosine: albedo RGB f max(0, N . l), f the
     // visible fraction of the light's region (V_key's band-0 coefficient times
     // sqrt(4 pi) over the region's solid angle), instead of V_key dotted with

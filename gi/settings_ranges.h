@@ -38,7 +38,8 @@ inline constexpr SettingRange<int> kLevelsPerOctave{"levels per octave", 1, 64, 
 inline constexpr SettingRange<int> kLevelOffset{"level offset", 0, 32, "Height pyramid level offset o_v, octaves"};
 inline constexpr SettingRange<float> kPeakBlend{"peak blend", 0.0f, 1.0f,
                                                 "Share of max-decimated octaves in the height pyramid"};
-inline constexpr SettingRange<int> kKeyLightAzimuths{"key light azimuths", 2, 256, "Azimuths over a key light's extent"};
+inline constexpr SettingRange<int> kKeyLightAzimuths{"key light azimuths", 2, 256,
+                                                     "Azimuths over a key light's extent"};
 inline constexpr SettingRange<float> kPhongExponent{"Phong exponent", 0.01f, 10000.0f, "Phong exponent S"};
 inline constexpr SettingRange<float> kSpecularWeight{"specular weight", 0.0f, 1.0f,
                                                      "Weight of the Phong lobe in the Lambert + Phong mixture"};

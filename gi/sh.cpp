@@ -11,9 +11,9 @@ namespace {
 // Normalisation constants of the cartesian forms.
 const double kY00 = 0.5 * std::sqrt(1.0 / kPi);
 const double kY1 = std::sqrt(3.0 / (4.0 * kPi));
-const double kY2a = 0.5 * std::sqrt(15.0 / kPi);    // xy, yz, xz
-const double kY20 = 0.25 * std::sqrt(5.0 / kPi);    // 3z^2 - 1
-const double kY22 = 0.25 * std::sqrt(15.0 / kPi);   // x^2 - y^2
+const double kY2a = 0.5 * std::sqrt(15.0 / kPi);   // xy, yz, xz
+const double kY20 = 0.25 * std::sqrt(5.0 / kPi);   // 3z^2 - 1
+const double kY22 = 0.25 * std::sqrt(15.0 / kPi);  // x^2 - y^2
 const double kY33 = 0.25 * std::sqrt(35.0 / (2.0 * kPi));
 const double kY32a = 0.5 * std::sqrt(105.0 / kPi);  // xyz
 const double kY31 = 0.25 * std::sqrt(21.0 / (2.0 * kPi));
@@ -169,7 +169,8 @@ const double* shTripleProductTensor() {
                 for (int i = 0; i < kShCount; ++i)
                     for (int j = 0; j < kShCount; ++j)
                         for (int k = 0; k < kShCount; ++k)
-                            tensor[static_cast<std::size_t>((i * kShCount + j) * kShCount + k)] += w * y[i] * y[j] * y[k];
+                            tensor[static_cast<std::size_t>((i * kShCount + j) * kShCount + k)] +=
+                                w * y[i] * y[j] * y[k];
             }
         }
         for (double& t : tensor)
@@ -184,7 +185,8 @@ ShMatrix shProductMatrix(const ShVector& light) {
     for (int i = 0; i < kShCount; ++i)
         for (int k = 0; k < kShCount; ++k) {
             double s = 0.0;
-            for (int j = 0; j < kShCount; ++j) s += c[(i * kShCount + j) * kShCount + k] * light[static_cast<std::size_t>(j)];
+            for (int j = 0; j < kShCount; ++j)
+                s += c[(i * kShCount + j) * kShCount + k] * light[static_cast<std::size_t>(j)];
             t[static_cast<std::size_t>(i * kShCount + k)] = s;
         }
     return t;

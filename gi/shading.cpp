@@ -15,7 +15,8 @@ namespace terrain::gi {
 LambertFactors lambertFactors() {
     double lamZh[3];
     for (int l = 0; l < 3; ++l) lamZh[l] = std::sqrt(4.0 * kPi / (2.0 * l + 1.0)) * lambertZonal()[l] / kPi;
-    const float lam0 = static_cast<float>(lamZh[0]), lam1 = static_cast<float>(lamZh[1]), lam2 = static_cast<float>(lamZh[2]);
+    const float lam0 = static_cast<float>(lamZh[0]), lam1 = static_cast<float>(lamZh[1]),
+                lam2 = static_cast<float>(lamZh[2]);
     return {lam0 * 0.28209479177387814f, lam1 * 0.48860251190291992f, lam2 * 1.0925484305920792f,
             lam2 * 0.31539156525252005f, lam2 * 0.54627421529603959f};
 }
@@ -29,8 +30,9 @@ void phongLobeFactors(double exponent, float ph[kShOrder]) {
 void setPhongExponentMap(AlbedoMap& map, const Grid& exponent) {
     for (std::size_t i = 0; i < exponent.v.size(); ++i)
         if (!(exponent.v[i] >= kMinPhongExponent && exponent.v[i] <= kMaxPhongExponent))
-            throw InputError("Phong exponent map: value " + std::to_string(exponent.v[i]) + " at index " + std::to_string(i) +
-                             " is not in [" + std::to_string(kMinPhongExponent) + ", " + std::to_string(kMaxPhongExponent) + "]");
+            throw InputError("Phong exponent map: value " + std::to_string(exponent.v[i]) + " at index " +
+                             std::to_string(i) + " is not in [" + std::to_string(kMinPhongExponent) + ", " +
+                             std::to_string(kMaxPhongExponent) + "]");
     map.phongExponent = exponent;
     for (Grid& g : map.phongLobe) g.resize(exponent.nx, exponent.ny);
     for (std::size_t i = 0; i < exponent.v.size(); ++i) {
@@ -78,15 +80,18 @@ template <class V, int S>
 // Each texel: lam(N) . I_c for the channels, lam(N) . V_env for the ambient
 // map, with lam the clamped-cosine zonal vector turned to the texel's normal.
 template <class V, int S>
-[[gnu::always_inline]] inline void lambertRowS(const float* vert, int nxrS, int nxr, int nCoef, const float* gxr, const float* gyr, const int* colIndex,
-                 const float* colFrac, const LambertFactors& lf, float diffuseWeight, const AlbedoMap* albedo, int y,
-                 int nx, ShadeMaps& out) {
+[[gnu::always_inline]] inline void lambertRowS(const float* vert, int nxrS, int nxr, int nCoef, const float* gxr,
+                                               const float* gyr, const int* colIndex, const float* colFrac,
+                                               const LambertFactors& lf, float diffuseWeight, const AlbedoMap* albedo,
+                                               int y, int nx, ShadeMaps& out) {
     float* amb = out.ambient.empty() ? nullptr : out.ambient.data() + static_cast<std::size_t>(y) * nx;
     float* rgb[3];
     const float* alb[3];
     for (int ch = 0; ch < 3; ++ch) {
         rgb[ch] = out.rgb[static_cast<std::size_t>(ch)].data() + static_cast<std::size_t>(y) * nx;
-        const Grid* a = albedo && !albedo->channel[static_cast<std::size_t>(ch)].empty() ? &albedo->channel[static_cast<std::size_t>(ch)] : nullptr;
+        const Grid* a = albedo && !albedo->channel[static_cast<std::size_t>(ch)].empty()
+                            ? &albedo->channel[static_cast<std::size_t>(ch)]
+                            : nullptr;
         alb[ch] = a ? a->data() + static_cast<std::size_t>(y) * nx : nullptr;
     }
     // texels [0, xVec) take the vector path: all of x .. x+L-1 below s (nxr - 1)
@@ -105,7 +110,8 @@ template <class V, int S>
         V acc = splat<V>(0.0f), oc[3] = {splat<V>(0.0f), splat<V>(0.0f), splat<V>(0.0f)};
         for (int i = 0; i < 9; ++i) {
             if (amb) acc += lam[i] * expandV<V, S>(vert + static_cast<std::size_t>(3 * nCoef + i) * nxrS, x);
-            for (int ch = 0; ch < 3; ++ch) oc[ch] += lam[i] * expandV<V, S>(vert + static_cast<std::size_t>(ch * nCoef + i) * nxrS, x);
+            for (int ch = 0; ch < 3; ++ch)
+                oc[ch] += lam[i] * expandV<V, S>(vert + static_cast<std::size_t>(ch * nCoef + i) * nxrS, x);
         }
         if (amb) store(amb + x, acc);
         for (int ch = 0; ch < 3; ++ch) {
@@ -146,7 +152,7 @@ template <class V, int S>
 // One full-resolution Lambert row: the SH planes interpolated vertically at
 // the receivers (Fig. 7), then lambertRowS.
 struct LambertRowJob {
-    const float* incident;  // 3 nCoef planes at the receivers
+    const float* incident;       // 3 nCoef planes at the receivers
     const VisibilityField* env;  // V_env (ambient); null: no ambient map
     std::size_t planeR;
     int nxr, nyr, nxrS, s, nCoef, nx;
@@ -167,7 +173,8 @@ template <class V>
     const int nv = j.nxr / L * L;
     const V fy = splat<V>(ry.f);
     for (int p = 0; p < nPlanes; ++p) {
-        const float* plane = p < 3 * j.nCoef ? j.incident + static_cast<std::size_t>(p) * j.planeR : j.env->plane(p - 3 * j.nCoef);
+        const float* plane =
+            p < 3 * j.nCoef ? j.incident + static_cast<std::size_t>(p) * j.planeR : j.env->plane(p - 3 * j.nCoef);
         const float* __restrict ra = plane + static_cast<std::size_t>(ry.i0) * j.nxr;
         const float* __restrict rb = plane + static_cast<std::size_t>(ry.i1) * j.nxr;
         float* __restrict v = vert + static_cast<std::size_t>(p) * j.nxrS;
@@ -180,18 +187,21 @@ template <class V>
     }
     auto row = [&](auto sTag) {
         constexpr int S = decltype(sTag)::value;
-        lambertRowS<V, S>(vert, j.nxrS, j.nxr, j.nCoef, gxr, gyr, j.colIndex, j.colFrac, j.lf,
-                          j.diffuseWeight, j.albedo, y, j.nx, *j.out);
+        lambertRowS<V, S>(vert, j.nxrS, j.nxr, j.nCoef, gxr, gyr, j.colIndex, j.colFrac, j.lf, j.diffuseWeight,
+                          j.albedo, y, j.nx, *j.out);
     };
-    if (j.s == 1) row(std::integral_constant<int, 1>{});
-    else if (j.s == 2) row(std::integral_constant<int, 2>{});
-    else row(std::integral_constant<int, 4>{});
+    if (j.s == 1)
+        row(std::integral_constant<int, 1>{});
+    else if (j.s == 2)
+        row(std::integral_constant<int, 2>{});
+    else
+        row(std::integral_constant<int, 4>{});
 }
 void lambertShadeRowSse(const LambertRowJob& j, float* vert, const float* gxr, const float* gyr, int y) {
     lambertShadeRowImpl<F4>(j, vert, gxr, gyr, y);
 }
 [[gnu::target("avx2"), gnu::flatten]] void lambertShadeRowAvx2(const LambertRowJob& j, float* vert, const float* gxr,
-                                                                const float* gyr, int y) {
+                                                               const float* gyr, int y) {
     lambertShadeRowImpl<F8>(j, vert, gxr, gyr, y);
 }
 
@@ -199,8 +209,8 @@ void lambertShadeRowSse(const LambertRowJob& j, float* vert, const float* gxr, c
 // 16 receivers at a time: the lights' V vectors are read once, each output
 // coefficient sums its non-zero matrix entries in a fixed order (light, k).
 template <class V>
-[[gnu::always_inline]] inline void incidentRowImpl(const ShadingLight* lights, int nl, int nCoef, int nxr, std::size_t planeR,
-                                                   ShadeMaps& out, int Y) {
+[[gnu::always_inline]] inline void incidentRowImpl(const ShadingLight* lights, int nl, int nCoef, int nxr,
+                                                   std::size_t planeR, ShadeMaps& out, int Y) {
     constexpr int L = LaneTraits<V>::n, NQ = 16 / L;
     const std::size_t r0 = static_cast<std::size_t>(Y) * nxr;
     for (int X = 0; X < nxr; X += 16) {
@@ -213,7 +223,8 @@ template <class V>
                     const float* p = lights[Li].visibility->plane(k) + r0 + X;
                     for (int q = 0; q < NQ; ++q) {
                         V a = splat<V>(0.0f);
-                        if (L * q + L <= n) a = load<V>(p + L * q);
+                        if (L * q + L <= n)
+                            a = load<V>(p + L * q);
                         else
                             for (int e = L * q; e < n; ++e) a[e - L * q] = p[e];
                         v[(Li - g0) * kShCount + k][q] = a;
@@ -225,7 +236,8 @@ template <class V>
                 for (int q = 0; q < NQ; ++q) acc[q] = splat<V>(0.0f);
                 if (g0 > 0)
                     for (int e = 0; e < n; ++e) acc[e / L][e % L] = o[e];
-                for (int e = out.incidentTermStart[static_cast<std::size_t>(c)]; e < out.incidentTermStart[static_cast<std::size_t>(c + 1)]; ++e) {
+                for (int e = out.incidentTermStart[static_cast<std::size_t>(c)];
+                     e < out.incidentTermStart[static_cast<std::size_t>(c + 1)]; ++e) {
                     const ShadeMaps::Term& term = out.incidentTerms[static_cast<std::size_t>(e)];
                     const int slot = term.index - g0 * kShCount;
                     if (slot < 0 || slot >= kMaxShadingLights * kShCount) continue;
@@ -233,7 +245,8 @@ template <class V>
                     for (int q = 0; q < NQ; ++q) acc[q] += t * v[slot][q];
                 }
                 for (int q = 0; q < NQ; ++q) {
-                    if (L * q + L <= n) store(o + L * q, acc[q]);
+                    if (L * q + L <= n)
+                        store(o + L * q, acc[q]);
                     else
                         for (int e = L * q; e < n; ++e) o[e] = acc[q][e - L * q];
                 }
@@ -245,7 +258,7 @@ void incidentRowSse(const ShadingLight* lights, int nl, int nCoef, int nxr, std:
     incidentRowImpl<F4>(lights, nl, nCoef, nxr, planeR, out, Y);
 }
 [[gnu::target("avx2"), gnu::flatten]] void incidentRowAvx2(const ShadingLight* lights, int nl, int nCoef, int nxr,
-                                                            std::size_t planeR, ShadeMaps& out, int Y) {
+                                                           std::size_t planeR, ShadeMaps& out, int Y) {
     incidentRowImpl<F8>(lights, nl, nCoef, nxr, planeR, out, Y);
 }
 
@@ -255,8 +268,10 @@ void sizeShadeMaps(int nx, int ny, std::size_t incidentSize, bool ambient, std::
     out.nx = nx;
     out.ny = ny;
     for (Grid& g : out.rgb) g.ensureSize(nx, ny);
-    if (!ambient) out.ambient = Grid{};
-    else out.ambient.ensureSize(nx, ny);
+    if (!ambient)
+        out.ambient = Grid{};
+    else
+        out.ambient.ensureSize(nx, ny);
     out.incident.resize(incidentSize);
     out.rowScratch.resize(rowScratchSize);
     out.basisScratch.resize(basisScratchSize);
@@ -280,7 +295,8 @@ void buildIncidentTerms(const ShadingLight* lights, int nl, int nCoef, ShadeMaps
         for (int i = 0; i < nCoef; ++i) {
             for (int L = 0; L < nl; ++L)
                 for (int k = 0; k < kShCount; ++k) {
-                    const float t = out.lightMatrices[((static_cast<std::size_t>(L) * 3 + ch) * kShCount + i) * kShCount + k];
+                    const float t =
+                        out.lightMatrices[((static_cast<std::size_t>(L) * 3 + ch) * kShCount + i) * kShCount + k];
                     if (t != 0.0f) {
                         ShadeMaps::Term term;
                         term.value = t;
@@ -288,7 +304,8 @@ void buildIncidentTerms(const ShadingLight* lights, int nl, int nCoef, ShadeMaps
                         out.incidentTerms.push_back(term);
                     }
                 }
-            out.incidentTermStart[static_cast<std::size_t>(ch * nCoef + i + 1)] = static_cast<int>(out.incidentTerms.size());
+            out.incidentTermStart[static_cast<std::size_t>(ch * nCoef + i + 1)] =
+                static_cast<int>(out.incidentTerms.size());
         }
 }
 
@@ -297,10 +314,10 @@ void buildIncidentTerms(const ShadingLight* lights, int nl, int nCoef, ShadeMaps
 // (interpolatePlanesToRow), the Lambert part at each texel's normal and the
 // Phong lobe about its reflection vector (phongShadeRow).
 struct PhongRowJob {
-    LambertRowJob base;          // planes, sizes, tables, Lambert factors, diffuse weight, albedo, out
-    float phUniform[kShOrder];   // the uniform lobe factors (phongLobeFactors of the settings)
+    LambertRowJob base;         // planes, sizes, tables, Lambert factors, diffuse weight, albedo, out
+    float phUniform[kShOrder];  // the uniform lobe factors (phongLobeFactors of the settings)
     float specWeight;
-    float view[3];               // unit vector towards the viewer
+    float view[3];  // unit vector towards the viewer
 };
 
 // ---- algorithm: SH vectors interpolated to row y (Fig. 7) ----
@@ -313,8 +330,8 @@ void interpolatePlanesToRow(const LambertRowJob& j, int y, float* vert, float* u
     const int Y0 = ry.i0, Y1 = ry.i1;
     const float fy = ry.f;
     for (int p = 0; p < nPlanes; ++p) {
-        const float* plane = p < 3 * nCoef ? j.incident + static_cast<std::size_t>(p) * j.planeR
-                                           : j.env->plane(p - 3 * nCoef);
+        const float* plane =
+            p < 3 * nCoef ? j.incident + static_cast<std::size_t>(p) * j.planeR : j.env->plane(p - 3 * nCoef);
         const float* __restrict ra = plane + static_cast<std::size_t>(Y0) * nxr;
         const float* __restrict rb = plane + static_cast<std::size_t>(Y1) * nxr;
         float* __restrict v = vert + static_cast<std::size_t>(p) * nxrS;
@@ -445,11 +462,12 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
 
     const LambertFactors lf = lambertFactors();
     const float diffuseWeight = settings.brdf == Brdf::Phong ? 0.0f : 1.0f;
-    const LambertRowJob lambertJob{out.incident.data(), ambient ? &env : nullptr, planeR, nxr, nyr, nxrS, s, nCoef, nx,
-                                   out.colIndex.data(), out.colFrac.data(), lf, diffuseWeight, albedo, &out};
+    const LambertRowJob lambertJob{
+        out.incident.data(), ambient ? &env : nullptr, planeR, nxr,           nyr,    nxrS, s, nCoef, nx,
+        out.colIndex.data(), out.colFrac.data(),       lf,     diffuseWeight, albedo, &out};
     const auto lambertShadeRow = wide ? lambertShadeRowAvx2 : lambertShadeRowSse;
-    PhongRowJob phongJob{lambertJob, {}, specularWeightOf(settings),
-                         {settings.viewDir[0], settings.viewDir[1], settings.viewDir[2]}};
+    PhongRowJob phongJob{
+        lambertJob, {}, specularWeightOf(settings), {settings.viewDir[0], settings.viewDir[1], settings.viewDir[2]}};
     phongLobeFactors(settings.phongExponent, phongJob.phUniform);
 
     // ---- schedule: fixed row blocks, each with its own scratch ---------------

@@ -18,9 +18,9 @@
 #include <array>
 #include <vector>
 
+#include "core/grid.h"
 #include "gi/sh.h"
 #include "gi/visibility.h"
-#include "core/grid.h"
 
 namespace terrain::gi {
 
@@ -28,8 +28,8 @@ enum class Brdf { Lambert, Phong, LambertPlusPhong };
 
 struct ShadingSettings {
     Brdf brdf = Brdf::Lambert;
-    float phongExponent = 32.0f;      // S in Section 7
-    float specularWeight = 0.25f;     // weight of the Phong lobe in LambertPlusPhong
+    float phongExponent = 32.0f;            // S in Section 7
+    float specularWeight = 0.25f;           // weight of the Phong lobe in LambertPlusPhong
     float viewDir[3] = {0.0f, 0.0f, 1.0f};  // unit vector towards the viewer (distant viewer)
 };
 
@@ -124,18 +124,18 @@ struct ShadeMaps {
     std::array<Grid, 3> rgb;  // outgoing radiance towards the viewer, full resolution
     Grid ambient;             // normal-weighted sky-view factor, full resolution
     // receiver-resolution buffers
-    std::vector<float> incident;  // 3 x coefficients planes: sum over lights of T_L V
-    std::vector<int> colIndex;    // per full-res column: left receiver
-    std::vector<float> colFrac;   // and the fraction towards the right one
+    std::vector<float> incident;       // 3 x coefficients planes: sum over lights of T_L V
+    std::vector<int> colIndex;         // per full-res column: left receiver
+    std::vector<float> colFrac;        // and the fraction towards the right one
     std::vector<float> lightMatrices;  // lights x 3 x 16 x 16, float copies of the product matrices
     struct Term {
         float value;  // the matrix entry
-        int index;  // light * 16 + k
+        int index;    // light * 16 + k
     };
     std::vector<Term> incidentTerms;     // non-zero matrix entries per output coefficient
     std::vector<int> incidentTermStart;  // 3 x coefficients + 1
-    std::vector<float> rowScratch;    // per row block: interpolated SH planes of one row
-    std::vector<float> basisScratch;  // per row block: rotated BRDF coefficients of one row
+    std::vector<float> rowScratch;       // per row block: interpolated SH planes of one row
+    std::vector<float> basisScratch;     // per row block: rotated BRDF coefficients of one row
 };
 
 /// Shades every texel. envVisibility supplies the ambient map (with ambient

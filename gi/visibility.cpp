@@ -2,12 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <cstdlib>
+#include <cstring>
 
-#include "gi/nlp.h"
 #include "core/parallel.h"
 #include "core/simd.h"
+#include "gi/nlp.h"
 
 namespace terrain::gi {
 
@@ -30,8 +30,8 @@ inline int padLanes(int n) { return (n + kRowPad - 1) / kRowPad * kRowPad; }
 struct StepGeometry {
     ScanStep step;
     int xFirst = 0, xLast = -1, yFirst = 0, yLast = -1;  // valid receivers
-    double dx = 0.0, dy = 0.0;                            // sample offset in field texels
-    int k = 1, fieldNx = 0, fieldNy = 0;                  // receiver spacing in field texels, field size
+    double dx = 0.0, dy = 0.0;                           // sample offset in field texels
+    int k = 1, fieldNx = 0, fieldNy = 0;                 // receiver spacing in field texels, field size
 };
 
 void validRange(double d, int k, int fieldN, int receivers, int& first, int& last) {
@@ -63,8 +63,10 @@ StepGeometry makeStep(const HeightPyramid& pyr, int i, double c, double sn) {
     const double texels = std::max(1.0, std::round(std::abs(ps.tauCells * major) / unit));
     const double tau = texels * unit / std::abs(major);
     double dx = tau * c, dy = tau * sn;
-    if (alongX) dx = std::copysign(texels * unit, c);
-    else dy = std::copysign(texels * unit, sn);
+    if (alongX)
+        dx = std::copysign(texels * unit, c);
+    else
+        dy = std::copysign(texels * unit, sn);
     int k, fieldNx, fieldNy;
     if (raw) {
         k = s;
@@ -199,7 +201,8 @@ struct BsplineMaxVisitor {
 // of each lane; all lanes are valid for i < nAll, none for i >= nAny.
 template <class V, int NV, class Visitor>
 [[gnu::always_inline]] inline void scanLanes(const ScanStep* table, const float* const* rowPtr, int X0, const float* h0,
-                                             const typename LaneTraits<V>::I* steps, int nAll, int nAny, Visitor& visit) {
+                                             const typename LaneTraits<V>::I* steps, int nAll, int nAny,
+                                             Visitor& visit) {
     using I = typename LaneTraits<V>::I;
     constexpr int L = LaneTraits<V>::n;
     V h[NV];
@@ -224,7 +227,8 @@ template <class V, int NV, class Visitor>
         I valid[NV];
         const I iv = I{} + i;
         for (int k = 0; k < NV; ++k) valid[k] = iv < steps[k];
-        if (i < nAny) sample(i, s);
+        if (i < nAny)
+            sample(i, s);
         else
             for (int k = 0; k < NV; ++k) s[k] = splat<V>(0.0f);
         visit.some(i, s, valid, steps);
@@ -235,8 +239,8 @@ template <class V, int NV, class Visitor>
 // `lanes` receivers (NV vectors). rowPtr: scratch for 2 x rowSteps pointers
 // (each step's taps at receiver 0 of row Y).
 template <class V, int lanes, template <class, int> class Visitor>
-[[gnu::always_inline]] inline void scanRow(const ScanStep* table, const int* colSteps, int rowSteps, int Y, const float* h0,
-                                           int nxrPad, float* out, const float** rowPtr) {
+[[gnu::always_inline]] inline void scanRow(const ScanStep* table, const int* colSteps, int rowSteps, int Y,
+                                           const float* h0, int nxrPad, float* out, const float** rowPtr) {
     using I = typename LaneTraits<V>::I;
     constexpr int L = LaneTraits<V>::n, NV = lanes / L;
     for (int i = 0; i < rowSteps; ++i) {
@@ -361,23 +365,23 @@ template <class V>
 // One row's azimuth batch (1 or 2 azimuths from j0): the scans, their maximum
 // slopes out, NLP vectors and V += G_j w_j.
 struct RowBatch {
-    const ScanStep* steps;        // the step table (azimuths x nSteps)
+    const ScanStep* steps;  // the step table (azimuths x nSteps)
     int nSteps, nxr, nyr, nxrPad, Y, j0, batch;
-    const int* stepsPerColumn;   // azimuths x nxrPad
-    const int* stepsPerRow;      // azimuths x nyr
-    const float* cosSin;         // azimuths x 2
-    const float* h0;             // the row's receiver heights
-    const float* gradX;          // receiver, footprint lo, hi (x nxrPad)
+    const int* stepsPerColumn;  // azimuths x nxrPad
+    const int* stepsPerRow;     // azimuths x nyr
+    const float* cosSin;        // azimuths x 2
+    const float* h0;            // the row's receiver heights
+    const float* gradX;         // receiver, footprint lo, hi (x nxrPad)
     const float* gradY;
-    bool foot;                   // footprint rows present
+    bool foot;  // footprint rows present
     BlockingMax blockingMax;
     const VisibilityTarget* target;
     const FoldedWedgeOperator* op;
-    float* maxRow;               // nxrPad scratch
-    float* nlp;                  // 2 x 4 x nxrPad scratch
-    const float** rowPtr;        // 2 x nSteps scratch
-    float* maxSlope;             // out.maxSlope (azimuths x planes)
-    float* const* vRows;         // the row of each SH plane of V
+    float* maxRow;         // nxrPad scratch
+    float* nlp;            // 2 x 4 x nxrPad scratch
+    const float** rowPtr;  // 2 x nSteps scratch
+    float* maxSlope;       // out.maxSlope (azimuths x planes)
+    float* const* vRows;   // the row of each SH plane of V
 };
 
 template <class V>
@@ -405,7 +409,8 @@ template <class V>
         nlps[a] = nlp;
         ops[a] = r.op->values.data() + static_cast<std::size_t>(j) * P;
     }
-    accumulateRows<V>(nlps, ops, r.batch, r.op->patternRow.data(), r.op->patternNlp.data(), P, r.vRows, r.nxr, r.nxrPad);
+    accumulateRows<V>(nlps, ops, r.batch, r.op->patternRow.data(), r.op->patternNlp.data(), P, r.vRows, r.nxr,
+                      r.nxrPad);
 }
 
 void rowBatchSse(const RowBatch& r) { rowBatchImpl<simd::F4>(r); }
@@ -530,11 +535,29 @@ void visibilityOfRow(const VisibilityRows& r, int Y, VisibilityScratch& sc) {
         std::fill(vRows[i], vRows[i] + nxr, 0.0f);
     }
     for (int j0 = 0; j0 < m; j0 += 2) {
-        const RowBatch rb{state.steps.data(), r.nSteps, nxr, nyr, r.nxrPad, Y, j0, std::min(2, m - j0),
-                          state.stepsPerColumn.data(), state.stepsPerRow.data(), state.cosSin.data(),
-                          sc.h0.data(), sc.gradX.data(), sc.gradY.data(), r.box != nullptr,
-                          r.settings.blockingMax, &r.target, r.target.op, sc.maxRow.data(), sc.nlp.data(),
-                          sc.rowPtr.data(), r.out.maxSlope.data(), vRows};
+        const RowBatch rb{state.steps.data(),
+                          r.nSteps,
+                          nxr,
+                          nyr,
+                          r.nxrPad,
+                          Y,
+                          j0,
+                          std::min(2, m - j0),
+                          state.stepsPerColumn.data(),
+                          state.stepsPerRow.data(),
+                          state.cosSin.data(),
+                          sc.h0.data(),
+                          sc.gradX.data(),
+                          sc.gradY.data(),
+                          r.box != nullptr,
+                          r.settings.blockingMax,
+                          &r.target,
+                          r.target.op,
+                          sc.maxRow.data(),
+                          sc.nlp.data(),
+                          sc.rowPtr.data(),
+                          r.out.maxSlope.data(),
+                          vRows};
         r.rowBatch(rb);
     }
 }
@@ -652,8 +675,18 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
     resizeBlockScratch(nBlocks, nxrPad, nSteps, state);
     // footprint box rows (sub-sampling), when the box is this grid's
     const FootprintBox* box = target.footprint && s > 1 && target.footprint->nxr == nxr && target.footprint->nyr == nyr
-                                  ? target.footprint : nullptr;
-    const VisibilityRows rows{pyr, gradX, gradY, settings, target, box, state, out, nxrPad, nSteps,
+                                  ? target.footprint
+                                  : nullptr;
+    const VisibilityRows rows{pyr,
+                              gradX,
+                              gradY,
+                              settings,
+                              target,
+                              box,
+                              state,
+                              out,
+                              nxrPad,
+                              nSteps,
                               simd::wideEnabled() ? rowBatchAvx2 : rowBatchSse};
     // ---- schedule: fixed row blocks in parallel, rows serially within a block,
     // every azimuth of a row before the next row (the row's h0 / tau table is

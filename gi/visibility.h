@@ -51,9 +51,9 @@
 // is bit-identical for any thread count.
 #include <vector>
 
+#include "core/grid.h"
 #include "gi/pyramid.h"
 #include "gi/wedge.h"
-#include "core/grid.h"
 
 namespace terrain::gi {
 
@@ -69,9 +69,9 @@ enum class BlockingMax {
 // Eq. 16's B-spline, which smooths the blocking-angle sequence and does not
 // converge to the exact horizon.
 struct VisibilitySettings {
-    int azimuths = 16;                                    // m (paper: 32)
-    AzimuthInterp interp = AzimuthInterp::Linear;         // M_lin (paper's main operator)
-    BlockingMax blockingMax = BlockingMax::Samples;       // paper: BsplineKnotsAndMidpoints
+    int azimuths = 16;                               // m (paper: 32)
+    AzimuthInterp interp = AzimuthInterp::Linear;    // M_lin (paper's main operator)
+    BlockingMax blockingMax = BlockingMax::Samples;  // paper: BsplineKnotsAndMidpoints
     // Sub-sampling: omega_min from the lowest tangent plane of the box of
     // gradients of the texels that interpolate the receiver's V (offsets
     // {-s/2, 0, s/2}^2 cells, FootprintBox; gi/frame passes it in the
@@ -88,8 +88,8 @@ struct VisibilityScratch {
     std::vector<float> maxRow;  // nxr: maximum blocking slope of the current row and azimuth
     std::vector<float> gradX;   // 3 x nxr: dh/dx at the receivers of the current row, footprint box lo, hi
     std::vector<float> gradY;
-    std::vector<float> h0;      // nxr: receiver heights of the current row
-    std::vector<float> nlp;     // 2 x 4 x nxr: NLP visibility vectors of the current row, two azimuths
+    std::vector<float> h0;             // nxr: receiver heights of the current row
+    std::vector<float> nlp;            // 2 x 4 x nxr: NLP visibility vectors of the current row, two azimuths
     std::vector<const float*> rowPtr;  // 2 x steps: each step's two taps for receiver 0 of the current row
 };
 
@@ -121,7 +121,7 @@ void computeFootprintBox(ConstGridView gradX, ConstGridView gradY, int subsample
 /// Azimuth set and elevation window of one visibility computation.
 struct VisibilityTarget {
     const FoldedWedgeOperator* op = nullptr;  // azimuths + folded wedge operator
-    bool window = false;       // key light: restrict to [sinLow, sinHigh] (Section 6)
+    bool window = false;                      // key light: restrict to [sinLow, sinHigh] (Section 6)
     // Sub-sampling: omega_min from the footprint box's lowest tangent plane
     // instead of the receiver's own (VisibilitySettings::footprintTangent;
     // null: the receiver's plane).
@@ -141,9 +141,9 @@ struct VisibilityField {
 /// Reusable buffers of the visibility stage.
 struct VisibilityState {
     std::vector<VisibilityScratch> blocks;
-    std::vector<ScanStep> steps;    // azimuths x steps
-    std::vector<int> validColumns;  // azimuths x steps: receivers X in [first, last] sample inside (x)
-    std::vector<int> validRows;     // azimuths x steps: same for receiver rows Y (pairs)
+    std::vector<ScanStep> steps;      // azimuths x steps
+    std::vector<int> validColumns;    // azimuths x steps: receivers X in [first, last] sample inside (x)
+    std::vector<int> validRows;       // azimuths x steps: same for receiver rows Y (pairs)
     std::vector<int> stepsPerColumn;  // azimuths x padded nxr: valid-prefix length from x alone
     std::vector<int> stepsPerRow;     // azimuths x nyr: valid-prefix length from y alone
     std::vector<float> cosSin;        // azimuths x 2: cos, sin of each azimuth (float)

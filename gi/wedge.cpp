@@ -55,8 +55,8 @@ void buildSparse(FoldedWedgeOperator& op) {
     op.values.assign(static_cast<std::size_t>(op.azimuths) * p, 0.0f);
     for (int j = 0; j < op.azimuths; ++j)
         for (int e = 0; e < p; ++e)
-            op.values[static_cast<std::size_t>(j * p + e)] =
-                static_cast<float>(op.dense[static_cast<std::size_t>(op.patternRow[e] * cols + j * 4 + op.patternNlp[e])]);
+            op.values[static_cast<std::size_t>(j * p + e)] = static_cast<float>(
+                op.dense[static_cast<std::size_t>(op.patternRow[e] * cols + j * 4 + op.patternNlp[e])]);
 }
 
 // dense += R(phi) * M[:, tap block]
@@ -68,7 +68,8 @@ void addRotatedBlock(FoldedWedgeOperator& op, const std::vector<double>& m, int 
         for (int l = 0; l < kNlpCount; ++l) {
             double s = 0.0;
             for (int k = 0; k < kShCount; ++k)
-                s += rot[static_cast<std::size_t>(r * kShCount + k)] * m[static_cast<std::size_t>(k * mcols + tap * 4 + l)];
+                s += rot[static_cast<std::size_t>(r * kShCount + k)] *
+                     m[static_cast<std::size_t>(k * mcols + tap * 4 + l)];
             op.dense[static_cast<std::size_t>(r * cols + sample * 4 + l)] += s;
         }
 }
@@ -79,10 +80,14 @@ double wedgeTapWeight(AzimuthInterp interp, int k, double a) {
     if (interp == AzimuthInterp::Linear) return k == 0 ? 1.0 - a : a;
     // Uniform cubic B-spline on samples j-1, j, j+1, j+2 (Nowrouzezahrai & Snyder 2009, Appendix A).
     switch (k) {
-        case 0: return (1.0 - a) * (1.0 - a) * (1.0 - a) / 6.0;
-        case 1: return (3.0 * a * a * a - 6.0 * a * a + 4.0) / 6.0;
-        case 2: return (-3.0 * a * a * a + 3.0 * a * a + 3.0 * a + 1.0) / 6.0;
-        default: return a * a * a / 6.0;
+        case 0:
+            return (1.0 - a) * (1.0 - a) * (1.0 - a) / 6.0;
+        case 1:
+            return (3.0 * a * a * a - 6.0 * a * a + 4.0) / 6.0;
+        case 2:
+            return (-3.0 * a * a * a + 3.0 * a * a + 3.0 * a + 1.0) / 6.0;
+        default:
+            return a * a * a / 6.0;
     }
 }
 

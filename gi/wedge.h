@@ -42,8 +42,8 @@ std::vector<double> wedgeOperator(AzimuthInterp interp, double deltaPhi);
 /// V = sum_j G_j w_j, with G_j a 16 x 4 block per azimuth sample j.
 struct FoldedWedgeOperator {
     int azimuths = 0;
-    std::vector<double> phi;          // azimuth of each sample (radians, from +x towards +y)
-    std::vector<double> dense;        // 16 x (4 * azimuths), row-major, column = j * 4 + l
+    std::vector<double> phi;    // azimuth of each sample (radians, from +x towards +y)
+    std::vector<double> dense;  // 16 x (4 * azimuths), row-major, column = j * 4 + l
     // Sparse form used by the kernels: the same (row, nlp) pattern for every j.
     std::vector<std::uint8_t> patternRow;  // SH row of each entry
     std::vector<std::uint8_t> patternNlp;  // NLP index of each entry

@@ -1,8 +1,8 @@
 // A window with an OpenGL core context through GLFW.
-#include <GLFW/glfw3.h>
-
 #include <cstdlib>
 #include <string>
+
+#include <GLFW/glfw3.h>
 
 #include "render/context.h"
 

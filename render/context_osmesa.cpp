@@ -1,11 +1,11 @@
 // Headless OpenGL through OSMesa (Mesa's off-screen interface; llvmpipe here).
 // The renderer draws into its own framebuffer objects, so the OSMesa buffer
 // itself is a tiny placeholder that only makes the context current.
-#include <GL/osmesa.h>
-
 #include <cstdlib>
 #include <string>
 #include <vector>
+
+#include <GL/osmesa.h>
 
 #include "render/context.h"
 
@@ -19,18 +19,30 @@ public:
         if (const char* driver = std::getenv("GALLIUM_DRIVER")) {
             const std::string d(driver);
             if (!d.empty() && d != "llvmpipe" && d != "softpipe")
-                throw ContextError("OSMesa: GALLIUM_DRIVER='" + d + "' is not a software driver OSMesa can use (llvmpipe, softpipe)");
+                throw ContextError("OSMesa: GALLIUM_DRIVER='" + d +
+                                   "' is not a software driver OSMesa can use (llvmpipe, softpipe)");
         }
         // Newest first: 4.5 core (llvmpipe), then 3.3 core.
         const int versions[][2] = {{4, 5}, {3, 3}};
         for (const auto& v : versions) {
-            const int attribs[] = {OSMESA_FORMAT,       OSMESA_RGBA, OSMESA_DEPTH_BITS, 24, OSMESA_STENCIL_BITS, 0,
-                                   OSMESA_PROFILE,      OSMESA_CORE_PROFILE, OSMESA_CONTEXT_MAJOR_VERSION, v[0],
-                                   OSMESA_CONTEXT_MINOR_VERSION, v[1], 0};
+            const int attribs[] = {OSMESA_FORMAT,
+                                   OSMESA_RGBA,
+                                   OSMESA_DEPTH_BITS,
+                                   24,
+                                   OSMESA_STENCIL_BITS,
+                                   0,
+                                   OSMESA_PROFILE,
+                                   OSMESA_CORE_PROFILE,
+                                   OSMESA_CONTEXT_MAJOR_VERSION,
+                                   v[0],
+                                   OSMESA_CONTEXT_MINOR_VERSION,
+                                   v[1],
+                                   0};
             ctx_ = OSMesaCreateContextAttribs(attribs, nullptr);
             if (ctx_) break;
         }
-        if (!ctx_) throw ContextError("OSMesa: cannot create an OpenGL 3.3+ core context (is Mesa's OSMesa/llvmpipe usable?)");
+        if (!ctx_)
+            throw ContextError("OSMesa: cannot create an OpenGL 3.3+ core context (is Mesa's OSMesa/llvmpipe usable?)");
         buffer_.assign(kSide * kSide * 4, 0);
         makeCurrent();
     }

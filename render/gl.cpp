@@ -8,8 +8,8 @@ namespace terrain::render {
 
 void loadGl(Gl& gl, GlGetProcAddress getProc) {
     if (!getProc) throw ContextError("OpenGL: no get-proc-address callback");
-#define TERRAIN_GL_LOAD(name, upper)                                                          \
-    gl.name = reinterpret_cast<PFNGL##upper##PROC>(getProc("gl" #name));                     \
+#define TERRAIN_GL_LOAD(name, upper)                                     \
+    gl.name = reinterpret_cast<PFNGL##upper##PROC>(getProc("gl" #name)); \
     if (!gl.name) throw ContextError("OpenGL: the context does not provide gl" #name);
     TERRAIN_GL_FUNCTIONS(TERRAIN_GL_LOAD)
 #undef TERRAIN_GL_LOAD

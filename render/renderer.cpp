@@ -156,7 +156,8 @@ void Renderer::upload(const engine::FrameData& f) {
                 const double phi = 2.0 * gi::kPi * (u + 0.5) / ew;
                 const double el = gi::kPi * (0.5 - (v + 0.5) / eh);
                 double rgb[3];
-                gi::evaluateShRgb(f.lights.sky, std::cos(el) * std::cos(phi), std::cos(el) * std::sin(phi), std::sin(el), rgb);
+                gi::evaluateShRgb(f.lights.sky, std::cos(el) * std::cos(phi), std::cos(el) * std::sin(phi),
+                                  std::sin(el), rgb);
                 for (int c = 0; c < 3; ++c)
                     envPixels_[(static_cast<std::size_t>(v) * ew + u) * 3 + static_cast<std::size_t>(c)] =
                         static_cast<float>(std::max(0.0, rgb[c]));
@@ -265,7 +266,8 @@ Renderer::FrameViews Renderer::frameViews(const OrbitCamera& cam, int width, int
     const glm::mat4 viewProj = proj * view;
     // ---- key light shadow map (orthographic, covering the terrain) ---------------
     const glm::vec3 keyDir = keyDirection(f.lights.key);
-    const float radius = 0.5f * std::sqrt(2.0f * extent * extent + (f.zMax - f.zMin) * exag * (f.zMax - f.zMin) * exag) + 1.0f;
+    const float radius =
+        0.5f * std::sqrt(2.0f * extent * extent + (f.zMax - f.zMin) * exag * (f.zMax - f.zMin) * exag) + 1.0f;
     const glm::vec3 up = std::abs(keyDir.z) > 0.99f ? glm::vec3(0, 1, 0) : glm::vec3(0, 0, 1);
     const glm::mat4 lightViewProj = glm::ortho(-radius, radius, -radius, radius, 0.0f, 4.0f * radius) *
                                     glm::lookAt(centre + keyDir * (2.0f * radius), centre, up);
@@ -417,7 +419,8 @@ void Renderer::drawToImage(const RenderSettings& s, int width, int height, std::
     checkGlError(gl_, "read-back");
     rgb.resize(static_cast<std::size_t>(width) * height * 3);
     for (int y = 0; y < height; ++y) {
-        const std::uint8_t* src = rgba.data() + static_cast<std::size_t>(height - 1 - y) * width * 4;  // GL: row 0 at the bottom
+        const std::uint8_t* src =
+            rgba.data() + static_cast<std::size_t>(height - 1 - y) * width * 4;  // GL: row 0 at the bottom
         std::uint8_t* dst = rgb.data() + static_cast<std::size_t>(y) * width * 3;
         for (int x = 0; x < width; ++x) {
             dst[3 * x] = src[4 * x];

@@ -17,8 +17,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "render/gl.h"
 #include "engine/frame_data.h"
+#include "render/gl.h"
 
 namespace terrain::render {
 
@@ -26,19 +26,19 @@ enum class ShadowMode { SoftVisibility, ShadowMap, None };
 
 enum class DebugView {
     None,
-    Ambient,        // gi/ ambient map (normal-weighted sky-view factor)
-    SkyVisibility,  // V: visible fraction of the sky hemisphere (V's constant term), receiver grid
-    KeyVisibility,  // the key light's soft visibility
-    Normals,        // full-resolution normals
-    PyramidLevel,   // one height-pyramid level, receiver grid
-    ShadeMap,       // gi/ RGB shade map (sky + key, white albedo)
+    Ambient,           // gi/ ambient map (normal-weighted sky-view factor)
+    SkyVisibility,     // V: visible fraction of the sky hemisphere (V's constant term), receiver grid
+    KeyVisibility,     // the key light's soft visibility
+    Normals,           // full-resolution normals
+    PyramidLevel,      // one height-pyramid level, receiver grid
+    ShadeMap,          // gi/ RGB shade map (sky + key, white albedo)
     IndirectRadiance,  // U: mean incident indirect radiance (U's constant term, or E / pi without U), receiver grid
 };
 
 struct OrbitCamera {
-    float yawDeg = 235.0f;    // azimuth of the eye around the terrain centre, from +x towards +y
-    float pitchDeg = 34.0f;   // elevation of the eye
-    float distance = 1.35f;   // in terrain extents
+    float yawDeg = 235.0f;   // azimuth of the eye around the terrain centre, from +x towards +y
+    float pitchDeg = 34.0f;  // elevation of the eye
+    float distance = 1.35f;  // in terrain extents
     float fovYDeg = 40.0f;
 };
 

@@ -66,8 +66,8 @@ void generateNoise(Grid& out, int nx, int ny, float cellSize, std::uint64_t seed
                 float weight = 1.0f;
                 for (int o = 0; o < s.octaves; ++o) {
                     const std::uint64_t octaveSeed = mix64(seed + 0x1000193ull * static_cast<std::uint64_t>(o));
-                    const float n = gradientNoise(static_cast<float>(x) * freq + 0.5f, static_cast<float>(y) * freq + 0.5f,
-                                                  octaveSeed);
+                    const float n = gradientNoise(static_cast<float>(x) * freq + 0.5f,
+                                                  static_cast<float>(y) * freq + 0.5f, octaveSeed);
                     if (s.ridged) {
                         // Ridged multifractal: sharp crests where the noise crosses zero,
                         // rougher detail where earlier octaves are high.
@@ -102,12 +102,23 @@ void generateShape(Grid& out, int nx, int ny, float cellSize, const ShapeSetting
             const float r = std::sqrt(px * px + py * py);
             float h = 0.0f;
             switch (s.shape) {
-                case Shape::Flat: break;
-                case Shape::GaussianBump: h = s.height * std::exp(-0.5f * r * r / (s.radius * s.radius)); break;
-                case Shape::Cone: h = s.height * std::fmax(0.0f, 1.0f - r / s.radius); break;
-                case Shape::CircularPit: h = r <= s.radius ? -s.height : 0.0f; break;
-                case Shape::Step: h = x >= nx / 2 ? s.height : 0.0f; break;
-                case Shape::Spike: h = (x == nx / 2 && y == ny / 2) ? s.height : 0.0f; break;
+                case Shape::Flat:
+                    break;
+                case Shape::GaussianBump:
+                    h = s.height * std::exp(-0.5f * r * r / (s.radius * s.radius));
+                    break;
+                case Shape::Cone:
+                    h = s.height * std::fmax(0.0f, 1.0f - r / s.radius);
+                    break;
+                case Shape::CircularPit:
+                    h = r <= s.radius ? -s.height : 0.0f;
+                    break;
+                case Shape::Step:
+                    h = x >= nx / 2 ? s.height : 0.0f;
+                    break;
+                case Shape::Spike:
+                    h = (x == nx / 2 && y == ny / 2) ? s.height : 0.0f;
+                    break;
                 case Shape::SineRidges: {
                     // distance across the crests: along the direction perpendicular to the crest line
                     const float across = -px * sa + py * ca;
@@ -132,13 +143,20 @@ Shape parseShape(const std::string& name) {
 
 const char* shapeName(Shape s) {
     switch (s) {
-        case Shape::Flat: return "flat";
-        case Shape::GaussianBump: return "bump";
-        case Shape::Cone: return "cone";
-        case Shape::CircularPit: return "pit";
-        case Shape::Step: return "step";
-        case Shape::Spike: return "spike";
-        case Shape::SineRidges: return "ridges";
+        case Shape::Flat:
+            return "flat";
+        case Shape::GaussianBump:
+            return "bump";
+        case Shape::Cone:
+            return "cone";
+        case Shape::CircularPit:
+            return "pit";
+        case Shape::Step:
+            return "step";
+        case Shape::Spike:
+            return "spike";
+        case Shape::SineRidges:
+            return "ridges";
     }
     return "?";
 }

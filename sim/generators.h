@@ -11,13 +11,13 @@
 namespace terrain {
 
 struct NoiseSettings {
-    float amplitude = 800.0f;     // m, peak-to-valley scale of the first octave
-    float wavelength = 6000.0f;   // m, wavelength of the first octave
+    float amplitude = 800.0f;    // m, peak-to-valley scale of the first octave
+    float wavelength = 6000.0f;  // m, wavelength of the first octave
     int octaves = 8;
-    float lacunarity = 2.0f;      // wavelength divisor per octave
-    float gain = 0.5f;            // amplitude factor per octave
-    bool ridged = false;          // ridged multifractal (sharp crests) instead of fBm
-    float offset = 0.0f;          // m added everywhere
+    float lacunarity = 2.0f;  // wavelength divisor per octave
+    float gain = 0.5f;        // amplitude factor per octave
+    bool ridged = false;      // ridged multifractal (sharp crests) instead of fBm
+    float offset = 0.0f;      // m added everywhere
 };
 
 /// Seeded fBm or ridged-noise mountains on an nx x ny grid with the given cell size.
@@ -30,11 +30,11 @@ enum class Shape { Flat, GaussianBump, Cone, CircularPit, Step, Spike, SineRidge
 
 struct ShapeSettings {
     Shape shape = Shape::Flat;
-    float base = 0.0f;      // m, height of the surrounding plane
-    float height = 10.0f;   // m, bump/cone/step/spike/ridge height, or pit depth
-    float radius = 20.0f;   // m, bump sigma, cone/pit radius
+    float base = 0.0f;         // m, height of the surrounding plane
+    float height = 10.0f;      // m, bump/cone/step/spike/ridge height, or pit depth
+    float radius = 20.0f;      // m, bump sigma, cone/pit radius
     float wavelength = 50.0f;  // m, sine ridges
-    float angleDeg = 0.0f;  // ridge crest direction, degrees from +x towards +y
+    float angleDeg = 0.0f;     // ridge crest direction, degrees from +x towards +y
 };
 
 /// Analytic shapes centred in the grid: flat, Gaussian bump, cone, circular

@@ -59,15 +59,15 @@ struct Fields {
 
 struct Coeffs {
     float dt;
-    float fluxGain;    // dt * g * A / l = dt * g * pipeArea * c   (m^2/s per metre of head)
-    float rainDt;      // m of rain this step
-    float cellArea;    // c^2
-    float dtOverArea;  // dt / c^2
-    float invCell;     // 1 / c
-    float halfInvCell; // 0.5 / c
-    float minSin2;     // minTilt^2
-    float capacity;    // Kc
-    float maxDepth;    // depth limiter of the capacity
+    float fluxGain;      // dt * g * A / l = dt * g * pipeArea * c   (m^2/s per metre of head)
+    float rainDt;        // m of rain this step
+    float cellArea;      // c^2
+    float dtOverArea;    // dt / c^2
+    float invCell;       // 1 / c
+    float halfInvCell;   // 0.5 / c
+    float minSin2;       // minTilt^2
+    float capacity;      // Kc
+    float maxDepth;      // depth limiter of the capacity
     float dissolveFrac;  // min(1, Ks dt)
     float depositFrac;   // min(1, Kd dt)
     float hardness;      // bedrock dissolution multiplier
@@ -269,11 +269,15 @@ void runRow(const Fields& F, const Coeffs& k, int y) {
 
 struct PipePass {
     template <class T, bool kEdge>
-    static void run(const Fields& F, const Coeffs& k, std::ptrdiff_t i, const Nbr& n) { pipeCell<T, kEdge>(F, k, i, n); }
+    static void run(const Fields& F, const Coeffs& k, std::ptrdiff_t i, const Nbr& n) {
+        pipeCell<T, kEdge>(F, k, i, n);
+    }
 };
 struct UpdatePass {
     template <class T, bool kEdge>
-    static void run(const Fields& F, const Coeffs& k, std::ptrdiff_t i, const Nbr& n) { updateCell<T, kEdge>(F, k, i, n); }
+    static void run(const Fields& F, const Coeffs& k, std::ptrdiff_t i, const Nbr& n) {
+        updateCell<T, kEdge>(F, k, i, n);
+    }
 };
 
 /// Rows per block of the pipelined schedule: about 32k cells, at least 4 rows.
@@ -334,10 +338,20 @@ void hydraulicStep(TerrainState& s, const HydraulicSettings& settings, float dt,
     k.evapKeep = std::clamp(1.0f - settings.evaporation * dt, 0.0f, 1.0f);
     k.open = !settings.closedBoundary;
 
-    const Fields F{s.bedrock.data(), s.soil.data(), s.water.data(), s.suspended.data(),
-                   s.fluxL.data(),   s.fluxR.data(), s.fluxT.data(), s.fluxB.data(),
-                   s.velX.data(),    s.velY.data(),  scratch.conc.data(), scratch.sin2.data(),
-                   nx,               ny};
+    const Fields F{s.bedrock.data(),
+                   s.soil.data(),
+                   s.water.data(),
+                   s.suspended.data(),
+                   s.fluxL.data(),
+                   s.fluxR.data(),
+                   s.fluxT.data(),
+                   s.fluxB.data(),
+                   s.velX.data(),
+                   s.velY.data(),
+                   scratch.conc.data(),
+                   scratch.sin2.data(),
+                   nx,
+                   ny};
 
     // Schedule (apart from the algorithm above): rows are cut into fixed
     // blocks (independent of the thread count). Phase 1 runs pass A on the

@@ -31,7 +31,8 @@ struct HydraulicSettings {
     float minTilt = 0.05f;          // lower bound on sin(tilt) in the capacity, so flat cells still erode a little
     float bedrockHardness = 0.3f;   // Ks multiplier for bedrock once the soil is gone (0..1)
     float maxErosionDepth = 10.0f;  // m, water depth beyond which capacity stops growing (depth limiter)
-    bool closedBoundary = true;     // true: no flux leaves the domain; false: water (and its sediment) pours out at the edges
+    bool closedBoundary =
+        true;  // true: no flux leaves the domain; false: water (and its sediment) pours out at the edges
 };
 
 /// Per-run scratch buffers (explicit state, reused across ticks).

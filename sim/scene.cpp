@@ -6,8 +6,8 @@
 #include <filesystem>
 
 #include "core/error.h"
-#include "sim/heightmap_io.h"
 #include "core/parallel.h"
+#include "sim/heightmap_io.h"
 
 #ifndef TERRAIN_DATA_DIR
 #define TERRAIN_DATA_DIR "../shared/data"
@@ -58,7 +58,8 @@ void noiseTerrain(SceneSettings& s, float extent, const NoiseSettings& noise) {
 std::vector<std::string> builtinSceneNames() { return {"erosion", "waves", "dem"}; }
 
 SceneSettings builtinScene(const std::string& name, int size, std::uint64_t seed) {
-    if (size < 1 || size > 16384) throw InputError("scene size " + std::to_string(size) + " is out of range (1..16384)");
+    if (size < 1 || size > 16384)
+        throw InputError("scene size " + std::to_string(size) + " is out of range (1..16384)");
     SceneSettings s;
     s.name = name;
     s.nx = s.ny = size;
@@ -146,8 +147,12 @@ void buildInitialTerrain(const SceneSettings& s, TerrainState& state) {
     float cellSize = s.cellSize;
     int nx = s.nx, ny = s.ny;
     switch (s.terrain.kind) {
-        case TerrainSource::Kind::Noise: generateNoise(ground, nx, ny, cellSize, s.seed, s.terrain.noise); break;
-        case TerrainSource::Kind::Shape: generateShape(ground, nx, ny, cellSize, s.terrain.shape); break;
+        case TerrainSource::Kind::Noise:
+            generateNoise(ground, nx, ny, cellSize, s.seed, s.terrain.noise);
+            break;
+        case TerrainSource::Kind::Shape:
+            generateShape(ground, nx, ny, cellSize, s.terrain.shape);
+            break;
         case TerrainSource::Kind::Dem: {
             float fileCell = s.terrain.demCellSize;
             Grid dem = readHeightmap(s.terrain.demFile, s.terrain.demZScale, s.terrain.demZOffset,
@@ -171,7 +176,8 @@ void buildInitialTerrain(const SceneSettings& s, TerrainState& state) {
         const float denom = nx > 1 ? static_cast<float>(nx - 1) : 1.0f;
         for (int y = 0; y < ny; ++y)
             for (int x = 0; x < nx; ++x)
-                ground(x, y) += s.terrain.rampStart + (s.terrain.rampEnd - s.terrain.rampStart) * static_cast<float>(x) / denom;
+                ground(x, y) +=
+                    s.terrain.rampStart + (s.terrain.rampEnd - s.terrain.rampStart) * static_cast<float>(x) / denom;
     }
     state.allocate(nx, ny, cellSize, layers);
     state.bedrock.v = ground.v;
@@ -227,7 +233,8 @@ void Simulation::tick() {
     state_.time += static_cast<double>(dt_);
     lastSubsteps_ = settings_.waves ? waveScratch_.lastSubsteps : 1;
     state_.tick += 1;
-    if (simulates) updateChanges();
+    if (simulates)
+        updateChanges();
     else {
         std::fill(changes_.dirty.begin(), changes_.dirty.end(), 0);
         changes_.dirtyCount = 0;

@@ -36,9 +36,9 @@ struct SceneSettings {
     float cellSize = 10.0f;  // m
     std::uint64_t seed = 1;
     TerrainSource terrain;
-    float soilDepth = 0.0f;    // m of loose material laid on the generated ground
+    float soilDepth = 0.0f;  // m of loose material laid on the generated ground
     bool hasWaterLevel = false;
-    float waterLevel = 0.0f;   // m: fill water up to this surface level at start
+    float waterLevel = 0.0f;  // m: fill water up to this surface level at start
 
     bool hydraulic = false;
     bool thermal = false;

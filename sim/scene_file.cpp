@@ -14,11 +14,11 @@
 //   [terrain]  kind = "noise" | "shape" | "dem", plus the generator's keys
 //   [hydraulic] enabled = true, ...   [thermal] ...   [waves] ...
 //   [waves.swell] ...   [[waves.drops]] ...
-#include <toml++/toml.h>
-
 #include <cmath>
 #include <filesystem>
 #include <set>
+
+#include <toml++/toml.h>
 
 #include "core/error.h"
 #include "sim/scene.h"
@@ -34,33 +34,43 @@ public:
 
     void num(const char* key, float& out) {
         if (const toml::node* n = get(key)) {
-            if (auto v = n->value<double>()) out = static_cast<float>(*v);
-            else fail(key, "a number");
+            if (auto v = n->value<double>())
+                out = static_cast<float>(*v);
+            else
+                fail(key, "a number");
             if (!std::isfinite(out)) fail(key, "a finite number");
         }
     }
     void num(const char* key, double& out) {
         if (const toml::node* n = get(key)) {
-            if (auto v = n->value<double>()) out = *v;
-            else fail(key, "a number");
+            if (auto v = n->value<double>())
+                out = *v;
+            else
+                fail(key, "a number");
         }
     }
     void integer(const char* key, int& out) {
         if (const toml::node* n = get(key)) {
-            if (auto v = n->value<std::int64_t>()) out = static_cast<int>(*v);
-            else fail(key, "an integer");
+            if (auto v = n->value<std::int64_t>())
+                out = static_cast<int>(*v);
+            else
+                fail(key, "an integer");
         }
     }
     void flag(const char* key, bool& out) {
         if (const toml::node* n = get(key)) {
-            if (auto v = n->value<bool>()) out = *v;
-            else fail(key, "true or false");
+            if (auto v = n->value<bool>())
+                out = *v;
+            else
+                fail(key, "true or false");
         }
     }
     void text(const char* key, std::string& out) {
         if (const toml::node* n = get(key)) {
-            if (auto v = n->value<std::string>()) out = *v;
-            else fail(key, "a string");
+            if (auto v = n->value<std::string>())
+                out = *v;
+            else
+                fail(key, "a string");
         }
     }
     const toml::node* get(const char* key) {
@@ -106,10 +116,14 @@ void readTerrain(TableReader& r, const toml::table& t, SceneSettings& s) {
     std::string kind;
     tr.text("kind", kind);
     if (!kind.empty()) {
-        if (kind == "noise") s.terrain.kind = TerrainSource::Kind::Noise;
-        else if (kind == "shape") s.terrain.kind = TerrainSource::Kind::Shape;
-        else if (kind == "dem") s.terrain.kind = TerrainSource::Kind::Dem;
-        else tr.fail("kind", "\"noise\", \"shape\" or \"dem\"");
+        if (kind == "noise")
+            s.terrain.kind = TerrainSource::Kind::Noise;
+        else if (kind == "shape")
+            s.terrain.kind = TerrainSource::Kind::Shape;
+        else if (kind == "dem")
+            s.terrain.kind = TerrainSource::Kind::Dem;
+        else
+            tr.fail("kind", "\"noise\", \"shape\" or \"dem\"");
     }
     NoiseSettings& n = s.terrain.noise;
     tr.num("amplitude", n.amplitude);
@@ -240,9 +254,10 @@ SceneSettings loadSceneFile(const std::string& file) {
     r.text("base", base);
     int nx = 256, ny = 256;
     if (const toml::node* sz = r.get("size")) {
-        if (auto v = sz->value<std::int64_t>()) nx = ny = static_cast<int>(*v);
-        else if (const toml::array* a = sz->as_array(); a && a->size() == 2 && a->get(0)->is_integer() &&
-                                                       a->get(1)->is_integer()) {
+        if (auto v = sz->value<std::int64_t>())
+            nx = ny = static_cast<int>(*v);
+        else if (const toml::array* a = sz->as_array();
+                 a && a->size() == 2 && a->get(0)->is_integer() && a->get(1)->is_integer()) {
             nx = static_cast<int>(*a->get(0)->value<std::int64_t>());
             ny = static_cast<int>(*a->get(1)->value<std::int64_t>());
         } else {

@@ -14,8 +14,8 @@ void checkDimensions(int nx, int ny, float cellSize) {
     if (nx < 1 || ny < 1)
         throw InputError("grid size " + std::to_string(nx) + " x " + std::to_string(ny) + " is empty or negative");
     if (nx > kMaxSide || ny > kMaxSide)
-        throw InputError("grid size " + std::to_string(nx) + " x " + std::to_string(ny) +
-                         " exceeds the limit of " + std::to_string(kMaxSide) + " per side");
+        throw InputError("grid size " + std::to_string(nx) + " x " + std::to_string(ny) + " exceeds the limit of " +
+                         std::to_string(kMaxSide) + " per side");
     if (!std::isfinite(cellSize) || cellSize <= 0.0f || cellSize > 1e6f)
         throw InputError("cell size " + std::to_string(cellSize) + " m is not a positive finite size up to 1e6 m");
 }
@@ -28,8 +28,10 @@ void TerrainState::allocate(int w, int h, float cell, const LayerSet& layers) {
     bedrock.resize(w, h);
     soil.resize(w, h);
     auto opt = [&](Grid& g, bool on, int gw, int gh) {
-        if (on) g.resize(gw, gh);
-        else g = Grid();
+        if (on)
+            g.resize(gw, gh);
+        else
+            g = Grid();
     };
     opt(water, layers.water || layers.sediment || layers.pipes || layers.faceVelocity, w, h);
     opt(suspended, layers.sediment, w, h);
@@ -113,8 +115,8 @@ std::uint64_t hashState(const TerrainState& s) {
     std::memcpy(&t, &s.time, 8);
     h.word(t);
     h.word(static_cast<std::uint64_t>(s.tick));
-    for (const Grid* g : {&s.bedrock, &s.soil, &s.water, &s.suspended, &s.fluxL, &s.fluxR, &s.fluxT, &s.fluxB,
-                          &s.velX, &s.velY, &s.faceU, &s.faceV}) {
+    for (const Grid* g : {&s.bedrock, &s.soil, &s.water, &s.suspended, &s.fluxL, &s.fluxR, &s.fluxT, &s.fluxB, &s.velX,
+                          &s.velY, &s.faceU, &s.faceV}) {
         h.word(g->v.size());
         h.bytes(g->v.data(), g->v.size() * sizeof(float));
     }

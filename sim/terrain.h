@@ -12,9 +12,9 @@ namespace terrain {
 
 /// Which optional layers a terrain carries.
 struct LayerSet {
-    bool water = false;      // water depth (hydraulic, waves)
-    bool sediment = false;   // suspended sediment (hydraulic)
-    bool pipes = false;      // virtual-pipe outflow fluxes + cell velocity (hydraulic)
+    bool water = false;         // water depth (hydraulic, waves)
+    bool sediment = false;      // suspended sediment (hydraulic)
+    bool pipes = false;         // virtual-pipe outflow fluxes + cell velocity (hydraulic)
     bool faceVelocity = false;  // staggered face velocities (waves)
 };
 

@@ -54,8 +54,8 @@ struct Fields {
 };
 
 struct Coeffs {
-    float talusAxis;  // t * c
-    float talusDiag;  // t * c * sqrt(2)
+    float talusAxis;     // t * c
+    float talusDiag;     // t * c * sqrt(2)
     float halfFraction;  // k / 2
     float deadZone;      // m: excess below which a cell does not shed
     bool erodeBedrock;
@@ -76,7 +76,7 @@ struct Nbr8 {
 
 inline Nbr8 edgeNeighbours(int x, int y, int nx, int ny) {
     const std::ptrdiff_t i = static_cast<std::ptrdiff_t>(y) * nx + x;
-    const bool l = x > 0, r = x < nx - 1, u = y > 0, d = y < ny - 1;
+    const bool l = x > 0, r = x<nx - 1, u = y> 0, d = y < ny - 1;
     Nbr8 n;
     const bool has[8] = {l, r, u, d, u && l, u && r, d && l, d && r};
     const std::ptrdiff_t off[8] = {-1, 1, -nx, nx, -nx - 1, -nx + 1, nx - 1, nx + 1};
@@ -181,11 +181,15 @@ void forEachCell8(const Fields& F, const Coeffs& k) {
 
 struct ShedPass {
     template <class T, bool kEdge>
-    static void run(const Fields& F, const Coeffs& k, std::ptrdiff_t i, const Nbr8& n) { shedCell<T, kEdge>(F, k, i, n); }
+    static void run(const Fields& F, const Coeffs& k, std::ptrdiff_t i, const Nbr8& n) {
+        shedCell<T, kEdge>(F, k, i, n);
+    }
 };
 struct SettlePass {
     template <class T, bool kEdge>
-    static void run(const Fields& F, const Coeffs& k, std::ptrdiff_t i, const Nbr8& n) { settleCell<T, kEdge>(F, k, i, n); }
+    static void run(const Fields& F, const Coeffs& k, std::ptrdiff_t i, const Nbr8& n) {
+        settleCell<T, kEdge>(F, k, i, n);
+    }
 };
 
 }  // namespace
@@ -207,8 +211,8 @@ void thermalStep(TerrainState& s, const ThermalSettings& settings, float dt, The
     k.erodeBedrock = settings.erodeBedrock;
     k.deadZone = kDeadZoneSlope * s.cellSize;
 
-    const Fields F{s.bedrock.data(), s.soil.data(), scratch.ground.data(), scratch.out.data(), scratch.share.data(),
-                   nx, ny};
+    const Fields F{
+        s.bedrock.data(), s.soil.data(), scratch.ground.data(), scratch.out.data(), scratch.share.data(), nx, ny};
     forEachCell8<ShedPass>(F, k);    // pass 1
     forEachCell8<SettlePass>(F, k);  // pass 2
 }

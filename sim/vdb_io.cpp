@@ -5,16 +5,17 @@
 // (x, y), background 0, with a uniform linear transform whose voxel size is
 // the cell size. Grids: `height` (bedrock + soil), `bedrock`, `soil`, and
 // `water`, `sediment` when the terrain has them.
-#include <openvdb/openvdb.h>
-#include <openvdb/io/File.h>
+#include "sim/vdb_io.h"
 
 #include <cmath>
 #include <filesystem>
 #include <mutex>
 
+#include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
+
 #include "core/error.h"
 #include "core/file_io.h"
-#include "sim/vdb_io.h"
 
 namespace terrain {
 namespace {

@@ -152,7 +152,7 @@ struct StepConsts {
     float etaInFlux = 0.0f;  // incoming elevation at the flux time level
     float seaLevel = 0.0f;
     float gravity = 9.81f;
-    float bref = 0.0f;       // m, reference level subtracted from the ground (precision at large offsets)
+    float bref = 0.0f;  // m, reference level subtracted from the ground (precision at large offsets)
 };
 
 struct Views {
@@ -160,13 +160,13 @@ struct Views {
     float* h = nullptr;
     const float* bed = nullptr;
     const float* soil = nullptr;
-    const float* u = nullptr;   // faceU, stride nx + 1
-    const float* v = nullptr;   // faceV, stride nx
-    float* out = nullptr;       // outflow, stride nx
-    float* qu = nullptr;        // fluxU, stride nx + 1
-    float* qv = nullptr;        // fluxV, stride nx
-    float* nu = nullptr;        // nextU
-    float* nv = nullptr;        // nextV
+    const float* u = nullptr;  // faceU, stride nx + 1
+    const float* v = nullptr;  // faceV, stride nx
+    float* out = nullptr;      // outflow, stride nx
+    float* qu = nullptr;       // fluxU, stride nx + 1
+    float* qv = nullptr;       // fluxV, stride nx
+    float* nu = nullptr;       // nextU
+    float* nv = nullptr;       // nextV
     std::size_t su() const { return static_cast<std::size_t>(nx) + 1; }
     std::size_t sc() const { return static_cast<std::size_t>(nx); }
     // Row y of the cell-centred arrays: its offset r and depth, bedrock, soil.
@@ -212,8 +212,8 @@ inline float swellVelocity(const StepConsts& c, float hCell, float gCell) {
 // Maxima are kept per lane and folded at the end (max is exact, so the
 // grouping changes nothing).
 template <class T>
-inline void outflowCell(int x, const float* u, const float* vS, const float* vN, const float* h, float* o,
-                        float invDx, T& mh, T& mv) {
+inline void outflowCell(int x, const float* u, const float* vS, const float* vN, const float* h, float* o, float invDx,
+                        T& mh, T& mv) {
     const T zero = splat<T>(0.0f);
     const T uW = load<T>(u + x), uE = load<T>(u + x + 1), s = load<T>(vS + x), n = load<T>(vN + x);
     const T outgoing = ((vmax(uE, zero) + vmax(-uW, zero)) + vmax(n, zero)) + vmax(-s, zero);
@@ -255,9 +255,9 @@ void outflowRows(const Views& w, int y0, int y1, float invDx, float* rowMaxDepth
 // Interior faces between cells A = a[x] and B = b[x] (A west/south of B):
 // q = u h*_up / max(1, dt o_up).
 template <class T>
-inline void faceFlux(int x, const float* hA, const float* hB, const float* bedA, const float* bedB,
-                     const float* soilA, const float* soilB, const float* oA, const float* oB, const float* vel,
-                     float dt, float bref, float* q) {
+inline void faceFlux(int x, const float* hA, const float* hB, const float* bedA, const float* bedB, const float* soilA,
+                     const float* soilB, const float* oA, const float* oB, const float* vel, float dt, float bref,
+                     float* q) {
     const T ref = splat<T>(bref), one = splat<T>(1.0f), dtv = splat<T>(dt);
     T hAs, hBs;
     reconstruct<T>(load<T>(hA + x), load<T>(hB + x), (load<T>(bedA + x) + load<T>(soilA + x)) - ref,
@@ -287,8 +287,8 @@ void fluxRows(const Views& w, const StepConsts& c, int y0, int y1) {
         const float* u = w.u + y * su;
         if (nx > 1) faceFluxes(nx - 1, h, h + 1, bed, bed + 1, soil, soil + 1, o, o + 1, u + 1, c.dt, c.bref, qu + 1);
         qu[0] = (c.swell && c.edge == 0) ? swellFlux(c, u[0], h[0], bed[0] + soil[0], o[0]) : 0.0f;
-        qu[nx] = (c.swell && c.edge == 1) ? swellFlux(c, u[nx], h[nx - 1], bed[nx - 1] + soil[nx - 1], o[nx - 1])
-                                          : 0.0f;
+        qu[nx] =
+            (c.swell && c.edge == 1) ? swellFlux(c, u[nx], h[nx - 1], bed[nx - 1] + soil[nx - 1], o[nx - 1]) : 0.0f;
         // y faces of row y: between cells (x, y-1) and (x, y).
         float* qv = w.qv + r;
         const float* v = w.v + r;
@@ -485,8 +485,8 @@ void checkLayers(const TerrainState& s) {
         s.faceV.nx != s.nx || s.faceV.ny != s.ny + 1)
         throw InputError("waves need the water and faceVelocity layers (water " + std::to_string(s.water.nx) + "x" +
                          std::to_string(s.water.ny) + ", faceU " + std::to_string(s.faceU.nx) + "x" +
-                         std::to_string(s.faceU.ny) + " for a " + std::to_string(s.nx) + "x" +
-                         std::to_string(s.ny) + " grid)");
+                         std::to_string(s.faceU.ny) + " for a " + std::to_string(s.nx) + "x" + std::to_string(s.ny) +
+                         " grid)");
 }
 
 // The reference level subtracted from every elevation in a step. Any
@@ -570,8 +570,8 @@ Substep planSubstep(const Views& w, WaveScratch& scratch, float dx, float g, flo
     return {hMax, n, h};
 }
 
-StepConsts stepConsts(const TerrainState& s, const WaveSettings& settings, const WaveScratch& scratch,
-                      float maxCourant, double t, const Substep& sub) {
+StepConsts stepConsts(const TerrainState& s, const WaveSettings& settings, const WaveScratch& scratch, float maxCourant,
+                      double t, const Substep& sub) {
     const float dx = s.cellSize;
     const float g = settings.gravity;
     const double h = sub.h;
@@ -603,10 +603,14 @@ void momentumPass(const Views& w, const StepConsts& c) {
 // P4, with the advection and friction terms compiled in only where they are on.
 void momentum(const Views& w, const StepConsts& c, const WaveSettings& settings) {
     const bool friction = settings.friction > 0.0f;
-    if (settings.advection && friction) momentumPass<true, true>(w, c);
-    else if (settings.advection) momentumPass<true, false>(w, c);
-    else if (friction) momentumPass<false, true>(w, c);
-    else momentumPass<false, false>(w, c);
+    if (settings.advection && friction)
+        momentumPass<true, true>(w, c);
+    else if (settings.advection)
+        momentumPass<true, false>(w, c);
+    else if (friction)
+        momentumPass<false, true>(w, c);
+    else
+        momentumPass<false, false>(w, c);
 }
 
 }  // namespace
@@ -634,7 +638,9 @@ float waveMaxDt(const TerrainState& s, const WaveSettings& settings) {
             }
             return r;
         },
-        [](Maxima a, Maxima b) { return Maxima{std::max(a.depth, b.depth), std::max(a.speed, b.speed)}; });
+        [](Maxima a, Maxima b) {
+            return Maxima{std::max(a.depth, b.depth), std::max(a.speed, b.speed)};
+        });
     // Sources still to come raise the depth the step must survive.
     float extra = 0.0f;
     for (const WaveDrop& d : settings.drops)

@@ -23,11 +23,11 @@ namespace terrain {
 
 /// An impulse: a Gaussian raise of the surface at a time (adds water).
 struct WaveDrop {
-    double time = 0.0;     // s
-    float x = 0.0f;        // m (grid point x sits at x * cellSize)
-    float y = 0.0f;        // m
-    float radius = 5.0f;   // m (Gaussian sigma)
-    float height = 0.5f;   // m added at the centre
+    double time = 0.0;    // s
+    float x = 0.0f;       // m (grid point x sits at x * cellSize)
+    float y = 0.0f;       // m
+    float radius = 5.0f;  // m (Gaussian sigma)
+    float height = 0.5f;  // m added at the centre
 };
 
 /// An incoming swell entering through one edge of the domain: a linear
@@ -35,32 +35,32 @@ struct WaveDrop {
 /// (radiation) condition, so outgoing waves leave through that edge too.
 struct WaveSwell {
     bool enabled = false;
-    int edge = 0;             // 0: -x, 1: +x, 2: -y, 3: +y
-    float amplitude = 0.3f;   // m
-    float period = 8.0f;      // s
-    float seaLevel = 0.0f;    // m, still-water surface elevation outside the edge
-    float rampPeriods = 1.0f; // the amplitude ramps up linearly over this many periods from t = 0
+    int edge = 0;              // 0: -x, 1: +x, 2: -y, 3: +y
+    float amplitude = 0.3f;    // m
+    float period = 8.0f;       // s
+    float seaLevel = 0.0f;     // m, still-water surface elevation outside the edge
+    float rampPeriods = 1.0f;  // the amplitude ramps up linearly over this many periods from t = 0
 };
 
 struct WaveSettings {
-    float gravity = 9.81f;      // m/s^2
-    float courant = 0.5f;       // fraction of the CFL limit used for the default step (waveMaxDt)
-    float maxCourant = 0.7f;    // hard limit: waveStep sub-steps internally above it (2-D forward-backward
-                                // gravity waves need c dt / dx <= 1/sqrt(2))
-    float dryDepth = 1.0e-4f;   // m: a face whose reconstructed depths are both below this carries no flow
-    float friction = 0.0f;      // Manning n (s/m^(1/3), 0 = frictionless)
-    bool advection = true;      // momentum advection (needed for dam breaks, bores)
+    float gravity = 9.81f;     // m/s^2
+    float courant = 0.5f;      // fraction of the CFL limit used for the default step (waveMaxDt)
+    float maxCourant = 0.7f;   // hard limit: waveStep sub-steps internally above it (2-D forward-backward
+                               // gravity waves need c dt / dx <= 1/sqrt(2))
+    float dryDepth = 1.0e-4f;  // m: a face whose reconstructed depths are both below this carries no flow
+    float friction = 0.0f;     // Manning n (s/m^(1/3), 0 = frictionless)
+    bool advection = true;     // momentum advection (needed for dam breaks, bores)
     WaveSwell swell;
     std::vector<WaveDrop> drops;
 };
 
 /// Buffers reused across steps (sized on the first call; no allocation after).
 struct WaveScratch {
-    Grid outflow;          // 1/s: sum of outgoing face velocities per cell / cellSize (positivity limiter), nx x ny
-    Grid fluxU, fluxV;     // m^2/s: face volume fluxes of the step, shaped like faceU / faceV
-    Grid nextU, nextV;     // m/s: new face velocities; swapped with faceU / faceV at the end of a step
+    Grid outflow;       // 1/s: sum of outgoing face velocities per cell / cellSize (positivity limiter), nx x ny
+    Grid fluxU, fluxV;  // m^2/s: face volume fluxes of the step, shaped like faceU / faceV
+    Grid nextU, nextV;  // m/s: new face velocities; swapped with faceU / faceV at the end of a step
     std::vector<float> rowMaxDepth, rowMaxSpeed;  // per-row maxima for the internal CFL check
-    int lastSubsteps = 0;  // internal sub-steps taken by the last waveStep (1 normally)
+    int lastSubsteps = 0;                         // internal sub-steps taken by the last waveStep (1 normally)
 };
 
 /// The largest stable time step (s): courant * cellSize / (sqrt(g h_max) + |u|_max),

@@ -22,7 +22,8 @@ inline Grid hills(int n, float amp) {
     Grid g(n, n);
     for (int y = 0; y < n; ++y)
         for (int x = 0; x < n; ++x) {
-            const float u = static_cast<float>(x) / static_cast<float>(n), v = static_cast<float>(y) / static_cast<float>(n);
+            const float u = static_cast<float>(x) / static_cast<float>(n),
+                        v = static_cast<float>(y) / static_cast<float>(n);
             g(x, y) = amp * (std::sin(6.3f * u) * std::cos(4.1f * v) + 0.5f * std::sin(13.0f * u + 7.0f * v) +
                              0.25f * std::cos(23.0f * v - 3.0f * u));
         }

@@ -2,8 +2,6 @@
 // determinism and symmetry. Terrains come from small local generators (sine
 // hills, cones, hash-based value noise) so these tests depend on nothing but
 // the two stages under test.
-#include <doctest/doctest.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -11,8 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "sim/hydraulic.h"
+#include <doctest/doctest.h>
+
 #include "core/parallel.h"
+#include "sim/hydraulic.h"
 #include "sim/terrain.h"
 #include "sim/thermal.h"
 
@@ -30,8 +30,8 @@ TerrainState makeState(int nx, int ny, float cell) {
 
 // Integer hash of (x, y, seed) to [0, 1).
 float hash01(int x, int y, std::uint32_t seed) {
-    std::uint32_t h = static_cast<std::uint32_t>(x) * 0x8da6b343u ^ static_cast<std::uint32_t>(y) * 0xd8163841u ^
-                      seed * 0xcb1ab31fu;
+    std::uint32_t h =
+        static_cast<std::uint32_t>(x) * 0x8da6b343u ^ static_cast<std::uint32_t>(y) * 0xd8163841u ^ seed * 0xcb1ab31fu;
     h ^= h >> 15;
     h *= 0x2c1b3c6du;
     h ^= h >> 12;
@@ -168,7 +168,8 @@ TEST_CASE("sim.hydraulic: closed basin conserves material and water over 1000 ti
         float maxSuspended = 0.0f;
         for (int t = 0; t < 1000; ++t) {
             sim.tick(s, dt);
-            if (t % 50 == 0) maxSuspended = std::max(maxSuspended, *std::max_element(s.suspended.v.begin(), s.suspended.v.end()));
+            if (t % 50 == 0)
+                maxSuspended = std::max(maxSuspended, *std::max_element(s.suspended.v.begin(), s.suspended.v.end()));
         }
         const Totals t1 = totals(s);
 
@@ -257,7 +258,7 @@ TEST_CASE("sim.thermal: relaxes every slope to the talus angle and conserves mat
         const float slope1 = maxGroundSlope(s);
         const double err = std::fabs(t1.material - t0.material) / materialAboveBase(t0, s);
         MESSAGE(name << ": max slope " << slope0 << " -> " << slope1 << " (tan talus " << tanTalus << ") after "
-                       << steps << " steps, relative material error " << err);
+                     << steps << " steps, relative material error " << err);
         CHECK(slope0 > tanTalus + 0.1f);
         CHECK(slope1 <= tanTalus + 1e-3f);
         CHECK(err <= 1e-5);
@@ -329,8 +330,8 @@ TEST_CASE("sim.hydraulic: rain erodes the slopes and deposits in the valleys") {
     const double err = std::fabs(totals(s).material - totals(start).material) / materialAboveBase(totals(start), start);
     MESSAGE("mean ground change, top quarter: " << highChange << " m; mean soil + suspended gain, bottom quarter: "
                                                 << lowSoilChange << " m; relative material error " << err);
-    CHECK(highChange < -0.01);   // the high ground lost material
-    CHECK(lowSoilChange > 0.01); // the low ground gained sediment
+    CHECK(highChange < -0.01);    // the high ground lost material
+    CHECK(lowSoilChange > 0.01);  // the low ground gained sediment
     CHECK(err <= 1e-5);
 }
 
@@ -360,7 +361,8 @@ TEST_CASE("sim.hydraulic: hard cases stay finite") {
         {"heights of 1e5 m", 37, 29, 1.0f, 1.0f, [](TerrainState& s) { roughTerrain(s, 1.0e5f, 50.0f, 1u); }},
         {"negative heights", 37, 29, 1.0f, 1.0f, [](TerrainState& s) { roughTerrain(s, -2000.0f, 50.0f, 2u); }},
         {"heavy rain (100x)", 37, 29, 1.0f, 100.0f, [](TerrainState& s) { roughTerrain(s, 0.0f, 50.0f, 4u); }},
-        {"heavy rain, 100 m cells", 37, 29, 100.0f, 100.0f, [](TerrainState& s) { roughTerrain(s, 0.0f, 2000.0f, 4u); }},
+        {"heavy rain, 100 m cells", 37, 29, 100.0f, 100.0f,
+         [](TerrainState& s) { roughTerrain(s, 0.0f, 2000.0f, 4u); }},
         {"10 cm cells", 37, 29, 0.1f, 1.0f, [](TerrainState& s) { roughTerrain(s, 0.0f, 5.0f, 6u); }},
         {"1000 m deep water", 37, 29, 1.0f, 1.0f,
          [](TerrainState& s) {
@@ -379,7 +381,7 @@ TEST_CASE("sim.hydraulic: hard cases stay finite") {
     for (const Case& c : cases) {
         for (const bool closed : {true, false}) {
             const std::string name = c.name;
-        CAPTURE(name);
+            CAPTURE(name);
             CAPTURE(closed);
             TerrainState s = makeState(c.nx, c.ny, c.cell);
             c.make(s);
@@ -495,9 +497,9 @@ TEST_CASE("sim.hydraulic: a mirrored terrain evolves bit-for-bit mirrored (SIMD,
     // Compared with float ==, which takes -0 == +0: a dry cell's velocity is
     // (+-flux) * 0, whose sign of zero legitimately flips under a mirror.
     auto sameLayers = [](const TerrainState& p, const TerrainState& q) {
-        const Grid TerrainState::*layers[] = {&TerrainState::bedrock, &TerrainState::soil,  &TerrainState::water,
+        const Grid TerrainState::*layers[] = {&TerrainState::bedrock,   &TerrainState::soil,  &TerrainState::water,
                                               &TerrainState::suspended, &TerrainState::fluxL, &TerrainState::fluxR,
-                                              &TerrainState::fluxT,   &TerrainState::fluxB, &TerrainState::velX,
+                                              &TerrainState::fluxT,     &TerrainState::fluxB, &TerrainState::velX,
                                               &TerrainState::velY};
         int differing = 0;
         for (auto layer : layers) differing += (p.*layer).v == (q.*layer).v ? 0 : 1;

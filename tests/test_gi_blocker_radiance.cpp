@@ -2,14 +2,14 @@
 // shading relation E(x) = O(x) sum w E_k / sum w O_k, and determinism. The
 // receivers' horizons (farSlope) come from the indirect scan in a frame; here
 // the tests fill them.
-#include <doctest/doctest.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
 #include <functional>
 #include <vector>
+
+#include <doctest/doctest.h>
 
 #include "core/parallel.h"
 #include "core/simd.h"
@@ -71,9 +71,7 @@ double lerpReceivers(const Setup& b, int x, int y, const std::function<double(in
     return (1.0 - fy) * ((1.0 - fx) * v(X0, Y0) + fx * v(X1, Y0)) + fy * ((1.0 - fx) * v(X0, Y1) + fx * v(X1, Y1));
 }
 
-double sin2OfSlope(double t) {
-    return t * t / (1.0 + t * t);
-}
+double sin2OfSlope(double t) { return t * t / (1.0 + t * t); }
 
 Grid bumpy(int nx, int ny) {
     return gridOf(nx, ny, [](int x, int y) {

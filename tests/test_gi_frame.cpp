@@ -1,13 +1,13 @@
 // gi/frame: one GI frame end to end: a flat plane, state reuse across frames
 // and sizes, input checks, amortisation (Section 7) and thread determinism.
-#include <doctest/doctest.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
 #include <utility>
 #include <vector>
+
+#include <doctest/doctest.h>
 
 #include "core/error.h"
 #include "core/parallel.h"

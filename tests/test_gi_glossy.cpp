@@ -1,20 +1,20 @@
 // Glossy indirect light: the SH radiance-vector pyramid
 // (gi/indirect_glossy), the per-texel Phong exponent map and the glossy
 // reference (gi/reference_glossy).
-#include <doctest/doctest.h>
-
 #include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
 #include <vector>
 
-#include "gi/frame.h"
-#include "tests/gi_test_terrain.h"
-#include "gi/glossy_exit_radiance.h"
-#include "gi/reference_gi.h"
+#include <doctest/doctest.h>
+
 #include "core/error.h"
 #include "core/parallel.h"
+#include "gi/frame.h"
+#include "gi/glossy_exit_radiance.h"
+#include "gi/reference_gi.h"
+#include "tests/gi_test_terrain.h"
 
 using namespace terrain;
 using namespace terrain::gi;
@@ -23,7 +23,6 @@ using gi_test::meanOver;
 using gi_test::valley;
 
 namespace {
-
 
 GiSettings glossySettings(Brdf brdf, float exponent, int bounces, GlossyIndirect mode, int subsample = 1) {
     GiSettings s = GiSettings{};
@@ -143,7 +142,8 @@ TEST_CASE("gi.glossy: glossy indirect is non-negative on average and each bounce
     }
 }
 
-TEST_CASE("gi.glossy: V valley with Phong walls: the vector pyramid matches the glossy reference, the scalar one does not") {
+TEST_CASE(
+    "gi.glossy: V valley with Phong walls: the vector pyramid matches the glossy reference, the scalar one does not") {
     // Walls at 45 degrees under a uniform sky, viewer overhead. Towards the
     // viewer a wall reflects the opposite wall (the shade forwarded by the
     // scalar pyramid); towards the opposite wall it reflects the sky and the
@@ -172,7 +172,8 @@ TEST_CASE("gi.glossy: V valley with Phong walls: the vector pyramid matches the 
         const double wallV = meanOver(vs.indirect.indirect[0], c + 3, c + 10, 10, n - 10);
         const double wallS = meanOver(ss.indirect.indirect[0], c + 3, c + 10, 10, n - 10);
         const double wallR = meanOver(ref.indirect[0], c + 3, c + 10, 10, n - 10);
-        MESSAGE("S = " << exponent << ": wall indirect vector " << wallV << ", scalar " << wallS << ", reference " << wallR);
+        MESSAGE("S = " << exponent << ": wall indirect vector " << wallV << ", scalar " << wallS << ", reference "
+                       << wallR);
         CHECK(wallR > 0.01);
         CHECK(wallV == doctest::Approx(wallR).epsilon(0.15));
         if (exponent > 10.0f) CHECK(std::fabs(wallV - wallR) < 0.5 * std::fabs(wallS - wallR));
@@ -221,7 +222,8 @@ TEST_CASE("gi.glossy: bit-identical for 1, 2, 3 and 8 threads (vector pyramid, e
             GiLighting light;
             light.environment = sunSkyLight();
             withThreads(threads, [&] {
-                runGiFrame(h.view(), 1.5f, light, glossySettings(Brdf::LambertPlusPhong, 10.0f, 2, GlossyIndirect::VectorPyramid, s), st, &a);
+                runGiFrame(h.view(), 1.5f, light,
+                           glossySettings(Brdf::LambertPlusPhong, 10.0f, 2, GlossyIndirect::VectorPyramid, s), st, &a);
             });
             results.push_back(allChannels(st.indirect.total));
         }
@@ -264,8 +266,10 @@ TEST_CASE("gi.glossy: the exponent map changes the lobe where it varies") {
     light.environment = sunSkyLight();
     GiState m, wide, sharp;
     runGiFrame(h.view(), 1.0f, light, glossySettings(Brdf::Phong, 7.0f, 0, GlossyIndirect::VectorPyramid), m, &mixed);
-    runGiFrame(h.view(), 1.0f, light, glossySettings(Brdf::Phong, 2.0f, 0, GlossyIndirect::VectorPyramid), wide, &plain);
-    runGiFrame(h.view(), 1.0f, light, glossySettings(Brdf::Phong, 200.0f, 0, GlossyIndirect::VectorPyramid), sharp, &plain);
+    runGiFrame(h.view(), 1.0f, light, glossySettings(Brdf::Phong, 2.0f, 0, GlossyIndirect::VectorPyramid), wide,
+               &plain);
+    runGiFrame(h.view(), 1.0f, light, glossySettings(Brdf::Phong, 200.0f, 0, GlossyIndirect::VectorPyramid), sharp,
+               &plain);
     CHECK(m.shade.rgb[0](5, 9) == wide.shade.rgb[0](5, 9));
     CHECK(m.shade.rgb[0](25, 9) == sharp.shade.rgb[0](25, 9));
     CHECK(wide.shade.rgb[0](25, 9) != sharp.shade.rgb[0](25, 9));
@@ -295,7 +299,8 @@ TEST_CASE("gi.glossy: hard cases stay finite") {
             GiState st;
             GiLighting light;
             light.environment = sunSkyLight();
-            runGiFrame(g.view(), 1.0f, light, glossySettings(Brdf::LambertPlusPhong, 50.0f, 2, GlossyIndirect::VectorPyramid, s), st, &a);
+            runGiFrame(g.view(), 1.0f, light,
+                       glossySettings(Brdf::LambertPlusPhong, 50.0f, 2, GlossyIndirect::VectorPyramid, s), st, &a);
             for (const Grid& c : st.indirect.total)
                 for (float v : c.v) REQUIRE(std::isfinite(v));
         }
@@ -320,7 +325,9 @@ TEST_CASE("gi.glossy: a second frame allocates nothing new") {
     const GiSettings s = glossySettings(Brdf::Phong, 30.0f, 2, GlossyIndirect::VectorPyramid, 2);
     runGiFrame(h.view(), 1.0f, GiLighting{}, s, st, &a);
     const float* p0 = st.indirect.glossy.exitSh.data();
-    const float* p1 = st.indirect.glossy.pyramid.fields[17].levels.empty() ? nullptr : st.indirect.glossy.pyramid.fields[17].levels[0].data();
+    const float* p1 = st.indirect.glossy.pyramid.fields[17].levels.empty()
+                          ? nullptr
+                          : st.indirect.glossy.pyramid.fields[17].levels[0].data();
     const float* p2 = st.indirect.glossy.blockScratch.data();
     Grid h2 = h;
     for (float& v : h2.v) v *= 1.3f;

@@ -1,16 +1,16 @@
 // Indirect light on the fast path: gi/indirect, gi/radiance_pyramid
 // and the amortised frame, checked against gi/reference_gi.
-#include <doctest/doctest.h>
-
 #include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
 
-#include "gi/frame.h"
-#include "tests/gi_test_terrain.h"
-#include "gi/reference_gi.h"
+#include <doctest/doctest.h>
+
 #include "core/parallel.h"
+#include "gi/frame.h"
+#include "gi/reference_gi.h"
+#include "tests/gi_test_terrain.h"
 
 using namespace terrain;
 using namespace terrain::gi;
@@ -19,7 +19,6 @@ using gi_test::meanOver;
 using gi_test::valley;
 
 namespace {
-
 
 GiSettings indirectSettings(int bounces, int subsample = 1) {
     GiSettings s = GiSettings{};
@@ -64,9 +63,10 @@ TEST_CASE("gi.indirect: V-shaped valley with white walls under a uniform sky mat
     const double exact = meanOver(ref.indirect[0], c - 1, c + 2, 12, n - 12);
     const double fastWall = meanOver(st.indirect.indirect[0], c + 6, c + 12, 12, n - 12);
     const double exactWall = meanOver(ref.indirect[0], c + 6, c + 12, 12, n - 12);
-    MESSAGE("valley bottom indirect: fast " << fast << ", reference " << exact << "; wall: fast " << fastWall << ", reference "
-                                            << exactWall << "; direct bottom fast " << meanOver(st.shade.rgb[0], c - 1, c + 2, 12, n - 12)
-                                            << " ref " << meanOver(ref.direct[0], c - 1, c + 2, 12, n - 12));
+    MESSAGE("valley bottom indirect: fast " << fast << ", reference " << exact << "; wall: fast " << fastWall
+                                            << ", reference " << exactWall << "; direct bottom fast "
+                                            << meanOver(st.shade.rgb[0], c - 1, c + 2, 12, n - 12) << " ref "
+                                            << meanOver(ref.direct[0], c - 1, c + 2, 12, n - 12));
     CHECK(fast > 0.05);
     CHECK(fast == doctest::Approx(exact).epsilon(0.10));
     CHECK(fastWall == doctest::Approx(exactWall).epsilon(0.10));
@@ -100,8 +100,8 @@ TEST_CASE("gi.indirect: indirect >= 0, each bounce adds less than the last, belo
         maxInd = std::max(maxInd, v);
     }
     const auto& m = st.indirect.bounceMean;
-    MESSAGE("bounce means " << m[0] << ", " << m[1] << ", " << m[2] << ", " << m[3] << "; indirect min " << minInd << ", max "
-                            << maxInd << ", bound " << directMax * albedo / (1.0f - albedo));
+    MESSAGE("bounce means " << m[0] << ", " << m[1] << ", " << m[2] << ", " << m[3] << "; indirect min " << minInd
+                            << ", max " << maxInd << ", bound " << directMax * albedo / (1.0f - albedo));
     CHECK(minInd >= -1e-3f * directMax);  // SH ringing of order-4 U may dip a hair below 0
     CHECK(m[0] > 0.0);
     for (int b = 1; b < 4; ++b) CHECK(m[static_cast<std::size_t>(b)] < m[static_cast<std::size_t>(b - 1)]);
@@ -132,14 +132,17 @@ TEST_CASE("gi.indirect: outputs are bit-identical for 1, 2, 3 and 8 threads") {
     const Grid h = hills(71, 10.0f);
     AlbedoMap a = uniformAlbedo(71, 71, 0.7f);
     for (int y = 0; y < 71; ++y)
-        for (int x = 0; x < 71; ++x) a.channel[1](x, y) = 0.3f + 0.4f * static_cast<float>((x * 7 + y * 3) % 11) / 11.0f;
+        for (int x = 0; x < 71; ++x)
+            a.channel[1](x, y) = 0.3f + 0.4f * static_cast<float>((x * 7 + y * 3) % 11) / 11.0f;
     for (int s : {1, 2}) {
         std::vector<std::vector<float>> results;
         for (int threads : {1, 2, 3, 8}) {
             GiState st;
             withThreads(threads, [&] { runGiFrame(h.view(), 1.5f, GiLighting{}, indirectSettings(2, s), st, &a); });
             std::vector<float> all;
-            for (int c = 0; c < 3; ++c) all.insert(all.end(), st.indirect.indirect[static_cast<std::size_t>(c)].v.begin(), st.indirect.indirect[static_cast<std::size_t>(c)].v.end());
+            for (int c = 0; c < 3; ++c)
+                all.insert(all.end(), st.indirect.indirect[static_cast<std::size_t>(c)].v.begin(),
+                           st.indirect.indirect[static_cast<std::size_t>(c)].v.end());
             results.push_back(all);
         }
         for (std::size_t i = 1; i < results.size(); ++i) CHECK(results[i] == results[0]);
@@ -224,8 +227,10 @@ TEST_CASE("gi.indirect: amortised frames equal the full update once two frames h
         if (f == 2) {
             CHECK((!sa.directUpdated && sa.indirectUpdated));
             for (int c = 0; c < 3; ++c) {
-                CHECK(sa.indirect.indirect[static_cast<std::size_t>(c)].v == sf.indirect.indirect[static_cast<std::size_t>(c)].v);
-                CHECK(sa.indirect.total[static_cast<std::size_t>(c)].v == sf.indirect.total[static_cast<std::size_t>(c)].v);
+                CHECK(sa.indirect.indirect[static_cast<std::size_t>(c)].v ==
+                      sf.indirect.indirect[static_cast<std::size_t>(c)].v);
+                CHECK(sa.indirect.total[static_cast<std::size_t>(c)].v ==
+                      sf.indirect.total[static_cast<std::size_t>(c)].v);
             }
         }
     }
@@ -242,7 +247,8 @@ TEST_CASE("gi.indirect: a second frame allocates nothing new") {
     runGiFrame(h.view(), 1.0f, GiLighting{}, indirectSettings(2, 2), st, &a);
     const float* p0 = st.indirect.indirect[0].data();
     const float* p1 = st.indirect.u[0].sh.data();
-    const float* p2 = st.indirect.radiance.fields[1].levels.empty() ? nullptr : st.indirect.radiance.fields[1].levels[0].data();
+    const float* p2 =
+        st.indirect.radiance.fields[1].levels.empty() ? nullptr : st.indirect.radiance.fields[1].levels[0].data();
     Grid h2 = h;
     for (float& v : h2.v) v *= 1.5f;
     runGiFrame(h2.view(), 1.0f, GiLighting{}, indirectSettings(2, 2), st, &a);
@@ -276,8 +282,8 @@ TEST_CASE("gi.indirect: converges to the reference as m, k, o grow and as sub-sa
         return relRmse(st.indirect.indirect[0], ref.indirect[0], 0.1f);
     };
     const double e0 = error(8, 2, 0, 1), e1 = error(16, 4, 1, 1), e2 = error(32, 4, 2, 1), e3 = error(64, 8, 4, 1);
-    MESSAGE("indirect rel. RMSE vs reference: (m, k, o) = (8, 2, 0) " << e0 << ", (16, 4, 1) " << e1 << ", (32, 4, 2) " << e2
-                                                                        << ", (64, 8, 4) " << e3);
+    MESSAGE("indirect rel. RMSE vs reference: (m, k, o) = (8, 2, 0) " << e0 << ", (16, 4, 1) " << e1 << ", (32, 4, 2) "
+                                                                      << e2 << ", (64, 8, 4) " << e3);
     CHECK(e1 < e0);
     CHECK(e3 < e1);
     CHECK(e3 < 0.08);
@@ -289,7 +295,9 @@ TEST_CASE("gi.indirect: converges to the reference as m, k, o grow and as sub-sa
     CHECK(s1 < s2);
 }
 
-TEST_CASE("gi.indirect: exact cosine at the receivers (and blocker radiance between them) matches the reference bounce, is deterministic, and is 0 on a plane") {
+TEST_CASE(
+    "gi.indirect: exact cosine at the receivers (and blocker radiance between them) matches the reference bounce, is "
+    "deterministic, and is 0 on a plane") {
     constexpr int kModeCount = 2;
     const LambertIndirect kModes[kModeCount] = {LambertIndirect::ShKernel, LambertIndirect::BlockerRadiance};
     // a V valley and a conical pit, albedo 0.6, uniform sky, one bounce, 1x and 2x
@@ -297,8 +305,7 @@ TEST_CASE("gi.indirect: exact cosine at the receivers (and blocker radiance betw
     Grid pit(n, n);
     const float c = 0.5f * static_cast<float>(n - 1);
     for (int y = 0; y < n; ++y)
-        for (int x = 0; x < n; ++x)
-            pit(x, y) = 0.8f * std::hypot(static_cast<float>(x) - c, static_cast<float>(y) - c);
+        for (int x = 0; x < n; ++x) pit(x, y) = 0.8f * std::hypot(static_cast<float>(x) - c, static_cast<float>(y) - c);
     const Grid vee = valley(n, n, 1.0f);
     const AlbedoMap a = uniformAlbedo(n, n, 0.6f);
     GiLighting light;

@@ -1,13 +1,13 @@
 // gi/pyramid: the height pyramid's steps (Eq. 14), levels against analytic
 // fields (constant, ramp, single spike), sizes, and determinism.
-#include <doctest/doctest.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstring>
 #include <utility>
 #include <vector>
+
+#include <doctest/doctest.h>
 
 #include "core/parallel.h"
 #include "gi/pyramid.h"

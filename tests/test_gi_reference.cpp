@@ -1,8 +1,8 @@
 // gi/reference: the ground truth itself, and convergence of the fast path to it.
-#include <doctest/doctest.h>
-
 #include <cmath>
 #include <functional>
+
+#include <doctest/doctest.h>
 
 #include "gi/frame.h"
 #include "gi/reference.h"
@@ -41,11 +41,12 @@ TEST_CASE("gi.reference: flat plane is exactly 1 and the pit matches r^2/(r^2+d^
     // Pit radius 24 cells, depth = radius: the rim sits between texels, so the
     // horizon is atan(d / r') with r' in [r, r + 1 cell]: bound the value by both.
     const double r = 24.0, d = 24.0;
-    const Grid pit = makeGrid(64, 64, [&](int x, int y) { return std::hypot(x - 32.0, y - 32.0) < r ? static_cast<float>(-d) : 0.0f; });
+    const Grid pit = makeGrid(
+        64, 64, [&](int x, int y) { return std::hypot(x - 32.0, y - 32.0) < r ? static_cast<float>(-d) : 0.0f; });
     renderReference(pit.cview(), 1.0f, nullptr, nullptr, ReferenceSettings{}, rr);
     const double v = rr.ambient(32, 32);
-    MESSAGE("reference pit centre " << v << ", r^2/(r^2+d^2) = " << r * r / (r * r + d * d) << ", with r+1: "
-                                    << (r + 1) * (r + 1) / ((r + 1) * (r + 1) + d * d));
+    MESSAGE("reference pit centre " << v << ", r^2/(r^2+d^2) = " << r * r / (r * r + d * d)
+                                    << ", with r+1: " << (r + 1) * (r + 1) / ((r + 1) * (r + 1) + d * d));
     CHECK(v >= r * r / (r * r + d * d) - 1e-6);
     CHECK(v <= (r + 1) * (r + 1) / ((r + 1) * (r + 1) + d * d) + 1e-6);
 }
@@ -57,7 +58,8 @@ TEST_CASE("gi.reference: SH lighting of the ground truth matches the ambient map
     ReferenceSettings rs;
     rs.azimuths = 64;
     renderReference(g.cview(), 1.0f, &sky, nullptr, rs, rr);
-    for (std::size_t i = 0; i < rr.ambient.size(); ++i) CHECK(rr.rgb[1].v[i] == doctest::Approx(rr.ambient.v[i]).epsilon(1e-5));
+    for (std::size_t i = 0; i < rr.ambient.size(); ++i)
+        CHECK(rr.rgb[1].v[i] == doctest::Approx(rr.ambient.v[i]).epsilon(1e-5));
 }
 
 TEST_CASE("gi.reference: the fast path converges to the ground truth as m, k_v and o_v grow") {
@@ -71,7 +73,9 @@ TEST_CASE("gi.reference: the fast path converges to the ground truth as m, k_v a
     const int border = 6;
     ReferenceResult rr;
     renderReference(g.cview(), 1.0f, nullptr, nullptr, ReferenceSettings{}, rr);
-    struct Setting { int m, kv, ov; };
+    struct Setting {
+        int m, kv, ov;
+    };
     const Setting sweep[] = {{8, 2, 0}, {16, 4, 1}, {32, 4, 2}, {64, 8, 4}, {128, 16, 6}};
     double previous = 1e9;
     for (const Setting& s : sweep) {

@@ -1,12 +1,12 @@
-#include <doctest/doctest.h>
-
 #include <algorithm>
 #include <cmath>
 #include <string>
 
+#include <doctest/doctest.h>
+
+#include "core/parallel.h"
 #include "gi/reference_gi.h"
 #include "tests/gi_test_terrain.h"
-#include "core/parallel.h"
 
 using namespace terrain;
 using namespace terrain::gi;
@@ -58,11 +58,12 @@ TEST_CASE("gi.reference_gi: gathering a uniform unit exit radiance gives 1 - amb
                 ++n;
                 CHECK(next[0](x, y) == next[1](x, y));
             }
-        MESSAGE(std::string(shape == 0 ? "pit" : "valley") << ": mean |gathered - (1 - ambient)| " << sumErr / n << ", max "
-                                                 << maxErr);
+        MESSAGE(std::string(shape == 0 ? "pit" : "valley")
+                << ": mean |gathered - (1 - ambient)| " << sumErr / n << ", max " << maxErr);
         CHECK(sumErr / n < 0.01);
         CHECK(maxErr < 0.05);
-        if (shape == 0) CHECK(next[0](20, 20) == doctest::Approx(0.5).epsilon(0.03));  // floor centre: 1 - r^2/(r^2+d^2)
+        if (shape == 0)
+            CHECK(next[0](20, 20) == doctest::Approx(0.5).epsilon(0.03));  // floor centre: 1 - r^2/(r^2+d^2)
     }
 }
 

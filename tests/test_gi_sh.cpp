@@ -1,10 +1,10 @@
 // gi/sh, gi/nlp, gi/wedge: the maths, each against an independent slow computation.
-#include <doctest/doctest.h>
-
 #include <cmath>
 #include <random>
 #include <string>
 #include <vector>
+
+#include <doctest/doctest.h>
 
 #include "gi/nlp.h"
 #include "gi/sh.h"
@@ -23,7 +23,8 @@ double sphereIntegral(F&& f, int nTheta = 400, int nPhi = 800) {
         const double theta = kPi * (a + 0.5) / nTheta;
         for (int b = 0; b < nPhi; ++b) {
             const double phi = 2.0 * kPi * (b + 0.5) / nPhi;
-            sum += f(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)) * std::sin(theta);
+            sum +=
+                f(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)) * std::sin(theta);
         }
     }
     return sum * (kPi / nTheta) * (2.0 * kPi / nPhi);
@@ -35,11 +36,13 @@ TEST_CASE("gi.sh: basis is orthonormal (dense quadrature)") {
     double maxErr = 0.0;
     for (int i = 0; i < kShCount; ++i)
         for (int j = i; j < kShCount; ++j) {
-            const double v = sphereIntegral([&](double x, double y, double z) {
-                double yv[kShCount];
-                shEvaluate(x, y, z, yv);
-                return yv[i] * yv[j];
-            }, 200, 400);
+            const double v = sphereIntegral(
+                [&](double x, double y, double z) {
+                    double yv[kShCount];
+                    shEvaluate(x, y, z, yv);
+                    return yv[i] * yv[j];
+                },
+                200, 400);
             maxErr = std::max(maxErr, std::abs(v - (i == j ? 1.0 : 0.0)));
         }
     MESSAGE("max |<Y_i, Y_j> - delta_ij| = " << maxErr);
@@ -54,7 +57,8 @@ TEST_CASE("gi.sh: separable form matches the cartesian form") {
         const double s = std::sqrt(1.0 - z * z);
         double y[kShCount];
         shEvaluate(s * std::cos(phi), s * std::sin(phi), z, y);
-        for (int i = 0; i < kShCount; ++i) CHECK(shAssociated(i, z) * shAzimuthal(i, phi) == doctest::Approx(y[i]).epsilon(1e-12));
+        for (int i = 0; i < kShCount; ++i)
+            CHECK(shAssociated(i, z) * shAzimuthal(i, phi) == doctest::Approx(y[i]).epsilon(1e-12));
     }
 }
 
@@ -75,7 +79,8 @@ TEST_CASE("gi.sh: z-rotation preserves norms and matches direct evaluation") {
         const ShMatrix m = shRotationZ(angle);
         for (int i = 0; i < kShCount; ++i) {
             double s = 0.0;
-            for (int k = 0; k < kShCount; ++k) s += m[static_cast<std::size_t>(i * kShCount + k)] * c[static_cast<std::size_t>(k)];
+            for (int k = 0; k < kShCount; ++k)
+                s += m[static_cast<std::size_t>(i * kShCount + k)] * c[static_cast<std::size_t>(k)];
             CHECK(s == doctest::Approx(r[static_cast<std::size_t>(i)]).epsilon(1e-12));
         }
         // f_rot(theta, phi) == f(theta, phi - angle) at random directions
@@ -102,11 +107,13 @@ TEST_CASE("gi.sh: zonal rotation matches the projection of the rotated lobe") {
     shRotateZonal(lambertZonal(), ax, ay, az, rotated);
     double norm = 0.0;
     for (int i = 0; i < kShCount; ++i) {
-        const double p = sphereIntegral([&](double x, double y, double z) {
-            double yv[kShCount];
-            shEvaluate(x, y, z, yv);
-            return std::max(0.0, x * ax + y * ay + z * az) * yv[i];
-        }, 300, 600);
+        const double p = sphereIntegral(
+            [&](double x, double y, double z) {
+                double yv[kShCount];
+                shEvaluate(x, y, z, yv);
+                return std::max(0.0, x * ax + y * ay + z * az) * yv[i];
+            },
+            300, 600);
         CHECK(rotated[i] == doctest::Approx(p).epsilon(1e-4).scale(1.0));
         norm += rotated[i] * rotated[i];
     }
@@ -120,18 +127,27 @@ TEST_CASE("gi.sh: product matrix equals the projection of the product") {
     std::mt19937 rng(3);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     ShVector a{}, b{};
-    for (int i = 0; i < kShCount; ++i) { a[static_cast<std::size_t>(i)] = u(rng); b[static_cast<std::size_t>(i)] = u(rng); }
+    for (int i = 0; i < kShCount; ++i) {
+        a[static_cast<std::size_t>(i)] = u(rng);
+        b[static_cast<std::size_t>(i)] = u(rng);
+    }
     const ShMatrix t = shProductMatrix(a);
     for (int i = 0; i < kShCount; ++i) {
         double fast = 0.0;
-        for (int k = 0; k < kShCount; ++k) fast += t[static_cast<std::size_t>(i * kShCount + k)] * b[static_cast<std::size_t>(k)];
-        const double slow = sphereIntegral([&](double x, double y, double z) {
-            double yv[kShCount];
-            shEvaluate(x, y, z, yv);
-            double fa = 0.0, fb = 0.0;
-            for (int k = 0; k < kShCount; ++k) { fa += a[static_cast<std::size_t>(k)] * yv[k]; fb += b[static_cast<std::size_t>(k)] * yv[k]; }
-            return fa * fb * yv[i];
-        }, 200, 400);
+        for (int k = 0; k < kShCount; ++k)
+            fast += t[static_cast<std::size_t>(i * kShCount + k)] * b[static_cast<std::size_t>(k)];
+        const double slow = sphereIntegral(
+            [&](double x, double y, double z) {
+                double yv[kShCount];
+                shEvaluate(x, y, z, yv);
+                double fa = 0.0, fb = 0.0;
+                for (int k = 0; k < kShCount; ++k) {
+                    fa += a[static_cast<std::size_t>(k)] * yv[k];
+                    fb += b[static_cast<std::size_t>(k)] * yv[k];
+                }
+                return fa * fb * yv[i];
+            },
+            200, 400);
         CHECK(fast == doctest::Approx(slow).epsilon(1e-4).scale(1.0));
     }
 }
@@ -147,7 +163,8 @@ TEST_CASE("gi.nlp: basis is orthonormal on [-1, 1]") {
             for (int j = 0; j < kNlpCount; ++j) gram[i][j] += p[i] * p[j] * 2.0 / n;
     }
     for (int i = 0; i < kNlpCount; ++i)
-        for (int j = 0; j < kNlpCount; ++j) CHECK(gram[i][j] == doctest::Approx(i == j ? 1.0 : 0.0).epsilon(1e-6).scale(1.0));
+        for (int j = 0; j < kNlpCount; ++j)
+            CHECK(gram[i][j] == doctest::Approx(i == j ? 1.0 : 0.0).epsilon(1e-6).scale(1.0));
     // and it is sqrt((2l+1)/2) P_l, not the misprinted vector of Section 4
     double p[kNlpCount];
     nlpEvaluate(0.3, p);
@@ -228,7 +245,11 @@ void bruteForceWedgeProjection(const FoldedWedgeOperator& op, AzimuthInterp inte
 TEST_CASE("gi.wedge: folded operators match brute-force integration of the interpolated function") {
     std::mt19937 rng(5);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
-    struct Case { int m; AzimuthInterp interp; bool full; };
+    struct Case {
+        int m;
+        AzimuthInterp interp;
+        bool full;
+    };
     for (const Case c : {Case{8, AzimuthInterp::Linear, true}, Case{8, AzimuthInterp::Bspline, true},
                          Case{5, AzimuthInterp::Bspline, true}, Case{3, AzimuthInterp::Linear, false}}) {
         const FoldedWedgeOperator op = c.full ? foldFullCircle(c.m, c.interp) : foldPartialRange(0.4, 1.3, c.m);
@@ -247,7 +268,8 @@ TEST_CASE("gi.wedge: folded operators match brute-force integration of the inter
         for (int j = 0; j < op.azimuths; ++j)
             for (int e = 0; e < op.patternSize(); ++e)
                 sparse[op.patternRow[static_cast<std::size_t>(e)]] +=
-                    op.values[static_cast<std::size_t>(j * op.patternSize() + e)] * nlp[static_cast<std::size_t>(j * 4 + op.patternNlp[static_cast<std::size_t>(e)])];
+                    op.values[static_cast<std::size_t>(j * op.patternSize() + e)] *
+                    nlp[static_cast<std::size_t>(j * 4 + op.patternNlp[static_cast<std::size_t>(e)])];
         for (int i = 0; i < kShCount; ++i) CHECK(sparse[i] == doctest::Approx(fast[i]).epsilon(1e-5).scale(1.0));
     }
     // M_lin is 16 x 8; M_bspl is 16 x 16 (4 samples x 4 NLP coefficients, as

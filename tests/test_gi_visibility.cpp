@@ -1,16 +1,16 @@
 // gi fast path: analytic cases, shadows, hard inputs, determinism, buffer reuse.
-#include <doctest/doctest.h>
-
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <functional>
 #include <vector>
 
-#include "gi/frame.h"
-#include "gi/reference.h"
+#include <doctest/doctest.h>
+
 #include "core/error.h"
 #include "core/parallel.h"
+#include "gi/frame.h"
+#include "gi/reference.h"
 
 using namespace terrain;
 using namespace terrain::gi;
@@ -117,7 +117,8 @@ TEST_CASE("gi.visibility: circular pit floor centre against r^2 / (r^2 + d^2)") 
         double s = 0.0;
         for (int a = 0; a < 256; ++a) {
             const double phi = 2.0 * kPi * (a + 0.5) / 256.0;
-            const double slope = referenceMaxSlope(g.cview(), static_cast<float>(cell), 36, 36, std::cos(phi), std::sin(phi), 0.0);
+            const double slope =
+                referenceMaxSlope(g.cview(), static_cast<float>(cell), 36, 36, std::cos(phi), std::sin(phi), 0.0);
             s += slope / std::sqrt(1.0 + slope * slope) / 256.0;
         }
         const double fast = st.shade.ambient(36, 36);
@@ -153,8 +154,8 @@ TEST_CASE("gi.visibility: a wall shades the side away from the key light") {
             const float shadowSide = st.shade.rgb[0](az == 0.0f ? 26 : 40, 24);
             const float litSide = st.shade.rgb[0](az == 0.0f ? 40 : 26, 24);
             const float open = st.shade.rgb[0](az == 0.0f ? 4 : 60, 24);
-            MESSAGE("az " << az << " s=" << s << ": shadow side " << shadowSide << ", lit side " << litSide << ", far " << open
-                          << " (unoccluded ideal sin(25 deg) = " << std::sin(25.0 * kPi / 180.0) << ")");
+            MESSAGE("az " << az << " s=" << s << ": shadow side " << shadowSide << ", lit side " << litSide << ", far "
+                          << open << " (unoccluded ideal sin(25 deg) = " << std::sin(25.0 * kPi / 180.0) << ")");
             CHECK(shadowSide < 0.25f * litSide);
             CHECK(litSide > 0.3f);
             CHECK(std::abs(open - litSide) < 0.1f * litSide);
@@ -165,9 +166,13 @@ TEST_CASE("gi.visibility: a wall shades the side away from the key light") {
 TEST_CASE("gi.visibility: hard cases give finite output") {
     std::vector<std::pair<const char*, Grid>> cases;
     cases.emplace_back("1000 m cliff", makeGrid(40, 40, [](int x, int) { return x < 20 ? 0.0f : 1000.0f; }));
-    cases.emplace_back("one-texel spike", makeGrid(33, 31, [](int x, int y) { return x == 16 && y == 15 ? 500.0f : 0.0f; }));
-    cases.emplace_back("1e5 m heights", makeGrid(30, 30, [](int x, int y) { return 1.0e5f + 50.0f * std::sin(0.3f * x) * std::cos(0.2f * y); }));
-    cases.emplace_back("negative heights", makeGrid(30, 30, [](int x, int y) { return -3000.0f + 40.0f * std::sin(0.5f * x + 0.1f * y); }));
+    cases.emplace_back("one-texel spike",
+                       makeGrid(33, 31, [](int x, int y) { return x == 16 && y == 15 ? 500.0f : 0.0f; }));
+    cases.emplace_back("1e5 m heights", makeGrid(30, 30, [](int x, int y) {
+                           return 1.0e5f + 50.0f * std::sin(0.3f * x) * std::cos(0.2f * y);
+                       }));
+    cases.emplace_back("negative heights",
+                       makeGrid(30, 30, [](int x, int y) { return -3000.0f + 40.0f * std::sin(0.5f * x + 0.1f * y); }));
     cases.emplace_back("1x1", Grid(1, 1, 5.0f));
     cases.emplace_back("2x2", makeGrid(2, 2, [](int x, int y) { return static_cast<float>(x * 10 + y); }));
     cases.emplace_back("1x7", makeGrid(1, 7, [](int, int y) { return static_cast<float>(y); }));
@@ -257,7 +262,8 @@ TEST_CASE("gi.visibility: a second frame on a changed field reuses every buffer"
     CHECK(hashState(st) != before);
 }
 
-TEST_CASE("gi.visibility: the SIMD scan matches its scalar twin bit for bit (every receiver, azimuth, rule, 1x/2x/4x)") {
+TEST_CASE(
+    "gi.visibility: the SIMD scan matches its scalar twin bit for bit (every receiver, azimuth, rule, 1x/2x/4x)") {
     const Grid g = hills(61, 47, 30.0f);
     for (int s : {1, 2, 4})
         for (BlockingMax rule : {BlockingMax::Samples, BlockingMax::BsplineKnotsAndMidpoints}) {
@@ -274,7 +280,8 @@ TEST_CASE("gi.visibility: the SIMD scan matches its scalar twin bit for bit (eve
                 for (int Y = 0; Y < v.nyr; ++Y)
                     for (int X = 0; X < v.nxr; ++X) {
                         const float fast = v.maxSlope[(static_cast<std::size_t>(j) * v.nyr + Y) * v.nxr + X];
-                        const float slow = scanReceiverScalar(st.pyramid, X, Y, st.envOperator.phi[static_cast<std::size_t>(j)], rule);
+                        const float slow =
+                            scanReceiverScalar(st.pyramid, X, Y, st.envOperator.phi[static_cast<std::size_t>(j)], rule);
                         if (std::memcmp(&fast, &slow, 4) != 0) ++mismatches;
                     }
             CHECK_MESSAGE(mismatches == 0, "s=" << s << " rule " << static_cast<int>(rule));

@@ -1,5 +1,3 @@
-#include <doctest/doctest.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -8,14 +6,16 @@
 #include <fstream>
 #include <limits>
 #include <string>
+
+#include <doctest/doctest.h>
 #include <unistd.h>
 
 #include "core/error.h"
-#include "sim/generators.h"
 #include "core/png_io.h"
-#include "sim/vdb_io.h"
+#include "sim/generators.h"
 #include "sim/heightmap_io.h"
 #include "sim/terrain.h"
+#include "sim/vdb_io.h"
 
 using namespace terrain;
 namespace fs = std::filesystem;
@@ -144,8 +144,7 @@ TEST_CASE("sim.io: corrupt or truncated VDB files and NaN heights are rejected")
     const std::string bytes = readBytes(good);
     writeBytes(dir / "truncated.vdb", bytes.substr(0, bytes.size() / 2));
     TerrainState r;
-    CHECK_THROWS_WITH_AS(readVdb((dir / "truncated.vdb").string(), r, {}), doctest::Contains("truncated.vdb"),
-                         IoError);
+    CHECK_THROWS_WITH_AS(readVdb((dir / "truncated.vdb").string(), r, {}), doctest::Contains("truncated.vdb"), IoError);
     writeBytes(dir / "garbage.vdb", std::string(300, 'x'));
     CHECK_THROWS_AS(readVdb((dir / "garbage.vdb").string(), r, {}), IoError);
     CHECK_THROWS_AS(readVdb((dir / "missing.vdb").string(), r, {}), IoError);

@@ -1,8 +1,8 @@
-#include <doctest/doctest.h>
-
 #include <algorithm>
 #include <cstdint>
 #include <vector>
+
+#include <doctest/doctest.h>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -12,15 +12,17 @@ using namespace terrain;
 
 TEST_CASE("sim.parallel: deterministic reduction is bit-identical for any thread count") {
     std::vector<float> v(100003);
-    for (std::size_t i = 0; i < v.size(); ++i) v[i] = 1.0f / static_cast<float>(i + 1) + 1e-3f * static_cast<float>(i % 7);
+    for (std::size_t i = 0; i < v.size(); ++i)
+        v[i] = 1.0f / static_cast<float>(i + 1) + 1e-3f * static_cast<float>(i % 7);
     auto sum = [&] {
-        return deterministicReduce(0, static_cast<int>(v.size()), 4096, 0.0f,
-                                   [&](int b, int e) {
-                                       float s = 0.0f;
-                                       for (int i = b; i < e; ++i) s += v[static_cast<std::size_t>(i)];
-                                       return s;
-                                   },
-                                   [](float a, float b) { return a + b; });
+        return deterministicReduce(
+            0, static_cast<int>(v.size()), 4096, 0.0f,
+            [&](int b, int e) {
+                float s = 0.0f;
+                for (int i = b; i < e; ++i) s += v[static_cast<std::size_t>(i)];
+                return s;
+            },
+            [](float a, float b) { return a + b; });
     };
     const float s1 = withThreads(1, sum);
     for (int t : {2, 3, 8}) CHECK(withThreads(t, sum) == s1);

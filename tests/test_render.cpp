@@ -2,19 +2,19 @@
 // slopes are brighter than slopes facing away, sky light brightens shadowed
 // valley floors, both key-light shadow modes darken them, and the same scene
 // gives the same image bytes on repeated runs and for any thread count.
-#include <doctest/doctest.h>
-
 #include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <vector>
 
+#include <doctest/doctest.h>
+
+#include "core/parallel.h"
+#include "engine/pipeline.h"
 #include "render/context.h"
 #include "render/gl.h"
-#include "engine/pipeline.h"
 #include "render/renderer.h"
-#include "core/parallel.h"
 #include "sim/scene.h"
 
 using namespace terrain;
@@ -139,9 +139,10 @@ TEST_CASE("render.headless: a small scene gives a non-empty image") {
 TEST_CASE("render.headless: a slope facing the key light is brighter than one facing away") {
     // Planes at 30 degrees; the key light comes from +x at 30 degrees elevation.
     const float k = std::tan(30.0f * 0.017453292f);
-    const auto facing = renderShape([&](float x, float) { return 400.0f - k * x; }, LightingMode::Direct,
-                                    ShadowMode::SoftVisibility);
-    const auto away = renderShape([&](float x, float) { return k * x; }, LightingMode::Direct, ShadowMode::SoftVisibility);
+    const auto facing =
+        renderShape([&](float x, float) { return 400.0f - k * x; }, LightingMode::Direct, ShadowMode::SoftVisibility);
+    const auto away =
+        renderShape([&](float x, float) { return k * x; }, LightingMode::Direct, ShadowMode::SoftVisibility);
     const double bFacing = centreBrightness(facing, 20, 12), bAway = centreBrightness(away, 20, 12);
     MESSAGE("facing " << bFacing << ", away " << bAway);
     CHECK(bFacing > bAway + 30.0);
@@ -181,9 +182,11 @@ TEST_CASE("render.shadow: the shadow map and the engine's soft visibility both s
         return d < 30.0f ? 0.0f : std::min(60.0f, (d - 30.0f) * 1.2f);
     };
     const double none = centreBrightness(renderShape(valley, LightingMode::KeyOnly, ShadowMode::None, 15.0f), 4, 4);
-    const double soft = centreBrightness(renderShape(valley, LightingMode::KeyOnly, ShadowMode::SoftVisibility, 15.0f), 4, 4);
+    const double soft =
+        centreBrightness(renderShape(valley, LightingMode::KeyOnly, ShadowMode::SoftVisibility, 15.0f), 4, 4);
     const double map = centreBrightness(renderShape(valley, LightingMode::KeyOnly, ShadowMode::ShadowMap, 15.0f), 4, 4);
-    MESSAGE("valley floor, key light only: no shadow " << none << ", soft visibility " << soft << ", shadow map " << map);
+    MESSAGE("valley floor, key light only: no shadow " << none << ", soft visibility " << soft << ", shadow map "
+                                                       << map);
     CHECK(none > soft + 30.0);
     CHECK(none > map + 30.0);
 }

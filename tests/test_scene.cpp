@@ -1,5 +1,3 @@
-#include <doctest/doctest.h>
-
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -7,6 +5,8 @@
 #include <map>
 #include <sstream>
 #include <string>
+
+#include <doctest/doctest.h>
 #include <unistd.h>
 
 #include "core/error.h"
@@ -121,7 +121,8 @@ TEST_CASE("sim.scene: golden hashes of the built-in scenes") {
         std::string scene, hash;
         int size, ticks, seed;
         while (in >> scene >> size >> ticks >> seed >> hash)
-            golden[scene + " " + std::to_string(size) + " " + std::to_string(ticks) + " " + std::to_string(seed)] = hash;
+            golden[scene + " " + std::to_string(size) + " " + std::to_string(ticks) + " " + std::to_string(seed)] =
+                hash;
     }
     const char* bless = std::getenv("TERRAIN_BLESS");
     std::ostringstream blessed;
@@ -129,8 +130,8 @@ TEST_CASE("sim.scene: golden hashes of the built-in scenes") {
         SceneSettings s = builtinScene(e.scene, e.size, static_cast<std::uint64_t>(e.seed));
         Simulation sim(s);
         for (int t = 0; t < e.ticks; ++t) sim.tick();
-        const std::string key = e.scene + " " + std::to_string(e.size) + " " + std::to_string(e.ticks) + " " +
-                                std::to_string(e.seed);
+        const std::string key =
+            e.scene + " " + std::to_string(e.size) + " " + std::to_string(e.ticks) + " " + std::to_string(e.seed);
         const std::string h = hashHex(hashState(sim.state()));
         blessed << key << " " << h << "\n";
         if (!bless) {
@@ -236,8 +237,7 @@ y = 30.0
     CHECK(sim.state().nx == 80);
 
     writeText(dir / "typo.toml", "base = \"erosion\"\n[hydraulic]\nrain_rat = 1.0\n");
-    CHECK_THROWS_WITH_AS(loadSceneFile((dir / "typo.toml").string()), doctest::Contains("hydraulic.rain_rat"),
-                         IoError);
+    CHECK_THROWS_WITH_AS(loadSceneFile((dir / "typo.toml").string()), doctest::Contains("hydraulic.rain_rat"), IoError);
     writeText(dir / "syntax.toml", "size = [1, \n");
     CHECK_THROWS_WITH_AS(loadSceneFile((dir / "syntax.toml").string()), doctest::Contains("line"), IoError);
     writeText(dir / "type.toml", "size = \"big\"\n");

@@ -1,13 +1,13 @@
 // The 8-wide AVX2 kernels (chosen at run time where the processor has AVX2)
 // against the 4-wide SSE2 baseline: every GI output must be bit-identical,
 // so results do not depend on which path a machine takes.
-#include <doctest/doctest.h>
-
 #include <vector>
 
-#include "gi/frame.h"
+#include <doctest/doctest.h>
+
 #include "core/parallel.h"
 #include "core/simd.h"
+#include "gi/frame.h"
 #include "tests/gi_test_terrain.h"
 
 using namespace terrain;
@@ -43,7 +43,8 @@ TEST_CASE("simd: the AVX2 and SSE2 kernels give bit-identical GI frames") {
     const Grid h = gi_test::hills(77, 12.0f);
     AlbedoMap a = uniformAlbedo(77, 77, 0.6f);
     for (int y = 0; y < 77; ++y)
-        for (int x = 0; x < 77; ++x) a.channel[0](x, y) = 0.3f + 0.5f * static_cast<float>((x * 5 + y * 3) % 13) / 13.0f;
+        for (int x = 0; x < 77; ++x)
+            a.channel[0](x, y) = 0.3f + 0.5f * static_cast<float>((x * 5 + y * 3) % 13) / 13.0f;
     for (int sub : {1, 2, 4})
         for (LambertIndirect lam : {LambertIndirect::BlockerRadiance, LambertIndirect::ShKernel}) {
             GiSettings s = GiSettings{};

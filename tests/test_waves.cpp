@@ -2,14 +2,14 @@
 // lake at rest, wave speed sqrt(g H), Ritter's dam break, the first seiche
 // mode, mass conservation, hard cases, determinism across thread counts,
 // swell and drops.
-#include <doctest/doctest.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
+
+#include <doctest/doctest.h>
 
 #include "core/parallel.h"
 #include "sim/terrain.h"
@@ -153,20 +153,20 @@ TEST_CASE("sim.waves: lake at rest on a rough, partly dry bottom stays at rest")
         for (std::size_t i = 0; i < eta0.size(); ++i) {
             eta0[i] = s.water.v[i] + s.bedrock.v[i];
             maxDepth = std::max(maxDepth, s.water.v[i]);
-    }
-    WaveSettings ws;
-    WaveScratch scratch;
-    for (int t = 0; t < 10000; ++t) tickAdaptive(s, ws, scratch);
-    const float maxVel = std::max(maxAbs(s.faceU), maxAbs(s.faceV));
-    float maxMove = 0.0f;  // surface movement over wet cells, relative to the deepest water
-    for (std::size_t i = 0; i < eta0.size(); ++i)
-        if (s.water.v[i] > 0.0f || eta0[i] != s.bedrock.v[i])  // wet now or before
-            maxMove = std::max(maxMove, std::fabs(s.water.v[i] + s.bedrock.v[i] - eta0[i]));
-    MESSAGE("rest lake at " << lift << " m: max |velocity| " << maxVel << " m/s, max surface move " << maxMove / maxDepth
-                                         << " of the max depth " << maxDepth << " m");
-    CHECK(maxVel <= 1e-5f);
-    CHECK(maxMove / maxDepth <= 1e-5f);
-    CHECK(allFinite(s));
+        }
+        WaveSettings ws;
+        WaveScratch scratch;
+        for (int t = 0; t < 10000; ++t) tickAdaptive(s, ws, scratch);
+        const float maxVel = std::max(maxAbs(s.faceU), maxAbs(s.faceV));
+        float maxMove = 0.0f;  // surface movement over wet cells, relative to the deepest water
+        for (std::size_t i = 0; i < eta0.size(); ++i)
+            if (s.water.v[i] > 0.0f || eta0[i] != s.bedrock.v[i])  // wet now or before
+                maxMove = std::max(maxMove, std::fabs(s.water.v[i] + s.bedrock.v[i] - eta0[i]));
+        MESSAGE("rest lake at " << lift << " m: max |velocity| " << maxVel << " m/s, max surface move "
+                                << maxMove / maxDepth << " of the max depth " << maxDepth << " m");
+        CHECK(maxVel <= 1e-5f);
+        CHECK(maxMove / maxDepth <= 1e-5f);
+        CHECK(allFinite(s));
     }
 }
 
@@ -283,8 +283,7 @@ TEST_CASE("sim.waves: first seiche period of a closed basin is 2L / sqrt(g H)") 
     fillToLevel(s, 0.0f);
     const float amp = 1e-3f * H;
     for (int y = 0; y < s.ny; ++y)
-        for (int x = 0; x < nx; ++x)
-            s.water(x, y) += amp * static_cast<float>(std::cos(kPi * (x + 0.5) / L));
+        for (int x = 0; x < nx; ++x) s.water(x, y) += amp * static_cast<float>(std::cos(kPi * (x + 0.5) / L));
     const double T = 2.0 * L / std::sqrt(9.81 * H);
     WaveSettings ws;
     WaveScratch scratch;
@@ -416,8 +415,8 @@ TEST_CASE("sim.waves: hard cases stay finite") {
         }
         INFO(c.name);
         MESSAGE(std::string(c.name) << ": dt " << dtMin << " .. " << dtMax << " s, max |u| "
-                       << std::max(maxAbs(s.faceU), maxAbs(s.faceV)) << " m/s, water " << m0 << " -> "
-                       << totalWater(s));
+                                    << std::max(maxAbs(s.faceU), maxAbs(s.faceV)) << " m/s, water " << m0 << " -> "
+                                    << totalWater(s));
         CHECK(allFinite(s));
         CHECK(minValue(s.water) >= 0.0f);
         CHECK(std::isfinite(dtMin));
@@ -449,9 +448,7 @@ TEST_CASE("sim.waves: bit-identical results for 1, 2, 3 and 8 threads") {
     for (auto [nx, ny] : {std::pair{307, 211}, std::pair{67, 45}}) {
         auto run = [nx = nx, ny = ny] {
             TerrainState s = makeWaterState(nx, ny, 1.5f);
-            setGround(s, [](int x, int y) {
-                return -4.0f + 0.05f * static_cast<float>(x) + 2.0f * hash01(x, y, 11);
-            });
+            setGround(s, [](int x, int y) { return -4.0f + 0.05f * static_cast<float>(x) + 2.0f * hash01(x, y, 11); });
             fillToLevel(s, 0.0f);
             WaveSettings ws;
             ws.friction = 0.02f;
@@ -520,8 +517,8 @@ TEST_CASE("sim.waves: swell enters, propagates and stays bounded") {
         MESSAGE("swell edge " << edge << ": interior rms eta " << rms << " m (a progressive wave of 0.1 m: "
                               << 0.1 / std::sqrt(2.0) << "), max |eta| " << maxEta << " m");
         CHECK(allFinite(s));
-        CHECK(rms > 0.05);        // the wave is in the interior
-        CHECK(maxEta < 0.35f);    // standing wave against the far wall: <= 2 A, plus a margin; no blow-up
+        CHECK(rms > 0.05);      // the wave is in the interior
+        CHECK(maxEta < 0.35f);  // standing wave against the far wall: <= 2 A, plus a margin; no blow-up
     }
 }
 

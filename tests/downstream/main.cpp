@@ -15,11 +15,11 @@
 namespace {
 
 constexpr int kSize = 64;
-constexpr float kCellSize = 1.0f;           // m
-constexpr int kBumpX = 16, kBumpY = 16;     // bump centre (cells), in one quadrant
-constexpr float kBumpHeight = 12.0f;        // m
-constexpr float kBumpSigma = 3.0f;          // cells
-constexpr int kFlatX = 54, kFlatY = 54;     // flat ground far from the bump
+constexpr float kCellSize = 1.0f;                    // m
+constexpr int kBumpX = 16, kBumpY = 16;              // bump centre (cells), in one quadrant
+constexpr float kBumpHeight = 12.0f;                 // m
+constexpr float kBumpSigma = 3.0f;                   // cells
+constexpr int kFlatX = 54, kFlatY = 54;              // flat ground far from the bump
 constexpr int kFootX = kBumpX + 8, kFootY = kBumpY;  // flat ground at the bump's foot
 
 terrain::Grid bumpHeights() {
