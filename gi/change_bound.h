@@ -1,0 +1,199 @@
+#pragma once
+// Conservative bounds on how much the environment visibility and the ambient
+// light of a receiver can change when the heights change, for change-driven
+// GI on animated terrain: a tile of receivers may keep its cached results
+// when the bound says they cannot have moved by more than a tolerance.
+//
+// The chain, each link derived from the code it bounds:
+//   |dh| per cell -> MaxChangePyramid (block maxima, box queries)
+//   -> each pyramid sample's reach (stepReachCells: which cells a sample of
+//      step i reads, through the bilinear taps, the level blend, the B-spline
+//      synthesis and the box / max decimations of gi/pyramid.cpp)
+//   -> every blocking slope (h(t_i) - h0) / t_i of the scan (gi/visibility.h)
+//      per tile (boundSlopeChange), and the height gradients of the tangent
+//      planes and normals (boundGradientChange)
+//   -> the ambient map (ambientChangeBound).
+// The bounds hold in real arithmetic. The float results carry their own
+// rounding on top (a few dozen ulp of the heights over the step length for a
+// slope); a caller's tolerance is far above it. Where no height within a
+// result's reach changed, the result is recomputed from the same floats by
+// the same operations, so a zero bound means bit-identical results.
+#include <vector>
+
+#include "core/grid.h"
+#include "gi/pyramid.h"
+#include "gi/visibility.h"
+
+namespace terrain::gi {
+
+/// Block maxima of the absolute height change: level k holds the maximum of
+/// |dh| over 2^k x 2^k cells (blocks aligned to multiples of 2^k, the last
+/// ones cut by the grid's edge); level 0 is |dh| itself, the last level 1 x 1.
+struct MaxChangePyramid {
+    int nx = 0, ny = 0;
+    std::vector<Grid> levels;
+};
+
+/// Builds (or rebuilds, reusing every buffer of the same size) the pyramid
+/// of |dh|; the sign of dh does not matter.
+void buildMaxChangePyramid(ConstGridView dh, MaxChangePyramid& out);
+
+/// The same for dh = after - before (same sizes), each |dh| rounded up to
+/// the next float so that it bounds the real difference of the two floats.
+void buildMaxChangePyramid(ConstGridView before, ConstGridView after, MaxChangePyramid& out);
+
+/// Upper bound of max |dh| over the cells [x0, x1] x [y0, y1] (inclusive,
+/// clamped to the grid; 0 when the clamped box is empty). Reads at most 4 x 4
+/// blocks of the finest level that covers the box with so few; exact when
+/// the box's edges fall on that level's block edges (in particular when the
+/// box is at most 4 x 4 cells), otherwise up to that level's block size
+/// larger on each side.
+float maxChangeInBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1);
+
+/// max |dh| over the whole grid (the top level).
+float maxChangeAll(const MaxChangePyramid& p);
+
+// ---- reach of a pyramid sample ----------------------------------------------------
+// Step i of a HeightPyramid samples a field at a point q (full-resolution
+// cells). The reach r_i is a Chebyshev radius around q: no height change at
+// a cell farther than r_i from q can alter the sample. From gi/pyramid.cpp
+// and gi/visibility.cpp (makeStep):
+//  - raw steps (level < 0): q lies on a grid line of the full-resolution
+//    heights, read linearly between the two texels either side across it,
+//    both less than one cell from q (the replicated padding column and row
+//    hold the edge texel, which is closer): r = 1.
+//  - level steps: q lies on a grid line of the level, blown out to the
+//    receiver grid, and is read between two receiver texels less than one
+//    receiver spacing s from q. A level texel at receiver (X, Y) blends
+//    S_o and S_(o+1) at cell (s X, s Y) with weights 1 - q_l and q_l (q_l = 0
+//    reads S_o alone; the last octave is read alone). S_0 is the height at
+//    that cell (reach 0). S_o, o >= 1, is the cubic B-spline synthesis of
+//    the octave image B_o at u = (x + 0.5) / 2^o - 0.5: taps floor(u) - 1 ..
+//    floor(u) + 2, clamped to the image (clamping only moves a tap towards
+//    the point), and B_o texel k decimates (mean or max, with the edge
+//    replicated inside its own block) exactly the cells [k 2^o, (k + 1) 2^o).
+//    The farthest cell of tap floor(u) - 1 lies (u - floor(u) + 1.5) 2^o -
+//    0.5 < 2.5 2^o - 0.5 cells before x, that of tap floor(u) + 2 at most
+//    (floor(u) + 2.5 - u) 2^o - 0.5 <= 2.5 2^o - 0.5 after it; the same holds
+//    along y (the synthesis is separable). So R_o = 2.5 2^o - 0.5 and
+//    r = s + R_o, with o the finer octave for q_l = 0 and the coarser one
+//    otherwise.
+
+/// r_i of every step of the pyramid, in full-resolution cells.
+std::vector<float> stepReachCells(const HeightPyramid& pyr);
+
+/// Factor by which a change of the heights by at most M in the max norm can
+/// move any level sample: every filter of the pyramid is 1-Lipschitz in the
+/// max norm (the 2 x 2 mean and max, the B-spline weights, which are
+/// non-negative for a fraction in [0, 1) and sum to 1, the level blend and
+/// the scan's linear read, weights in [0, 1]) except the mean / max blend,
+/// whose weights 1 - b and b (b = peakBlend) give |1 - b| + |b|.
+float heightFilterLipschitz(const HeightPyramid& pyr);
+
+// ---- blocking slopes per tile ----------------------------------------------------
+// Tile (tx, ty) holds receivers X in [T tx, T tx + T), Y in [T ty, T ty + T)
+// (cut by the grid), T = tileReceivers; tiles are row-major, tileCount(nxr, T)
+// per row. Step i of azimuth (c, sn) samples at the distance t' (cells) the
+// scan moves it to: a whole number n >= 1 of field texels (size u: 1 cell for
+// raw steps, s for level steps) along the major axis, t' = n u / |major| with
+// n = max(1, round(tau_i |major| / u)) and |major| >= 1/sqrt2, so
+//   max(u, tau_i - u / sqrt2) <= t' <= max(sqrt2 u, tau_i + u / sqrt2),
+// and the slope is (h(q) - h0) / (t' cellSize), h0 the height at the
+// receiver's cell. With M_i the largest |dh| within t'_max + r_i of any
+// receiver of the tile (the tile's cell box dilated by that Chebyshev
+// distance) and M0 the largest |dh| over the tile's cell box (which holds
+// the receivers' cells, where h0 is read),
+//   |d slope_i| <= (L M_i + M0) / (t'_min cellSize)   (L: heightFilterLipschitz)
+// and the bound of the tile is the maximum over the steps. The maximum
+// blocking slope (BlockingMax::Samples) is a maximum over a sequence whose
+// length depends on geometry only, so it moves by at most the same bound;
+// Eq. 16's midpoints (9 (s0 + s1) - (s_-1 + s2)) / 16 move by up to 20 / 16
+// of it (blockingMaxLipschitz).
+
+inline int tileCount(int receivers, int tileReceivers) { return (receivers + tileReceivers - 1) / tileReceivers; }
+
+/// Bound on |change| of every blocking slope of tile (tx, ty) (metres per
+/// metre). `dh` must cover the pyramid's full-resolution grid.
+float boundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int tx, int ty);
+
+/// boundOfTile of every tile, row-major (tileCount(nxr, T) x tileCount(nyr, T)),
+/// in parallel. Throws InputError when tileReceivers < 1 or the sizes of dh
+/// and the pyramid differ.
+void boundSlopeChange(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers,
+                      std::vector<float>& tileBound);
+
+/// How much the maximum blocking slope can move per unit of the per-step
+/// bound: 1 for the sample maximum, 20 / 16 for Eq. 16's midpoints.
+float blockingMaxLipschitz(BlockingMax rule);
+
+// ---- tangent planes and normals per tile -------------------------------------------
+// omega_min (gi/visibility.h) reads the height gradient at the receiver, or
+// with sub-sampling the box of gradients over its footprint texels (offsets
+// {-s/2, 0, s/2}^2 cells, clamped), whose bounds are minima and maxima of
+// gradients (1-Lipschitz); shading reads each texel's own gradient. The
+// gradient (gi/frame.cpp computeGradient) is (h(x+1) - h(x-1)) / (2
+// cellSize) inside, moving by at most M / cellSize, and one-sided (h(1) -
+// h(0)) / cellSize on the border rows and columns, moving by at most 2 M /
+// cellSize, M the largest |dh| over the footprint dilated by one cell.
+
+/// Bound on |change| of each gradient component (metres per metre) over the
+/// footprint texels of tile (tx, ty).
+float gradientBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int tx, int ty);
+
+/// gradientBoundOfTile of every tile (layout and errors as boundSlopeChange).
+void boundGradientChange(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers,
+                         std::vector<float>& tileBound);
+
+// ---- from slopes to shade ---------------------------------------------------------
+// Exact integral: along azimuth phi the sky is visible above the elevation
+// sigma(phi) = atan(t(phi)); the occluded band moves by |d sigma| <= |dt|, and
+// a band of elevation width d over the full circle has a cosine-weighted
+// solid angle of at most 2 pi d (cos <= 1), so irradiance / pi moves by at
+// most 2 Lmax max|dt| (kShadePerSlopeExact).
+//
+// The engine's ambient map is a different function of the horizon. It is
+// lam(N) . V / pi (gi/shading.h): V is the order-4 SH projection of W, the
+// azimuthal interpolation (non-negative weights summing to 1) of each
+// azimuth's order-4 Legendre approximation in z = sin(elevation) of "visible
+// above sin(sigma)" (Eq. 11, gi/wedge.h); lam has bands 0..2 only, so the
+// ambient is the integral of W times k(N . w), k the band-limited clamped
+// cosine / pi. Moving sin(sigma) of azimuth sample j to u changes it by
+// integral over phi of beta_j(phi) g(u, phi), with g the order-4 Legendre
+// projection in z of k(N . w(z, phi)): g peaks above k's maximum, so the
+// per-slope constant is 2 pi max|g| over normals, azimuths and u, rounded up
+// (kShadePerSlope; the unit test 'gi.change_bound: SH constants' computes
+// max|g| by quadrature and checks the constant against it, and the ambient
+// tests check it against the engine's outputs). The maximum of the blocking
+// slope and the tangent slope moves by at most the larger of their moves,
+// and sin(atan t) is 1-Lipschitz.
+//
+// A normal moving by |dN| changes k(N . w) - k(N' . w) = (dN . w)(k1 + k2 (N
+// + N') . w) for the quadratic k = k0 + k1 t + k2 t^2; k integrates to the
+// same value for every normal, so W may be shifted to its mid-range first:
+// the change is at most (range W / 2) max over m in [0, 1] (the integrand is
+// convex in m: the ends) of the integral of |x| |k1 + 2 k2 m z| over the
+// sphere, times |dN| (kShadePerNormal; checked by the same test). |dN| <=
+// |d gradient| (the unit normal is a 1-Lipschitz function of the gradient)
+// <= sqrt2 G for a per-component bound G, and the tangent slope gx c + gy sn
+// moves by at most sqrt2 G too.
+//
+// Scope: the ambient map (uniform unit sky: Lmax = 1) and the direct light
+// of a uniform sky of radiance Lmax at white albedo. A non-uniform sky's SH
+// product reshapes the kernel; its bound needs its own constant. Texels
+// between receivers interpolate the V of up to four receivers (Fig. 7), so
+// their bound is the largest of the tiles those receivers belong to.
+inline constexpr float kShadePerSlopeExact = 2.0f;
+inline constexpr float kShadePerSlope = 2.25f;
+inline constexpr float kShadePerNormal = 1.05f;
+
+/// Bound on |change| of the engine's ambient / uniform-sky shade per unit of
+/// the horizon slope change, for sky radiance at most maxSkyRadiance.
+inline float shadeChangePerSlope(float maxSkyRadiance) { return kShadePerSlope * maxSkyRadiance; }
+
+/// Bound on |change| of the ambient map (times maxSkyRadiance for a uniform
+/// sky) at the receiver texels of a tile, from the tile's slope bound (its
+/// maximum blocking slope's: boundOfTile times blockingMaxLipschitz) and its
+/// gradient bound.
+float ambientChangeBound(float slopeBound, float gradientBound, float maxSkyRadiance);
+
+}  // namespace terrain::gi

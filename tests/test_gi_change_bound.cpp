@@ -1,0 +1,394 @@
+// gi/change_bound: bounds on how much the visibility scan and the ambient
+// light can change when the heights change. Box maxima against brute force,
+// the reach of pyramid samples against single-cell changes, the SH constants
+// against quadrature, and the tile bounds against the engine's own frames
+// before and after perturbations of a terrain.
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <random>
+#include <sstream>
+#include <vector>
+
+#include <doctest/doctest.h>
+
+#include "core/error.h"
+#include "gi/change_bound.h"
+#include "gi/frame.h"
+#include "gi/nlp.h"
+#include "gi/sh.h"
+#include "tests/gi_test_terrain.h"
+
+using namespace terrain;
+using namespace terrain::gi;
+using gi_test::gridOf;
+
+namespace {
+
+constexpr float kCell = 2.0f;  // metres
+
+float bruteMax(const Grid& g, int x0, int y0, int x1, int y1) {
+    float m = 0.0f;
+    for (int y = std::max(y0, 0); y <= std::min(y1, g.ny - 1); ++y)
+        for (int x = std::max(x0, 0); x <= std::min(x1, g.nx - 1); ++x) m = std::max(m, std::fabs(g(x, y)));
+    return m;
+}
+
+// Rolling hills, a cliff along a wavy line (high side x > cliffEdge) and a
+// little noise, heights in metres.
+float cliffEdge(int nx, int y) {
+    return 0.62f * static_cast<float>(nx) + 4.0f * std::sin(0.2f * static_cast<float>(y));
+}
+
+Grid baseTerrain(int nx, int ny) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> noise(-0.25f, 0.25f);
+    return gridOf(nx, ny, [&](int x, int y) {
+        const float fx = static_cast<float>(x), fy = static_cast<float>(y);
+        const float hills =
+            14.0f * std::sin(0.13f * fx) * std::cos(0.11f * fy) + 5.0f * std::sin(0.37f * fx + 0.29f * fy);
+        return hills + (fx > cliffEdge(nx, y) ? 10.0f : 0.0f) + noise(rng);
+    });
+}
+
+enum class Change { Bump, Noise, CliffCollapse, Spike };
+const char* nameOf(Change c) {
+    switch (c) {
+        case Change::Bump:
+            return "bump";
+        case Change::Noise:
+            return "noise";
+        case Change::CliffCollapse:
+            return "cliff collapse";
+        case Change::Spike:
+            return "spike";
+    }
+    return "";
+}
+
+// (a) a local Gaussian bump (cut at 4 sigma), (b) low-amplitude noise
+// everywhere, (c) the cliff's edge lowered and its foot raised over a stretch
+// of rows, (d) one texel raised.
+Grid perturbed(const Grid& base, Change c, unsigned seed) {
+    Grid g = base;
+    const int nx = g.nx, ny = g.ny;
+    std::mt19937 rng(seed);
+    if (c == Change::Bump) {
+        const float cx = 0.35f * nx, cy = 0.45f * ny, sigma = 3.0f;
+        for (int y = 0; y < ny; ++y)
+            for (int x = 0; x < nx; ++x) {
+                const float r2 = (x - cx) * (x - cx) + (y - cy) * (y - cy);
+                if (r2 < 16.0f * sigma * sigma) g(x, y) += 3.0f * std::exp(-r2 / (2.0f * sigma * sigma));
+            }
+    } else if (c == Change::Noise) {
+        std::uniform_real_distribution<float> u(-0.02f, 0.02f);
+        for (float& v : g.v) v += u(rng);
+    } else if (c == Change::CliffCollapse) {
+        for (int y = static_cast<int>(0.3f * ny); y < static_cast<int>(0.6f * ny); ++y)
+            for (int x = 0; x < nx; ++x) {
+                const float d = static_cast<float>(x) - cliffEdge(nx, y);
+                if (d > 0.0f && d <= 3.0f)
+                    g(x, y) -= 6.0f * (1.0f - d / 4.0f);
+                else if (d <= 0.0f && d > -5.0f)
+                    g(x, y) += 3.0f * (1.0f + d / 5.0f);
+            }
+    } else {
+        g(static_cast<int>(0.7f * nx), static_cast<int>(0.25f * ny)) += 8.0f;
+    }
+    return g;
+}
+
+float maxAbs(const Grid& g) {
+    float m = 0.0f;
+    for (float v : g.v) m = std::max(m, std::fabs(v));
+    return m;
+}
+
+double median(std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+}
+
+// What one before / after comparison found.
+struct Comparison {
+    int slopeOver = 0, ambientOver = 0;            // receivers past bound + allowance
+    double worstSlope = 0.0, worstAmbient = 0.0;   // largest change / bound
+    std::vector<double> slopeLoose, ambientLoose;  // per receiver: bound / change where the change is clearly non-zero
+    std::vector<double> tileSlopeLoose, tileAmbientLoose;  // per tile: bound / largest change in the tile
+};
+
+// Per tile: the bound and the largest change of its receivers.
+struct TileChange {
+    double slopeBound = 0.0, ambientBound = 0.0, slope = 0.0, ambient = 0.0;
+};
+
+void addTileLooseness(const std::vector<TileChange>& tiles, Comparison& c) {
+    for (const TileChange& t : tiles) {
+        if (t.slope > 1e-3) c.tileSlopeLoose.push_back(t.slopeBound / t.slope);
+        if (t.ambient > 1e-4) c.tileAmbientLoose.push_back(t.ambientBound / t.ambient);
+    }
+}
+
+// Frames a (heights h0) and b (h1): every receiver's maximum blocking slope
+// at every azimuth and its ambient texel against its tile's bounds.
+Comparison compareFrames(const GiState& a, const GiState& b, const Grid& h0, const Grid& h1, int T, float lipschitz) {
+    MaxChangePyramid dh;
+    buildMaxChangePyramid(h0.cview(), h1.cview(), dh);
+    std::vector<float> slopeBound, gradBound;
+    boundSlopeChange(dh, a.pyramid, T, slopeBound);
+    boundGradientChange(dh, a.pyramid, T, gradBound);
+    const HeightPyramid& p = a.pyramid;
+    const int nxr = p.nxr, nyr = p.nyr, s = p.subsample, tilesX = tileCount(nxr, T);
+    const int m = static_cast<int>(a.envVisibility.maxSlope.size() / (static_cast<std::size_t>(nxr) * nyr));
+    // Float rounding: a level sample is some dozen float operations deep,
+    // each off by half an ulp of a height at most, and the slope divides by
+    // the step (>= 1 cell); before and after round independently.
+    const double hMax = std::max(maxAbs(h0), maxAbs(h1));
+    const double heightUlps = 64.0 * FLT_EPSILON * hMax / kCell;
+    Comparison c;
+    std::vector<TileChange> tiles(slopeBound.size());
+    for (int Y = 0; Y < nyr; ++Y)
+        for (int X = 0; X < nxr; ++X) {
+            const std::size_t t = static_cast<std::size_t>(Y / T) * tilesX + static_cast<std::size_t>(X / T);
+            const double sb = lipschitz * slopeBound[t];
+            double change = 0.0, allowance = 0.0;
+            for (int j = 0; j < m; ++j) {
+                const std::size_t i = (static_cast<std::size_t>(j) * nyr + Y) * nxr + X;
+                const double s0 = a.envVisibility.maxSlope[i], s1 = b.envVisibility.maxSlope[i];
+                change = std::max(change, std::fabs(s1 - s0));
+                allowance =
+                    std::max(allowance, heightUlps + 4.0 * FLT_EPSILON * std::max(std::fabs(s0), std::fabs(s1)));
+            }
+            c.slopeOver += change > sb + allowance;
+            if (sb > 0.0) c.worstSlope = std::max(c.worstSlope, change / sb);
+            if (change > 1e-3) c.slopeLoose.push_back(sb / change);
+            const double ab = ambientChangeBound(static_cast<float>(sb), gradBound[t], 1.0f);
+            const double ambChange = std::fabs(b.shade.ambient(s * X, s * Y) - a.shade.ambient(s * X, s * Y));
+            c.ambientOver += ambChange > ab + 1e-5;  // a few ulp of values about 1
+            if (ab > 0.0) c.worstAmbient = std::max(c.worstAmbient, ambChange / ab);
+            if (ambChange > 1e-4) c.ambientLoose.push_back(ab / ambChange);
+            tiles[t] = {sb, ab, std::max(tiles[t].slope, change), std::max(tiles[t].ambient, ambChange)};
+        }
+    addTileLooseness(tiles, c);
+    return c;
+}
+
+void runFrame(const Grid& h, const GiSettings& settings, GiState& st) {
+    runGiFrame(h.cview(), kCell, GiLighting{}, settings, st);
+}
+
+struct Config {
+    int nx, ny, subsample, tile;
+    bool paper;  // paperGiSettings (Eq. 16's maximum, mean pyramid, receiver tangent planes) instead of GiSettings{}
+};
+
+}  // namespace
+
+TEST_CASE("gi.change_bound: box maxima bound the brute-force maximum, exactly on aligned boxes") {
+    std::mt19937 rng(7);
+    MaxChangePyramid p;
+    for (int trial = 0; trial < 30; ++trial) {
+        const int nx = 1 + static_cast<int>(rng() % 90), ny = 1 + static_cast<int>(rng() % 90);
+        std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+        const Grid dh = gridOf(nx, ny, [&](int, int) { return u(rng); });
+        buildMaxChangePyramid(dh.cview(), p);
+        int exact = 0;
+        for (int q = 0; q < 200; ++q) {
+            const int x0 = static_cast<int>(rng() % (nx + 10)) - 5, y0 = static_cast<int>(rng() % (ny + 10)) - 5;
+            const int x1 = x0 + static_cast<int>(rng() % (q % 2 ? 6 : nx + 5));
+            const int y1 = y0 + static_cast<int>(rng() % (q % 2 ? 6 : ny + 5));
+            const float got = maxChangeInBox(p, x0, y0, x1, y1), want = bruteMax(dh, x0, y0, x1, y1);
+            CHECK(got >= want);
+            const int w = std::min(x1, nx - 1) - std::max(x0, 0) + 1, h = std::min(y1, ny - 1) - std::max(y0, 0) + 1;
+            if (w <= 4 && h <= 4) {
+                CHECK(got == want);
+                ++exact;
+            }
+        }
+        CHECK(exact > 0);
+        // boxes on the block edges of level k (cut by the grid's edge) are exact
+        for (int k = 0; k < static_cast<int>(p.levels.size()); ++k) {
+            const int b = 1 << k, bx = static_cast<int>(rng() % static_cast<unsigned>(p.levels[k].nx));
+            const int by = static_cast<int>(rng() % static_cast<unsigned>(p.levels[k].ny));
+            const int cx = 1 + static_cast<int>(rng() % 4), cy = 1 + static_cast<int>(rng() % 4);
+            const int x0 = bx * b, y0 = by * b, x1 = (bx + cx) * b - 1, y1 = (by + cy) * b - 1;
+            CHECK(maxChangeInBox(p, x0, y0, x1, y1) == bruteMax(dh, x0, y0, x1, y1));
+        }
+        CHECK(maxChangeAll(p) == bruteMax(dh, 0, 0, nx - 1, ny - 1));
+    }
+    // a rebuild of the same size reuses every buffer
+    const Grid a = gridOf(37, 21, [](int x, int y) { return static_cast<float>(x - y); });
+    buildMaxChangePyramid(a.cview(), p);
+    std::vector<const float*> before;
+    for (const Grid& g : p.levels) before.push_back(g.data());
+    buildMaxChangePyramid(a.cview(), gridOf(37, 21, [](int x, int) { return static_cast<float>(x); }).cview(), p);
+    for (std::size_t k = 0; k < p.levels.size(); ++k) CHECK(p.levels[k].data() == before[k]);
+    CHECK(maxChangeAll(p) == 20.0f);
+}
+
+TEST_CASE("gi.change_bound: a height change moves pyramid levels only within the reach, by at most its size") {
+    const int nx = 150, ny = 101;
+    const Grid base = baseTerrain(nx, ny);
+    for (int s : {1, 2, 4})
+        for (float blend : {0.0f, 0.5f}) {
+            PyramidSettings ps;
+            ps.peakBlend = blend;
+            ps.levelOffset = 1;  // more level steps on a small grid
+            HeightPyramid p0, p1;
+            buildHeightPyramid(base.cview(), kCell, s, ps, p0);
+            const std::vector<float> reach = stepReachCells(p0);
+            double tightest = 0.0;
+            for (const int cx : {0, 37, nx - 1}) {
+                const int cy = cx == 37 ? 52 : cx % ny;
+                Grid h = base;
+                h(cx, cy) += 4.0f;
+                buildHeightPyramid(h.cview(), kCell, s, ps, p1);
+                for (std::size_t i = 0; i < p0.steps.size(); ++i) {
+                    const int level = p0.steps[i].level;
+                    if (level < 0) continue;
+                    const double r = reach[i] - s;  // the level texel's own reach
+                    const PaddedField &a = p0.levels[static_cast<std::size_t>(level)],
+                                      &b = p1.levels[static_cast<std::size_t>(level)];
+                    int far = -1;
+                    float worst = 0.0f;
+                    for (int Y = 0; Y < p0.nyr; ++Y)
+                        for (int X = 0; X < p0.nxr; ++X) {
+                            const float d = std::fabs(b.row(Y)[X] - a.row(Y)[X]);
+                            if (d == 0.0f) continue;
+                            far = std::max(far, std::max(std::abs(s * X - cx), std::abs(s * Y - cy)));
+                            worst = std::max(worst, d);
+                        }
+                    CHECK(far <= r);
+                    CHECK(worst <= 4.0f * heightFilterLipschitz(p0) * (1.0f + 1e-5f));
+                    tightest = std::max(tightest, far / r);
+                }
+            }
+            MESSAGE("s=" << s << " peak blend " << blend << ": farthest changed level texel / its reach " << tightest);
+        }
+}
+
+TEST_CASE("gi.change_bound: SH constants cover the engine's horizon kernel") {
+    // k(t) = sum_l z_l sqrt((2l + 1) / (4 pi)) P_l(t) / pi: lam(N) . V is the integral of W k(N . w)
+    const double* zh = lambertZonal();
+    const double kPiD = 3.14159265358979323846;
+    const double k0 = zh[0] * std::sqrt(1.0 / (4.0 * kPiD)) / kPiD, k1 = zh[1] * std::sqrt(3.0 / (4.0 * kPiD)) / kPiD;
+    const double k2 = zh[2] * std::sqrt(5.0 / (4.0 * kPiD)) / kPiD;
+    auto k = [&](double t) { return k0 + k1 * t + k2 * 0.5 * (3.0 * t * t - 1.0); };
+    // max |g|: g(u) = sum_l NLP_l(u) integral over z of NLP_l(z) k(N . w(z, phi)), midpoint rule in z
+    const int nz = 800;
+    double maxG = 0.0;
+    for (int it = 0; it < 90; ++it)
+        for (int ip = 0; ip <= 60; ++ip) {
+            const double tilt = it * kPiD / 180.0, phi = ip * kPiD / 60.0;
+            double proj[kNlpCount] = {};
+            for (int iz = 0; iz < nz; ++iz) {
+                const double z = -1.0 + (iz + 0.5) * 2.0 / nz, r = std::sqrt(1.0 - z * z);
+                double nlp[kNlpCount];
+                nlpEvaluate(z, nlp);
+                const double kv = k(std::sin(tilt) * r * std::cos(phi) + std::cos(tilt) * z) * 2.0 / nz;
+                for (int l = 0; l < kNlpCount; ++l) proj[l] += nlp[l] * kv;
+            }
+            for (int iu = 0; iu <= 100; ++iu) {
+                double nlp[kNlpCount];
+                nlpEvaluate(-1.0 + iu * 0.02, nlp);
+                double g = 0.0;
+                for (int l = 0; l < kNlpCount; ++l) g += nlp[l] * proj[l];
+                maxG = std::max(maxG, std::fabs(g));
+            }
+        }
+    // the range of W: order-4 Legendre approximations of "visible above s"
+    double wLo = 1.0, wHi = 0.0;
+    for (int is = 0; is <= 400; ++is) {
+        double v[kNlpCount];
+        nlpVisibleAbove(-1.0 + is * 0.005, v);
+        for (int iz = 0; iz <= 400; ++iz) {
+            double nlp[kNlpCount];
+            nlpEvaluate(-1.0 + iz * 0.005, nlp);
+            const double w = v[0] * nlp[0] + v[1] * nlp[1] + v[2] * nlp[2] + v[3] * nlp[3];
+            wLo = std::min(wLo, w);
+            wHi = std::max(wHi, w);
+        }
+    }
+    // integral over the sphere of |x| |k1 + 2 k2' m z| (k2' = 1.5 k2, k's t^2 coefficient), m = 0 and 1
+    double d[2] = {};
+    for (int m = 0; m < 2; ++m)
+        for (int iz = 0; iz < 20000; ++iz) {
+            const double z = -1.0 + (iz + 0.5) * 2.0 / 20000;
+            d[m] += 4.0 * std::sqrt(1.0 - z * z) * std::fabs(k1 + 3.0 * k2 * m * z) * 2.0 / 20000;
+        }
+    const double perSlope = 2.0 * kPiD * maxG, perNormal = 0.5 * (wHi - wLo) * std::max(d[0], d[1]);
+    MESSAGE("per slope: 2 pi max|g| = " << perSlope << " (constant " << kShadePerSlope << ", exact integral "
+                                        << kShadePerSlopeExact << "); per normal: " << perNormal << " (constant "
+                                        << kShadePerNormal << "); W in [" << wLo << ", " << wHi << "]");
+    CHECK(perSlope <= kShadePerSlope);
+    CHECK(perNormal <= kShadePerNormal);
+}
+
+TEST_CASE("gi.change_bound: tile bounds hold for the engine's slopes and ambient light") {
+    const Config configs[] = {
+        {97, 70, 1, 8, false}, {120, 83, 2, 8, false}, {150, 118, 4, 4, false}, {80, 96, 1, 6, true}};
+    double worstSlope = 0.0, worstAmbient = 0.0;
+    for (const Config& cfg : configs) {
+        GiSettings settings = cfg.paper ? paperGiSettings() : GiSettings{};
+        settings.subsample = cfg.subsample;
+        settings.indirect.bounces = 0;
+        const float lipschitz = blockingMaxLipschitz(settings.visibility.blockingMax);
+        const Grid base = baseTerrain(cfg.nx, cfg.ny);
+        GiState before, after;
+        runFrame(base, settings, before);
+        for (Change change : {Change::Bump, Change::Noise, Change::CliffCollapse, Change::Spike}) {
+            const Grid h = perturbed(base, change, 5u + static_cast<unsigned>(change));
+            runFrame(h, settings, after);
+            const Comparison c = compareFrames(before, after, base, h, cfg.tile, lipschitz);
+            std::ostringstream label;
+            label << cfg.nx << " x " << cfg.ny << " s=" << cfg.subsample << " tiles of " << cfg.tile
+                  << (cfg.paper ? " (paper settings)" : "") << ", " << nameOf(change);
+            INFO(label.str());
+            CHECK(c.slopeOver == 0);
+            CHECK(c.ambientOver == 0);
+            worstSlope = std::max(worstSlope, c.worstSlope);
+            worstAmbient = std::max(worstAmbient, c.worstAmbient);
+            if (change == Change::Bump)
+                MESSAGE(label.str() << ": median bound / change per receiver " << median(c.slopeLoose) << " (slopes), "
+                                    << median(c.ambientLoose) << " (ambient); per tile (largest change) "
+                                    << median(c.tileSlopeLoose) << " (slopes, " << c.tileSlopeLoose.size()
+                                    << " tiles), " << median(c.tileAmbientLoose) << " (ambient, "
+                                    << c.tileAmbientLoose.size() << ")");
+        }
+    }
+    MESSAGE("worst change / bound: slopes " << worstSlope << ", ambient " << worstAmbient);
+}
+
+TEST_CASE("gi.change_bound: no change gives zero bounds, a distant change a small positive one") {
+    const Grid h = baseTerrain(90, 70);
+    HeightPyramid pyr;
+    buildHeightPyramid(h.cview(), kCell, 1, PyramidSettings{}, pyr);
+    MaxChangePyramid dh;
+    buildMaxChangePyramid(h.cview(), h.cview(), dh);
+    std::vector<float> slope, grad;
+    boundSlopeChange(dh, pyr, 8, slope);
+    boundGradientChange(dh, pyr, 8, grad);
+    REQUIRE(slope.size() == static_cast<std::size_t>(tileCount(90, 8) * tileCount(70, 8)));
+    CHECK(std::all_of(slope.begin(), slope.end(), [](float v) { return v == 0.0f; }));
+    CHECK(std::all_of(grad.begin(), grad.end(), [](float v) { return v == 0.0f; }));
+    CHECK(ambientChangeBound(0.0f, 0.0f, 1.0f) == 0.0f);
+
+    Grid g = h;
+    g(2, 3) += 5.0f;
+    buildMaxChangePyramid(h.cview(), g.cview(), dh);
+    boundSlopeChange(dh, pyr, 8, slope);
+    boundGradientChange(dh, pyr, 8, grad);
+    const float near = slope.front(), far = slope.back();
+    MESSAGE("spike in the first tile: bound there " << near << ", in the farthest tile " << far);
+    CHECK(far > 0.0f);
+    CHECK(far < near / 10.0f);
+    CHECK(grad.front() > 0.0f);
+    CHECK(grad.back() == 0.0f);
+    CHECK(boundOfTile(dh, pyr, 8, tileCount(90, 8) - 1, tileCount(70, 8) - 1) == far);
+
+    CHECK_THROWS_AS(boundSlopeChange(dh, pyr, 0, slope), InputError);
+    MaxChangePyramid small;
+    buildMaxChangePyramid(gridOf(10, 10, [](int, int) { return 1.0f; }).cview(), small);
+    CHECK_THROWS_AS(boundGradientChange(small, pyr, 8, grad), InputError);
+}
