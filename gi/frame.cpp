@@ -209,13 +209,16 @@ void environmentVisibility(const GiSettings& settings, GiState& st) {
 
 // Each key light's own visibility over its azimuthal extent and elevation
 // interval (Section 6); operators cached per light.
-void keyLightVisibility(const GiLighting& lighting, const GiSettings& settings, GiState& st) {
+void keyLightVisibility(const GiLighting& lighting, const GiSettings& settings, const std::vector<bool>& recompute,
+                        GiState& st) {
     const std::size_t nKeys = lighting.keys.size();
     st.keyOperators.resize(nKeys);
     st.keyOperatorLights.resize(nKeys);
     st.keyVisibility.resize(nKeys);
     const bool footprint = settings.subsample > 1 && settings.visibility.footprintTangent;
     for (std::size_t k = 0; k < nKeys; ++k) {
+        if (!recompute[k]) continue;
+        ++st.keyVisibilitiesRecomputed;
         const KeyLight& light = lighting.keys[k];
         const KeyLightExtent ext = keyLightExtent(light);
         if (st.keyOperators[k].azimuths != settings.keyLightAzimuths || !sameLight(st.keyOperatorLights[k], light)) {
@@ -255,40 +258,69 @@ void directShading(const GiLighting& lighting, const GiSettings& settings, const
             addKeyLightExactCosine(lighting.keys[k], st.keyVisibility[k], settings.subsample, albedo, st, st.shade.rgb);
 }
 
+// The direct light's stages: geometry (gradient, pyramid, environment V)
+// where it changed, each key light's V where its region of the sky or the
+// geometry changed, and the shading.
+void runDirectStages(ConstGridView heights, float cellSize, const GiLighting& lighting, const GiSettings& settings,
+                     const FrameChange& change, const AlbedoMap* albedo, GiState& st) {
+    auto t = Clock::now();
+    if (change.geometry) {
+        computeGradient(heights, cellSize, st.gradX, st.gradY);
+        st.timings.gradient = msSince(t);
+        t = Clock::now();
+        buildHeightPyramid(heights, cellSize, settings.subsample, settings.pyramid, st.pyramid);
+        st.timings.pyramid = msSince(t);
+        t = Clock::now();
+        environmentVisibility(settings, st);
+        st.timings.visibility = msSince(t);
+        st.receiversRecomputed = 1.0;
+    }
+    t = Clock::now();
+    keyLightVisibility(lighting, settings, change.keyGeometry, st);
+    st.timings.keyVisibility = msSince(t);
+    t = Clock::now();
+    directShading(lighting, settings, albedo, st);
+    st.timings.shading = msSince(t);
+}
+
 }  // namespace
 
 void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lighting, const GiSettings& settings,
                 GiState& st, const AlbedoMap* albedo) {
     validateFrameInputs(heights, cellSize, lighting, settings, albedo);
-    planAmortisation(heights, settings, st);
-    st.timings.indirect = 0.0;
-    if (!st.directUpdated) {
-        // indirect only: geometry, pyramid, visibility and direct shade are the last frame's
-        const auto ti = Clock::now();
-        runIndirectStage(settings, st, albedo);
-        st.timings.total = msSince(ti);
+    const FrameChange change = settings.incremental
+                                   ? compareFrameInputs(st.lastInputs, heights, cellSize, lighting, settings, albedo)
+                                   : everythingChanged(lighting.keys.size());
+    if (settings.incremental) st.geometryChanged = change.geometry;
+    st.timings = GiTimings{};
+    st.receiversRecomputed = 0.0;
+    st.keyVisibilitiesRecomputed = 0;
+    if (!change.any() && !st.directStale && !st.indirectStale) {
+        st.directUpdated = st.indirectUpdated = false;  // the cached results are this frame's
         return;
     }
+    planAmortisation(heights, settings, st);
     const auto t0 = Clock::now();
-    auto t = t0;
-    computeGradient(heights, cellSize, st.gradX, st.gradY);
-    st.timings.gradient = msSince(t);
-    t = Clock::now();
-    buildHeightPyramid(heights, cellSize, settings.subsample, settings.pyramid, st.pyramid);
-    st.timings.pyramid = msSince(t);
-    t = Clock::now();
-    environmentVisibility(settings, st);
-    st.timings.visibility = msSince(t);
-    t = Clock::now();
-    keyLightVisibility(lighting, settings, st);
-    st.timings.keyVisibility = msSince(t);
-    t = Clock::now();
-    directShading(lighting, settings, albedo, st);
-    st.timings.shading = msSince(t);
-    if (st.indirectUpdated)
+    if (!st.directUpdated) {
+        // indirect only: geometry, pyramid, visibility and direct shade are the last frame's
         runIndirectStage(settings, st, albedo);
-    else if (settings.indirect.bounces > 0)
-        sumDirectAndIndirect(st.shade.rgb, st.indirect);  // the last indirect light on the new direct shade
+        st.directStale = change.any();
+        st.indirectStale = false;
+    } else {
+        runDirectStages(heights, cellSize, lighting, settings, change, albedo, st);
+        st.directStale = false;
+        if (st.indirectUpdated) {
+            runIndirectStage(settings, st, albedo);
+            st.indirectStale = false;
+        } else if (settings.indirect.bounces > 0) {
+            sumDirectAndIndirect(st.shade.rgb, st.indirect);  // the last indirect light on the new direct shade
+            st.indirectStale = true;
+        }
+    }
+    if (settings.incremental)
+        recordFrameInputs(heights, cellSize, lighting, settings, albedo, st.lastInputs);
+    else
+        st.lastInputs.valid = false;
     st.timings.total = msSince(t0);
 }
 

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/grid.h"
+#include "gi/frame_change.h"
 #include "gi/indirect.h"
 #include "gi/lights.h"
 #include "gi/pyramid.h"
@@ -15,11 +16,6 @@
 #include "gi/wedge.h"
 
 namespace terrain::gi {
-
-struct GiLighting {
-    ShRgb environment = uniformSkyLight(1.0f);
-    std::vector<KeyLight> keys;
-};
 
 /// Milliseconds per stage of the last frame.
 struct GiTimings {
@@ -48,10 +44,18 @@ struct GiState {
     // Indirect light (gi/indirect.h): indirect.indirect and indirect.total
     // (= shade.rgb + indirect) are valid when settings.indirect.bounces > 0.
     IndirectState indirect;
-    // Shading amortisation (Section 7): the caller sets geometryChanged = false
-    // when the heights did not change since the last frame (e.g. from the
-    // simulator's change report); with settings.indirect.amortise such frames
-    // update the direct and the indirect light alternately.
+    // Incremental frames (GiSettings::incremental, gi/frame_change.h): the
+    // inputs of the cached results, and whether an amortised frame left the
+    // direct or the indirect light behind its inputs.
+    FrameInputs lastInputs;
+    bool directStale = false, indirectStale = false;
+    double receiversRecomputed = 0.0;   // fraction of the receivers whose environment V the last frame recomputed
+    int keyVisibilitiesRecomputed = 0;  // key lights whose V the last frame recomputed
+    // Shading amortisation (Section 7): with settings.indirect.amortise, frames
+    // on unchanged geometry update the direct and the indirect light
+    // alternately. Incremental frames set geometryChanged themselves; without
+    // them the caller says whether the heights changed since the last frame
+    // (e.g. from the simulator's change report).
     bool geometryChanged = true;
     int amortisePhase = 0;             // next static frame: 0 direct, 1 indirect
     bool amortiseReady = false;        // a full frame with the current key ran before

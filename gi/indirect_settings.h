@@ -43,6 +43,7 @@ struct IndirectSettings {
     LambertIndirect lambert = LambertIndirect::BlockerRadiance;  // paper: ShKernel
     // Azimuths of the indirect scan (0: the visibility's m; paper: 0).
     int azimuths = 8;
+    bool operator==(const IndirectSettings&) const = default;
 };
 
 /// Throws InputError when a setting is out of range.

@@ -71,4 +71,10 @@ void validateKeyLight(const KeyLight& k);
 /// Evaluates an SH RGB radiance in direction d.
 void evaluateShRgb(const ShRgb& l, double x, double y, double z, double out[3]);
 
+/// The lights of a GI frame: an environment and any number of key lights.
+struct GiLighting {
+    ShRgb environment = uniformSkyLight(1.0f);
+    std::vector<KeyLight> keys;
+};
+
 }  // namespace terrain::gi

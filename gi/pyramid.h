@@ -43,6 +43,7 @@ struct PyramidSettings {
     int levelsPerOctave = 4;  // k_v (paper: 4)
     int levelOffset = 3;      // o_v in octaves (paper: 2)
     float peakBlend = 0.5f;   // 0 = mean pyramid (paper); 1 = max-decimated octaves
+    bool operator==(const PyramidSettings&) const = default;
 };
 
 /// Floats of slack before and after a scanned field: the scan's 16-receiver

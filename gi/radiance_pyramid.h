@@ -31,6 +31,7 @@ namespace terrain::gi {
 struct RadiancePyramidSettings {
     int levelsPerOctave = 2;  // k_u (paper: 4)
     int levelOffset = 3;      // o_u in octaves (paper: 2)
+    bool operator==(const RadiancePyramidSettings&) const = default;
 };
 
 /// One pyramid per scalar field (3 for RGB radiance, 3 x n for SH vectors),

@@ -26,6 +26,11 @@ struct GiSettings {
     bool keyLightExactCosine = true;  // paper: false
     ShadingSettings shading;
     IndirectSettings indirect;  // bounces, radiance pyramid, amortisation
+    // Incremental frames (gi/frame_change.h): a stage reruns only when its
+    // inputs changed since the cached result; off: every frame recomputes
+    // everything (for comparison).
+    bool incremental = true;
+    bool operator==(const GiSettings&) const = default;
 };
 
 /// The paper's settings: m = 32 azimuths, k_v = 4, o_v = 2, a mean height

@@ -31,6 +31,7 @@ struct ShadingSettings {
     float phongExponent = 32.0f;            // S in Section 7
     float specularWeight = 0.25f;           // weight of the Phong lobe in LambertPlusPhong
     float viewDir[3] = {0.0f, 0.0f, 1.0f};  // unit vector towards the viewer (distant viewer)
+    bool operator==(const ShadingSettings&) const = default;
 };
 
 /// Per-texel surface parameters; empty grids mean the uniform values.

@@ -80,6 +80,7 @@ struct VisibilitySettings {
     // lower one is visible to that neighbour. Its effect on accuracy:
     // README.md, "Footprint tangent planes"; at 1x it changes nothing.
     bool footprintTangent = true;  // paper: false
+    bool operator==(const VisibilitySettings&) const = default;
 };
 
 /// Per-block scratch of the scan (one per fixed row block), rows padded to a

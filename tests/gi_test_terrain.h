@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "core/grid.h"
+#include "gi/frame.h"
 
 namespace terrain::gi_test {
 
@@ -51,6 +52,42 @@ Grid gridOf(int nx, int ny, F&& f) {
 template <class A, class B>
 bool sameBits(const A& a, const B& b) {
     return a.size() == b.size() && (a.size() == 0 || std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0);
+}
+
+// A smooth field with ridges of several wavelengths.
+inline Grid bumpy(int nx, int ny) {
+    return gridOf(nx, ny, [](int x, int y) {
+        return static_cast<float>(9.0 * std::sin(0.21 * x) * std::cos(0.17 * y) + 3.0 * std::sin(0.8 * x + 0.45 * y) +
+                                  1.5 * std::cos(0.05 * x * y));
+    });
+}
+
+inline gi::GiLighting sunSkyAndKey() {
+    gi::GiLighting light;
+    light.environment = gi::sunSkyLight();
+    gi::KeyLight k;
+    k.azimuthDeg = 130.0f;
+    k.elevationDeg = 28.0f;
+    light.keys.push_back(k);
+    return light;
+}
+
+inline gi::GiSettings withBounces(gi::GiSettings s, int subsample, int bounces) {
+    s.subsample = subsample;
+    s.indirect.bounces = bounces;
+    return s;
+}
+
+// Every output a caller reads: ambient, direct shade, indirect and total.
+inline bool sameOutputs(const gi::GiState& a, const gi::GiState& b) {
+    bool ok = sameBits(a.shade.ambient.v, b.shade.ambient.v);
+    for (int c = 0; c < 3; ++c) {
+        const std::size_t i = static_cast<std::size_t>(c);
+        ok = ok && sameBits(a.shade.rgb[i].v, b.shade.rgb[i].v) &&
+             sameBits(a.indirect.indirect[i].v, b.indirect.indirect[i].v) &&
+             sameBits(a.indirect.total[i].v, b.indirect.total[i].v);
+    }
+    return ok;
 }
 
 }  // namespace terrain::gi_test

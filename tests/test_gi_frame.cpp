@@ -16,45 +16,14 @@
 
 using namespace terrain;
 using namespace terrain::gi;
+using gi_test::bumpy;
 using gi_test::gridOf;
 using gi_test::sameBits;
+using gi_test::sameOutputs;
+using gi_test::sunSkyAndKey;
+using gi_test::withBounces;
 
 namespace {
-
-Grid bumpy(int nx, int ny) {
-    return gridOf(nx, ny, [](int x, int y) {
-        return static_cast<float>(9.0 * std::sin(0.21 * x) * std::cos(0.17 * y) + 3.0 * std::sin(0.8 * x + 0.45 * y) +
-                                  1.5 * std::cos(0.05 * x * y));
-    });
-}
-
-GiLighting sunSkyAndKey() {
-    GiLighting light;
-    light.environment = sunSkyLight();
-    KeyLight k;
-    k.azimuthDeg = 130.0f;
-    k.elevationDeg = 28.0f;
-    light.keys.push_back(k);
-    return light;
-}
-
-GiSettings withBounces(GiSettings s, int subsample, int bounces) {
-    s.subsample = subsample;
-    s.indirect.bounces = bounces;
-    return s;
-}
-
-// Every output a caller reads: ambient, direct shade, indirect and total.
-bool sameOutputs(const GiState& a, const GiState& b) {
-    bool ok = sameBits(a.shade.ambient.v, b.shade.ambient.v);
-    for (int c = 0; c < 3; ++c) {
-        const std::size_t i = static_cast<std::size_t>(c);
-        ok = ok && sameBits(a.shade.rgb[i].v, b.shade.rgb[i].v) &&
-             sameBits(a.indirect.indirect[i].v, b.indirect.indirect[i].v) &&
-             sameBits(a.indirect.total[i].v, b.indirect.total[i].v);
-    }
-    return ok;
-}
 
 double worstDeviation(const Grid& g, float value) {
     double worst = 0.0;
@@ -142,14 +111,17 @@ TEST_CASE("gi.frame: NaN/Inf heights, a bad cell size or sub-sampling throw Inpu
 
 TEST_CASE(
     "gi.frame: amortised static frames alternate direct and indirect updates, and each total equals the full frame's") {
-    // gi/frame.h: with settings.indirect.amortise and geometryChanged = false,
+    // gi/frame.h: without incremental frames, with settings.indirect.amortise and geometryChanged = false,
     // after a full frame the static frames update the direct light (phase 0)
     // and the indirect light (phase 1) in turn; a geometry change, or a frame
     // of another size or settings, updates both and restarts at phase 0.
     const Grid h = bumpy(48, 40);
     const AlbedoMap alb = uniformAlbedo(48, 40, 0.65f);
     const GiLighting light = sunSkyAndKey();
-    const GiSettings full = withBounces(GiSettings{}, 2, 1);
+    // Amortisation as the caller drives it (geometryChanged); incremental
+    // frames would skip these static frames altogether (gi.frame_change tests).
+    GiSettings full = withBounces(GiSettings{}, 2, 1);
+    full.incremental = false;
     GiSettings amort = full;
     amort.indirect.amortise = true;
     GiState ref;

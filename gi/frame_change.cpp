@@ -1,0 +1,88 @@
+#include "gi/frame_change.h"
+
+#include <cstring>
+
+namespace terrain::gi {
+namespace {
+
+bool sameGrid(const Grid& a, ConstGridView b) {
+    if (a.nx != b.nx || a.ny != b.ny) return false;
+    for (int y = 0; y < b.ny; ++y)
+        if (std::memcmp(a.data() + static_cast<std::size_t>(y) * a.nx, b.row(y), sizeof(float) * b.nx) != 0)
+            return false;
+    return true;
+}
+
+bool sameGrid(const Grid& a, const Grid& b) { return sameGrid(a, b.cview()); }
+
+bool sameAlbedo(const FrameInputs& last, const AlbedoMap* albedo) {
+    if (last.hasAlbedo != (albedo != nullptr)) return false;
+    if (!albedo) return true;
+    for (std::size_t c = 0; c < 3; ++c)
+        if (!sameGrid(last.albedo.channel[c], albedo->channel[c]) ||
+            !sameGrid(last.albedo.phongLobe[c], albedo->phongLobe[c]))
+            return false;
+    return sameGrid(last.albedo.phongExponent, albedo->phongExponent);
+}
+
+// The key light's visibility depends on its region of the sky only.
+bool sameKeyRegion(const KeyLight& a, const KeyLight& b) {
+    return a.azimuthDeg == b.azimuthDeg && a.elevationDeg == b.elevationDeg && a.radiusDeg == b.radiusDeg;
+}
+
+bool sameKeyRadiance(const KeyLight& a, const KeyLight& b) {
+    return a.rgb[0] == b.rgb[0] && a.rgb[1] == b.rgb[1] && a.rgb[2] == b.rgb[2];
+}
+
+void copyGrid(ConstGridView from, Grid& to) {
+    to.ensureSize(from.nx, from.ny);
+    for (int y = 0; y < from.ny; ++y)
+        std::memcpy(to.data() + static_cast<std::size_t>(y) * from.nx, from.row(y), sizeof(float) * from.nx);
+}
+
+}  // namespace
+
+bool FrameChange::any() const {
+    if (geometry || radiance) return true;
+    for (bool k : keyGeometry)
+        if (k) return true;
+    return false;
+}
+
+FrameChange everythingChanged(std::size_t keys) {
+    FrameChange c;
+    c.keyGeometry.assign(keys, true);
+    return c;
+}
+
+FrameChange compareFrameInputs(const FrameInputs& last, ConstGridView heights, float cellSize,
+                               const GiLighting& lighting, const GiSettings& settings, const AlbedoMap* albedo) {
+    const std::size_t nKeys = lighting.keys.size();
+    if (!last.valid) return everythingChanged(nKeys);
+    FrameChange c;
+    c.geometry = cellSize != last.cellSize || !(settings == last.settings) || !sameGrid(last.heights, heights);
+    c.keyGeometry.assign(nKeys, true);
+    bool keyRadiance = nKeys != last.keys.size();
+    for (std::size_t k = 0; k < nKeys; ++k) {
+        const bool known = k < last.keys.size();
+        c.keyGeometry[k] = c.geometry || !known || !sameKeyRegion(lighting.keys[k], last.keys[k]);
+        keyRadiance = keyRadiance || !known || !sameKeyRadiance(lighting.keys[k], last.keys[k]);
+    }
+    const bool environment = lighting.environment.c != last.environment.c;
+    c.radiance = environment || keyRadiance || !sameAlbedo(last, albedo);
+    return c;
+}
+
+void recordFrameInputs(ConstGridView heights, float cellSize, const GiLighting& lighting, const GiSettings& settings,
+                       const AlbedoMap* albedo, FrameInputs& out) {
+    copyGrid(heights, out.heights);
+    out.cellSize = cellSize;
+    out.settings = settings;
+    out.environment = lighting.environment;
+    out.keys = lighting.keys;
+    out.hasAlbedo = albedo != nullptr;
+    if (albedo) out.albedo = *albedo;
+    out.valid = true;
+}
+
+}  // namespace terrain::gi

@@ -1,0 +1,55 @@
+#pragma once
+// What a GI frame's cached results were computed from, and what changed
+// since: the frame's stages rerun only where their inputs changed.
+//
+// Every stage is a pure function of its inputs, so a stage whose inputs are
+// bit for bit those of the cached result reproduces it bit for bit; skipping
+// it changes nothing. The dependencies:
+//   heights, cell size, settings -> gradient, height pyramid, environment V
+//   + a key light's direction and size -> that key light's V
+//   + lighting (radiances), albedo -> direct shading, indirect bounces
+// Static geometry and static lights: a frame does no GI work. A moving sun on
+// static geometry: its key light's visibility and the shading. A changed
+// environment: the shading (V is cached).
+#include <array>
+#include <vector>
+
+#include "core/grid.h"
+#include "gi/lights.h"
+#include "gi/settings.h"
+#include "gi/shading.h"
+
+namespace terrain::gi {
+
+/// The inputs of the last frame (copies: the caller may reuse its buffers).
+struct FrameInputs {
+    bool valid = false;
+    Grid heights;
+    float cellSize = 0.0f;
+    GiSettings settings;
+    ShRgb environment;
+    std::vector<KeyLight> keys;
+    bool hasAlbedo = false;
+    AlbedoMap albedo;
+};
+
+/// Which inputs differ from the recorded ones.
+struct FrameChange {
+    bool geometry = true;           // heights, cell size or any setting: gradient, pyramid and every V
+    std::vector<bool> keyGeometry;  // per key light: its V (direction, size, or count changed)
+    bool radiance = true;           // environment, key radiances or albedo: shading and indirect light
+    bool any() const;
+};
+
+/// Everything changed (no record, or incremental frames switched off).
+FrameChange everythingChanged(std::size_t keys);
+
+/// Compares this frame's inputs with the record.
+FrameChange compareFrameInputs(const FrameInputs& last, ConstGridView heights, float cellSize,
+                               const GiLighting& lighting, const GiSettings& settings, const AlbedoMap* albedo);
+
+/// Records this frame's inputs (buffers reused: no allocation for a frame of the same size).
+void recordFrameInputs(ConstGridView heights, float cellSize, const GiLighting& lighting, const GiSettings& settings,
+                       const AlbedoMap* albedo, FrameInputs& out);
+
+}  // namespace terrain::gi
