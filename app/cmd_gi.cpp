@@ -310,7 +310,7 @@ void printFrameTimes(int f, int frames, const gi::GiState& state, int bounces) {
         "indirect %.2f ms, total %.2f ms%s\n",
         f, t.gradient, t.pyramid, t.visibility, t.keyVisibility, t.shading, t.indirect, t.total,
         f == 0 && frames > 1 ? " (warm-up)" : "");
-    if (bounces > 0)
+    if (bounces > 0 && state.indirectUpdated)
         std::printf("  indirect: radiance pyramids %.2f ms, scans %.2f ms, shading %.2f ms\n",
                     state.indirect.timings.pyramid, state.indirect.timings.scan, state.indirect.timings.shading);
 }
@@ -379,6 +379,10 @@ Runner addGiCommand(CLI::App& app) {
     sub->add_option("--bounces", gs.indirect.bounces, gi::describe(r::kBounces))->capture_default_str();
     sub->add_option("--brdf", o->brdf, "lambert | phong:EXP | mix:W[,EXP] (Lambert + W x Phong)");
     sub->add_option("--albedo", o->albedo, "Albedo R,G,B in [0, 1] or an sRGB PNG of the field's size");
+    sub->add_option("--gi-incremental", gs.incremental,
+                    "on: with --frames, rerun only the stages whose inputs changed (the same field: no work after the "
+                    "first frame); off: every frame recomputes everything")
+        ->capture_default_str();
     sub->add_flag("--amortise", gs.indirect.amortise,
                   "With --frames on static geometry: alternate direct and indirect updates");
     sub->add_option("--out-indirect", o->outIndirect,

@@ -75,6 +75,10 @@ void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize) {
         ->capture_default_str();
     sub->add_option("--bounces", o.bounces, gi::describe(gi::ranges::kBounces) + ", with --lighting global")
         ->capture_default_str();
+    sub->add_option("--gi-incremental", o.giIncremental,
+                    "on: GI reruns only the stages whose inputs changed since the last frame; off: every frame "
+                    "recomputes everything")
+        ->capture_default_str();
     sub->add_flag("--amortise", o.amortise,
                   "Shading amortisation: on static geometry update direct and indirect light on alternate frames");
     sub->add_option("--shadow", o.shadow, "Key light shadow: soft (engine visibility) | map (shadow map) | none")
@@ -110,6 +114,7 @@ void toSettings(const RenderOptions& o, engine::PipelineSettings& p, render::Ren
     p.gi.subsample = o.subsample;
     p.gi.indirect.bounces = o.bounces;
     p.gi.indirect.amortise = o.amortise;
+    p.gi.incremental = o.giIncremental;
     gi::validateGiSettings(p.gi);
     p.ticksPerFrame = o.ticksPerFrame;
     p.pyramidLevel = o.pyramidLevel;

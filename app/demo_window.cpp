@@ -71,6 +71,7 @@ void drawPanel(FramePipeline& pipeline, RenderSettings& rs, bool& paused, const 
     if (ImGui::Combo("lighting", &lighting, lightingNames, 3)) ps.lighting = static_cast<LightingMode>(lighting);
     ImGui::SliderInt("bounces", &ps.gi.indirect.bounces, 0, 3);
     ImGui::Checkbox("amortise shading", &ps.gi.indirect.amortise);
+    ImGui::Checkbox("incremental GI", &ps.gi.incremental);
     int sub = ps.gi.subsample == 1 ? 0 : (ps.gi.subsample == 2 ? 1 : 2);
     ImGui::Text("sub-sampling");
     ImGui::SameLine();

@@ -25,6 +25,7 @@ struct RenderOptions {
     std::string lighting = "global";  // key | direct | global (direct + `bounces` indirect bounces)
     int bounces = 1;
     bool amortise = false;
+    bool giIncremental = true;
     std::string shadow = "soft";  // soft | map | none
     std::string debug = "none";   // none | ambient | v | key | normals | pyramid | shade | u
     int pyramidLevel = 4;

@@ -35,11 +35,25 @@ gi::GiLighting giLighting(const SceneLights& lights) {
 
 // Per texel: ground and water depth; the shade without the key light and the
 // key light's own shade; the key light's soft visibility and the ambient map.
+// Ground and water depth of every texel (they may move apart while their
+// sum, the lit surface, stays: packed every frame).
+void packHeights(const TerrainState& s, FrameData& f) {
+    const int nx = s.nx, ny = s.ny;
+    f.heights.resize(2 * static_cast<std::size_t>(nx) * ny);
+    parallelForRows(ny, nx, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < nx; ++x) {
+                const std::size_t i = static_cast<std::size_t>(y) * nx + x;
+                f.heights[2 * i] = s.ground(x, y);
+                f.heights[2 * i + 1] = s.hasWater() ? s.water(x, y) : 0.0f;
+            }
+    });
+}
+
 void packTexels(const TerrainState& s, const gi::GiState& gi, const std::array<Grid, 3>& keyRgb, const gi::KeyLight& k,
                 bool indirect, FrameData& f) {
     const int nx = s.nx, ny = s.ny;
     const std::size_t n = static_cast<std::size_t>(nx) * ny;
-    f.heights.resize(2 * n);
     f.shade.resize(4 * n);
     f.key.resize(4 * n);
     const float ce = std::cos(k.elevationDeg * kDeg);
@@ -51,8 +65,6 @@ void packTexels(const TerrainState& s, const gi::GiState& gi, const std::array<G
         for (int y = y0; y < y1; ++y)
             for (int x = 0; x < nx; ++x) {
                 const std::size_t i = static_cast<std::size_t>(y) * nx + x;
-                f.heights[2 * i] = s.ground(x, y);
-                f.heights[2 * i + 1] = s.hasWater() ? s.water(x, y) : 0.0f;
                 float keyC[3];
                 for (int c = 0; c < 3; ++c) {
                     keyC[c] = std::max(0.0f, keyRgb[static_cast<std::size_t>(c)].v[i]);
@@ -211,18 +223,31 @@ void FramePipeline::light() {
     // (Nowrouzezahrai & Snyder 2009, Section 7) when it is on.
     gi::GiSettings gs = settings_.gi;
     if (settings_.lighting != LightingMode::Global) gs.indirect.bounces = 0;
+    // Incremental GI frames see for themselves what changed since the cached
+    // results (gi/frame_change.h); without them the simulator's report of the
+    // last tick says whether the surface moved.
     const ChangeReport& ch = sim_.changes();
     gi_.geometryChanged = exag != lastExaggeration_ || ch.maxGroundChange > 0.0f || ch.maxWaterChange > 0.0f;
     lastExaggeration_ = exag;
     gi::runGiFrame(surface_.cview(), s.cellSize, lighting, gs, gi_);
     const double surfaceMs = msSince(t);
 
-    // The key light's share of the shade map: gi/ shading with that light alone.
     t = Clock::now();
+    FrameData& f = frame_;
+    packHeights(s, f);
+    const bool giUpdated = gi_.directUpdated || gi_.indirectUpdated;
+    if (!giUpdated && f.lighting == settings_.lighting && packedPyramidLevel_ == settings_.pyramidLevel) {
+        // nothing the light sees changed: the packed shade is this frame's
+        f.tick = s.tick;
+        f.time = s.time;
+        recordGiTimings(gi_, gs, surfaceMs, msSince(t), timings_);
+        return;
+    }
+    packedPyramidLevel_ = settings_.pyramidLevel;
+    // The key light's share of the shade map: gi/ shading with that light alone.
     gi::shadeKeyLight(gi_, gs, lighting, 0, keyScratch_, keyOnly_);
 
     // ---- pack what the renderer uploads -----------------------------------------
-    FrameData& f = frame_;
     f.lighting = settings_.lighting;
     f.exaggeration = exag;
     f.lights = lights_;

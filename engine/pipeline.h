@@ -69,6 +69,7 @@ private:
     float autoExaggeration_ = 1.0f;
     bool first_ = true;
     float lastExaggeration_ = -1.0f;  // exaggeration of the last lit frame (a change moves the surface)
+    int packedPyramidLevel_ = -2;     // the debug level in the packed receiver data (-2: none packed yet)
     Grid surface_;                    // ground + water: what the light sees
     gi::GiState gi_;
     gi::ShadeMaps keyScratch_;     // buffers of the key light's own shading

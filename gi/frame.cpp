@@ -287,6 +287,7 @@ void runDirectStages(ConstGridView heights, float cellSize, const GiLighting& li
 
 void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lighting, const GiSettings& settings,
                 GiState& st, const AlbedoMap* albedo) {
+    const auto t0 = Clock::now();  // the whole frame: input checks and the comparison included
     validateFrameInputs(heights, cellSize, lighting, settings, albedo);
     const FrameChange change = settings.incremental
                                    ? compareFrameInputs(st.lastInputs, heights, cellSize, lighting, settings, albedo)
@@ -297,10 +298,10 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
     st.keyVisibilitiesRecomputed = 0;
     if (!change.any() && !st.directStale && !st.indirectStale) {
         st.directUpdated = st.indirectUpdated = false;  // the cached results are this frame's
+        st.timings.total = msSince(t0);
         return;
     }
     planAmortisation(heights, settings, st);
-    const auto t0 = Clock::now();
     if (!st.directUpdated) {
         // indirect only: geometry, pyramid, visibility and direct shade are the last frame's
         runIndirectStage(settings, st, albedo);
