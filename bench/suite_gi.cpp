@@ -13,6 +13,7 @@
 #include <fstream>
 #include <memory>
 #include <optional>
+#include <random>
 #include <string>
 #include <thread>
 #include <vector>
@@ -196,6 +197,7 @@ public:
     void quickAccuracy() const;
     void plotFromCsv() const;
     void cpuStages() const;
+    void tileTiming() const;
 
 private:
     const GiOptions& o_;
@@ -655,6 +657,74 @@ void GiSuite::cpuStages() const {
     }
 }
 
+// ---------------------------------------------------------------------------
+// tiles: computeVisibility restricted to receiver tiles (change-driven GI)
+// against the whole grid, 512^2 at 2x, engine settings, the environment's V
+// ---------------------------------------------------------------------------
+// A fraction of the tiles dirty: scattered at random, or one square cluster
+// in the middle (a local change).
+void pickDirtyTiles(double fraction, bool clustered, std::mt19937& rng, ReceiverTiles& t) {
+    std::fill(t.dirty.begin(), t.dirty.end(), 0);
+    const int n = std::max(1, static_cast<int>(std::lround(fraction * t.tilesX * t.tilesY)));
+    if (clustered) {
+        const int side = std::max(1, static_cast<int>(std::lround(std::sqrt(static_cast<double>(n)))));
+        const int tx0 = (t.tilesX - side) / 2, ty0 = (t.tilesY - side) / 2;
+        for (int k = 0; k < n; ++k) t.setDirty(tx0 + k % side, ty0 + k / side);
+        return;
+    }
+    std::vector<int> order(t.dirty.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+    std::shuffle(order.begin(), order.end(), rng);
+    for (int k = 0; k < n; ++k) t.dirty[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])] = 1;
+}
+
+void GiSuite::tileTiming() const {
+    const Dem c512 = crop(loadAlps(ctx_.dataDir), 512, "c512");
+    GiSettings set = engineDefaults();
+    set.subsample = 2;
+    GiState st;
+    withThreads(o_.threads, [&] { runGiFrame(c512.heights.cview(), c512.cell, GiLighting{}, set, st); });
+    VisibilityTarget env;
+    env.op = &st.envOperator;
+    env.footprint = &st.footprint;
+    const auto time = [&](const ReceiverTiles* only) {
+        std::vector<double> ms;
+        withThreads(o_.threads, [&] {
+            for (int r = 0; r < o_.runs + 1; ++r) {
+                const auto t0 = Clock::now();
+                computeVisibility(st.pyramid, st.gradX.cview(), st.gradY.cview(), set.visibility, env,
+                                  st.visibilityState, st.envVisibility, only);
+                const double t = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+                if (r > 0) ms.push_back(t);  // the first run warms up
+            }
+        });
+        return ms;
+    };
+    const auto report = [&](const char* what, const ReceiverTiles* only) {
+        const std::vector<double> ms = time(only);
+        const double share = only ? 100.0 * only->dirtyFraction() : 100.0;
+        std::printf("%-34s receivers %5.1f %%  median %7.2f ms  min %7.2f ms\n", what, share, median(ms),
+                    *std::min_element(ms.begin(), ms.end()));
+    };
+    std::printf("computeVisibility, %s 2x (%d x %d receivers), %d threads, %d runs\n", c512.name.c_str(),
+                st.pyramid.nxr, st.pyramid.nyr, o_.threads, o_.runs);
+    report("no tiles (whole grid)", nullptr);
+    std::mt19937 rng(1);
+    for (int size : {16, 32}) {
+        ReceiverTiles t;
+        t.reset(st.pyramid.nxr, st.pyramid.nyr, size, true);
+        report(("tiles " + std::to_string(size) + ": all dirty").c_str(), &t);
+        for (double f : {0.5, 0.1, 0.01})
+            for (bool clustered : {false, true}) {
+                pickDirtyTiles(f, clustered, rng, t);
+                const std::string what = "tiles " + std::to_string(size) + ": " + std::to_string(t.dirtyCount()) +
+                                         " / " + std::to_string(t.dirty.size()) +
+                                         (clustered ? " clustered" : " random");
+                report(what.c_str(), &t);
+            }
+    }
+}
+
 struct Mode {
     const char* name;
     const char* help;
@@ -674,6 +744,8 @@ const Mode kModes[] = {
      &GiSuite::quickAccuracy},
     {"plot", "Only redraw gi_speed_error.png from an existing gi_timing.csv", &GiSuite::plotFromCsv},
     {"cpu", "CPU time per stage, one thread, minimum over the runs (stdout)", &GiSuite::cpuStages},
+    {"tiles", "computeVisibility with receiver tiles (1 %, 10 %, 50 %, all dirty) vs the whole grid (stdout)",
+     &GiSuite::tileTiming},
 };
 
 int runGi(const CLI::App& sub, const GiOptions& o, const BenchContext& ctx) {
@@ -711,8 +783,9 @@ Runner addGiSuite(CLI::App& app, const BenchContext& ctx) {
             mode->add_option("--case", o->onlyCase, "Only this case (0-based; -1: all)")
                 ->envname("GI_CASE")
                 ->capture_default_str();
-        if (name == "stages") {
+        if (name == "stages" || name == "tiles")
             mode->add_option("--threads", o->threads, "Worker threads")->envname("GI_THREADS")->capture_default_str();
+        if (name == "stages") {
             mode->add_option("--dump", o->dump,
                              "write: store the outputs in the --cache folder; compare: the change against them")
                 ->envname("GI_DUMP")

@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "core/simd.h"
+#include "gi/indirect_scan_tables.h"
 
 namespace terrain::gi {
 
@@ -180,11 +181,12 @@ struct CastingRow {
     [[gnu::always_inline]] void walk(const AzimuthSteps& az) {
         const I rowLimit = I{} + in.steps;
         int nActive = 0, nMax = 0;
-        for (int G = 0; G < pad / L; ++G) {
-            const int nAny = startGroup(G, az, rowLimit);
-            nMax = std::max(nMax, nAny);
-            if (nAny > 0) active[nActive++] = G;
-        }
+        for (const ColumnSpan& span : in.spans)
+            for (int G = span.x0 / L; G < indirectRowPad(span.x1) / L; ++G) {
+                const int nAny = startGroup(G, az, rowLimit);
+                nMax = std::max(nMax, nAny);
+                if (nAny > 0) active[nActive++] = G;
+            }
         const V hMax = splat<V>(in.hMax);
         for (int i = 0; i < nMax && nActive > 0; ++i) {
             const StepTaps<V> tp = stepTaps<V>(az, i, in.Y);
@@ -204,19 +206,20 @@ struct CastingRow {
         const V k0 = splat<V>(0.70710678118654752440f), k1 = splat<V>(0.61237243569579452455f);
         const V k2 = splat<V>(0.79056941504209483300f), k3 = splat<V>(0.23385358667337133659f);
         for (int c = 0; c < 3; ++c)
-            for (int X0 = 0; X0 < pad; X0 += L) {
-                V Ac[nMo];
-                for (int p = 0; p < nMo; ++p) Ac[p] = load<V>(A + static_cast<std::size_t>(c * nMo + p) * pad + X0);
-                if constexpr (Exact) {
-                    store(out + static_cast<std::size_t>(c) * pad + X0, Ac[0]);
-                } else {
-                    float* base = out + static_cast<std::size_t>(c) * 4 * pad + X0;
-                    store(base, k0 * Ac[0]);
-                    store(base + pad, k1 * Ac[1]);
-                    store(base + 2 * pad, k2 * (Ac[2] - Ac[0]));
-                    store(base + 3 * pad, k3 * (splat<V>(5.0f) * Ac[3] - splat<V>(6.0f) * Ac[1]));
+            for (const ColumnSpan& span : in.spans)
+                for (int X0 = span.x0; X0 < indirectRowPad(span.x1); X0 += L) {
+                    V Ac[nMo];
+                    for (int p = 0; p < nMo; ++p) Ac[p] = load<V>(A + static_cast<std::size_t>(c * nMo + p) * pad + X0);
+                    if constexpr (Exact) {
+                        store(out + static_cast<std::size_t>(c) * pad + X0, Ac[0]);
+                    } else {
+                        float* base = out + static_cast<std::size_t>(c) * 4 * pad + X0;
+                        store(base, k0 * Ac[0]);
+                        store(base + pad, k1 * Ac[1]);
+                        store(base + 2 * pad, k2 * (Ac[2] - Ac[0]));
+                        store(base + 3 * pad, k3 * (splat<V>(5.0f) * Ac[3] - splat<V>(6.0f) * Ac[1]));
+                    }
                 }
-            }
     }
 };
 

@@ -32,8 +32,10 @@
 // field's highest height, seen from each lane's receiver at the current
 // distance, can no longer beat that lane's running maximum (no member can
 // follow; results unchanged).
+#include <span>
 #include <vector>
 
+#include "gi/receiver_tiles.h"
 #include "gi/visibility.h"
 
 namespace terrain::gi {
@@ -68,16 +70,22 @@ struct AzimuthSteps {
     float cosPhi, sinPhi;
 };
 
-/// One receiver row: padded inputs (loadReceiverRow) and the row's valid prefix.
+/// One receiver row: padded inputs (loadReceiverRow), the row's valid
+/// prefix, and the receivers to scan: column spans (gi/receiver_tiles.h)
+/// starting on multiples of 16, each run to its end rounded up to the lane
+/// group (indirectRowPad); a whole row: one span [0, nxr). Each receiver's
+/// result does not depend on the spans.
 struct ReceiverRow {
     int Y, steps;
+    std::span<const ColumnSpan> spans;
     const float *h0, *margin, *gx, *gy;
     float hMax;  // the field's highest height: no sample rises above it
 };
 
-/// Scans one receiver row along one azimuth; out: IndirectScratch::result
-/// (and the running values in ::state). The AVX2 and SSE2 variants give
-/// identical bits. pad: the padded row length, a multiple of 8 (indirectRowPad).
+/// Scans one receiver row's spans along one azimuth; out, at the spans'
+/// receivers: IndirectScratch::result (and the running values in ::state).
+/// The AVX2 and SSE2 variants give identical bits. pad: the padded row
+/// length, a multiple of 8 (indirectRowPad).
 using CastRowFn = void (*)(const AzimuthSteps&, const ReceiverRow&, IndirectScratch&, int pad);
 CastRowFn castRowFor(CastingMoments moments);
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/error.h"
 #include "core/parallel.h"
 #include "core/simd.h"
 #include "gi/blocker_radiance.h"
@@ -13,25 +14,40 @@ namespace {
 
 using namespace simd;
 
-// One row and azimuth's exact moments into the row's E sums, per channel
-// (pad floats each): sums[c] += result[c].
+// One row and azimuth's exact moments into the row's E sums at the
+// receivers [x0, x1) (x0 a multiple of 16), per channel (pad floats each):
+// sums[c] += result[c].
 template <class V>
-[[gnu::always_inline]] inline void accumulateIrradianceImpl(const float* result, float* sums, int pad, int nxr) {
+[[gnu::always_inline]] inline void accumulateIrradianceImpl(const float* result, float* sums, int pad, int x0, int x1,
+                                                            int nxr) {
     constexpr int L = LaneTraits<V>::n;
-    const int nv = nxr / L * L;
+    const int nv = std::min(x1, nxr / L * L);
     for (int c = 0; c < 3; ++c) {
         float* __restrict e = sums + static_cast<std::size_t>(c) * pad;
         const float* __restrict w = result + static_cast<std::size_t>(c) * pad;
-        for (int X = 0; X < nv; X += L) store(e + X, load<V>(e + X) + load<V>(w + X));
-        for (int X = nv; X < nxr; ++X) e[X] += w[X];
+        for (int X = x0; X < nv; X += L) store(e + X, load<V>(e + X) + load<V>(w + X));
+        for (int X = nv; X < x1; ++X) e[X] += w[X];
     }
 }
-void accumulateIrradianceSse(const float* result, float* sums, int pad, int nxr) {
-    accumulateIrradianceImpl<F4>(result, sums, pad, nxr);
+void accumulateIrradianceSse(const float* result, float* sums, int pad, int x0, int x1, int nxr) {
+    accumulateIrradianceImpl<F4>(result, sums, pad, x0, x1, nxr);
 }
-[[gnu::target("avx2"), gnu::flatten]] void accumulateIrradianceAvx2(const float* result, float* sums, int pad,
-                                                                    int nxr) {
-    accumulateIrradianceImpl<F8>(result, sums, pad, nxr);
+[[gnu::target("avx2"), gnu::flatten]] void accumulateIrradianceAvx2(const float* result, float* sums, int pad, int x0,
+                                                                    int x1, int nxr) {
+    accumulateIrradianceImpl<F8>(result, sums, pad, x0, x1, nxr);
+}
+
+// Receiver tiles: the state must hold a previous result of this receiver
+// grid, which the clean receivers keep.
+void checkCachedReceivers(const HeightPyramid& pyr, int azimuths, const BlockerRadianceState& st) {
+    const std::size_t planeR = static_cast<std::size_t>(pyr.nxr) * pyr.nyr;
+    bool same = st.nxr == pyr.nxr && st.nyr == pyr.nyr && st.subsample == pyr.subsample && st.azimuths == azimuths;
+    for (const std::vector<float>& e : st.receiverShade) same = same && e.size() == planeR;
+    if (pyr.subsample > 1) same = same && st.farSlope.size() == planeR * static_cast<std::size_t>(azimuths);
+    if (!same)
+        throw InputError(
+            "blocker radiance: receiver tiles need the previous result of this receiver grid and these "
+            "azimuths in the state");
 }
 
 }  // namespace
@@ -41,6 +57,7 @@ BlockerRadianceIndirect::BlockerRadianceIndirect(const IndirectInputs& in, const
     : in_(in), settings_(settings), st_(st), scan_(in, CastingMoments::Irradiance, st) {}
 
 void BlockerRadianceIndirect::beginFrame() {
+    if (in_.only) checkCachedReceivers(in_.heights, in_.op.azimuths, st_.blocker);
     prepareBlockerRadiance(in_.heights, in_.op.azimuths, st_.blocker);
     scan_.beginFrame();
 }
@@ -59,14 +76,16 @@ void BlockerRadianceIndirect::scan(int b) {
 }
 
 // Casting sets and the exact irradiance at one block of receiver rows
-// (horizons: and the receivers' horizons, BlockerRadianceState::farSlope).
+// (horizons: and the receivers' horizons, BlockerRadianceState::farSlope),
+// over the rows' spans (receiver tiles).
 void BlockerRadianceIndirect::scanBlock(int block, bool horizons) {
     const int nxr = in_.heights.nxr, nyr = in_.heights.nyr, pad = scan_.pad();
     const std::size_t planeR = static_cast<std::size_t>(nxr) * nyr;
-    void (*const accumulate)(const float*, float*, int, int) =
+    void (*const accumulate)(const float*, float*, int, int, int, int) =
         simd::wideEnabled() ? accumulateIrradianceAvx2 : accumulateIrradianceSse;
     IndirectScratch& sc = st_.blocks[static_cast<std::size_t>(block)];
     const RowBlock rb = scan_.rowBlock(block);
+    if (!scan_.hasWork(rb)) return;  // no dirty tile in these rows: every receiver keeps its values
     // the rows' receiver heights and gradients; E sums zeroed
     scan_.loadRows(rb, sc);
     std::fill(sc.irradiance.data(), sc.irradiance.data() + 3 * static_cast<std::size_t>(rb.rows) * pad, 0.0f);
@@ -74,13 +93,16 @@ void BlockerRadianceIndirect::scanBlock(int block, bool horizons) {
         const AzimuthSteps az = scan_.azimuth(j);
         for (int r = 0; r < rb.rows; ++r) {
             const int Y = rb.yBegin + r;
+            float* far = horizons ? st_.blocker.farSlope.data() + static_cast<std::size_t>(j) * planeR +
+                                        static_cast<std::size_t>(Y) * nxr
+                                  : nullptr;
             scan_.castRow(az, j, Y, r, sc);
-            // the receivers' horizon along this azimuth (the walk's running maximum)
-            if (horizons)
-                std::copy(sc.state.data(), sc.state.data() + nxr,
-                          st_.blocker.farSlope.data() + static_cast<std::size_t>(j) * planeR +
-                              static_cast<std::size_t>(Y) * nxr);
-            accumulate(sc.result.data(), sc.irradiance.data() + 3 * static_cast<std::size_t>(r) * pad, pad, nxr);
+            for (const ColumnSpan& span : scan_.spans(Y)) {
+                // the receivers' horizon along this azimuth (the walk's running maximum)
+                if (horizons) std::copy(sc.state.data() + span.x0, sc.state.data() + span.x1, far + span.x0);
+                accumulate(sc.result.data(), sc.irradiance.data() + 3 * static_cast<std::size_t>(r) * pad, pad, span.x0,
+                           span.x1, nxr);
+            }
         }
     }
     receiverIrradiance(rb, sc);
@@ -96,14 +118,18 @@ void BlockerRadianceIndirect::receiverIrradiance(const RowBlock& rb, const Indir
         const std::size_t at = static_cast<std::size_t>(rb.yBegin + r) * nxr;
         const float* gx = sc.gx.data() + ro;
         const float* gy = sc.gy.data() + ro;
-        for (int c = 0; c < 3; ++c) {
-            const float* e = sc.irradiance.data() + 3 * ro + static_cast<std::size_t>(c) * pad;
-            float* out = st_.blocker.receiverShade[static_cast<std::size_t>(c)].data() + at;
-            for (int X = 0; X < nxr; ++X) out[X] = eScale / std::sqrt(1.0f + gx[X] * gx[X] + gy[X] * gy[X]) * e[X];
-        }
+        for (const ColumnSpan& span : scan_.spans(rb.yBegin + r))
+            for (int c = 0; c < 3; ++c) {
+                const float* e = sc.irradiance.data() + 3 * ro + static_cast<std::size_t>(c) * pad;
+                float* out = st_.blocker.receiverShade[static_cast<std::size_t>(c)].data() + at;
+                for (int X = span.x0; X < span.x1; ++X)
+                    out[X] = eScale / std::sqrt(1.0f + gx[X] * gx[X] + gy[X] * gy[X]) * e[X];
+            }
     }
 }
 
+// The texel passes stay whole with receiver tiles: they cost little beside
+// the scan, and read the clean receivers' cached horizons and E.
 void BlockerRadianceIndirect::shade(int b, ShadeMaps& out) {
     if (b == 1 && in_.heights.subsample > 1)
         computeTexelOcclusion(in_.heights, in_.gradX, in_.gradY, in_.op.phi, st_.blocker);

@@ -36,7 +36,9 @@ public:
     virtual void beginFrame() = 0;
     /// The pyramid of the previous bounce's exit radiance (Section 5.3).
     virtual void buildPyramid(const BounceSource& previous) = 0;
-    /// Bounce b's step table and casting-set scan.
+    /// Bounce b's step table and casting-set scan (with receiver tiles,
+    /// IndirectInputs::only, the receivers of the dirty tiles only, where
+    /// the strategy supports them).
     virtual void scan(int b) = 0;
     /// Bounce b's exit radiance L_b at full resolution (out.rgb; with U also
     /// its incident SH vectors).

@@ -19,7 +19,8 @@
 //
 // Schedule: fixed row blocks, each receiver written by one block, no
 // reductions across blocks: bit-identical for any thread count; no
-// allocation after the first frame of a given size and settings.
+// allocation after the first frame of a given size and settings. Receiver
+// tiles (IndirectInputs::only) are ignored: every receiver is scanned.
 #include "gi/indirect_bounces.h"
 #include "gi/sh.h"
 

@@ -5,6 +5,7 @@
 
 #include "core/grid.h"
 #include "gi/pyramid.h"
+#include "gi/receiver_tiles.h"
 #include "gi/shading.h"
 #include "gi/visibility.h"
 #include "gi/wedge.h"
@@ -23,6 +24,20 @@ struct IndirectInputs {
     const ShadeMaps* directShade;
     const AlbedoMap* albedo;  // null: 1
     const ShadingSettings& shading;
+    // Receiver tiles (change-driven GI, gi/receiver_tiles.h); null: every
+    // receiver. The Lambert strategies' scans then recompute the receivers of
+    // the dirty tiles only (BlockerRadiance: E and the horizons; ShKernel: U),
+    // bit-identical to a full scan, and leave the others' values in the state
+    // as they are: the caller's cache, which must hold a result of this
+    // receiver grid and these settings (InputError when the sizes differ).
+    // The state holds the outputs of one bounce, the one scanned last: a
+    // clean receiver keeps the previous call's last bounce at bounce 1 and
+    // this call's bounce b - 1 at bounce b, so the tiles give a consistent
+    // result with one bounce; more bounces need a cache per bounce, which the
+    // state does not keep. The texel passes after the scan (occlusion,
+    // shading) stay whole: they cost little beside the scan.
+    // GlossyIndirect::VectorPyramid ignores the tiles (every receiver).
+    const ReceiverTiles* only = nullptr;
 };
 
 }  // namespace terrain::gi

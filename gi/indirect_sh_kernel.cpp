@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdint>
 
+#include "core/error.h"
 #include "core/parallel.h"
 #include "core/simd.h"
 #include "gi/sh.h"
@@ -13,11 +14,12 @@ namespace {
 
 using namespace simd;
 
-// One row and azimuth's NLP coefficients into U: U_c += G_j u_(c, j) over
-// the sparse pattern of the folded wedge operator (Eq. 21).
+// One row and azimuth's NLP coefficients into U at the receivers [x0, x1)
+// (x0 a multiple of 16): U_c += G_j u_(c, j) over the sparse pattern of the
+// folded wedge operator (Eq. 21).
 struct URowSums {
     const float* nlp;  // 3 channels x 4 NLP x pad
-    int pad, nxr;
+    int pad, nxr, x0, x1;
     int patSize;
     const std::uint8_t *patRow, *patNlp;
     const float* vals;   // the operator's entries of this azimuth
@@ -29,11 +31,11 @@ struct URowSums {
 template <class V>
 [[gnu::always_inline]] inline void accumulateUImpl(const URowSums& r) {
     constexpr int L = LaneTraits<V>::n;
-    const int nv = r.nxr / L * L;
+    const int nv = std::min(r.x1, r.nxr / L * L);
     auto axpy = [&](float* __restrict dst, const float* __restrict w, float gval) {
         const V g = splat<V>(gval);
-        for (int X = 0; X < nv; X += L) store(dst + X, load<V>(dst + X) + g * load<V>(w + X));
-        for (int X = nv; X < r.nxr; ++X) dst[X] += gval * w[X];
+        for (int X = r.x0; X < nv; X += L) store(dst + X, load<V>(dst + X) + g * load<V>(w + X));
+        for (int X = nv; X < r.x1; ++X) dst[X] += gval * w[X];
     };
     for (int e = 0; e < r.patSize; ++e) {
         const int row = r.patRow[e];
@@ -59,6 +61,11 @@ ShKernelIndirect::ShKernelIndirect(const IndirectInputs& in, const IndirectSetti
 void ShKernelIndirect::beginFrame() {
     const int nxr = in_.heights.nxr, nyr = in_.heights.nyr;
     const std::size_t planeR = static_cast<std::size_t>(nxr) * nyr;
+    // receiver tiles: the clean receivers keep the U of a previous scan
+    if (in_.only)
+        for (const VisibilityField& u : st_.u)
+            if (u.nxr != nxr || u.nyr != nyr || u.sh.size() != planeR * kShCount)
+                throw InputError("SH kernel: receiver tiles need the previous U of this receiver grid in the state");
     for (int c = 0; c < 3; ++c) {
         VisibilityField& u = st_.u[static_cast<std::size_t>(c)];
         u.nxr = nxr;
@@ -89,7 +96,7 @@ void ShKernelIndirect::scan(int) {
 }
 
 // Casting sets, Eq. 12 and U through the folded wedge operator for one block
-// of receiver rows.
+// of receiver rows, over the rows' spans (receiver tiles).
 void ShKernelIndirect::scanBlock(int block) {
     const int nxr = in_.heights.nxr, nyr = in_.heights.nyr, pad = scan_.pad();
     const std::size_t planeR = static_cast<std::size_t>(nxr) * nyr;
@@ -98,37 +105,45 @@ void ShKernelIndirect::scanBlock(int block) {
     void (*const accumulate)(const URowSums&) = simd::wideEnabled() ? accumulateUAvx2 : accumulateUSse;
     IndirectScratch& sc = st_.blocks[static_cast<std::size_t>(block)];
     const RowBlock rb = scan_.rowBlock(block);
-    // the rows' receiver heights and gradients; U rows zeroed
+    if (!scan_.hasWork(rb)) return;  // no dirty tile in these rows: every receiver keeps its U
+    // the rows' receiver heights and gradients; U zeroed in the spans
     scan_.loadRows(rb, sc);
     for (int r = 0; r < rb.rows; ++r)
-        for (int c = 0; c < 3; ++c)
-            for (int i = 0; i < nRows_; ++i) {
-                float* u = st_.u[static_cast<std::size_t>(c)].plane(i) + static_cast<std::size_t>(rb.yBegin + r) * nxr;
-                std::fill(u, u + nxr, 0.0f);
-            }
+        for (const ColumnSpan& span : scan_.spans(rb.yBegin + r))
+            for (int c = 0; c < 3; ++c)
+                for (int i = 0; i < nRows_; ++i) {
+                    float* u =
+                        st_.u[static_cast<std::size_t>(c)].plane(i) + static_cast<std::size_t>(rb.yBegin + r) * nxr;
+                    std::fill(u + span.x0, u + span.x1, 0.0f);
+                }
     for (int j = 0; j < op.azimuths; ++j) {
         const AzimuthSteps az = scan_.azimuth(j);
         const float* vals = op.values.data() + static_cast<std::size_t>(j) * P;
         for (int r = 0; r < rb.rows; ++r) {
             const int Y = rb.yBegin + r;
-            scan_.castRow(az, j, Y, r, sc);
             float* uRow[3];
             for (int c = 0; c < 3; ++c)
                 uRow[c] = st_.u[static_cast<std::size_t>(c)].plane(0) + static_cast<std::size_t>(Y) * nxr;
-            accumulate({sc.result.data(),
-                        pad,
-                        nxr,
-                        P,
-                        op.patternRow.data(),
-                        op.patternNlp.data(),
-                        vals,
-                        nRows_,
-                        {uRow[0], uRow[1], uRow[2]},
-                        planeR});
+            scan_.castRow(az, j, Y, r, sc);
+            for (const ColumnSpan& span : scan_.spans(Y))
+                accumulate({sc.result.data(),
+                            pad,
+                            nxr,
+                            span.x0,
+                            span.x1,
+                            P,
+                            op.patternRow.data(),
+                            op.patternNlp.data(),
+                            vals,
+                            nRows_,
+                            {uRow[0], uRow[1], uRow[2]},
+                            planeR});
         }
     }
 }
 
+// The texel pass stays whole with receiver tiles: it costs little beside the
+// scan, and interpolates the clean receivers' cached U.
 void ShKernelIndirect::shade(int, ShadeMaps& out) {
     shadeTexels(in_.gradX, in_.gradY, in_.heights.subsample, in_.envVisibility, st_.lights.data(), 3, in_.albedo,
                 in_.shading, out, false);

@@ -9,6 +9,7 @@
 #include "gi/blocker_radiance.h"
 #include "gi/casting_set_scan.h"
 #include "gi/radiance_pyramid.h"
+#include "gi/receiver_tiles.h"
 #include "gi/shading.h"
 #include "gi/visibility.h"
 
@@ -34,6 +35,7 @@ struct IndirectState {
     std::vector<ScanStep> heightSteps;    // azimuths x steps
     std::vector<ScanStep> radianceSteps;  // Lambert strategies: channels x azimuths x steps
     std::vector<int> stepsPerColumn, stepsPerRow;
+    DirtySpans spans;                      // Lambert strategies: the receiver columns to scan, per row
     std::vector<IndirectScratch> blocks;   // Lambert strategies: per block of receiver rows
     std::array<VisibilityField, 3> u;      // U per channel (16 SH planes at the receivers; not with BlockerRadiance)
     int uZeroFrom = kShCount;              // U's planes from this one on are known to be 0

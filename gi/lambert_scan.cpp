@@ -43,6 +43,7 @@ void LambertScan::beginFrame() {
     st_.radianceSteps.resize(3 * tableSize_);
     st_.stepsPerColumn.resize(static_cast<std::size_t>(m) * pad_);
     st_.stepsPerRow.resize(static_cast<std::size_t>(m) * nyr);
+    dirtySpans(in_.only, in_.heights.nxr, nyr, st_.spans);
 }
 
 void LambertScan::buildPyramid(const std::array<Grid, 3>& exit, const RadiancePyramidSettings& settings) {
@@ -64,6 +65,12 @@ void LambertScan::buildStepTable() {
 RowBlock LambertScan::rowBlock(int block) const {
     const int yBegin = block * kRowsPerBlock;
     return {yBegin, std::min(kRowsPerBlock, in_.heights.nyr - yBegin)};
+}
+
+bool LambertScan::hasWork(const RowBlock& rb) const {
+    for (int r = 0; r < rb.rows; ++r)
+        if (!spans(rb.yBegin + r).empty()) return true;
+    return false;
 }
 
 void LambertScan::loadRows(const RowBlock& rb, IndirectScratch& sc) const {
@@ -89,7 +96,7 @@ void LambertScan::castRow(const AzimuthSteps& az, int j, int Y, int r, IndirectS
     const std::size_t ro = static_cast<std::size_t>(r) * pad_;
     const int rowSteps = st_.stepsPerRow[static_cast<std::size_t>(j) * in_.heights.nyr + static_cast<std::size_t>(Y)];
     const ReceiverRow row{
-        Y, rowSteps, sc.h0.data() + ro, sc.margin.data() + ro, sc.gx.data() + ro, sc.gy.data() + ro, hMax_};
+        Y, rowSteps, spans(Y), sc.h0.data() + ro, sc.margin.data() + ro, sc.gx.data() + ro, sc.gy.data() + ro, hMax_};
     castRow_(az, row, sc, pad_);
 }
 

@@ -10,14 +10,20 @@
 // rows of every level, which stay in cache), every receiver written by one
 // block: bit-identical for any thread count; no allocation after the first
 // frame of a given size and settings.
+//
+// Receiver tiles (IndirectInputs::only): rows are scanned over their dirty
+// column spans only (spans(Y)), blocks without any skipped (hasWork); each
+// scanned receiver gets the bits of a full scan.
 #include <array>
 #include <cstddef>
+#include <span>
 
 #include "core/grid.h"
 #include "gi/casting_set_scan.h"
 #include "gi/indirect_inputs.h"
 #include "gi/indirect_state.h"
 #include "gi/radiance_pyramid.h"
+#include "gi/receiver_tiles.h"
 
 namespace terrain::gi {
 
@@ -34,7 +40,8 @@ public:
     LambertScan(const IndirectInputs& in, CastingMoments moments, IndirectState& st);
 
     /// Sizes the step tables and the blocks' scratch (IndirectScratch::irradiance
-    /// with CastingMoments::Irradiance) and finds the field's highest height.
+    /// with CastingMoments::Irradiance), finds the field's highest height and
+    /// the receiver spans to scan (InputError: tiles of another receiver grid).
     void beginFrame();
     /// The RGB radiance pyramid of the previous bounce's exit radiance (Section 5.3).
     void buildPyramid(const std::array<Grid, 3>& exit, const RadiancePyramidSettings& settings);
@@ -43,11 +50,16 @@ public:
 
     int blockCount() const { return nBlocks_; }
     RowBlock rowBlock(int block) const;
+    /// The receiver columns of row Y to scan (the whole row without tiles).
+    std::span<const ColumnSpan> spans(int Y) const { return st_.spans.ofRow(Y); }
+    /// Whether some row of the block has a span to scan.
+    bool hasWork(const RowBlock& rb) const;
     /// The block's receiver rows (loadReceiverRow) into its scratch.
     void loadRows(const RowBlock& rb, IndirectScratch& sc) const;
     /// Azimuth j's step tables.
     AzimuthSteps azimuth(int j) const;
-    /// Scans receiver row Y, row r of its block, along azimuth j: sc.result.
+    /// Scans receiver row Y, row r of its block, along azimuth j: sc.result
+    /// at the receivers of spans(Y).
     void castRow(const AzimuthSteps& az, int j, int Y, int r, IndirectScratch& sc) const;
 
     int pad() const { return pad_; }

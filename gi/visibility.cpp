@@ -4,7 +4,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <span>
 
+#include "core/error.h"
 #include "core/parallel.h"
 #include "core/simd.h"
 #include "gi/nlp.h"
@@ -235,12 +237,18 @@ template <class V, int NV, class Visitor>
     }
 }
 
-// Maximum blocking slope of a row of receivers for one azimuth, in groups of
-// `lanes` receivers (NV vectors). rowPtr: scratch for 2 x rowSteps pointers
-// (each step's taps at receiver 0 of row Y).
+// The receivers a row's kernels run over: each span from its start (a
+// multiple of 16) to its end rounded up to the 16-receiver group (the padded
+// row's end for a span ending at nxr: as in a whole row).
+inline int spanEnd(const ColumnSpan& span) { return padLanes(span.x1); }
+
+// Maximum blocking slope of the receivers of a row's spans for one azimuth,
+// in groups of `lanes` receivers (NV vectors). rowPtr: scratch for 2 x
+// rowSteps pointers (each step's taps at receiver 0 of row Y).
 template <class V, int lanes, template <class, int> class Visitor>
 [[gnu::always_inline]] inline void scanRow(const ScanStep* table, const int* colSteps, int rowSteps, int Y,
-                                           const float* h0, int nxrPad, float* out, const float** rowPtr) {
+                                           const float* h0, std::span<const ColumnSpan> spans, float* out,
+                                           const float** rowPtr) {
     using I = typename LaneTraits<V>::I;
     constexpr int L = LaneTraits<V>::n, NV = lanes / L;
     for (int i = 0; i < rowSteps; ++i) {
@@ -250,35 +258,38 @@ template <class V, int lanes, template <class, int> class Visitor>
         rowPtr[2 * i + 1] = st.field + (o + st.offB);
     }
     const I rowLimit = I{} + rowSteps;
-    for (int X0 = 0; X0 < nxrPad; X0 += lanes) {
-        I steps[NV];
-        I lo = rowLimit, hi = I{};
-        for (int k = 0; k < NV; ++k) {
-            I c;
-            std::memcpy(&c, colSteps + X0 + L * k, sizeof c);
-            steps[k] = c < rowLimit ? c : rowLimit;
-            lo = steps[k] < lo ? steps[k] : lo;
-            hi = steps[k] > hi ? steps[k] : hi;
+    for (const ColumnSpan& span : spans)
+        for (int X0 = span.x0; X0 < spanEnd(span); X0 += lanes) {
+            I steps[NV];
+            I lo = rowLimit, hi = I{};
+            for (int k = 0; k < NV; ++k) {
+                I c;
+                std::memcpy(&c, colSteps + X0 + L * k, sizeof c);
+                steps[k] = c < rowLimit ? c : rowLimit;
+                lo = steps[k] < lo ? steps[k] : lo;
+                hi = steps[k] > hi ? steps[k] : hi;
+            }
+            int nAll = lo[0], nAny = hi[0];
+            for (int l = 1; l < L; ++l) {
+                nAll = std::min(nAll, static_cast<int>(lo[l]));
+                nAny = std::max(nAny, static_cast<int>(hi[l]));
+            }
+            Visitor<V, NV> visit;
+            scanLanes<V, NV>(table, rowPtr, X0, h0, steps, nAll, nAny, visit);
+            visit.result(out + X0);
         }
-        int nAll = lo[0], nAny = hi[0];
-        for (int l = 1; l < L; ++l) {
-            nAll = std::min(nAll, static_cast<int>(lo[l]));
-            nAny = std::max(nAny, static_cast<int>(hi[l]));
-        }
-        Visitor<V, NV> visit;
-        scanLanes<V, NV>(table, rowPtr, X0, h0, steps, nAll, nAny, visit);
-        visit.result(out + X0);
-    }
 }
 
 // ---- algorithm: Eq. 11 and the folded wedge operator for one azimuth -------
-// NLP vectors of a row of receivers (4 rows of nxr), then V += G_j w_j over
-// the sparse pattern, each entry a contiguous multiply-add over the row.
-// omega_min: elevation of the tangent plane along the azimuth (Section 3).
+// NLP vectors of the receivers of a row's spans (4 rows of nxrPad), then
+// V += G_j w_j over the sparse pattern, each entry a contiguous multiply-add
+// over the row. omega_min: elevation of the tangent plane along the azimuth
+// (Section 3).
 template <class V>
 [[gnu::always_inline]] inline void nlpRow(const float* __restrict maxSlope, const float* __restrict gx,
                                           const float* __restrict gy, float cosPhi, float sinPhi,
-                                          const VisibilityTarget& target, float* __restrict nlp, int nxrPad) {
+                                          const VisibilityTarget& target, float* __restrict nlp,
+                                          std::span<const ColumnSpan> spans, int nxrPad) {
     constexpr int L = LaneTraits<V>::n;
     const V c = splat<V>(cosPhi), sn = splat<V>(sinPhi);
     const V one = splat<V>(1.0f), lim = splat<V>(1e6f), nlim = splat<V>(-1e6f);
@@ -286,47 +297,50 @@ template <class V>
     const V k2 = splat<V>(0.79056941504209483300f), k3 = splat<V>(0.23385358667337133659f);
     const V five = splat<V>(5.0f), four = splat<V>(4.0f);
     const V sLow = splat<V>(target.sinLow), sHigh = splat<V>(target.sinHigh);
-    for (int X = 0; X < nxrPad; X += L) {
-        const V tangent = load<V>(gx + X) * c + load<V>(gy + X) * sn;
-        const V ms = load<V>(maxSlope + X);
-        V t = ms < tangent ? tangent : ms;
-        t = t < nlim ? nlim : (t > lim ? lim : t);  // sinFromSlope
-        const V s = t / sqrtv(one + t * t);
-        V w0, w1, w2, w3;
-        if (target.window) {
-            // nlpVisibleBetween(lo, hi): occlusion(hi) - occlusion(lo)
-            const V lo = s < sLow ? sLow : s;
-            const V hi = lo < sHigh ? sHigh : lo;
-            const V cl = one - lo * lo, ch = one - hi * hi;
-            w0 = (hi + one) * k0 - (lo + one) * k0;
-            w1 = (-k1) * ch - (-k1) * cl;
-            w2 = (-k2) * hi * ch - (-k2) * lo * cl;
-            w3 = k3 * ch * (five * ch - four) - k3 * cl * (five * cl - four);
-        } else {
-            // nlpVisibleAbove(s)
-            const V c2 = one - s * s;
-            w0 = (one - s) * k0;
-            w1 = k1 * c2;
-            w2 = k2 * s * c2;
-            w3 = (-k3) * c2 * (five * c2 - four);
+    for (const ColumnSpan& span : spans)
+        for (int X = span.x0; X < spanEnd(span); X += L) {
+            const V tangent = load<V>(gx + X) * c + load<V>(gy + X) * sn;
+            const V ms = load<V>(maxSlope + X);
+            V t = ms < tangent ? tangent : ms;
+            t = t < nlim ? nlim : (t > lim ? lim : t);  // sinFromSlope
+            const V s = t / sqrtv(one + t * t);
+            V w0, w1, w2, w3;
+            if (target.window) {
+                // nlpVisibleBetween(lo, hi): occlusion(hi) - occlusion(lo)
+                const V lo = s < sLow ? sLow : s;
+                const V hi = lo < sHigh ? sHigh : lo;
+                const V cl = one - lo * lo, ch = one - hi * hi;
+                w0 = (hi + one) * k0 - (lo + one) * k0;
+                w1 = (-k1) * ch - (-k1) * cl;
+                w2 = (-k2) * hi * ch - (-k2) * lo * cl;
+                w3 = k3 * ch * (five * ch - four) - k3 * cl * (five * cl - four);
+            } else {
+                // nlpVisibleAbove(s)
+                const V c2 = one - s * s;
+                w0 = (one - s) * k0;
+                w1 = k1 * c2;
+                w2 = k2 * s * c2;
+                w3 = (-k3) * c2 * (five * c2 - four);
+            }
+            store(nlp + X, w0);
+            store(nlp + nxrPad + X, w1);
+            store(nlp + 2 * nxrPad + X, w2);
+            store(nlp + 3 * nxrPad + X, w3);
         }
-        store(nlp + X, w0);
-        store(nlp + nxrPad + X, w1);
-        store(nlp + 2 * nxrPad + X, w2);
-        store(nlp + 3 * nxrPad + X, w3);
-    }
 }
 
-// V += G_j w_j for a batch of azimuths (1 or 2), each SH row of V read and
-// written once per batch; the additions run in the same order as one azimuth
-// and one entry after the other (bit-identical to the plain sequence).
+// V += G_j w_j for a batch of azimuths (1 or 2) at the receivers of a row's
+// spans, each SH row of V read and written once per batch; the additions run
+// in the same order as one azimuth and one entry after the other
+// (bit-identical to the plain sequence). Receivers below the row's last
+// multiple of 16 go 16 at a time, the rest one by one, whatever the spans.
 // opValues: the folded operator's entries of each azimuth.
 template <class V>
 [[gnu::always_inline]] inline void accumulateRows(const float* const* nlp, const float* const* opValues, int batch,
                                                   const std::uint8_t* patRow, const std::uint8_t* patNlp, int patSize,
-                                                  float* const* vRows, int nxr, int nxrPad) {
+                                                  float* const* vRows, int nxr, std::span<const ColumnSpan> spans,
+                                                  int nxrPad) {
     constexpr int kMaxTerms = 8, L = LaneTraits<V>::n, NA = 16 / L;
-    const int n16 = nxr / 16 * 16;
     int e = 0;
     while (e < patSize) {
         const int r = patRow[e];
@@ -345,33 +359,38 @@ template <class V>
                 ++nt;
             }
         float* __restrict v = vRows[r];
-        // 16 receivers at a time: independent addition chains
-        for (int X = 0; X < n16; X += 16) {
-            V acc[NA];
-            for (int k = 0; k < NA; ++k) acc[k] = load<V>(v + X + L * k);
-            for (int t = 0; t < nt; ++t)
-                for (int k = 0; k < NA; ++k) acc[k] += g[t] * load<V>(w[t] + X + L * k);
-            for (int k = 0; k < NA; ++k) store(v + X + L * k, acc[k]);
-        }
-        for (int X = n16; X < nxr; ++X) {
-            float acc = v[X];
-            for (int t = 0; t < nt; ++t) acc += gs[t] * w[t][X];
-            v[X] = acc;
+        for (const ColumnSpan& span : spans) {
+            // 16 receivers at a time: independent addition chains
+            const int n16 = std::min(span.x1, nxr / 16 * 16);
+            for (int X = span.x0; X < n16; X += 16) {
+                V acc[NA];
+                for (int k = 0; k < NA; ++k) acc[k] = load<V>(v + X + L * k);
+                for (int t = 0; t < nt; ++t)
+                    for (int k = 0; k < NA; ++k) acc[k] += g[t] * load<V>(w[t] + X + L * k);
+                for (int k = 0; k < NA; ++k) store(v + X + L * k, acc[k]);
+            }
+            for (int X = n16; X < span.x1; ++X) {
+                float acc = v[X];
+                for (int t = 0; t < nt; ++t) acc += gs[t] * w[t][X];
+                v[X] = acc;
+            }
         }
         e = e1;
     }
 }
 
-// One row's azimuth batch (1 or 2 azimuths from j0): the scans, their maximum
-// slopes out, NLP vectors and V += G_j w_j.
+// One row's azimuth batch (1 or 2 azimuths from j0) over the receivers of
+// the row's spans: the scans, their maximum slopes out, NLP vectors and
+// V += G_j w_j.
 struct RowBatch {
     const ScanStep* steps;  // the step table (azimuths x nSteps)
     int nSteps, nxr, nyr, nxrPad, Y, j0, batch;
-    const int* stepsPerColumn;  // azimuths x nxrPad
-    const int* stepsPerRow;     // azimuths x nyr
-    const float* cosSin;        // azimuths x 2
-    const float* h0;            // the row's receiver heights
-    const float* gradX;         // receiver, footprint lo, hi (x nxrPad)
+    std::span<const ColumnSpan> spans;  // the receivers of row Y to compute
+    const int* stepsPerColumn;          // azimuths x nxrPad
+    const int* stepsPerRow;             // azimuths x nyr
+    const float* cosSin;                // azimuths x 2
+    const float* h0;                    // the row's receiver heights
+    const float* gradX;                 // receiver, footprint lo, hi (x nxrPad)
     const float* gradY;
     bool foot;  // footprint rows present
     BlockingMax blockingMax;
@@ -396,20 +415,20 @@ template <class V>
         const int* colSteps = r.stepsPerColumn + static_cast<std::size_t>(j) * r.nxrPad;
         const int rowSteps = r.stepsPerRow[static_cast<std::size_t>(j) * r.nyr + static_cast<std::size_t>(r.Y)];
         if (r.blockingMax == BlockingMax::Samples)
-            scanRow<V, 16, SampleMaxVisitor>(table, colSteps, rowSteps, r.Y, r.h0, r.nxrPad, r.maxRow, r.rowPtr);
+            scanRow<V, 16, SampleMaxVisitor>(table, colSteps, rowSteps, r.Y, r.h0, r.spans, r.maxRow, r.rowPtr);
         else
-            scanRow<V, 8, BsplineMaxVisitor>(table, colSteps, rowSteps, r.Y, r.h0, r.nxrPad, r.maxRow, r.rowPtr);
+            scanRow<V, 8, BsplineMaxVisitor>(table, colSteps, rowSteps, r.Y, r.h0, r.spans, r.maxRow, r.rowPtr);
         float* maxOut = r.maxSlope + planeSize * j + static_cast<std::size_t>(r.Y) * r.nxr;
-        std::copy(r.maxRow, r.maxRow + r.nxr, maxOut);
+        for (const ColumnSpan& span : r.spans) std::copy(r.maxRow + span.x0, r.maxRow + span.x1, maxOut + span.x0);
         float* nlp = r.nlp + static_cast<std::size_t>(a) * 4 * r.nxrPad;
         const float cj = r.cosSin[2 * static_cast<std::size_t>(j)], sj = r.cosSin[2 * static_cast<std::size_t>(j) + 1];
         const float* tgx = r.foot ? r.gradX + (cj >= 0.0f ? 1 : 2) * r.nxrPad : r.gradX;
         const float* tgy = r.foot ? r.gradY + (sj >= 0.0f ? 1 : 2) * r.nxrPad : r.gradY;
-        nlpRow<V>(r.maxRow, tgx, tgy, cj, sj, *r.target, nlp, r.nxrPad);
+        nlpRow<V>(r.maxRow, tgx, tgy, cj, sj, *r.target, nlp, r.spans, r.nxrPad);
         nlps[a] = nlp;
         ops[a] = r.op->values.data() + static_cast<std::size_t>(j) * P;
     }
-    accumulateRows<V>(nlps, ops, r.batch, r.op->patternRow.data(), r.op->patternNlp.data(), P, r.vRows, r.nxr,
+    accumulateRows<V>(nlps, ops, r.batch, r.op->patternRow.data(), r.op->patternNlp.data(), P, r.vRows, r.nxr, r.spans,
                       r.nxrPad);
 }
 
@@ -525,14 +544,15 @@ void loadReceiverRow(const VisibilityRows& r, int Y, VisibilityScratch& sc) {
     }
 }
 
-// V of receiver row Y (loaded by loadReceiverRow): every azimuth, two at a time.
-void visibilityOfRow(const VisibilityRows& r, int Y, VisibilityScratch& sc) {
+// V of the receivers of row Y's spans (loaded by loadReceiverRow): every
+// azimuth, two at a time.
+void visibilityOfRow(const VisibilityRows& r, int Y, std::span<const ColumnSpan> spans, VisibilityScratch& sc) {
     const int nxr = r.pyr.nxr, nyr = r.pyr.nyr, m = r.target.op->azimuths;
     VisibilityState& state = r.state;
     float* vRows[kShCount];
     for (int i = 0; i < kShCount; ++i) {
         vRows[i] = r.out.plane(i) + static_cast<std::size_t>(Y) * nxr;
-        std::fill(vRows[i], vRows[i] + nxr, 0.0f);
+        for (const ColumnSpan& span : spans) std::fill(vRows[i] + span.x0, vRows[i] + span.x1, 0.0f);
     }
     for (int j0 = 0; j0 < m; j0 += 2) {
         const RowBatch rb{state.steps.data(),
@@ -543,6 +563,7 @@ void visibilityOfRow(const VisibilityRows& r, int Y, VisibilityScratch& sc) {
                           Y,
                           j0,
                           std::min(2, m - j0),
+                          spans,
                           state.stepsPerColumn.data(),
                           state.stepsPerRow.data(),
                           state.cosSin.data(),
@@ -658,17 +679,24 @@ float scanReceiverScalar(const HeightPyramid& pyr, int X, int Y, double phi, Blo
 
 void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridView gradY,
                        const VisibilitySettings& settings, const VisibilityTarget& target, VisibilityState& state,
-                       VisibilityField& out) {
+                       VisibilityField& out, const ReceiverTiles* only) {
     const FoldedWedgeOperator& op = *target.op;
     const int nxr = pyr.nxr, nyr = pyr.nyr, s = pyr.subsample;
     const int nxrPad = padLanes(nxr);
     const int m = op.azimuths;
     const int nSteps = static_cast<int>(pyr.steps.size());
     const std::size_t planeSize = static_cast<std::size_t>(nxr) * nyr;
+    if (only && (out.nxr != nxr || out.nyr != nyr || out.sh.size() != planeSize * kShCount ||
+                 out.maxSlope.size() != planeSize * m))
+        throw InputError(
+            "computeVisibility: receiver tiles need the previous result of this receiver grid and these "
+            "azimuths in the output");
+    dirtySpans(only, nxr, nyr, state.spans);
     out.nxr = nxr;
     out.nyr = nyr;
     out.sh.resize(planeSize * kShCount);
     out.maxSlope.resize(planeSize * m);
+    if (state.spans.empty()) return;  // no dirty tile (or no receiver): every receiver keeps its value
 
     buildStepTables(pyr, op, nxrPad, state);
     const int nBlocks = std::max(1, std::min(nyr, kMaxBlocks));
@@ -697,8 +725,11 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
             const int yBegin = static_cast<int>(static_cast<long long>(nyr) * block / nBlocks);
             const int yEnd = static_cast<int>(static_cast<long long>(nyr) * (block + 1) / nBlocks);
             for (int Y = yBegin; Y < yEnd; ++Y) {
+                // rows without a dirty span (receiver tiles) are skipped
+                const std::span<const ColumnSpan> spans = state.spans.ofRow(Y);
+                if (spans.empty()) continue;
                 loadReceiverRow(rows, Y, sc);
-                visibilityOfRow(rows, Y, sc);
+                visibilityOfRow(rows, Y, spans, sc);
             }
         }
     });

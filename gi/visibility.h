@@ -49,10 +49,18 @@
 // the row.
 // Every receiver is written by exactly one block (gather only), so the result
 // is bit-identical for any thread count.
+//
+// Receiver tiles (gi/receiver_tiles.h, change-driven GI): given dirty tiles,
+// only their receivers are recomputed; rows without a dirty tile are
+// skipped, and within a row the kernels run over the dirty column spans
+// only, which start on the 16-receiver groups of the full row, so each
+// recomputed receiver gets the same bits as in a full computation. The step
+// tables stay whole (every column's valid prefix).
 #include <vector>
 
 #include "core/grid.h"
 #include "gi/pyramid.h"
+#include "gi/receiver_tiles.h"
 #include "gi/wedge.h"
 
 namespace terrain::gi {
@@ -148,6 +156,7 @@ struct VisibilityState {
     std::vector<int> stepsPerColumn;  // azimuths x padded nxr: valid-prefix length from x alone
     std::vector<int> stepsPerRow;     // azimuths x nyr: valid-prefix length from y alone
     std::vector<float> cosSin;        // azimuths x 2: cos, sin of each azimuth (float)
+    DirtySpans spans;                 // the receiver columns to compute, per row
 };
 
 /// One step of the scan table as computeVisibility builds it (exposed for
@@ -186,9 +195,15 @@ inline constexpr float kHeightMarginRel = 1.0f / 1048576.0f;  // 2^-20
 
 /// Computes V for every receiver of the pyramid. gradX/gradY are full
 /// resolution height derivatives (metres per metre).
+/// With `only` (receiver tiles of this receiver grid), out must already hold
+/// a result of the same target and settings (only its sizes are checked:
+/// InputError when they are not this grid's and azimuth count's): the
+/// receivers of the dirty tiles are recomputed (V and maxSlope),
+/// bit-identical to a full computation, and every other receiver keeps its
+/// values. Null: every receiver.
 void computeVisibility(const HeightPyramid& pyramid, ConstGridView gradX, ConstGridView gradY,
                        const VisibilitySettings& settings, const VisibilityTarget& target, VisibilityState& state,
-                       VisibilityField& out);
+                       VisibilityField& out, const ReceiverTiles* only = nullptr);
 
 /// Eq. 16 over one receiver's valid slope sequence (scalar twin of the scan's
 /// visitors; scanReceiverScalar uses it).
