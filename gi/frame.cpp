@@ -192,7 +192,7 @@ void planAmortisation(ConstGridView heights, const GiSettings& settings, GiState
 
 // The environment's visibility V at the receivers; with sub-sampling and
 // footprint tangent planes, omega_min from each receiver's footprint box.
-void environmentVisibility(const GiSettings& settings, GiState& st) {
+void environmentVisibility(const GiSettings& settings, const ReceiverTiles* only, GiState& st) {
     if (st.envOperatorAzimuths != settings.visibility.azimuths || st.envOperatorInterp != settings.visibility.interp) {
         st.envOperator = foldFullCircle(settings.visibility.azimuths, settings.visibility.interp);
         st.envOperatorAzimuths = settings.visibility.azimuths;
@@ -204,20 +204,22 @@ void environmentVisibility(const GiSettings& settings, GiState& st) {
     envTarget.op = &st.envOperator;
     envTarget.footprint = footprint ? &st.footprint : nullptr;
     computeVisibility(st.pyramid, st.gradX.cview(), st.gradY.cview(), settings.visibility, envTarget,
-                      st.visibilityState, st.envVisibility);
+                      st.visibilityState, st.envVisibility, only);
 }
 
 // Each key light's own visibility over its azimuthal extent and elevation
 // interval (Section 6); operators cached per light.
-void keyLightVisibility(const GiLighting& lighting, const GiSettings& settings, const std::vector<bool>& recompute,
-                        GiState& st) {
+// With `only`, a key light whose region of the sky is the same as last frame
+// recomputes only those tiles (the heights changed); a new region, all.
+void keyLightVisibility(const GiLighting& lighting, const GiSettings& settings, const FrameChange& change,
+                        const ReceiverTiles* only, GiState& st) {
     const std::size_t nKeys = lighting.keys.size();
     st.keyOperators.resize(nKeys);
     st.keyOperatorLights.resize(nKeys);
     st.keyVisibility.resize(nKeys);
     const bool footprint = settings.subsample > 1 && settings.visibility.footprintTangent;
     for (std::size_t k = 0; k < nKeys; ++k) {
-        if (!recompute[k]) continue;
+        if (!change.keyGeometry[k]) continue;
         ++st.keyVisibilitiesRecomputed;
         const KeyLight& light = lighting.keys[k];
         const KeyLightExtent ext = keyLightExtent(light);
@@ -234,7 +236,7 @@ void keyLightVisibility(const GiLighting& lighting, const GiSettings& settings, 
         VisibilitySettings ks = settings.visibility;
         ks.azimuths = settings.keyLightAzimuths;
         computeVisibility(st.pyramid, st.gradX.cview(), st.gradY.cview(), ks, target, st.visibilityState,
-                          st.keyVisibility[k]);
+                          st.keyVisibility[k], change.keyRegion[k] ? nullptr : only);
     }
 }
 
@@ -260,10 +262,13 @@ void directShading(const GiLighting& lighting, const GiSettings& settings, const
 
 // The direct light's stages: geometry (gradient, pyramid, environment V)
 // where it changed, each key light's V where its region of the sky or the
-// geometry changed, and the shading.
+// geometry changed, and the shading. When only the heights changed, the
+// visibility reruns in the tiles whose cached V may have drifted beyond the
+// tolerance (gi/visibility_cache.h).
 void runDirectStages(ConstGridView heights, float cellSize, const GiLighting& lighting, const GiSettings& settings,
                      const FrameChange& change, const AlbedoMap* albedo, GiState& st) {
     auto t = Clock::now();
+    const ReceiverTiles* only = nullptr;
     if (change.geometry) {
         computeGradient(heights, cellSize, st.gradX, st.gradY);
         st.timings.gradient = msSince(t);
@@ -271,12 +276,19 @@ void runDirectStages(ConstGridView heights, float cellSize, const GiLighting& li
         buildHeightPyramid(heights, cellSize, settings.subsample, settings.pyramid, st.pyramid);
         st.timings.pyramid = msSince(t);
         t = Clock::now();
-        environmentVisibility(settings, st);
+        const bool tiled = change.heightsOnly && !st.lastInputs.heights.empty();
+        if (tiled)
+            planVisibilityTiles(st.lastInputs.heights.cview(), heights, st.pyramid, settings.visibility.blockingMax,
+                                settings.tolerance, st.visibilityCache);
+        else
+            resetVisibilityCache(st.pyramid, st.visibilityCache);
+        only = tiled ? &st.visibilityCache.tiles : nullptr;
+        environmentVisibility(settings, only, st);
         st.timings.visibility = msSince(t);
-        st.receiversRecomputed = 1.0;
+        st.receiversRecomputed = tiled ? st.visibilityCache.tiles.dirtyFraction() : 1.0;
     }
     t = Clock::now();
-    keyLightVisibility(lighting, settings, change.keyGeometry, st);
+    keyLightVisibility(lighting, settings, change, only, st);
     st.timings.keyVisibility = msSince(t);
     t = Clock::now();
     directShading(lighting, settings, albedo, st);

@@ -13,6 +13,7 @@
 #include "gi/settings.h"
 #include "gi/shading.h"
 #include "gi/visibility.h"
+#include "gi/visibility_cache.h"
 #include "gi/wedge.h"
 
 namespace terrain::gi {
@@ -48,6 +49,7 @@ struct GiState {
     // inputs of the cached results, and whether an amortised frame left the
     // direct or the indirect light behind its inputs.
     FrameInputs lastInputs;
+    VisibilityCache visibilityCache;  // per tile, how far the cached V may have drifted
     bool directStale = false, indirectStale = false;
     double receiversRecomputed = 0.0;   // fraction of the receivers whose environment V the last frame recomputed
     int keyVisibilitiesRecomputed = 0;  // key lights whose V the last frame recomputed

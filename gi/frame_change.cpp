@@ -52,6 +52,7 @@ bool FrameChange::any() const {
 FrameChange everythingChanged(std::size_t keys) {
     FrameChange c;
     c.keyGeometry.assign(keys, true);
+    c.keyRegion.assign(keys, true);
     return c;
 }
 
@@ -60,12 +61,17 @@ FrameChange compareFrameInputs(const FrameInputs& last, ConstGridView heights, f
     const std::size_t nKeys = lighting.keys.size();
     if (!last.valid) return everythingChanged(nKeys);
     FrameChange c;
-    c.geometry = cellSize != last.cellSize || !(settings == last.settings) || !sameGrid(last.heights, heights);
+    const bool sameFrame = cellSize == last.cellSize && settings == last.settings && last.heights.nx == heights.nx &&
+                           last.heights.ny == heights.ny;
+    c.geometry = !sameFrame || !sameGrid(last.heights, heights);
+    c.heightsOnly = sameFrame && c.geometry;
     c.keyGeometry.assign(nKeys, true);
+    c.keyRegion.assign(nKeys, true);
     bool keyRadiance = nKeys != last.keys.size();
     for (std::size_t k = 0; k < nKeys; ++k) {
         const bool known = k < last.keys.size();
-        c.keyGeometry[k] = c.geometry || !known || !sameKeyRegion(lighting.keys[k], last.keys[k]);
+        c.keyRegion[k] = !known || !sameKeyRegion(lighting.keys[k], last.keys[k]);
+        c.keyGeometry[k] = c.geometry || c.keyRegion[k];
         keyRadiance = keyRadiance || !known || !sameKeyRadiance(lighting.keys[k], last.keys[k]);
     }
     const bool environment = lighting.environment.c != last.environment.c;

@@ -35,8 +35,12 @@ struct FrameInputs {
 
 /// Which inputs differ from the recorded ones.
 struct FrameChange {
-    bool geometry = true;           // heights, cell size or any setting: gradient, pyramid and every V
-    std::vector<bool> keyGeometry;  // per key light: its V (direction, size, or count changed)
+    bool geometry = true;  // heights, cell size or any setting: gradient, pyramid and every V
+    // Only the heights changed (same size, cell size and settings): the
+    // visibility may be recomputed tile by tile (gi/visibility_cache.h).
+    bool heightsOnly = false;
+    std::vector<bool> keyGeometry;  // per key light: its V (geometry, direction, size, or count changed)
+    std::vector<bool> keyRegion;    // per key light: its region of the sky is new (direction, size, count)
     bool radiance = true;           // environment, key radiances or albedo: shading and indirect light
     bool any() const;
 };

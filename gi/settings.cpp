@@ -33,6 +33,7 @@ void validateGiSettings(const GiSettings& s) {
     checkRange(ranges::kKeyLightAzimuths, s.keyLightAzimuths);
     checkRange(ranges::kPhongExponent, s.shading.phongExponent);
     checkRange(ranges::kSpecularWeight, s.shading.specularWeight);
+    checkRange(ranges::kTolerance, s.tolerance);
     validateIndirectSettings(s.indirect);
 }
 

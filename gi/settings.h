@@ -30,6 +30,11 @@ struct GiSettings {
     // inputs changed since the cached result; off: every frame recomputes
     // everything (for comparison).
     bool incremental = true;
+    // With incremental frames: the largest change of the ambient map (unit
+    // sky, irradiance / pi) a receiver's cached visibility may be behind by,
+    // by a conservative bound (gi/visibility_cache.h); 0: recompute whatever
+    // may have changed at all (bit-identical to full frames).
+    float tolerance = 0.0f;
     bool operator==(const GiSettings&) const = default;
 };
 

@@ -1,5 +1,7 @@
 // gi/frame_change: incremental frames rerun a stage only when its inputs
 // changed, and give bit for bit what a full recompute gives.
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include <doctest/doctest.h>
@@ -102,5 +104,38 @@ TEST_CASE("gi.frame_change: incremental frames of an eroding terrain equal full 
             withThreads(threads[i], [&] { checkAgainstFull(h, light, settings, states[i]); });
         for (std::size_t i = 1; i < states.size(); ++i) CHECK(sameOutputs(states[i], states[0]));
         CHECK(states[0].directUpdated == (f != 2 && f != 4));
+    }
+}
+
+TEST_CASE("gi.frame_change: a crater recomputes the tiles within its reach, within the tolerance of a full frame") {
+    Grid h = bumpy(256, 256);
+    GiLighting light;    // uniform unit sky: the shade is the ambient map the tolerance speaks of
+    for (int s : {1}) {  // at 2x this field has 4 x 4 tiles, all within the bound's reach
+        GiSettings settings = withBounces(GiSettings{}, s, 0);
+        // The bound is conservative and loose (pyramid filters reach far at coarse
+        // levels): a tolerance of 0.05 of the ambient map keeps the far tiles.
+        settings.tolerance = 5e-2f;
+        GiState inc;
+        runGiFrame(h.cview(), 10.0f, light, settings, inc);
+        Grid crater = h;
+        for (int y = 120; y < 136; ++y)
+            for (int x = 120; x < 136; ++x) crater(x, y) -= 6.0f;  // 16 x 16 cells, 6 m deep
+        runGiFrame(crater.cview(), 10.0f, light, settings, inc);
+        GiSettings off = settings;
+        off.incremental = false;
+        GiState full;
+        runGiFrame(crater.cview(), 10.0f, light, off, full);
+        INFO("subsample " << s << ", receivers recomputed " << inc.receiversRecomputed);
+        MESSAGE("crater at " << s << "x: " << 100.0 * inc.receiversRecomputed << " % of the receivers recomputed");
+        CHECK(inc.receiversRecomputed > 0.0);
+        CHECK(inc.receiversRecomputed < 0.9);
+        double worst = 0.0;
+        for (std::size_t i = 0; i < full.shade.ambient.v.size(); ++i)
+            worst = std::max(worst, std::fabs(static_cast<double>(inc.shade.ambient.v[i]) - full.shade.ambient.v[i]));
+        MESSAGE("largest ambient difference from the full frame " << worst);
+        CHECK(worst <= settings.tolerance);
+        // the crater's own tile is among the recomputed ones: its floor sees the walls
+        const int r = 128 / s / kVisibilityTile;
+        CHECK(inc.visibilityCache.tiles.isDirty(r, r));
     }
 }

@@ -1,0 +1,44 @@
+#pragma once
+// Which receiver tiles must recompute their visibility after the heights
+// changed (the frame's one place for it; the scans only take the tiles).
+//
+// Per tile of kVisibilityTile x kVisibilityTile receivers the cache keeps how
+// far its cached V can have drifted since it was computed: each frame with
+// new heights adds the frame's conservative bounds (gi/change_bound.h: the
+// largest move of any blocking slope, and of the height gradients behind the
+// tangent planes), turned into the largest change of the ambient map (unit
+// sky) they allow. A tile is recomputed, and its drift reset to 0, when its
+// drift exceeds the tolerance; tolerance 0 recomputes every tile whose inputs
+// may have changed at all, which reproduces a full recompute bit for bit.
+// Sums of per-frame bounds bound the accumulated change (triangle
+// inequality), so slow changes over many frames are caught too.
+#include <vector>
+
+#include "core/grid.h"
+#include "gi/change_bound.h"
+#include "gi/pyramid.h"
+#include "gi/receiver_tiles.h"
+#include "gi/visibility.h"
+
+namespace terrain::gi {
+
+/// Receivers per side of a visibility tile (a multiple of ReceiverTiles::kTileAlign).
+inline constexpr int kVisibilityTile = 32;
+
+struct VisibilityCache {
+    MaxChangePyramid change;                   // |dh| of this frame
+    std::vector<float> slopeBound, gradBound;  // this frame's bounds per tile
+    std::vector<float> drift;                  // per tile: ambient-map change allowed since its V was computed
+    ReceiverTiles tiles;                       // this frame's tiles to recompute
+};
+
+/// Forgets the drift: every tile's V is about to be computed from scratch.
+void resetVisibilityCache(const HeightPyramid& pyr, VisibilityCache& cache);
+
+/// Adds the change from `before` to the pyramid's heights `after` to every
+/// tile's drift and marks the tiles whose drift exceeds `tolerance` (their
+/// drift reset to 0): cache.tiles. `pyr` is the pyramid of `after`.
+void planVisibilityTiles(ConstGridView before, ConstGridView after, const HeightPyramid& pyr, BlockingMax rule,
+                         float tolerance, VisibilityCache& cache);
+
+}  // namespace terrain::gi
