@@ -383,6 +383,7 @@ Runner addGiCommand(CLI::App& app) {
                     "on: with --frames, rerun only the stages whose inputs changed (the same field: no work after the "
                     "first frame); off: every frame recomputes everything")
         ->capture_default_str();
+    sub->add_option("--gi-tolerance", gs.tolerance, gi::describe(r::kTolerance))->capture_default_str();
     sub->add_flag("--amortise", gs.indirect.amortise,
                   "With --frames on static geometry: alternate direct and indirect updates");
     sub->add_option("--out-indirect", o->outIndirect,

@@ -79,6 +79,7 @@ void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize) {
                     "on: GI reruns only the stages whose inputs changed since the last frame; off: every frame "
                     "recomputes everything")
         ->capture_default_str();
+    sub->add_option("--gi-tolerance", o.giTolerance, gi::describe(gi::ranges::kTolerance))->capture_default_str();
     sub->add_flag("--amortise", o.amortise,
                   "Shading amortisation: on static geometry update direct and indirect light on alternate frames");
     sub->add_option("--shadow", o.shadow, "Key light shadow: soft (engine visibility) | map (shadow map) | none")
@@ -115,6 +116,7 @@ void toSettings(const RenderOptions& o, engine::PipelineSettings& p, render::Ren
     p.gi.indirect.bounces = o.bounces;
     p.gi.indirect.amortise = o.amortise;
     p.gi.incremental = o.giIncremental;
+    p.gi.tolerance = o.giTolerance;
     gi::validateGiSettings(p.gi);
     p.ticksPerFrame = o.ticksPerFrame;
     p.pyramidLevel = o.pyramidLevel;
@@ -186,6 +188,7 @@ int runHeadlessRender(const RenderOptions& o, const char* label) {
                 pipeline.ticksPerFrame(), o.width, o.height, render::glDescription(gl).c_str());
         }
         std::vector<std::vector<double>> stage(7);
+        double recomputed = 0.0;  // receivers whose visibility the frames recomputed, summed over frames
         std::vector<std::uint8_t> rgb;
         Progress progress(label, o.frames, !o.quiet);
         for (int f = 0; f < o.frames; ++f) {
@@ -201,6 +204,7 @@ int runHeadlessRender(const RenderOptions& o, const char* label) {
             writePngRgb((std::filesystem::path(o.out) / name).string(), o.width, o.height, rgb);
             const double writeMs = msSince(t);
             const engine::StageTimings& tm = pipeline.timings();
+            recomputed += pipeline.giState().receiversRecomputed;
             const double values[7] = {tm.sim, tm.pyramids, tm.scan, tm.integrate, tm.shade, renderMs, writeMs};
             for (int i = 0; i < 7; ++i) stage[static_cast<std::size_t>(i)].push_back(values[i]);
             progress.update(f + 1);
@@ -217,6 +221,8 @@ int runHeadlessRender(const RenderOptions& o, const char* label) {
                 std::printf(" %s %.1f%s", names[i], m, i == 6 ? "" : ",");
             }
             std::printf(" (total %.1f; integrate is fused into scan in gi/)\n", sum);
+            std::printf("%s: GI receivers recomputed: %.1f %% per frame on average (incremental GI %s)\n", label,
+                        100.0 * recomputed / o.frames, o.giIncremental ? "on" : "off");
             std::printf("%s: %d frames written to %s\n", label, o.frames, dir.c_str());
         }
         if (!o.video.empty()) {

@@ -65,6 +65,8 @@ void drawPanel(FramePipeline& pipeline, RenderSettings& rs, bool& paused, const 
     ImGui::Text("%.1f fps", fpsAvg > 0.0 ? 1000.0 / fpsAvg : 0.0);
     ImGui::Text("ms: sim %.1f  pyramids %.1f  scan %.1f", avg.sim, avg.pyramids, avg.scan);
     ImGui::Text("    integrate %.1f  shade %.1f  render %.1f", avg.integrate, avg.shade, avg.render);
+    // incremental GI: a paused or static scene recomputes nothing
+    ImGui::Text("GI receivers recomputed: %.0f %%", 100.0 * pipeline.giState().receiversRecomputed);
     ImGui::Separator();
     ImGui::Checkbox("pause simulation", &paused);
     int lighting = static_cast<int>(ps.lighting);
@@ -72,6 +74,7 @@ void drawPanel(FramePipeline& pipeline, RenderSettings& rs, bool& paused, const 
     ImGui::SliderInt("bounces", &ps.gi.indirect.bounces, 0, 3);
     ImGui::Checkbox("amortise shading", &ps.gi.indirect.amortise);
     ImGui::Checkbox("incremental GI", &ps.gi.incremental);
+    ImGui::SliderFloat("GI tolerance", &ps.gi.tolerance, 0.0f, 0.1f, "%.3f");
     int sub = ps.gi.subsample == 1 ? 0 : (ps.gi.subsample == 2 ? 1 : 2);
     ImGui::Text("sub-sampling");
     ImGui::SameLine();

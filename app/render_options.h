@@ -26,6 +26,7 @@ struct RenderOptions {
     int bounces = 1;
     bool amortise = false;
     bool giIncremental = true;
+    float giTolerance = 0.0f;
     std::string shadow = "soft";  // soft | map | none
     std::string debug = "none";   // none | ambient | v | key | normals | pyramid | shade | u
     int pyramidLevel = 4;
