@@ -41,6 +41,7 @@ int main(int argc, char** argv) {
     add(&addGiSuite);
     add(&addGiIndirectSuite);
     add(&addGiGlossySuite);
+    add(&addGiIncrementalSuite);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
