@@ -60,6 +60,22 @@ std::string shellQuote(const std::string& s) {
     return q + "'";
 }
 
+// The per-stage medians and the share of GI receivers recomputed.
+void printSummary(const char* label, const RenderOptions& o, const std::vector<std::vector<double>>& stage,
+                  double recomputed) {
+    static const char* names[7] = {"sim", "pyramids", "scan", "integrate", "shade", "render", "png write"};
+    std::printf("%s: per-stage time per frame (median of %d frames, ms):", label, o.frames);
+    double sum = 0.0;
+    for (int i = 0; i < 7; ++i) {
+        const double m = median(stage[static_cast<std::size_t>(i)]);
+        sum += m;
+        std::printf(" %s %.1f%s", names[i], m, i == 6 ? "" : ",");
+    }
+    std::printf(" (total %.1f; integrate is fused into scan in gi/)\n", sum);
+    std::printf("%s: GI receivers recomputed: %.1f %% per frame on average (incremental GI %s)\n", label,
+                100.0 * recomputed / o.frames, o.giIncremental ? "on" : "off");
+}
+
 }  // namespace
 
 void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize) {
@@ -212,17 +228,7 @@ int runHeadlessRender(const RenderOptions& o, const char* label) {
         progress.finish();
         const std::string dir = std::filesystem::absolute(o.out).lexically_normal().string();
         if (!o.quiet) {
-            static const char* names[7] = {"sim", "pyramids", "scan", "integrate", "shade", "render", "png write"};
-            std::printf("%s: per-stage time per frame (median of %d frames, ms):", label, o.frames);
-            double sum = 0.0;
-            for (int i = 0; i < 7; ++i) {
-                const double m = median(stage[static_cast<std::size_t>(i)]);
-                sum += m;
-                std::printf(" %s %.1f%s", names[i], m, i == 6 ? "" : ",");
-            }
-            std::printf(" (total %.1f; integrate is fused into scan in gi/)\n", sum);
-            std::printf("%s: GI receivers recomputed: %.1f %% per frame on average (incremental GI %s)\n", label,
-                        100.0 * recomputed / o.frames, o.giIncremental ? "on" : "off");
+            printSummary(label, o, stage, recomputed);
             std::printf("%s: %d frames written to %s\n", label, o.frames, dir.c_str());
         }
         if (!o.video.empty()) {
