@@ -161,6 +161,48 @@ float boundOfTileFrom(const MaxChangePyramid& dh, const HeightPyramid& pyr, int 
     return roundUp(best);
 }
 
+// max |dh| within reach of step i's samples along direction (c, sn) from any
+// receiver of the tile: the tile's cells swept from t'_min to t'_max along the
+// direction, dilated by the reach plus one cell, and cut to the box of all
+// azimuths (changeWithinStep), which holds the samples too.
+float changeAlongStep(const MaxChangePyramid& dh, const StepExtent& e, const CellBox& c, double cs, double sn) {
+    const double xa = e.tauMin * cs, xb = e.tauMax * cs, ya = e.tauMin * sn, yb = e.tauMax * sn;
+    const double r = e.reach + 1.0;
+    const int d = static_cast<int>(std::ceil(e.tauMax + e.reach));
+    return maxChangeInBox(dh, c.x0 + std::max(-d, static_cast<int>(std::floor(std::min(xa, xb) - r))),
+                          c.y0 + std::max(-d, static_cast<int>(std::floor(std::min(ya, yb) - r))),
+                          c.x1 + std::min(d, static_cast<int>(std::ceil(std::max(xa, xb) + r))),
+                          c.y1 + std::min(d, static_cast<int>(std::ceil(std::max(ya, yb) + r))));
+}
+
+// Per-step extents of a pyramid, and the smallest t'_min from each step on.
+struct StepTable {
+    std::vector<StepExtent> extent;
+    std::vector<double> tauMinFrom;
+};
+StepTable stepTable(const HeightPyramid& pyr) {
+    StepTable t;
+    const int n = static_cast<int>(pyr.steps.size()), firstLevel = firstLevelStep(pyr);
+    for (int i = 0; i < n; ++i) {
+        t.extent.push_back(stepExtent(pyr, i));
+        t.tauMinFrom.push_back(tauMinFrom(pyr, i, firstLevel));
+    }
+    return t;
+}
+
+double azimuthBoundFrom(const MaxChangePyramid& dh, const HeightPyramid& pyr, const StepTable& steps,
+                        const CellBox& c, double m0, double cs, double sn, double lipschitz) {
+    const double mAll = maxChangeAll(dh), cellSize = pyr.cellSize;
+    double best = 0.0;
+    for (std::size_t i = 0; i < steps.extent.size(); ++i) {
+        // no later step can beat best even if it sees the largest change anywhere
+        if ((lipschitz * mAll + m0) / (steps.tauMinFrom[i] * cellSize) <= best) break;
+        const double m = changeAlongStep(dh, steps.extent[i], c, cs, sn);
+        best = std::max(best, (lipschitz * m + m0) / (steps.extent[i].tauMin * cellSize));
+    }
+    return best;
+}
+
 // Fills one value per tile, tile rows in parallel.
 template <class PerTile>
 void forEachTile(const HeightPyramid& pyr, int T, std::vector<float>& out, PerTile&& perTile) {
@@ -275,6 +317,50 @@ void boundGradientChange(const MaxChangePyramid& dh, const HeightPyramid& pyr, i
 float ambientChangeBound(float slopeBound, float gradientBound, float maxSkyRadiance) {
     const double g = kSqrt2Up * gradientBound;  // bounds both the tangent slope's and the normal's move
     const double v = maxSkyRadiance * (kShadePerSlope * std::max<double>(slopeBound, g) + kShadePerNormal * g);
+    return roundUp(v);
+}
+
+float azimuthBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int tx, int ty,
+                         double phi) {
+    const CellBox c = tileCells(pyr, tileReceivers, tx, ty);
+    const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
+    return roundUp(azimuthBoundFrom(dh, pyr, stepTable(pyr), c, m0, std::cos(phi), std::sin(phi),
+                                    heightFilterLipschitz(pyr)));
+}
+
+void boundSlopeChangePerAzimuth(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers,
+                                int azimuths, std::vector<float>& tileBound) {
+    requireSameSize(dh, pyr, tileReceivers);
+    if (azimuths < 1) throw InputError("change bound: at least one azimuth");
+    const StepTable steps = stepTable(pyr);
+    const double lipschitz = heightFilterLipschitz(pyr);
+    std::vector<double> cs(static_cast<std::size_t>(azimuths)), sn(cs.size());
+    for (int j = 0; j < azimuths; ++j) {
+        const double phi = 2.0 * 3.14159265358979323846 * j / azimuths;
+        cs[static_cast<std::size_t>(j)] = std::cos(phi);
+        sn[static_cast<std::size_t>(j)] = std::sin(phi);
+    }
+    const int T = tileReceivers, tilesX = tileCount(pyr.nxr, T), tilesY = tileCount(pyr.nyr, T);
+    const std::size_t m = static_cast<std::size_t>(azimuths);
+    tileBound.resize(static_cast<std::size_t>(tilesX) * static_cast<std::size_t>(tilesY) * m);
+    parallelFor(0, tilesY, 1, [&](int ty0, int ty1) {
+        for (int ty = ty0; ty < ty1; ++ty)
+            for (int tx = 0; tx < tilesX; ++tx) {
+                const CellBox c = tileCells(pyr, T, tx, ty);
+                const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
+                float* out = tileBound.data() + (static_cast<std::size_t>(ty) * tilesX + tx) * m;
+                for (std::size_t j = 0; j < m; ++j)
+                    out[j] = roundUp(azimuthBoundFrom(dh, pyr, steps, c, m0, cs[j], sn[j], lipschitz));
+            }
+    });
+}
+
+float ambientChangeBoundPerAzimuth(const float* slopeBound, int azimuths, float gradientBound, float maxSkyRadiance,
+                                   bool withNormals) {
+    const double g = kSqrt2Up * gradientBound;
+    double sum = 0.0;
+    for (int j = 0; j < azimuths; ++j) sum += std::max<double>(slopeBound[j], g);
+    const double v = maxSkyRadiance * (kShadePerSlope * sum / azimuths + (withNormals ? kShadePerNormal * g : 0.0));
     return roundUp(v);
 }
 

@@ -122,6 +122,29 @@ float boundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tile
 void boundSlopeChange(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers,
                       std::vector<float>& tileBound);
 
+// ---- blocking slopes per tile and azimuth ------------------------------------------
+// A height change moves the slopes of an azimuth only when it lies within
+// reach of that azimuth's samples. Step i of azimuth phi samples receiver p at
+// q = p + t' (cos phi, sin phi) (gi/visibility.cpp, makeStep: the sample is
+// moved along the ray), t' in [t'_min, t'_max] as above; over the tile's
+// receivers these points fill the tile's cell box swept along that segment,
+// whose bounding box, dilated by r_i plus one cell (the engine's float
+// direction differs from the exact one by far less), holds every cell the
+// step reads. With M_ij the largest |dh| there the bound of azimuth j is the
+// maximum over the steps of (L M_ij + M0) / (t'_min cellSize), as above; it
+// is never larger than the tile's bound over all azimuths.
+
+/// Bound on |change| of every blocking slope of tile (tx, ty) along azimuth
+/// phi (radians, from +x towards +y).
+float azimuthBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int tx, int ty,
+                         double phi);
+
+/// azimuthBoundOfTile of every tile at the m = azimuths samples phi_j = 2 pi
+/// j / m of the full circle (gi/wedge.h, foldFullCircle): tileBound[t m + j],
+/// tiles row-major as boundSlopeChange (same errors; InputError for azimuths < 1).
+void boundSlopeChangePerAzimuth(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers,
+                                int azimuths, std::vector<float>& tileBound);
+
 /// How much the maximum blocking slope can move per unit of the per-step
 /// bound: 1 for the sample maximum, 20 / 16 for Eq. 16's midpoints.
 float blockingMaxLipschitz(BlockingMax rule);
@@ -182,6 +205,15 @@ void boundGradientChange(const MaxChangePyramid& dh, const HeightPyramid& pyr, i
 // product reshapes the kernel; its bound needs its own constant. Texels
 // between receivers interpolate the V of up to four receivers (Fig. 7), so
 // their bound is the largest of the tiles those receivers belong to.
+//
+// Per azimuth: sample j enters W with the weight beta_j(phi) (the hat of
+// linear interpolation, or the cubic B-spline of the full circle), whose
+// integral over phi is 2 pi / m for m evenly spaced samples. Moving sample
+// j's sin(sigma) by du_j changes the ambient by at most (2 pi / m) max|g|
+// |du_j|, so the whole change is at most (kShadePerSlope / m) sum_j |du_j|
+// (ambientChangeBoundPerAzimuth): an azimuth whose horizon did not move
+// costs nothing, where the full-circle form charges every azimuth with the
+// largest move. |du_j| <= max(slope bound of azimuth j, sqrt2 G) as above.
 inline constexpr float kShadePerSlopeExact = 2.0f;
 inline constexpr float kShadePerSlope = 2.25f;
 inline constexpr float kShadePerNormal = 1.05f;
@@ -195,5 +227,12 @@ inline float shadeChangePerSlope(float maxSkyRadiance) { return kShadePerSlope *
 /// maximum blocking slope's: boundOfTile times blockingMaxLipschitz) and its
 /// gradient bound.
 float ambientChangeBound(float slopeBound, float gradientBound, float maxSkyRadiance);
+
+/// The same from per-azimuth slope bounds of the m = azimuths samples of the
+/// full circle (each the maximum blocking slope's: azimuthBoundOfTile times
+/// blockingMaxLipschitz) and the gradient bound; `withNormals` adds the
+/// shading normals' move (kShadePerNormal), which a cached V does not see.
+float ambientChangeBoundPerAzimuth(const float* slopeBound, int azimuths, float gradientBound, float maxSkyRadiance,
+                                   bool withNormals);
 
 }  // namespace terrain::gi
