@@ -29,9 +29,12 @@ namespace terrain::gi {
 /// Block maxima of the absolute height change: level k holds the maximum of
 /// |dh| over 2^k x 2^k cells (blocks aligned to multiples of 2^k, the last
 /// ones cut by the grid's edge); level 0 is |dh| itself, the last level 1 x 1.
+/// `sums` holds the sums of |dh| over the same blocks (sums[0] is empty:
+/// level 0 is its own sum; each sum rounded up to the next float).
 struct MaxChangePyramid {
     int nx = 0, ny = 0;
     std::vector<Grid> levels;
+    std::vector<Grid> sums;
 };
 
 /// Builds (or rebuilds, reusing every buffer of the same size) the pyramid
@@ -42,13 +45,16 @@ void buildMaxChangePyramid(ConstGridView dh, MaxChangePyramid& out);
 /// the next float so that it bounds the real difference of the two floats.
 void buildMaxChangePyramid(ConstGridView before, ConstGridView after, MaxChangePyramid& out);
 
-/// Upper bound of max |dh| over the cells [x0, x1] x [y0, y1] (inclusive,
-/// clamped to the grid; 0 when the clamped box is empty). Reads at most 4 x 4
-/// blocks of the finest level that covers the box with so few; exact when
-/// the box's edges fall on that level's block edges (in particular when the
-/// box is at most 4 x 4 cells), otherwise up to that level's block size
-/// larger on each side.
+/// max |dh| over the cells [x0, x1] x [y0, y1] (inclusive, clamped to the
+/// grid; 0 when the clamped box is empty), exact: from the at most 4 x 4
+/// blocks of the finest level that covers the box with so few, it descends
+/// into the blocks the box's edges cut, only where they could raise the
+/// maximum found so far.
 float maxChangeInBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1);
+
+/// Upper bound of the sum of |dh| over the same box: the sum over the at
+/// most 4 x 4 blocks that cover it (up to a block larger on each side).
+double sumChangeInBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1);
 
 /// max |dh| over the whole grid (the top level).
 float maxChangeAll(const MaxChangePyramid& p);
@@ -131,8 +137,22 @@ void boundSlopeChange(const MaxChangePyramid& dh, const HeightPyramid& pyr, int 
 // whose bounding box, dilated by r_i plus one cell (the engine's float
 // direction differs from the exact one by far less), holds every cell the
 // step reads. With M_ij the largest |dh| there the bound of azimuth j is the
-// maximum over the steps of (L M_ij + M0) / (t'_min cellSize), as above; it
-// is never larger than the tile's bound over all azimuths.
+// maximum over the steps of (D_ij + M0) / (t'_min cellSize), with D_ij <= L
+// M_ij the largest move of a level sample there; it is never larger than the
+// tile's bound over all azimuths.
+//
+// D_ij weighs the change by the filters: a level sample of octave o >= 1 is a
+// convex combination (bilinear read, level blend, B-spline taps) of the octave
+// images' texels within the box, blended as (1 - b) mean + b max (b =
+// peakBlend). A max texel moves by at most M_ij. A mean texel is the 2 x 2
+// mean applied o times, the edge replicated: a separable weight w_o(x) w_o(y)
+// per cell, 2^-o per axis inside whole blocks and up to 1 in the block the
+// grid's edge cuts. So it moves by at most min(M_ij, W S_ij), S_ij the sum of
+// |dh| over the box (sumChangeInBox) and W the largest cell weight there (of
+// the finer octave for a blended level, whose weights are the larger), and
+//   D_ij = |1 - b| min(M_ij, W S_ij) + |b| M_ij.
+// A far change of small area then counts by its share of the filter, not by
+// its full height. Raw steps and octave 0 read heights: D_ij = M_ij.
 
 /// Bound on |change| of every blocking slope of tile (tx, ty) along azimuth
 /// phi (radians, from +x towards +y).

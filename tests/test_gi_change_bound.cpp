@@ -203,28 +203,31 @@ struct Config {
 
 }  // namespace
 
-TEST_CASE("gi.change_bound: box maxima bound the brute-force maximum, exactly on aligned boxes") {
+TEST_CASE("gi.change_bound: box maxima equal the brute-force maximum, box sums bound the brute-force sum") {
     std::mt19937 rng(7);
     MaxChangePyramid p;
     for (int trial = 0; trial < 30; ++trial) {
         const int nx = 1 + static_cast<int>(rng() % 90), ny = 1 + static_cast<int>(rng() % 90);
         std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-        const Grid dh = gridOf(nx, ny, [&](int, int) { return u(rng); });
+        // sparse changes half of the time: most blocks zero, as after a local edit
+        const bool sparse = trial % 2 == 1;
+        const Grid dh = gridOf(nx, ny, [&](int, int) { return sparse && rng() % 16 != 0 ? 0.0f : u(rng); });
         buildMaxChangePyramid(dh.cview(), p);
-        int exact = 0;
         for (int q = 0; q < 200; ++q) {
             const int x0 = static_cast<int>(rng() % (nx + 10)) - 5, y0 = static_cast<int>(rng() % (ny + 10)) - 5;
             const int x1 = x0 + static_cast<int>(rng() % (q % 2 ? 6 : nx + 5));
             const int y1 = y0 + static_cast<int>(rng() % (q % 2 ? 6 : ny + 5));
-            const float got = maxChangeInBox(p, x0, y0, x1, y1), want = bruteMax(dh, x0, y0, x1, y1);
-            CHECK(got >= want);
-            const int w = std::min(x1, nx - 1) - std::max(x0, 0) + 1, h = std::min(y1, ny - 1) - std::max(y0, 0) + 1;
-            if (w <= 4 && h <= 4) {
-                CHECK(got == want);
-                ++exact;
-            }
+            CHECK(maxChangeInBox(p, x0, y0, x1, y1) == bruteMax(dh, x0, y0, x1, y1));
+            double sum = 0.0;
+            for (int y = std::max(y0, 0); y <= std::min(y1, ny - 1); ++y)
+                for (int x = std::max(x0, 0); x <= std::min(x1, nx - 1); ++x) sum += std::fabs(dh(x, y));
+            CHECK(sumChangeInBox(p, x0, y0, x1, y1) >= sum * (1.0 - 1e-12));
         }
-        CHECK(exact > 0);
+        CHECK(sumChangeInBox(p, 0, 0, nx - 1, ny - 1) <= [&] {
+            double all = 0.0;
+            for (float v : dh.v) all += std::fabs(v);
+            return all * (1.0 + 1e-6) + 1e-30;
+        }());
         // boxes on the block edges of level k (cut by the grid's edge) are exact
         for (int k = 0; k < static_cast<int>(p.levels.size()); ++k) {
             const int b = 1 << k, bx = static_cast<int>(rng() % static_cast<unsigned>(p.levels[k].nx));
