@@ -184,6 +184,12 @@ int lastQuietStep(const MaxChangePyramid& dh, const HeightPyramid& pyr, const Ce
     return quiet;
 }
 
+// The first step whose samples may see a change: quiet steps' boxes hold the
+// tile's own cells, so with a change there (m0 > 0) every step counts.
+int firstBusyStep(const MaxChangePyramid& dh, const HeightPyramid& pyr, const CellBox& c, double m0) {
+    return m0 > 0.0 ? 0 : lastQuietStep(dh, pyr, c) + 1;
+}
+
 // boundOfTile with the first level step found once per call.
 float boundOfTileFrom(const MaxChangePyramid& dh, const HeightPyramid& pyr, int T, int tx, int ty, int firstLevel,
                       double lipschitz) {
@@ -192,7 +198,7 @@ float boundOfTileFrom(const MaxChangePyramid& dh, const HeightPyramid& pyr, int 
     const double mAll = maxChangeAll(dh);
     const double cellSize = pyr.cellSize;
     // quiet steps' boxes hold the tile's own cells (m0 = 0): their slopes do not move
-    const int first = m0 > 0.0 ? 0 : lastQuietStep(dh, pyr, c) + 1;
+    const int first = firstBusyStep(dh, pyr, c, m0);
     double best = 0.0;
     for (int i = first; i < static_cast<int>(pyr.steps.size()); ++i) {
         // no later step can beat best even if it sees the largest change anywhere
@@ -303,11 +309,12 @@ double filteredChange(const MaxChangePyramid& dh, const StepTable& t, int i, con
     return t.meanPart * mean + t.maxPart * m;
 }
 
+// Steps before `first` see no change from any azimuth (lastQuietStep).
 double azimuthBoundFrom(const MaxChangePyramid& dh, const HeightPyramid& pyr, const StepTable& steps,
-                        const CellBox& c, double m0, double cs, double sn, double lipschitz) {
+                        const CellBox& c, double m0, int first, double cs, double sn, double lipschitz) {
     const double mAll = maxChangeAll(dh), cellSize = pyr.cellSize;
     double best = 0.0;
-    for (std::size_t i = 0; i < steps.extent.size(); ++i) {
+    for (std::size_t i = static_cast<std::size_t>(first); i < steps.extent.size(); ++i) {
         // no later step can beat best even if it sees the largest change anywhere
         if ((lipschitz * mAll + m0) / (steps.tauMinFrom[i] * cellSize) <= best) break;
         const CellBox box = stepBoxAlong(steps.extent[i], c, cs, sn);
@@ -454,8 +461,8 @@ float azimuthBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, i
                          double phi) {
     const CellBox c = tileCells(pyr, tileReceivers, tx, ty);
     const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
-    return roundUp(azimuthBoundFrom(dh, pyr, stepTable(pyr), c, m0, std::cos(phi), std::sin(phi),
-                                    heightFilterLipschitz(pyr)));
+    return roundUp(azimuthBoundFrom(dh, pyr, stepTable(pyr), c, m0, firstBusyStep(dh, pyr, c, m0), std::cos(phi),
+                                    std::sin(phi), heightFilterLipschitz(pyr)));
 }
 
 void boundSlopeChangePerAzimuth(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers,
@@ -478,9 +485,10 @@ void boundSlopeChangePerAzimuth(const MaxChangePyramid& dh, const HeightPyramid&
             for (int tx = 0; tx < tilesX; ++tx) {
                 const CellBox c = tileCells(pyr, T, tx, ty);
                 const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
+                const int first = firstBusyStep(dh, pyr, c, m0);
                 float* out = tileBound.data() + (static_cast<std::size_t>(ty) * tilesX + tx) * m;
                 for (std::size_t j = 0; j < m; ++j)
-                    out[j] = roundUp(azimuthBoundFrom(dh, pyr, steps, c, m0, cs[j], sn[j], lipschitz));
+                    out[j] = roundUp(azimuthBoundFrom(dh, pyr, steps, c, m0, first, cs[j], sn[j], lipschitz));
             }
     });
 }

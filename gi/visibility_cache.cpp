@@ -41,7 +41,8 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
     std::vector<float> perAzimuth(m);
     for (std::size_t t = 0; t < cache.drift.size(); ++t) {
         for (std::size_t j = 0; j < m; ++j) perAzimuth[j] = lipschitz * cache.azimuthBound[t * m + j];
-        const float env = ambientChangeBoundPerAzimuth(perAzimuth.data(), vis.azimuths, cache.gradBound[t], 1.0f, false);
+        const float env =
+            ambientChangeBoundPerAzimuth(perAzimuth.data(), vis.azimuths, cache.gradBound[t], 1.0f, false);
         cache.tiles.dirty[t] = addDrift(env, tolerance, cache.drift[t]) ? 1 : 0;
         const float slope = std::max(lipschitz * cache.slopeBound[t], std::sqrt(2.0f) * cache.gradBound[t]);
         cache.keyTiles.dirty[t] = addDrift(shadeChangePerSlope(1.0f) * slope, tolerance, cache.keyDrift[t]) ? 1 : 0;
