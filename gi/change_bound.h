@@ -10,9 +10,10 @@
 //      step i reads, through the bilinear taps, the level blend, the B-spline
 //      synthesis and the box / max decimations of gi/pyramid.cpp)
 //   -> every blocking slope (h(t_i) - h0) / t_i of the scan (gi/visibility.h)
-//      per tile (boundSlopeChange), and the height gradients of the tangent
-//      planes and normals (boundGradientChange)
-//   -> the ambient map (ambientChangeBound).
+//      per tile (boundSlopeChange) or per tile and azimuth, weighed by the
+//      filters (boundSlopeChangePerAzimuth), and the height gradients of the
+//      tangent planes and normals (boundGradientChange)
+//   -> the ambient map (ambientChangeBound, ambientChangeBoundPerAzimuth).
 // The bounds hold in real arithmetic. The float results carry their own
 // rounding on top (a few dozen ulp of the heights over the step length for a
 // slope); a caller's tolerance is far above it. Where no height within a

@@ -51,7 +51,7 @@ Grid baseTerrain(int nx, int ny) {
     });
 }
 
-enum class Change { Bump, Noise, CliffCollapse, Spike };
+enum class Change { Bump, Noise, CliffCollapse, Spike, EdgeSpikes };
 const char* nameOf(Change c) {
     switch (c) {
         case Change::Bump:
@@ -62,13 +62,16 @@ const char* nameOf(Change c) {
             return "cliff collapse";
         case Change::Spike:
             return "spike";
+        case Change::EdgeSpikes:
+            return "edge spikes";
     }
     return "";
 }
 
 // (a) a local Gaussian bump (cut at 4 sigma), (b) low-amplitude noise
 // everywhere, (c) the cliff's edge lowered and its foot raised over a stretch
-// of rows, (d) one texel raised.
+// of rows, (d) one texel raised, (e) texels on the last column and row raised
+// (where the grid's edge cuts the octaves' blocks, whose cells weigh more).
 Grid perturbed(const Grid& base, Change c, unsigned seed) {
     Grid g = base;
     const int nx = g.nx, ny = g.ny;
@@ -92,8 +95,12 @@ Grid perturbed(const Grid& base, Change c, unsigned seed) {
                 else if (d <= 0.0f && d > -5.0f)
                     g(x, y) += 3.0f * (1.0f + d / 5.0f);
             }
-    } else {
+    } else if (c == Change::Spike) {
         g(static_cast<int>(0.7f * nx), static_cast<int>(0.25f * ny)) += 8.0f;
+    } else {
+        g(nx - 1, ny - 1) += 8.0f;
+        g(nx - 1, ny / 3) -= 5.0f;
+        g(nx / 4, ny - 1) += 6.0f;
     }
     return g;
 }
@@ -358,7 +365,7 @@ TEST_CASE("gi.change_bound: tile bounds hold for the engine's slopes and ambient
         const Grid base = baseTerrain(cfg.nx, cfg.ny);
         GiState before, after;
         runFrame(base, settings, before);
-        for (Change change : {Change::Bump, Change::Noise, Change::CliffCollapse, Change::Spike}) {
+        for (Change change : {Change::Bump, Change::Noise, Change::CliffCollapse, Change::Spike, Change::EdgeSpikes}) {
             const Grid h = perturbed(base, change, 5u + static_cast<unsigned>(change));
             runFrame(h, settings, after);
             const Comparison c = compareFrames(before, after, base, h, cfg.tile, lipschitz);
