@@ -30,12 +30,32 @@ void sizeLevels(int nx, int ny, MaxChangePyramid& p) {
     int count = 1;
     for (int w = nx, h = ny; w > 1 || h > 1; w = (w + 1) / 2, h = (h + 1) / 2) ++count;
     p.levels.resize(static_cast<std::size_t>(count));
+    p.sums.resize(p.levels.size());
     int w = nx, h = ny;
-    for (Grid& g : p.levels) {
-        if (g.nx != w || g.ny != h) g.resize(w, h);
+    for (std::size_t k = 0; k < p.levels.size(); ++k) {
+        if (p.levels[k].nx != w || p.levels[k].ny != h) p.levels[k].resize(w, h);
+        if (k > 0 && (p.sums[k].nx != w || p.sums[k].ny != h)) p.sums[k].resize(w, h);
         w = (w + 1) / 2;
         h = (h + 1) / 2;
     }
+}
+
+// Block sums of the next level: each cell of the cut edge blocks counted once.
+void sumLevel(const Grid& src, Grid& dst) {
+    parallelForRows(dst.ny, dst.nx, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y) {
+            const float* ra = src.data() + static_cast<std::size_t>(2 * y) * src.nx;
+            const float* rb = 2 * y + 1 < src.ny ? ra + src.nx : nullptr;
+            float* out = dst.data() + static_cast<std::size_t>(y) * dst.nx;
+            for (int x = 0; x < dst.nx; ++x) {
+                const int xa = 2 * x;
+                const bool pair = xa + 1 < src.nx;
+                double v = static_cast<double>(ra[xa]) + (pair ? ra[xa + 1] : 0.0f);
+                if (rb) v += static_cast<double>(rb[xa]) + (pair ? rb[xa + 1] : 0.0f);
+                out[x] = roundUp(v);
+            }
+        }
+    });
 }
 
 // Levels 1.. from level 0: 2 x 2 maxima, the edge replicated inside its block.
@@ -54,7 +74,32 @@ void decimateLevels(MaxChangePyramid& p) {
                 }
             }
         });
+        sumLevel(k == 1 ? p.levels[0] : p.sums[k - 1], p.sums[k]);
     }
+}
+
+// Cells [x0, x1] x [y0, y1], inclusive.
+struct CellBox {
+    int x0, y0, x1, y1;
+};
+
+// Raises m to the largest |dh| of the cells of block (bx, by) of level k that
+// lie in the box (clamped to the grid), descending into the blocks the box
+// cuts only while they could beat m.
+void maxOfBlockInBox(const MaxChangePyramid& p, const CellBox& box, int k, int bx, int by, float& m) {
+    const Grid& g = p.levels[static_cast<std::size_t>(k)];
+    if (bx >= g.nx || by >= g.ny) return;
+    const float v = g.v[static_cast<std::size_t>(by) * g.nx + bx];
+    if (v <= m) return;
+    const int cx0 = bx << k, cy0 = by << k;
+    const int cx1 = std::min(((bx + 1) << k) - 1, p.nx - 1), cy1 = std::min(((by + 1) << k) - 1, p.ny - 1);
+    if (cx0 > box.x1 || cy0 > box.y1 || cx1 < box.x0 || cy1 < box.y0) return;
+    if (k == 0 || (cx0 >= box.x0 && cy0 >= box.y0 && cx1 <= box.x1 && cy1 <= box.y1)) {
+        m = v;
+        return;
+    }
+    for (int cy = 2 * by; cy <= 2 * by + 1; ++cy)
+        for (int cx = 2 * bx; cx <= 2 * bx + 1; ++cx) maxOfBlockInBox(p, box, k - 1, cx, cy, m);
 }
 
 void requireSameSize(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers) {
@@ -63,10 +108,7 @@ void requireSameSize(const MaxChangePyramid& dh, const HeightPyramid& pyr, int t
         throw InputError("change bound: the height change grid and the height pyramid differ in size");
 }
 
-// Cells of the receivers of tile (tx, ty): [x0, x1] x [y0, y1].
-struct CellBox {
-    int x0, y0, x1, y1;
-};
+// Cells of the receivers of tile (tx, ty).
 CellBox tileCells(const HeightPyramid& pyr, int T, int tx, int ty) {
     const int s = pyr.subsample;
     const int X0 = T * tx, Y0 = T * ty;
@@ -142,6 +184,12 @@ int lastQuietStep(const MaxChangePyramid& dh, const HeightPyramid& pyr, const Ce
     return quiet;
 }
 
+// The first step whose samples may see a change: quiet steps' boxes hold the
+// tile's own cells, so with a change there (m0 > 0) every step counts.
+int firstBusyStep(const MaxChangePyramid& dh, const HeightPyramid& pyr, const CellBox& c, double m0) {
+    return m0 > 0.0 ? 0 : lastQuietStep(dh, pyr, c) + 1;
+}
+
 // boundOfTile with the first level step found once per call.
 float boundOfTileFrom(const MaxChangePyramid& dh, const HeightPyramid& pyr, int T, int tx, int ty, int firstLevel,
                       double lipschitz) {
@@ -150,7 +198,7 @@ float boundOfTileFrom(const MaxChangePyramid& dh, const HeightPyramid& pyr, int 
     const double mAll = maxChangeAll(dh);
     const double cellSize = pyr.cellSize;
     // quiet steps' boxes hold the tile's own cells (m0 = 0): their slopes do not move
-    const int first = m0 > 0.0 ? 0 : lastQuietStep(dh, pyr, c) + 1;
+    const int first = firstBusyStep(dh, pyr, c, m0);
     double best = 0.0;
     for (int i = first; i < static_cast<int>(pyr.steps.size()); ++i) {
         // no later step can beat best even if it sees the largest change anywhere
@@ -159,6 +207,121 @@ float boundOfTileFrom(const MaxChangePyramid& dh, const HeightPyramid& pyr, int 
         best = std::max(best, (lipschitz * m + m0) / (stepExtent(pyr, i).tauMin * cellSize));
     }
     return roundUp(best);
+}
+
+// Cells within reach of step i's samples along direction (c, sn) from any
+// receiver of the tile: the tile's cells swept from t'_min to t'_max along the
+// direction, dilated by the reach plus one cell, and cut to the box of all
+// azimuths (changeWithinStep), which holds the samples too.
+CellBox stepBoxAlong(const StepExtent& e, const CellBox& c, double cs, double sn) {
+    const double xa = e.tauMin * cs, xb = e.tauMax * cs, ya = e.tauMin * sn, yb = e.tauMax * sn;
+    const double r = e.reach + 1.0;
+    const int d = static_cast<int>(std::ceil(e.tauMax + e.reach));
+    return {c.x0 + std::max(-d, static_cast<int>(std::floor(std::min(xa, xb) - r))),
+            c.y0 + std::max(-d, static_cast<int>(std::floor(std::min(ya, yb) - r))),
+            c.x1 + std::min(d, static_cast<int>(std::ceil(std::max(xa, xb) + r))),
+            c.y1 + std::min(d, static_cast<int>(std::ceil(std::max(ya, yb) + r)))};
+}
+
+// The finer octave a level step reads (0 for raw steps: the heights themselves).
+int stepOctave(const HeightPyramid& pyr, int i) {
+    const int level = pyr.steps[static_cast<std::size_t>(i)].level;
+    if (level < 0) return 0;
+    const int kv = std::max(1, pyr.settings.levelsPerOctave);
+    return std::min(level / kv, static_cast<int>(pyr.synth.size()) - 1);
+}
+
+// Per axis, the largest weight of one cell in a texel of the mean octave o:
+// 2^-o in whole blocks, larger in the last block when the grid's edge cuts it
+// (replicated cells count twice in a 2 x 2 mean).
+struct AxisWeights {
+    std::vector<int> lastStart;               // per octave: first cell of the last block
+    std::vector<std::vector<double>> suffix;  // per octave: max weight from cell lastStart + k on
+    double maxOver(int o, int a0, int a1) const {
+        const double inside = std::ldexp(1.0, -o);
+        const int start = lastStart[static_cast<std::size_t>(o)];
+        if (a1 < start) return inside;
+        const std::vector<double>& suf = suffix[static_cast<std::size_t>(o)];
+        const int k = std::clamp(a0 - start, 0, static_cast<int>(suf.size()) - 1);
+        return std::max(inside, suf[static_cast<std::size_t>(k)]);
+    }
+};
+
+AxisWeights axisWeights(int n, int octaves) {
+    AxisWeights a;
+    std::vector<double> w(static_cast<std::size_t>(n), 1.0);
+    int size = n;  // texels of octave o - 1
+    for (int o = 0; o < octaves; ++o) {
+        if (o > 0) {
+            for (int x = 0; x < n; ++x) {
+                const int t = x >> (o - 1);
+                w[static_cast<std::size_t>(x)] *= t == size - 1 && t % 2 == 0 ? 1.0 : 0.5;
+            }
+            size = (size + 1) / 2;
+        }
+        const int start = std::min((size - 1) << o, n - 1);
+        std::vector<double> suf(static_cast<std::size_t>(n - start));
+        double m = 0.0;
+        for (int x = n - 1; x >= start; --x) suf[static_cast<std::size_t>(x - start)] = m = std::max(m, w[x]);
+        a.lastStart.push_back(start);
+        a.suffix.push_back(std::move(suf));
+    }
+    return a;
+}
+
+// Per-step extents of a pyramid, the smallest t'_min from each step on, and
+// what the filters make of a change (see change_bound.h).
+struct StepTable {
+    std::vector<StepExtent> extent;
+    std::vector<double> tauMinFrom;
+    std::vector<int> octave;
+    AxisWeights wx, wy;
+    double meanPart = 1.0, maxPart = 0.0;  // |1 - b|, |b|
+};
+StepTable stepTable(const HeightPyramid& pyr) {
+    StepTable t;
+    const int n = static_cast<int>(pyr.steps.size()), firstLevel = firstLevelStep(pyr);
+    for (int i = 0; i < n; ++i) {
+        t.extent.push_back(stepExtent(pyr, i));
+        t.tauMinFrom.push_back(tauMinFrom(pyr, i, firstLevel));
+        t.octave.push_back(stepOctave(pyr, i));
+    }
+    const int octaves = std::max(1, static_cast<int>(pyr.synth.size()));
+    t.wx = axisWeights(pyr.nx, octaves);
+    t.wy = axisWeights(pyr.ny, octaves);
+    const double b = pyr.settings.peakBlend;
+    if (b > 0.0) {
+        t.meanPart = std::fabs(1.0 - b);
+        t.maxPart = std::fabs(b);
+    }
+    return t;
+}
+
+// D: the largest move of step i's level samples from the changes in box.
+double filteredChange(const MaxChangePyramid& dh, const StepTable& t, int i, const CellBox& box) {
+    const double m = maxChangeInBox(dh, box.x0, box.y0, box.x1, box.y1);
+    const int o = t.octave[static_cast<std::size_t>(i)];
+    if (o == 0 || m == 0.0) return (t.meanPart + t.maxPart) * m;
+    const int x0 = std::max(box.x0, 0), y0 = std::max(box.y0, 0);
+    const int x1 = std::min(box.x1, dh.nx - 1), y1 = std::min(box.y1, dh.ny - 1);
+    const double w = t.wx.maxOver(o, x0, x1) * t.wy.maxOver(o, y0, y1);
+    const double mean = std::min(m, w * sumChangeInBox(dh, x0, y0, x1, y1));
+    return t.meanPart * mean + t.maxPart * m;
+}
+
+// Steps before `first` see no change from any azimuth (lastQuietStep).
+double azimuthBoundFrom(const MaxChangePyramid& dh, const HeightPyramid& pyr, const StepTable& steps,
+                        const CellBox& c, double m0, int first, double cs, double sn, double lipschitz) {
+    const double mAll = maxChangeAll(dh), cellSize = pyr.cellSize;
+    double best = 0.0;
+    for (std::size_t i = static_cast<std::size_t>(first); i < steps.extent.size(); ++i) {
+        // no later step can beat best even if it sees the largest change anywhere
+        if ((lipschitz * mAll + m0) / (steps.tauMinFrom[i] * cellSize) <= best) break;
+        const CellBox box = stepBoxAlong(steps.extent[i], c, cs, sn);
+        const double d = filteredChange(dh, steps, static_cast<int>(i), box);
+        best = std::max(best, (d + m0) / (steps.extent[i].tauMin * cellSize));
+    }
+    return best;
 }
 
 // Fills one value per tile, tile rows in parallel.
@@ -216,13 +379,29 @@ float maxChangeInBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1) 
     int k = 0;
     const int top = static_cast<int>(p.levels.size()) - 1;
     while (k < top && ((x1 >> k) - (x0 >> k) >= kBlocksPerAxis || (y1 >> k) - (y0 >> k) >= kBlocksPerAxis)) ++k;
-    const Grid& g = p.levels[static_cast<std::size_t>(k)];
+    const CellBox box{x0, y0, x1, y1};
     float m = 0.0f;
+    for (int by = y0 >> k; by <= y1 >> k; ++by)
+        for (int bx = x0 >> k; bx <= x1 >> k; ++bx) maxOfBlockInBox(p, box, k, bx, by, m);
+    return m;
+}
+
+double sumChangeInBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1) {
+    x0 = std::max(x0, 0);
+    y0 = std::max(y0, 0);
+    x1 = std::min(x1, p.nx - 1);
+    y1 = std::min(y1, p.ny - 1);
+    if (x0 > x1 || y0 > y1 || p.levels.empty()) return 0.0;
+    int k = 0;
+    const int top = static_cast<int>(p.levels.size()) - 1;
+    while (k < top && ((x1 >> k) - (x0 >> k) >= kBlocksPerAxis || (y1 >> k) - (y0 >> k) >= kBlocksPerAxis)) ++k;
+    const Grid& g = k == 0 ? p.levels[0] : p.sums[static_cast<std::size_t>(k)];
+    double sum = 0.0;
     for (int by = y0 >> k; by <= y1 >> k; ++by) {
         const float* row = g.data() + static_cast<std::size_t>(by) * g.nx;
-        for (int bx = x0 >> k; bx <= x1 >> k; ++bx) m = std::max(m, row[bx]);
+        for (int bx = x0 >> k; bx <= x1 >> k; ++bx) sum += row[bx];
     }
-    return m;
+    return sum;
 }
 
 float maxChangeAll(const MaxChangePyramid& p) {
@@ -275,6 +454,51 @@ void boundGradientChange(const MaxChangePyramid& dh, const HeightPyramid& pyr, i
 float ambientChangeBound(float slopeBound, float gradientBound, float maxSkyRadiance) {
     const double g = kSqrt2Up * gradientBound;  // bounds both the tangent slope's and the normal's move
     const double v = maxSkyRadiance * (kShadePerSlope * std::max<double>(slopeBound, g) + kShadePerNormal * g);
+    return roundUp(v);
+}
+
+float azimuthBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int tx, int ty,
+                         double phi) {
+    const CellBox c = tileCells(pyr, tileReceivers, tx, ty);
+    const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
+    return roundUp(azimuthBoundFrom(dh, pyr, stepTable(pyr), c, m0, firstBusyStep(dh, pyr, c, m0), std::cos(phi),
+                                    std::sin(phi), heightFilterLipschitz(pyr)));
+}
+
+void boundSlopeChangePerAzimuth(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers,
+                                int azimuths, std::vector<float>& tileBound) {
+    requireSameSize(dh, pyr, tileReceivers);
+    if (azimuths < 1) throw InputError("change bound: at least one azimuth");
+    const StepTable steps = stepTable(pyr);
+    const double lipschitz = heightFilterLipschitz(pyr);
+    std::vector<double> cs(static_cast<std::size_t>(azimuths)), sn(cs.size());
+    for (int j = 0; j < azimuths; ++j) {
+        const double phi = 2.0 * 3.14159265358979323846 * j / azimuths;
+        cs[static_cast<std::size_t>(j)] = std::cos(phi);
+        sn[static_cast<std::size_t>(j)] = std::sin(phi);
+    }
+    const int T = tileReceivers, tilesX = tileCount(pyr.nxr, T), tilesY = tileCount(pyr.nyr, T);
+    const std::size_t m = static_cast<std::size_t>(azimuths);
+    tileBound.resize(static_cast<std::size_t>(tilesX) * static_cast<std::size_t>(tilesY) * m);
+    parallelFor(0, tilesY, 1, [&](int ty0, int ty1) {
+        for (int ty = ty0; ty < ty1; ++ty)
+            for (int tx = 0; tx < tilesX; ++tx) {
+                const CellBox c = tileCells(pyr, T, tx, ty);
+                const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
+                const int first = firstBusyStep(dh, pyr, c, m0);
+                float* out = tileBound.data() + (static_cast<std::size_t>(ty) * tilesX + tx) * m;
+                for (std::size_t j = 0; j < m; ++j)
+                    out[j] = roundUp(azimuthBoundFrom(dh, pyr, steps, c, m0, first, cs[j], sn[j], lipschitz));
+            }
+    });
+}
+
+float ambientChangeBoundPerAzimuth(const float* slopeBound, int azimuths, float gradientBound, float maxSkyRadiance,
+                                   bool withNormals) {
+    const double g = kSqrt2Up * gradientBound;
+    double sum = 0.0;
+    for (int j = 0; j < azimuths; ++j) sum += std::max<double>(slopeBound[j], g);
+    const double v = maxSkyRadiance * (kShadePerSlope * sum / azimuths + (withNormals ? kShadePerNormal * g : 0.0));
     return roundUp(v);
 }
 

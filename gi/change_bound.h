@@ -10,9 +10,10 @@
 //      step i reads, through the bilinear taps, the level blend, the B-spline
 //      synthesis and the box / max decimations of gi/pyramid.cpp)
 //   -> every blocking slope (h(t_i) - h0) / t_i of the scan (gi/visibility.h)
-//      per tile (boundSlopeChange), and the height gradients of the tangent
-//      planes and normals (boundGradientChange)
-//   -> the ambient map (ambientChangeBound).
+//      per tile (boundSlopeChange) or per tile and azimuth, weighed by the
+//      filters (boundSlopeChangePerAzimuth), and the height gradients of the
+//      tangent planes and normals (boundGradientChange)
+//   -> the ambient map (ambientChangeBound, ambientChangeBoundPerAzimuth).
 // The bounds hold in real arithmetic. The float results carry their own
 // rounding on top (a few dozen ulp of the heights over the step length for a
 // slope); a caller's tolerance is far above it. Where no height within a
@@ -29,9 +30,12 @@ namespace terrain::gi {
 /// Block maxima of the absolute height change: level k holds the maximum of
 /// |dh| over 2^k x 2^k cells (blocks aligned to multiples of 2^k, the last
 /// ones cut by the grid's edge); level 0 is |dh| itself, the last level 1 x 1.
+/// `sums` holds the sums of |dh| over the same blocks (sums[0] is empty:
+/// level 0 is its own sum; each sum rounded up to the next float).
 struct MaxChangePyramid {
     int nx = 0, ny = 0;
     std::vector<Grid> levels;
+    std::vector<Grid> sums;
 };
 
 /// Builds (or rebuilds, reusing every buffer of the same size) the pyramid
@@ -42,13 +46,16 @@ void buildMaxChangePyramid(ConstGridView dh, MaxChangePyramid& out);
 /// the next float so that it bounds the real difference of the two floats.
 void buildMaxChangePyramid(ConstGridView before, ConstGridView after, MaxChangePyramid& out);
 
-/// Upper bound of max |dh| over the cells [x0, x1] x [y0, y1] (inclusive,
-/// clamped to the grid; 0 when the clamped box is empty). Reads at most 4 x 4
-/// blocks of the finest level that covers the box with so few; exact when
-/// the box's edges fall on that level's block edges (in particular when the
-/// box is at most 4 x 4 cells), otherwise up to that level's block size
-/// larger on each side.
+/// max |dh| over the cells [x0, x1] x [y0, y1] (inclusive, clamped to the
+/// grid; 0 when the clamped box is empty), exact: from the at most 4 x 4
+/// blocks of the finest level that covers the box with so few, it descends
+/// into the blocks the box's edges cut, only where they could raise the
+/// maximum found so far.
 float maxChangeInBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1);
+
+/// Upper bound of the sum of |dh| over the same box: the sum over the at
+/// most 4 x 4 blocks that cover it (up to a block larger on each side).
+double sumChangeInBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1);
 
 /// max |dh| over the whole grid (the top level).
 float maxChangeAll(const MaxChangePyramid& p);
@@ -122,6 +129,43 @@ float boundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tile
 void boundSlopeChange(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers,
                       std::vector<float>& tileBound);
 
+// ---- blocking slopes per tile and azimuth ------------------------------------------
+// A height change moves the slopes of an azimuth only when it lies within
+// reach of that azimuth's samples. Step i of azimuth phi samples receiver p at
+// q = p + t' (cos phi, sin phi) (gi/visibility.cpp, makeStep: the sample is
+// moved along the ray), t' in [t'_min, t'_max] as above; over the tile's
+// receivers these points fill the tile's cell box swept along that segment,
+// whose bounding box, dilated by r_i plus one cell (the engine's float
+// direction differs from the exact one by far less), holds every cell the
+// step reads. With M_ij the largest |dh| there the bound of azimuth j is the
+// maximum over the steps of (D_ij + M0) / (t'_min cellSize), with D_ij <= L
+// M_ij the largest move of a level sample there; it is never larger than the
+// tile's bound over all azimuths.
+//
+// D_ij weighs the change by the filters: a level sample of octave o >= 1 is a
+// convex combination (bilinear read, level blend, B-spline taps) of the octave
+// images' texels within the box, blended as (1 - b) mean + b max (b =
+// peakBlend). A max texel moves by at most M_ij. A mean texel is the 2 x 2
+// mean applied o times, the edge replicated: a separable weight w_o(x) w_o(y)
+// per cell, 2^-o per axis inside whole blocks and up to 1 in the block the
+// grid's edge cuts. So it moves by at most min(M_ij, W S_ij), S_ij the sum of
+// |dh| over the box (sumChangeInBox) and W the largest cell weight there (of
+// the finer octave for a blended level, whose weights are the larger), and
+//   D_ij = |1 - b| min(M_ij, W S_ij) + |b| M_ij.
+// A far change of small area then counts by its share of the filter, not by
+// its full height. Raw steps and octave 0 read heights: D_ij = M_ij.
+
+/// Bound on |change| of every blocking slope of tile (tx, ty) along azimuth
+/// phi (radians, from +x towards +y).
+float azimuthBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int tx, int ty,
+                         double phi);
+
+/// azimuthBoundOfTile of every tile at the m = azimuths samples phi_j = 2 pi
+/// j / m of the full circle (gi/wedge.h, foldFullCircle): tileBound[t m + j],
+/// tiles row-major as boundSlopeChange (same errors; InputError for azimuths < 1).
+void boundSlopeChangePerAzimuth(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers,
+                                int azimuths, std::vector<float>& tileBound);
+
 /// How much the maximum blocking slope can move per unit of the per-step
 /// bound: 1 for the sample maximum, 20 / 16 for Eq. 16's midpoints.
 float blockingMaxLipschitz(BlockingMax rule);
@@ -182,6 +226,15 @@ void boundGradientChange(const MaxChangePyramid& dh, const HeightPyramid& pyr, i
 // product reshapes the kernel; its bound needs its own constant. Texels
 // between receivers interpolate the V of up to four receivers (Fig. 7), so
 // their bound is the largest of the tiles those receivers belong to.
+//
+// Per azimuth: sample j enters W with the weight beta_j(phi) (the hat of
+// linear interpolation, or the cubic B-spline of the full circle), whose
+// integral over phi is 2 pi / m for m evenly spaced samples. Moving sample
+// j's sin(sigma) by du_j changes the ambient by at most (2 pi / m) max|g|
+// |du_j|, so the whole change is at most (kShadePerSlope / m) sum_j |du_j|
+// (ambientChangeBoundPerAzimuth): an azimuth whose horizon did not move
+// costs nothing, where the full-circle form charges every azimuth with the
+// largest move. |du_j| <= max(slope bound of azimuth j, sqrt2 G) as above.
 inline constexpr float kShadePerSlopeExact = 2.0f;
 inline constexpr float kShadePerSlope = 2.25f;
 inline constexpr float kShadePerNormal = 1.05f;
@@ -195,5 +248,12 @@ inline float shadeChangePerSlope(float maxSkyRadiance) { return kShadePerSlope *
 /// maximum blocking slope's: boundOfTile times blockingMaxLipschitz) and its
 /// gradient bound.
 float ambientChangeBound(float slopeBound, float gradientBound, float maxSkyRadiance);
+
+/// The same from per-azimuth slope bounds of the m = azimuths samples of the
+/// full circle (each the maximum blocking slope's: azimuthBoundOfTile times
+/// blockingMaxLipschitz) and the gradient bound; `withNormals` adds the
+/// shading normals' move (kShadePerNormal), which a cached V does not see.
+float ambientChangeBoundPerAzimuth(const float* slopeBound, int azimuths, float gradientBound, float maxSkyRadiance,
+                                   bool withNormals);
 
 }  // namespace terrain::gi

@@ -268,7 +268,8 @@ void directShading(const GiLighting& lighting, const GiSettings& settings, const
 void runDirectStages(ConstGridView heights, float cellSize, const GiLighting& lighting, const GiSettings& settings,
                      const FrameChange& change, const AlbedoMap* albedo, GiState& st) {
     auto t = Clock::now();
-    const ReceiverTiles* only = nullptr;
+    const ReceiverTiles* only = nullptr;     // the environment's tiles to recompute (null: all)
+    const ReceiverTiles* keyOnly = nullptr;  // the key lights'
     if (change.geometry) {
         computeGradient(heights, cellSize, st.gradX, st.gradY);
         st.timings.gradient = msSince(t);
@@ -278,17 +279,18 @@ void runDirectStages(ConstGridView heights, float cellSize, const GiLighting& li
         t = Clock::now();
         const bool tiled = change.heightsOnly && !st.lastInputs.heights.empty();
         if (tiled)
-            planVisibilityTiles(st.lastInputs.heights.cview(), heights, st.pyramid, settings.visibility.blockingMax,
+            planVisibilityTiles(st.lastInputs.heights.cview(), heights, st.pyramid, settings.visibility,
                                 settings.tolerance, st.visibilityCache);
         else
             resetVisibilityCache(st.pyramid, st.visibilityCache);
         only = tiled ? &st.visibilityCache.tiles : nullptr;
+        keyOnly = tiled ? &st.visibilityCache.keyTiles : nullptr;
         environmentVisibility(settings, only, st);
         st.timings.visibility = msSince(t);
         st.receiversRecomputed = tiled ? st.visibilityCache.tiles.dirtyFraction() : 1.0;
     }
     t = Clock::now();
-    keyLightVisibility(lighting, settings, change, only, st);
+    keyLightVisibility(lighting, settings, change, keyOnly, st);
     st.timings.keyVisibility = msSince(t);
     t = Clock::now();
     directShading(lighting, settings, albedo, st);

@@ -5,29 +5,47 @@
 
 namespace terrain::gi {
 
-void resetVisibilityCache(const HeightPyramid& pyr, VisibilityCache& cache) {
-    cache.tiles.reset(pyr.nxr, pyr.nyr, kVisibilityTile, true);
-    cache.drift.assign(cache.tiles.dirty.size(), 0.0f);
+namespace {
+
+// Adds one frame's bound to a tile's drift; true (drift reset) when the tile recomputes.
+bool addDrift(float bound, float tolerance, float& drift) {
+    drift += bound;
+    const bool recompute = drift > tolerance;
+    if (recompute) drift = 0.0f;
+    return recompute;
 }
 
-void planVisibilityTiles(ConstGridView before, ConstGridView after, const HeightPyramid& pyr, BlockingMax rule,
-                         float tolerance, VisibilityCache& cache) {
+}  // namespace
+
+void resetVisibilityCache(const HeightPyramid& pyr, VisibilityCache& cache) {
+    cache.tiles.reset(pyr.nxr, pyr.nyr, kVisibilityTile, true);
+    cache.keyTiles.reset(pyr.nxr, pyr.nyr, kVisibilityTile, true);
+    cache.drift.assign(cache.tiles.dirty.size(), 0.0f);
+    cache.keyDrift.assign(cache.tiles.dirty.size(), 0.0f);
+}
+
+void planVisibilityTiles(ConstGridView before, ConstGridView after, const HeightPyramid& pyr,
+                         const VisibilitySettings& vis, float tolerance, VisibilityCache& cache) {
     if (cache.tiles.nxr != pyr.nxr || cache.tiles.nyr != pyr.nyr || cache.drift.size() != cache.tiles.dirty.size())
         resetVisibilityCache(pyr, cache);
     buildMaxChangePyramid(before, after, cache.change);
     boundSlopeChange(cache.change, pyr, kVisibilityTile, cache.slopeBound);
+    boundSlopeChangePerAzimuth(cache.change, pyr, kVisibilityTile, vis.azimuths, cache.azimuthBound);
     boundGradientChange(cache.change, pyr, kVisibilityTile, cache.gradBound);
     // V depends on the heights through the maximum blocking slope and, below
     // it, the tangent plane's slope along the azimuth (moving by at most
     // sqrt2 times a gradient component's bound); shading reruns at the new
     // normals every frame, so only V's own change counts.
-    const float lipschitz = blockingMaxLipschitz(rule);
+    const float lipschitz = blockingMaxLipschitz(vis.blockingMax);
+    const std::size_t m = static_cast<std::size_t>(vis.azimuths);
+    std::vector<float> perAzimuth(m);
     for (std::size_t t = 0; t < cache.drift.size(); ++t) {
+        for (std::size_t j = 0; j < m; ++j) perAzimuth[j] = lipschitz * cache.azimuthBound[t * m + j];
+        const float env =
+            ambientChangeBoundPerAzimuth(perAzimuth.data(), vis.azimuths, cache.gradBound[t], 1.0f, false);
+        cache.tiles.dirty[t] = addDrift(env, tolerance, cache.drift[t]) ? 1 : 0;
         const float slope = std::max(lipschitz * cache.slopeBound[t], std::sqrt(2.0f) * cache.gradBound[t]);
-        cache.drift[t] += shadeChangePerSlope(1.0f) * slope;
-        const bool recompute = cache.drift[t] > tolerance;
-        cache.tiles.dirty[t] = recompute ? 1 : 0;
-        if (recompute) cache.drift[t] = 0.0f;
+        cache.keyTiles.dirty[t] = addDrift(shadeChangePerSlope(1.0f) * slope, tolerance, cache.keyDrift[t]) ? 1 : 0;
     }
 }
 

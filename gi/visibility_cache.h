@@ -5,13 +5,18 @@
 // Per tile of kVisibilityTile x kVisibilityTile receivers the cache keeps how
 // far its cached V can have drifted since it was computed: each frame with
 // new heights adds the frame's conservative bounds (gi/change_bound.h: the
-// largest move of any blocking slope, and of the height gradients behind the
-// tangent planes), turned into the largest change of the ambient map (unit
-// sky) they allow. A tile is recomputed, and its drift reset to 0, when its
-// drift exceeds the tolerance; tolerance 0 recomputes every tile whose inputs
-// may have changed at all, which reproduces a full recompute bit for bit.
-// Sums of per-frame bounds bound the accumulated change (triangle
-// inequality), so slow changes over many frames are caught too.
+// move of the blocking slopes of each environment azimuth, and of the height
+// gradients behind the tangent planes), turned into the largest change of the
+// ambient map (unit sky) they allow. A tile is recomputed, and its drift
+// reset to 0, when its drift exceeds the tolerance; tolerance 0 recomputes
+// every tile whose inputs may have changed at all, which reproduces a full
+// recompute bit for bit. Sums of per-frame bounds bound the accumulated
+// change (triangle inequality), so slow changes over many frames are caught
+// too.
+//
+// Key lights sample their own azimuths, between the environment's: their
+// tiles (keyTiles) keep a drift of their own from the bound over all
+// azimuths, the full-circle form (kShadePerSlope times the largest move).
 #include <vector>
 
 #include "core/grid.h"
@@ -27,18 +32,22 @@ inline constexpr int kVisibilityTile = 32;
 
 struct VisibilityCache {
     MaxChangePyramid change;                   // |dh| of this frame
-    std::vector<float> slopeBound, gradBound;  // this frame's bounds per tile
-    std::vector<float> drift;                  // per tile: ambient-map change allowed since its V was computed
-    ReceiverTiles tiles;                       // this frame's tiles to recompute
+    std::vector<float> slopeBound, gradBound;  // this frame's bounds per tile (all azimuths)
+    std::vector<float> azimuthBound;           // per tile and environment azimuth (tile-major)
+    std::vector<float> drift, keyDrift;        // per tile: ambient-map change allowed since its V was computed
+    ReceiverTiles tiles;                       // this frame's tiles to recompute (environment)
+    ReceiverTiles keyTiles;                    // the same for the key lights
 };
 
 /// Forgets the drift: every tile's V is about to be computed from scratch.
 void resetVisibilityCache(const HeightPyramid& pyr, VisibilityCache& cache);
 
 /// Adds the change from `before` to the pyramid's heights `after` to every
-/// tile's drift and marks the tiles whose drift exceeds `tolerance` (their
-/// drift reset to 0): cache.tiles. `pyr` is the pyramid of `after`.
-void planVisibilityTiles(ConstGridView before, ConstGridView after, const HeightPyramid& pyr, BlockingMax rule,
-                         float tolerance, VisibilityCache& cache);
+/// tile's drifts and marks the tiles whose drift exceeds `tolerance` (their
+/// drift reset to 0): cache.tiles for the environment's V (`vis`: its
+/// azimuths and maximum rule), cache.keyTiles for the key lights'. `pyr` is
+/// the pyramid of `after`.
+void planVisibilityTiles(ConstGridView before, ConstGridView after, const HeightPyramid& pyr,
+                         const VisibilitySettings& vis, float tolerance, VisibilityCache& cache);
 
 }  // namespace terrain::gi
