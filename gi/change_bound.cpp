@@ -310,8 +310,8 @@ double filteredChange(const MaxChangePyramid& dh, const StepTable& t, int i, con
 }
 
 // Steps before `first` see no change from any azimuth (lastQuietStep).
-double azimuthBoundFrom(const MaxChangePyramid& dh, const HeightPyramid& pyr, const StepTable& steps,
-                        const CellBox& c, double m0, int first, double cs, double sn, double lipschitz) {
+double azimuthBoundFrom(const MaxChangePyramid& dh, const HeightPyramid& pyr, const StepTable& steps, const CellBox& c,
+                        double m0, int first, double cs, double sn, double lipschitz) {
     const double mAll = maxChangeAll(dh), cellSize = pyr.cellSize;
     double best = 0.0;
     for (std::size_t i = static_cast<std::size_t>(first); i < steps.extent.size(); ++i) {
@@ -465,8 +465,8 @@ float azimuthBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, i
                                     std::sin(phi), heightFilterLipschitz(pyr)));
 }
 
-void boundSlopeChangePerAzimuth(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers,
-                                int azimuths, std::vector<float>& tileBound) {
+void boundSlopeChangePerAzimuth(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int azimuths,
+                                std::vector<float>& tileBound) {
     requireSameSize(dh, pyr, tileReceivers);
     if (azimuths < 1) throw InputError("change bound: at least one azimuth");
     const StepTable steps = stepTable(pyr);

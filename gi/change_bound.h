@@ -163,8 +163,8 @@ float azimuthBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, i
 /// azimuthBoundOfTile of every tile at the m = azimuths samples phi_j = 2 pi
 /// j / m of the full circle (gi/wedge.h, foldFullCircle): tileBound[t m + j],
 /// tiles row-major as boundSlopeChange (same errors; InputError for azimuths < 1).
-void boundSlopeChangePerAzimuth(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers,
-                                int azimuths, std::vector<float>& tileBound);
+void boundSlopeChangePerAzimuth(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int azimuths,
+                                std::vector<float>& tileBound);
 
 /// How much the maximum blocking slope can move per unit of the per-step
 /// bound: 1 for the sample maximum, 20 / 16 for Eq. 16's midpoints.

@@ -119,9 +119,9 @@ double median(std::vector<double> v) {
 
 // What one before / after comparison found.
 struct Comparison {
-    int slopeOver = 0, ambientOver = 0;            // receivers past bound + allowance
-    int azimuthOver = 0, azimuthAmbientOver = 0;   // the same for the per-azimuth bounds (per receiver and azimuth)
-    int azimuthAboveTile = 0;                      // per-azimuth bounds above the tile's bound over all azimuths
+    int slopeOver = 0, ambientOver = 0;           // receivers past bound + allowance
+    int azimuthOver = 0, azimuthAmbientOver = 0;  // the same for the per-azimuth bounds (per receiver and azimuth)
+    int azimuthAboveTile = 0;                     // per-azimuth bounds above the tile's bound over all azimuths
     double worstAzimuth = 0.0, worstAzimuthAmbient = 0.0;
     std::vector<double> tileAzimuthAmbientLoose;   // per tile: per-azimuth ambient bound / largest change
     double worstSlope = 0.0, worstAmbient = 0.0;   // largest change / bound
@@ -392,7 +392,7 @@ TEST_CASE("gi.change_bound: tile bounds hold for the engine's slopes and ambient
         }
     }
     MESSAGE("worst change / bound: slopes " << worstSlope << ", ambient " << worstAmbient << "; per azimuth: slopes "
-                                             << worstAzimuth << ", ambient " << worstAzimuthAmbient);
+                                            << worstAzimuth << ", ambient " << worstAzimuthAmbient);
 }
 
 TEST_CASE("gi.change_bound: no change gives zero bounds, a distant change a small positive one") {
