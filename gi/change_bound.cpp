@@ -369,16 +369,27 @@ void buildMaxChangePyramid(ConstGridView before, ConstGridView after, MaxChangeP
     decimateLevels(p);
 }
 
-float maxChangeInBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1) {
+namespace {
+
+// Clamps the box to the grid and returns the finest level whose blocks cover
+// it with at most kBlocksPerAxis per axis; -1 for an empty box.
+int clampBoxToLevel(const MaxChangePyramid& p, int& x0, int& y0, int& x1, int& y1) {
     x0 = std::max(x0, 0);
     y0 = std::max(y0, 0);
     x1 = std::min(x1, p.nx - 1);
     y1 = std::min(y1, p.ny - 1);
-    if (x0 > x1 || y0 > y1 || p.levels.empty()) return 0.0f;
-    // the finest level whose blocks cover the box with at most kBlocksPerAxis per axis
+    if (x0 > x1 || y0 > y1 || p.levels.empty()) return -1;
     int k = 0;
     const int top = static_cast<int>(p.levels.size()) - 1;
     while (k < top && ((x1 >> k) - (x0 >> k) >= kBlocksPerAxis || (y1 >> k) - (y0 >> k) >= kBlocksPerAxis)) ++k;
+    return k;
+}
+
+}  // namespace
+
+float maxChangeInBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1) {
+    const int k = clampBoxToLevel(p, x0, y0, x1, y1);
+    if (k < 0) return 0.0f;
     const CellBox box{x0, y0, x1, y1};
     float m = 0.0f;
     for (int by = y0 >> k; by <= y1 >> k; ++by)
@@ -387,14 +398,8 @@ float maxChangeInBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1) 
 }
 
 double sumChangeInBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1) {
-    x0 = std::max(x0, 0);
-    y0 = std::max(y0, 0);
-    x1 = std::min(x1, p.nx - 1);
-    y1 = std::min(y1, p.ny - 1);
-    if (x0 > x1 || y0 > y1 || p.levels.empty()) return 0.0;
-    int k = 0;
-    const int top = static_cast<int>(p.levels.size()) - 1;
-    while (k < top && ((x1 >> k) - (x0 >> k) >= kBlocksPerAxis || (y1 >> k) - (y0 >> k) >= kBlocksPerAxis)) ++k;
+    const int k = clampBoxToLevel(p, x0, y0, x1, y1);
+    if (k < 0) return 0.0;
     const Grid& g = k == 0 ? p.levels[0] : p.sums[static_cast<std::size_t>(k)];
     double sum = 0.0;
     for (int by = y0 >> k; by <= y1 >> k; ++by) {
