@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/grid.h"
+#include "gi/settings.h"
 
 namespace terrain::bench {
 
@@ -65,5 +66,13 @@ Grid alpsCentreCrop(const std::string& dataDir, int size, float& cell);
 /// Relative RMSE of a against b over the interior (10 % border left out), all
 /// three channels; bias = mean difference / RMS of b.
 double relRmse(const std::array<Grid, 3>& a, const std::array<Grid, 3>& b, double& bias);
+
+/// The settings with incremental frames off: the timing suites light the same
+/// field frame after frame and time whole frames (a static field would
+/// otherwise do no work after the first; gi-incremental measures that).
+inline gi::GiSettings wholeFrames(gi::GiSettings s) {
+    s.incremental = false;
+    return s;
+}
 
 }  // namespace terrain::bench

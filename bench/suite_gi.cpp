@@ -99,9 +99,9 @@ std::string settingsName(const GiSettings& s) {
     return buf;
 }
 
-GiSettings paperSettings() { return paperGiSettings(); }
+GiSettings paperSettings() { return wholeFrames(paperGiSettings()); }
 
-GiSettings engineDefaults() { return GiSettings{}; }
+GiSettings engineDefaults() { return wholeFrames(GiSettings{}); }
 
 // The direct-light settings a table compares, printed from the settings
 // themselves so that the text cannot drift from what ran.
@@ -122,7 +122,7 @@ std::string buildFlags() {
 
 struct Row {
     std::string label;
-    GiSettings s = paperGiSettings();
+    GiSettings s = wholeFrames(paperGiSettings());
     ErrorStats e;
     Timing t;
 };
@@ -334,7 +334,7 @@ void GiSuite::explore() const {
     for (int o : {2, 3, 4})
         for (float peak : {0.0f, 0.25f, 0.5f})
             for (BlockingMax bm : {BlockingMax::BsplineKnotsAndMidpoints, BlockingMax::Samples}) {
-                GiSettings s = paperGiSettings();
+                GiSettings s = wholeFrames(paperGiSettings());
                 s.pyramid.levelOffset = o;
                 s.pyramid.peakBlend = peak;
                 s.visibility.blockingMax = bm;
@@ -364,7 +364,7 @@ void GiSuite::convergence() const {
     const Grid ref = referenceAmbient(small, 1, border);
     std::vector<Row> rows;
     auto base = [] {
-        GiSettings s = paperGiSettings();
+        GiSettings s = wholeFrames(paperGiSettings());
         s.visibility.blockingMax = BlockingMax::Samples;
         return s;
     };

@@ -29,7 +29,7 @@ struct GlossyOptions {
 constexpr float albedo = 0.6f;
 
 GiSettings settingsFor(Brdf brdf, float exponent, int s, int bounces, GlossyIndirect mode) {
-    GiSettings g = GiSettings{};
+    GiSettings g = wholeFrames(GiSettings{});
     g.subsample = s;
     g.shading.brdf = brdf;
     g.shading.phongExponent = exponent;

@@ -204,7 +204,7 @@ std::string diagnose(const Dem& d, const GiLighting& light, float albedo) {
     e = relRmse(indSh, ind, b);
     md += fmtErr("(d) ref. indirect, SH Lambert kernel vs cosine (truncation floor)", e, b);
     for (int sub : {1, 2}) {
-        GiSettings g = GiSettings{};
+        GiSettings g = wholeFrames(GiSettings{});
         g.subsample = sub;
         g.indirect.bounces = 1;
         GiState st;
@@ -326,7 +326,7 @@ private:
     std::vector<Reference> refs;  // their references
 
     GiSettings settingsFor(int s, int bounces, bool paper) const {
-        GiSettings g = paper ? paperGiSettings() : GiSettings{};
+        GiSettings g = wholeFrames(paper ? paperGiSettings() : GiSettings{});
         g.subsample = s;
         g.indirect.bounces = bounces;
         if (o_.indirectAzimuths > 0) g.indirect.azimuths = o_.indirectAzimuths;
