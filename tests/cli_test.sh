@@ -90,6 +90,11 @@ done
 expect_error "bad indirect kernel" "indirect-kernel" "$T" gi --heightmap "$hm24" --cell-size 10 --bounces 1 --indirect-kernel cosine
 expect_error "retired indirect kernel" "indirect-kernel" "$T" gi --heightmap "$hm24" --cell-size 10 --bounces 1 --indirect-kernel exact
 expect_error "bad indirect azimuths" "indirect azimuths" "$T" gi --heightmap "$hm24" --cell-size 10 --bounces 1 --indirect-azimuths 2
+expect_error "GI tolerance out of range" "GI tolerance" "$T" gi --heightmap "$hm24" --cell-size 10 --gi-tolerance 2
+# the same field twice: the second frame of incremental GI does nothing, and the outputs equal a full frame's
+"$T" gi --heightmap "$hm24" --cell-size 10 --bounces 1 --frames 2 --out-indirect "$tmp/inc_on.npy" >/dev/null 2>&1 &&
+  "$T" gi --heightmap "$hm24" --cell-size 10 --bounces 1 --frames 2 --gi-incremental off --out-indirect "$tmp/inc_off.npy" >/dev/null 2>&1 &&
+  cmp -s "$tmp/inc_on.npy" "$tmp/inc_off.npy" && ok || bad "gi --gi-incremental on and off differ"
 
 echo "cli: $pass passed, $fail failed"
 [ $fail -eq 0 ]
