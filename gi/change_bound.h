@@ -23,6 +23,7 @@
 
 #include "core/grid.h"
 #include "gi/pyramid.h"
+#include "gi/receiver_tiles.h"
 #include "gi/visibility.h"
 
 namespace terrain::gi {
@@ -116,8 +117,6 @@ float heightFilterLipschitz(const HeightPyramid& pyr);
 // length depends on geometry only, so it moves by at most the same bound;
 // Eq. 16's midpoints (9 (s0 + s1) - (s_-1 + s2)) / 16 move by up to 20 / 16
 // of it (blockingMaxLipschitz).
-
-inline int tileCount(int receivers, int tileReceivers) { return (receivers + tileReceivers - 1) / tileReceivers; }
 
 /// Bound on |change| of every blocking slope of tile (tx, ty) (metres per
 /// metre). `dh` must cover the pyramid's full-resolution grid.

@@ -104,10 +104,6 @@ ShadingLight keyShadingLight(const KeyLight& light, const VisibilityField& v) {
     return out;
 }
 
-bool sameLight(const KeyLight& a, const KeyLight& b) {
-    return a.azimuthDeg == b.azimuthDeg && a.elevationDeg == b.elevationDeg && a.radiusDeg == b.radiusDeg;
-}
-
 }  // namespace
 
 void checkHeightsFinite(ConstGridView h) {
@@ -219,11 +215,12 @@ void keyLightVisibility(const GiLighting& lighting, const GiSettings& settings, 
     st.keyVisibility.resize(nKeys);
     const bool footprint = settings.subsample > 1 && settings.visibility.footprintTangent;
     for (std::size_t k = 0; k < nKeys; ++k) {
-        if (!change.keyGeometry[k]) continue;
+        if (!change.keyVisibility(k)) continue;
         ++st.keyVisibilitiesRecomputed;
         const KeyLight& light = lighting.keys[k];
         const KeyLightExtent ext = keyLightExtent(light);
-        if (st.keyOperators[k].azimuths != settings.keyLightAzimuths || !sameLight(st.keyOperatorLights[k], light)) {
+        if (st.keyOperators[k].azimuths != settings.keyLightAzimuths ||
+            !sameSkyRegion(st.keyOperatorLights[k], light)) {
             st.keyOperators[k] = foldPartialRange(ext.phiStart, ext.phiEnd, settings.keyLightAzimuths);
             st.keyOperatorLights[k] = light;
         }
@@ -333,7 +330,7 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
         }
     }
     if (settings.incremental)
-        recordFrameInputs(heights, cellSize, lighting, settings, albedo, st.lastInputs);
+        recordFrameInputs(heights, cellSize, lighting, settings, albedo, change, st.lastInputs);
     else
         st.lastInputs.valid = false;
     st.timings.total = msSince(t0);

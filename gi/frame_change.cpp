@@ -1,5 +1,6 @@
 #include "gi/frame_change.h"
 
+#include <algorithm>
 #include <cstring>
 
 namespace terrain::gi {
@@ -25,11 +26,6 @@ bool sameAlbedo(const FrameInputs& last, const AlbedoMap* albedo) {
     return sameGrid(last.albedo.phongExponent, albedo->phongExponent);
 }
 
-// The key light's visibility depends on its region of the sky only.
-bool sameKeyRegion(const KeyLight& a, const KeyLight& b) {
-    return a.azimuthDeg == b.azimuthDeg && a.elevationDeg == b.elevationDeg && a.radiusDeg == b.radiusDeg;
-}
-
 bool sameKeyRadiance(const KeyLight& a, const KeyLight& b) {
     return a.rgb[0] == b.rgb[0] && a.rgb[1] == b.rgb[1] && a.rgb[2] == b.rgb[2];
 }
@@ -43,15 +39,11 @@ void copyGrid(ConstGridView from, Grid& to) {
 }  // namespace
 
 bool FrameChange::any() const {
-    if (geometry || radiance) return true;
-    for (bool k : keyGeometry)
-        if (k) return true;
-    return false;
+    return geometry || radiance || std::find(keyRegion.begin(), keyRegion.end(), true) != keyRegion.end();
 }
 
 FrameChange everythingChanged(std::size_t keys) {
     FrameChange c;
-    c.keyGeometry.assign(keys, true);
     c.keyRegion.assign(keys, true);
     return c;
 }
@@ -65,13 +57,11 @@ FrameChange compareFrameInputs(const FrameInputs& last, ConstGridView heights, f
                            last.heights.ny == heights.ny;
     c.geometry = !sameFrame || !sameGrid(last.heights, heights);
     c.heightsOnly = sameFrame && c.geometry;
-    c.keyGeometry.assign(nKeys, true);
     c.keyRegion.assign(nKeys, true);
     bool keyRadiance = nKeys != last.keys.size();
     for (std::size_t k = 0; k < nKeys; ++k) {
         const bool known = k < last.keys.size();
-        c.keyRegion[k] = !known || !sameKeyRegion(lighting.keys[k], last.keys[k]);
-        c.keyGeometry[k] = c.geometry || c.keyRegion[k];
+        c.keyRegion[k] = !known || !sameSkyRegion(lighting.keys[k], last.keys[k]);
         keyRadiance = keyRadiance || !known || !sameKeyRadiance(lighting.keys[k], last.keys[k]);
     }
     const bool environment = lighting.environment.c != last.environment.c;
@@ -80,14 +70,14 @@ FrameChange compareFrameInputs(const FrameInputs& last, ConstGridView heights, f
 }
 
 void recordFrameInputs(ConstGridView heights, float cellSize, const GiLighting& lighting, const GiSettings& settings,
-                       const AlbedoMap* albedo, FrameInputs& out) {
-    copyGrid(heights, out.heights);
+                       const AlbedoMap* albedo, const FrameChange& change, FrameInputs& out) {
+    if (change.geometry) copyGrid(heights, out.heights);
     out.cellSize = cellSize;
     out.settings = settings;
     out.environment = lighting.environment;
     out.keys = lighting.keys;
     out.hasAlbedo = albedo != nullptr;
-    if (albedo) out.albedo = *albedo;
+    if (albedo && change.radiance) out.albedo = *albedo;
     out.valid = true;
 }
 

@@ -39,10 +39,11 @@ struct FrameChange {
     // Only the heights changed (same size, cell size and settings): the
     // visibility may be recomputed tile by tile (gi/visibility_cache.h).
     bool heightsOnly = false;
-    std::vector<bool> keyGeometry;  // per key light: its V (geometry, direction, size, or count changed)
-    std::vector<bool> keyRegion;    // per key light: its region of the sky is new (direction, size, count)
-    bool radiance = true;           // environment, key radiances or albedo: shading and indirect light
+    std::vector<bool> keyRegion;  // per key light: its region of the sky is new (direction, size, count)
+    bool radiance = true;         // environment, key radiances or albedo: shading and indirect light
     bool any() const;
+    /// Key light k's visibility must be recomputed (the geometry or its region changed).
+    bool keyVisibility(std::size_t k) const { return geometry || keyRegion[k]; }
 };
 
 /// Everything changed (no record, or incremental frames switched off).
@@ -52,8 +53,9 @@ FrameChange everythingChanged(std::size_t keys);
 FrameChange compareFrameInputs(const FrameInputs& last, ConstGridView heights, float cellSize,
                                const GiLighting& lighting, const GiSettings& settings, const AlbedoMap* albedo);
 
-/// Records this frame's inputs (buffers reused: no allocation for a frame of the same size).
+/// Records this frame's inputs; the heights and the albedo maps are copied
+/// only when `change` says they may differ from the record (buffers reused).
 void recordFrameInputs(ConstGridView heights, float cellSize, const GiLighting& lighting, const GiSettings& settings,
-                       const AlbedoMap* albedo, FrameInputs& out);
+                       const AlbedoMap* albedo, const FrameChange& change, FrameInputs& out);
 
 }  // namespace terrain::gi

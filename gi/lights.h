@@ -71,6 +71,12 @@ void validateKeyLight(const KeyLight& k);
 /// Evaluates an SH RGB radiance in direction d.
 void evaluateShRgb(const ShRgb& l, double x, double y, double z, double out[3]);
 
+/// True when a and b cover the same region of the sky (direction and size):
+/// a key light's visibility depends on that alone, not on its radiance.
+inline bool sameSkyRegion(const KeyLight& a, const KeyLight& b) {
+    return a.azimuthDeg == b.azimuthDeg && a.elevationDeg == b.elevationDeg && a.radiusDeg == b.radiusDeg;
+}
+
 /// The lights of a GI frame: an environment and any number of key lights.
 struct GiLighting {
     ShRgb environment = uniformSkyLight(1.0f);

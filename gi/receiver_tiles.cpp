@@ -9,8 +9,6 @@ namespace terrain::gi {
 
 namespace {
 
-int tilesAlong(int receivers, int size) { return (receivers + size - 1) / size; }
-
 void checkTileSize(int size) {
     if (size <= 0 || size % ReceiverTiles::kTileAlign != 0)
         throw InputError("receiver tiles: tile size " + std::to_string(size) + " is not a positive multiple of " +
@@ -25,8 +23,8 @@ void ReceiverTiles::reset(int receiversX, int receiversY, int size, bool allDirt
     nxr = receiversX;
     nyr = receiversY;
     tileSize = size;
-    tilesX = tilesAlong(nxr, size);
-    tilesY = tilesAlong(nyr, size);
+    tilesX = tileCount(nxr, size);
+    tilesY = tileCount(nyr, size);
     dirty.assign(static_cast<std::size_t>(tilesX) * tilesY, allDirty ? 1 : 0);
 }
 
@@ -58,8 +56,8 @@ void dirtySpans(const ReceiverTiles* only, int nxr, int nyr, DirtySpans& out) {
         return;
     }
     checkTileSize(only->tileSize);
-    if (only->nxr != nxr || only->nyr != nyr || only->tilesX != tilesAlong(nxr, only->tileSize) ||
-        only->tilesY != tilesAlong(nyr, only->tileSize) ||
+    if (only->nxr != nxr || only->nyr != nyr || only->tilesX != tileCount(nxr, only->tileSize) ||
+        only->tilesY != tileCount(nyr, only->tileSize) ||
         only->dirty.size() != static_cast<std::size_t>(only->tilesX) * only->tilesY)
         throw InputError("receiver tiles: made for a " + std::to_string(only->nxr) + " x " + std::to_string(only->nyr) +
                          " receiver grid, not " + std::to_string(nxr) + " x " + std::to_string(nyr));

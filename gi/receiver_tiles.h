@@ -27,6 +27,9 @@
 
 namespace terrain::gi {
 
+/// Tiles of tileReceivers along an axis of `receivers` (the last one partial).
+inline int tileCount(int receivers, int tileReceivers) { return (receivers + tileReceivers - 1) / tileReceivers; }
+
 /// Receiver tiles of a tile-restricted scan and their dirty flags.
 struct ReceiverTiles {
     static constexpr int kTileAlign = 16;  // tileSize must be a multiple of it (the kernels' receiver groups)

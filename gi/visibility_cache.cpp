@@ -38,7 +38,8 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
     // normals every frame, so only V's own change counts.
     const float lipschitz = blockingMaxLipschitz(vis.blockingMax);
     const std::size_t m = static_cast<std::size_t>(vis.azimuths);
-    std::vector<float> perAzimuth(m);
+    std::vector<float>& perAzimuth = cache.tileAzimuths;
+    perAzimuth.resize(m);  // no allocation after the first frame of these settings
     for (std::size_t t = 0; t < cache.drift.size(); ++t) {
         for (std::size_t j = 0; j < m; ++j) perAzimuth[j] = lipschitz * cache.azimuthBound[t * m + j];
         const float env =

@@ -35,6 +35,7 @@ struct VisibilityCache {
     std::vector<float> slopeBound, gradBound;  // this frame's bounds per tile (all azimuths)
     std::vector<float> azimuthBound;           // per tile and environment azimuth (tile-major)
     std::vector<float> drift, keyDrift;        // per tile: ambient-map change allowed since its V was computed
+    std::vector<float> tileAzimuths;           // scratch: one tile's per-azimuth slope bounds
     ReceiverTiles tiles;                       // this frame's tiles to recompute (environment)
     ReceiverTiles keyTiles;                    // the same for the key lights
 };
