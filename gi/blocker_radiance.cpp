@@ -225,6 +225,8 @@ void occlusionAtReceivers(const HeightPyramid& pyr, ConstGridView gradX, ConstGr
 }  // namespace
 
 void prepareBlockerRadiance(const HeightPyramid& pyr, int azimuths, BlockerRadianceState& st) {
+    if (st.nx != pyr.nx || st.ny != pyr.ny || st.subsample != pyr.subsample || st.azimuths != azimuths)
+        st.occlusionValid = false;
     st.nx = pyr.nx;
     st.ny = pyr.ny;
     st.nxr = pyr.nxr;
@@ -256,6 +258,7 @@ void computeTexelOcclusion(const HeightPyramid& pyr, ConstGridView gradX, ConstG
                              simd::wideEnabled() ? occlusionAzimuthAvx2 : occlusionAzimuthSse};
     occlusionAtTexels(pyr, gradX, gradY, B, stride, nTaps, pass, st);
     occlusionAtReceivers(pyr, gradX, gradY, pass, st);
+    st.occlusionValid = true;
 }
 
 void shadeBlockerRadiance(BlockerRadianceState& st, const AlbedoMap* albedo, std::array<Grid, 3>& rgb) {

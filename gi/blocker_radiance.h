@@ -57,6 +57,7 @@ struct BlockerRadianceState {
     std::vector<float> farSlope;           // azimuths planes of nxr * nyr: the receivers' horizons (tan), from the scan
     std::vector<float> heights;            // full-resolution heights with a border of s cells (outside: no blocker)
     Grid occlusion;                        // O / pi at every texel
+    bool occlusionValid = false;           // occlusion and receiverOcclusion hold a result of this grid
     std::vector<float> receiverOcclusion;  // O / pi at the receivers
     std::array<std::vector<float>, 3> receiverShade;  // E / pi at the receivers, per channel
     std::vector<float> scratch;                       // per block of rows: padded row buffers

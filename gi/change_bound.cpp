@@ -498,6 +498,41 @@ void boundSlopeChangePerAzimuth(const MaxChangePyramid& dh, const HeightPyramid&
     });
 }
 
+// Largest D_ij over the steps of one azimuth; steps before `first` see no
+// change from any azimuth, and no step's D exceeds the largest change anywhere.
+double sampleBoundFrom(const MaxChangePyramid& dv, const StepTable& steps, const CellBox& c, int first, double cs,
+                       double sn) {
+    const double mAll = maxChangeAll(dv);
+    double best = 0.0;
+    for (std::size_t i = static_cast<std::size_t>(first); i < steps.extent.size() && best < mAll; ++i) {
+        const CellBox box = stepBoxAlong(steps.extent[i], c, cs, sn);
+        best = std::max(best, filteredChange(dv, steps, static_cast<int>(i), box));
+    }
+    return best;
+}
+
+void boundSampleChangePerAzimuth(const MaxChangePyramid& dv, const HeightPyramid& field, int tileReceivers,
+                                 int azimuths, std::vector<float>& tileBound) {
+    requireSameSize(dv, field, tileReceivers);
+    if (azimuths < 1) throw InputError("change bound: at least one azimuth");
+    const StepTable steps = stepTable(field);
+    const int T = tileReceivers, tilesX = tileCount(field.nxr, T), tilesY = tileCount(field.nyr, T);
+    const std::size_t m = static_cast<std::size_t>(azimuths);
+    tileBound.resize(static_cast<std::size_t>(tilesX) * static_cast<std::size_t>(tilesY) * m);
+    parallelFor(0, tilesY, 1, [&](int ty0, int ty1) {
+        for (int ty = ty0; ty < ty1; ++ty)
+            for (int tx = 0; tx < tilesX; ++tx) {
+                const CellBox c = tileCells(field, T, tx, ty);
+                const int first = lastQuietStep(dv, field, c) + 1;
+                float* out = tileBound.data() + (static_cast<std::size_t>(ty) * tilesX + tx) * m;
+                for (std::size_t j = 0; j < m; ++j) {
+                    const double phi = 2.0 * 3.14159265358979323846 * static_cast<double>(j) / azimuths;
+                    out[j] = roundUp(sampleBoundFrom(dv, steps, c, first, std::cos(phi), std::sin(phi)));
+                }
+            }
+    });
+}
+
 float ambientChangeBoundPerAzimuth(const float* slopeBound, int azimuths, float gradientBound, float maxSkyRadiance,
                                    bool withNormals) {
     const double g = kSqrt2Up * gradientBound;

@@ -16,29 +16,58 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
-// Indirect bounces over the last computed direct shade.
-void runIndirectStage(const GiSettings& settings, GiState& st, const AlbedoMap* albedo) {
-    const auto t = Clock::now();
+// The folded wedge operator of the indirect scan: the environment's, or
+// one of its own azimuths (IndirectSettings::azimuths), cached.
+const FoldedWedgeOperator& indirectScanOperator(const GiSettings& settings, GiState& st) {
     const int m = settings.indirect.azimuths;
-    const FoldedWedgeOperator* op = &st.envOperator;
-    if (m != 0 && m != settings.visibility.azimuths) {
-        if (st.indirectOperatorAzimuths != m || st.indirectOperatorInterp != settings.visibility.interp) {
-            st.indirectOperator = foldFullCircle(m, settings.visibility.interp);
-            st.indirectOperatorAzimuths = m;
-            st.indirectOperatorInterp = settings.visibility.interp;
-        }
-        op = &st.indirectOperator;
+    if (m == 0 || m == settings.visibility.azimuths) return st.envOperator;
+    if (st.indirectOperatorAzimuths != m || st.indirectOperatorInterp != settings.visibility.interp) {
+        st.indirectOperator = foldFullCircle(m, settings.visibility.interp);
+        st.indirectOperatorAzimuths = m;
+        st.indirectOperatorInterp = settings.visibility.interp;
     }
+    return st.indirectOperator;
+}
+
+// The receivers whose indirect light is re-gathered this frame
+// (gi/indirect_cache.h); null: every receiver.
+const ReceiverTiles* planIndirect(const GiSettings& settings, const FrameChange& change, int azimuths, GiState& st) {
+    const bool tiled = settings.incremental && gathersByTiles(settings.indirect, settings.shading) &&
+                       (!change.geometry || change.heightsOnly);
+    if (!tiled) {
+        invalidateIndirectCache(st.indirectCache);
+        return nullptr;
+    }
+    const IndirectPlanInputs in{.source = st.shade.rgb,
+                                .heights = st.pyramid,
+                                .lastPyramid = st.indirect.radiance,
+                                .geometryTiles = change.geometry ? &st.visibilityCache.keyTiles : nullptr,
+                                .azimuths = azimuths,
+                                .tolerance = settings.tolerance};
+    return planIndirectTiles(in, st.indirectCache);
+}
+
+// Indirect bounces over the last computed direct shade, re-gathered where
+// its sources or the geometry within reach changed (incremental frames).
+void runIndirectStage(const GiSettings& settings, const FrameChange& change, GiState& st, const AlbedoMap* albedo) {
+    const auto t = Clock::now();
+    const FoldedWedgeOperator& op = indirectScanOperator(settings, st);
+    const ReceiverTiles* only = planIndirect(settings, change, op.azimuths, st);
     const IndirectInputs in{.heights = st.pyramid,
                             .gradX = st.gradX.cview(),
                             .gradY = st.gradY.cview(),
-                            .op = *op,
+                            .op = op,
                             .envVisibility = st.envVisibility,
                             .direct = st.shade.rgb,
                             .directShade = &st.shade,
                             .albedo = albedo,
-                            .shading = settings.shading};
+                            .shading = settings.shading,
+                            .only = only,
+                            .sameGeometry = !change.geometry};
     computeIndirect(in, settings.indirect, st.indirect);
+    if (settings.incremental && gathersByTiles(settings.indirect, settings.shading))
+        recordIndirectSource(st.shade.rgb, st.pyramid, only == nullptr, st.indirectCache);
+    st.indirectRecomputed = only ? only->dirtyFraction() : 1.0;
     st.timings.indirect = msSince(t);
 }
 
@@ -315,14 +344,14 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
     planAmortisation(heights, settings, st);
     if (!st.directUpdated) {
         // indirect only: geometry, pyramid, visibility and direct shade are the last frame's
-        runIndirectStage(settings, st, albedo);
+        runIndirectStage(settings, change, st, albedo);
         st.directStale = change.any();
         st.indirectStale = false;
     } else {
         runDirectStages(heights, cellSize, lighting, settings, change, albedo, st);
         st.directStale = false;
         if (st.indirectUpdated) {
-            runIndirectStage(settings, st, albedo);
+            runIndirectStage(settings, change, st, albedo);
             st.indirectStale = false;
         } else if (settings.indirect.bounces > 0) {
             sumDirectAndIndirect(st.shade.rgb, st.indirect);  // the last indirect light on the new direct shade

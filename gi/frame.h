@@ -8,6 +8,7 @@
 #include "core/grid.h"
 #include "gi/frame_change.h"
 #include "gi/indirect.h"
+#include "gi/indirect_cache.h"
 #include "gi/lights.h"
 #include "gi/pyramid.h"
 #include "gi/settings.h"
@@ -50,9 +51,11 @@ struct GiState {
     // direct or the indirect light behind its inputs.
     FrameInputs lastInputs;
     VisibilityCache visibilityCache;  // per tile, how far the cached V may have drifted
+    IndirectCache indirectCache;      // per tile, how far the cached indirect light may have drifted
     bool directStale = false, indirectStale = false;
     double receiversRecomputed = 0.0;   // fraction of the receivers whose environment V the last frame recomputed
     int keyVisibilitiesRecomputed = 0;  // key lights whose V the last frame recomputed
+    double indirectRecomputed = 0.0;    // fraction of the receivers whose indirect light the last frame re-gathered
     // Shading amortisation (Section 7): with settings.indirect.amortise, frames
     // on unchanged geometry update the direct and the indirect light
     // alternately. Incremental frames set geometryChanged themselves; without

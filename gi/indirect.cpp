@@ -22,4 +22,9 @@ void computeIndirect(const IndirectInputs& in, const IndirectSettings& settings,
     }
 }
 
+bool gathersByTiles(const IndirectSettings& settings, const ShadingSettings& shading) {
+    return settings.bounces == 1 && shading.brdf == Brdf::Lambert &&
+           settings.lambert == LambertIndirect::BlockerRadiance;
+}
+
 }  // namespace terrain::gi

@@ -28,4 +28,9 @@ namespace terrain::gi {
 /// without a usable in.directShade.
 void computeIndirect(const IndirectInputs& in, const IndirectSettings& settings, IndirectState& state);
 
+/// The settings choose a strategy whose one-bounce result can be re-gathered
+/// by receiver tiles over a cached one (IndirectInputs::only, with the bound
+/// of gi/indirect_cache.h): LambertIndirect::BlockerRadiance, one bounce.
+bool gathersByTiles(const IndirectSettings& settings, const ShadingSettings& shading);
+
 }  // namespace terrain::gi

@@ -128,10 +128,12 @@ void BlockerRadianceIndirect::receiverIrradiance(const RowBlock& rb, const Indir
     }
 }
 
-// The texel passes stay whole with receiver tiles: they cost little beside
-// the scan, and read the clean receivers' cached horizons and E.
+// The texel passes stay whole with receiver tiles, reading the clean
+// receivers' cached horizons and E; the occlusion, a function of the
+// geometry alone, is kept when the geometry is the last call's.
 void BlockerRadianceIndirect::shade(int b, ShadeMaps& out) {
-    if (b == 1 && in_.heights.subsample > 1)
+    const bool keepOcclusion = in_.sameGeometry && st_.blocker.occlusionValid;
+    if (b == 1 && in_.heights.subsample > 1 && !keepOcclusion)
         computeTexelOcclusion(in_.heights, in_.gradX, in_.gradY, in_.op.phi, st_.blocker);
     shadeBlockerRadiance(st_.blocker, in_.albedo, out.rgb);
 }

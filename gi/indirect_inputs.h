@@ -34,10 +34,14 @@ struct IndirectInputs {
     // clean receiver keeps the previous call's last bounce at bounce 1 and
     // this call's bounce b - 1 at bounce b, so the tiles give a consistent
     // result with one bounce; more bounces need a cache per bounce, which the
-    // state does not keep. The texel passes after the scan (occlusion,
-    // shading) stay whole: they cost little beside the scan.
+    // state does not keep (gathersByTiles, gi/indirect.h). The texel passes
+    // after the scan stay whole: they cost little beside the scan.
     // GlossyIndirect::VectorPyramid ignores the tiles (every receiver).
     const ReceiverTiles* only = nullptr;
+    // The heights, gradients and settings are those of the state's last
+    // call: BlockerRadiance keeps the texel occlusion it computed then
+    // (a pure function of them), where it holds one of this grid.
+    bool sameGeometry = false;
 };
 
 }  // namespace terrain::gi

@@ -1,0 +1,66 @@
+#pragma once
+// Which receiver tiles must re-gather their indirect light (the frame's one
+// place for it; the Lambert scan only takes the tiles, IndirectInputs::only).
+//
+// One bounce of LambertIndirect::BlockerRadiance gathers, at each receiver,
+// the direct light L_0 of its casting sets. Its result can move for two
+// reasons, and a tile re-gathers when either says so:
+//  - the blockers' radiance: each frame adds, per tile, the bound of
+//    gi/change_bound.h on how far the frame's change of L_0 moves the
+//    samples the tile's scan reads (boundSampleChangePerAzimuth, the largest
+//    over the indirect azimuths: the gathered irradiance and the mean blocker
+//    radiance move by at most that much, in shade units). The sum of these
+//    bounds since the tile's cached result was computed bounds its drift
+//    (triangle inequality); beyond the tolerance, the tile re-gathers.
+//  - the geometry within reach: the tiles whose key-light visibility
+//    recomputes this frame (VisibilityCache::keyTiles, the bound over every
+//    azimuth, so it covers the indirect azimuths): their casting sets have
+//    drifted beyond the tolerance in the ambient map's units.
+// Tolerance 0 re-gathers every tile where either bound is not 0, which gives
+// the full recompute bit for bit. More than one bounce, or another strategy:
+// every receiver (no per-bounce cache).
+#include <array>
+#include <vector>
+
+#include "core/grid.h"
+#include "gi/change_bound.h"
+#include "gi/pyramid.h"
+#include "gi/radiance_pyramid.h"
+#include "gi/receiver_tiles.h"
+
+namespace terrain::gi {
+
+struct IndirectCache {
+    bool valid = false;               // the fields below describe the cached indirect result
+    std::array<Grid, 3> lastSource;   // L_0 the last indirect pass read
+    Grid sourceChange;                // this frame: max over channels |L_0 - lastSource| (rounded up)
+    MaxChangePyramid change;          // its block maxima and sums
+    std::vector<float> azimuthBound;  // per tile and indirect azimuth (tile-major)
+    std::vector<float> drift;         // per tile: bound of the radiance change since its result was gathered
+    ReceiverTiles tiles;              // this frame's tiles to re-gather
+};
+
+/// What the frame knows when it plans the indirect tiles.
+struct IndirectPlanInputs {
+    const std::array<Grid, 3>& source;   // this frame's L_0 (full resolution)
+    const HeightPyramid& heights;        // this frame's height pyramid
+    const RadiancePyramid& lastPyramid;  // the last indirect pass's radiance pyramid (its steps)
+    const ReceiverTiles* geometryTiles;  // tiles whose geometry drifted beyond the tolerance; null: none
+    int azimuths;                        // of the indirect scan
+    float tolerance;
+};
+
+/// The tiles to re-gather (cache.tiles), or null when every receiver must be
+/// (no valid cache of this grid: the drifts start again at 0).
+const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCache& cache);
+
+/// After an indirect pass over `source` (on the receiver grid of `heights`):
+/// it is what the next frame compares with; `all` when the pass gathered
+/// every receiver (the tiles and drifts start again at 0).
+void recordIndirectSource(const std::array<Grid, 3>& source, const HeightPyramid& heights, bool all,
+                          IndirectCache& cache);
+
+/// Forgets the cache: the next pass gathers every receiver.
+inline void invalidateIndirectCache(IndirectCache& cache) { cache.valid = false; }
+
+}  // namespace terrain::gi
