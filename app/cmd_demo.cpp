@@ -28,8 +28,8 @@ int runDemo(DemoOptions& d) {
     RenderOptions& o = d.render;
     engine::PipelineSettings ps;
     render::RenderSettings rs;
-    toSettings(o, ps, rs);
     const SceneSettings scene = resolveScene(o.scene, o.size, static_cast<std::uint64_t>(o.seed));
+    toSettings(o, scene, ps, rs);
     std::string why = d.headless ? "headless requested" : render::noDisplayReason();
     std::unique_ptr<render::WindowContext> window;
     if (why.empty()) {

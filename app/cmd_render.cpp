@@ -61,8 +61,8 @@ std::string shellQuote(const std::string& s) {
 }
 
 // The per-stage medians and the share of GI receivers recomputed.
-void printSummary(const char* label, const RenderOptions& o, const std::vector<std::vector<double>>& stage,
-                  double recomputed) {
+void printSummary(const char* label, const RenderOptions& o, const engine::PipelineSettings& ps,
+                  const std::vector<std::vector<double>>& stage, double recomputed, double indirectRecomputed) {
     static const char* names[7] = {"sim", "pyramids", "scan", "integrate", "shade", "render", "png write"};
     std::printf("%s: per-stage time per frame (median of %d frames, ms):", label, o.frames);
     double sum = 0.0;
@@ -72,8 +72,17 @@ void printSummary(const char* label, const RenderOptions& o, const std::vector<s
         std::printf(" %s %.1f%s", names[i], m, i == 6 ? "" : ",");
     }
     std::printf(" (total %.1f; integrate is fused into scan in gi/)\n", sum);
-    std::printf("%s: GI receivers recomputed: %.1f %% per frame on average (incremental GI %s)\n", label,
-                100.0 * recomputed / o.frames, o.giIncremental ? "on" : "off");
+    std::printf(
+        "%s: GI receivers recomputed per frame on average: visibility %.1f %%, indirect light %.1f %% (incremental "
+        "GI %s, tolerance %g)\n",
+        label, 100.0 * recomputed / o.frames, 100.0 * indirectRecomputed / o.frames, ps.gi.incremental ? "on" : "off",
+        static_cast<double>(ps.gi.tolerance));
+}
+
+std::string formatNumber(float v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", static_cast<double>(v));
+    return buf;
 }
 
 }  // namespace
@@ -93,9 +102,10 @@ void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize) {
         ->capture_default_str();
     sub->add_option("--gi-incremental", o.giIncremental,
                     "on: GI reruns only the stages whose inputs changed since the last frame; off: every frame "
-                    "recomputes everything")
-        ->capture_default_str();
-    sub->add_option("--gi-tolerance", o.giTolerance, gi::describe(gi::ranges::kTolerance))->capture_default_str();
+                    "recomputes everything (default: the scene file's [gi] incremental, else on)");
+    sub->add_option("--gi-tolerance", o.giTolerance,
+                    gi::describe(gi::ranges::kTolerance) + " (default: the scene file's [gi] tolerance, else " +
+                        formatNumber(engine::defaultPipelineGi().tolerance) + ")");
     sub->add_flag("--amortise", o.amortise,
                   "Shading amortisation: on static geometry update direct and indirect light on alternate frames");
     sub->add_option("--shadow", o.shadow, "Key light shadow: soft (engine visibility) | map (shadow map) | none")
@@ -115,7 +125,8 @@ void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize) {
     sub->add_flag("--quiet", o.quiet, "Print only errors");
 }
 
-void toSettings(const RenderOptions& o, engine::PipelineSettings& p, render::RenderSettings& r) {
+void toSettings(const RenderOptions& o, const SceneSettings& scene, engine::PipelineSettings& p,
+                render::RenderSettings& r) {
     using namespace render;
     using namespace engine;
     if (o.frames < 1 || o.frames > 100000) throw InputError("--frames must be 1..100000");
@@ -131,8 +142,8 @@ void toSettings(const RenderOptions& o, engine::PipelineSettings& p, render::Ren
     p.gi.subsample = o.subsample;
     p.gi.indirect.bounces = o.bounces;
     p.gi.indirect.amortise = o.amortise;
-    p.gi.incremental = o.giIncremental;
-    p.gi.tolerance = o.giTolerance;
+    p.gi.incremental = o.giIncremental.value_or(scene.gi.incremental.value_or(p.gi.incremental));
+    p.gi.tolerance = o.giTolerance.value_or(scene.gi.tolerance.value_or(p.gi.tolerance));
     gi::validateGiSettings(p.gi);
     p.ticksPerFrame = o.ticksPerFrame;
     p.pyramidLevel = o.pyramidLevel;
@@ -182,11 +193,11 @@ void toSettings(const RenderOptions& o, engine::PipelineSettings& p, render::Ren
 int runHeadlessRender(const RenderOptions& o, const char* label) {
     engine::PipelineSettings ps;
     render::RenderSettings rs;
-    toSettings(o, ps, rs);
-    if (!o.video.empty() && std::filesystem::path(o.video).extension() != ".mp4")
-        throw InputError("--video must name an .mp4 file (got '" + o.video + "')");
     // Everything that can fail on bad input fails before any file is written.
     const SceneSettings scene = resolveScene(o.scene, o.size, static_cast<std::uint64_t>(o.seed));
+    toSettings(o, scene, ps, rs);
+    if (!o.video.empty() && std::filesystem::path(o.video).extension() != ".mp4")
+        throw InputError("--video must name an .mp4 file (got '" + o.video + "')");
     std::unique_ptr<render::GlContext> context = render::createHeadlessContext();
     ensureWritableDirectory(o.out);
     return withThreads(o.threads, [&] {
@@ -204,7 +215,8 @@ int runHeadlessRender(const RenderOptions& o, const char* label) {
                 pipeline.ticksPerFrame(), o.width, o.height, render::glDescription(gl).c_str());
         }
         std::vector<std::vector<double>> stage(7);
-        double recomputed = 0.0;  // receivers whose visibility the frames recomputed, summed over frames
+        double recomputed = 0.0;          // receivers whose visibility the frames recomputed, summed over frames
+        double indirectRecomputed = 0.0;  // the same for the indirect light
         std::vector<std::uint8_t> rgb;
         Progress progress(label, o.frames, !o.quiet);
         for (int f = 0; f < o.frames; ++f) {
@@ -221,6 +233,7 @@ int runHeadlessRender(const RenderOptions& o, const char* label) {
             const double writeMs = msSince(t);
             const engine::StageTimings& tm = pipeline.timings();
             recomputed += pipeline.giState().receiversRecomputed;
+            indirectRecomputed += pipeline.giState().indirectRecomputed;
             const double values[7] = {tm.sim, tm.pyramids, tm.scan, tm.integrate, tm.shade, renderMs, writeMs};
             for (int i = 0; i < 7; ++i) stage[static_cast<std::size_t>(i)].push_back(values[i]);
             progress.update(f + 1);
@@ -228,7 +241,7 @@ int runHeadlessRender(const RenderOptions& o, const char* label) {
         progress.finish();
         const std::string dir = std::filesystem::absolute(o.out).lexically_normal().string();
         if (!o.quiet) {
-            printSummary(label, o, stage, recomputed);
+            printSummary(label, o, ps, stage, recomputed, indirectRecomputed);
             std::printf("%s: %d frames written to %s\n", label, o.frames, dir.c_str());
         }
         if (!o.video.empty()) {

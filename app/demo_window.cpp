@@ -66,7 +66,8 @@ void drawPanel(FramePipeline& pipeline, RenderSettings& rs, bool& paused, const 
     ImGui::Text("ms: sim %.1f  pyramids %.1f  scan %.1f", avg.sim, avg.pyramids, avg.scan);
     ImGui::Text("    integrate %.1f  shade %.1f  render %.1f", avg.integrate, avg.shade, avg.render);
     // incremental GI: a paused or static scene recomputes nothing
-    ImGui::Text("GI receivers recomputed: %.0f %%", 100.0 * pipeline.giState().receiversRecomputed);
+    ImGui::Text("GI recomputed: visibility %.0f %%, indirect %.0f %%", 100.0 * pipeline.giState().receiversRecomputed,
+                100.0 * pipeline.giState().indirectRecomputed);
     ImGui::Separator();
     ImGui::Checkbox("pause simulation", &paused);
     int lighting = static_cast<int>(ps.lighting);

@@ -1,6 +1,7 @@
 #pragma once
 // Options shared by `terrain render` and `terrain demo` (its headless
 // fallback), and the headless render both run.
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -25,8 +26,8 @@ struct RenderOptions {
     std::string lighting = "global";  // key | direct | global (direct + `bounces` indirect bounces)
     int bounces = 1;
     bool amortise = false;
-    bool giIncremental = true;
-    float giTolerance = 0.0f;
+    std::optional<bool> giIncremental;  // given on the command line: over the scene's [gi] table
+    std::optional<float> giTolerance;
     std::string shadow = "soft";  // soft | map | none
     std::string debug = "none";   // none | ambient | v | key | normals | pyramid | shade | u
     int pyramidLevel = 4;
@@ -40,8 +41,10 @@ struct RenderOptions {
 void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize);
 
 /// Checks the options and turns them into pipeline and renderer settings
-/// (throws InputError naming the bad option).
-void toSettings(const RenderOptions& o, engine::PipelineSettings& pipeline, render::RenderSettings& renderer);
+/// (throws InputError naming the bad option); the scene's GI hints apply
+/// where the command line is silent.
+void toSettings(const RenderOptions& o, const SceneSettings& scene, engine::PipelineSettings& pipeline,
+                render::RenderSettings& renderer);
 
 /// The headless render: PNG frames in o.out (atomic writes), a progress bar,
 /// the per-stage timing summary and, when asked, an mp4. Returns the exit code.

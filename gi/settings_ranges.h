@@ -44,7 +44,9 @@ inline constexpr SettingRange<float> kPhongExponent{"Phong exponent", 0.01f, 100
 inline constexpr SettingRange<float> kSpecularWeight{"specular weight", 0.0f, 1.0f,
                                                      "Weight of the Phong lobe in the Lambert + Phong mixture"};
 inline constexpr SettingRange<float> kTolerance{
-    "GI tolerance", 0.0f, 1.0f, "Largest change of the ambient map a cached visibility may be behind by (0: exact)"};
+    "GI tolerance", 0.0f, 1.0f,
+    "Largest change in shade units a cached GI result may be behind by: the ambient map's for the visibility, the "
+    "gathered radiance's for the indirect light (0: exact)"};
 inline constexpr SettingRange<int> kBounces{"bounces", 0, 16, "Indirect light bounces (0: direct light only)"};
 inline constexpr SettingRange<int> kRadianceLevelsPerOctave{"radiance levels per octave", 1, 64,
                                                             "Radiance pyramid levels per octave k_u"};

@@ -3,6 +3,7 @@
 // fixed time step. A scene runs only the stages it declares (model only what
 // a scene needs): no water layers without water, no erosion without erosion.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,14 @@ struct TerrainSource {
     float rampEnd = 0.0f;      // m added at the last column (a tilted coast)
 };
 
+/// How a scene asks to be lit by the GI (a scene file's [gi] table). Unset
+/// values leave the engine's defaults; command-line options override both.
+/// Plain values: the GI checks their ranges when it applies them.
+struct SceneGiHints {
+    std::optional<bool> incremental;  // change-driven GI frames (GiSettings::incremental)
+    std::optional<float> tolerance;   // GiSettings::tolerance, shade units
+};
+
 struct SceneSettings {
     std::string name = "erosion";
     int nx = 256;
@@ -49,6 +58,7 @@ struct SceneSettings {
 
     float dt = 0.0f;      // s; 0 = the default, derived from the CFL limits
     int changeTile = 32;  // cells per side of a change-tracking tile
+    SceneGiHints gi;
 };
 
 /// The built-in scenes: "erosion", "waves", "dem". size is the grid side

@@ -14,6 +14,7 @@
 //   [terrain]  kind = "noise" | "shape" | "dem", plus the generator's keys
 //   [hydraulic] enabled = true, ...   [thermal] ...   [waves] ...
 //   [waves.swell] ...   [[waves.drops]] ...
+//   [gi] incremental = true, tolerance = 0.01   # change-driven GI frames
 #include <cmath>
 #include <filesystem>
 #include <set>
@@ -237,6 +238,22 @@ void readWaves(const std::string& file, const toml::table& t, SceneSettings& s) 
     r.finish();
 }
 
+void readGi(const std::string& file, const toml::table& t, SceneSettings& s) {
+    TableReader r(t, file, "gi.");
+    if (r.get("incremental")) {
+        bool on = true;
+        r.flag("incremental", on);
+        s.gi.incremental = on;
+    }
+    if (r.get("tolerance")) {
+        float tolerance = 0.0f;
+        r.num("tolerance", tolerance);
+        if (tolerance < 0.0f) r.fail("tolerance", "a number >= 0");
+        s.gi.tolerance = tolerance;
+    }
+    r.finish();
+}
+
 }  // namespace
 
 SceneSettings loadSceneFile(const std::string& file) {
@@ -293,6 +310,7 @@ SceneSettings loadSceneFile(const std::string& file) {
     if (const toml::table* t = r.table("hydraulic")) readHydraulic(file, *t, s);
     if (const toml::table* t = r.table("thermal")) readThermal(file, *t, s);
     if (const toml::table* t = r.table("waves")) readWaves(file, *t, s);
+    if (const toml::table* t = r.table("gi")) readGi(file, *t, s);
     r.finish();
     try {
         checkDimensions(s.nx, s.ny, s.cellSize);

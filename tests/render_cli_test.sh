@@ -79,5 +79,16 @@ if [ "$(id -u)" != 0 ]; then
 fi
 expect_error "uncreatable output" "output folder" /proc/terrain-out "$T" render "${small[@]}" --frames 1 --out /proc/terrain-out
 
+# a scene file's [gi] table sets incremental GI and its tolerance; the command line overrides it
+printf 'base = "erosion"\nsize = 32\n[gi]\nincremental = false\ntolerance = 0.02\n' >"$tmp/gi.toml"
+"$T" render --scene "$tmp/gi.toml" "${small[@]}" --frames 2 --out "$tmp/g1" >"$tmp/o" 2>&1 \
+  && grep -q "incremental GI off, tolerance 0.02)" "$tmp/o" && ok || bad "scene [gi] table: $(cat "$tmp/o")"
+"$T" render --scene "$tmp/gi.toml" "${small[@]}" --frames 2 --out "$tmp/g2" --gi-incremental on --gi-tolerance 0 >"$tmp/o" 2>&1 \
+  && grep -q "incremental GI on, tolerance 0)" "$tmp/o" && ok || bad "command line over [gi]: $(cat "$tmp/o")"
+printf 'base = "erosion"\nsize = 32\n[gi]\ntolerance = 3.0\n' >"$tmp/gi_bad.toml"
+expect_error "scene [gi] tolerance out of range" "GI tolerance" "$tmp/g3" "$T" render --scene "$tmp/gi_bad.toml" "${small[@]}" --frames 1 --out "$tmp/g3"
+printf 'base = "erosion"\nsize = 32\n[gi]\ntolerence = 0.1\n' >"$tmp/gi_typo.toml"
+expect_error "scene [gi] unknown key" "unknown key 'gi.tolerence'" "$tmp/g4" "$T" render --scene "$tmp/gi_typo.toml" "${small[@]}" --frames 1 --out "$tmp/g4"
+
 echo "render_cli: $pass passed, $fail failed"
 [ $fail -eq 0 ]
