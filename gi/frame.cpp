@@ -335,6 +335,7 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
     if (settings.incremental) st.geometryChanged = change.geometry;
     st.timings = GiTimings{};
     st.receiversRecomputed = 0.0;
+    st.indirectRecomputed = 0.0;
     st.keyVisibilitiesRecomputed = 0;
     if (!change.any() && !st.directStale && !st.indirectStale) {
         st.directUpdated = st.indirectUpdated = false;  // the cached results are this frame's

@@ -47,6 +47,7 @@ TEST_CASE("gi.frame_change: a static scene does no GI work after the first frame
             CHECK_FALSE(st.directUpdated);
             CHECK_FALSE(st.indirectUpdated);
             CHECK(st.receiversRecomputed == 0.0);
+            CHECK(st.indirectRecomputed == 0.0);
             CHECK(sameOutputs(st, first));
         }
         // switched off, the same frame recomputes everything, with the same result
