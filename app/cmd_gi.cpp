@@ -384,6 +384,7 @@ Runner addGiCommand(CLI::App& app) {
                     "first frame); off: every frame recomputes everything")
         ->capture_default_str();
     sub->add_option("--gi-tolerance", gs.tolerance, gi::describe(r::kTolerance))->capture_default_str();
+    sub->add_option("--gi-refresh", gs.refreshEvery, gi::describe(r::kRefreshEvery))->capture_default_str();
     sub->add_flag("--amortise", gs.indirect.amortise,
                   "With --frames on static geometry: alternate direct and indirect updates");
     sub->add_option("--out-indirect", o->outIndirect,

@@ -106,6 +106,8 @@ void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize) {
     sub->add_option("--gi-tolerance", o.giTolerance,
                     gi::describe(gi::ranges::kTolerance) + " (default: the scene file's [gi] tolerance, else " +
                         formatNumber(engine::defaultPipelineGi().tolerance) + ")");
+    sub->add_option("--gi-refresh", o.giRefresh,
+                    gi::describe(gi::ranges::kRefreshEvery) + " (default: the scene file's [gi] refresh, else 0)");
     sub->add_flag("--amortise", o.amortise,
                   "Shading amortisation: on static geometry update direct and indirect light on alternate frames");
     sub->add_option("--shadow", o.shadow, "Key light shadow: soft (engine visibility) | map (shadow map) | none")
@@ -144,6 +146,7 @@ void toSettings(const RenderOptions& o, const SceneSettings& scene, engine::Pipe
     p.gi.indirect.amortise = o.amortise;
     p.gi.incremental = o.giIncremental.value_or(scene.gi.incremental.value_or(p.gi.incremental));
     p.gi.tolerance = o.giTolerance.value_or(scene.gi.tolerance.value_or(p.gi.tolerance));
+    p.gi.refreshEvery = o.giRefresh.value_or(scene.gi.refreshEvery.value_or(p.gi.refreshEvery));
     gi::validateGiSettings(p.gi);
     p.ticksPerFrame = o.ticksPerFrame;
     p.pyramidLevel = o.pyramidLevel;

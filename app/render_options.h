@@ -28,6 +28,7 @@ struct RenderOptions {
     bool amortise = false;
     std::optional<bool> giIncremental;  // given on the command line: over the scene's [gi] table
     std::optional<float> giTolerance;
+    std::optional<int> giRefresh;
     std::string shadow = "soft";  // soft | map | none
     std::string debug = "none";   // none | ambient | v | key | normals | pyramid | shade | u
     int pyramidLevel = 4;

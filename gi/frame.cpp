@@ -329,7 +329,10 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
                 GiState& st, const AlbedoMap* albedo) {
     const auto t0 = Clock::now();  // the whole frame: input checks and the comparison included
     validateFrameInputs(heights, cellSize, lighting, settings, albedo);
-    const FrameChange change = settings.incremental
+    const bool refresh =
+        settings.incremental && settings.refreshEvery > 0 && ++st.framesSinceRefresh >= settings.refreshEvery;
+    if (refresh || !settings.incremental) st.framesSinceRefresh = 0;
+    const FrameChange change = settings.incremental && !refresh
                                    ? compareFrameInputs(st.lastInputs, heights, cellSize, lighting, settings, albedo)
                                    : everythingChanged(lighting.keys.size());
     if (settings.incremental) st.geometryChanged = change.geometry;

@@ -55,6 +55,7 @@ struct GiState {
     bool directStale = false, indirectStale = false;
     double receiversRecomputed = 0.0;   // fraction of the receivers whose environment V the last frame recomputed
     int keyVisibilitiesRecomputed = 0;  // key lights whose V the last frame recomputed
+    int framesSinceRefresh = 0;         // incremental frames since the last full one (GiSettings::refreshEvery)
     double indirectRecomputed = 0.0;    // fraction of the receivers whose indirect light the last frame re-gathered
     // Shading amortisation (Section 7): with settings.indirect.amortise, frames
     // on unchanged geometry update the direct and the indirect light

@@ -34,6 +34,7 @@ void validateGiSettings(const GiSettings& s) {
     checkRange(ranges::kPhongExponent, s.shading.phongExponent);
     checkRange(ranges::kSpecularWeight, s.shading.specularWeight);
     checkRange(ranges::kTolerance, s.tolerance);
+    checkRange(ranges::kRefreshEvery, s.refreshEvery);
     validateIndirectSettings(s.indirect);
 }
 

@@ -35,6 +35,10 @@ struct GiSettings {
     // by a conservative bound (gi/visibility_cache.h); 0: recompute whatever
     // may have changed at all (bit-identical to full frames).
     float tolerance = 0.0f;
+    // With incremental frames: every refreshEvery-th frame recomputes
+    // everything, bit-identical to a full frame, whatever the bounds say
+    // (0: never).
+    int refreshEvery = 0;
     bool operator==(const GiSettings&) const = default;
 };
 

@@ -47,6 +47,8 @@ inline constexpr SettingRange<float> kTolerance{
     "GI tolerance", 0.0f, 1.0f,
     "Largest change in shade units a cached GI result may be behind by: the ambient map's for the visibility, the "
     "gathered radiance's for the indirect light (0: exact)"};
+inline constexpr SettingRange<int> kRefreshEvery{"GI refresh interval", 0, 1000000,
+                                                 "With incremental GI, recompute everything every N frames (0: never)"};
 inline constexpr SettingRange<int> kBounces{"bounces", 0, 16, "Indirect light bounces (0: direct light only)"};
 inline constexpr SettingRange<int> kRadianceLevelsPerOctave{"radiance levels per octave", 1, 64,
                                                             "Radiance pyramid levels per octave k_u"};

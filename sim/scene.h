@@ -36,6 +36,7 @@ struct TerrainSource {
 struct SceneGiHints {
     std::optional<bool> incremental;  // change-driven GI frames (GiSettings::incremental)
     std::optional<float> tolerance;   // GiSettings::tolerance, shade units
+    std::optional<int> refreshEvery;  // GiSettings::refreshEvery, frames
 };
 
 struct SceneSettings {

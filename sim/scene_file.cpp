@@ -14,7 +14,7 @@
 //   [terrain]  kind = "noise" | "shape" | "dem", plus the generator's keys
 //   [hydraulic] enabled = true, ...   [thermal] ...   [waves] ...
 //   [waves.swell] ...   [[waves.drops]] ...
-//   [gi] incremental = true, tolerance = 0.01   # change-driven GI frames
+//   [gi] incremental = true, tolerance = 0.01, refresh = 0   # change-driven GI frames
 #include <cmath>
 #include <filesystem>
 #include <set>
@@ -250,6 +250,11 @@ void readGi(const std::string& file, const toml::table& t, SceneSettings& s) {
         r.num("tolerance", tolerance);
         if (tolerance < 0.0f) r.fail("tolerance", "a number >= 0");
         s.gi.tolerance = tolerance;
+    }
+    if (r.get("refresh")) {
+        int every = 0;
+        r.integer("refresh", every);
+        s.gi.refreshEvery = every;
     }
     r.finish();
 }

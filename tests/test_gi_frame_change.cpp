@@ -188,3 +188,30 @@ TEST_CASE("gi.frame_change: a crater recomputes the tiles within its reach, with
                                                                    << medianOf(perAzimuth));
     }
 }
+
+TEST_CASE("gi.frame_change: a full refresh every N frames equals a full recompute bit for bit") {
+    const Grid h = bumpy(96, 80);
+    GiLighting light = sunSkyAndKey();
+    GiSettings settings = withBounces(GiSettings{}, 2, 1);
+    settings.tolerance = 0.05f;
+    settings.refreshEvery = 3;
+    GiState inc;
+    Grid moving = h;
+    for (int f = 1; f <= 7; ++f) {
+        moving(40 + f, 30) += 0.5f;  // a small change each frame, below the tolerance far from it
+        light.keys[0].rgb[2] *= 1.001f;
+        runGiFrame(moving.cview(), 2.0f, light, settings, inc);
+        GiSettings off = settings;
+        off.incremental = false;
+        GiState full;
+        runGiFrame(moving.cview(), 2.0f, light, off, full);
+        CAPTURE(f);
+        if (f % 3 == 0) {
+            CHECK(inc.receiversRecomputed == 1.0);
+            CHECK(inc.indirectRecomputed == 1.0);
+            CHECK(sameOutputs(inc, full));
+        } else if (f > 1) {
+            CHECK(inc.receiversRecomputed < 1.0);
+        }
+    }
+}
