@@ -303,7 +303,7 @@ void runDirectStages(ConstGridView heights, float cellSize, const GiLighting& li
         buildHeightPyramid(heights, cellSize, settings.subsample, settings.pyramid, st.pyramid);
         st.timings.pyramid = msSince(t);
         t = Clock::now();
-        const bool tiled = change.heightsOnly && !st.lastInputs.heights.empty();
+        const bool tiled = change.heightsOnly && !st.lastInputs.heights.empty() && shouldPlanTiles(st.visibilityCache);
         if (tiled)
             planVisibilityTiles(st.lastInputs.heights.cview(), heights, st.pyramid, settings.visibility,
                                 settings.tolerance, st.visibilityCache);

@@ -24,6 +24,12 @@ void resetVisibilityCache(const HeightPyramid& pyr, VisibilityCache& cache) {
     cache.keyDrift.assign(cache.tiles.dirty.size(), 0.0f);
 }
 
+bool shouldPlanTiles(VisibilityCache& cache) {
+    if (cache.framesWithoutPlan == 0) return true;
+    --cache.framesWithoutPlan;
+    return false;
+}
+
 void planVisibilityTiles(ConstGridView before, ConstGridView after, const HeightPyramid& pyr,
                          const VisibilitySettings& vis, float tolerance, VisibilityCache& cache) {
     if (cache.tiles.nxr != pyr.nxr || cache.tiles.nyr != pyr.nyr || cache.drift.size() != cache.tiles.dirty.size())
@@ -48,6 +54,9 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
         const float slope = std::max(lipschitz * cache.slopeBound[t], std::sqrt(2.0f) * cache.gradBound[t]);
         cache.keyTiles.dirty[t] = addDrift(shadeChangePerSlope(1.0f) * slope, tolerance, cache.keyDrift[t]) ? 1 : 0;
     }
+    const int all = static_cast<int>(cache.drift.size());
+    if (cache.tiles.dirtyCount() == all && cache.keyTiles.dirtyCount() == all)
+        cache.framesWithoutPlan = kFramesWithoutPlan;
 }
 
 }  // namespace terrain::gi

@@ -30,6 +30,13 @@ namespace terrain::gi {
 /// Receivers per side of a visibility tile (a multiple of ReceiverTiles::kTileAlign).
 inline constexpr int kVisibilityTile = 32;
 
+/// After a plan that found every tile dirty, this many frames recompute
+/// everything without computing the bounds: a terrain that changes
+/// everywhere (rain on an eroding terrain) would dirty every tile again, and
+/// the bounds would only add their cost. Recomputing is always within the
+/// tolerance, and the choice depends on the frames alone (deterministic).
+inline constexpr int kFramesWithoutPlan = 7;
+
 struct VisibilityCache {
     MaxChangePyramid change;                   // |dh| of this frame
     std::vector<float> slopeBound, gradBound;  // this frame's bounds per tile (all azimuths)
@@ -38,7 +45,13 @@ struct VisibilityCache {
     std::vector<float> tileAzimuths;           // scratch: one tile's per-azimuth slope bounds
     ReceiverTiles tiles;                       // this frame's tiles to recompute (environment)
     ReceiverTiles keyTiles;                    // the same for the key lights
+    int framesWithoutPlan = 0;                 // frames left that recompute everything unplanned
 };
+
+/// Whether this frame's changed heights should be planned tile by tile
+/// (false: recompute everything, resetVisibilityCache); counts the frames
+/// of kFramesWithoutPlan down.
+bool shouldPlanTiles(VisibilityCache& cache);
 
 /// Forgets the drift: every tile's V is about to be computed from scratch.
 void resetVisibilityCache(const HeightPyramid& pyr, VisibilityCache& cache);
