@@ -196,8 +196,9 @@ void validateFrameInputs(ConstGridView heights, float cellSize, const GiLighting
 }
 
 // Shading amortisation (Nowrouzezahrai & Snyder 2009, Section 7): on static
-// geometry, frames with the same key alternate between updating the direct
-// and the indirect light. Sets st.directUpdated / st.indirectUpdated.
+// geometry (or, with incremental frames, geometry that moved by less than the
+// tolerance everywhere), frames with the same key alternate between updating
+// the direct and the indirect light. Sets st.directUpdated / st.indirectUpdated.
 void planAmortisation(ConstGridView heights, const GiSettings& settings, GiState& st) {
     const std::array<int, 7> key = {heights.nx,
                                     heights.ny,
@@ -286,13 +287,36 @@ void directShading(const GiLighting& lighting, const GiSettings& settings, const
             addKeyLightExactCosine(lighting.keys[k], st.keyVisibility[k], settings.subsample, albedo, st, st.shade.rgb);
 }
 
+// Which receivers' visibility the frame recomputes, planned before any stage
+// runs so that amortisation sees whether the geometry moved beyond the
+// tolerance: when only the heights changed, the tiles whose cached V may have
+// drifted beyond it (gi/visibility_cache.h; the last frame's pyramid has the
+// same steps); otherwise every receiver.
+struct GeometryPlan {
+    bool tiled = false;            // recompute the visibility cache's dirty tiles only
+    bool withinTolerance = false;  // tiled, and no tile's V drifted beyond the tolerance
+};
+
+GeometryPlan planGeometry(ConstGridView heights, const GiSettings& settings, const FrameChange& change, GiState& st) {
+    GeometryPlan plan;
+    if (!change.geometry) return plan;
+    const auto t = Clock::now();
+    plan.tiled = change.heightsOnly && !st.lastInputs.heights.empty() && shouldPlanTiles(st.visibilityCache);
+    if (plan.tiled) {
+        VisibilityCache& cache = st.visibilityCache;
+        planVisibilityTiles(st.lastInputs.heights.cview(), heights, st.pyramid, settings.visibility, settings.tolerance,
+                            cache);
+        plan.withinTolerance = cache.tiles.dirtyCount() == 0 && cache.keyTiles.dirtyCount() == 0;
+    }
+    st.timings.visibility = msSince(t);
+    return plan;
+}
+
 // The direct light's stages: geometry (gradient, pyramid, environment V)
 // where it changed, each key light's V where its region of the sky or the
-// geometry changed, and the shading. When only the heights changed, the
-// visibility reruns in the tiles whose cached V may have drifted beyond the
-// tolerance (gi/visibility_cache.h).
+// geometry changed, and the shading; the visibility over the plan's tiles.
 void runDirectStages(ConstGridView heights, float cellSize, const GiLighting& lighting, const GiSettings& settings,
-                     const FrameChange& change, const AlbedoMap* albedo, GiState& st) {
+                     const FrameChange& change, const GeometryPlan& plan, const AlbedoMap* albedo, GiState& st) {
     auto t = Clock::now();
     const ReceiverTiles* only = nullptr;     // the environment's tiles to recompute (null: all)
     const ReceiverTiles* keyOnly = nullptr;  // the key lights'
@@ -303,17 +327,12 @@ void runDirectStages(ConstGridView heights, float cellSize, const GiLighting& li
         buildHeightPyramid(heights, cellSize, settings.subsample, settings.pyramid, st.pyramid);
         st.timings.pyramid = msSince(t);
         t = Clock::now();
-        const bool tiled = change.heightsOnly && !st.lastInputs.heights.empty() && shouldPlanTiles(st.visibilityCache);
-        if (tiled)
-            planVisibilityTiles(st.lastInputs.heights.cview(), heights, st.pyramid, settings.visibility,
-                                settings.tolerance, st.visibilityCache);
-        else
-            resetVisibilityCache(st.pyramid, st.visibilityCache);
-        only = tiled ? &st.visibilityCache.tiles : nullptr;
-        keyOnly = tiled ? &st.visibilityCache.keyTiles : nullptr;
+        if (!plan.tiled) resetVisibilityCache(st.pyramid, st.visibilityCache);
+        only = plan.tiled ? &st.visibilityCache.tiles : nullptr;
+        keyOnly = plan.tiled ? &st.visibilityCache.keyTiles : nullptr;
         environmentVisibility(settings, only, st);
-        st.timings.visibility = msSince(t);
-        st.receiversRecomputed = tiled ? st.visibilityCache.tiles.dirtyFraction() : 1.0;
+        st.timings.visibility += msSince(t);
+        st.receiversRecomputed = plan.tiled ? st.visibilityCache.tiles.dirtyFraction() : 1.0;
     }
     t = Clock::now();
     keyLightVisibility(lighting, settings, change, keyOnly, st);
@@ -335,7 +354,6 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
     const FrameChange change = settings.incremental && !refresh
                                    ? compareFrameInputs(st.lastInputs, heights, cellSize, lighting, settings, albedo)
                                    : everythingChanged(lighting.keys.size());
-    if (settings.incremental) st.geometryChanged = change.geometry;
     st.timings = GiTimings{};
     st.receiversRecomputed = 0.0;
     st.indirectRecomputed = 0.0;
@@ -345,14 +363,17 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
         st.timings.total = msSince(t0);
         return;
     }
+    const GeometryPlan plan = planGeometry(heights, settings, change, st);
+    if (settings.incremental) st.geometryChanged = change.geometry && !plan.withinTolerance;
     planAmortisation(heights, settings, st);
     if (!st.directUpdated) {
-        // indirect only: geometry, pyramid, visibility and direct shade are the last frame's
+        // indirect only: geometry, pyramid, visibility and direct shade are the
+        // last direct frame's, and so are the recorded inputs (below)
         runIndirectStage(settings, change, st, albedo);
         st.directStale = change.any();
         st.indirectStale = false;
     } else {
-        runDirectStages(heights, cellSize, lighting, settings, change, albedo, st);
+        runDirectStages(heights, cellSize, lighting, settings, change, plan, albedo, st);
         st.directStale = false;
         if (st.indirectUpdated) {
             runIndirectStage(settings, change, st, albedo);
@@ -362,10 +383,12 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
             st.indirectStale = true;
         }
     }
-    if (settings.incremental)
-        recordFrameInputs(heights, cellSize, lighting, settings, albedo, change, st.lastInputs);
-    else
+    // An indirect-only frame leaves the record at the last direct frame's
+    // inputs: the next direct frame then sees every change it skipped.
+    if (!settings.incremental)
         st.lastInputs.valid = false;
+    else if (st.directUpdated)
+        recordFrameInputs(heights, cellSize, lighting, settings, albedo, change, st.lastInputs);
     st.timings.total = msSince(t0);
 }
 

@@ -30,11 +30,16 @@ struct GiSettings {
     // inputs changed since the cached result; off: every frame recomputes
     // everything (for comparison).
     bool incremental = true;
-    // With incremental frames: the largest change of the ambient map (unit
-    // sky, irradiance / pi) a receiver's cached visibility may be behind by,
-    // by a conservative bound (gi/visibility_cache.h); 0: recompute whatever
-    // may have changed at all (bit-identical to full frames).
-    float tolerance = 0.0f;
+    // With incremental frames: the largest change, in shade units, a cached
+    // result may be behind by, by conservative bounds: of the ambient map
+    // (unit sky, irradiance / pi) for a receiver's visibility
+    // (gi/visibility_cache.h), of the gathered radiance for its indirect
+    // light (gi/indirect_cache.h); 0: recompute whatever may have changed at
+    // all (bit-identical to full frames). The default is the largest that
+    // kept every frame of 300-frame erosion and waves runs within 0.2 %
+    // relative RMS and 1 % of the mean at any texel of full frames
+    // (bench/results/gi_incremental.md).
+    float tolerance = 0.02f;
     // With incremental frames: every refreshEvery-th frame recomputes
     // everything, bit-identical to a full frame, whatever the bounds say
     // (0: never).
