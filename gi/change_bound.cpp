@@ -336,6 +336,45 @@ void forEachTile(const HeightPyramid& pyr, int T, std::vector<float>& out, PerTi
     });
 }
 
+// Largest D_ij over the steps of one azimuth; steps before `first` see no
+// change from any azimuth, and no step's D exceeds the largest change anywhere.
+double sampleBoundFrom(const MaxChangePyramid& dv, const StepTable& steps, const CellBox& c, int first, double cs,
+                       double sn) {
+    const double mAll = maxChangeAll(dv);
+    double best = 0.0;
+    for (std::size_t i = static_cast<std::size_t>(first); i < steps.extent.size() && best < mAll; ++i) {
+        const CellBox box = stepBoxAlong(steps.extent[i], c, cs, sn);
+        best = std::max(best, filteredChange(dv, steps, static_cast<int>(i), box));
+    }
+    return best;
+}
+
+// Fills `azimuths` values per tile (tile-major) at the m samples phi_j = 2 pi
+// j / m of the full circle, tile rows in parallel: perTile(cells, first step
+// that can see a change, cos phi, sin phi, out) writes one tile's m values.
+template <class PerTile>
+void forEachTileAndAzimuth(const MaxChangePyramid& dv, const HeightPyramid& pyr, int T, int azimuths,
+                           std::vector<float>& out, PerTile&& perTile) {
+    requireSameSize(dv, pyr, T);
+    if (azimuths < 1) throw InputError("change bound: at least one azimuth");
+    std::vector<double> cs(static_cast<std::size_t>(azimuths)), sn(cs.size());
+    for (int j = 0; j < azimuths; ++j) {
+        const double phi = 2.0 * 3.14159265358979323846 * j / azimuths;
+        cs[static_cast<std::size_t>(j)] = std::cos(phi);
+        sn[static_cast<std::size_t>(j)] = std::sin(phi);
+    }
+    const int tilesX = tileCount(pyr.nxr, T), tilesY = tileCount(pyr.nyr, T);
+    const std::size_t m = static_cast<std::size_t>(azimuths);
+    out.resize(static_cast<std::size_t>(tilesX) * static_cast<std::size_t>(tilesY) * m);
+    parallelFor(0, tilesY, 1, [&](int ty0, int ty1) {
+        for (int ty = ty0; ty < ty1; ++ty)
+            for (int tx = 0; tx < tilesX; ++tx) {
+                float* values = out.data() + (static_cast<std::size_t>(ty) * tilesX + tx) * m;
+                perTile(tileCells(pyr, T, tx, ty), cs, sn, values);
+            }
+    });
+}
+
 }  // namespace
 
 void buildMaxChangePyramid(ConstGridView dh, MaxChangePyramid& p) {
@@ -472,65 +511,28 @@ float azimuthBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, i
 
 void boundSlopeChangePerAzimuth(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int azimuths,
                                 std::vector<float>& tileBound) {
-    requireSameSize(dh, pyr, tileReceivers);
-    if (azimuths < 1) throw InputError("change bound: at least one azimuth");
     const StepTable steps = stepTable(pyr);
     const double lipschitz = heightFilterLipschitz(pyr);
-    std::vector<double> cs(static_cast<std::size_t>(azimuths)), sn(cs.size());
-    for (int j = 0; j < azimuths; ++j) {
-        const double phi = 2.0 * 3.14159265358979323846 * j / azimuths;
-        cs[static_cast<std::size_t>(j)] = std::cos(phi);
-        sn[static_cast<std::size_t>(j)] = std::sin(phi);
-    }
-    const int T = tileReceivers, tilesX = tileCount(pyr.nxr, T), tilesY = tileCount(pyr.nyr, T);
-    const std::size_t m = static_cast<std::size_t>(azimuths);
-    tileBound.resize(static_cast<std::size_t>(tilesX) * static_cast<std::size_t>(tilesY) * m);
-    parallelFor(0, tilesY, 1, [&](int ty0, int ty1) {
-        for (int ty = ty0; ty < ty1; ++ty)
-            for (int tx = 0; tx < tilesX; ++tx) {
-                const CellBox c = tileCells(pyr, T, tx, ty);
-                const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
-                const int first = firstBusyStep(dh, pyr, c, m0);
-                float* out = tileBound.data() + (static_cast<std::size_t>(ty) * tilesX + tx) * m;
-                for (std::size_t j = 0; j < m; ++j)
-                    out[j] = roundUp(azimuthBoundFrom(dh, pyr, steps, c, m0, first, cs[j], sn[j], lipschitz));
-            }
-    });
-}
-
-// Largest D_ij over the steps of one azimuth; steps before `first` see no
-// change from any azimuth, and no step's D exceeds the largest change anywhere.
-double sampleBoundFrom(const MaxChangePyramid& dv, const StepTable& steps, const CellBox& c, int first, double cs,
-                       double sn) {
-    const double mAll = maxChangeAll(dv);
-    double best = 0.0;
-    for (std::size_t i = static_cast<std::size_t>(first); i < steps.extent.size() && best < mAll; ++i) {
-        const CellBox box = stepBoxAlong(steps.extent[i], c, cs, sn);
-        best = std::max(best, filteredChange(dv, steps, static_cast<int>(i), box));
-    }
-    return best;
+    forEachTileAndAzimuth(
+        dh, pyr, tileReceivers, azimuths, tileBound,
+        [&](const CellBox& c, const std::vector<double>& cs, const std::vector<double>& sn, float* out) {
+            const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
+            const int first = firstBusyStep(dh, pyr, c, m0);
+            for (std::size_t j = 0; j < cs.size(); ++j)
+                out[j] = roundUp(azimuthBoundFrom(dh, pyr, steps, c, m0, first, cs[j], sn[j], lipschitz));
+        });
 }
 
 void boundSampleChangePerAzimuth(const MaxChangePyramid& dv, const HeightPyramid& field, int tileReceivers,
                                  int azimuths, std::vector<float>& tileBound) {
-    requireSameSize(dv, field, tileReceivers);
-    if (azimuths < 1) throw InputError("change bound: at least one azimuth");
     const StepTable steps = stepTable(field);
-    const int T = tileReceivers, tilesX = tileCount(field.nxr, T), tilesY = tileCount(field.nyr, T);
-    const std::size_t m = static_cast<std::size_t>(azimuths);
-    tileBound.resize(static_cast<std::size_t>(tilesX) * static_cast<std::size_t>(tilesY) * m);
-    parallelFor(0, tilesY, 1, [&](int ty0, int ty1) {
-        for (int ty = ty0; ty < ty1; ++ty)
-            for (int tx = 0; tx < tilesX; ++tx) {
-                const CellBox c = tileCells(field, T, tx, ty);
-                const int first = lastQuietStep(dv, field, c) + 1;
-                float* out = tileBound.data() + (static_cast<std::size_t>(ty) * tilesX + tx) * m;
-                for (std::size_t j = 0; j < m; ++j) {
-                    const double phi = 2.0 * 3.14159265358979323846 * static_cast<double>(j) / azimuths;
-                    out[j] = roundUp(sampleBoundFrom(dv, steps, c, first, std::cos(phi), std::sin(phi)));
-                }
-            }
-    });
+    forEachTileAndAzimuth(
+        dv, field, tileReceivers, azimuths, tileBound,
+        [&](const CellBox& c, const std::vector<double>& cs, const std::vector<double>& sn, float* out) {
+            const int first = lastQuietStep(dv, field, c) + 1;
+            for (std::size_t j = 0; j < cs.size(); ++j)
+                out[j] = roundUp(sampleBoundFrom(dv, steps, c, first, cs[j], sn[j]));
+        });
 }
 
 float ambientChangeBoundPerAzimuth(const float* slopeBound, int azimuths, float gradientBound, float maxSkyRadiance,

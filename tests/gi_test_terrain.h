@@ -90,4 +90,17 @@ inline bool sameOutputs(const gi::GiState& a, const gi::GiState& b) {
     return ok;
 }
 
+// Runs one frame of the incremental state `inc` and the same frame on a fresh
+// state with incremental frames off; true when every output is the same bit
+// for bit.
+inline bool incrementalMatchesFull(const Grid& h, float cellSize, const gi::GiLighting& light, const gi::GiSettings& s,
+                                   gi::GiState& inc) {
+    gi::runGiFrame(h.cview(), cellSize, light, s, inc);
+    gi::GiSettings off = s;
+    off.incremental = false;
+    gi::GiState full;
+    gi::runGiFrame(h.cview(), cellSize, light, off, full);
+    return sameOutputs(inc, full);
+}
+
 }  // namespace terrain::gi_test

@@ -14,24 +14,10 @@
 using namespace terrain;
 using namespace terrain::gi;
 using gi_test::bumpy;
+using gi_test::incrementalMatchesFull;
 using gi_test::sameOutputs;
 using gi_test::sunSkyAndKey;
 using gi_test::withBounces;
-
-namespace {
-
-// One frame of the incremental state `inc`, checked against a full recompute
-// on a fresh state with incremental frames off.
-void checkAgainstFull(const Grid& h, const GiLighting& light, const GiSettings& s, GiState& inc) {
-    runGiFrame(h.cview(), 2.0f, light, s, inc);
-    GiSettings off = s;
-    off.incremental = false;
-    GiState full;
-    runGiFrame(h.cview(), 2.0f, light, off, full);
-    CHECK(sameOutputs(inc, full));
-}
-
-}  // namespace
 
 TEST_CASE("gi.frame_change: a static scene does no GI work after the first frame") {
     const Grid h = bumpy(64, 48);
@@ -68,7 +54,7 @@ TEST_CASE("gi.frame_change: a moving sun on static geometry reruns its visibilit
     runGiFrame(h.cview(), 2.0f, light, settings, st);
     for (int f = 0; f < 4; ++f) {
         light.keys[0].azimuthDeg += 1.0f;  // 1 degree per frame
-        checkAgainstFull(h, light, settings, st);
+        CHECK(incrementalMatchesFull(h, 2.0f, light, settings, st));
         CHECK(st.receiversRecomputed == 0.0);
         CHECK(st.timings.visibility == 0.0);  // the environment's V is cached: not even timed
         CHECK(st.keyVisibilitiesRecomputed == 1);
@@ -78,12 +64,12 @@ TEST_CASE("gi.frame_change: a moving sun on static geometry reruns its visibilit
     light.environment = sunSkyLight();
     for (auto& c : light.environment.c)
         for (double& v : c) v *= 1.5;
-    checkAgainstFull(h, light, settings, st);
+    CHECK(incrementalMatchesFull(h, 2.0f, light, settings, st));
     CHECK(st.receiversRecomputed == 0.0);
     CHECK(st.keyVisibilitiesRecomputed == 0);
     // a brighter key light of the same size and direction: no visibility at all
     light.keys[0].rgb[0] = 2.0f;
-    checkAgainstFull(h, light, settings, st);
+    CHECK(incrementalMatchesFull(h, 2.0f, light, settings, st));
     CHECK(st.timings.visibility == 0.0);
     CHECK(st.keyVisibilitiesRecomputed == 0);
 }
@@ -104,7 +90,7 @@ TEST_CASE("gi.frame_change: incremental frames of an eroding terrain equal full 
         if (f == 3) light.keys[0].elevationDeg += 2.0f;
         sim.state().groundHeight(h);
         for (std::size_t i = 0; i < states.size(); ++i)
-            withThreads(threads[i], [&] { checkAgainstFull(h, light, settings, states[i]); });
+            withThreads(threads[i], [&] { CHECK(incrementalMatchesFull(h, 2.0f, light, settings, states[i])); });
         for (std::size_t i = 1; i < states.size(); ++i) CHECK(sameOutputs(states[i], states[0]));
         CHECK(states[0].directUpdated == (f != 2 && f != 4));
     }

@@ -20,6 +20,7 @@
 using namespace terrain;
 using namespace terrain::gi;
 using gi_test::bumpy;
+using gi_test::incrementalMatchesFull;
 using gi_test::sameOutputs;
 using gi_test::sunSkyAndKey;
 using gi_test::withBounces;
@@ -27,15 +28,6 @@ using gi_test::withBounces;
 namespace {
 
 constexpr float kCell = 2.0f;
-
-void checkAgainstFull(const Grid& h, const GiLighting& light, const GiSettings& s, GiState& inc) {
-    runGiFrame(h.cview(), kCell, light, s, inc);
-    GiSettings off = s;
-    off.incremental = false;
-    GiState full;
-    runGiFrame(h.cview(), kCell, light, off, full);
-    CHECK(sameOutputs(inc, full));
-}
 
 // Largest |a - b| over every channel of two RGB maps.
 double largestDifference(const std::array<Grid, 3>& a, const std::array<Grid, 3>& b) {
@@ -66,7 +58,7 @@ TEST_CASE("gi.indirect_cache: one-bounce incremental frames equal full recompute
             if (f == 4) light.keys[0].rgb[1] *= 1.5f;
             sim.state().groundHeight(h);
             for (std::size_t i = 0; i < states.size(); ++i)
-                withThreads(threads[i], [&] { checkAgainstFull(h, light, settings, states[i]); });
+                withThreads(threads[i], [&] { CHECK(incrementalMatchesFull(h, kCell, light, settings, states[i])); });
             for (std::size_t i = 1; i < states.size(); ++i) CHECK(sameOutputs(states[i], states[0]));
             CHECK(states[0].indirectUpdated == (f != 2));
         }
