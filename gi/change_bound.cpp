@@ -350,8 +350,8 @@ double sampleBoundFrom(const MaxChangePyramid& dv, const StepTable& steps, const
 }
 
 // Fills `azimuths` values per tile (tile-major) at the m samples phi_j = 2 pi
-// j / m of the full circle, tile rows in parallel: perTile(cells, first step
-// that can see a change, cos phi, sin phi, out) writes one tile's m values.
+// j / m of the full circle, tile rows in parallel: perTile(the tile's cells,
+// cos phi_j and sin phi_j of every j, out) writes one tile's m values.
 template <class PerTile>
 void forEachTileAndAzimuth(const MaxChangePyramid& dv, const HeightPyramid& pyr, int T, int azimuths,
                            std::vector<float>& out, PerTile&& perTile) {
@@ -391,18 +391,31 @@ void buildMaxChangePyramid(ConstGridView dh, MaxChangePyramid& p) {
 }
 
 void buildMaxChangePyramid(ConstGridView before, ConstGridView after, MaxChangePyramid& p) {
-    if (before.nx != after.nx || before.ny != after.ny)
-        throw InputError("change bound: the heights before and after differ in size");
-    sizeLevels(before.nx, before.ny, p);
+    buildMaxChangePyramid(std::span<const ConstGridView>(&before, 1), std::span<const ConstGridView>(&after, 1), p);
+}
+
+void buildMaxChangePyramid(std::span<const ConstGridView> before, std::span<const ConstGridView> after,
+                           MaxChangePyramid& p) {
+    if (before.empty() || before.size() != after.size())
+        throw InputError("change bound: as many fields before as after, at least one");
+    const int nx = before[0].nx, ny = before[0].ny;
+    for (std::size_t c = 0; c < before.size(); ++c)
+        if (before[c].nx != nx || before[c].ny != ny || after[c].nx != nx || after[c].ny != ny)
+            throw InputError("change bound: the fields before and after differ in size");
+    sizeLevels(nx, ny, p);
     Grid& base = p.levels[0];
-    parallelForRows(before.ny, before.nx, [&](int y0, int y1) {
+    parallelForRows(ny, nx, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
-            const float* a = before.row(y);
-            const float* b = after.row(y);
             float* out = base.data() + static_cast<std::size_t>(y) * base.nx;
-            // the difference of two floats is exact in double
-            for (int x = 0; x < before.nx; ++x)
-                out[x] = roundUp(std::fabs(static_cast<double>(b[x]) - static_cast<double>(a[x])));
+            std::fill(out, out + nx, 0.0f);
+            for (std::size_t c = 0; c < before.size(); ++c) {
+                const float* a = before[c].row(y);
+                const float* b = after[c].row(y);
+                // the difference of two floats is exact in double
+                for (int x = 0; x < nx; ++x)
+                    out[x] =
+                        std::max(out[x], roundUp(std::fabs(static_cast<double>(b[x]) - static_cast<double>(a[x]))));
+            }
         }
     });
     decimateLevels(p);
@@ -495,9 +508,10 @@ void boundGradientChange(const MaxChangePyramid& dh, const HeightPyramid& pyr, i
                 [&](int tx, int ty) { return gradientBoundOfTile(dh, pyr, tileReceivers, tx, ty); });
 }
 
-float ambientChangeBound(float slopeBound, float gradientBound, float maxSkyRadiance) {
+float ambientChangeBound(float slopeBound, float gradientBound, float maxSkyRadiance, bool withNormals) {
     const double g = kSqrt2Up * gradientBound;  // bounds both the tangent slope's and the normal's move
-    const double v = maxSkyRadiance * (kShadePerSlope * std::max<double>(slopeBound, g) + kShadePerNormal * g);
+    const double v =
+        maxSkyRadiance * (kShadePerSlope * std::max<double>(slopeBound, g) + (withNormals ? kShadePerNormal * g : 0.0));
     return roundUp(v);
 }
 

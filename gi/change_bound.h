@@ -19,6 +19,7 @@
 // slope); a caller's tolerance is far above it. Where no height within a
 // result's reach changed, the result is recomputed from the same floats by
 // the same operations, so a zero bound means bit-identical results.
+#include <span>
 #include <vector>
 
 #include "core/grid.h"
@@ -46,6 +47,12 @@ void buildMaxChangePyramid(ConstGridView dh, MaxChangePyramid& out);
 /// The same for dh = after - before (same sizes), each |dh| rounded up to
 /// the next float so that it bounds the real difference of the two floats.
 void buildMaxChangePyramid(ConstGridView before, ConstGridView after, MaxChangePyramid& out);
+
+/// The same for the largest change over several fields of one size (the
+/// channels of a radiance): max over c of |after[c] - before[c]| per cell,
+/// rounded up. Throws InputError when the counts or the sizes differ.
+void buildMaxChangePyramid(std::span<const ConstGridView> before, std::span<const ConstGridView> after,
+                           MaxChangePyramid& out);
 
 /// max |dh| over the cells [x0, x1] x [y0, y1] (inclusive, clamped to the
 /// grid; 0 when the clamped box is empty), exact: from the at most 4 x 4
@@ -255,20 +262,16 @@ inline constexpr float kShadePerSlopeExact = 2.0f;
 inline constexpr float kShadePerSlope = 2.25f;
 inline constexpr float kShadePerNormal = 1.05f;
 
-/// Bound on |change| of the engine's ambient / uniform-sky shade per unit of
-/// the horizon slope change, for sky radiance at most maxSkyRadiance.
-inline float shadeChangePerSlope(float maxSkyRadiance) { return kShadePerSlope * maxSkyRadiance; }
-
 /// Bound on |change| of the ambient map (times maxSkyRadiance for a uniform
 /// sky) at the receiver texels of a tile, from the tile's slope bound (its
 /// maximum blocking slope's: boundOfTile times blockingMaxLipschitz) and its
-/// gradient bound.
-float ambientChangeBound(float slopeBound, float gradientBound, float maxSkyRadiance);
+/// gradient bound; `withNormals` adds the shading normals' move
+/// (kShadePerNormal), which a cached V does not see.
+float ambientChangeBound(float slopeBound, float gradientBound, float maxSkyRadiance, bool withNormals);
 
 /// The same from per-azimuth slope bounds of the m = azimuths samples of the
 /// full circle (each the maximum blocking slope's: azimuthBoundOfTile times
-/// blockingMaxLipschitz) and the gradient bound; `withNormals` adds the
-/// shading normals' move (kShadePerNormal), which a cached V does not see.
+/// blockingMaxLipschitz) and the gradient bound.
 float ambientChangeBoundPerAzimuth(const float* slopeBound, int azimuths, float gradientBound, float maxSkyRadiance,
                                    bool withNormals);
 

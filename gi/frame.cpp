@@ -30,11 +30,11 @@ const FoldedWedgeOperator& indirectScanOperator(const GiSettings& settings, GiSt
 }
 
 // The receivers whose indirect light is re-gathered this frame
-// (gi/indirect_cache.h); null: every receiver.
-const ReceiverTiles* planIndirect(const GiSettings& settings, const FrameChange& change, int azimuths, GiState& st) {
-    const bool tiled = settings.incremental && gathersByTiles(settings.indirect, settings.shading) &&
-                       (!change.geometry || change.heightsOnly);
-    if (!tiled) {
+// (gi/indirect_cache.h); null: every receiver. `cached`: the frame keeps an
+// indirect cache (incremental frames, a strategy that gathers by tiles).
+const ReceiverTiles* planIndirect(const GiSettings& settings, const FrameChange& change, bool cached, int azimuths,
+                                  GiState& st) {
+    if (!cached || (change.geometry && !change.heightsOnly)) {
         invalidateIndirectCache(st.indirectCache);
         return nullptr;
     }
@@ -52,7 +52,8 @@ const ReceiverTiles* planIndirect(const GiSettings& settings, const FrameChange&
 void runIndirectStage(const GiSettings& settings, const FrameChange& change, GiState& st, const AlbedoMap* albedo) {
     const auto t = Clock::now();
     const FoldedWedgeOperator& op = indirectScanOperator(settings, st);
-    const ReceiverTiles* only = planIndirect(settings, change, op.azimuths, st);
+    const bool cached = settings.incremental && gathersByTiles(settings.indirect, settings.shading);
+    const ReceiverTiles* only = planIndirect(settings, change, cached, op.azimuths, st);
     const IndirectInputs in{.heights = st.pyramid,
                             .gradX = st.gradX.cview(),
                             .gradY = st.gradY.cview(),
@@ -65,8 +66,7 @@ void runIndirectStage(const GiSettings& settings, const FrameChange& change, GiS
                             .only = only,
                             .sameGeometry = !change.geometry};
     computeIndirect(in, settings.indirect, st.indirect);
-    if (settings.incremental && gathersByTiles(settings.indirect, settings.shading))
-        recordIndirectSource(st.shade.rgb, st.pyramid, only == nullptr, st.indirectCache);
+    if (cached) recordIndirectSource(st.shade.rgb, st.pyramid, only == nullptr, st.indirectCache);
     st.indirectRecomputed = only ? only->dirtyFraction() : 1.0;
     st.timings.indirect = msSince(t);
 }

@@ -1,10 +1,7 @@
 #include "gi/indirect_cache.h"
 
 #include <algorithm>
-#include <cmath>
-#include <limits>
 
-#include "core/parallel.h"
 #include "gi/visibility_cache.h"
 
 namespace terrain::gi {
@@ -24,30 +21,13 @@ bool cacheFits(const IndirectPlanInputs& in, const IndirectCache& cache) {
            (!in.geometryTiles || in.geometryTiles->dirty.size() == cache.tiles.dirty.size());
 }
 
-// max over the channels of |source - last|, each rounded up to the next
-// float so that it bounds the real difference of the two floats.
-void sourceChange(const std::array<Grid, 3>& source, const std::array<Grid, 3>& last, Grid& out) {
-    out.ensureSize(source[0].nx, source[0].ny);
-    parallelForRows(out.ny, out.nx, [&](int y0, int y1) {
-        const std::size_t a = static_cast<std::size_t>(y0) * out.nx, e = static_cast<std::size_t>(y1) * out.nx;
-        for (std::size_t i = a; i < e; ++i) {
-            float m = 0.0f;
-            for (std::size_t c = 0; c < 3; ++c) {
-                const double d = std::fabs(static_cast<double>(source[c].v[i]) - last[c].v[i]);
-                float f = static_cast<float>(d);
-                if (static_cast<double>(f) < d) f = std::nextafter(f, std::numeric_limits<float>::infinity());
-                m = std::max(m, f);
-            }
-            out.v[i] = m;
-        }
-    });
-}
-
 // Adds this frame's radiance bounds (per tile: the largest over the
 // azimuths) to the drifts; none when L_0 did not change at all.
 void addRadianceDrift(const IndirectPlanInputs& in, IndirectCache& cache) {
-    sourceChange(in.source, cache.lastSource, cache.sourceChange);
-    buildMaxChangePyramid(cache.sourceChange.cview(), cache.change);
+    const std::array<ConstGridView, 3> before{cache.lastSource[0].cview(), cache.lastSource[1].cview(),
+                                              cache.lastSource[2].cview()};
+    const std::array<ConstGridView, 3> after{in.source[0].cview(), in.source[1].cview(), in.source[2].cview()};
+    buildMaxChangePyramid(before, after, cache.change);
     if (maxChangeAll(cache.change) == 0.0f) return;
     boundSampleChangePerAzimuth(cache.change, in.lastPyramid.fields[0], kVisibilityTile, in.azimuths,
                                 cache.azimuthBound);

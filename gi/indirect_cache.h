@@ -33,8 +33,7 @@ namespace terrain::gi {
 struct IndirectCache {
     bool valid = false;               // the fields below describe the cached indirect result
     std::array<Grid, 3> lastSource;   // L_0 the last indirect pass read
-    Grid sourceChange;                // this frame: max over channels |L_0 - lastSource| (rounded up)
-    MaxChangePyramid change;          // its block maxima and sums
+    MaxChangePyramid change;          // this frame: max over the channels of |L_0 - lastSource|
     std::vector<float> azimuthBound;  // per tile and indirect azimuth (tile-major)
     std::vector<float> drift;         // per tile: bound of the radiance change since its result was gathered
     ReceiverTiles tiles;              // this frame's tiles to re-gather

@@ -1,7 +1,6 @@
 #include "gi/visibility_cache.h"
 
 #include <algorithm>
-#include <cmath>
 
 namespace terrain::gi {
 
@@ -51,8 +50,8 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
         const float env =
             ambientChangeBoundPerAzimuth(perAzimuth.data(), vis.azimuths, cache.gradBound[t], 1.0f, false);
         cache.tiles.dirty[t] = addDrift(env, tolerance, cache.drift[t]) ? 1 : 0;
-        const float slope = std::max(lipschitz * cache.slopeBound[t], std::sqrt(2.0f) * cache.gradBound[t]);
-        cache.keyTiles.dirty[t] = addDrift(shadeChangePerSlope(1.0f) * slope, tolerance, cache.keyDrift[t]) ? 1 : 0;
+        const float key = ambientChangeBound(lipschitz * cache.slopeBound[t], cache.gradBound[t], 1.0f, false);
+        cache.keyTiles.dirty[t] = addDrift(key, tolerance, cache.keyDrift[t]) ? 1 : 0;
     }
     const int all = static_cast<int>(cache.drift.size());
     if (cache.tiles.dirtyCount() == all && cache.keyTiles.dirtyCount() == all)

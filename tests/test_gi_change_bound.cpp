@@ -184,7 +184,7 @@ Comparison compareFrames(const GiState& a, const GiState& b, const Grid& h0, con
             c.slopeOver += change > sb + allowance;
             if (sb > 0.0) c.worstSlope = std::max(c.worstSlope, change / sb);
             if (change > 1e-3) c.slopeLoose.push_back(sb / change);
-            const double ab = ambientChangeBound(static_cast<float>(sb), gradBound[t], 1.0f);
+            const double ab = ambientChangeBound(static_cast<float>(sb), gradBound[t], 1.0f, true);
             const double ambChange = std::fabs(b.shade.ambient(s * X, s * Y) - a.shade.ambient(s * X, s * Y));
             c.ambientOver += ambChange > ab + 1e-5;  // a few ulp of values about 1
             const double azb = ambientChangeBoundPerAzimuth(perAzimuth.data(), m, gradBound[t], 1.0f, true);
@@ -407,7 +407,7 @@ TEST_CASE("gi.change_bound: no change gives zero bounds, a distant change a smal
     REQUIRE(slope.size() == static_cast<std::size_t>(tileCount(90, 8) * tileCount(70, 8)));
     CHECK(std::all_of(slope.begin(), slope.end(), [](float v) { return v == 0.0f; }));
     CHECK(std::all_of(grad.begin(), grad.end(), [](float v) { return v == 0.0f; }));
-    CHECK(ambientChangeBound(0.0f, 0.0f, 1.0f) == 0.0f);
+    CHECK(ambientChangeBound(0.0f, 0.0f, 1.0f, true) == 0.0f);
 
     Grid g = h;
     g(2, 3) += 5.0f;
