@@ -113,7 +113,7 @@ void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize) {
     sub->add_option("--shadow", o.shadow, "Key light shadow: soft (engine visibility) | map (shadow map) | none")
         ->capture_default_str();
     sub->add_option("--debug", o.debug,
-                    "Debug view: none | ambient | v | u (with --lighting global) | key | normals | pyramid | shade")
+                    "Debug view: none | ambient | v | u (with --lighting global) | key | normals | pyramid | shade | albedo")
         ->capture_default_str();
     sub->add_option("--pyramid-level", o.pyramidLevel, "Height-pyramid level for --debug pyramid")
         ->capture_default_str();
@@ -180,12 +180,14 @@ void toSettings(const RenderOptions& o, const SceneSettings& scene, engine::Pipe
         r.debug = DebugView::PyramidLevel;
     else if (o.debug == "shade")
         r.debug = DebugView::ShadeMap;
+    else if (o.debug == "albedo")
+        r.debug = DebugView::Albedo;
     else if (o.debug == "u") {
         r.debug = DebugView::IndirectRadiance;
         if (p.lighting != LightingMode::Global)
             throw InputError("--debug u needs --lighting global (U is the indirect light)");
     } else
-        throw InputError("--debug must be none, ambient, v, u, key, normals, pyramid or shade (got '" + o.debug + "')");
+        throw InputError("--debug must be none, ambient, v, u, key, normals, pyramid, shade or albedo (got '" + o.debug + "')");
     r.exposure = o.exposure;
     p.verticalExaggeration = o.exaggeration;
     r.camera.yawDeg = o.yaw;

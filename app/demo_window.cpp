@@ -54,8 +54,8 @@ void steerCamera(OrbitCamera& camera) {
 void drawPanel(FramePipeline& pipeline, RenderSettings& rs, bool& paused, const StageTimings& avg, double fpsAvg) {
     const char* lightingNames[] = {"key light only", "direct (sky + key)", "global (direct + bounces)"};
     const char* shadowNames[] = {"engine soft visibility", "shadow map", "none"};
-    const char* debugNames[] = {"none",    "ambient",       "V (sky visibility)", "key visibility",
-                                "normals", "pyramid level", "GI shade map",       "U (indirect, global)"};
+    const char* debugNames[] = {"none",          "ambient",      "V (sky visibility)",   "key visibility",    "normals",
+                                "pyramid level", "GI shade map", "U (indirect, global)", "albedo (materials)"};
     PipelineSettings& ps = pipeline.settings();
     SceneLights& lights = pipeline.lights();
     ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
@@ -88,7 +88,7 @@ void drawPanel(FramePipeline& pipeline, RenderSettings& rs, bool& paused, const 
     int shadow = static_cast<int>(rs.shadow);
     if (ImGui::Combo("key shadow", &shadow, shadowNames, 3)) rs.shadow = static_cast<ShadowMode>(shadow);
     int debug = static_cast<int>(rs.debug);
-    if (ImGui::Combo("view", &debug, debugNames, 8)) rs.debug = static_cast<DebugView>(debug);
+    if (ImGui::Combo("view", &debug, debugNames, 9)) rs.debug = static_cast<DebugView>(debug);
     ImGui::SliderInt("pyramid level", &ps.pyramidLevel, 0, 16);
     ImGui::Checkbox("water", &rs.water);
     ImGui::SameLine();

@@ -4,11 +4,15 @@
 //
 // Per texel (full resolution unless noted):
 //   heights    ground (bedrock + soil) and water depth, m
-//   skyShade   RGB radiance the environment (sky) gives a white Lambertian
-//              texel, with the engine's soft visibility (gi shade map minus
-//              the key light's share)
-//   keyShade   RGB radiance the key light gives it, with the engine's soft
-//              visibility V_key (gi/ shading of the key light alone)
+//   albedo     linear RGB albedo and Phong exponent of the surface (the
+//              scene's materials, engine/material_maps.h): the GI's albedo
+//              map and the renderer's base colour
+//   skyShade   RGB radiance the texel reflects of the environment and of the
+//              indirect light (the GI's result with the albedo, minus the
+//              key light's share)
+//   keyShade   RGB radiance the key light gives a white texel, with the
+//              engine's soft visibility V_key (gi/ shading of the key light
+//              alone; times the albedo it is the key light's share)
 //   keyVisibility  keyShade / unshadowed key light (0..1): the key light's
 //              soft visibility, which also modulates the specular term
 //   ambient    gi/ ambient map (normal-weighted sky-view factor)
@@ -39,11 +43,12 @@ struct SceneLights {
 struct FrameData {
     int nx = 0, ny = 0;
     float cellSize = 1.0f;
-    float zMin = 0.0f, zMax = 1.0f;  // ground range of the first frame (fixed colour ramp)
+    float zMin = 0.0f, zMax = 1.0f;  // ground range of the first frame (camera framing, debug views)
     bool hasWater = false;
     float exaggeration = 1.0f;            // vertical exaggeration (applied by the renderer to the heights)
-    bool coast = false;                   // colour palette: coast (waves scenes) or mountains
     std::vector<float> heights;           // 2 per texel: ground, water depth
+    std::vector<float> albedo;            // 4 per texel: linear RGB albedo, Phong exponent
+    std::int64_t albedoVersion = 0;       // new (unique in the process) whenever `albedo` changes
     std::vector<float> shade;             // 4 per texel: sky RGB, key visibility
     std::vector<float> key;               // 4 per texel: key RGB, ambient
     int nxr = 0, nyr = 0, subsample = 1;  // receiver grid

@@ -1,6 +1,7 @@
 #include "engine/pipeline.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 
@@ -33,8 +34,6 @@ gi::GiLighting giLighting(const SceneLights& lights) {
     return lighting;
 }
 
-// Per texel: ground and water depth; the shade without the key light and the
-// key light's own shade; the key light's soft visibility and the ambient map.
 // Ground and water depth of every texel (they may move apart while their
 // sum, the lit surface, stays: packed every frame).
 void packHeights(const TerrainState& s, FrameData& f) {
@@ -50,9 +49,13 @@ void packHeights(const TerrainState& s, FrameData& f) {
     });
 }
 
-void packTexels(const TerrainState& s, const gi::GiState& gi, const std::array<Grid, 3>& keyRgb, const gi::KeyLight& k,
-                bool indirect, FrameData& f) {
-    const int nx = s.nx, ny = s.ny;
+// Per texel: the shade without the key light's share and the key light's
+// own shade of a white texel; its soft visibility and the ambient map.
+// `total` is the GI's result with the albedo, so the key light's share of it
+// is the albedo times keyRgb.
+void packTexels(const gi::GiState& gi, const std::array<Grid, 3>& total, const std::array<Grid, 3>& keyRgb,
+                const gi::AlbedoMap& albedo, const gi::KeyLight& k, FrameData& f) {
+    const int nx = total[0].nx, ny = total[0].ny;
     const std::size_t n = static_cast<std::size_t>(nx) * ny;
     f.shade.resize(4 * n);
     f.key.resize(4 * n);
@@ -60,17 +63,15 @@ void packTexels(const TerrainState& s, const gi::GiState& gi, const std::array<G
     const float lx = ce * std::cos(k.azimuthDeg * kDeg), ly = ce * std::sin(k.azimuthDeg * kDeg);
     const float lz = std::sin(k.elevationDeg * kDeg);
     const float keyLum = 0.2126f * k.rgb[0] + 0.7152f * k.rgb[1] + 0.0722f * k.rgb[2];
-    const auto& total = indirect ? gi.indirect.total : gi.shade.rgb;
     parallelForRows(ny, nx, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y)
             for (int x = 0; x < nx; ++x) {
                 const std::size_t i = static_cast<std::size_t>(y) * nx + x;
                 float keyC[3];
-                for (int c = 0; c < 3; ++c) {
-                    keyC[c] = std::max(0.0f, keyRgb[static_cast<std::size_t>(c)].v[i]);
-                    f.shade[4 * i + static_cast<std::size_t>(c)] = std::max(
-                        0.0f, total[static_cast<std::size_t>(c)].v[i] - keyRgb[static_cast<std::size_t>(c)].v[i]);
-                    f.key[4 * i + static_cast<std::size_t>(c)] = keyC[c];
+                for (std::size_t c = 0; c < 3; ++c) {
+                    keyC[c] = std::max(0.0f, keyRgb[c].v[i]);
+                    f.shade[4 * i + c] = std::max(0.0f, total[c].v[i] - albedo.channel[c].v[i] * keyRgb[c].v[i]);
+                    f.key[4 * i + c] = keyC[c];
                 }
                 // Soft visibility of the key light: its shade over the unshadowed N.L shade.
                 const float gx = gi.gradX.v[i], gy = gi.gradY.v[i];
@@ -81,6 +82,24 @@ void packTexels(const TerrainState& s, const gi::GiState& gi, const std::array<G
                 f.key[4 * i + 3] = gi.shade.ambient.v[i];
             }
     });
+}
+
+// Albedo and Phong exponent of every texel.
+void packAlbedo(const MaterialMaps& maps, FrameData& f) {
+    const std::size_t n = maps.exponent.v.size();
+    f.albedo.resize(4 * n);
+    parallelFor(0, static_cast<int>(maps.exponent.ny), 1, [&](int y0, int y1) {
+        const std::size_t a = static_cast<std::size_t>(y0) * maps.exponent.nx;
+        const std::size_t e = static_cast<std::size_t>(y1) * maps.exponent.nx;
+        for (std::size_t i = a; i < e; ++i) {
+            for (std::size_t c = 0; c < 3; ++c) f.albedo[4 * i + c] = maps.albedo.channel[c].v[i];
+            f.albedo[4 * i + 3] = maps.exponent.v[i];
+        }
+    });
+    // unique in the process, so that a renderer fed by several pipelines
+    // never takes one pipeline's maps for another's
+    static std::atomic<std::int64_t> versions{0};
+    f.albedoVersion = ++versions;
 }
 
 // Receiver grid: sky visibility fraction (V_00 sqrt(4 pi) / 2 pi), one
@@ -166,8 +185,9 @@ gi::GiSettings defaultPipelineGi() {
 }
 
 FramePipeline::FramePipeline(const SceneSettings& scene, const PipelineSettings& settings, const SceneLights& lights)
-    : sim_(scene), settings_(settings), lights_(lights) {
+    : sim_(scene), settings_(settings), lights_(lights), materials_(scene.materials) {
     gi::validateGiSettings(settings_.gi);
+    validateMaterials(materials_);
     if (settings_.ticksPerFrame < 0) throw InputError("ticks per frame must be >= 0");
     ticksPerFrame_ = settings_.ticksPerFrame;
     if (ticksPerFrame_ == 0) {
@@ -188,7 +208,6 @@ void FramePipeline::terrainReplaced() {
     frame_.ny = s.ny;
     frame_.cellSize = s.cellSize;
     frame_.hasWater = s.hasWater();
-    frame_.coast = sim_.settings().waves;
     float lo = s.ground(0, 0), hi = lo;
     for (int y = 0; y < s.ny; ++y)
         for (int x = 0; x < s.nx; ++x) {
@@ -199,6 +218,13 @@ void FramePipeline::terrainReplaced() {
     frame_.zMax = hi > lo ? hi : lo + 1.0f;
     const float extent = static_cast<float>(std::max(s.nx, s.ny) - 1) * s.cellSize;
     autoExaggeration_ = std::clamp(0.15f * extent / (frame_.zMax - frame_.zMin), 1.0f, 10.0f);
+    mapsTick_ = -1;
+}
+
+void FramePipeline::setMaterials(const MaterialSet& materials) {
+    validateMaterials(materials);
+    materials_ = materials;
+    mapsTick_ = -1;
 }
 
 void FramePipeline::advance() {
@@ -216,6 +242,12 @@ void FramePipeline::light() {
     const TerrainState& s = sim_.state();
     auto t = Clock::now();
     exaggeratedSurface(s, exag, surface_);
+    // The materials follow the terrain: derived again only when it ticked.
+    const bool newMaps = mapsTick_ != s.tick;
+    if (newMaps) {
+        deriveMaterialMaps(s, materials_, maps_);
+        mapsTick_ = s.tick;
+    }
     const gi::GiLighting lighting = giLighting(lights_);
     // Global lighting adds gi.indirect.bounces indirect bounces (gi/indirect.h);
     // the other modes none. The simulator's change report says whether the
@@ -229,12 +261,13 @@ void FramePipeline::light() {
     const ChangeReport& ch = sim_.changes();
     gi_.geometryChanged = exag != lastExaggeration_ || ch.maxGroundChange > 0.0f || ch.maxWaterChange > 0.0f;
     lastExaggeration_ = exag;
-    gi::runGiFrame(surface_.cview(), s.cellSize, lighting, gs, gi_);
+    gi::runGiFrame(surface_.cview(), s.cellSize, lighting, gs, gi_, &maps_.albedo);
     const double surfaceMs = msSince(t);
 
     t = Clock::now();
     FrameData& f = frame_;
     packHeights(s, f);
+    if (newMaps) packAlbedo(maps_, f);
     const bool giUpdated = gi_.directUpdated || gi_.indirectUpdated;
     if (!giUpdated && f.lighting == settings_.lighting && packedPyramidLevel_ == settings_.pyramidLevel) {
         // nothing the light sees changed: the packed shade is this frame's
@@ -254,7 +287,7 @@ void FramePipeline::light() {
     f.tick = s.tick;
     f.time = s.time;
     const bool indirect = gs.indirect.bounces > 0;
-    packTexels(s, gi_, keyOnly_, lights_.key, indirect, f);
+    packTexels(gi_, indirect ? gi_.indirect.total : gi_.shade.rgb, keyOnly_, maps_.albedo, lights_.key, f);
     packReceivers(gi_, surface_, settings_, exag, indirect, f);
     const double packMs = msSince(t);
     recordGiTimings(gi_, gs, surfaceMs, packMs, timings_);

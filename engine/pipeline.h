@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "engine/frame_data.h"
+#include "engine/material_maps.h"
 #include "gi/frame.h"
 #include "sim/scene.h"
 
@@ -50,6 +51,12 @@ public:
     PipelineSettings& settings() { return settings_; }
     const PipelineSettings& settings() const { return settings_; }
     SceneLights& lights() { return lights_; }
+    /// The materials the maps are derived from (the scene's at start).
+    const MaterialSet& materials() const { return materials_; }
+    /// Replaces them (validated); the next light() derives the maps anew.
+    void setMaterials(const MaterialSet& materials);
+    /// The per-texel maps of the last light() (the GI's albedo and the renderer's base colour).
+    const MaterialMaps& materialMaps() const { return maps_; }
     const FrameData& frame() const { return frame_; }
     const Simulation& simulation() const { return sim_; }
     /// For tools and tests that set the ground themselves; call terrainReplaced() after.
@@ -71,6 +78,9 @@ private:
     float lastExaggeration_ = -1.0f;  // exaggeration of the last lit frame (a change moves the surface)
     int packedPyramidLevel_ = -2;     // the debug level in the packed receiver data (-2: none packed yet)
     Grid surface_;                    // ground + water: what the light sees
+    MaterialSet materials_;
+    MaterialMaps maps_;
+    std::int64_t mapsTick_ = -1;  // the tick the maps were derived at (-1: to derive)
     gi::GiState gi_;
     gi::ShadeMaps keyScratch_;     // buffers of the key light's own shading
     std::array<Grid, 3> keyOnly_;  // the key light's shade alone (white albedo)

@@ -111,8 +111,8 @@ Renderer::~Renderer() {
     releaseTarget(hdr_);
     releaseTarget(ldr_);
     releaseTarget(shadow_);
-    const GLuint textures[] = {heightTex_, shadeTex_, keyTex_, receiverTex_, envTex_};
-    gl_.DeleteTextures(5, textures);
+    const GLuint textures[] = {heightTex_, shadeTex_, keyTex_, receiverTex_, envTex_, albedoTex_};
+    gl_.DeleteTextures(6, textures);
     gl_.DeleteBuffers(1, &indexBuffer_);
     gl_.DeleteVertexArrays(1, &vao_);
     for (GLuint p : {terrainProgram_, waterProgram_, shadowProgram_, postProgram_}) gl_.DeleteProgram(p);
@@ -141,6 +141,11 @@ void Renderer::upload(const engine::FrameData& f) {
     streamTexture(shadeTex_, shadeW_, shadeH_, f.nx, f.ny, GL_RGBA32F, GL_RGBA, f.shade.data());
     streamTexture(keyTex_, keyW_, keyH_, f.nx, f.ny, GL_RGBA32F, GL_RGBA, f.key.data());
     streamTexture(receiverTex_, recvW_, recvH_, f.nxr, f.nyr, GL_RGBA32F, GL_RGBA, f.receiver.data());
+    // the materials change only when the terrain does
+    if (f.albedoVersion != albedoVersion_ || albedoW_ != f.nx || albedoH_ != f.ny) {
+        streamTexture(albedoTex_, albedoW_, albedoH_, f.nx, f.ny, GL_RGBA32F, GL_RGBA, f.albedo.data());
+        albedoVersion_ = f.albedoVersion;
+    }
 
     // The environment map: the sky's SH radiance baked to 64 x 32 texels
     // (order 4 is band-limited, i.e. already a prefiltered map).
@@ -193,7 +198,6 @@ void Renderer::upload(const engine::FrameData& f) {
     meta_.zMin = f.zMin;
     meta_.zMax = f.zMax;
     meta_.hasWater = f.hasWater;
-    meta_.coast = f.coast;
     meta_.exaggeration = f.exaggeration;
     meta_.lights = f.lights;
     meta_.lighting = f.lighting;
@@ -340,8 +344,8 @@ void Renderer::drawSurfaces(const RenderSettings& s, const FrameViews& v, int wi
     gl_.Enable(GL_DEPTH_TEST);
     gl_.DepthFunc(GL_LESS);
     gl_.Disable(GL_CULL_FACE);
-    const GLuint textures[] = {heightTex_, shadeTex_, keyTex_, receiverTex_, envTex_, shadow_.depth};
-    for (int i = 0; i < 6; ++i) {
+    const GLuint textures[] = {heightTex_, shadeTex_, keyTex_, receiverTex_, envTex_, shadow_.depth, albedoTex_};
+    for (int i = 0; i < 7; ++i) {
         gl_.ActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + i));
         gl_.BindTexture(GL_TEXTURE_2D, textures[i]);
     }
@@ -368,6 +372,7 @@ void Renderer::surfaceUniforms(GLuint p, int water, const RenderSettings& s, con
     u.i("uReceiver", 3);
     u.i("uEnv", 4);
     u.i("uShadowMap", 5);
+    u.i("uAlbedo", 6);
     u.i2("uReceiverGrid", f.nxr, f.nyr);
     u.i("uSubsample", f.subsample);
     u.v3("uEye", v.eye);
@@ -379,7 +384,6 @@ void Renderer::surfaceUniforms(GLuint p, int water, const RenderSettings& s, con
     u.i("uSpecular", s.specular ? 1 : 0);
     u.i("uDebug", static_cast<int>(s.debug));
     u.f2("uZRange", f.zMin, f.zMax);
-    u.i("uPalette", f.coast ? 1 : 0);
     u.m4("uLightViewProj", v.lightViewProj);
     u.f("uShadowTexel", shadow_.w > 0 ? 1.0f / static_cast<float>(shadow_.w) : 0.0f);
 }

@@ -31,8 +31,9 @@ enum class DebugView {
     KeyVisibility,     // the key light's soft visibility
     Normals,           // full-resolution normals
     PyramidLevel,      // one height-pyramid level, receiver grid
-    ShadeMap,          // gi/ RGB shade map (sky + key, white albedo)
+    ShadeMap,          // the GI's diffuse result: sky, key light and indirect light, with the albedo
     IndirectRadiance,  // U: mean incident indirect radiance (U's constant term, or E / pi without U), receiver grid
+    Albedo,            // the materials' albedo map: the GI's albedo and the base colour
 };
 
 struct OrbitCamera {
@@ -90,9 +91,10 @@ private:
     GLuint vao_ = 0, indexBuffer_ = 0;
     std::int64_t indexCount_ = 0;
     int meshNx_ = 0, meshNy_ = 0;
-    GLuint heightTex_ = 0, shadeTex_ = 0, keyTex_ = 0, receiverTex_ = 0, envTex_ = 0;
+    GLuint heightTex_ = 0, shadeTex_ = 0, keyTex_ = 0, receiverTex_ = 0, envTex_ = 0, albedoTex_ = 0;
     int heightW_ = 0, heightH_ = 0, shadeW_ = 0, shadeH_ = 0, keyW_ = 0, keyH_ = 0, recvW_ = 0, recvH_ = 0, envW_ = 0,
-        envH_ = 0;
+        envH_ = 0, albedoW_ = 0, albedoH_ = 0;
+    std::int64_t albedoVersion_ = -1;  // FrameData::albedoVersion of the uploaded albedo
     Target hdr_, ldr_, shadow_;
     engine::FrameData meta_;  // the uploaded frame's sizes, lights and modes (no per-texel arrays)
     std::vector<float> envPixels_;

@@ -37,8 +37,9 @@ void main() {}
 inline constexpr const char* kCommon = R"(
 const float PI = 3.14159265358979;
 uniform sampler2D uHeight;
-uniform sampler2D uShade;     // RGBA32F: sky shade RGB, key visibility
-uniform sampler2D uKey;       // RGBA32F: key shade RGB, ambient
+uniform sampler2D uShade;     // RGBA32F: reflected sky and indirect light RGB (with the albedo), key visibility
+uniform sampler2D uKey;       // RGBA32F: key shade RGB of a white surface, ambient
+uniform sampler2D uAlbedo;    // RGBA32F: linear albedo RGB (the GI's albedo map), Phong exponent
 uniform sampler2D uReceiver;  // RG32F at the receiver grid: sky visibility, pyramid level
 uniform sampler2D uEnv;       // RGB32F equirectangular environment (prefiltered: order-4 SH)
 uniform sampler2DShadow uShadowMap;
@@ -55,7 +56,6 @@ uniform int uShadowMode;      // 0 soft visibility (engine), 1 shadow map, 2 non
 uniform int uSpecular;
 uniform int uDebug;
 uniform vec2 uZRange;
-uniform int uPalette;         // 0 mountains, 1 coast
 uniform mat4 uLightViewProj;
 uniform float uShadowTexel;
 in vec3 vWorld;
@@ -133,21 +133,12 @@ void keyLight(vec2 uv, vec3 n, out float vis, out vec3 diffuse) {
     }
 }
 vec3 skyShade(vec2 uv) { return uLighting == 0 ? vec3(0.0) : texture(uShade, uv).rgb; }
+// Beckmann roughness of the material's Phong exponent S: m = sqrt(2 / (S + 2)),
+// the Phong-Beckmann correspondence S = 2 / m^2 - 2 of Walter et al. 2007.
+float roughness(vec2 uv) { return sqrt(2.0 / (texture(uAlbedo, uv).a + 2.0)); }
 )";
 
 inline constexpr const char* kTerrainFragment = R"(
-vec3 albedo(float h, vec3 n) {
-    float t = clamp((h - uZRange.x) / max(uZRange.y - uZRange.x, 1e-3), 0.0, 1.0);
-    vec3 c;
-    if (uPalette == 1) {  // coast: sea bed sand, beach, grass above
-        c = h < 0.8 ? vec3(0.55, 0.48, 0.34) : mix(vec3(0.55, 0.48, 0.34), vec3(0.17, 0.25, 0.09), clamp((h - 0.8) / 1.5, 0.0, 1.0));
-    } else {  // mountains: meadows, scree, snow on the top fifth
-        c = t < 0.6 ? mix(vec3(0.13, 0.20, 0.07), vec3(0.27, 0.25, 0.19), t / 0.6)
-                    : mix(vec3(0.27, 0.25, 0.19), vec3(0.75, 0.76, 0.80), smoothstep(0.78, 0.86, t));
-    }
-    // steep slopes are bare rock
-    return mix(c, vec3(0.30, 0.28, 0.26), clamp((0.78 - n.z) * 4.0, 0.0, 1.0));
-}
 void main() {
     vec2 uv = uvOf(vCell);
     vec3 n = normalAt(vCell, false);
@@ -160,18 +151,18 @@ void main() {
         else if (uDebug == 4) c = n * 0.5 + 0.5;
         else if (uDebug == 5) c = vec3((r.g - uZRange.x) / max(uZRange.y - uZRange.x, 1e-3));
         else if (uDebug == 7) c = vec3(r.b * 2.0);
-        else c = texture(uShade, uv).rgb + texture(uKey, uv).rgb;
+        else if (uDebug == 8) c = texture(uAlbedo, uv).rgb;
+        else c = texture(uShade, uv).rgb + texture(uAlbedo, uv).rgb * texture(uKey, uv).rgb;
         fragColor = vec4(clamp(c, 0.0, 1.0), 1.0);
         return;
     }
-    vec2 hw = texture(uHeight, uv).rg;
     float vis;
     vec3 keyDiffuse;
     keyLight(uv, n, vis, keyDiffuse);
-    vec3 a = albedo(hw.r, n);
-    if (hw.g > 0.002) a *= 0.75;  // wet ground
-    vec3 c = a * (skyShade(uv) + keyDiffuse);
-    if (uSpecular == 1) c += 0.35 * uKeyRgb * vis * torranceSparrow(n, normalize(uEye - vWorld), uKeyDir, 0.4, 0.04);
+    // the GI bounced light off this albedo already: only the key light's share needs it
+    vec3 c = skyShade(uv) + texture(uAlbedo, uv).rgb * keyDiffuse;
+    if (uSpecular == 1)
+        c += 0.35 * uKeyRgb * vis * torranceSparrow(n, normalize(uEye - vWorld), uKeyDir, roughness(uv), 0.04);
     fragColor = vec4(c, 1.0);
 }
 )";
@@ -191,14 +182,12 @@ void main() {
     float skyVis = clamp(texture(uReceiver, receiverUv(vCell)).r, 0.0, 1.0);
     vec3 mirror = environment(r) * skyVis;
     float f = schlick(max(dot(n, v), 0.0), 0.02);  // water, n = 1.33
-    vec3 glint = uSpecular == 1 ? uKeyRgb * vis * torranceSparrow(n, v, uKeyDir, 0.07, 0.02) : vec3(0.0);
-    // Diffuse part: light scattered by the water body; the lit terrain shows
-    // through where the water is shallow (transmittance down and back up).
-    vec3 body = vec3(0.015, 0.06, 0.08) * (skyShade(uv) + keyDiffuse);
-    float transmit = exp(-vDepth / 1.2);
-    vec3 c = f * mirror + glint + (1.0 - f) * (1.0 - transmit) * body;
-    float alpha = f + (1.0 - f) * (1.0 - transmit);
-    fragColor = vec4(c, alpha);  // premultiplied: blended ONE, ONE_MINUS_SRC_ALPHA over the terrain
+    vec3 glint = uSpecular == 1 ? uKeyRgb * vis * torranceSparrow(n, v, uKeyDir, roughness(uv), 0.02) : vec3(0.0);
+    // Diffuse part: the water body and the bed seen through it, one albedo
+    // in the GI's map (engine/material_maps.h), lit like the terrain.
+    vec3 body = skyShade(uv) + texture(uAlbedo, uv).rgb * keyDiffuse;
+    vec3 c = f * mirror + glint + (1.0 - f) * body;
+    fragColor = vec4(c, 1.0);  // premultiplied, opaque: the bed is in the body's albedo
 }
 )";
 

@@ -117,6 +117,7 @@ SceneSettings builtinScene(const std::string& name, int size, std::uint64_t seed
     } else {
         throw InputError("unknown scene '" + name + "' (built-in scenes: erosion, waves, dem; or a .toml file)");
     }
+    s.materials = builtinMaterials(name);
     return s;
 }
 

@@ -9,6 +9,7 @@
 
 #include "sim/generators.h"
 #include "sim/hydraulic.h"
+#include "sim/materials.h"
 #include "sim/terrain.h"
 #include "sim/thermal.h"
 #include "sim/waves.h"
@@ -60,6 +61,7 @@ struct SceneSettings {
     float dt = 0.0f;      // s; 0 = the default, derived from the CFL limits
     int changeTile = 32;  // cells per side of a change-tracking tile
     SceneGiHints gi;
+    MaterialSet materials;  // what the surface is made of, where (sim/materials.h)
 };
 
 /// The built-in scenes: "erosion", "waves", "dem". size is the grid side

@@ -15,6 +15,11 @@
 //   [hydraulic] enabled = true, ...   [thermal] ...   [waves] ...
 //   [waves.swell] ...   [[waves.drops]] ...
 //   [gi] incremental = true, tolerance = 0.01, refresh = 0   # change-driven GI frames
+//   [materials.bedrock] albedo = [r, g, b], exponent = 10     # sim/materials.h; likewise
+//   [materials.soil] ... cover_depth   [materials.vegetation] ... min_altitude, max_altitude,
+//   altitude_fade, max_slope   [materials.snow] ... line, altitude_fade, max_slope
+//   [materials.wet] darkening, depth, exponent   [materials.water] albedo, exponent, clarity
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <set>
@@ -48,6 +53,17 @@ public:
                 out = *v;
             else
                 fail(key, "a number");
+        }
+    }
+    void rgb(const char* key, std::array<float, 3>& out) {
+        if (const toml::node* n = get(key)) {
+            const toml::array* a = n->as_array();
+            if (!a || a->size() != 3) fail(key, "an array of three numbers [r, g, b]");
+            for (std::size_t c = 0; c < 3; ++c) {
+                auto v = a->get(c)->value<double>();
+                if (!v || !std::isfinite(*v)) fail(key, "an array of three numbers [r, g, b]");
+                out[c] = static_cast<float>(*v);
+            }
         }
     }
     void integer(const char* key, int& out) {
@@ -238,6 +254,69 @@ void readWaves(const std::string& file, const toml::table& t, SceneSettings& s) 
     r.finish();
 }
 
+void readMaterial(TableReader& r, Material& m) {
+    r.rgb("albedo", m.albedo);
+    r.num("exponent", m.phongExponent);
+}
+
+// A rule's table switches it on unless it says `enabled = false`.
+void readMaterials(const std::string& file, const toml::table& t, MaterialSet& m) {
+    TableReader r(t, file, "materials.");
+    if (const toml::table* b = r.table("bedrock")) {
+        TableReader q(*b, file, "materials.bedrock.");
+        readMaterial(q, m.bedrock);
+        q.finish();
+    }
+    if (const toml::table* b = r.table("soil")) {
+        TableReader q(*b, file, "materials.soil.");
+        readMaterial(q, m.soil.material);
+        q.num("cover_depth", m.soil.coverDepth);
+        q.finish();
+    }
+    if (const toml::table* b = r.table("vegetation")) {
+        TableReader q(*b, file, "materials.vegetation.");
+        VegetationRule& v = m.vegetation;
+        v.enabled = true;
+        q.flag("enabled", v.enabled);
+        readMaterial(q, v.material);
+        q.num("min_altitude", v.minAltitude);
+        q.num("max_altitude", v.maxAltitude);
+        q.num("altitude_fade", v.altitudeFade);
+        q.num("max_slope", v.maxSlopeDeg);
+        q.finish();
+    }
+    if (const toml::table* b = r.table("snow")) {
+        TableReader q(*b, file, "materials.snow.");
+        SnowRule& v = m.snow;
+        v.enabled = true;
+        q.flag("enabled", v.enabled);
+        readMaterial(q, v.material);
+        q.num("line", v.line);
+        q.num("altitude_fade", v.altitudeFade);
+        q.num("max_slope", v.maxSlopeDeg);
+        q.finish();
+    }
+    if (const toml::table* b = r.table("wet")) {
+        TableReader q(*b, file, "materials.wet.");
+        q.num("darkening", m.wet.darkening);
+        q.num("depth", m.wet.depth);
+        q.num("exponent", m.wet.phongExponent);
+        q.finish();
+    }
+    if (const toml::table* b = r.table("water")) {
+        TableReader q(*b, file, "materials.water.");
+        readMaterial(q, m.water.material);
+        q.num("clarity", m.water.clarity);
+        q.finish();
+    }
+    r.finish();
+    try {
+        validateMaterials(m);
+    } catch (const InputError& e) {
+        throw IoError(file, e.what());
+    }
+}
+
 void readGi(const std::string& file, const toml::table& t, SceneSettings& s) {
     TableReader r(t, file, "gi.");
     if (r.get("incremental")) {
@@ -316,6 +395,7 @@ SceneSettings loadSceneFile(const std::string& file) {
     if (const toml::table* t = r.table("thermal")) readThermal(file, *t, s);
     if (const toml::table* t = r.table("waves")) readWaves(file, *t, s);
     if (const toml::table* t = r.table("gi")) readGi(file, *t, s);
+    if (const toml::table* t = r.table("materials")) readMaterials(file, *t, s.materials);
     r.finish();
     try {
         checkDimensions(s.nx, s.ny, s.cellSize);

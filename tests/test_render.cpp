@@ -57,6 +57,8 @@ std::vector<std::uint8_t> renderShape(const std::function<float(float, float)>& 
     scene.hydraulic = scene.thermal = false;
     scene.soilDepth = 0.0f;
     scene.cellSize = 10.0f;
+    scene.materials = MaterialSet{};  // one grey: these tests measure the light, not the materials
+    scene.materials.bedrock.albedo = {0.5f, 0.5f, 0.5f};
     PipelineSettings ps;
     ps.lighting = lighting;
     ps.verticalExaggeration = 1.0f;
@@ -134,6 +136,29 @@ TEST_CASE("render.headless: a small scene gives a non-empty image") {
     CHECK(hi - lo > 40);
     const std::uint8_t* c = rgb.data() + (static_cast<std::size_t>(kH / 2) * kW + kW / 2) * 3;
     CHECK((c[0] != corner[0] || c[1] != corner[1] || c[2] != corner[2]));
+}
+
+TEST_CASE("render.materials: the renderer's base colour is the GI's albedo map") {
+    SceneSettings scene = builtinScene("erosion", 64, 1);
+    scene.hydraulic = scene.thermal = false;
+    scene.materials = MaterialSet{};
+    scene.materials.bedrock.albedo = {0.2f, 0.5f, 0.8f};
+    scene.materials.soil.material = scene.materials.bedrock;
+    FramePipeline pipeline(scene, PipelineSettings{});
+    pipeline.advance();
+    pipeline.light();
+    RenderSettings rs = topDown();
+    rs.debug = DebugView::Albedo;
+    std::vector<std::uint8_t> rgb;
+    gpu().renderer->upload(pipeline.frame());
+    gpu().renderer->drawToImage(rs, kW, kH, rgb);
+    // the albedo, sRGB-encoded, at the centre of the image
+    const std::uint8_t* c = rgb.data() + (static_cast<std::size_t>(kH / 2) * kW + kW / 2) * 3;
+    for (int k = 0; k < 3; ++k) {
+        const double a = scene.materials.bedrock.albedo[static_cast<std::size_t>(k)];
+        const double srgb = a <= 0.0031308 ? 12.92 * a : 1.055 * std::pow(a, 1.0 / 2.4) - 0.055;
+        CHECK_MESSAGE(std::abs(c[k] - 255.0 * srgb) <= 1.5, "channel ", k, ": ", int(c[k]), " for ", 255.0 * srgb);
+    }
 }
 
 TEST_CASE("render.headless: a slope facing the key light is brighter than one facing away") {
