@@ -8,7 +8,7 @@
 namespace terrain::engine {
 namespace {
 
-constexpr float kRadToDeg = 57.29577951308232f;
+constexpr float kDegToRad = 0.017453292519943295f;
 
 float smoothstep(float e0, float e1, float x) {
     const float t = std::clamp((x - e0) / (e1 - e0), 0.0f, 1.0f);
@@ -22,63 +22,105 @@ struct Blend {
     float logExponent;
 };
 Blend blendOf(const Material& m) { return {m.albedo, std::log(m.phongExponent)}; }
-void mixInto(Blend& b, const Material& m, float w) {
+void mixInto(Blend& b, const Blend& m, float w) {
     if (w <= 0.0f) return;
     for (std::size_t c = 0; c < 3; ++c) b.albedo[c] += w * (m.albedo[c] - b.albedo[c]);
-    b.logExponent += w * (std::log(m.phongExponent) - b.logExponent);
+    b.logExponent += w * (m.logExponent - b.logExponent);
 }
 
-// 1 below the slope limit, fading to 0 over kSlopeFadeDeg above it.
-float belowSlope(float slopeDeg, float maxSlopeDeg) {
-    return 1.0f - smoothstep(maxSlopeDeg, maxSlopeDeg + kSlopeFadeDeg, slopeDeg);
+// A slope limit as tangents: full cover below tan(limit), none above
+// tan(limit + kSlopeFadeDeg), so that a texel needs no arctangent.
+struct SlopeLimit {
+    float tanFull, tanNone;
+    explicit SlopeLimit(float limitDeg)
+        : tanFull(std::tan(std::min(limitDeg, 89.9f) * kDegToRad)),
+          tanNone(std::tan(std::min(limitDeg + kSlopeFadeDeg, 89.95f) * kDegToRad)) {}
+    float cover(float tanSlope) const { return 1.0f - smoothstep(tanFull, tanNone, tanSlope); }
+};
+
+// The rules with everything that does not depend on the texel worked out once.
+struct Rules {
+    const MaterialSet& m;
+    Blend bedrock, soil, vegetation, snow, waterBody;
+    float logWet;
+    SlopeLimit vegetationSlope, snowSlope;
+    explicit Rules(const MaterialSet& set)
+        : m(set),
+          bedrock(blendOf(set.bedrock)),
+          soil(blendOf(set.soil.material)),
+          vegetation(blendOf(set.vegetation.material)),
+          snow(blendOf(set.snow.material)),
+          waterBody(blendOf(set.water.material)),
+          logWet(std::log(set.wet.phongExponent)),
+          vegetationSlope(set.vegetation.maxSlopeDeg),
+          snowSlope(set.snow.maxSlopeDeg) {}
+
+    Material at(float altitude, float tanSlope, float soilDepth, float water) const {
+        Blend b = bedrock;
+        mixInto(b, soil, smoothstep(0.0f, m.soil.coverDepth, soilDepth));
+        if (m.vegetation.enabled) {
+            const VegetationRule& v = m.vegetation;
+            const float band = smoothstep(v.minAltitude - v.altitudeFade, v.minAltitude, altitude) *
+                               (1.0f - smoothstep(v.maxAltitude, v.maxAltitude + v.altitudeFade, altitude));
+            mixInto(b, vegetation, band * vegetationSlope.cover(tanSlope));
+        }
+        if (m.snow.enabled)
+            mixInto(b, snow,
+                    smoothstep(m.snow.line, m.snow.line + m.snow.altitudeFade, altitude) * snowSlope.cover(tanSlope));
+        if (water > 0.0f) {
+            const float soaked = smoothstep(0.0f, m.wet.depth, water);
+            for (float& a : b.albedo) a *= 1.0f + soaked * (m.wet.darkening - 1.0f);
+            b.logExponent += soaked * (logWet - b.logExponent);
+            // the bed seen through the water, down and back up
+            mixInto(b, waterBody, 1.0f - std::exp(-2.0f * water / m.water.clarity));
+        }
+        return {b.albedo, std::exp(b.logExponent)};
+    }
+};
+
+// Ground height (bedrock + soil) of row y of the state.
+struct GroundRow {
+    const float *rock, *soil;
+    float operator[](int x) const { return rock[x] + soil[x]; }
+};
+GroundRow groundRow(const TerrainState& s, int y) {
+    const std::size_t at = static_cast<std::size_t>(y) * s.nx;
+    return {s.bedrock.data() + at, s.soil.data() + at};
 }
 
-// Slope (degrees) of the ground at (x, y): central differences, one-sided at the edges.
-float slopeAt(const TerrainState& s, int x, int y) {
+// Tangent of the ground's slope at (x, y) from its row and the rows above and
+// below: central differences, one-sided at the edges.
+float tanSlopeAt(const TerrainState& s, const GroundRow& up, const GroundRow& row, const GroundRow& down, int rowSpan,
+                 int x) {
     const int x0 = std::max(x - 1, 0), x1 = std::min(x + 1, s.nx - 1);
-    const int y0 = std::max(y - 1, 0), y1 = std::min(y + 1, s.ny - 1);
-    const float gx = x1 > x0 ? (s.ground(x1, y) - s.ground(x0, y)) / (static_cast<float>(x1 - x0) * s.cellSize) : 0.0f;
-    const float gy = y1 > y0 ? (s.ground(x, y1) - s.ground(x, y0)) / (static_cast<float>(y1 - y0) * s.cellSize) : 0.0f;
-    return std::atan(std::sqrt(gx * gx + gy * gy)) * kRadToDeg;
+    const float gx = x1 > x0 ? (row[x1] - row[x0]) / (static_cast<float>(x1 - x0) * s.cellSize) : 0.0f;
+    const float gy = rowSpan > 0 ? (down[x] - up[x]) / (static_cast<float>(rowSpan) * s.cellSize) : 0.0f;
+    return std::sqrt(gx * gx + gy * gy);
 }
 
 }  // namespace
 
 Material materialAt(const MaterialSet& m, float altitude, float slopeDeg, float soil, float water) {
-    Blend b = blendOf(m.bedrock);
-    mixInto(b, m.soil.material, smoothstep(0.0f, m.soil.coverDepth, soil));
-    if (m.vegetation.enabled) {
-        const VegetationRule& v = m.vegetation;
-        const float band = smoothstep(v.minAltitude - v.altitudeFade, v.minAltitude, altitude) *
-                           (1.0f - smoothstep(v.maxAltitude, v.maxAltitude + v.altitudeFade, altitude));
-        mixInto(b, v.material, band * belowSlope(slopeDeg, v.maxSlopeDeg));
-    }
-    if (m.snow.enabled) {
-        const SnowRule& v = m.snow;
-        mixInto(b, v.material,
-                smoothstep(v.line, v.line + v.altitudeFade, altitude) * belowSlope(slopeDeg, v.maxSlopeDeg));
-    }
-    if (water > 0.0f) {
-        const float soaked = smoothstep(0.0f, m.wet.depth, water);
-        for (float& a : b.albedo) a *= 1.0f + soaked * (m.wet.darkening - 1.0f);
-        b.logExponent += soaked * (std::log(m.wet.phongExponent) - b.logExponent);
-        // the bed seen through the water, down and back up
-        mixInto(b, m.water.material, 1.0f - std::exp(-2.0f * water / m.water.clarity));
-    }
-    return {b.albedo, std::exp(b.logExponent)};
+    return Rules(m).at(altitude, std::tan(slopeDeg * kDegToRad), soil, water);
 }
 
 void deriveMaterialMaps(const TerrainState& s, const MaterialSet& m, MaterialMaps& out) {
     for (Grid& g : out.albedo.channel) g.ensureSize(s.nx, s.ny);
     out.exponent.ensureSize(s.nx, s.ny);
+    const Rules rules(m);
     parallelForRows(s.ny, s.nx, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y)
+        for (int y = y0; y < y1; ++y) {
+            const int ya = std::max(y - 1, 0), yb = std::min(y + 1, s.ny - 1);
+            const GroundRow up = groundRow(s, ya), row = groundRow(s, y), down = groundRow(s, yb);
+            const std::size_t at = static_cast<std::size_t>(y) * s.nx;
+            const float* water = s.hasWater() ? s.water.data() + at : nullptr;
             for (int x = 0; x < s.nx; ++x) {
                 const Material mat =
-                    materialAt(m, s.ground(x, y), slopeAt(s, x, y), s.soil(x, y), s.hasWater() ? s.water(x, y) : 0.0f);
-                for (std::size_t c = 0; c < 3; ++c) out.albedo.channel[c](x, y) = mat.albedo[c];
-                out.exponent(x, y) = mat.phongExponent;
+                    rules.at(row[x], tanSlopeAt(s, up, row, down, yb - ya, x), row.soil[x], water ? water[x] : 0.0f);
+                for (std::size_t c = 0; c < 3; ++c) out.albedo.channel[c].v[at + x] = mat.albedo[c];
+                out.exponent.v[at + x] = mat.phongExponent;
             }
+        }
     });
 }
 

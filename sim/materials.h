@@ -10,7 +10,8 @@
 //   1. bedrock, covered by soil as the soil layer thickens
 //      (smoothstep from 0 to soil.coverDepth);
 //   2. vegetation where the altitude lies in its band and the slope is below
-//      its limit (faded over altitudeFade metres and kSlopeFadeDeg degrees);
+//      its limit (faded over altitudeFade metres, and from the limit to
+//      kSlopeFadeDeg degrees above it, smoothly in the slope's tangent);
 //   3. snow above the snow line on slopes below its limit (faded likewise);
 //   4. wet ground where water stands: albedo times wet.darkening, reached at
 //      wet.depth metres of water;
