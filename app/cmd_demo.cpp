@@ -28,7 +28,7 @@ int runDemo(DemoOptions& d) {
     RenderOptions& o = d.render;
     engine::PipelineSettings ps;
     render::RenderSettings rs;
-    const SceneSettings scene = resolveScene(o.scene, o.size, static_cast<std::uint64_t>(o.seed));
+    const SceneSettings scene = resolveRenderScene(o);
     toSettings(o, scene, ps, rs);
     std::string why = d.headless ? "headless requested" : render::noDisplayReason();
     std::unique_ptr<render::WindowContext> window;

@@ -10,11 +10,13 @@
 #include <vector>
 
 #include "app/commands.h"
+#include "app/light_options.h"
 #include "core/error.h"
 #include "core/image_io.h"
 #include "core/parallel.h"
 #include "core/parse.h"
 #include "core/png_io.h"
+#include "engine/light_rig.h"
 #include "gi/albedo_io.h"
 #include "gi/frame.h"
 #include "gi/reference.h"
@@ -29,8 +31,7 @@ struct GiOptions {
     double cellSize = 0.0;
     double zScale = 1.0;
     double zOffset = 0.0;
-    std::string light = "uniform";
-    std::vector<std::string> keys;
+    LightOptions lights;  // over a uniform sky of radiance 1 and no key light
     // The numeric settings bind straight into the engine's settings: their
     // defaults and ranges are the engine's own (gi/settings.h).
     gi::GiSettings settings = gi::GiSettings{};
@@ -100,36 +101,6 @@ std::string extensionOf(const std::string& f) {
     std::string e = dot == std::string::npos ? "" : f.substr(dot);
     for (char& c : e) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     return e;
-}
-
-gi::KeyLight parseKey(const std::string& text) {
-    const std::vector<float> v = parseNumberList(text, "--key");
-    if (v.size() != 6) throw InputError("--key '" + text + "': expected AZ_DEG,EL_DEG,RADIUS_DEG,R,G,B");
-    gi::KeyLight k;
-    k.azimuthDeg = v[0];
-    k.elevationDeg = v[1];
-    k.radiusDeg = v[2];
-    k.rgb[0] = v[3];
-    k.rgb[1] = v[4];
-    k.rgb[2] = v[5];
-    gi::validateKeyLight(k);
-    return k;
-}
-
-gi::ShRgb parseLight(const std::string& light) {
-    if (light == "uniform") return gi::uniformSkyLight(1.0f);
-    if (light == "sunsky") return gi::sunSkyLight();
-    if (light.rfind("env:", 0) == 0) {
-        const std::string file = light.substr(4);
-        int w = 0, h = 0;
-        const std::vector<float> rgb = readEquirect(file, w, h);
-        try {
-            return gi::projectEquirect(rgb, w, h);
-        } catch (const InputError& e) {
-            throw IoError(file, e.what());
-        }
-    }
-    throw InputError("--light must be uniform, sunsky or env:FILE (got '" + light + "')");
 }
 
 void writeShade(const std::string& file, const std::array<Grid, 3>& rgb) {
@@ -249,13 +220,16 @@ struct GiInputs {
     double cell = 0.0;
     gi::AlbedoMap albedoMap;
     const gi::AlbedoMap* albedo = nullptr;
-    gi::GiLighting lighting;
+    std::unique_ptr<engine::LightRig> lights;  // frame f is lit by lights->at(f)
+    gi::GiLighting lighting;                   // frame 0's
 };
 
 GiInputs readInputs(const GiOptions& o, const ExponentSource& exponent) {
     GiInputs in;
-    for (const std::string& k : o.keys) in.lighting.keys.push_back(parseKey(k));
-    in.lighting.environment = parseLight(o.light);
+    LightSet lights;  // a uniform sky of radiance 1 unless the options say otherwise
+    applyLightOptions(o.lights, lights);
+    in.lights = std::make_unique<engine::LightRig>(lights);
+    in.lighting = engine::giLighting(in.lights->at(0));
     float cellFromFile = 0.0f;
     in.heights = readHeightmap(o.heightmap, static_cast<float>(o.zScale), static_cast<float>(o.zOffset), &cellFromFile);
     in.cell = o.cellSize > 0.0 ? o.cellSize : cellFromFile;
@@ -322,7 +296,9 @@ int runFastPath(const GiOptions& o, const gi::GiSettings& settings, const GiInpu
     const int bounces = settings.indirect.bounces;
     for (int f = 0; f < o.frames; ++f) {
         state.geometryChanged = f == 0;  // the same field every frame: static geometry after the first
-        gi::runGiFrame(in.heights.cview(), static_cast<float>(in.cell), in.lighting, settings, state, in.albedo);
+        // a sun moving with the time of day lights each frame anew
+        const gi::GiLighting lighting = f == 0 ? in.lighting : engine::giLighting(in.lights->at(f));
+        gi::runGiFrame(in.heights.cview(), static_cast<float>(in.cell), lighting, settings, state, in.albedo);
         if (o.time) printFrameTimes(f, o.frames, state, bounces);
         if (f > 0 || o.frames == 1) totals.push_back(state.timings.total);
     }
@@ -358,8 +334,7 @@ Runner addGiCommand(CLI::App& app) {
     sub->add_option("--cell-size", o->cellSize, "Metres between grid points (required for PNG)");
     sub->add_option("--z-scale", o->zScale, "Metres per PNG unit (S)");
     sub->add_option("--z-offset", o->zOffset, "Height of PNG value 0 in metres (O)");
-    sub->add_option("--light", o->light, "uniform | sunsky | env:FILE (.exr/.hdr equirectangular)");
-    sub->add_option("--key", o->keys, "Key light AZ_DEG,EL_DEG,RADIUS_DEG,R,G,B (repeatable)");
+    addLightOptions(sub, o->lights, "a uniform sky of radiance 1, no key light, no sun");
     gi::GiSettings& gs = o->settings;
     namespace r = gi::ranges;
     sub->add_option("--subsample", gs.subsample, gi::describe(r::kSubsample))->capture_default_str();

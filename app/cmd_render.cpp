@@ -18,6 +18,7 @@
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/parallel.h"
+#include "core/parse.h"
 #include "core/png_io.h"
 #include "engine/pipeline.h"
 #include "render/context.h"
@@ -79,13 +80,13 @@ void printSummary(const char* label, const RenderOptions& o, const engine::Pipel
         static_cast<double>(ps.gi.tolerance));
 }
 
-std::string formatNumber(float v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", static_cast<double>(v));
-    return buf;
-}
-
 }  // namespace
+
+SceneSettings resolveRenderScene(const RenderOptions& o) {
+    SceneSettings scene = resolveScene(o.scene, o.size, static_cast<std::uint64_t>(o.seed));
+    applyLightOptions(o.lights, scene.lights);
+    return scene;
+}
 
 void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize) {
     if (withSize) sub->add_option("--size", o.size, "Grid side in cells")->capture_default_str();
@@ -96,6 +97,7 @@ void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize) {
     sub->add_option("--seed", o.seed, "Seed for the scene generator")->capture_default_str();
     sub->add_option("--threads", o.threads, "Worker threads (0 = all cores)")->capture_default_str();
     sub->add_option("--subsample", o.subsample, gi::describe(gi::ranges::kSubsample))->capture_default_str();
+    addLightOptions(sub, o.lights, "the scene");
     sub->add_option("--lighting", o.lighting, "key (key light only) | direct (sky + key) | global (direct + bounces)")
         ->capture_default_str();
     sub->add_option("--bounces", o.bounces, gi::describe(gi::ranges::kBounces) + ", with --lighting global")
@@ -112,8 +114,9 @@ void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize) {
                   "Shading amortisation: on static geometry update direct and indirect light on alternate frames");
     sub->add_option("--shadow", o.shadow, "Key light shadow: soft (engine visibility) | map (shadow map) | none")
         ->capture_default_str();
-    sub->add_option("--debug", o.debug,
-                    "Debug view: none | ambient | v | u (with --lighting global) | key | normals | pyramid | shade | albedo")
+    sub->add_option(
+           "--debug", o.debug,
+           "Debug view: none | ambient | v | u (with --lighting global) | key | normals | pyramid | shade | albedo")
         ->capture_default_str();
     sub->add_option("--pyramid-level", o.pyramidLevel, "Height-pyramid level for --debug pyramid")
         ->capture_default_str();
@@ -187,7 +190,8 @@ void toSettings(const RenderOptions& o, const SceneSettings& scene, engine::Pipe
         if (p.lighting != LightingMode::Global)
             throw InputError("--debug u needs --lighting global (U is the indirect light)");
     } else
-        throw InputError("--debug must be none, ambient, v, u, key, normals, pyramid, shade or albedo (got '" + o.debug + "')");
+        throw InputError("--debug must be none, ambient, v, u, key, normals, pyramid, shade or albedo (got '" +
+                         o.debug + "')");
     r.exposure = o.exposure;
     p.verticalExaggeration = o.exaggeration;
     r.camera.yawDeg = o.yaw;
@@ -199,17 +203,17 @@ int runHeadlessRender(const RenderOptions& o, const char* label) {
     engine::PipelineSettings ps;
     render::RenderSettings rs;
     // Everything that can fail on bad input fails before any file is written.
-    const SceneSettings scene = resolveScene(o.scene, o.size, static_cast<std::uint64_t>(o.seed));
+    const SceneSettings scene = resolveRenderScene(o);
     toSettings(o, scene, ps, rs);
     if (!o.video.empty() && std::filesystem::path(o.video).extension() != ".mp4")
         throw InputError("--video must name an .mp4 file (got '" + o.video + "')");
     std::unique_ptr<render::GlContext> context = render::createHeadlessContext();
-    ensureWritableDirectory(o.out);
     return withThreads(o.threads, [&] {
         render::Gl gl;
         render::loadGl(gl, context->procAddress());
         render::Renderer renderer(gl);
-        engine::FramePipeline pipeline(scene, ps);
+        engine::FramePipeline pipeline(scene, ps);  // reads an image environment
+        ensureWritableDirectory(o.out);
         const TerrainState& st = pipeline.simulation().state();
         if (!o.quiet) {
             std::printf(

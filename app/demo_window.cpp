@@ -50,6 +50,42 @@ void steerCamera(OrbitCamera& camera) {
     }
 }
 
+// The panel's light controls: they edit a copy of the declared lights and
+// hand it back when something changed (the sky is re-projected then).
+void drawLightControls(FramePipeline& pipeline) {
+    LightSet l = pipeline.lightSpec();
+    bool changed = false;
+    EnvironmentSpec& e = l.environment;
+    if (e.kind != EnvironmentSpec::Kind::Image) {
+        int kind = e.kind == EnvironmentSpec::Kind::SunSky ? 1 : 0;
+        const char* kinds[] = {"uniform sky", "sun and sky"};
+        if (ImGui::Combo("environment", &kind, kinds, 2)) {
+            e.kind = kind == 1 ? EnvironmentSpec::Kind::SunSky : EnvironmentSpec::Kind::Uniform;
+            changed = true;
+        }
+    }
+    changed |= ImGui::SliderFloat("sky intensity", &e.intensity, 0.0f, 4.0f);
+    SunSpec& sun = l.sun;
+    changed |= ImGui::Checkbox("sun follows the time of day", &sun.enabled);
+    if (sun.enabled) {
+        changed |= ImGui::SliderFloat("hour", &sun.hour, 0.0f, 24.0f, "%.2f h");
+        changed |= ImGui::SliderFloat("hours per frame", &sun.hoursPerFrame, 0.0f, 0.5f, "%.3f");
+        changed |= ImGui::SliderFloat("latitude", &sun.latitudeDeg, -90.0f, 90.0f);
+        changed |= ImGui::SliderInt("day of year", &sun.dayOfYear, 1, 366);
+    }
+    for (std::size_t k = 0; k < l.keys.size(); ++k) {
+        KeyLightSpec& key = l.keys[k];
+        ImGui::PushID(static_cast<int>(k));
+        ImGui::Text("key light %zu", k + 1);
+        changed |= ImGui::SliderFloat("azimuth", &key.azimuthDeg, 0.0f, 359.0f);
+        changed |= ImGui::SliderFloat("elevation", &key.elevationDeg, 1.0f, 89.0f);
+        changed |= ImGui::SliderFloat("radius", &key.radiusDeg, 0.5f, 15.0f);
+        changed |= ImGui::ColorEdit3("colour", key.rgb.data(), ImGuiColorEditFlags_Float | ImGuiColorEditFlags_HDR);
+        ImGui::PopID();
+    }
+    if (changed) pipeline.setLights(l);
+}
+
 // The control panel: what is shown, the frame's timings, and the settings it edits.
 void drawPanel(FramePipeline& pipeline, RenderSettings& rs, bool& paused, const StageTimings& avg, double fpsAvg) {
     const char* lightingNames[] = {"key light only", "direct (sky + key)", "global (direct + bounces)"};
@@ -57,7 +93,6 @@ void drawPanel(FramePipeline& pipeline, RenderSettings& rs, bool& paused, const 
     const char* debugNames[] = {"none",          "ambient",      "V (sky visibility)",   "key visibility",    "normals",
                                 "pyramid level", "GI shade map", "U (indirect, global)", "albedo (materials)"};
     PipelineSettings& ps = pipeline.settings();
-    SceneLights& lights = pipeline.lights();
     ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
     ImGui::Begin("terrain");
     ImGui::Text("%s  %d x %d  tick %lld", pipeline.simulation().settings().name.c_str(), pipeline.frame().nx,
@@ -96,9 +131,7 @@ void drawPanel(FramePipeline& pipeline, RenderSettings& rs, bool& paused, const 
     ImGui::SliderFloat("exposure", &rs.exposure, 0.1f, 4.0f);
     ImGui::SliderFloat("exaggeration (0 = auto)", &ps.verticalExaggeration, 0.0f, 10.0f);
     ImGui::Separator();
-    ImGui::SliderFloat("sun azimuth", &lights.key.azimuthDeg, 0.0f, 359.0f);
-    ImGui::SliderFloat("sun elevation", &lights.key.elevationDeg, 3.0f, 85.0f);
-    ImGui::SliderFloat("sun radius", &lights.key.radiusDeg, 0.5f, 15.0f);
+    drawLightControls(pipeline);
     ImGui::TextDisabled("drag: orbit, wheel: zoom");
     ImGui::End();
 }

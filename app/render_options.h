@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/light_options.h"
 #include "engine/pipeline.h"
 #include "render/renderer.h"
 
@@ -36,10 +37,14 @@ struct RenderOptions {
     float exaggeration = 0.0f;  // 0 = automatic
     float yaw = 235.0f, pitch = 34.0f, distance = 1.35f;
     bool quiet = false;
+    LightOptions lights;  // over the scene's [lights]
 };
 
 /// Adds the options above (except the scene) to a subcommand.
 void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize);
+
+/// The scene the options name, with the light options over its lights.
+SceneSettings resolveRenderScene(const RenderOptions& o);
 
 /// Checks the options and turns them into pipeline and renderer settings
 /// (throws InputError naming the bad option); the scene's GI hints apply

@@ -2,6 +2,7 @@
 #include "core/parse.h"
 
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 #include "core/error.h"
@@ -22,6 +23,12 @@ std::vector<float> parseNumberList(const std::string& text, const std::string& o
         }
     }
     return v;
+}
+
+std::string formatNumber(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return buf;
 }
 
 }  // namespace terrain

@@ -9,4 +9,7 @@ namespace terrain {
 /// naming `option` and the offending item when one is not a number.
 std::vector<float> parseNumberList(const std::string& text, const std::string& option);
 
+/// A number as people write it in messages ("%g": 0.02, 25, 1e+06).
+std::string formatNumber(double v);
+
 }  // namespace terrain

@@ -19,7 +19,9 @@
 //   and at the receiver resolution: the sky visibility fraction (V's
 //   constant term), one height-pyramid level and the mean incident indirect
 //   radiance (U's constant term, or E / pi with the blocker-radiance kernel), for debug views.
+#include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "gi/lights.h"
@@ -33,10 +35,28 @@ enum class LightingMode {
     Global,   // direct + `bounces` indirect bounces (gi/indirect.h)
 };
 
-/// Lights of the demo scenes.
+/// An equirectangular RGB radiance image (gi/lights.h's convention: column
+/// 0 starts at azimuth 0, row 0 is the zenith), 3 floats per pixel.
+struct EnvironmentImage {
+    int width = 0, height = 0;
+    std::vector<float> rgb;
+};
+
+/// What the sky behind the terrain looks like.
+enum class SkyKind {
+    Sh,        // the environment's SH (a uniform sky is exact in SH)
+    Gradient,  // the analytic sky: horizon to zenith, linear in sin(elevation); `ground` below
+    Image,     // an HDR image (`image`, times `imageScale`)
+};
+
+/// The lights of one frame, resolved (engine/light_rig.h).
 struct SceneLights {
-    gi::ShRgb sky;     // environment radiance (SH); also the water's reflection map
-    gi::KeyLight key;  // the sun
+    gi::ShRgb sky;                   // environment radiance (SH); also the water's reflection map
+    std::vector<gi::KeyLight> keys;  // the first is the sun: specular highlights and the shadow map
+    SkyKind skyKind = SkyKind::Sh;
+    std::array<float, 3> zenith{}, horizon{}, ground{};  // SkyKind::Gradient, radiance
+    std::shared_ptr<const EnvironmentImage> image;        // SkyKind::Image
+    float imageScale = 1.0f;
 };
 
 /// Everything the renderer uploads for one frame.

@@ -27,13 +27,6 @@ void exaggeratedSurface(const TerrainState& s, float exag, Grid& surface) {
     });
 }
 
-gi::GiLighting giLighting(const SceneLights& lights) {
-    gi::GiLighting lighting;
-    lighting.environment = lights.sky;
-    lighting.keys = {lights.key};
-    return lighting;
-}
-
 // Ground and water depth of every texel (they may move apart while their
 // sum, the lit surface, stays: packed every frame).
 void packHeights(const TerrainState& s, FrameData& f) {
@@ -54,15 +47,16 @@ void packHeights(const TerrainState& s, FrameData& f) {
 // `total` is the GI's result with the albedo, so the key light's share of it
 // is the albedo times keyRgb.
 void packTexels(const gi::GiState& gi, const std::array<Grid, 3>& total, const std::array<Grid, 3>& keyRgb,
-                const gi::AlbedoMap& albedo, const gi::KeyLight& k, FrameData& f) {
+                const gi::AlbedoMap& albedo, const gi::KeyLight* key, FrameData& f) {
     const int nx = total[0].nx, ny = total[0].ny;
     const std::size_t n = static_cast<std::size_t>(nx) * ny;
     f.shade.resize(4 * n);
     f.key.resize(4 * n);
+    const gi::KeyLight k = key ? *key : gi::KeyLight{};
     const float ce = std::cos(k.elevationDeg * kDeg);
     const float lx = ce * std::cos(k.azimuthDeg * kDeg), ly = ce * std::sin(k.azimuthDeg * kDeg);
     const float lz = std::sin(k.elevationDeg * kDeg);
-    const float keyLum = 0.2126f * k.rgb[0] + 0.7152f * k.rgb[1] + 0.0722f * k.rgb[2];
+    const float keyLum = key ? 0.2126f * k.rgb[0] + 0.7152f * k.rgb[1] + 0.0722f * k.rgb[2] : 0.0f;
     parallelForRows(ny, nx, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y)
             for (int x = 0; x < nx; ++x) {
@@ -157,35 +151,14 @@ void recordGiTimings(const gi::GiState& gi, const gi::GiSettings& gs, double sur
 
 }  // namespace
 
-SceneLights defaultLights() {
-    SceneLights l;
-    // A clear sky without its own sun lobe: the sun is the key light (its
-    // visibility and specular are computed separately).
-    gi::SunSkySettings sky;
-    sky.sun[0] = sky.sun[1] = sky.sun[2] = 0.0f;
-    const float horizon[3] = {0.62f, 0.76f, 1.0f};
-    for (int c = 0; c < 3; ++c) {
-        sky.zenith[c] *= 0.45f;
-        sky.horizon[c] = 0.45f * horizon[c];
-    }
-    l.sky = gi::sunSkyLight(sky);
-    l.key.azimuthDeg = 300.0f;
-    l.key.elevationDeg = 22.0f;
-    l.key.radiusDeg = 3.0f;
-    l.key.rgb[0] = 1.9f;
-    l.key.rgb[1] = 1.75f;
-    l.key.rgb[2] = 1.5f;
-    return l;
-}
-
 gi::GiSettings defaultPipelineGi() {
     gi::GiSettings s = gi::GiSettings{};
     s.indirect.bounces = 1;
     return s;
 }
 
-FramePipeline::FramePipeline(const SceneSettings& scene, const PipelineSettings& settings, const SceneLights& lights)
-    : sim_(scene), settings_(settings), lights_(lights), materials_(scene.materials) {
+FramePipeline::FramePipeline(const SceneSettings& scene, const PipelineSettings& settings)
+    : sim_(scene), settings_(settings), rig_(scene.lights), materials_(scene.materials) {
     gi::validateGiSettings(settings_.gi);
     validateMaterials(materials_);
     if (settings_.ticksPerFrame < 0) throw InputError("ticks per frame must be >= 0");
@@ -221,6 +194,8 @@ void FramePipeline::terrainReplaced() {
     mapsTick_ = -1;
 }
 
+void FramePipeline::setLights(const LightSet& lights) { rig_ = LightRig(lights, &rig_); }
+
 void FramePipeline::setMaterials(const MaterialSet& materials) {
     validateMaterials(materials);
     materials_ = materials;
@@ -229,8 +204,10 @@ void FramePipeline::setMaterials(const MaterialSet& materials) {
 
 void FramePipeline::advance() {
     const auto t0 = Clock::now();
-    if (!first_)
+    if (!first_) {
         for (int t = 0; t < ticksPerFrame_; ++t) sim_.tick();
+        ++frameIndex_;
+    }
     first_ = false;
     timings_.sim = msSince(t0);
 }
@@ -248,6 +225,7 @@ void FramePipeline::light() {
         deriveMaterialMaps(s, materials_, maps_);
         mapsTick_ = s.tick;
     }
+    lights_ = rig_.at(frameIndex_);
     const gi::GiLighting lighting = giLighting(lights_);
     // Global lighting adds gi.indirect.bounces indirect bounces (gi/indirect.h);
     // the other modes none. The simulator's change report says whether the
@@ -277,8 +255,17 @@ void FramePipeline::light() {
         return;
     }
     packedPyramidLevel_ = settings_.pyramidLevel;
-    // The key light's share of the shade map: gi/ shading with that light alone.
-    gi::shadeKeyLight(gi_, gs, lighting, 0, keyScratch_, keyOnly_);
+    // The first key light's share of the shade map: gi/ shading with that
+    // light alone (the renderer adds its specular and can swap its shadows).
+    const gi::KeyLight* key = lighting.keys.empty() ? nullptr : &lighting.keys[0];
+    if (key) {
+        gi::shadeKeyLight(gi_, gs, lighting, 0, keyScratch_, keyOnly_);
+    } else {
+        for (Grid& g : keyOnly_) {
+            g.ensureSize(s.nx, s.ny);
+            std::fill(g.v.begin(), g.v.end(), 0.0f);
+        }
+    }
 
     // ---- pack what the renderer uploads -----------------------------------------
     f.lighting = settings_.lighting;
@@ -287,7 +274,7 @@ void FramePipeline::light() {
     f.tick = s.tick;
     f.time = s.time;
     const bool indirect = gs.indirect.bounces > 0;
-    packTexels(gi_, indirect ? gi_.indirect.total : gi_.shade.rgb, keyOnly_, maps_.albedo, lights_.key, f);
+    packTexels(gi_, indirect ? gi_.indirect.total : gi_.shade.rgb, keyOnly_, maps_.albedo, key, f);
     packReceivers(gi_, surface_, settings_, exag, indirect, f);
     const double packMs = msSince(t);
     recordGiTimings(gi_, gs, surfaceMs, packMs, timings_);

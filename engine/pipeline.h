@@ -7,14 +7,12 @@
 #include <vector>
 
 #include "engine/frame_data.h"
+#include "engine/light_rig.h"
 #include "engine/material_maps.h"
 #include "gi/frame.h"
 #include "sim/scene.h"
 
 namespace terrain::engine {
-
-/// Lights of the demo scenes.
-SceneLights defaultLights();
 
 /// The engine's GI settings with one indirect bounce.
 gi::GiSettings defaultPipelineGi();
@@ -40,17 +38,25 @@ struct StageTimings {
 
 class FramePipeline {
 public:
-    FramePipeline(const SceneSettings& scene, const PipelineSettings& settings,
-                  const SceneLights& lights = defaultLights());
+    /// Lights and materials come from the scene (its `lights` and `materials`).
+    FramePipeline(const SceneSettings& scene, const PipelineSettings& settings);
 
-    /// Advances the simulation by one frame's ticks (none for the first frame).
+    /// Advances the simulation by one frame's ticks (none for the first frame)
+    /// and the time of day by one frame.
     void advance();
     /// Runs GI on the current terrain and fills frame().
     void light();
 
     PipelineSettings& settings() { return settings_; }
     const PipelineSettings& settings() const { return settings_; }
-    SceneLights& lights() { return lights_; }
+    /// The lights as declared, and this frame's (the sun moved to its time of day).
+    const LightSet& lightSpec() const { return rig_.spec(); }
+    const SceneLights& lights() const { return lights_; }
+    /// Replaces the declared lights (validated; an image environment is read
+    /// here); the next light() uses them.
+    void setLights(const LightSet& lights);
+    /// Frames advanced since the first (the sun's clock).
+    int frameIndex() const { return frameIndex_; }
     /// The materials the maps are derived from (the scene's at start).
     const MaterialSet& materials() const { return materials_; }
     /// Replaces them (validated); the next light() derives the maps anew.
@@ -71,7 +77,9 @@ public:
 private:
     Simulation sim_;
     PipelineSettings settings_;
+    LightRig rig_;
     SceneLights lights_;
+    int frameIndex_ = 0;
     int ticksPerFrame_ = 1;
     float autoExaggeration_ = 1.0f;
     bool first_ = true;

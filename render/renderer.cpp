@@ -84,6 +84,16 @@ glm::vec3 keyDirection(const gi::KeyLight& k) {
     return {ce * std::cos(k.azimuthDeg * kDeg), ce * std::sin(k.azimuthDeg * kDeg), std::sin(k.elevationDeg * kDeg)};
 }
 
+// The first key light (the sun) has the specular highlights and the shadow
+// map; with none, a black light overhead.
+gi::KeyLight sunOf(const engine::SceneLights& l) {
+    if (!l.keys.empty()) return l.keys[0];
+    gi::KeyLight dark;
+    dark.elevationDeg = 90.0f;
+    dark.rgb[0] = dark.rgb[1] = dark.rgb[2] = 0.0f;
+    return dark;
+}
+
 }  // namespace
 
 std::uint64_t hashBytes(const std::vector<std::uint8_t>& bytes) {
@@ -269,7 +279,7 @@ Renderer::FrameViews Renderer::frameViews(const OrbitCamera& cam, int width, int
                                             std::max(dist * 0.02f, 0.01f), dist * 4.0f + (f.zMax - f.zMin) * exag);
     const glm::mat4 viewProj = proj * view;
     // ---- key light shadow map (orthographic, covering the terrain) ---------------
-    const glm::vec3 keyDir = keyDirection(f.lights.key);
+    const glm::vec3 keyDir = keyDirection(sunOf(f.lights));
     const float radius =
         0.5f * std::sqrt(2.0f * extent * extent + (f.zMax - f.zMin) * exag * (f.zMax - f.zMin) * exag) + 1.0f;
     const glm::vec3 up = std::abs(keyDir.z) > 0.99f ? glm::vec3(0, 1, 0) : glm::vec3(0, 0, 1);
@@ -377,7 +387,8 @@ void Renderer::surfaceUniforms(GLuint p, int water, const RenderSettings& s, con
     u.i("uSubsample", f.subsample);
     u.v3("uEye", v.eye);
     u.v3("uKeyDir", v.keyDir);
-    u.v3("uKeyRgb", glm::vec3(f.lights.key.rgb[0], f.lights.key.rgb[1], f.lights.key.rgb[2]));
+    const gi::KeyLight sun = sunOf(f.lights);
+    u.v3("uKeyRgb", glm::vec3(sun.rgb[0], sun.rgb[1], sun.rgb[2]));
     u.i("uLighting",
         f.lighting == engine::LightingMode::KeyOnly ? 0 : (f.lighting == engine::LightingMode::Direct ? 1 : 2));
     u.i("uShadowMode", s.shadow == ShadowMode::SoftVisibility ? 0 : (wantShadowMap ? 1 : 2));

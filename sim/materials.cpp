@@ -3,19 +3,20 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/parse.h"
 
 namespace terrain {
 namespace {
 
 void requireIn(const std::string& what, float v, float lo, float hi) {
     if (!(v >= lo && v <= hi))
-        throw InputError("material " + what + " = " + std::to_string(v) + " is out of range [" + std::to_string(lo) +
-                         ", " + std::to_string(hi) + "]");
+        throw InputError("material " + what + " = " + formatNumber(v) + " is out of range [" + formatNumber(lo) + ", " +
+                         formatNumber(hi) + "]");
 }
 
 void requirePositive(const std::string& what, float v) {
     if (!(v > 0.0f) || !std::isfinite(v))
-        throw InputError("material " + what + " = " + std::to_string(v) + " must be a positive number");
+        throw InputError("material " + what + " = " + formatNumber(v) + " must be a positive number");
 }
 
 void validateMaterial(const std::string& name, const Material& m) {

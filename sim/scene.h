@@ -10,6 +10,7 @@
 #include "sim/generators.h"
 #include "sim/hydraulic.h"
 #include "sim/materials.h"
+#include "sim/scene_lights.h"
 #include "sim/terrain.h"
 #include "sim/thermal.h"
 #include "sim/waves.h"
@@ -62,6 +63,7 @@ struct SceneSettings {
     int changeTile = 32;  // cells per side of a change-tracking tile
     SceneGiHints gi;
     MaterialSet materials;  // what the surface is made of, where (sim/materials.h)
+    LightSet lights = builtinLights();  // how it is lit (sim/scene_lights.h)
 };
 
 /// The built-in scenes: "erosion", "waves", "dem". size is the grid side

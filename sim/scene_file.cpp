@@ -19,6 +19,10 @@
 //   [materials.soil] ... cover_depth   [materials.vegetation] ... min_altitude, max_altitude,
 //   altitude_fade, max_slope   [materials.snow] ... line, altitude_fade, max_slope
 //   [materials.wet] darkening, depth, exponent   [materials.water] albedo, exponent, clarity
+//   [lights] environment = "uniform" | "sunsky" | "sky.exr", intensity = 1.0   # sim/scene_lights.h
+//   [lights.sky] zenith, horizon, ground = [r, g, b]      # the sunsky model's colours
+//   [[lights.key]] azimuth, elevation, radius, rgb         # replaces the base scene's key lights
+//   [lights.sun] latitude, day, hour, hours_per_frame, north, radius, rgb
 #include <array>
 #include <cmath>
 #include <filesystem>
@@ -128,6 +132,13 @@ int parseEdge(const std::string& file, const std::string& e) {
     throw IoError(file, "'waves.swell.edge' must be one of -x, +x, -y, +y (got '" + e + "')");
 }
 
+// A path in a scene file is relative to the file.
+std::string besideFile(const std::string& file, const std::string& path) {
+    std::filesystem::path p(path);
+    if (p.is_relative()) p = std::filesystem::path(file).parent_path() / p;
+    return p.string();
+}
+
 void readTerrain(TableReader& r, const toml::table& t, SceneSettings& s) {
     TableReader tr(t, r.file(), "terrain.");
     std::string kind;
@@ -167,12 +178,7 @@ void readTerrain(TableReader& r, const toml::table& t, SceneSettings& s) {
     tr.num("angle", sh.angleDeg);
     std::string file;
     tr.text("file", file);
-    if (!file.empty()) {
-        // relative paths are relative to the scene file
-        std::filesystem::path p(file);
-        if (p.is_relative()) p = std::filesystem::path(r.file()).parent_path() / p;
-        s.terrain.demFile = p.string();
-    }
+    if (!file.empty()) s.terrain.demFile = besideFile(r.file(), file);
     tr.num("z_scale", s.terrain.demZScale);
     tr.num("z_offset", s.terrain.demZOffset);
     tr.num("cell_size", s.terrain.demCellSize);
@@ -317,6 +323,78 @@ void readMaterials(const std::string& file, const toml::table& t, MaterialSet& m
     }
 }
 
+void readEnvironment(TableReader& r, const std::string& file, EnvironmentSpec& e) {
+    std::string kind;
+    r.text("environment", kind);
+    if (kind == "uniform") {
+        e.kind = EnvironmentSpec::Kind::Uniform;
+    } else if (kind == "sunsky") {
+        e.kind = EnvironmentSpec::Kind::SunSky;
+    } else if (!kind.empty()) {
+        const std::string ext = std::filesystem::path(kind).extension().string();
+        if (ext != ".exr" && ext != ".hdr")
+            r.fail("environment", "\"uniform\", \"sunsky\" or an .exr / .hdr image");
+        e.kind = EnvironmentSpec::Kind::Image;
+        e.file = besideFile(file, kind);
+    }
+    r.num("intensity", e.intensity);
+    if (const toml::table* t = r.table("sky")) {
+        TableReader q(*t, file, "lights.sky.");
+        q.rgb("zenith", e.zenith);
+        q.rgb("horizon", e.horizon);
+        q.rgb("ground", e.ground);
+        q.finish();
+    }
+}
+
+// [[lights.key]] tables replace the base scene's key lights.
+void readKeys(TableReader& r, const std::string& file, std::vector<KeyLightSpec>& keys) {
+    const toml::node* n = r.get("key");
+    if (!n) return;
+    const toml::array* arr = n->as_array();
+    if (!arr) r.fail("key", "an array of tables ([[lights.key]])");
+    keys.clear();
+    for (const toml::node& item : *arr) {
+        const toml::table* t = item.as_table();
+        if (!t) r.fail("key", "an array of tables ([[lights.key]])");
+        TableReader q(*t, file, "lights.key.");
+        KeyLightSpec k;
+        q.num("azimuth", k.azimuthDeg);
+        q.num("elevation", k.elevationDeg);
+        q.num("radius", k.radiusDeg);
+        q.rgb("rgb", k.rgb);
+        q.finish();
+        keys.push_back(k);
+    }
+}
+
+void readSun(const toml::table& t, const std::string& file, SunSpec& sun) {
+    TableReader q(t, file, "lights.sun.");
+    sun.enabled = true;
+    q.flag("enabled", sun.enabled);
+    q.num("latitude", sun.latitudeDeg);
+    q.integer("day", sun.dayOfYear);
+    q.num("hour", sun.hour);
+    q.num("hours_per_frame", sun.hoursPerFrame);
+    q.num("north", sun.northAzimuthDeg);
+    q.num("radius", sun.radiusDeg);
+    q.rgb("rgb", sun.rgb);
+    q.finish();
+}
+
+void readLights(const std::string& file, const toml::table& t, LightSet& lights) {
+    TableReader r(t, file, "lights.");
+    readEnvironment(r, file, lights.environment);
+    readKeys(r, file, lights.keys);
+    if (const toml::table* sun = r.table("sun")) readSun(*sun, file, lights.sun);
+    r.finish();
+    try {
+        validateLights(lights);
+    } catch (const InputError& e) {
+        throw IoError(file, e.what());
+    }
+}
+
 void readGi(const std::string& file, const toml::table& t, SceneSettings& s) {
     TableReader r(t, file, "gi.");
     if (r.get("incremental")) {
@@ -396,6 +474,7 @@ SceneSettings loadSceneFile(const std::string& file) {
     if (const toml::table* t = r.table("waves")) readWaves(file, *t, s);
     if (const toml::table* t = r.table("gi")) readGi(file, *t, s);
     if (const toml::table* t = r.table("materials")) readMaterials(file, *t, s.materials);
+    if (const toml::table* t = r.table("lights")) readLights(file, *t, s.lights);
     r.finish();
     try {
         checkDimensions(s.nx, s.ny, s.cellSize);

@@ -36,10 +36,9 @@ std::unique_ptr<FramePipeline> litWall(const std::array<float, 3>& floorAlbedo) 
     ps.lighting = LightingMode::Global;
     ps.verticalExaggeration = 1.0f;
     ps.gi.subsample = 1;
-    SceneLights lights = defaultLights();
-    lights.key.azimuthDeg = 180.0f;  // from -x: lights the floor and the wall's face
-    lights.key.elevationDeg = 35.0f;
-    auto p = std::make_unique<FramePipeline>(scene, ps, lights);
+    scene.lights.keys.at(0).azimuthDeg = 180.0f;  // from -x: lights the floor and the wall's face
+    scene.lights.keys.at(0).elevationDeg = 35.0f;
+    auto p = std::make_unique<FramePipeline>(scene, ps);
     TerrainState& st = p->simulation().state();
     for (int y = 0; y < st.ny; ++y)
         for (int x = 0; x < st.nx; ++x) {

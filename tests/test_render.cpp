@@ -62,10 +62,9 @@ std::vector<std::uint8_t> renderShape(const std::function<float(float, float)>& 
     PipelineSettings ps;
     ps.lighting = lighting;
     ps.verticalExaggeration = 1.0f;
-    SceneLights lights = defaultLights();
-    lights.key.azimuthDeg = 0.0f;
-    lights.key.elevationDeg = keyElevation;
-    FramePipeline pipeline(scene, ps, lights);
+    scene.lights.keys.at(0).azimuthDeg = 0.0f;
+    scene.lights.keys.at(0).elevationDeg = keyElevation;
+    FramePipeline pipeline(scene, ps);
     TerrainState& st = pipeline.simulation().state();
     for (int y = 0; y < st.ny; ++y)
         for (int x = 0; x < st.nx; ++x) {
