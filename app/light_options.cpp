@@ -66,6 +66,9 @@ void addLightOptions(CLI::App* sub, LightOptions& o, const std::string& defaults
                     "(default: " +
                         defaults + ")");
     sub->add_option("--light-intensity", o.intensity, "Environment radiance scale (default: " + defaults + ")");
+    sub->add_option("--visibility", o.visibility,
+                    "Haze: metres at which the distance fades into the horizon sky, 0 = clear air (default: " +
+                        defaults + ")");
     sub->add_option("--key", o.keys,
                     "Key light AZ_DEG,EL_DEG,RADIUS_DEG,R,G,B (repeatable; replaces the default key lights; "
                     "'none' for none)");
@@ -79,6 +82,7 @@ void addLightOptions(CLI::App* sub, LightOptions& o, const std::string& defaults
 void applyLightOptions(const LightOptions& o, LightSet& lights) {
     if (o.environment) applyEnvironment(*o.environment, lights.environment);
     if (o.intensity) lights.environment.intensity = *o.intensity;
+    if (o.visibility) lights.environment.visibility = *o.visibility;
     if (!o.keys.empty()) {
         lights.keys.clear();
         if (!(o.keys.size() == 1 && o.keys[0] == "none"))

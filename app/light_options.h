@@ -15,6 +15,7 @@ namespace terrain::app {
 struct LightOptions {
     std::optional<std::string> environment;  // --light uniform | sunsky | env:FILE | FILE.exr / FILE.hdr
     std::optional<float> intensity;          // --light-intensity
+    std::optional<float> visibility;         // --visibility (m, haze)
     std::vector<std::string> keys;           // --key AZ,EL,RADIUS,R,G,B (repeatable) or none
     std::optional<std::string> sun;          // --sun HOUR[,HOURS_PER_FRAME[,LATITUDE[,DAY]]] or off
 };

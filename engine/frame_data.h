@@ -57,6 +57,7 @@ struct SceneLights {
     std::array<float, 3> zenith{}, horizon{}, ground{};  // SkyKind::Gradient, radiance
     std::shared_ptr<const EnvironmentImage> image;        // SkyKind::Image
     float imageScale = 1.0f;
+    float hazeExtinction = 0.0f;  // per metre of view distance (0: clear air)
 };
 
 /// Everything the renderer uploads for one frame.

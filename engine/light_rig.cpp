@@ -110,6 +110,7 @@ LightRig::LightRig(const LightSet& spec, const LightRig* previous) : spec_(spec)
 SceneLights LightRig::at(int frame) const {
     SceneLights l;
     const EnvironmentSpec& e = spec_.environment;
+    l.hazeExtinction = e.visibility > 0.0f ? 3.912f / e.visibility : 0.0f;
     const SunSpec& sun = spec_.sun;
     float skyScale = e.intensity;
     if (sun.enabled) {

@@ -207,6 +207,10 @@ void FramePipeline::advance() {
     if (!first_) {
         for (int t = 0; t < ticksPerFrame_; ++t) sim_.tick();
         ++frameIndex_;
+    } else {
+        // the scene's spin-up: the first frame shows it already running
+        const double spinUp = sim_.settings().spinUp;
+        while (sim_.state().time < spinUp) sim_.tick();
     }
     first_ = false;
     timings_.sim = msSince(t0);

@@ -41,8 +41,8 @@ public:
     /// Lights and materials come from the scene (its `lights` and `materials`).
     FramePipeline(const SceneSettings& scene, const PipelineSettings& settings);
 
-    /// Advances the simulation by one frame's ticks (none for the first frame)
-    /// and the time of day by one frame.
+    /// Advances the simulation by one frame's ticks and the time of day by
+    /// one frame; the first call runs the scene's spin-up instead.
     void advance();
     /// Runs GI on the current terrain and fills frame().
     void light();

@@ -95,9 +95,12 @@ SceneSettings builtinScene(const std::string& name, int size, std::uint64_t seed
         s.waveSettings.swell.amplitude = 0.25f;
         s.waveSettings.swell.period = 6.0f;
         s.waveSettings.swell.seaLevel = s.waterLevel;
+        // the swell crosses the bay (at sqrt(g h), about 9 m/s) before the
+        // first frame; the drops fall from 2 s into the animation on
+        s.spinUp = 40.0f;
         for (int i = 0; i < 4; ++i) {
             WaveDrop d;
-            d.time = 2.0 + 5.0 * i;
+            d.time = s.spinUp + 2.0 + 5.0 * i;
             d.x = extent * (0.3f + 0.12f * static_cast<float>(i));
             d.y = extent * (0.25f + 0.17f * static_cast<float>((i * 3) % 4));
             d.radius = 6.0f;
@@ -118,6 +121,7 @@ SceneSettings builtinScene(const std::string& name, int size, std::uint64_t seed
         throw InputError("unknown scene '" + name + "' (built-in scenes: erosion, waves, dem; or a .toml file)");
     }
     s.materials = builtinMaterials(name);
+    s.lights = builtinLights(name);
     return s;
 }
 

@@ -60,10 +60,13 @@ struct SceneSettings {
     WaveSettings waveSettings;
 
     float dt = 0.0f;      // s; 0 = the default, derived from the CFL limits
+    // s of simulated time an animation runs before its first frame (a sea
+    // whose swell has already reached the shore); `terrain sim` starts at 0.
+    float spinUp = 0.0f;
     int changeTile = 32;  // cells per side of a change-tracking tile
     SceneGiHints gi;
     MaterialSet materials;  // what the surface is made of, where (sim/materials.h)
-    LightSet lights = builtinLights();  // how it is lit (sim/scene_lights.h)
+    LightSet lights = builtinLights("");  // how it is lit (sim/scene_lights.h)
 };
 
 /// The built-in scenes: "erosion", "waves", "dem". size is the grid side

@@ -8,6 +8,7 @@
 //   cell_size = 1.5           # m
 //   seed = 7
 //   dt = 0.0                  # s, 0 = derived from the CFL limits
+//   spin_up = 0.0             # s simulated before an animation's first frame
 //   change_tile = 32
 //   soil_depth = 2.0          # m
 //   water_level = 0.0         # m, fill water up to this level
@@ -19,7 +20,8 @@
 //   [materials.soil] ... cover_depth   [materials.vegetation] ... min_altitude, max_altitude,
 //   altitude_fade, max_slope   [materials.snow] ... line, altitude_fade, max_slope
 //   [materials.wet] darkening, depth, exponent   [materials.water] albedo, exponent, clarity
-//   [lights] environment = "uniform" | "sunsky" | "sky.exr", intensity = 1.0   # sim/scene_lights.h
+//   [lights] environment = "uniform" | "sunsky" | "sky.exr", intensity = 1.0,   # sim/scene_lights.h
+//            visibility = 400000.0   # m, haze (0: clear)
 //   [lights.sky] zenith, horizon, ground = [r, g, b]      # the sunsky model's colours
 //   [[lights.key]] azimuth, elevation, radius, rgb         # replaces the base scene's key lights
 //   [lights.sun] latitude, day, hour, hours_per_frame, north, radius, rgb
@@ -338,6 +340,7 @@ void readEnvironment(TableReader& r, const std::string& file, EnvironmentSpec& e
         e.file = besideFile(file, kind);
     }
     r.num("intensity", e.intensity);
+    r.num("visibility", e.visibility);
     if (const toml::table* t = r.table("sky")) {
         TableReader q(*t, file, "lights.sky.");
         q.rgb("zenith", e.zenith);
@@ -462,6 +465,8 @@ SceneSettings loadSceneFile(const std::string& file) {
     r.integer("seed", seed);
     s.seed = static_cast<std::uint64_t>(seed);
     r.num("dt", s.dt);
+    r.num("spin_up", s.spinUp);
+    if (!(s.spinUp >= 0.0f) || s.spinUp > 1.0e6f) r.fail("spin_up", "a time in [0, 1e6] s");
     r.integer("change_tile", s.changeTile);
     r.num("soil_depth", s.soilDepth);
     if (r.get("water_level")) {

@@ -30,7 +30,7 @@ void validateKey(const std::string& what, float azimuth, float elevation, float 
 
 }  // namespace
 
-LightSet builtinLights() {
+LightSet builtinLights(const std::string& scene) {
     LightSet l;
     l.environment.kind = EnvironmentSpec::Kind::SunSky;
     KeyLightSpec sun;
@@ -39,6 +39,7 @@ LightSet builtinLights() {
     sun.radiusDeg = 3.0f;
     sun.rgb = {1.9f, 1.75f, 1.5f};
     l.keys.push_back(sun);
+    if (scene == "dem") l.environment.visibility = 400000.0f;
     return l;
 }
 
@@ -49,6 +50,8 @@ void validateLights(const LightSet& l) {
     requireRadiance("sky zenith", e.zenith);
     requireRadiance("sky horizon", e.horizon);
     requireRadiance("sky ground", e.ground);
+    if (!(e.visibility >= 0.0f) || !std::isfinite(e.visibility))
+        throw InputError("lights: visibility must be finite and >= 0 m (0: no haze)");
     if (e.kind == EnvironmentSpec::Kind::Image && e.file.empty())
         throw InputError("lights: an image environment needs a file (.exr or .hdr)");
     for (std::size_t k = 0; k < l.keys.size(); ++k) {

@@ -24,6 +24,10 @@ struct EnvironmentSpec {
     std::array<float, 3> zenith{0.135f, 0.2025f, 0.3825f};
     std::array<float, 3> horizon{0.279f, 0.342f, 0.45f};
     std::array<float, 3> ground{0.10f, 0.09f, 0.08f};
+    // Haze: the distance at which a dark object fades into the horizon sky
+    // (meteorological visibility; extinction 3.912 / visibility, Koschmieder
+    // 1924). 0: a perfectly clear atmosphere.
+    float visibility = 0.0f;  // m
 };
 
 /// A spherical cap light: R,G,B is the shade it gives an unoccluded white
@@ -56,8 +60,9 @@ struct LightSet {
 };
 
 /// The lights of the built-in scenes: a clear sky and a low sun from the
-/// north-west as a fixed key light.
-LightSet builtinLights();
+/// north-west as a fixed key light; the 60 km "dem" scene adds the haze of a
+/// clear alpine day.
+LightSet builtinLights(const std::string& scene);
 
 /// Throws InputError naming the first bad value (negative or non-finite
 /// radiance, a key light's elevation outside [-90, 90] or radius outside

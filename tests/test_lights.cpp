@@ -87,7 +87,7 @@ TEST_CASE("lights: the analytic sky mixes its SH basis exactly as gi/ projects i
 }
 
 TEST_CASE("lights: the sun is the first key light, moves each frame and sets") {
-    LightSet set = builtinLights();
+    LightSet set = builtinLights("erosion");
     set.sun.enabled = true;
     set.sun.hour = 16.0f;
     set.sun.hoursPerFrame = 1.0f;
