@@ -17,7 +17,7 @@ PACKAGES=(
   libglm-dev libglfw3-dev libosmesa6-dev libgl-dev
   libopenvdb-dev libboost-dev libboost-iostreams-dev libtbb-dev libimath-dev libopenexr-dev libblosc-dev
   doctest-dev libpng-dev libtomlplusplus-dev libcli11-dev libimgui-dev
-  xvfb xauth
+  xvfb xauth xdotool
 )
 
 missing=()

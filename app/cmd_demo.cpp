@@ -47,10 +47,16 @@ int runDemo(DemoOptions& d) {
     return withThreads(o.threads, [&] {
         render::Gl gl;
         render::loadGl(gl, window->procAddress());
-        engine::FramePipeline pipeline(scene, ps);
-        std::printf("demo: scene %s in a window (%s); drag to orbit, wheel to zoom\n", scene.name.c_str(),
-                    render::glDescription(gl).c_str());
-        const int shown = runWindowDemo(*window, gl, pipeline, rs, d.frames->count() > 0 ? o.frames : 0);
+        WindowDemoSetup setup;
+        // R reloads: the scene file read again, with the same options over it
+        setup.loadScene = [&o, &ps] { return std::make_unique<engine::FramePipeline>(resolveRenderScene(o), ps); };
+        setup.screenshotDir = o.out;
+        setup.maxFrames = d.frames->count() > 0 ? o.frames : 0;
+        std::printf(
+            "demo: scene %s in a window (%s); drag to orbit, wheel to zoom, WASD/QE to fly, P pause, space step, F12 "
+            "screenshot, R reload, H hide the panel\n",
+            scene.name.c_str(), render::glDescription(gl).c_str());
+        const int shown = runWindowDemo(*window, gl, setup, rs);
         std::printf("demo: %d frames shown\n", shown);
         return 0;
     });

@@ -5,17 +5,17 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "app/commands.h"
+#include "app/gi_images.h"
 #include "app/light_options.h"
 #include "core/error.h"
-#include "core/image_io.h"
 #include "core/parallel.h"
 #include "core/parse.h"
-#include "core/png_io.h"
 #include "engine/light_rig.h"
 #include "gi/albedo_io.h"
 #include "gi/frame.h"
@@ -40,6 +40,7 @@ struct GiOptions {
     int threads = 0;
     bool reference = false;
     std::string outShade, outAmbient;
+    float exposure = 1.0f;  // of the .png shade map
     int frames = 1;
     bool time = false;
     // indirect light
@@ -82,54 +83,6 @@ void parseBrdf(const std::string& text, gi::ShadingSettings& s) {
     }
     if (!(s.phongExponent >= 1.0f && s.phongExponent <= 10000.0f))
         throw InputError("--brdf: Phong exponent must be in [1, 10000]");
-}
-
-void writeIndirect(const std::string& file, const std::array<Grid, 3>& rgb) {
-    const std::string e = file.size() >= 4 ? file.substr(file.size() - 4) : "";
-    std::string ext = e;
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (ext == ".npy")
-        writeNpyRgb(file, rgb);
-    else if (ext == ".exr")
-        writeExr(file, {&rgb[0], &rgb[1], &rgb[2]});
-    else
-        throw InputError("--out-indirect must end in .npy or .exr (got '" + file + "')");
-}
-
-std::string extensionOf(const std::string& f) {
-    const auto dot = f.find_last_of('.');
-    std::string e = dot == std::string::npos ? "" : f.substr(dot);
-    for (char& c : e) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return e;
-}
-
-void writeShade(const std::string& file, const std::array<Grid, 3>& rgb) {
-    const std::string ext = extensionOf(file);
-    if (ext == ".exr") {
-        writeExr(file, {&rgb[0], &rgb[1], &rgb[2]});
-        return;
-    }
-    if (ext != ".png") throw InputError("--out-shade must end in .png or .exr (got '" + file + "')");
-    const int w = rgb[0].nx, h = rgb[0].ny;
-    std::vector<std::uint8_t> px(static_cast<std::size_t>(w) * h * 3);
-    for (std::size_t i = 0; i < rgb[0].size(); ++i)
-        for (int c = 0; c < 3; ++c) {
-            // linear radiance -> sRGB, clamped to [0, 1]
-            float v = std::clamp(rgb[static_cast<std::size_t>(c)].v[i], 0.0f, 1.0f);
-            v = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
-            px[i * 3 + static_cast<std::size_t>(c)] = static_cast<std::uint8_t>(std::lround(v * 255.0f));
-        }
-    writePngRgb(file, w, h, px, 3);
-}
-
-void writeAmbient(const std::string& file, const Grid& ambient) {
-    const std::string ext = extensionOf(file);
-    if (ext == ".npy")
-        writeNpy(file, ambient);
-    else if (ext == ".exr")
-        writeExr(file, {&ambient});
-    else
-        throw InputError("--out-ambient must end in .npy or .exr (got '" + file + "')");
 }
 
 // The phong exponent option: a constant, or a 16-bit PNG mapped to a range.
@@ -206,8 +159,10 @@ void checkOptions(const GiOptions& o) {
         throw InputError("--out-shade must end in .png or .exr (got '" + o.outShade + "')");
     if (!o.outAmbient.empty() && extensionOf(o.outAmbient) != ".npy" && extensionOf(o.outAmbient) != ".exr")
         throw InputError("--out-ambient must end in .npy or .exr (got '" + o.outAmbient + "')");
-    if (!o.outIndirect.empty() && extensionOf(o.outIndirect) != ".npy" && extensionOf(o.outIndirect) != ".exr")
-        throw InputError("--out-indirect must end in .npy or .exr (got '" + o.outIndirect + "')");
+    const std::string indirectExt = extensionOf(o.outIndirect);
+    if (!o.outIndirect.empty() && indirectExt != ".npy" && indirectExt != ".exr" && indirectExt != ".png")
+        throw InputError("--out-indirect must end in .npy, .exr or .png (got '" + o.outIndirect + "')");
+    if (!(o.exposure > 0.0f && o.exposure < 1000.0f)) throw InputError("--exposure must be in (0, 1000)");
     if (!o.outIndirect.empty() && o.settings.indirect.bounces == 0 && !o.reference)
         throw InputError("--out-indirect needs --bounces >= 1");
     if (o.referenceDirections < 16 || o.referenceDirections > (1 << 20))
@@ -262,7 +217,7 @@ int runReference(const GiOptions& o, const gi::GiSettings& settings, const GiInp
         gi::renderReferenceGi(in.heights.cview(), static_cast<float>(in.cell), in.lighting.environment, in.albedo, gs,
                               gr);
         if (o.time) std::printf("reference: %.1f ms\n", msSince(t0));
-        if (!o.outShade.empty()) writeShade(o.outShade, gr.total);
+        if (!o.outShade.empty()) writeShade(o.outShade, gr.total, o.exposure);
         if (!o.outAmbient.empty()) writeAmbient(o.outAmbient, gr.ambient);
         if (!o.outIndirect.empty()) writeIndirect(o.outIndirect, gr.indirect);
         return 0;
@@ -272,7 +227,7 @@ int runReference(const GiOptions& o, const gi::GiSettings& settings, const GiInp
     gi::ReferenceResult rr;
     gi::renderReference(in.heights.cview(), static_cast<float>(in.cell), &in.lighting.environment, in.albedo, rs, rr);
     if (o.time) std::printf("reference: %.1f ms\n", msSince(t0));
-    if (!o.outShade.empty()) writeShade(o.outShade, rr.rgb);
+    if (!o.outShade.empty()) writeShade(o.outShade, rr.rgb, o.exposure);
     if (!o.outAmbient.empty()) writeAmbient(o.outAmbient, rr.ambient);
     return 0;
 }
@@ -306,7 +261,7 @@ int runFastPath(const GiOptions& o, const gi::GiSettings& settings, const GiInpu
         std::sort(totals.begin(), totals.end());
         std::printf("%.2f ms per frame\n", totals[totals.size() / 2]);
     }
-    if (!o.outShade.empty()) writeShade(o.outShade, bounces > 0 ? state.indirect.total : state.shade.rgb);
+    if (!o.outShade.empty()) writeShade(o.outShade, bounces > 0 ? state.indirect.total : state.shade.rgb, o.exposure);
     if (!o.outAmbient.empty()) writeAmbient(o.outAmbient, state.shade.ambient);
     if (!o.outIndirect.empty()) writeIndirect(o.outIndirect, state.indirect.indirect);
     return 0;
@@ -348,6 +303,8 @@ Runner addGiCommand(CLI::App& app) {
     sub->add_option("--threads", o->threads, "Worker threads (0 = all)");
     sub->add_flag("--reference", o->reference, "Ground truth instead of the fast path (slow)");
     sub->add_option("--out-shade", o->outShade, "RGB shade map (.png sRGB 8-bit, or .exr)");
+    sub->add_option("--exposure", o->exposure, "Scale of the .png shade map before sRGB encoding")
+        ->capture_default_str();
     sub->add_option("--out-ambient", o->outAmbient, "Ambient (sky-view) map (.npy float32, or .exr)");
     sub->add_option("--frames", o->frames, "Run the frame N times on the same field (first = warm-up)");
     sub->add_flag("--time", o->time, "Print the time of each stage and the median ms per frame");
@@ -363,7 +320,8 @@ Runner addGiCommand(CLI::App& app) {
     sub->add_flag("--amortise", gs.indirect.amortise,
                   "With --frames on static geometry: alternate direct and indirect updates");
     sub->add_option("--out-indirect", o->outIndirect,
-                    "Indirect light alone, RGB (.npy float32 (rows, columns, 3), or .exr)");
+                    "Indirect light alone, RGB (.npy float32 (rows, columns, 3), .exr, or .png: its luminance in false "
+                    "colour, black to white at its 99th percentile)");
     sub->add_option("--radiance-levels-per-octave", gs.indirect.radiance.levelsPerOctave,
                     gi::describe(r::kRadianceLevelsPerOctave) + " (paper 4)")
         ->capture_default_str();

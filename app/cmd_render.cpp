@@ -85,6 +85,7 @@ void printSummary(const char* label, const RenderOptions& o, const engine::Pipel
 SceneSettings resolveRenderScene(const RenderOptions& o) {
     SceneSettings scene = resolveScene(o.scene, o.size, static_cast<std::uint64_t>(o.seed));
     applyLightOptions(o.lights, scene.lights);
+    applyCameraOptions(o.camera, scene.camera);
     return scene;
 }
 
@@ -124,9 +125,7 @@ void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize) {
     sub->add_option("--exaggeration", o.exaggeration,
                     "Vertical exaggeration (0 = automatic: relief >= 15% of the extent)")
         ->capture_default_str();
-    sub->add_option("--yaw", o.yaw, "Camera azimuth in degrees")->capture_default_str();
-    sub->add_option("--pitch", o.pitch, "Camera elevation in degrees")->capture_default_str();
-    sub->add_option("--distance", o.distance, "Camera distance in terrain extents")->capture_default_str();
+    addCameraOptions(sub, o.camera);
     sub->add_flag("--quiet", o.quiet, "Print only errors");
 }
 
@@ -141,8 +140,6 @@ void toSettings(const RenderOptions& o, const SceneSettings& scene, engine::Pipe
     if (o.ticksPerFrame < 0) throw InputError("--ticks-per-frame must be >= 0");
     if (!(o.exposure > 0.0f && o.exposure < 1000.0f)) throw InputError("--exposure must be > 0");
     if (!(o.exaggeration >= 0.0f && o.exaggeration <= 100.0f)) throw InputError("--exaggeration must be in [0, 100]");
-    if (!(o.distance > 0.05f && o.distance < 100.0f)) throw InputError("--distance must be in (0.05, 100)");
-    if (!(o.pitch > -89.0f && o.pitch < 89.5f)) throw InputError("--pitch must be in (-89, 89.5) degrees");
     p.gi = engine::defaultPipelineGi();
     p.gi.subsample = o.subsample;
     p.gi.indirect.bounces = o.bounces;
@@ -194,9 +191,7 @@ void toSettings(const RenderOptions& o, const SceneSettings& scene, engine::Pipe
                          o.debug + "')");
     r.exposure = o.exposure;
     p.verticalExaggeration = o.exaggeration;
-    r.camera.yawDeg = o.yaw;
-    r.camera.pitchDeg = o.pitch;
-    r.camera.distance = o.distance;
+    r.camera = cameraOfFrame(scene.camera, 0);
 }
 
 int runHeadlessRender(const RenderOptions& o, const char* label) {
@@ -232,6 +227,7 @@ int runHeadlessRender(const RenderOptions& o, const char* label) {
             pipeline.advance();
             pipeline.light();
             auto t = Clock::now();
+            rs.camera = cameraOfFrame(scene.camera, f);
             renderer.upload(pipeline.frame());
             renderer.drawToImage(rs, o.width, o.height, rgb);
             const double renderMs = msSince(t);

@@ -3,10 +3,18 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
 
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
 #include <imgui.h>
+
+#include "app/progress.h"
+#include "app/window_controls.h"
+#include "core/error.h"
+#include "core/png_io.h"
 
 namespace terrain::app {
 using namespace render;
@@ -36,19 +44,6 @@ struct ImGuiSession {
     ImGuiSession(const ImGuiSession&) = delete;
     ImGuiSession& operator=(const ImGuiSession&) = delete;
 };
-
-// Left drag orbits, the wheel zooms (unless ImGui wants the mouse).
-void steerCamera(OrbitCamera& camera) {
-    ImGuiIO& io = ImGui::GetIO();
-    if (!io.WantCaptureMouse) {
-        if (io.MouseDown[0]) {
-            camera.yawDeg -= io.MouseDelta.x * 0.3f;
-            camera.pitchDeg = std::clamp(camera.pitchDeg + io.MouseDelta.y * 0.3f, 2.0f, 89.0f);
-        }
-        if (io.MouseWheel != 0.0f)
-            camera.distance = std::clamp(camera.distance * (1.0f - 0.1f * io.MouseWheel), 0.2f, 6.0f);
-    }
-}
 
 // The panel's light controls: they edit a copy of the declared lights and
 // hand it back when something changed (the sky is re-projected then).
@@ -132,8 +127,36 @@ void drawPanel(FramePipeline& pipeline, RenderSettings& rs, bool& paused, const 
     ImGui::SliderFloat("exaggeration (0 = auto)", &ps.verticalExaggeration, 0.0f, 10.0f);
     ImGui::Separator();
     drawLightControls(pipeline);
-    ImGui::TextDisabled("drag: orbit, wheel: zoom");
+    ImGui::TextDisabled("drag: orbit, wheel: zoom, WASD/QE: fly");
+    ImGui::TextDisabled("P: pause, space: step, F12: screenshot, R: reload, H: hide");
     ImGui::End();
+}
+
+// R: the scene anew from its file (or the built-in); a bad file keeps the
+// scene running and says why.
+void reloadScene(const WindowDemoSetup& setup, std::unique_ptr<FramePipeline>& pipeline) {
+    try {
+        pipeline = setup.loadScene();
+        std::printf("demo: reloaded scene %s\n", pipeline->simulation().settings().name.c_str());
+    } catch (const Error& e) {
+        std::fprintf(stderr, "demo: reload failed, the scene keeps running: %s\n", e.what());
+    }
+}
+
+// F12: the frame as the window shows it (without the panel) to a PNG.
+void writeScreenshot(Renderer& renderer, const RenderSettings& rs, int w, int h, const std::string& dir, int n) {
+    try {
+        ensureWritableDirectory(dir);
+        std::vector<std::uint8_t> rgb;
+        renderer.drawToImage(rs, w, h, rgb);
+        char name[40];
+        std::snprintf(name, sizeof name, "screenshot_%04d.png", n);
+        const std::string file = (std::filesystem::path(dir) / name).string();
+        writePngRgb(file, w, h, rgb);
+        std::printf("demo: screenshot %s\n", file.c_str());
+    } catch (const Error& e) {
+        std::fprintf(stderr, "demo: no screenshot: %s\n", e.what());
+    }
 }
 
 void smoothTimings(StageTimings& avg, const StageTimings& tm) {
@@ -147,42 +170,55 @@ void smoothTimings(StageTimings& avg, const StageTimings& tm) {
 
 }  // namespace
 
-int runWindowDemo(WindowContext& window, const Gl& gl, FramePipeline& pipeline, RenderSettings& rs, int maxFrames) {
+int runWindowDemo(WindowContext& window, const Gl& gl, const WindowDemoSetup& setup, RenderSettings& rs) {
     Renderer renderer(gl);
+    KeyLatch latch(window.nativeHandle());  // before ImGui's backend, which chains to its callback
     ImGuiSession imgui(window.nativeHandle());
-    bool paused = false;
-    int frames = 0;
+    std::unique_ptr<FramePipeline> pipeline = setup.loadScene();
+    bool paused = false, panel = true;
+    int frames = 0, screenshots = 0;
     StageTimings avg;
     double fpsAvg = 0.0;
     auto last = Clock::now();
-    while (!window.shouldClose() && (maxFrames <= 0 || frames < maxFrames)) {
+    while (!window.shouldClose() && (setup.maxFrames <= 0 || frames < setup.maxFrames)) {
         window.pollEvents();
-        // ---- simulation + GI ----------------------------------------------------------
-        if (!paused)
-            pipeline.advance();
-        else
-            pipeline.timings().sim = 0.0;
-        pipeline.light();
-        // ---- camera and panel -----------------------------------------------------------
         ImGui_ImplOpenGL3_NewFrame();
         ImGui_ImplGlfw_NewFrame();
         ImGui::NewFrame();
-        steerCamera(rs.camera);
-        drawPanel(pipeline, rs, paused, avg, fpsAvg);
+        const WindowActions keys = readWindowControls(rs.camera, static_cast<float>(fpsAvg / 1000.0), latch);
+        if (keys.reload) reloadScene(setup, pipeline);
+        if (keys.togglePause) {
+            paused = !paused;
+            std::printf("demo: %s at tick %lld\n", paused ? "paused" : "running",
+                        static_cast<long long>(pipeline->frame().tick));
+        }
+        panel ^= keys.togglePanel;
+        // ---- simulation + GI (a paused window does no GI work: nothing changed) ------
+        if (!paused || keys.step) {
+            pipeline->advance();
+            if (paused)
+                std::printf("demo: stepped to tick %lld\n",
+                            static_cast<long long>(pipeline->simulation().state().tick));
+        } else {
+            pipeline->timings().sim = 0.0;
+        }
+        pipeline->light();
+        if (panel) drawPanel(*pipeline, rs, paused, avg, fpsAvg);
         ImGui::Render();
         // ---- draw ------------------------------------------------------------------------
         int w = 0, h = 0;
         window.framebufferSize(w, h);
         const auto t = Clock::now();
         if (w > 0 && h > 0) {
-            renderer.upload(pipeline.frame());
+            renderer.upload(pipeline->frame());
             renderer.draw(rs, w, h, 0);
+            if (keys.screenshot) writeScreenshot(renderer, rs, w, h, setup.screenshotDir, ++screenshots);
         }
         ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
         gl.Finish();
-        pipeline.timings().render = msSince(t);
+        pipeline->timings().render = msSince(t);
         window.swapBuffers();
-        smoothTimings(avg, pipeline.timings());
+        smoothTimings(avg, pipeline->timings());
         smooth(fpsAvg, msSince(last));
         last = Clock::now();
         ++frames;

@@ -66,9 +66,9 @@ void addLightOptions(CLI::App* sub, LightOptions& o, const std::string& defaults
                     "(default: " +
                         defaults + ")");
     sub->add_option("--light-intensity", o.intensity, "Environment radiance scale (default: " + defaults + ")");
-    sub->add_option("--visibility", o.visibility,
-                    "Haze: metres at which the distance fades into the horizon sky, 0 = clear air (default: " +
-                        defaults + ")");
+    sub->add_option(
+        "--visibility", o.visibility,
+        "Haze: metres at which the distance fades into the horizon sky, 0 = clear air (default: " + defaults + ")");
     sub->add_option("--key", o.keys,
                     "Key light AZ_DEG,EL_DEG,RADIUS_DEG,R,G,B (repeatable; replaces the default key lights; "
                     "'none' for none)");

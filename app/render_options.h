@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/camera_options.h"
 #include "app/light_options.h"
 #include "engine/pipeline.h"
 #include "render/renderer.h"
@@ -35,15 +36,15 @@ struct RenderOptions {
     int pyramidLevel = 4;
     float exposure = 1.0f;
     float exaggeration = 0.0f;  // 0 = automatic
-    float yaw = 235.0f, pitch = 34.0f, distance = 1.35f;
     bool quiet = false;
-    LightOptions lights;  // over the scene's [lights]
+    LightOptions lights;   // over the scene's [lights]
+    CameraOptions camera;  // over the scene's [camera]
 };
 
 /// Adds the options above (except the scene) to a subcommand.
 void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize);
 
-/// The scene the options name, with the light options over its lights.
+/// The scene the options name, with the light and camera options over its own.
 SceneSettings resolveRenderScene(const RenderOptions& o);
 
 /// Checks the options and turns them into pipeline and renderer settings

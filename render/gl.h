@@ -16,7 +16,8 @@ using GlGetProcAddress = GlProc (*)(const char* name);  // same alias as in rend
 // X(member, PFN name part): member `Clear` is loaded from "glClear" with type PFNGLCLEARPROC.
 #define TERRAIN_GL_FUNCTIONS(X)                                                                                       \
     X(ActiveTexture, ACTIVETEXTURE)                                                                                   \
-    X(AttachShader, ATTACHSHADER) X(BindBuffer, BINDBUFFER) X(BindFramebuffer, BINDFRAMEBUFFER)                       \
+    X(AttachShader, ATTACHSHADER)                                                                                     \
+    X(BindBuffer, BINDBUFFER) X(BindFramebuffer, BINDFRAMEBUFFER) X(BlitFramebuffer, BLITFRAMEBUFFER)                 \
         X(BindTexture, BINDTEXTURE) X(BindVertexArray, BINDVERTEXARRAY) X(BlendFunc, BLENDFUNC)                       \
             X(BufferData, BUFFERDATA) X(CheckFramebufferStatus, CHECKFRAMEBUFFERSTATUS) X(Clear, CLEAR)               \
                 X(ClearColor, CLEARCOLOR) X(ClearDepth, CLEARDEPTH) X(CompileShader, COMPILESHADER) X(                \

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -105,7 +106,7 @@ std::uint64_t hashBytes(const std::vector<std::uint8_t>& bytes) {
     return h;
 }
 
-Renderer::Renderer(const Gl& gl) : gl_(gl) {
+Renderer::Renderer(const Gl& gl) : gl_(gl), sky_(gl) {
     using namespace shaders;
     const char* version = "#version 330 core\n";
     terrainProgram_ = link(gl_, {kMeshVertex}, {version, kCommon, kTerrainFragment}, "terrain");
@@ -114,16 +115,32 @@ Renderer::Renderer(const Gl& gl) : gl_(gl) {
     postProgram_ = link(gl_, {kPostVertex}, {kPostFragment}, "post");
     gl_.GenVertexArrays(1, &vao_);
     gl_.GenBuffers(1, &indexBuffer_);
+    // One chunk's 16 stitch variants, one after another (render/terrain_lod.h).
+    std::vector<std::uint16_t> chunkIndices;
+    for (int stitched = 0; stitched < kStitchVariants; ++stitched) {
+        chunkFirst_[stitched] = static_cast<int>(chunkIndices.size());
+        for (const ChunkTriangle& t : chunkTriangles(kChunkQuads, stitched))
+            chunkIndices.insert(chunkIndices.end(), t.begin(), t.end());
+        chunkCount_[stitched] = static_cast<int>(chunkIndices.size()) - chunkFirst_[stitched];
+    }
+    gl_.GenBuffers(1, &chunkIndexBuffer_);
+    gl_.BindVertexArray(vao_);
+    gl_.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, chunkIndexBuffer_);
+    gl_.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(chunkIndices.size() * sizeof(std::uint16_t)),
+                   chunkIndices.data(), GL_STATIC_DRAW);
+    gl_.BindVertexArray(0);
     checkGlError(gl_, "renderer set-up");
 }
 
 Renderer::~Renderer() {
     releaseTarget(hdr_);
+    releaseTarget(sceneCopy_);
     releaseTarget(ldr_);
     releaseTarget(shadow_);
-    const GLuint textures[] = {heightTex_, shadeTex_, keyTex_, receiverTex_, envTex_, albedoTex_};
-    gl_.DeleteTextures(6, textures);
+    const GLuint textures[] = {heightTex_, shadeTex_, keyTex_, receiverTex_, albedoTex_};
+    gl_.DeleteTextures(5, textures);
     gl_.DeleteBuffers(1, &indexBuffer_);
+    gl_.DeleteBuffers(1, &chunkIndexBuffer_);
     gl_.DeleteVertexArrays(1, &vao_);
     for (GLuint p : {terrainProgram_, waterProgram_, shadowProgram_, postProgram_}) gl_.DeleteProgram(p);
 }
@@ -157,48 +174,10 @@ void Renderer::upload(const engine::FrameData& f) {
         albedoVersion_ = f.albedoVersion;
     }
 
-    // The environment map: the sky's SH radiance baked to 64 x 32 texels
-    // (order 4 is band-limited, i.e. already a prefiltered map).
-    const int ew = 64, eh = 32;
-    const bool newEnv = !envTex_ || meta_.lights.sky.c != f.lights.sky.c;
-    ensureTexture(envTex_, envW_, envH_, ew, eh, GL_RGB32F, GL_RGB, true);
-    gl_.BindTexture(GL_TEXTURE_2D, envTex_);
-    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
-    if (newEnv || envPixels_.empty()) {
-        envPixels_.resize(static_cast<std::size_t>(ew) * eh * 3);
-        for (int v = 0; v < eh; ++v)
-            for (int u = 0; u < ew; ++u) {
-                const double phi = 2.0 * gi::kPi * (u + 0.5) / ew;
-                const double el = gi::kPi * (0.5 - (v + 0.5) / eh);
-                double rgb[3];
-                gi::evaluateShRgb(f.lights.sky, std::cos(el) * std::cos(phi), std::cos(el) * std::sin(phi),
-                                  std::sin(el), rgb);
-                for (int c = 0; c < 3; ++c)
-                    envPixels_[(static_cast<std::size_t>(v) * ew + u) * 3 + static_cast<std::size_t>(c)] =
-                        static_cast<float>(std::max(0.0, rgb[c]));
-            }
-        gl_.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, ew, eh, GL_RGB, GL_FLOAT, envPixels_.data());
-    }
+    sky_.upload(f.lights);
 
-    // Index buffer: two triangles per quad, rebuilt only when the size changes.
-    if (meshNx_ != f.nx || meshNy_ != f.ny) {
-        std::vector<std::uint32_t> idx;
-        idx.reserve(static_cast<std::size_t>(std::max(f.nx - 1, 0)) * std::max(f.ny - 1, 0) * 6);
-        for (int y = 0; y + 1 < f.ny; ++y)
-            for (int x = 0; x + 1 < f.nx; ++x) {
-                const std::uint32_t a = static_cast<std::uint32_t>(y * f.nx + x), b = a + 1,
-                                    c = a + static_cast<std::uint32_t>(f.nx), d = c + 1;
-                idx.insert(idx.end(), {a, b, d, a, d, c});
-            }
-        gl_.BindVertexArray(vao_);
-        gl_.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, indexBuffer_);
-        gl_.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(idx.size() * sizeof(std::uint32_t)), idx.data(),
-                       GL_STATIC_DRAW);
-        gl_.BindVertexArray(0);
-        indexCount_ = static_cast<std::int64_t>(idx.size());
-        meshNx_ = f.nx;
-        meshNy_ = f.ny;
-    }
+    // The chunks' errors and bounds follow the heights (render/terrain_lod.h).
+    buildChunkTree(f.heights, f.nx, f.ny, f.cellSize, f.exaggeration, f.hasWater, kChunkQuads, lodTree_);
     meta_.nx = f.nx;
     meta_.ny = f.ny;
     meta_.nxr = f.nxr;
@@ -247,6 +226,56 @@ void Renderer::ensureTarget(Target& t, int w, int h, GLenum colorFormat, bool de
     t.h = h;
 }
 
+// Two triangles per quad, rebuilt only when the size changes.
+void Renderer::ensureFullGrid() {
+    if (meshNx_ == meta_.nx && meshNy_ == meta_.ny) return;
+    const int nx = meta_.nx, ny = meta_.ny;
+    std::vector<std::uint32_t> idx;
+    idx.reserve(static_cast<std::size_t>(std::max(nx - 1, 0)) * std::max(ny - 1, 0) * 6);
+    for (int y = 0; y + 1 < ny; ++y)
+        for (int x = 0; x + 1 < nx; ++x) {
+            const std::uint32_t a = static_cast<std::uint32_t>(y * nx + x), b = a + 1,
+                                c = a + static_cast<std::uint32_t>(nx), d = c + 1;
+            idx.insert(idx.end(), {a, b, d, a, d, c});
+        }
+    gl_.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, indexBuffer_);
+    gl_.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(idx.size() * sizeof(std::uint32_t)), idx.data(),
+                   GL_STATIC_DRAW);
+    indexCount_ = static_cast<std::int64_t>(idx.size());
+    meshNx_ = nx;
+    meshNy_ = ny;
+}
+
+Renderer::MeshCount Renderer::drawMesh(GLuint program, const float* cullViewProj, bool lod, bool waterOnly) {
+    const GLint origin = gl_.GetUniformLocation(program, "uOrigin"), step = gl_.GetUniformLocation(program, "uStep"),
+                row = gl_.GetUniformLocation(program, "uRow");
+    MeshCount n;
+    if (!lod) {
+        ensureFullGrid();
+        gl_.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, indexBuffer_);
+        gl_.Uniform2i(origin, 0, 0);
+        gl_.Uniform1i(step, 1);
+        gl_.Uniform1i(row, meta_.nx);
+        gl_.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(indexCount_), GL_UNSIGNED_INT, nullptr);
+        n.triangles = indexCount_ / 3;
+    } else {
+        gl_.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, chunkIndexBuffer_);
+        gl_.Uniform1i(row, kChunkQuads + 1);
+        for (const LodChunk& c : lodSelection_.chunks) {
+            if ((waterOnly && !c.wet) || !boxInClipVolume(cullViewProj, c.boxMin, c.boxMax)) continue;
+            gl_.Uniform2i(origin, c.x0, c.y0);
+            gl_.Uniform1i(step, 1 << c.level);
+            const auto offset = static_cast<std::uintptr_t>(chunkFirst_[c.stitched]) * sizeof(std::uint16_t);
+            gl_.DrawElements(GL_TRIANGLES, chunkCount_[c.stitched], GL_UNSIGNED_SHORT,
+                             reinterpret_cast<const void*>(offset));
+            n.triangles += chunkCount_[c.stitched] / 3;
+            ++n.chunks;
+        }
+    }
+    stats_.triangles += n.triangles;
+    return n;
+}
+
 void Renderer::releaseTarget(Target& t) {
     if (t.fbo) gl_.DeleteFramebuffers(1, &t.fbo);
     if (t.color) gl_.DeleteTextures(1, &t.color);
@@ -258,9 +287,36 @@ void Renderer::releaseTarget(Target& t) {
 struct Renderer::FrameViews {
     glm::vec3 eye;
     glm::mat4 viewProj;
+    float nearPlane, farPlane;
     glm::vec3 keyDir;
     glm::mat4 lightViewProj;  // orthographic, covering the terrain
 };
+
+// The lowest the eye may be at (x, y): above the highest surface of the
+// finest chunks around it (render/terrain_lod.h) by twice the near plane's
+// distance, so the camera never dips under the terrain nor cuts it open.
+float Renderer::lowestEye(float x, float y, float nearPlane) const {
+    float lowest = -std::numeric_limits<float>::infinity();
+    if (lodTree_.levels.empty()) return lowest;
+    const ChunkTree::Level& fine = lodTree_.levels[0];
+    const float span = static_cast<float>(lodTree_.quads) * lodTree_.cellSize;
+    const int cx = static_cast<int>(std::floor(x / span)), cy = static_cast<int>(std::floor(y / span));
+    for (int j = std::max(cy - 1, 0); j <= std::min(cy + 1, fine.nodesY - 1); ++j)
+        for (int i = std::max(cx - 1, 0); i <= std::min(cx + 1, fine.nodesX - 1); ++i)
+            lowest = std::max(lowest, fine.zMax[static_cast<std::size_t>(j) * fine.nodesX + i] + 2.0f * nearPlane);
+    return lowest;
+}
+
+std::array<float, 3> Renderer::eyeOf(const OrbitCamera& cam) const {
+    const engine::FrameData& f = meta_;
+    const float exag = f.exaggeration;
+    const float extent = static_cast<float>(std::max(f.nx, f.ny) - 1) * f.cellSize;
+    const float cp = std::cos(cam.pitchDeg * kDeg), dist = extent * cam.distance;
+    const float x = (cam.targetX * (f.nx - 1) + dist / f.cellSize * cp * std::cos(cam.yawDeg * kDeg)) * f.cellSize;
+    const float y = (cam.targetY * (f.ny - 1) + dist / f.cellSize * cp * std::sin(cam.yawDeg * kDeg)) * f.cellSize;
+    const float z = (f.zMin + cam.targetZ * (f.zMax - f.zMin)) * exag + dist * std::sin(cam.pitchDeg * kDeg);
+    return {x, y, std::max(z, lowestEye(x, y, std::max(dist * 0.02f, 0.01f)))};
+}
 
 Renderer::FrameViews Renderer::frameViews(const OrbitCamera& cam, int width, int height) const {
     const engine::FrameData& f = meta_;
@@ -269,14 +325,15 @@ Renderer::FrameViews Renderer::frameViews(const OrbitCamera& cam, int width, int
     const glm::vec3 centre(0.5f * (f.nx - 1) * f.cellSize, 0.5f * (f.ny - 1) * f.cellSize,
                            0.5f * (f.zMin + f.zMax) * exag);
     // ---- camera ------------------------------------------------------------------
-    const float cp = std::cos(cam.pitchDeg * kDeg);
-    const glm::vec3 eye = centre + extent * cam.distance *
-                                       glm::vec3(cp * std::cos(cam.yawDeg * kDeg), cp * std::sin(cam.yawDeg * kDeg),
-                                                 std::sin(cam.pitchDeg * kDeg));
+    const glm::vec3 target(cam.targetX * (f.nx - 1) * f.cellSize, cam.targetY * (f.ny - 1) * f.cellSize,
+                           (f.zMin + cam.targetZ * (f.zMax - f.zMin)) * exag);
+    const std::array<float, 3> e = eyeOf(cam);
+    const glm::vec3 eye(e[0], e[1], e[2]);
     const float dist = extent * cam.distance;
-    const glm::mat4 view = glm::lookAt(eye, centre, glm::vec3(0, 0, 1));
-    const glm::mat4 proj = glm::perspective(cam.fovYDeg * kDeg, static_cast<float>(width) / height,
-                                            std::max(dist * 0.02f, 0.01f), dist * 4.0f + (f.zMax - f.zMin) * exag);
+    const glm::mat4 view = glm::lookAt(eye, target, glm::vec3(0, 0, 1));
+    const float nearPlane = std::max(dist * 0.02f, 0.01f), farPlane = dist * 4.0f + (f.zMax - f.zMin) * exag;
+    const glm::mat4 proj =
+        glm::perspective(cam.fovYDeg * kDeg, static_cast<float>(width) / height, nearPlane, farPlane);
     const glm::mat4 viewProj = proj * view;
     // ---- key light shadow map (orthographic, covering the terrain) ---------------
     const glm::vec3 keyDir = keyDirection(sunOf(f.lights));
@@ -285,7 +342,7 @@ Renderer::FrameViews Renderer::frameViews(const OrbitCamera& cam, int width, int
     const glm::vec3 up = std::abs(keyDir.z) > 0.99f ? glm::vec3(0, 1, 0) : glm::vec3(0, 0, 1);
     const glm::mat4 lightViewProj = glm::ortho(-radius, radius, -radius, radius, 0.0f, 4.0f * radius) *
                                     glm::lookAt(centre + keyDir * (2.0f * radius), centre, up);
-    return {eye, viewProj, keyDir, lightViewProj};
+    return {eye, viewProj, nearPlane, farPlane, keyDir, lightViewProj};
 }
 
 namespace {
@@ -307,7 +364,19 @@ void Renderer::draw(const RenderSettings& s, int width, int height, GLuint frame
     if (width < 1 || height < 1 || width > 16384 || height > 16384)
         throw InputError("image size must be 1..16384 pixels per side");
     if (!heightTex_) throw ContextError("renderer: draw before upload");
+    if (!(s.lodPixelError >= 0.0f && s.lodPixelError <= kMaxLodPixelError))
+        throw InputError("LOD pixel error must be in [0, " + std::to_string(kMaxLodPixelError) + "]");
     const FrameViews v = frameViews(s.camera, width, height);
+    // The frame's chunks, for every mesh pass (render/terrain_lod.h).
+    const bool lod = s.lodPixelError > 0.0f;
+    stats_ = {};
+    if (lod) {
+        LodView view;
+        std::copy_n(glm::value_ptr(v.eye), 3, view.eye);
+        view.pixelsPerUnit = static_cast<float>(height) / (2.0f * std::tan(0.5f * s.camera.fovYDeg * kDeg));
+        view.pixelError = s.lodPixelError;
+        selectChunks(lodTree_, view, lodSelection_);
+    }
     const bool debug = s.debug != DebugView::None;
     gl_.BindVertexArray(vao_);
     const bool wantShadowMap = s.shadow == ShadowMode::ShadowMap && !debug;
@@ -317,8 +386,8 @@ void Renderer::draw(const RenderSettings& s, int width, int height, GLuint frame
     ensureTarget(hdr_, width, height, GL_RGBA16F, true);
     gl_.ActiveTexture(GL_TEXTURE0);
     gl_.BindTexture(GL_TEXTURE_2D, heightTex_);
-    if (wantShadowMap) drawShadowMap(v);
-    drawSurfaces(s, v, width, height, wantShadowMap);
+    if (wantShadowMap) drawShadowMap(v, lod);
+    drawSurfaces(s, v, width, height, wantShadowMap, lod);
     drawPost(s, v, width, height, framebuffer);
     gl_.BindVertexArray(0);
     gl_.ActiveTexture(GL_TEXTURE0);
@@ -326,7 +395,9 @@ void Renderer::draw(const RenderSettings& s, int width, int height, GLuint frame
 }
 
 // ---- key light shadow map -----------------------------------------------------------
-void Renderer::drawShadowMap(const FrameViews& v) {
+// The same chunks as the camera's (culled by the light's volume), so that the
+// shadows fall from the surface the camera sees.
+void Renderer::drawShadowMap(const FrameViews& v, bool lod) {
     const int side = shadow_.w;
     gl_.BindFramebuffer(GL_FRAMEBUFFER, shadow_.fbo);
     gl_.Viewport(0, 0, side, side);
@@ -338,14 +409,36 @@ void Renderer::drawShadowMap(const FrameViews& v) {
     gl_.PolygonOffset(1.5f, 2.0f);
     gl_.UseProgram(shadowProgram_);
     meshUniforms(gl_, meta_, shadowProgram_, v.lightViewProj, 0);
-    gl_.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(indexCount_), GL_UNSIGNED_INT, nullptr);
+    drawMesh(shadowProgram_, glm::value_ptr(v.lightViewProj), lod);
     gl_.Disable(GL_POLYGON_OFFSET_FILL);
 }
 
 // ---- terrain and water into the HDR target ------------------------------------------
-void Renderer::drawSurfaces(const RenderSettings& s, const FrameViews& v, int width, int height, bool wantShadowMap) {
+// The water reflects the terrain drawn so far (kWaterFragment's screen-space
+// reflection): its colour and depth are copied to textures it can read
+// while it draws into the target they came from. Leaves hdr_ bound, the
+// copies on texture units 7 and 8.
+void Renderer::copySceneForReflections(int width, int height) {
+    gl_.ActiveTexture(GL_TEXTURE8);  // what follows binds textures: keep the surfaces' units 0-6
+    ensureTarget(sceneCopy_, width, height, GL_RGBA16F, true);
+    gl_.BindTexture(GL_TEXTURE_2D, sceneCopy_.depth);
+    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_NONE);  // read as distances, not compared
+    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    gl_.BindFramebuffer(GL_READ_FRAMEBUFFER, hdr_.fbo);
+    gl_.BindFramebuffer(GL_DRAW_FRAMEBUFFER, sceneCopy_.fbo);
+    gl_.BlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT,
+                        GL_NEAREST);
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, hdr_.fbo);
+    gl_.ActiveTexture(GL_TEXTURE7);
+    gl_.BindTexture(GL_TEXTURE_2D, sceneCopy_.color);
+    gl_.ActiveTexture(GL_TEXTURE8);
+    gl_.BindTexture(GL_TEXTURE_2D, sceneCopy_.depth);
+}
+
+void Renderer::drawSurfaces(const RenderSettings& s, const FrameViews& v, int width, int height, bool wantShadowMap,
+                            bool lod) {
     const engine::FrameData& f = meta_;
-    const GLsizei indexCount = static_cast<GLsizei>(indexCount_);
     gl_.BindFramebuffer(GL_FRAMEBUFFER, hdr_.fbo);
     gl_.Viewport(0, 0, width, height);
     gl_.ClearColor(0, 0, 0, 0);
@@ -354,19 +447,27 @@ void Renderer::drawSurfaces(const RenderSettings& s, const FrameViews& v, int wi
     gl_.Enable(GL_DEPTH_TEST);
     gl_.DepthFunc(GL_LESS);
     gl_.Disable(GL_CULL_FACE);
-    const GLuint textures[] = {heightTex_, shadeTex_, keyTex_, receiverTex_, envTex_, shadow_.depth, albedoTex_};
+    const GLuint textures[] = {heightTex_,       shadeTex_,     keyTex_,   receiverTex_,
+                               sky_.shTexture(), shadow_.depth, albedoTex_};
     for (int i = 0; i < 7; ++i) {
         gl_.ActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + i));
         gl_.BindTexture(GL_TEXTURE_2D, textures[i]);
     }
     surfaceUniforms(terrainProgram_, 0, s, v, wantShadowMap);
-    gl_.DrawElements(GL_TRIANGLES, indexCount, GL_UNSIGNED_INT, nullptr);
+    const MeshCount terrain = drawMesh(terrainProgram_, glm::value_ptr(v.viewProj), lod);
+    stats_.terrainTriangles = terrain.triangles;
+    stats_.terrainChunks = terrain.chunks;
     if (s.water && f.hasWater && s.debug == DebugView::None) {
+        copySceneForReflections(width, height);
         surfaceUniforms(waterProgram_, 1, s, v, wantShadowMap);
+        Uniforms u{gl_, waterProgram_};
+        u.i("uSceneColor", 7);
+        u.i("uSceneDepth", 8);
+        u.f2("uNearFar", v.nearPlane, v.farPlane);
         gl_.Enable(GL_BLEND);
         gl_.BlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
         gl_.DepthMask(GL_FALSE);
-        gl_.DrawElements(GL_TRIANGLES, indexCount, GL_UNSIGNED_INT, nullptr);
+        drawMesh(waterProgram_, glm::value_ptr(v.viewProj), lod, true);  // the terrain's chunks that show water
         gl_.DepthMask(GL_TRUE);
         gl_.Disable(GL_BLEND);
     }
@@ -383,6 +484,7 @@ void Renderer::surfaceUniforms(GLuint p, int water, const RenderSettings& s, con
     u.i("uEnv", 4);
     u.i("uShadowMap", 5);
     u.i("uAlbedo", 6);
+    u.f("uHaze", f.lights.hazeExtinction);
     u.i2("uReceiverGrid", f.nxr, f.nyr);
     u.i("uSubsample", f.subsample);
     u.v3("uEye", v.eye);
@@ -407,11 +509,9 @@ void Renderer::drawPost(const RenderSettings& s, const FrameViews& v, int width,
     gl_.UseProgram(postProgram_);
     gl_.ActiveTexture(GL_TEXTURE0);
     gl_.BindTexture(GL_TEXTURE_2D, hdr_.color);
-    gl_.ActiveTexture(GL_TEXTURE1);
-    gl_.BindTexture(GL_TEXTURE_2D, envTex_);
+    sky_.setBackground(postProgram_, meta_.lights, 1, 2);
     Uniforms u{gl_, postProgram_};
     u.i("uHdr", 0);
-    u.i("uEnv", 1);
     u.m4("uInvViewProj", glm::inverse(v.viewProj));
     u.v3("uEye", v.eye);
     u.f2("uSize", static_cast<float>(width), static_cast<float>(height));

@@ -2,10 +2,11 @@
 // The OpenGL 3.3 core renderer shared by the window and the headless path.
 //
 // Per frame: upload the heights (one RG32F texture: ground, water depth) and
-// the GI textures of FrameData; draw the terrain mesh (one vertex per grid
-// point, positions fetched from the height texture by gl_VertexID, two
-// triangles per quad) into an HDR target; draw water as a second surface
-// (ground + depth) blended over the lit terrain; tone map and encode sRGB.
+// the GI textures of FrameData; draw the terrain mesh (chunks whose
+// resolution follows the screen-space error, render/terrain_lod.h; positions
+// fetched from the height texture by gl_VertexID) into an HDR target; draw
+// water as a second surface (ground + depth, the same chunks) blended over
+// the lit terrain; tone map and encode sRGB.
 //
 // Materials (Heidrich & Seidel 1999): Torrance-Sparrow specular for the key light
 // (Beckmann distribution, Smith geometry term, Schlick's Fresnel), modulated
@@ -14,11 +15,14 @@
 // sky's order-4 SH, a band-limited hence prefiltered map, baked to a small
 // equirectangular texture) weighted by Fresnel: L = F L_m + (1 - F) L_d
 // (Section 4.4), L_d the water body and the lit terrain seen through it.
+#include <array>
 #include <cstdint>
 #include <vector>
 
 #include "engine/frame_data.h"
 #include "render/gl.h"
+#include "render/sky.h"
+#include "render/terrain_lod.h"
 
 namespace terrain::render {
 
@@ -41,6 +45,8 @@ struct OrbitCamera {
     float pitchDeg = 34.0f;  // elevation of the eye
     float distance = 1.35f;  // in terrain extents
     float fovYDeg = 40.0f;
+    // the point looked at: fractions of the extent along x and y, of the relief along z
+    float targetX = 0.5f, targetY = 0.5f, targetZ = 0.5f;
 };
 
 struct RenderSettings {
@@ -50,7 +56,19 @@ struct RenderSettings {
     bool water = true;
     bool specular = true;
     int shadowMapSize = 2048;
+    // Level of detail: the largest screen-space error of the mesh, in pixels
+    // (render/terrain_lod.h), in [0, kMaxLodPixelError]; 0: the full grid,
+    // one vertex per grid point everywhere. The shading is full resolution
+    // either way.
+    float lodPixelError = 1.0f;
     OrbitCamera camera;
+};
+
+/// What the last draw() drew of the terrain mesh.
+struct DrawStats {
+    std::int64_t triangles = 0;         // every mesh pass: shadow map, terrain, water
+    std::int64_t terrainTriangles = 0;  // the terrain pass alone
+    int terrainChunks = 0;              // chunks the terrain pass drew (0: the full grid in one draw)
 };
 
 class Renderer {
@@ -67,6 +85,11 @@ public:
     void draw(const RenderSettings& settings, int width, int height, GLuint framebuffer);
     /// Headless: draws into an own 8-bit target and reads it back as RGB, row 0 at the top.
     void drawToImage(const RenderSettings& settings, int width, int height, std::vector<std::uint8_t>& rgb);
+    /// Where the eye of `camera` is (world metres, z exaggerated) for the
+    /// uploaded frame: never under the terrain, whatever the camera asks.
+    std::array<float, 3> eyeOf(const OrbitCamera& camera) const;
+    /// Triangles and chunks of the last draw().
+    const DrawStats& lastDrawStats() const { return stats_; }
 
 private:
     struct Target {
@@ -81,23 +104,43 @@ private:
     // The passes of draw().
     struct FrameViews;
     FrameViews frameViews(const OrbitCamera& camera, int width, int height) const;
-    void drawShadowMap(const FrameViews& v);
-    void drawSurfaces(const RenderSettings& s, const FrameViews& v, int width, int height, bool wantShadowMap);
+    float lowestEye(float x, float y, float nearPlane) const;
+    void drawShadowMap(const FrameViews& v, bool lod);
+    struct MeshCount {
+        std::int64_t triangles = 0;
+        int chunks = 0;
+    };
+    /// The terrain mesh with `program`: the full grid, or (lod) the selected
+    /// chunks inside the clip volume of `cullViewProj` (column-major 4 x 4),
+    /// only those that show water if `waterOnly`.
+    MeshCount drawMesh(GLuint program, const float* cullViewProj, bool lod, bool waterOnly = false);
+    /// The full grid's index buffer, bound to the vertex array of draw().
+    void ensureFullGrid();
+    void copySceneForReflections(int width, int height);
+    void drawSurfaces(const RenderSettings& s, const FrameViews& v, int width, int height, bool wantShadowMap,
+                      bool lod);
     void surfaceUniforms(GLuint p, int water, const RenderSettings& s, const FrameViews& v, bool wantShadowMap);
     void drawPost(const RenderSettings& s, const FrameViews& v, int width, int height, GLuint framebuffer);
 
     const Gl& gl_;
     GLuint terrainProgram_ = 0, waterProgram_ = 0, shadowProgram_ = 0, postProgram_ = 0;
     GLuint vao_ = 0, indexBuffer_ = 0;
-    std::int64_t indexCount_ = 0;
+    std::int64_t indexCount_ = 0;  // of the full grid, built on its first draw
     int meshNx_ = 0, meshNy_ = 0;
-    GLuint heightTex_ = 0, shadeTex_ = 0, keyTex_ = 0, receiverTex_ = 0, envTex_ = 0, albedoTex_ = 0;
-    int heightW_ = 0, heightH_ = 0, shadeW_ = 0, shadeH_ = 0, keyW_ = 0, keyH_ = 0, recvW_ = 0, recvH_ = 0, envW_ = 0,
-        envH_ = 0, albedoW_ = 0, albedoH_ = 0;
+    // Chunked LOD: the 16 stitch variants of one chunk's indices (16 bits,
+    // one after another), the uploaded heights' chunk tree, the frame's chunks.
+    GLuint chunkIndexBuffer_ = 0;
+    int chunkFirst_[kStitchVariants] = {}, chunkCount_[kStitchVariants] = {};
+    ChunkTree lodTree_;
+    ChunkSelection lodSelection_;
+    DrawStats stats_;
+    GLuint heightTex_ = 0, shadeTex_ = 0, keyTex_ = 0, receiverTex_ = 0, albedoTex_ = 0;
+    int heightW_ = 0, heightH_ = 0, shadeW_ = 0, shadeH_ = 0, keyW_ = 0, keyH_ = 0, recvW_ = 0, recvH_ = 0,
+        albedoW_ = 0, albedoH_ = 0;
     std::int64_t albedoVersion_ = -1;  // FrameData::albedoVersion of the uploaded albedo
-    Target hdr_, ldr_, shadow_;
+    Target hdr_, ldr_, shadow_, sceneCopy_;
     engine::FrameData meta_;  // the uploaded frame's sizes, lights and modes (no per-texel arrays)
-    std::vector<float> envPixels_;
+    Sky sky_;
 };
 
 /// FNV-1a 64-bit hash of image bytes (for determinism checks).

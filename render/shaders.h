@@ -3,8 +3,10 @@
 
 namespace terrain::render::shaders {
 
-// Shared by terrain, water and the shadow pass: one vertex per grid point,
-// its position fetched from the height texture (heights stream every frame).
+// Shared by terrain, water and the shadow pass: the vertices of one chunk
+// (render/terrain_lod.h) or of the full grid, uRow a row, every uStep-th grid
+// point from uOrigin, clamped to the grid; positions fetched from the height
+// texture (heights stream every frame).
 inline constexpr const char* kMeshVertex = R"(#version 330 core
 uniform sampler2D uHeight;   // RG32F: ground (m), water depth (m)
 uniform ivec2 uGrid;         // nx, ny
@@ -12,11 +14,14 @@ uniform float uCell;         // m between grid points
 uniform float uExag;         // vertical exaggeration
 uniform mat4 uViewProj;
 uniform int uWater;          // 1: the water surface (ground + depth)
+uniform ivec2 uOrigin;       // the chunk's first grid point
+uniform int uStep;           // grid points between its vertices
+uniform int uRow;            // vertices per row
 out vec3 vWorld;
 out vec2 vCell;
 out float vDepth;
 void main() {
-    ivec2 g = ivec2(gl_VertexID % uGrid.x, gl_VertexID / uGrid.x);
+    ivec2 g = min(uOrigin + ivec2(gl_VertexID % uRow, gl_VertexID / uRow) * uStep, uGrid - 1);
     vec2 hw = texelFetch(uHeight, g, 0).rg;
     float z = hw.r;
     // Dry points of the water surface sit just under the ground, so the
@@ -58,6 +63,7 @@ uniform int uDebug;
 uniform vec2 uZRange;
 uniform mat4 uLightViewProj;
 uniform float uShadowTexel;
+uniform float uHaze;          // extinction per metre of view distance (0: clear air)
 in vec3 vWorld;
 in vec2 vCell;
 in float vDepth;
@@ -133,9 +139,18 @@ void keyLight(vec2 uv, vec3 n, out float vis, out vec3 diffuse) {
     }
 }
 vec3 skyShade(vec2 uv) { return uLighting == 0 ? vec3(0.0) : texture(uShade, uv).rgb; }
-// Beckmann roughness of the material's Phong exponent S: m = sqrt(2 / (S + 2)),
-// the Phong-Beckmann correspondence S = 2 / m^2 - 2 of Walter et al. 2007.
-float roughness(vec2 uv) { return sqrt(2.0 / (texture(uAlbedo, uv).a + 2.0)); }
+// Aerial perspective: the surface's radiance fades along the view ray into
+// the sky's radiance at the horizon in that direction (Beer-Lambert).
+vec3 hazed(vec3 c) {
+    if (uHaze <= 0.0) return c;
+    vec3 ray = vWorld - uEye;
+    float t = exp(-uHaze * length(ray));
+    vec2 h = length(ray.xy) > 0.0 ? normalize(ray.xy) : vec2(1.0, 0.0);
+    return c * t + environment(vec3(h, 0.0)) * (1.0 - t);
+}
+// Beckmann roughness of a Phong exponent S: m = sqrt(2 / (S + 2)), the
+// Phong-Beckmann correspondence S = 2 / m^2 - 2 of Walter et al. 2007.
+float roughness(float exponent) { return sqrt(2.0 / (exponent + 2.0)); }
 )";
 
 inline constexpr const char* kTerrainFragment = R"(
@@ -160,14 +175,45 @@ void main() {
     vec3 keyDiffuse;
     keyLight(uv, n, vis, keyDiffuse);
     // the GI bounced light off this albedo already: only the key light's share needs it
-    vec3 c = skyShade(uv) + texture(uAlbedo, uv).rgb * keyDiffuse;
+    vec4 material = texture(uAlbedo, uv);
+    vec3 c = skyShade(uv) + material.rgb * keyDiffuse;
     if (uSpecular == 1)
-        c += 0.35 * uKeyRgb * vis * torranceSparrow(n, normalize(uEye - vWorld), uKeyDir, roughness(uv), 0.04);
-    fragColor = vec4(c, 1.0);
+        c += 0.35 * uKeyRgb * vis * torranceSparrow(n, normalize(uEye - vWorld), uKeyDir, roughness(material.a), 0.04);
+    fragColor = vec4(hazed(c), 1.0);
 }
 )";
 
 inline constexpr const char* kWaterFragment = R"(
+uniform sampler2D uSceneColor;  // the terrain pass's HDR colour, copied before the water
+uniform sampler2D uSceneDepth;  // and its depth
+uniform mat4 uViewProj;
+uniform vec2 uNearFar;          // the projection's near and far distances
+float viewDistance(float depth) {  // window depth -> distance along the view axis
+    float z = depth * 2.0 - 1.0;
+    return 2.0 * uNearFar.x * uNearFar.y / (uNearFar.y + uNearFar.x - z * (uNearFar.y - uNearFar.x));
+}
+// Screen-space reflection: march the reflected ray from p in growing steps,
+// project each point and stop where it passes just behind the terrain drawn
+// there; rgb is that terrain's colour, a its weight (0: no hit, fading out
+// towards the screen's edges where the march loses sight of it).
+vec4 terrainReflection(vec3 p, vec3 r) {
+    float t = 0.004 * length(uEye - p);
+    for (int i = 0; i < 16; ++i) {
+        vec4 c = uViewProj * vec4(p + r * t, 1.0);
+        if (c.w <= 0.0) break;
+        vec3 ndc = c.xyz / c.w;
+        if (abs(ndc.x) > 1.0 || abs(ndc.y) > 1.0 || ndc.z > 1.0) break;
+        vec2 uv = ndc.xy * 0.5 + 0.5;
+        float scene = viewDistance(texture(uSceneDepth, uv).r);
+        float ray = viewDistance(ndc.z * 0.5 + 0.5);
+        if (ray > scene && ray - scene < 0.5 * t + 0.01 * ray) {
+            vec2 edge = smoothstep(1.0, 0.85, abs(ndc.xy));
+            return vec4(texture(uSceneColor, uv).rgb, edge.x * edge.y);
+        }
+        t *= 1.6;
+    }
+    return vec4(0.0);
+}
 void main() {
     if (vDepth < 0.02 || uDebug != 0) discard;
     vec2 uv = uvOf(vCell);
@@ -176,18 +222,21 @@ void main() {
     float vis;
     vec3 keyDiffuse;
     keyLight(uv, n, vis, keyDiffuse);
-    // Mirror term: the prefiltered environment in the reflection direction,
-    // dimmed by how much of the sky the water sees.
+    // Mirror term: the terrain where the reflected ray meets it on screen,
+    // else the prefiltered environment in that direction, dimmed by how much
+    // of the sky the water sees.
     vec3 r = reflect(-v, n);
     float skyVis = clamp(texture(uReceiver, receiverUv(vCell)).r, 0.0, 1.0);
-    vec3 mirror = environment(r) * skyVis;
+    vec4 terrain = terrainReflection(vWorld, r);
+    vec3 mirror = mix(environment(r) * skyVis, terrain.rgb, terrain.a);
     float f = schlick(max(dot(n, v), 0.0), 0.02);  // water, n = 1.33
-    vec3 glint = uSpecular == 1 ? uKeyRgb * vis * torranceSparrow(n, v, uKeyDir, roughness(uv), 0.02) : vec3(0.0);
+    vec4 material = texture(uAlbedo, uv);
+    vec3 glint = uSpecular == 1 ? uKeyRgb * vis * torranceSparrow(n, v, uKeyDir, roughness(material.a), 0.02) : vec3(0.0);
     // Diffuse part: the water body and the bed seen through it, one albedo
     // in the GI's map (engine/material_maps.h), lit like the terrain.
-    vec3 body = skyShade(uv) + texture(uAlbedo, uv).rgb * keyDiffuse;
+    vec3 body = skyShade(uv) + material.rgb * keyDiffuse;
     vec3 c = f * mirror + glint + (1.0 - f) * body;
-    fragColor = vec4(c, 1.0);  // premultiplied, opaque: the bed is in the body's albedo
+    fragColor = vec4(hazed(c), 1.0);  // opaque: the bed is in the body's albedo
 }
 )";
 
@@ -198,11 +247,21 @@ void main() {
 }
 )";
 
-// Tone mapping (ACES fit) and sRGB encoding; the sky where no terrain was drawn.
+// Tone mapping (ACES fit) and sRGB encoding; the sky where no terrain was
+// drawn (render/sky.h): the sky model, the HDR image or the SH map, and a
+// disc for each key light.
 inline constexpr const char* kPostFragment = R"(#version 330 core
 const float PI = 3.14159265358979;
 uniform sampler2D uHdr;
-uniform sampler2D uEnv;
+uniform sampler2D uEnv;       // the environment's SH, baked
+uniform sampler2D uSkyImage;  // the HDR environment image (uSkyKind 2)
+uniform int uSkyKind;         // 0 SH, 1 gradient, 2 image
+uniform vec3 uZenith, uHorizon;
+uniform float uImageScale;
+uniform int uDiscs;
+uniform vec3 uDiscDir[4];
+uniform float uDiscCos[4];
+uniform vec3 uDiscRadiance[4];
 uniform mat4 uInvViewProj;
 uniform vec3 uEye;
 uniform vec2 uSize;
@@ -213,16 +272,25 @@ vec3 aces(vec3 x) { return clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59
 vec3 srgb(vec3 c) {
     return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
 }
+// Column = azimuth from +x towards +y, row 0 = zenith.
+vec2 equirect(vec3 d) { return vec2(atan(d.y, d.x) / (2.0 * PI), 0.5 - asin(clamp(d.z, -1.0, 1.0)) / PI); }
+vec3 background(vec3 d) {
+    vec3 up = normalize(vec3(d.xy, max(d.z, 0.0)));  // below the horizon: the horizon's colour
+    vec3 c = uSkyKind == 1 ? uHorizon + (uZenith - uHorizon) * up.z
+           : uSkyKind == 2 ? uImageScale * texture(uSkyImage, equirect(d)).rgb
+                           : texture(uEnv, equirect(up)).rgb;
+    for (int k = 0; k < uDiscs; ++k) {
+        float edge = 0.1 * (1.0 - uDiscCos[k]);  // a soft rim a tenth of the cap wide
+        c += uDiscRadiance[k] * smoothstep(uDiscCos[k] - edge, uDiscCos[k] + edge, dot(d, uDiscDir[k]));
+    }
+    return c;
+}
 void main() {
     vec4 c = texelFetch(uHdr, ivec2(gl_FragCoord.xy), 0);
     if (c.a <= 0.0) {
         if (uTonemap == 0) { fragColor = vec4(0.0, 0.0, 0.0, 1.0); return; }
         vec4 p = uInvViewProj * vec4(gl_FragCoord.xy / uSize * 2.0 - 1.0, 1.0, 1.0);
-        vec3 d = normalize(p.xyz / p.w - uEye);
-        d.z = max(d.z, 0.0);  // below the horizon: the horizon's colour
-        float u = atan(d.y, d.x) / (2.0 * PI);
-        float v = 0.5 - asin(clamp(d.z, -1.0, 1.0)) / PI;
-        c.rgb = texture(uEnv, vec2(u, v)).rgb;
+        c.rgb = background(normalize(p.xyz / p.w - uEye));
     }
     vec3 x = uTonemap == 1 ? aces(c.rgb * uExposure) : clamp(c.rgb, 0.0, 1.0);
     fragColor = vec4(srgb(x), 1.0);

@@ -10,6 +10,7 @@
 #include "sim/generators.h"
 #include "sim/hydraulic.h"
 #include "sim/materials.h"
+#include "sim/scene_camera.h"
 #include "sim/scene_lights.h"
 #include "sim/terrain.h"
 #include "sim/thermal.h"
@@ -59,14 +60,15 @@ struct SceneSettings {
     ThermalSettings thermalSettings;
     WaveSettings waveSettings;
 
-    float dt = 0.0f;      // s; 0 = the default, derived from the CFL limits
+    float dt = 0.0f;  // s; 0 = the default, derived from the CFL limits
     // s of simulated time an animation runs before its first frame (a sea
     // whose swell has already reached the shore); `terrain sim` starts at 0.
     float spinUp = 0.0f;
     int changeTile = 32;  // cells per side of a change-tracking tile
     SceneGiHints gi;
-    MaterialSet materials;  // what the surface is made of, where (sim/materials.h)
+    MaterialSet materials;                // what the surface is made of, where (sim/materials.h)
     LightSet lights = builtinLights("");  // how it is lit (sim/scene_lights.h)
+    CameraPath camera;                    // where an animation looks from (sim/scene_camera.h)
 };
 
 /// The built-in scenes: "erosion", "waves", "dem". size is the grid side

@@ -25,6 +25,7 @@
 //   [lights.sky] zenith, horizon, ground = [r, g, b]      # the sunsky model's colours
 //   [[lights.key]] azimuth, elevation, radius, rgb         # replaces the base scene's key lights
 //   [lights.sun] latitude, day, hour, hours_per_frame, north, radius, rgb
+//   [camera] fov = 40   [[camera.key]] frame, yaw, pitch, distance, target = [x, y(, z)]   # sim/scene_camera.h
 #include <array>
 #include <cmath>
 #include <filesystem>
@@ -334,8 +335,7 @@ void readEnvironment(TableReader& r, const std::string& file, EnvironmentSpec& e
         e.kind = EnvironmentSpec::Kind::SunSky;
     } else if (!kind.empty()) {
         const std::string ext = std::filesystem::path(kind).extension().string();
-        if (ext != ".exr" && ext != ".hdr")
-            r.fail("environment", "\"uniform\", \"sunsky\" or an .exr / .hdr image");
+        if (ext != ".exr" && ext != ".hdr") r.fail("environment", "\"uniform\", \"sunsky\" or an .exr / .hdr image");
         e.kind = EnvironmentSpec::Kind::Image;
         e.file = besideFile(file, kind);
     }
@@ -393,6 +393,42 @@ void readLights(const std::string& file, const toml::table& t, LightSet& lights)
     r.finish();
     try {
         validateLights(lights);
+    } catch (const InputError& e) {
+        throw IoError(file, e.what());
+    }
+}
+
+void readCamera(const std::string& file, const toml::table& t, CameraPath& path) {
+    TableReader r(t, file, "camera.");
+    r.num("fov", path.fovYDeg);
+    if (const toml::node* n = r.get("key")) {
+        const toml::array* arr = n->as_array();
+        if (!arr) r.fail("key", "an array of tables ([[camera.key]])");
+        path.keys.clear();
+        for (const toml::node& item : *arr) {
+            const toml::table* kt = item.as_table();
+            if (!kt) r.fail("key", "an array of tables ([[camera.key]])");
+            TableReader q(*kt, file, "camera.key.");
+            CameraKey k;
+            q.num("frame", k.frame);
+            q.num("yaw", k.yawDeg);
+            q.num("pitch", k.pitchDeg);
+            q.num("distance", k.distance);
+            if (const toml::node* tn = q.get("target")) {
+                const toml::array* a = tn->as_array();
+                bool numbers = a && (a->size() == 2 || a->size() == 3);
+                for (std::size_t j = 0; numbers && j < a->size(); ++j) numbers = a->get(j)->value<double>().has_value();
+                if (!numbers) q.fail("target", "[x, y] or [x, y, z], fractions of the extent (z: of the relief)");
+                for (std::size_t j = 0; j < a->size(); ++j)
+                    k.target[j] = static_cast<float>(*a->get(j)->value<double>());
+            }
+            q.finish();
+            path.keys.push_back(k);
+        }
+    }
+    r.finish();
+    try {
+        validateCameraPath(path);
     } catch (const InputError& e) {
         throw IoError(file, e.what());
     }
@@ -480,6 +516,7 @@ SceneSettings loadSceneFile(const std::string& file) {
     if (const toml::table* t = r.table("gi")) readGi(file, *t, s);
     if (const toml::table* t = r.table("materials")) readMaterials(file, *t, s.materials);
     if (const toml::table* t = r.table("lights")) readLights(file, *t, s.lights);
+    if (const toml::table* t = r.table("camera")) readCamera(file, *t, s.camera);
     r.finish();
     try {
         checkDimensions(s.nx, s.ny, s.cellSize);

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # End-to-end checks of `terrain render` and `terrain demo`: frames, determinism,
 # the timing summary, the video message, the no-display fallback, the window
-# under Xvfb (when xvfb-run exists), and one-line errors with nothing written.
+# under Xvfb and its keys (when xvfb-run and xdotool exist), lights from the
+# command line, and one-line errors with nothing written.
 # Usage: render_cli_test.sh path/to/terrain
 set -u
 T=$1
@@ -52,6 +53,17 @@ env -u DISPLAY -u WAYLAND_DISPLAY "$T" demo --scene waves "${small[@]}" --frames
 if command -v xvfb-run >/dev/null; then
   timeout 120 xvfb-run -a "$T" demo --scene erosion --size 32 --frames 3 --width 320 --height 200 >"$tmp/o" 2>&1 \
     && grep -q "3 frames shown" "$tmp/o" && ok || bad "demo window under Xvfb: $(cat "$tmp/o")"
+  # its keys, pressed for real (xdotool): pause, single step, screenshot, reload, hide the panel, resume
+  if command -v xdotool >/dev/null; then
+    timeout 120 xvfb-run -a -s "-screen 0 1024x768x24" bash "$(dirname "$0")/window_keys.sh" "$T" "$tmp/k" "$tmp/klog"
+    for line in "demo: paused at tick" "demo: stepped to tick" "demo: screenshot .*/k/screenshot_0001.png" \
+                "demo: reloaded scene erosion" "demo: running at tick" "300 frames shown"; do
+      grep -q "$line" "$tmp/klog" && ok || bad "window keys: no '$line' in: $(cat "$tmp/klog")"
+    done
+    [ -s "$tmp/k/screenshot_0001.png" ] && ok || bad "window keys: no screenshot file"
+  else
+    echo "render_cli: xdotool not found, window key check skipped"
+  fi
 else
   echo "render_cli: xvfb-run not found, window check skipped"
 fi
@@ -104,6 +116,13 @@ expect_error "missing environment image" "nowhere.exr" "$tmp/l3" "$T" render "${
 expect_error "bad environment" "--light must be" "$tmp/l4" "$T" render "${small[@]}" --light cloudy --out "$tmp/l4"
 printf 'base = "dem"\nsize = 32\n[lights.sun]\nday = 0\n' >"$tmp/sun_bad.toml"
 expect_error "scene [lights] bad day" "day of the year" "$tmp/l5" "$T" render --scene "$tmp/sun_bad.toml" "${small[@]}" --frames 1 --out "$tmp/l5"
+
+# camera keyframes: the frames follow the path; bad keys are one-line errors
+"$T" render --scene erosion "${small[@]}" --frames 3 --out "$tmp/c1" --quiet --camera-key 0,200,30,1.2 --camera-key 2,300,20,0.8,0.4,0.6 \
+  && ! cmp -s "$tmp/c1/frame_0000.png" "$tmp/c1/frame_0002.png" && ok || bad "camera keys leave the frames unchanged"
+expect_error "bad camera key" "expected FRAME" "$tmp/c2" "$T" render "${small[@]}" --camera-key 0,1 --out "$tmp/c2"
+expect_error "camera keys out of order" "frames must increase" "$tmp/c3" "$T" render "${small[@]}" --camera-key 5,0,30,1 --camera-key 2,0,30,1 --out "$tmp/c3"
+expect_error "bad pitch" "pitch" "$tmp/c4" "$T" render "${small[@]}" --pitch 95 --out "$tmp/c4"
 
 echo "render_cli: $pass passed, $fail failed"
 [ $fail -eq 0 ]
