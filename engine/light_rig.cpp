@@ -5,16 +5,12 @@
 
 #include "core/error.h"
 #include "core/image_io.h"
+#include "engine/smoothstep.h"
 
 namespace terrain::engine {
 namespace {
 
 constexpr double kDeg = 0.017453292519943295;
-
-float smoothstep(float e0, float e1, float x) {
-    const float t = std::clamp((x - e0) / (e1 - e0), 0.0f, 1.0f);
-    return t * t * (3.0f - 2.0f * t);
-}
 
 // The analytic sky (gi::sunSkyLight without its sun lobe) is linear in its
 // three colours: project each term once at radiance 1 and mix per frame.

@@ -4,16 +4,12 @@
 #include <cmath>
 
 #include "core/parallel.h"
+#include "engine/smoothstep.h"
 
 namespace terrain::engine {
 namespace {
 
 constexpr float kDegToRad = 0.017453292519943295f;
-
-float smoothstep(float e0, float e1, float x) {
-    const float t = std::clamp((x - e0) / (e1 - e0), 0.0f, 1.0f);
-    return t * t * (3.0f - 2.0f * t);
-}
 
 // A material in the form the rules blend: albedo linearly, the exponent by
 // its logarithm (equal steps are equal ratios of the lobe width).
