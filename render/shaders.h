@@ -227,9 +227,12 @@ void main() {
     // of the sky the water sees.
     vec3 r = reflect(-v, n);
     float skyVis = clamp(texture(uReceiver, receiverUv(vCell)).r, 0.0, 1.0);
-    vec4 terrain = terrainReflection(vWorld, r);
-    vec3 mirror = mix(environment(r) * skyVis, terrain.rgb, terrain.a);
     float f = schlick(max(dot(n, v), 0.0), 0.02);  // water, n = 1.33
+    // The march is the water's dearest part: it runs only where Fresnel lets
+    // the reflection show (grazing views), fading in over f = 0.05 .. 0.1.
+    float reflective = smoothstep(0.05, 0.1, f);
+    vec4 terrain = reflective > 0.0 ? terrainReflection(vWorld, r) : vec4(0.0);
+    vec3 mirror = mix(environment(r) * skyVis, terrain.rgb, terrain.a * reflective);
     vec4 material = texture(uAlbedo, uv);
     vec3 glint = uSpecular == 1 ? uKeyRgb * vis * torranceSparrow(n, v, uKeyDir, roughness(material.a), 0.02) : vec3(0.0);
     // Diffuse part: the water body and the bed seen through it, one albedo
@@ -275,10 +278,14 @@ vec3 srgb(vec3 c) {
 // Column = azimuth from +x towards +y, row 0 = zenith.
 vec2 equirect(vec3 d) { return vec2(atan(d.y, d.x) / (2.0 * PI), 0.5 - asin(clamp(d.z, -1.0, 1.0)) / PI); }
 vec3 background(vec3 d) {
-    vec3 up = normalize(vec3(d.xy, max(d.z, 0.0)));  // below the horizon: the horizon's colour
-    vec3 c = uSkyKind == 1 ? uHorizon + (uZenith - uHorizon) * up.z
-           : uSkyKind == 2 ? uImageScale * texture(uSkyImage, equirect(d)).rgb
-                           : texture(uEnv, equirect(up)).rgb;
+    vec3 c;
+    if (uSkyKind == 1) {
+        c = uHorizon + (uZenith - uHorizon) * max(d.z, 0.0);  // below the horizon: the horizon's colour
+    } else if (uSkyKind == 2) {
+        c = uImageScale * texture(uSkyImage, equirect(d)).rgb;
+    } else {
+        c = texture(uEnv, equirect(normalize(vec3(d.xy, max(d.z, 0.0))))).rgb;
+    }
     for (int k = 0; k < uDiscs; ++k) {
         float edge = 0.1 * (1.0 - uDiscCos[k]);  // a soft rim a tenth of the cap wide
         c += uDiscRadiance[k] * smoothstep(uDiscCos[k] - edge, uDiscCos[k] + edge, dot(d, uDiscDir[k]));
