@@ -102,19 +102,21 @@ expect_error "scene [gi] tolerance out of range" "GI tolerance" "$tmp/g3" "$T" r
 printf 'base = "erosion"\nsize = 32\n[gi]\ntolerence = 0.1\n' >"$tmp/gi_typo.toml"
 expect_error "scene [gi] unknown key" "unknown key 'gi.tolerence'" "$tmp/g4" "$T" render --scene "$tmp/gi_typo.toml" "${small[@]}" --frames 1 --out "$tmp/g4"
 
-# lights from the command line over the scene's: the same flags on render and demo
+# lights from the command line over the scene's: the same flags on render and demo (a static scene:
+# only the lights change the frames)
+printf 'base = "erosion"\nsize = 32\n[hydraulic]\nenabled = false\n[thermal]\nenabled = false\n' >"$tmp/still.toml"
 for lights in "--light uniform --key none" "--light sunsky --light-intensity 0.5 --key 90,30,4,1,0.8,0.6 --key 270,20,3,0.3,0.3,0.5" \
               "--sun 7,0.5" "--sun 12,0,-33.9,355"; do
   # shellcheck disable=SC2086
-  "$T" render --scene dem "${small[@]}" --frames 2 --out "$tmp/l" --quiet $lights >"$tmp/o" 2>&1 && [ -s "$tmp/l/frame_0001.png" ] && ok || bad "render $lights: $(cat "$tmp/o")"
+  "$T" render --scene "$tmp/still.toml" "${small[@]}" --frames 2 --out "$tmp/l" --quiet $lights >"$tmp/o" 2>&1 && [ -s "$tmp/l/frame_0001.png" ] && ok || bad "render $lights: $(cat "$tmp/o")"
 done
-"$T" render --scene dem "${small[@]}" --frames 3 --out "$tmp/s1" --quiet --sun 6,2 && ! cmp -s "$tmp/s1/frame_0000.png" "$tmp/s1/frame_0002.png" \
+"$T" render --scene "$tmp/still.toml" "${small[@]}" --frames 3 --out "$tmp/s1" --quiet --sun 6,2 && ! cmp -s "$tmp/s1/frame_0000.png" "$tmp/s1/frame_0002.png" \
   && ok || bad "a moving sun leaves the frames unchanged"
 expect_error "bad key light" "expected AZ_DEG" "$tmp/l1" "$T" render "${small[@]}" --key 1,2,3 --out "$tmp/l1"
 expect_error "bad sun hour" "sun hour" "$tmp/l2" "$T" demo --headless "${small[@]}" --sun 30 --out "$tmp/l2"
 expect_error "missing environment image" "nowhere.exr" "$tmp/l3" "$T" render "${small[@]}" --light "$tmp/nowhere.exr" --frames 1 --out "$tmp/l3"
 expect_error "bad environment" "--light must be" "$tmp/l4" "$T" render "${small[@]}" --light cloudy --out "$tmp/l4"
-printf 'base = "dem"\nsize = 32\n[lights.sun]\nday = 0\n' >"$tmp/sun_bad.toml"
+printf 'base = "erosion"\nsize = 32\n[lights.sun]\nday = 0\n' >"$tmp/sun_bad.toml"
 expect_error "scene [lights] bad day" "day of the year" "$tmp/l5" "$T" render --scene "$tmp/sun_bad.toml" "${small[@]}" --frames 1 --out "$tmp/l5"
 
 # camera keyframes: the frames follow the path; bad keys are one-line errors

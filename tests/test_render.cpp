@@ -166,7 +166,7 @@ TEST_CASE("render.materials: the renderer's base colour is the GI's albedo map")
 }
 
 TEST_CASE("render.camera: the eye never dips under the terrain") {
-    FramePipeline pipeline(resolveScene("dem", 64, 1), PipelineSettings{});
+    FramePipeline pipeline(resolveScene("erosion", 64, 1), PipelineSettings{});
     pipeline.advance();
     pipeline.light();
     const FrameData& f = pipeline.frame();
