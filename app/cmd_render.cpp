@@ -122,6 +122,10 @@ void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize) {
     sub->add_option("--pyramid-level", o.pyramidLevel, "Height-pyramid level for --debug pyramid")
         ->capture_default_str();
     sub->add_option("--exposure", o.exposure, "Exposure before tone mapping")->capture_default_str();
+    sub->add_option("--lod", o.lodPixelError,
+                    "Level of detail: the mesh's largest screen-space error in pixels (0 = the full grid, one vertex "
+                    "per grid point)")
+        ->capture_default_str();
     sub->add_option("--exaggeration", o.exaggeration,
                     "Vertical exaggeration (0 = automatic: relief >= 15% of the extent)")
         ->capture_default_str();
@@ -140,6 +144,8 @@ void toSettings(const RenderOptions& o, const SceneSettings& scene, engine::Pipe
     if (o.ticksPerFrame < 0) throw InputError("--ticks-per-frame must be >= 0");
     if (!(o.exposure > 0.0f && o.exposure < 1000.0f)) throw InputError("--exposure must be > 0");
     if (!(o.exaggeration >= 0.0f && o.exaggeration <= 100.0f)) throw InputError("--exaggeration must be in [0, 100]");
+    if (!(o.lodPixelError >= 0.0f && o.lodPixelError <= render::kMaxLodPixelError))
+        throw InputError("--lod must be in [0, " + formatNumber(render::kMaxLodPixelError) + "] pixels");
     p.gi = engine::defaultPipelineGi();
     p.gi.subsample = o.subsample;
     p.gi.indirect.bounces = o.bounces;
@@ -191,6 +197,7 @@ void toSettings(const RenderOptions& o, const SceneSettings& scene, engine::Pipe
                          o.debug + "')");
     r.exposure = o.exposure;
     p.verticalExaggeration = o.exaggeration;
+    r.lodPixelError = o.lodPixelError;
     r.camera = cameraOfFrame(scene.camera, 0);
 }
 

@@ -35,7 +35,8 @@ struct RenderOptions {
     std::string debug = "none";   // none | ambient | v | key | normals | pyramid | shade | u
     int pyramidLevel = 4;
     float exposure = 1.0f;
-    float exaggeration = 0.0f;  // 0 = automatic
+    float exaggeration = 0.0f;   // 0 = automatic
+    float lodPixelError = 1.0f;  // render/terrain_lod.h; 0 = the full grid
     bool quiet = false;
     LightOptions lights;   // over the scene's [lights]
     CameraOptions camera;  // over the scene's [camera]

@@ -30,7 +30,7 @@ grep -q "frames written to" "$tmp/log" && ok || bad "render does not print the f
 # every mode renders
 for mode in "--lighting key" "--lighting global --bounces 2" "--shadow map" "--shadow none" "--subsample 1" "--subsample 4" \
             "--debug ambient" "--debug v" "--debug key" "--debug normals" "--debug pyramid" "--debug shade" \
-            "--lighting global --debug u" "--lighting global --amortise"; do
+            "--lighting global --debug u" "--lighting global --amortise" "--lod 0" "--lod 4"; do
   # shellcheck disable=SC2086
   "$T" render --scene waves "${small[@]}" --frames 1 --out "$tmp/m" --quiet $mode >"$tmp/o" 2>&1 && [ -s "$tmp/m/frame_0000.png" ] && ok || bad "render $mode: $(cat "$tmp/o")"
 done
@@ -124,6 +124,7 @@ expect_error "scene [lights] bad day" "day of the year" "$tmp/l5" "$T" render --
   && ! cmp -s "$tmp/c1/frame_0000.png" "$tmp/c1/frame_0002.png" && ok || bad "camera keys leave the frames unchanged"
 expect_error "bad camera key" "expected FRAME" "$tmp/c2" "$T" render "${small[@]}" --camera-key 0,1 --out "$tmp/c2"
 expect_error "camera keys out of order" "frames must increase" "$tmp/c3" "$T" render "${small[@]}" --camera-key 5,0,30,1 --camera-key 2,0,30,1 --out "$tmp/c3"
+expect_error "bad level of detail" "lod" "$tmp/c5" "$T" render "${small[@]}" --lod -1 --out "$tmp/c5"
 expect_error "bad pitch" "pitch" "$tmp/c4" "$T" render "${small[@]}" --pitch 95 --out "$tmp/c4"
 
 echo "render_cli: $pass passed, $fail failed"
