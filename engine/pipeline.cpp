@@ -216,6 +216,31 @@ void FramePipeline::advance() {
     timings_.sim = msSince(t0);
 }
 
+// The materials follow the terrain: derived again only when it ticked (or
+// was replaced, or the materials changed). Returns whether they were.
+bool FramePipeline::updateMaterialMaps() {
+    const TerrainState& s = sim_.state();
+    if (mapsTick_ == s.tick) return false;
+    deriveMaterialMaps(s, materials_, maps_);
+    mapsTick_ = s.tick;
+    return true;
+}
+
+// The first key light's share of the shade map, of a white texel: gi/
+// shading with that light alone (the renderer adds its specular and can swap
+// its shadows); zero without key lights. Returns that light, or none.
+const gi::KeyLight* FramePipeline::shadeFirstKey(const gi::GiSettings& gs, const gi::GiLighting& lighting) {
+    if (!lighting.keys.empty()) {
+        gi::shadeKeyLight(gi_, gs, lighting, 0, keyScratch_, keyOnly_);
+        return &lighting.keys[0];
+    }
+    for (Grid& g : keyOnly_) {
+        g.ensureSize(sim_.state().nx, sim_.state().ny);
+        std::fill(g.v.begin(), g.v.end(), 0.0f);
+    }
+    return nullptr;
+}
+
 void FramePipeline::light() {
     if (!(settings_.verticalExaggeration >= 0.0f && settings_.verticalExaggeration <= 100.0f))
         throw InputError("vertical exaggeration must be in [0, 100] (0 = automatic)");
@@ -223,12 +248,7 @@ void FramePipeline::light() {
     const TerrainState& s = sim_.state();
     auto t = Clock::now();
     exaggeratedSurface(s, exag, surface_);
-    // The materials follow the terrain: derived again only when it ticked.
-    const bool newMaps = mapsTick_ != s.tick;
-    if (newMaps) {
-        deriveMaterialMaps(s, materials_, maps_);
-        mapsTick_ = s.tick;
-    }
+    const bool newMaps = updateMaterialMaps();
     lights_ = rig_.at(frameIndex_);
     const gi::GiLighting lighting = giLighting(lights_);
     // Global lighting adds gi.indirect.bounces indirect bounces (gi/indirect.h);
@@ -259,17 +279,7 @@ void FramePipeline::light() {
         return;
     }
     packedPyramidLevel_ = settings_.pyramidLevel;
-    // The first key light's share of the shade map: gi/ shading with that
-    // light alone (the renderer adds its specular and can swap its shadows).
-    const gi::KeyLight* key = lighting.keys.empty() ? nullptr : &lighting.keys[0];
-    if (key) {
-        gi::shadeKeyLight(gi_, gs, lighting, 0, keyScratch_, keyOnly_);
-    } else {
-        for (Grid& g : keyOnly_) {
-            g.ensureSize(s.nx, s.ny);
-            std::fill(g.v.begin(), g.v.end(), 0.0f);
-        }
-    }
+    const gi::KeyLight* key = shadeFirstKey(gs, lighting);
 
     // ---- pack what the renderer uploads -----------------------------------------
     f.lighting = settings_.lighting;

@@ -75,6 +75,9 @@ public:
     const gi::GiState& giState() const { return gi_; }
 
 private:
+    bool updateMaterialMaps();
+    const gi::KeyLight* shadeFirstKey(const gi::GiSettings& gs, const gi::GiLighting& lighting);
+
     Simulation sim_;
     PipelineSettings settings_;
     LightRig rig_;
