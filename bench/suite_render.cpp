@@ -52,22 +52,6 @@ struct SceneTimes {
     int ticksPerFrame = 0;
 };
 
-// Per pixel the largest |a - b| over R, G, B: its mean, and the fraction above 8 levels.
-void imageDifference(const std::vector<std::uint8_t>& a, const std::vector<std::uint8_t>& b, double& mean,
-                     double& above8) {
-    double sum = 0.0;
-    std::size_t above = 0;
-    for (std::size_t i = 0; i + 2 < a.size(); i += 3) {
-        int d = 0;
-        for (std::size_t c = 0; c < 3; ++c) d = std::max(d, std::abs(int(a[i + c]) - int(b[i + c])));
-        sum += d;
-        above += d > 8 ? 1 : 0;
-    }
-    const double pixels = static_cast<double>(a.size() / 3);
-    mean = sum / pixels;
-    above8 = static_cast<double>(above) / pixels;
-}
-
 SceneTimes measureScene(Renderer& renderer, const char* scene, int size, const RenderOptions& o, int width,
                         int height) {
     PipelineSettings ps;
@@ -98,10 +82,9 @@ SceneTimes measureScene(Renderer& renderer, const char* scene, int size, const R
         }
         if (f == 0) continue;  // warm-up
         for (std::size_t m = 0; m < modes && reference < modes; ++m) {
-            double mean = 0.0, above = 0.0;
-            imageDifference(images[reference], images[m], mean, above);
-            meanDifference[m].push_back(mean);
-            above8[m].push_back(above);
+            const render::ImageDifference d = render::compareImages(images[reference], images[m], 8);
+            meanDifference[m].push_back(d.mean);
+            above8[m].push_back(d.fractionAbove);
         }
         const StageTimings& s = pipeline.timings();
         const double v[6] = {s.sim, s.pyramids, s.scan, s.integrate, s.shade, upload};

@@ -106,6 +106,20 @@ std::uint64_t hashBytes(const std::vector<std::uint8_t>& bytes) {
     return h;
 }
 
+ImageDifference compareImages(const std::vector<std::uint8_t>& a, const std::vector<std::uint8_t>& b, int levels) {
+    if (a.size() != b.size() || a.size() % 3 != 0) throw InputError("compareImages: two RGB images of one size");
+    double sum = 0.0;
+    std::size_t above = 0;
+    for (std::size_t i = 0; i < a.size(); i += 3) {
+        int d = 0;
+        for (std::size_t c = 0; c < 3; ++c) d = std::max(d, std::abs(int(a[i + c]) - int(b[i + c])));
+        sum += d;
+        above += d > levels ? 1 : 0;
+    }
+    const double pixels = std::max<double>(1.0, static_cast<double>(a.size() / 3));
+    return {sum / pixels, static_cast<double>(above) / pixels};
+}
+
 Renderer::Renderer(const Gl& gl) : gl_(gl), sky_(gl) {
     using namespace shaders;
     const char* version = "#version 330 core\n";

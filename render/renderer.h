@@ -146,4 +146,12 @@ private:
 /// FNV-1a 64-bit hash of image bytes (for determinism checks).
 std::uint64_t hashBytes(const std::vector<std::uint8_t>& bytes);
 
+/// How two 8-bit RGB images of one size differ: per pixel the largest
+/// |a - b| over R, G, B, its mean over the pixels and the fraction of pixels
+/// where it exceeds `levels`.
+struct ImageDifference {
+    double mean = 0.0, fractionAbove = 0.0;
+};
+ImageDifference compareImages(const std::vector<std::uint8_t>& a, const std::vector<std::uint8_t>& b, int levels);
+
 }  // namespace terrain::render

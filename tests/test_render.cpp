@@ -323,22 +323,6 @@ double bruteForceChunkError(const std::vector<float>& h, int nx, int ny, float e
     return worst;
 }
 
-/// Per pixel the largest difference over R, G, B: its mean, and the fraction of
-/// pixels where it is above `levels`.
-std::pair<double, double> imageDifference(const std::vector<std::uint8_t>& a, const std::vector<std::uint8_t>& b,
-                                          int levels) {
-    double sum = 0.0;
-    std::size_t above = 0;
-    for (std::size_t i = 0; i + 2 < a.size(); i += 3) {
-        int d = 0;
-        for (std::size_t c = 0; c < 3; ++c) d = std::max(d, std::abs(int(a[i + c]) - int(b[i + c])));
-        sum += d;
-        if (d > levels) ++above;
-    }
-    const double pixels = static_cast<double>(a.size() / 3);
-    return {sum / pixels, static_cast<double>(above) / pixels};
-}
-
 /// Frame `frames` of a built-in scene at size^2 (2x GI sub-sampling, as the render benchmark).
 FrameData sceneFrame(const char* name, int size, int frames) {
     PipelineSettings ps;
@@ -562,7 +546,8 @@ TEST_CASE(
     rs.lodPixelError = 1.0f;  // the default
     r.drawToImage(rs, w, h, lod);
     const DrawStats stats = r.lastDrawStats();
-    const auto [meanDiff, above] = imageDifference(full, lod, 8);
+    const ImageDifference diff = compareImages(full, lod, 8);
+    const double meanDiff = diff.mean, above = diff.fractionAbove;
     MESSAGE("1 px: " << stats.terrainTriangles << " of " << fullTriangles << " triangles, " << stats.terrainChunks
                      << " chunks; mean difference " << meanDiff << " levels, " << 100.0 * above
                      << " % of pixels differ by more than 8 levels");
