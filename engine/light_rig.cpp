@@ -103,21 +103,31 @@ LightRig::LightRig(const LightSet& spec, const LightRig* previous) : spec_(spec)
     }
 }
 
+SunState sunState(const SunSpec& sun, int frame) {
+    SunState s;
+    if (!sun.enabled) return s;
+    const SunPosition p = sunPosition(sun, sun.hour + static_cast<double>(sun.hoursPerFrame) * frame);
+    const std::array<float, 3> t = sunTransmittance(p.elevationDeg);
+    // a sun wholly below the horizon lights nothing
+    if (p.elevationDeg > -sun.radiusDeg)
+        s.key = keyLight(p.azimuthDeg, p.elevationDeg, sun.radiusDeg,
+                         {sun.rgb[0] * t[0], sun.rgb[1] * t[1], sun.rgb[2] * t[2]});
+    s.daylight = daylight(p.elevationDeg);
+    // the horizon takes on the low sun's colour (its light's hue, brightest
+    // channel 1) as it sets: not at all from 20 deg up, 60 % at 0 deg
+    const std::array<float, 3> low = sunTransmittance(std::max(p.elevationDeg, 0.0f));
+    const float k = 0.6f * (1.0f - smoothstep(0.0f, 20.0f, p.elevationDeg));
+    for (std::size_t c = 0; c < 3; ++c) s.horizonTint[c] = 1.0f + k * (low[c] / low[0] - 1.0f);
+    return s;
+}
+
 SceneLights LightRig::at(int frame) const {
     SceneLights l;
     const EnvironmentSpec& e = spec_.environment;
     l.hazeExtinction = e.visibility > 0.0f ? 3.912f / e.visibility : 0.0f;
-    const SunSpec& sun = spec_.sun;
-    float skyScale = e.intensity;
-    if (sun.enabled) {
-        const SunPosition p = sunPosition(sun, sun.hour + static_cast<double>(sun.hoursPerFrame) * frame);
-        const std::array<float, 3> t = sunTransmittance(p.elevationDeg);
-        // a sun wholly below the horizon lights nothing
-        if (p.elevationDeg > -sun.radiusDeg)
-            l.keys.push_back(keyLight(p.azimuthDeg, p.elevationDeg, sun.radiusDeg,
-                                      {sun.rgb[0] * t[0], sun.rgb[1] * t[1], sun.rgb[2] * t[2]}));
-        skyScale *= daylight(p.elevationDeg);
-    }
+    const SunState sun = sunState(spec_.sun, frame);
+    if (sun.key) l.keys.push_back(*sun.key);
+    const float skyScale = e.intensity * sun.daylight;
     for (const KeyLightSpec& k : spec_.keys)
         l.keys.push_back(keyLight(k.azimuthDeg, k.elevationDeg, k.radiusDeg, k.rgb));
     switch (e.kind) {
@@ -128,7 +138,7 @@ SceneLights LightRig::at(int frame) const {
         case EnvironmentSpec::Kind::SunSky:
             for (std::size_t c = 0; c < 3; ++c) {
                 l.zenith[c] = skyScale * e.zenith[c];
-                l.horizon[c] = skyScale * e.horizon[c];
+                l.horizon[c] = skyScale * e.horizon[c] * sun.horizonTint[c];
                 l.ground[c] = skyScale * e.ground[c];
                 const std::array<float, 3> w{l.zenith[c], l.horizon[c], l.ground[c]};
                 for (std::size_t i = 0; i < l.sky.c[c].size(); ++i)

@@ -5,6 +5,7 @@
 // in the sky.
 #include <array>
 #include <memory>
+#include <optional>
 
 #include "engine/frame_data.h"
 #include "sim/scene_lights.h"
@@ -26,6 +27,16 @@ SunPosition sunPosition(const SunSpec& spec, double hour);
 /// along the relative air mass of Kasten & Young 1989 with Rayleigh optical
 /// depths (Bucholtz 1995) plus a light aerosol load. 0 below the horizon.
 std::array<float, 3> sunTransmittance(float elevationDeg);
+
+/// What the sun does to a frame's lights: its key light (none once it is
+/// below the horizon), the daylight it leaves in the sky (1 at full day) and
+/// the tint it gives the horizon as it sets (1 by day).
+struct SunState {
+    std::optional<gi::KeyLight> key;
+    float daylight = 1.0f;
+    std::array<float, 3> horizonTint{1.0f, 1.0f, 1.0f};
+};
+SunState sunState(const SunSpec& sun, int frame);
 
 class LightRig {
 public:

@@ -97,6 +97,13 @@ TEST_CASE("lights: the sun is the first key light, moves each frame and sets") {
     CHECK(at16.keys[1].azimuthDeg == set.keys[0].azimuthDeg);  // the fixed key follows the sun
     CHECK(at18.keys[0].elevationDeg < at16.keys[0].elevationDeg);
     CHECK(at18.keys[0].rgb[2] / at18.keys[0].rgb[0] < at16.keys[0].rgb[2] / at16.keys[0].rgb[0]);
+    // the horizon reddens as the sun sets
+    LightSet sky = set;
+    sky.environment.kind = EnvironmentSpec::Kind::SunSky;
+    const LightRig skyRig(sky);
+    const SceneLights noon = skyRig.at(-4), dusk = skyRig.at(3);  // 12 h and 19 h
+    CHECK(dusk.horizon[0] / dusk.horizon[2] > 1.5f * noon.horizon[0] / noon.horizon[2]);
+    CHECK(noon.horizon[2] == doctest::Approx(sky.environment.horizon[2] * sunState(sky.sun, -4).daylight));
     // at night: no sun, a faint sky
     REQUIRE(at23.keys.size() == 1);
     CHECK(at23.sky.c[0][0] < 0.05 * at16.sky.c[0][0]);
