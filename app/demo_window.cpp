@@ -81,6 +81,27 @@ void drawLightControls(FramePipeline& pipeline) {
     if (changed) pipeline.setLights(l);
 }
 
+// The panel's material controls: albedos and where vegetation and snow lie;
+// a change re-derives the maps (and so re-lights the GI) on the next frame.
+void drawMaterialControls(FramePipeline& pipeline) {
+    if (!ImGui::CollapsingHeader("materials")) return;
+    MaterialSet m = pipeline.materials();
+    bool changed = false;
+    const auto colour = [&](const char* name, Material& mat) {
+        changed |= ImGui::ColorEdit3(name, mat.albedo.data(), ImGuiColorEditFlags_Float);
+    };
+    colour("bedrock", m.bedrock);
+    colour("soil", m.soil.material);
+    colour("vegetation", m.vegetation.material);
+    colour("snow", m.snow.material);
+    colour("water body", m.water.material);
+    if (m.vegetation.enabled)
+        changed |= ImGui::DragFloat("vegetation up to (m)", &m.vegetation.maxAltitude, 10.0f,
+                                    m.vegetation.minAltitude + 1.0f, 1.0e5f);
+    if (m.snow.enabled) changed |= ImGui::DragFloat("snow line (m)", &m.snow.line, 10.0f, -1.0e4f, 1.0e5f);
+    if (changed) pipeline.setMaterials(m);
+}
+
 // The control panel: what is shown, the frame's timings, and the settings it edits.
 void drawPanel(FramePipeline& pipeline, RenderSettings& rs, bool& paused, const StageTimings& avg, double fpsAvg) {
     const char* lightingNames[] = {"key light only", "direct (sky + key)", "global (direct + bounces)"};
@@ -127,6 +148,8 @@ void drawPanel(FramePipeline& pipeline, RenderSettings& rs, bool& paused, const 
     ImGui::SliderFloat("exaggeration (0 = auto)", &ps.verticalExaggeration, 0.0f, 10.0f);
     ImGui::Separator();
     drawLightControls(pipeline);
+    ImGui::Separator();
+    drawMaterialControls(pipeline);
     ImGui::TextDisabled("drag: orbit, wheel: zoom, WASD/QE: fly");
     ImGui::TextDisabled("P: pause, space: step, F12: screenshot, R: reload, H: hide");
     ImGui::End();
