@@ -37,7 +37,7 @@ struct SlopeLimit {
 // The rules with everything that does not depend on the texel worked out once.
 struct Rules {
     const MaterialSet& m;
-    Blend bedrock, soil, vegetation, snow, waterBody;
+    Blend bedrock, soil, vegetation, snow, waterBody, foam;
     float logWet;
     SlopeLimit vegetationSlope, snowSlope;
     explicit Rules(const MaterialSet& set)
@@ -47,11 +47,12 @@ struct Rules {
           vegetation(blendOf(set.vegetation.material)),
           snow(blendOf(set.snow.material)),
           waterBody(blendOf(set.water.material)),
+          foam(blendOf(set.foam.material)),
           logWet(std::log(set.wet.phongExponent)),
           vegetationSlope(set.vegetation.maxSlopeDeg),
           snowSlope(set.snow.maxSlopeDeg) {}
 
-    Material at(float altitude, float tanSlope, float soilDepth, float water) const {
+    Material at(float altitude, float tanSlope, float soilDepth, float water, float depthGradient) const {
         Blend b = bedrock;
         mixInto(b, soil, smoothstep(0.0f, m.soil.coverDepth, soilDepth));
         if (m.vegetation.enabled) {
@@ -69,6 +70,12 @@ struct Rules {
             b.logExponent += soaked * (logWet - b.logExponent);
             // the bed seen through the water, down and back up
             mixInto(b, waterBody, 1.0f - std::exp(-2.0f * water / m.water.clarity));
+            if (m.foam.enabled) {
+                const FoamRule& f = m.foam;
+                mixInto(b, foam,
+                        (1.0f - smoothstep(0.5f * f.maxDepth, f.maxDepth, water)) *
+                            smoothstep(f.minDepthGradient, 2.5f * f.minDepthGradient, depthGradient));
+            }
         }
         return {b.albedo, std::exp(b.logExponent)};
     }
@@ -84,10 +91,11 @@ GroundRow groundRow(const TerrainState& s, int y) {
     return {s.bedrock.data() + at, s.soil.data() + at};
 }
 
-// Tangent of the ground's slope at (x, y) from its row and the rows above and
-// below: central differences, one-sided at the edges.
-float tanSlopeAt(const TerrainState& s, const GroundRow& up, const GroundRow& row, const GroundRow& down, int rowSpan,
-                 int x) {
+// Magnitude of a field's gradient at (x, y) (the ground's: the tangent of its
+// slope) from its row and the rows above and below: central differences,
+// one-sided at the edges.
+template <class Row>
+float tanSlopeAt(const TerrainState& s, const Row& up, const Row& row, const Row& down, int rowSpan, int x) {
     const int x0 = std::max(x - 1, 0), x1 = std::min(x + 1, s.nx - 1);
     const float gx = x1 > x0 ? (row[x1] - row[x0]) / (static_cast<float>(x1 - x0) * s.cellSize) : 0.0f;
     const float gy = rowSpan > 0 ? (down[x] - up[x]) / (static_cast<float>(rowSpan) * s.cellSize) : 0.0f;
@@ -96,8 +104,9 @@ float tanSlopeAt(const TerrainState& s, const GroundRow& up, const GroundRow& ro
 
 }  // namespace
 
-Material materialAt(const MaterialSet& m, float altitude, float slopeDeg, float soil, float water) {
-    return Rules(m).at(altitude, std::tan(slopeDeg * kDegToRad), soil, water);
+Material materialAt(const MaterialSet& m, float altitude, float slopeDeg, float soil, float water,
+                    float depthGradient) {
+    return Rules(m).at(altitude, std::tan(slopeDeg * kDegToRad), soil, water, depthGradient);
 }
 
 void deriveMaterialMaps(const TerrainState& s, const MaterialSet& m, MaterialMaps& out) {
@@ -109,10 +118,16 @@ void deriveMaterialMaps(const TerrainState& s, const MaterialSet& m, MaterialMap
             const int ya = std::max(y - 1, 0), yb = std::min(y + 1, s.ny - 1);
             const GroundRow up = groundRow(s, ya), row = groundRow(s, y), down = groundRow(s, yb);
             const std::size_t at = static_cast<std::size_t>(y) * s.nx;
-            const float* water = s.hasWater() ? s.water.data() + at : nullptr;
+            const float* water = s.hasWater() ? s.water.data() : nullptr;
+            const std::size_t nx = static_cast<std::size_t>(s.nx);
             for (int x = 0; x < s.nx; ++x) {
+                const float depth = water ? water[at + x] : 0.0f;
+                // the depth's gradient only where foam could form
+                const float dDepth = water && m.foam.enabled && depth > 0.0f
+                                         ? tanSlopeAt(s, water + ya * nx, water + at, water + yb * nx, yb - ya, x)
+                                         : 0.0f;
                 const Material mat =
-                    rules.at(row[x], tanSlopeAt(s, up, row, down, yb - ya, x), row.soil[x], water ? water[x] : 0.0f);
+                    rules.at(row[x], tanSlopeAt(s, up, row, down, yb - ya, x), row.soil[x], depth, dDepth);
                 for (std::size_t c = 0; c < 3; ++c) out.albedo.channel[c].v[at + x] = mat.albedo[c];
                 out.exponent.v[at + x] = mat.phongExponent;
             }

@@ -21,7 +21,9 @@ struct MaterialMaps {
 void deriveMaterialMaps(const TerrainState& state, const MaterialSet& materials, MaterialMaps& out);
 
 /// The material of one texel from its ground altitude (m), slope (degrees),
-/// soil thickness and water depth (m): the rules of sim/materials.h.
-Material materialAt(const MaterialSet& m, float altitude, float slopeDeg, float soil, float water);
+/// soil thickness, water depth (m) and the magnitude of the depth's gradient
+/// (m per m): the rules of sim/materials.h.
+Material materialAt(const MaterialSet& m, float altitude, float slopeDeg, float soil, float water,
+                    float depthGradient = 0.0f);
 
 }  // namespace terrain::engine

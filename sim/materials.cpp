@@ -56,6 +56,9 @@ void validateMaterials(const MaterialSet& m) {
     requireIn("wet.exponent", m.wet.phongExponent, 1.0f, 10000.0f);
     validateMaterial("water", m.water.material);
     requirePositive("water.clarity", m.water.clarity);
+    validateMaterial("foam", m.foam.material);
+    requirePositive("foam.max_depth", m.foam.maxDepth);
+    requirePositive("foam.min_gradient", m.foam.minDepthGradient);
 }
 
 // Albedos: typical broadband values (Oke 1987, "Boundary Layer Climates",
@@ -90,6 +93,7 @@ MaterialSet builtinMaterials(const std::string& scene) {
         m.vegetation.maxSlopeDeg = 30.0f;
         m.wet.darkening = 0.55f;  // wet sand 0.20-0.25 against 0.35-0.45 dry
         m.water.clarity = 3.0f;
+        m.foam.enabled = true;  // sea foam: a broadband albedo of about 0.5-0.8 when dense
     } else if (scene == "dem") {
         // the Mont Blanc massif: forest and alpine meadows up to about
         // 2500 m, bare granite above, glaciers and firn above about 2900 m

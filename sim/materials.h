@@ -16,7 +16,11 @@
 //   4. wet ground where water stands: albedo times wet.darkening, reached at
 //      wet.depth metres of water;
 //   5. water: the ground seen through the water body, a two-layer diffuse
-//      mix, ground weight exp(-2 depth / water.clarity) (down and back up).
+//      mix, ground weight exp(-2 depth / water.clarity) (down and back up);
+//   6. foam (when enabled) in the swash zone: shallow water whose depth
+//      changes fast across the ground (the sea thinning out over a beach,
+//      the fronts of waves running up it); a film flowing down a slope keeps
+//      its depth and stays clear.
 // Albedos blend linearly, Phong exponents geometrically (lobe widths).
 #include <array>
 #include <string>
@@ -62,6 +66,13 @@ struct WaterRule {
     float clarity = 1.5f;  // m: depth scale of the light that reaches the bed
 };
 
+struct FoamRule {
+    Material material{{0.75f, 0.77f, 0.78f}, 20.0f};
+    bool enabled = false;
+    float maxDepth = 0.5f;           // m: none in deeper water (fading from half this depth)
+    float minDepthGradient = 0.02f;  // m per m: full foam from 2.5 times this
+};
+
 struct MaterialSet {
     Material bedrock{{0.26f, 0.25f, 0.24f}, 10.0f};
     SoilRule soil;
@@ -69,6 +80,7 @@ struct MaterialSet {
     SnowRule snow;
     WetRule wet;
     WaterRule water;
+    FoamRule foam;
 };
 
 /// Degrees over which the slope limits fade in.

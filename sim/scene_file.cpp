@@ -20,6 +20,7 @@
 //   [materials.soil] ... cover_depth   [materials.vegetation] ... min_altitude, max_altitude,
 //   altitude_fade, max_slope   [materials.snow] ... line, altitude_fade, max_slope
 //   [materials.wet] darkening, depth, exponent   [materials.water] albedo, exponent, clarity
+//   [materials.foam] enabled, albedo, exponent, max_depth, min_gradient
 //   [lights] environment = "uniform" | "sunsky" | "sky.exr", intensity = 1.0,   # sim/scene_lights.h
 //            visibility = 400000.0   # m, haze (0: clear)
 //   [lights.sky] zenith, horizon, ground = [r, g, b]      # the sunsky model's colours
@@ -316,6 +317,15 @@ void readMaterials(const std::string& file, const toml::table& t, MaterialSet& m
         TableReader q(*b, file, "materials.water.");
         readMaterial(q, m.water.material);
         q.num("clarity", m.water.clarity);
+        q.finish();
+    }
+    if (const toml::table* b = r.table("foam")) {
+        TableReader q(*b, file, "materials.foam.");
+        m.foam.enabled = true;
+        q.flag("enabled", m.foam.enabled);
+        readMaterial(q, m.foam.material);
+        q.num("max_depth", m.foam.maxDepth);
+        q.num("min_gradient", m.foam.minDepthGradient);
         q.finish();
     }
     r.finish();

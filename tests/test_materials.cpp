@@ -89,6 +89,15 @@ TEST_CASE("materials: each rule puts its material where it belongs") {
                                                (1.0f - bedWeight) * bare.water.material.albedo[c])
                                    .epsilon(1e-5));
     checkAlbedo(materialAt(bare, 1000.0f, 10.0f, 0.0f, 100.0f), bare.water.material, 1e-4f);
+    // foam on shallow water whose depth changes fast (the swash zone), none
+    // on a film of the same depth that keeps its depth
+    MaterialSet beach = builtinMaterials("waves");
+    REQUIRE(beach.foam.enabled);
+    const Material front = materialAt(beach, 0.0f, 5.0f, 0.0f, 0.1f, 0.2f);
+    checkAlbedo(front, beach.foam.material);
+    const Material film = materialAt(beach, 0.0f, 5.0f, 0.0f, 0.1f, 0.0f);
+    beach.foam.enabled = false;
+    checkAlbedo(film, materialAt(beach, 0.0f, 5.0f, 0.0f, 0.1f, 0.2f));
     // exponents blend geometrically: half soil is the geometric mean
     bare.soil.coverDepth = 1.0f;
     const float half = materialAt(bare, 0.0f, 0.0f, 0.5f, 0.0f).phongExponent;
