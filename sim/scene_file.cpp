@@ -31,6 +31,7 @@
 #include <cmath>
 #include <filesystem>
 #include <set>
+#include <span>
 
 #include <toml++/toml.h>
 
@@ -63,16 +64,20 @@ public:
                 fail(key, "a number");
         }
     }
-    void rgb(const char* key, std::array<float, 3>& out) {
+    // An array of lo..hi finite numbers into the first entries of out.
+    void numbers(const char* key, std::span<float> out, std::size_t lo, const std::string& expected) {
         if (const toml::node* n = get(key)) {
             const toml::array* a = n->as_array();
-            if (!a || a->size() != 3) fail(key, "an array of three numbers [r, g, b]");
-            for (std::size_t c = 0; c < 3; ++c) {
+            if (!a || a->size() < lo || a->size() > out.size()) fail(key, expected);
+            for (std::size_t c = 0; c < a->size(); ++c) {
                 auto v = a->get(c)->value<double>();
-                if (!v || !std::isfinite(*v)) fail(key, "an array of three numbers [r, g, b]");
+                if (!v || !std::isfinite(*v)) fail(key, expected);
                 out[c] = static_cast<float>(*v);
             }
         }
+    }
+    void rgb(const char* key, std::array<float, 3>& out) {
+        numbers(key, out, 3, "an array of three numbers [r, g, b]");
     }
     void integer(const char* key, int& out) {
         if (const toml::node* n = get(key)) {
@@ -109,6 +114,35 @@ public:
         }
         return nullptr;
     }
+    // The table `key`, read by read(reader) and checked for unknown keys;
+    // false when there is none.
+    template <class Read>
+    bool child(const char* key, Read&& read) {
+        const toml::table* t = table(key);
+        if (!t) return false;
+        TableReader q(*t, file_, path_ + key + ".");
+        read(q);
+        q.finish();
+        return true;
+    }
+    // Each table of the array of tables `key` ([[path.key]]), in order;
+    // false when there is none.
+    template <class Read>
+    bool children(const char* key, Read&& read) {
+        const toml::node* n = get(key);
+        if (!n) return false;
+        const std::string expected = "an array of tables ([[" + path_ + key + "]])";
+        const toml::array* arr = n->as_array();
+        if (!arr) fail(key, expected);
+        for (const toml::node& item : *arr) {
+            const toml::table* t = item.as_table();
+            if (!t) fail(key, expected);
+            TableReader q(*t, file_, path_ + key + ".");
+            read(q);
+            q.finish();
+        }
+        return true;
+    }
     [[noreturn]] void fail(const std::string& key, const std::string& expected) const {
         throw IoError(file_, "'" + path_ + key + "' must be " + expected);
     }
@@ -143,10 +177,19 @@ std::string besideFile(const std::string& file, const std::string& path) {
     return p.string();
 }
 
-void readTerrain(TableReader& r, const toml::table& t, SceneSettings& s) {
-    TableReader tr(t, r.file(), "terrain.");
+// Runs a check that throws InputError as an error of the scene file.
+template <class Check>
+void checkIn(const std::string& file, Check&& check) {
+    try {
+        check();
+    } catch (const InputError& e) {
+        throw IoError(file, e.what());
+    }
+}
+
+void readTerrain(TableReader& r, SceneSettings& s) {
     std::string kind;
-    tr.text("kind", kind);
+    r.text("kind", kind);
     if (!kind.empty()) {
         if (kind == "noise")
             s.terrain.kind = TerrainSource::Kind::Noise;
@@ -155,19 +198,19 @@ void readTerrain(TableReader& r, const toml::table& t, SceneSettings& s) {
         else if (kind == "dem")
             s.terrain.kind = TerrainSource::Kind::Dem;
         else
-            tr.fail("kind", "\"noise\", \"shape\" or \"dem\"");
+            r.fail("kind", "\"noise\", \"shape\" or \"dem\"");
     }
     NoiseSettings& n = s.terrain.noise;
-    tr.num("amplitude", n.amplitude);
-    tr.num("wavelength", n.wavelength);
-    tr.integer("octaves", n.octaves);
-    tr.num("lacunarity", n.lacunarity);
-    tr.num("gain", n.gain);
-    tr.flag("ridged", n.ridged);
-    tr.num("offset", n.offset);
+    r.num("amplitude", n.amplitude);
+    r.num("wavelength", n.wavelength);
+    r.integer("octaves", n.octaves);
+    r.num("lacunarity", n.lacunarity);
+    r.num("gain", n.gain);
+    r.flag("ridged", n.ridged);
+    r.num("offset", n.offset);
     ShapeSettings& sh = s.terrain.shape;
     std::string shape;
-    tr.text("shape", shape);
+    r.text("shape", shape);
     if (!shape.empty()) {
         try {
             sh.shape = parseShape(shape);
@@ -175,25 +218,23 @@ void readTerrain(TableReader& r, const toml::table& t, SceneSettings& s) {
             throw IoError(r.file(), std::string("terrain.shape: ") + e.what());
         }
     }
-    tr.num("base", sh.base);
-    tr.num("height", sh.height);
-    tr.num("radius", sh.radius);
-    tr.num("ridge_wavelength", sh.wavelength);
-    tr.num("angle", sh.angleDeg);
+    r.num("base", sh.base);
+    r.num("height", sh.height);
+    r.num("radius", sh.radius);
+    r.num("ridge_wavelength", sh.wavelength);
+    r.num("angle", sh.angleDeg);
     std::string file;
-    tr.text("file", file);
+    r.text("file", file);
     if (!file.empty()) s.terrain.demFile = besideFile(r.file(), file);
-    tr.num("z_scale", s.terrain.demZScale);
-    tr.num("z_offset", s.terrain.demZOffset);
-    tr.num("cell_size", s.terrain.demCellSize);
-    tr.flag("resample", s.terrain.demResample);
-    tr.num("ramp_start", s.terrain.rampStart);
-    tr.num("ramp_end", s.terrain.rampEnd);
-    tr.finish();
+    r.num("z_scale", s.terrain.demZScale);
+    r.num("z_offset", s.terrain.demZOffset);
+    r.num("cell_size", s.terrain.demCellSize);
+    r.flag("resample", s.terrain.demResample);
+    r.num("ramp_start", s.terrain.rampStart);
+    r.num("ramp_end", s.terrain.rampEnd);
 }
 
-void readHydraulic(const std::string& file, const toml::table& t, SceneSettings& s) {
-    TableReader r(t, file, "hydraulic.");
+void readHydraulic(TableReader& r, SceneSettings& s) {
     HydraulicSettings& h = s.hydraulicSettings;
     r.flag("enabled", s.hydraulic);
     r.num("gravity", h.gravity);
@@ -207,20 +248,16 @@ void readHydraulic(const std::string& file, const toml::table& t, SceneSettings&
     r.num("bedrock_hardness", h.bedrockHardness);
     r.num("max_erosion_depth", h.maxErosionDepth);
     r.flag("closed_boundary", h.closedBoundary);
-    r.finish();
 }
 
-void readThermal(const std::string& file, const toml::table& t, SceneSettings& s) {
-    TableReader r(t, file, "thermal.");
+void readThermal(TableReader& r, SceneSettings& s) {
     r.flag("enabled", s.thermal);
     r.num("talus_deg", s.thermalSettings.talusAngleDeg);
     r.num("rate", s.thermalSettings.rate);
     r.flag("erode_bedrock", s.thermalSettings.erodeBedrock);
-    r.finish();
 }
 
-void readWaves(const std::string& file, const toml::table& t, SceneSettings& s) {
-    TableReader r(t, file, "waves.");
+void readWaves(TableReader& r, SceneSettings& s) {
     WaveSettings& w = s.waveSettings;
     r.flag("enabled", s.waves);
     r.num("gravity", w.gravity);
@@ -229,39 +266,29 @@ void readWaves(const std::string& file, const toml::table& t, SceneSettings& s) 
     r.num("dry_depth", w.dryDepth);
     r.num("friction", w.friction);
     r.flag("advection", w.advection);
-    if (const toml::table* sw = r.table("swell")) {
-        TableReader q(*sw, file, "waves.swell.");
+    r.child("swell", [&](TableReader& q) {
         w.swell.enabled = true;
         q.flag("enabled", w.swell.enabled);
         std::string edge;
         q.text("edge", edge);
-        if (!edge.empty()) w.swell.edge = parseEdge(file, edge);
+        if (!edge.empty()) w.swell.edge = parseEdge(r.file(), edge);
         q.num("amplitude", w.swell.amplitude);
         q.num("period", w.swell.period);
         w.swell.seaLevel = s.waterLevel;  // default: the scene's water level
         q.num("sea_level", w.swell.seaLevel);
         q.num("ramp_periods", w.swell.rampPeriods);
-        q.finish();
-    }
-    if (const toml::node* d = r.get("drops")) {
-        const toml::array* arr = d->as_array();
-        if (!arr) r.fail("drops", "an array of tables ([[waves.drops]])");
-        w.drops.clear();
-        for (const toml::node& item : *arr) {
-            const toml::table* dt = item.as_table();
-            if (!dt) r.fail("drops", "an array of tables ([[waves.drops]])");
-            TableReader q(*dt, file, "waves.drops.");
-            WaveDrop drop;
-            q.num("time", drop.time);
-            q.num("x", drop.x);
-            q.num("y", drop.y);
-            q.num("radius", drop.radius);
-            q.num("height", drop.height);
-            q.finish();
-            w.drops.push_back(drop);
-        }
-    }
-    r.finish();
+    });
+    std::vector<WaveDrop> drops;
+    const bool given = r.children("drops", [&](TableReader& q) {
+        WaveDrop drop;
+        q.num("time", drop.time);
+        q.num("x", drop.x);
+        q.num("y", drop.y);
+        q.num("radius", drop.radius);
+        q.num("height", drop.height);
+        drops.push_back(drop);
+    });
+    if (given) w.drops = std::move(drops);
 }
 
 void readMaterial(TableReader& r, Material& m) {
@@ -270,21 +297,13 @@ void readMaterial(TableReader& r, Material& m) {
 }
 
 // A rule's table switches it on unless it says `enabled = false`.
-void readMaterials(const std::string& file, const toml::table& t, MaterialSet& m) {
-    TableReader r(t, file, "materials.");
-    if (const toml::table* b = r.table("bedrock")) {
-        TableReader q(*b, file, "materials.bedrock.");
-        readMaterial(q, m.bedrock);
-        q.finish();
-    }
-    if (const toml::table* b = r.table("soil")) {
-        TableReader q(*b, file, "materials.soil.");
+void readMaterials(TableReader& r, MaterialSet& m) {
+    r.child("bedrock", [&](TableReader& q) { readMaterial(q, m.bedrock); });
+    r.child("soil", [&](TableReader& q) {
         readMaterial(q, m.soil.material);
         q.num("cover_depth", m.soil.coverDepth);
-        q.finish();
-    }
-    if (const toml::table* b = r.table("vegetation")) {
-        TableReader q(*b, file, "materials.vegetation.");
+    });
+    r.child("vegetation", [&](TableReader& q) {
         VegetationRule& v = m.vegetation;
         v.enabled = true;
         q.flag("enabled", v.enabled);
@@ -293,10 +312,8 @@ void readMaterials(const std::string& file, const toml::table& t, MaterialSet& m
         q.num("max_altitude", v.maxAltitude);
         q.num("altitude_fade", v.altitudeFade);
         q.num("max_slope", v.maxSlopeDeg);
-        q.finish();
-    }
-    if (const toml::table* b = r.table("snow")) {
-        TableReader q(*b, file, "materials.snow.");
+    });
+    r.child("snow", [&](TableReader& q) {
         SnowRule& v = m.snow;
         v.enabled = true;
         q.flag("enabled", v.enabled);
@@ -304,39 +321,26 @@ void readMaterials(const std::string& file, const toml::table& t, MaterialSet& m
         q.num("line", v.line);
         q.num("altitude_fade", v.altitudeFade);
         q.num("max_slope", v.maxSlopeDeg);
-        q.finish();
-    }
-    if (const toml::table* b = r.table("wet")) {
-        TableReader q(*b, file, "materials.wet.");
+    });
+    r.child("wet", [&](TableReader& q) {
         q.num("darkening", m.wet.darkening);
         q.num("depth", m.wet.depth);
         q.num("exponent", m.wet.phongExponent);
-        q.finish();
-    }
-    if (const toml::table* b = r.table("water")) {
-        TableReader q(*b, file, "materials.water.");
+    });
+    r.child("water", [&](TableReader& q) {
         readMaterial(q, m.water.material);
         q.num("clarity", m.water.clarity);
-        q.finish();
-    }
-    if (const toml::table* b = r.table("foam")) {
-        TableReader q(*b, file, "materials.foam.");
+    });
+    r.child("foam", [&](TableReader& q) {
         m.foam.enabled = true;
         q.flag("enabled", m.foam.enabled);
         readMaterial(q, m.foam.material);
         q.num("max_depth", m.foam.maxDepth);
         q.num("min_gradient", m.foam.minDepthGradient);
-        q.finish();
-    }
-    r.finish();
-    try {
-        validateMaterials(m);
-    } catch (const InputError& e) {
-        throw IoError(file, e.what());
-    }
+    });
 }
 
-void readEnvironment(TableReader& r, const std::string& file, EnvironmentSpec& e) {
+void readEnvironment(TableReader& r, EnvironmentSpec& e) {
     std::string kind;
     r.text("environment", kind);
     if (kind == "uniform") {
@@ -347,42 +351,18 @@ void readEnvironment(TableReader& r, const std::string& file, EnvironmentSpec& e
         const std::string ext = std::filesystem::path(kind).extension().string();
         if (ext != ".exr" && ext != ".hdr") r.fail("environment", "\"uniform\", \"sunsky\" or an .exr / .hdr image");
         e.kind = EnvironmentSpec::Kind::Image;
-        e.file = besideFile(file, kind);
+        e.file = besideFile(r.file(), kind);
     }
     r.num("intensity", e.intensity);
     r.num("visibility", e.visibility);
-    if (const toml::table* t = r.table("sky")) {
-        TableReader q(*t, file, "lights.sky.");
+    r.child("sky", [&](TableReader& q) {
         q.rgb("zenith", e.zenith);
         q.rgb("horizon", e.horizon);
         q.rgb("ground", e.ground);
-        q.finish();
-    }
+    });
 }
 
-// [[lights.key]] tables replace the base scene's key lights.
-void readKeys(TableReader& r, const std::string& file, std::vector<KeyLightSpec>& keys) {
-    const toml::node* n = r.get("key");
-    if (!n) return;
-    const toml::array* arr = n->as_array();
-    if (!arr) r.fail("key", "an array of tables ([[lights.key]])");
-    keys.clear();
-    for (const toml::node& item : *arr) {
-        const toml::table* t = item.as_table();
-        if (!t) r.fail("key", "an array of tables ([[lights.key]])");
-        TableReader q(*t, file, "lights.key.");
-        KeyLightSpec k;
-        q.num("azimuth", k.azimuthDeg);
-        q.num("elevation", k.elevationDeg);
-        q.num("radius", k.radiusDeg);
-        q.rgb("rgb", k.rgb);
-        q.finish();
-        keys.push_back(k);
-    }
-}
-
-void readSun(const toml::table& t, const std::string& file, SunSpec& sun) {
-    TableReader q(t, file, "lights.sun.");
+void readSun(TableReader& q, SunSpec& sun) {
     sun.enabled = true;
     q.flag("enabled", sun.enabled);
     q.num("latitude", sun.latitudeDeg);
@@ -392,60 +372,41 @@ void readSun(const toml::table& t, const std::string& file, SunSpec& sun) {
     q.num("north", sun.northAzimuthDeg);
     q.num("radius", sun.radiusDeg);
     q.rgb("rgb", sun.rgb);
-    q.finish();
 }
 
-void readLights(const std::string& file, const toml::table& t, LightSet& lights) {
-    TableReader r(t, file, "lights.");
-    readEnvironment(r, file, lights.environment);
-    readKeys(r, file, lights.keys);
-    if (const toml::table* sun = r.table("sun")) readSun(*sun, file, lights.sun);
-    r.finish();
-    try {
-        validateLights(lights);
-    } catch (const InputError& e) {
-        throw IoError(file, e.what());
-    }
+// [[lights.key]] tables replace the base scene's key lights.
+void readLights(TableReader& r, LightSet& lights) {
+    readEnvironment(r, lights.environment);
+    std::vector<KeyLightSpec> keys;
+    const bool given = r.children("key", [&](TableReader& q) {
+        KeyLightSpec k;
+        q.num("azimuth", k.azimuthDeg);
+        q.num("elevation", k.elevationDeg);
+        q.num("radius", k.radiusDeg);
+        q.rgb("rgb", k.rgb);
+        keys.push_back(k);
+    });
+    if (given) lights.keys = std::move(keys);
+    r.child("sun", [&](TableReader& q) { readSun(q, lights.sun); });
 }
 
-void readCamera(const std::string& file, const toml::table& t, CameraPath& path) {
-    TableReader r(t, file, "camera.");
+// [[camera.key]] tables replace the base scene's path.
+void readCamera(TableReader& r, CameraPath& path) {
     r.num("fov", path.fovYDeg);
-    if (const toml::node* n = r.get("key")) {
-        const toml::array* arr = n->as_array();
-        if (!arr) r.fail("key", "an array of tables ([[camera.key]])");
-        path.keys.clear();
-        for (const toml::node& item : *arr) {
-            const toml::table* kt = item.as_table();
-            if (!kt) r.fail("key", "an array of tables ([[camera.key]])");
-            TableReader q(*kt, file, "camera.key.");
-            CameraKey k;
-            q.num("frame", k.frame);
-            q.num("yaw", k.yawDeg);
-            q.num("pitch", k.pitchDeg);
-            q.num("distance", k.distance);
-            if (const toml::node* tn = q.get("target")) {
-                const toml::array* a = tn->as_array();
-                bool numbers = a && (a->size() == 2 || a->size() == 3);
-                for (std::size_t j = 0; numbers && j < a->size(); ++j) numbers = a->get(j)->value<double>().has_value();
-                if (!numbers) q.fail("target", "[x, y] or [x, y, z], fractions of the extent (z: of the relief)");
-                for (std::size_t j = 0; j < a->size(); ++j)
-                    k.target[j] = static_cast<float>(*a->get(j)->value<double>());
-            }
-            q.finish();
-            path.keys.push_back(k);
-        }
-    }
-    r.finish();
-    try {
-        validateCameraPath(path);
-    } catch (const InputError& e) {
-        throw IoError(file, e.what());
-    }
+    std::vector<CameraKey> keys;
+    const bool given = r.children("key", [&](TableReader& q) {
+        CameraKey k;
+        q.num("frame", k.frame);
+        q.num("yaw", k.yawDeg);
+        q.num("pitch", k.pitchDeg);
+        q.num("distance", k.distance);
+        q.numbers("target", k.target, 2, "[x, y] or [x, y, z], fractions of the extent (z: of the relief)");
+        keys.push_back(k);
+    });
+    if (given) path.keys = std::move(keys);
 }
 
-void readGi(const std::string& file, const toml::table& t, SceneSettings& s) {
-    TableReader r(t, file, "gi.");
+void readGi(TableReader& r, SceneSettings& s) {
     if (r.get("incremental")) {
         bool on = true;
         r.flag("incremental", on);
@@ -462,7 +423,6 @@ void readGi(const std::string& file, const toml::table& t, SceneSettings& s) {
         r.integer("refresh", every);
         s.gi.refreshEvery = every;
     }
-    r.finish();
 }
 
 }  // namespace
@@ -519,20 +479,19 @@ SceneSettings loadSceneFile(const std::string& file) {
         s.hasWaterLevel = true;
         r.num("water_level", s.waterLevel);
     }
-    if (const toml::table* t = r.table("terrain")) readTerrain(r, *t, s);
-    if (const toml::table* t = r.table("hydraulic")) readHydraulic(file, *t, s);
-    if (const toml::table* t = r.table("thermal")) readThermal(file, *t, s);
-    if (const toml::table* t = r.table("waves")) readWaves(file, *t, s);
-    if (const toml::table* t = r.table("gi")) readGi(file, *t, s);
-    if (const toml::table* t = r.table("materials")) readMaterials(file, *t, s.materials);
-    if (const toml::table* t = r.table("lights")) readLights(file, *t, s.lights);
-    if (const toml::table* t = r.table("camera")) readCamera(file, *t, s.camera);
+    r.child("terrain", [&](TableReader& q) { readTerrain(q, s); });
+    r.child("hydraulic", [&](TableReader& q) { readHydraulic(q, s); });
+    r.child("thermal", [&](TableReader& q) { readThermal(q, s); });
+    r.child("waves", [&](TableReader& q) { readWaves(q, s); });
+    r.child("gi", [&](TableReader& q) { readGi(q, s); });
+    if (r.child("materials", [&](TableReader& q) { readMaterials(q, s.materials); }))
+        checkIn(file, [&] { validateMaterials(s.materials); });
+    if (r.child("lights", [&](TableReader& q) { readLights(q, s.lights); }))
+        checkIn(file, [&] { validateLights(s.lights); });
+    if (r.child("camera", [&](TableReader& q) { readCamera(q, s.camera); }))
+        checkIn(file, [&] { validateCameraPath(s.camera); });
     r.finish();
-    try {
-        checkDimensions(s.nx, s.ny, s.cellSize);
-    } catch (const InputError& e) {
-        throw IoError(file, e.what());
-    }
+    checkIn(file, [&] { checkDimensions(s.nx, s.ny, s.cellSize); });
     return s;
 }
 
