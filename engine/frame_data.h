@@ -55,7 +55,7 @@ struct SceneLights {
     std::vector<gi::KeyLight> keys;  // the first is the sun: specular highlights and the shadow map
     SkyKind skyKind = SkyKind::Sh;
     std::array<float, 3> zenith{}, horizon{}, ground{};  // SkyKind::Gradient, radiance
-    std::shared_ptr<const EnvironmentImage> image;        // SkyKind::Image
+    std::shared_ptr<const EnvironmentImage> image;       // SkyKind::Image
     float imageScale = 1.0f;
     float hazeExtinction = 0.0f;  // per metre of view distance (0: clear air)
 };
@@ -66,10 +66,13 @@ struct FrameData {
     float cellSize = 1.0f;
     float zMin = 0.0f, zMax = 1.0f;  // ground range of the first frame (camera framing, debug views)
     bool hasWater = false;
-    float exaggeration = 1.0f;            // vertical exaggeration (applied by the renderer to the heights)
-    std::vector<float> heights;           // 2 per texel: ground, water depth
-    std::vector<float> albedo;            // 4 per texel: linear RGB albedo, Phong exponent
-    std::int64_t albedoVersion = 0;       // new (unique in the process) whenever `albedo` changes
+    float exaggeration = 1.0f;   // vertical exaggeration (applied by the renderer to the heights)
+    std::vector<float> heights;  // 2 per texel: ground, water depth
+    std::vector<float> albedo;   // 4 per texel: linear RGB albedo, Phong exponent
+    // New, unique in the process, whenever the arrays they name change (a
+    // renderer uploads only what changed, and never takes one pipeline's
+    // arrays for another's): heights; albedo; shade, key and receiver.
+    std::int64_t heightsVersion = 0, albedoVersion = 0, shadeVersion = 0;
     std::vector<float> shade;             // 4 per texel: sky RGB, key visibility
     std::vector<float> key;               // 4 per texel: key RGB, ambient
     int nxr = 0, nyr = 0, subsample = 1;  // receiver grid

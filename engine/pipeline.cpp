@@ -27,8 +27,14 @@ void exaggeratedSurface(const TerrainState& s, float exag, Grid& surface) {
     });
 }
 
+// A version number for FrameData, unique in the process.
+std::int64_t nextVersion() {
+    static std::atomic<std::int64_t> versions{0};
+    return ++versions;
+}
+
 // Ground and water depth of every texel (they may move apart while their
-// sum, the lit surface, stays: packed every frame).
+// sum, the lit surface, stays: packed whenever the terrain ticked).
 void packHeights(const TerrainState& s, FrameData& f) {
     const int nx = s.nx, ny = s.ny;
     f.heights.resize(2 * static_cast<std::size_t>(nx) * ny);
@@ -90,10 +96,7 @@ void packAlbedo(const MaterialMaps& maps, FrameData& f) {
             f.albedo[4 * i + 3] = maps.exponent.v[i];
         }
     });
-    // unique in the process, so that a renderer fed by several pipelines
-    // never takes one pipeline's maps for another's
-    static std::atomic<std::int64_t> versions{0};
-    f.albedoVersion = ++versions;
+    f.albedoVersion = nextVersion();
 }
 
 // Receiver grid: sky visibility fraction (V_00 sqrt(4 pi) / 2 pi), one
@@ -192,6 +195,7 @@ void FramePipeline::terrainReplaced() {
     const float extent = static_cast<float>(std::max(s.nx, s.ny) - 1) * s.cellSize;
     autoExaggeration_ = std::clamp(0.15f * extent / (frame_.zMax - frame_.zMin), 1.0f, 10.0f);
     mapsTick_ = -1;
+    heightsTick_ = -1;
 }
 
 void FramePipeline::setLights(const LightSet& lights) { rig_ = LightRig(lights, &rig_); }
@@ -268,7 +272,11 @@ void FramePipeline::light() {
 
     t = Clock::now();
     FrameData& f = frame_;
-    packHeights(s, f);
+    if (heightsTick_ != s.tick) {
+        packHeights(s, f);
+        f.heightsVersion = nextVersion();
+        heightsTick_ = s.tick;
+    }
     if (newMaps) packAlbedo(maps_, f);
     const bool giUpdated = gi_.directUpdated || gi_.indirectUpdated;
     if (!giUpdated && f.lighting == settings_.lighting && packedPyramidLevel_ == settings_.pyramidLevel) {
@@ -290,6 +298,7 @@ void FramePipeline::light() {
     const bool indirect = gs.indirect.bounces > 0;
     packTexels(gi_, indirect ? gi_.indirect.total : gi_.shade.rgb, keyOnly_, maps_.albedo, key, f);
     packReceivers(gi_, surface_, settings_, exag, indirect, f);
+    f.shadeVersion = nextVersion();
     const double packMs = msSince(t);
     recordGiTimings(gi_, gs, surfaceMs, packMs, timings_);
 }

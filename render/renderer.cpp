@@ -178,11 +178,18 @@ void Renderer::streamTexture(GLuint& tex, int& w, int& h, int nw, int nh, GLenum
 
 void Renderer::upload(const engine::FrameData& f) {
     gl_.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    streamTexture(heightTex_, heightW_, heightH_, f.nx, f.ny, GL_RG32F, GL_RG, f.heights.data());
-    streamTexture(shadeTex_, shadeW_, shadeH_, f.nx, f.ny, GL_RGBA32F, GL_RGBA, f.shade.data());
-    streamTexture(keyTex_, keyW_, keyH_, f.nx, f.ny, GL_RGBA32F, GL_RGBA, f.key.data());
-    streamTexture(receiverTex_, recvW_, recvH_, f.nxr, f.nyr, GL_RGBA32F, GL_RGBA, f.receiver.data());
-    // the materials change only when the terrain does
+    // only what changed since the last upload (a paused or static scene: nothing)
+    const bool newHeights = f.heightsVersion != heightsVersion_ || heightW_ != f.nx || heightH_ != f.ny;
+    if (newHeights) {
+        streamTexture(heightTex_, heightW_, heightH_, f.nx, f.ny, GL_RG32F, GL_RG, f.heights.data());
+        heightsVersion_ = f.heightsVersion;
+    }
+    if (f.shadeVersion != shadeVersion_ || shadeW_ != f.nx || shadeH_ != f.ny || recvW_ != f.nxr || recvH_ != f.nyr) {
+        streamTexture(shadeTex_, shadeW_, shadeH_, f.nx, f.ny, GL_RGBA32F, GL_RGBA, f.shade.data());
+        streamTexture(keyTex_, keyW_, keyH_, f.nx, f.ny, GL_RGBA32F, GL_RGBA, f.key.data());
+        streamTexture(receiverTex_, recvW_, recvH_, f.nxr, f.nyr, GL_RGBA32F, GL_RGBA, f.receiver.data());
+        shadeVersion_ = f.shadeVersion;
+    }
     if (f.albedoVersion != albedoVersion_ || albedoW_ != f.nx || albedoH_ != f.ny) {
         streamTexture(albedoTex_, albedoW_, albedoH_, f.nx, f.ny, GL_RGBA32F, GL_RGBA, f.albedo.data());
         albedoVersion_ = f.albedoVersion;
@@ -190,8 +197,9 @@ void Renderer::upload(const engine::FrameData& f) {
 
     sky_.upload(f.lights);
 
-    // The chunks' errors and bounds follow the heights (render/terrain_lod.h).
-    buildChunkTree(f.heights, f.nx, f.ny, f.cellSize, f.exaggeration, f.hasWater, kChunkQuads, lodTree_);
+    // The chunks' errors and bounds follow the heights as drawn (render/terrain_lod.h).
+    if (newHeights || lodTree_.levels.empty() || f.exaggeration != meta_.exaggeration || f.hasWater != meta_.hasWater)
+        buildChunkTree(f.heights, f.nx, f.ny, f.cellSize, f.exaggeration, f.hasWater, kChunkQuads, lodTree_);
     meta_.nx = f.nx;
     meta_.ny = f.ny;
     meta_.nxr = f.nxr;

@@ -137,7 +137,8 @@ private:
     GLuint heightTex_ = 0, shadeTex_ = 0, keyTex_ = 0, receiverTex_ = 0, albedoTex_ = 0;
     int heightW_ = 0, heightH_ = 0, shadeW_ = 0, shadeH_ = 0, keyW_ = 0, keyH_ = 0, recvW_ = 0, recvH_ = 0,
         albedoW_ = 0, albedoH_ = 0;
-    std::int64_t albedoVersion_ = -1;  // FrameData::albedoVersion of the uploaded albedo
+    // FrameData's versions of what was uploaded last
+    std::int64_t heightsVersion_ = -1, albedoVersion_ = -1, shadeVersion_ = -1;
     Target hdr_, ldr_, shadow_, sceneCopy_;
     engine::FrameData meta_;  // the uploaded frame's sizes, lights and modes (no per-texel arrays)
     Sky sky_;
