@@ -80,6 +80,30 @@ void printSummary(const char* label, const RenderOptions& o, const engine::Pipel
         static_cast<double>(ps.gi.tolerance));
 }
 
+// --video: the frames as an mp4 through ffmpeg (atomic), or a message that
+// ffmpeg is missing.
+void encodeVideo(const RenderOptions& o, const std::string& dir, const char* label) {
+    const std::string ffmpeg = findOnPath("ffmpeg");
+    if (ffmpeg.empty()) {
+        std::printf(
+            "%s: ffmpeg is not installed, so no %s was made (the PNG frames are in %s; "
+            "install ffmpeg, e.g. apt-get install ffmpeg, for video)\n",
+            label, o.video.c_str(), dir.c_str());
+    } else {
+        const std::string tmp = temporaryNameFor(o.video) + ".mp4";
+        const std::string cmd = shellQuote(ffmpeg) + " -loglevel error -y -framerate 24 -i " +
+                                shellQuote((std::filesystem::path(o.out) / "frame_%04d.png").string()) +
+                                " -c:v libx264 -pix_fmt yuv420p -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' " + shellQuote(tmp);
+        if (std::system(cmd.c_str()) != 0) {
+            std::error_code ec;
+            std::filesystem::remove(tmp, ec);
+            throw IoError(o.video, "ffmpeg failed to encode the frames");
+        }
+        commitTemporary(tmp, o.video);
+        if (!o.quiet) std::printf("%s: video written to %s\n", label, o.video.c_str());
+    }
+}
+
 }  // namespace
 
 SceneSettings resolveRenderScene(const RenderOptions& o) {
@@ -256,28 +280,7 @@ int runHeadlessRender(const RenderOptions& o, const char* label) {
             printSummary(label, o, ps, stage, recomputed, indirectRecomputed);
             std::printf("%s: %d frames written to %s\n", label, o.frames, dir.c_str());
         }
-        if (!o.video.empty()) {
-            const std::string ffmpeg = findOnPath("ffmpeg");
-            if (ffmpeg.empty()) {
-                std::printf(
-                    "%s: ffmpeg is not installed, so no %s was made (the PNG frames are in %s; "
-                    "install ffmpeg, e.g. apt-get install ffmpeg, for video)\n",
-                    label, o.video.c_str(), dir.c_str());
-            } else {
-                const std::string tmp = temporaryNameFor(o.video) + ".mp4";
-                const std::string cmd = shellQuote(ffmpeg) + " -loglevel error -y -framerate 24 -i " +
-                                        shellQuote((std::filesystem::path(o.out) / "frame_%04d.png").string()) +
-                                        " -c:v libx264 -pix_fmt yuv420p -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' " +
-                                        shellQuote(tmp);
-                if (std::system(cmd.c_str()) != 0) {
-                    std::error_code ec;
-                    std::filesystem::remove(tmp, ec);
-                    throw IoError(o.video, "ffmpeg failed to encode the frames");
-                }
-                commitTemporary(tmp, o.video);
-                if (!o.quiet) std::printf("%s: video written to %s\n", label, o.video.c_str());
-            }
-        }
+        if (!o.video.empty()) encodeVideo(o, dir, label);
         return 0;
     });
 }
