@@ -46,7 +46,17 @@ void applyCameraOptions(const CameraOptions& o, CameraPath& path) {
         path.keys = {still};
     }
     if (o.fov) path.fovYDeg = *o.fov;
-    validateCameraPath(path);
+    try {
+        validateCameraPath(path);
+    } catch (const InputError& e) {
+        throw InputError(std::string(e.what()) +
+                         " (--yaw, --pitch, --distance, --fov, --camera-key or the scene's [camera])");
+    }
+}
+
+void checkCameraOptions(const CameraOptions& o) {
+    CameraPath none;
+    applyCameraOptions(o, none);
 }
 
 render::OrbitCamera cameraOfFrame(const CameraPath& path, int frame) {

@@ -26,6 +26,10 @@ void addCameraOptions(CLI::App* sub, CameraOptions& o);
 /// the path's first key). Validates; throws InputError naming the option.
 void applyCameraOptions(const CameraOptions& o, CameraPath& path);
 
+/// The options on their own, before a scene is read: applied to an empty
+/// path, they must give a valid one. Throws InputError naming the option.
+void checkCameraOptions(const CameraOptions& o);
+
 /// The renderer's camera at `frame` of the path (its default camera when the
 /// path has no keys).
 render::OrbitCamera cameraOfFrame(const CameraPath& path, int frame);

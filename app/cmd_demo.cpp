@@ -28,8 +28,9 @@ int runDemo(DemoOptions& d) {
     RenderOptions& o = d.render;
     engine::PipelineSettings ps;
     render::RenderSettings rs;
+    toSettings(o, ps, rs);
     const SceneSettings scene = resolveRenderScene(o);
-    toSettings(o, scene, ps, rs);
+    applyScene(o, scene, ps, rs);
     std::string why = d.headless ? "headless requested" : render::noDisplayReason();
     std::unique_ptr<render::WindowContext> window;
     if (why.empty()) {

@@ -13,7 +13,10 @@
 #include "app/commands.h"
 #include "app/gi_images.h"
 #include "app/light_options.h"
+#include "app/option_ranges.h"
+#include "app/progress.h"
 #include "core/error.h"
+#include "core/finite.h"
 #include "core/parallel.h"
 #include "core/parse.h"
 #include "engine/light_rig.h"
@@ -22,6 +25,7 @@
 #include "gi/reference.h"
 #include "gi/reference_gi.h"
 #include "sim/heightmap_io.h"
+#include "sim/scene_ranges.h"
 
 namespace terrain::app {
 namespace {
@@ -76,13 +80,11 @@ void parseBrdf(const std::string& text, gi::ShadingSettings& s) {
         const auto comma = rest.find(',');
         s.specularWeight = number(rest.substr(0, comma));
         if (comma != std::string::npos) s.phongExponent = number(rest.substr(comma + 1));
-        if (!(s.specularWeight >= 0.0f && s.specularWeight <= 1.0f))
-            throw InputError("--brdf mix: weight must be in [0, 1]");
+        checkRange(gi::ranges::kSpecularWeight, s.specularWeight, "--brdf mix: weight");
     } else {
         throw InputError("--brdf must be lambert, phong:EXP or mix:W[,EXP] (got '" + text + "')");
     }
-    if (!(s.phongExponent >= 1.0f && s.phongExponent <= 10000.0f))
-        throw InputError("--brdf: Phong exponent must be in [1, 10000]");
+    checkRange(gi::ranges::kPhongExponent, s.phongExponent, "--brdf: Phong exponent");
 }
 
 // The phong exponent option: a constant, or a 16-bit PNG mapped to a range.
@@ -149,12 +151,24 @@ gi::GiSettings settingsFrom(const GiOptions& o, ExponentSource& exponent) {
     return settings;
 }
 
-// Everything about the options that can be wrong, before any work starts.
-void checkOptions(const GiOptions& o) {
-    if (o.threads < 0 || o.threads > 256) throw InputError("--threads must be 0 (all) .. 256");
-    if (o.frames < 1 || o.frames > 100000) throw InputError("--frames must be >= 1");
-    if (!std::isfinite(o.zScale) || !std::isfinite(o.zOffset))
-        throw InputError("--z-scale and --z-offset must be finite");
+// The GI settings the flags set, each in its range (naming the flag;
+// validateGiSettings checks them all again, with what no flag sets).
+void checkGiFlags(const gi::GiSettings& s) {
+    namespace r = gi::ranges;
+    checkRange(r::kSubsample, s.subsample, "--subsample");
+    checkRange(r::kAzimuths, s.visibility.azimuths, "--azimuths");
+    checkRange(r::kLevelsPerOctave, s.pyramid.levelsPerOctave, "--levels-per-octave");
+    checkRange(r::kLevelOffset, s.pyramid.levelOffset, "--level-offset");
+    checkRange(r::kBounces, s.indirect.bounces, "--bounces");
+    checkRange(r::kTolerance, s.tolerance, "--gi-tolerance");
+    checkRange(r::kRefreshEvery, s.refreshEvery, "--gi-refresh");
+    checkRange(r::kRadianceLevelsPerOctave, s.indirect.radiance.levelsPerOctave, "--radiance-levels-per-octave");
+    checkRange(r::kRadianceLevelOffset, s.indirect.radiance.levelOffset, "--radiance-level-offset");
+    checkRange(r::kIndirectAzimuths, s.indirect.azimuths, "--indirect-azimuths");
+}
+
+// The output files, before any work: each must be a file in a folder we can write to.
+void checkOutputs(const GiOptions& o) {
     if (!o.outShade.empty() && extensionOf(o.outShade) != ".png" && extensionOf(o.outShade) != ".exr")
         throw InputError("--out-shade must end in .png or .exr (got '" + o.outShade + "')");
     if (!o.outAmbient.empty() && extensionOf(o.outAmbient) != ".npy" && extensionOf(o.outAmbient) != ".exr")
@@ -162,11 +176,26 @@ void checkOptions(const GiOptions& o) {
     const std::string indirectExt = extensionOf(o.outIndirect);
     if (!o.outIndirect.empty() && indirectExt != ".npy" && indirectExt != ".exr" && indirectExt != ".png")
         throw InputError("--out-indirect must end in .npy, .exr or .png (got '" + o.outIndirect + "')");
-    if (!(o.exposure > 0.0f && o.exposure < 1000.0f)) throw InputError("--exposure must be in (0, 1000)");
     if (!o.outIndirect.empty() && o.settings.indirect.bounces == 0 && !o.reference)
         throw InputError("--out-indirect needs --bounces >= 1");
-    if (o.referenceDirections < 16 || o.referenceDirections > (1 << 20))
-        throw InputError("--reference-directions must be 16 .. 2^20");
+    for (const std::string* out : {&o.outShade, &o.outAmbient, &o.outIndirect})
+        if (!out->empty()) checkWritableFile(*out);
+}
+
+// Everything about the options that can be wrong, before any input is read.
+void checkOptions(const GiOptions& o) {
+    namespace r = option_ranges;
+    namespace sr = scene_ranges;
+    checkRange(r::kThreads, o.threads);
+    checkRange(r::kFrames, o.frames);
+    checkRange(r::kExposure, o.exposure);
+    checkRange(r::kReferenceDirections, o.referenceDirections);
+    checkRange(widened(sr::kDemCellSize), o.cellSize, "--cell-size");
+    checkRange(widened(sr::kDemZScale), o.zScale, "--z-scale");
+    checkRange(widened(sr::kAltitude), o.zOffset, "--z-offset");
+    checkGiFlags(o.settings);
+    checkLightOptions(o.lights);
+    checkOutputs(o);
 }
 
 // What a frame lights: the heights, their cell size and the albedo maps.
@@ -188,13 +217,36 @@ GiInputs readInputs(const GiOptions& o, const ExponentSource& exponent) {
     float cellFromFile = 0.0f;
     in.heights = readHeightmap(o.heightmap, static_cast<float>(o.zScale), static_cast<float>(o.zOffset), &cellFromFile);
     in.cell = o.cellSize > 0.0 ? o.cellSize : cellFromFile;
-    if (!(in.cell > 0.0) || !std::isfinite(in.cell))
-        throw InputError("--cell-size must be > 0 (metres between grid points)");
+    if (!(in.cell > 0.0)) throw InputError("--cell-size is needed for a PNG heightmap (metres between grid points)");
+    checkRange(scene_ranges::kCellSize, static_cast<float>(in.cell), o.heightmap + ": cell size");
     if (!o.albedo.empty()) in.albedoMap = gi::loadAlbedo(o.albedo, in.heights.nx, in.heights.ny);
     if (exponent.fromFile)
         gi::loadPhongExponentMap(o.phongExponent, in.heights.nx, in.heights.ny, exponent.lo, exponent.hi, in.albedoMap);
     in.albedo = o.albedo.empty() && !exponent.fromFile ? nullptr : &in.albedoMap;
     return in;
+}
+
+// A frame's results, the maps `terrain gi` can write.
+struct GiResults {
+    const std::array<Grid, 3>* shade = nullptr;
+    const Grid* ambient = nullptr;
+    const std::array<Grid, 3>* indirect = nullptr;  // null: none computed
+};
+
+// Every result is checked finite before any file is written: no NaN or Inf
+// leaves the command, and a failing run leaves earlier files as they were.
+void writeResults(const GiOptions& o, const GiResults& r) {
+    try {
+        for (const Grid& g : *r.shade) requireFinite(g, "the shade map");
+        requireFinite(*r.ambient, "the ambient map");
+        if (r.indirect)
+            for (const Grid& g : *r.indirect) requireFinite(g, "the indirect light");
+    } catch (const InputError& e) {
+        throw InputError(std::string(e.what()) + "; nothing written");
+    }
+    if (!o.outShade.empty()) writeShade(o.outShade, *r.shade, o.exposure);
+    if (!o.outAmbient.empty()) writeAmbient(o.outAmbient, *r.ambient);
+    if (!o.outIndirect.empty()) writeIndirect(o.outIndirect, *r.indirect);
 }
 
 using Clock = std::chrono::steady_clock;
@@ -217,9 +269,7 @@ int runReference(const GiOptions& o, const gi::GiSettings& settings, const GiInp
         gi::renderReferenceGi(in.heights.cview(), static_cast<float>(in.cell), in.lighting.environment, in.albedo, gs,
                               gr);
         if (o.time) std::printf("reference: %.1f ms\n", msSince(t0));
-        if (!o.outShade.empty()) writeShade(o.outShade, gr.total, o.exposure);
-        if (!o.outAmbient.empty()) writeAmbient(o.outAmbient, gr.ambient);
-        if (!o.outIndirect.empty()) writeIndirect(o.outIndirect, gr.indirect);
+        writeResults(o, {&gr.total, &gr.ambient, &gr.indirect});
         return 0;
     }
     gi::ReferenceSettings rs;
@@ -227,8 +277,7 @@ int runReference(const GiOptions& o, const gi::GiSettings& settings, const GiInp
     gi::ReferenceResult rr;
     gi::renderReference(in.heights.cview(), static_cast<float>(in.cell), &in.lighting.environment, in.albedo, rs, rr);
     if (o.time) std::printf("reference: %.1f ms\n", msSince(t0));
-    if (!o.outShade.empty()) writeShade(o.outShade, rr.rgb, o.exposure);
-    if (!o.outAmbient.empty()) writeAmbient(o.outAmbient, rr.ambient);
+    writeResults(o, {&rr.rgb, &rr.ambient, nullptr});
     return 0;
 }
 
@@ -261,9 +310,8 @@ int runFastPath(const GiOptions& o, const gi::GiSettings& settings, const GiInpu
         std::sort(totals.begin(), totals.end());
         std::printf("%.2f ms per frame\n", totals[totals.size() / 2]);
     }
-    if (!o.outShade.empty()) writeShade(o.outShade, bounces > 0 ? state.indirect.total : state.shade.rgb, o.exposure);
-    if (!o.outAmbient.empty()) writeAmbient(o.outAmbient, state.shade.ambient);
-    if (!o.outIndirect.empty()) writeIndirect(o.outIndirect, state.indirect.indirect);
+    writeResults(o, {bounces > 0 ? &state.indirect.total : &state.shade.rgb, &state.shade.ambient,
+                     bounces > 0 ? &state.indirect.indirect : nullptr});
     return 0;
 }
 
@@ -272,9 +320,10 @@ int runGi(const GiOptions& o) {
     ExponentSource exponent;
     const gi::GiSettings settings = settingsFrom(o, exponent);
     const GiInputs in = readInputs(o, exponent);
-    // after every input is read: a bad input gives one error line on stderr
-    std::fprintf(stderr, "terrain gi: %s, %d x %d cells of %.4g m\n", o.heightmap.c_str(), in.heights.nx, in.heights.ny,
-                 in.cell);
+    // on stdout: stderr carries errors only
+    std::printf("terrain gi: %s, %d x %d cells of %.4g m\n", o.heightmap.c_str(), in.heights.nx, in.heights.ny,
+                in.cell);
+    std::fflush(stdout);
     return withThreads(o.threads,
                        [&] { return o.reference ? runReference(o, settings, in) : runFastPath(o, settings, in); });
 }
@@ -286,9 +335,12 @@ Runner addGiCommand(CLI::App& app) {
     CLI::App* sub =
         app.add_subcommand("gi", "Global illumination of a height field: soft shadows from sky and key lights");
     sub->add_option("--heightmap", o->heightmap, "16-bit PNG (height = O + S * value) or .vdb")->required();
-    sub->add_option("--cell-size", o->cellSize, "Metres between grid points (required for PNG)");
-    sub->add_option("--z-scale", o->zScale, "Metres per PNG unit (S)");
-    sub->add_option("--z-offset", o->zOffset, "Height of PNG value 0 in metres (O)");
+    namespace sr = scene_ranges;
+    namespace opt = option_ranges;
+    sub->add_option("--cell-size", o->cellSize, describe(sr::kDemCellSize) + " (required for PNG)");
+    sub->add_option("--z-scale", o->zScale, describe(sr::kDemZScale) + " (S)")->capture_default_str();
+    sub->add_option("--z-offset", o->zOffset, describe(sr::kAltitude) + ": the height of PNG value 0 (O)")
+        ->capture_default_str();
     addLightOptions(sub, o->lights, "a uniform sky of radiance 1, no key light, no sun");
     gi::GiSettings& gs = o->settings;
     namespace r = gi::ranges;
@@ -300,13 +352,15 @@ Runner addGiCommand(CLI::App& app) {
     sub->add_option("--level-offset", gs.pyramid.levelOffset, gi::describe(r::kLevelOffset) + " (paper 2)")
         ->capture_default_str();
     sub->add_option("--interp", o->interp, "Azimuthal interpolation: linear | bspline");
-    sub->add_option("--threads", o->threads, "Worker threads (0 = all)");
+    sub->add_option("--threads", o->threads, describe(opt::kThreads))->capture_default_str();
     sub->add_flag("--reference", o->reference, "Ground truth instead of the fast path (slow)");
     sub->add_option("--out-shade", o->outShade, "RGB shade map (.png sRGB 8-bit, or .exr)");
-    sub->add_option("--exposure", o->exposure, "Scale of the .png shade map before sRGB encoding")
+    sub->add_option("--exposure", o->exposure, describe(opt::kExposure) + " (of the .png shade map, before sRGB)")
         ->capture_default_str();
     sub->add_option("--out-ambient", o->outAmbient, "Ambient (sky-view) map (.npy float32, or .exr)");
-    sub->add_option("--frames", o->frames, "Run the frame N times on the same field (first = warm-up)");
+    sub->add_option("--frames", o->frames,
+                    describe(opt::kFrames) + ": run the frame N times on the same field (first = warm-up)")
+        ->capture_default_str();
     sub->add_flag("--time", o->time, "Print the time of each stage and the median ms per frame");
     sub->add_option("--bounces", gs.indirect.bounces, gi::describe(r::kBounces))->capture_default_str();
     sub->add_option("--brdf", o->brdf, "lambert | phong:EXP | mix:W[,EXP] (Lambert + W x Phong)");
@@ -334,8 +388,8 @@ Runner addGiCommand(CLI::App& app) {
         "--indirect-kernel", o->indirectKernel,
         "Lambert indirect light: blocker (exact cosine at the receivers, between them the blockers' mean radiance "
         "times each texel's occlusion, engine default) | sh (order-4 SH kernel, paper)");
-    sub->add_option("--reference-directions", o->referenceDirections,
-                    "Directions of the indirect reference (default 2048)");
+    sub->add_option("--reference-directions", o->referenceDirections, describe(opt::kReferenceDirections))
+        ->capture_default_str();
     sub->add_option("--glossy", o->glossy,
                     "Glossy indirect light (phong/mix BRDFs): vector (SH radiance-vector pyramid, Fig. 5 middle) | "
                     "scalar (shade pyramid, Fig. 5 right)");

@@ -2,6 +2,8 @@
 // frames, optionally an mp4 through ffmpeg, with a per-stage timing summary.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -13,6 +15,7 @@
 #include <unistd.h>
 
 #include "app/commands.h"
+#include "app/option_ranges.h"
 #include "app/progress.h"
 #include "app/render_options.h"
 #include "core/error.h"
@@ -25,6 +28,7 @@
 #include "render/gl.h"
 #include "render/renderer.h"
 #include "sim/scene.h"
+#include "sim/scene_ranges.h"
 
 namespace terrain::app {
 namespace {
@@ -107,20 +111,27 @@ void encodeVideo(const RenderOptions& o, const std::string& dir, const char* lab
 }  // namespace
 
 SceneSettings resolveRenderScene(const RenderOptions& o) {
-    SceneSettings scene = resolveScene(o.scene, o.size, static_cast<std::uint64_t>(o.seed));
+    SceneOverrides over;
+    over.size = o.size;
+    if (o.seed) over.seed = static_cast<std::uint64_t>(*o.seed);
+    SceneSettings scene = resolveScene(o.scene, over);
     applyLightOptions(o.lights, scene.lights);
     applyCameraOptions(o.camera, scene.camera);
     return scene;
 }
 
 void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize) {
-    if (withSize) sub->add_option("--size", o.size, "Grid side in cells")->capture_default_str();
-    sub->add_option("--frames", o.frames, "Frames to render")->capture_default_str();
-    sub->add_option("--width", o.width, "Image width in pixels")->capture_default_str();
-    sub->add_option("--height", o.height, "Image height in pixels")->capture_default_str();
-    sub->add_option("--ticks-per-frame", o.ticksPerFrame, "Simulation ticks between frames (0 = scene default)");
-    sub->add_option("--seed", o.seed, "Seed for the scene generator")->capture_default_str();
-    sub->add_option("--threads", o.threads, "Worker threads (0 = all cores)")->capture_default_str();
+    namespace r = option_ranges;
+    namespace sr = scene_ranges;
+    if (withSize)
+        sub->add_option("--size", o.size,
+                        describe(sr::kSize) + " (default: the scene file's size, which keeps its extent; else 256)");
+    sub->add_option("--frames", o.frames, describe(r::kFrames))->capture_default_str();
+    sub->add_option("--width", o.width, describe(r::kImageSide))->capture_default_str();
+    sub->add_option("--height", o.height, describe(r::kImageSide))->capture_default_str();
+    sub->add_option("--ticks-per-frame", o.ticksPerFrame, describe(r::kTicksPerFrame));
+    sub->add_option("--seed", o.seed, describe(sr::kSeed) + " (default: the scene file's, else 1)");
+    sub->add_option("--threads", o.threads, describe(r::kThreads))->capture_default_str();
     sub->add_option("--subsample", o.subsample, gi::describe(gi::ranges::kSubsample))->capture_default_str();
     addLightOptions(sub, o.lights, "the scene");
     sub->add_option("--lighting", o.lighting, "key (key light only) | direct (sky + key) | global (direct + bounces)")
@@ -143,96 +154,183 @@ void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize) {
            "--debug", o.debug,
            "Debug view: none | ambient | v | u (with --lighting global) | key | normals | pyramid | shade | albedo")
         ->capture_default_str();
-    sub->add_option("--pyramid-level", o.pyramidLevel, "Height-pyramid level for --debug pyramid")
+    sub->add_option("--pyramid-level", o.pyramidLevel, describe(r::kPyramidLevel))->capture_default_str();
+    sub->add_option("--exposure", o.exposure, describe(r::kExposure))->capture_default_str();
+    sub->add_option("--lod", o.lodPixelError, describe(kLodRange) + " (0: the full grid, one vertex per grid point)")
         ->capture_default_str();
-    sub->add_option("--exposure", o.exposure, "Exposure before tone mapping")->capture_default_str();
-    sub->add_option("--lod", o.lodPixelError,
-                    "Level of detail: the mesh's largest screen-space error in pixels (0 = the full grid, one vertex "
-                    "per grid point)")
-        ->capture_default_str();
-    sub->add_option("--exaggeration", o.exaggeration,
-                    "Vertical exaggeration (0 = automatic: relief >= 15% of the extent)")
-        ->capture_default_str();
+    sub->add_option("--exaggeration", o.exaggeration, describe(r::kExaggeration))->capture_default_str();
     addCameraOptions(sub, o.camera);
     sub->add_flag("--quiet", o.quiet, "Print only errors");
 }
 
-void toSettings(const RenderOptions& o, const SceneSettings& scene, engine::PipelineSettings& p,
-                render::RenderSettings& r) {
-    using namespace render;
-    using namespace engine;
-    if (o.frames < 1 || o.frames > 100000) throw InputError("--frames must be 1..100000");
-    if (o.width < 16 || o.height < 16 || o.width > 8192 || o.height > 8192)
-        throw InputError("--width and --height must be 16..8192 pixels");
-    if (o.threads < 0 || o.threads > 256) throw InputError("--threads must be 0 (all) .. 256");
-    if (o.ticksPerFrame < 0) throw InputError("--ticks-per-frame must be >= 0");
-    if (!(o.exposure > 0.0f && o.exposure < 1000.0f)) throw InputError("--exposure must be > 0");
-    if (!(o.exaggeration >= 0.0f && o.exaggeration <= 100.0f)) throw InputError("--exaggeration must be in [0, 100]");
-    if (!(o.lodPixelError >= 0.0f && o.lodPixelError <= render::kMaxLodPixelError))
-        throw InputError("--lod must be in [0, " + formatNumber(render::kMaxLodPixelError) + "] pixels");
+namespace {
+
+// The numbers among the options, each in its range.
+void checkRenderRanges(const RenderOptions& o) {
+    namespace r = option_ranges;
+    checkRange(r::kFrames, o.frames);
+    checkRange(r::kImageSide, o.width, "--width");
+    checkRange(r::kImageSide, o.height, "--height");
+    checkRange(r::kThreads, o.threads);
+    checkRange(r::kTicksPerFrame, o.ticksPerFrame);
+    checkRange(r::kPyramidLevel, o.pyramidLevel);
+    checkRange(r::kExposure, o.exposure);
+    checkRange(r::kExaggeration, o.exaggeration);
+    checkRange(kLodRange, o.lodPixelError);
+    if (o.size) checkRange(scene_ranges::kSize, *o.size, "--size");
+    if (o.seed) checkRange(scene_ranges::kSeed, *o.seed, "--seed");
+    checkRange(gi::ranges::kSubsample, o.subsample, "--subsample");
+    checkRange(gi::ranges::kBounces, o.bounces, "--bounces");
+    if (o.giTolerance) checkRange(gi::ranges::kTolerance, *o.giTolerance, "--gi-tolerance");
+    if (o.giRefresh) checkRange(gi::ranges::kRefreshEvery, *o.giRefresh, "--gi-refresh");
+    if (!o.video.empty() && std::filesystem::path(o.video).extension() != ".mp4")
+        throw InputError("--video must name an .mp4 file (got '" + o.video + "')");
+}
+
+engine::LightingMode lightingOf(const std::string& text) {
+    using engine::LightingMode;
+    if (text == "key") return LightingMode::KeyOnly;
+    if (text == "direct") return LightingMode::Direct;
+    if (text == "global") return LightingMode::Global;
+    throw InputError("--lighting must be key, direct or global (got '" + text + "')");
+}
+
+render::ShadowMode shadowOf(const std::string& text) {
+    using render::ShadowMode;
+    if (text == "soft") return ShadowMode::SoftVisibility;
+    if (text == "map") return ShadowMode::ShadowMap;
+    if (text == "none") return ShadowMode::None;
+    throw InputError("--shadow must be soft, map or none (got '" + text + "')");
+}
+
+render::DebugView debugOf(const std::string& text) {
+    using render::DebugView;
+    static const std::pair<const char*, DebugView> views[] = {
+        {"none", DebugView::None},         {"ambient", DebugView::Ambient}, {"v", DebugView::SkyVisibility},
+        {"key", DebugView::KeyVisibility}, {"normals", DebugView::Normals}, {"pyramid", DebugView::PyramidLevel},
+        {"shade", DebugView::ShadeMap},    {"albedo", DebugView::Albedo},   {"u", DebugView::IndirectRadiance}};
+    for (const auto& [name, view] : views)
+        if (text == name) return view;
+    throw InputError("--debug must be none, ambient, v, u, key, normals, pyramid, shade or albedo (got '" + text +
+                     "')");
+}
+
+}  // namespace
+
+void toSettings(const RenderOptions& o, engine::PipelineSettings& p, render::RenderSettings& r) {
+    checkRenderRanges(o);
     p.gi = engine::defaultPipelineGi();
     p.gi.subsample = o.subsample;
     p.gi.indirect.bounces = o.bounces;
     p.gi.indirect.amortise = o.amortise;
-    p.gi.incremental = o.giIncremental.value_or(scene.gi.incremental.value_or(p.gi.incremental));
-    p.gi.tolerance = o.giTolerance.value_or(scene.gi.tolerance.value_or(p.gi.tolerance));
-    p.gi.refreshEvery = o.giRefresh.value_or(scene.gi.refreshEvery.value_or(p.gi.refreshEvery));
+    if (o.giIncremental) p.gi.incremental = *o.giIncremental;
+    if (o.giTolerance) p.gi.tolerance = *o.giTolerance;
+    if (o.giRefresh) p.gi.refreshEvery = *o.giRefresh;
     gi::validateGiSettings(p.gi);
     p.ticksPerFrame = o.ticksPerFrame;
     p.pyramidLevel = o.pyramidLevel;
-    if (o.lighting == "key")
-        p.lighting = LightingMode::KeyOnly;
-    else if (o.lighting == "direct")
-        p.lighting = LightingMode::Direct;
-    else if (o.lighting == "global")
-        p.lighting = LightingMode::Global;
-    else
-        throw InputError("--lighting must be key, direct or global (got '" + o.lighting + "')");
-    if (o.shadow == "soft")
-        r.shadow = ShadowMode::SoftVisibility;
-    else if (o.shadow == "map")
-        r.shadow = ShadowMode::ShadowMap;
-    else if (o.shadow == "none")
-        r.shadow = ShadowMode::None;
-    else
-        throw InputError("--shadow must be soft, map or none (got '" + o.shadow + "')");
-    if (o.debug == "none")
-        r.debug = DebugView::None;
-    else if (o.debug == "ambient")
-        r.debug = DebugView::Ambient;
-    else if (o.debug == "v")
-        r.debug = DebugView::SkyVisibility;
-    else if (o.debug == "key")
-        r.debug = DebugView::KeyVisibility;
-    else if (o.debug == "normals")
-        r.debug = DebugView::Normals;
-    else if (o.debug == "pyramid")
-        r.debug = DebugView::PyramidLevel;
-    else if (o.debug == "shade")
-        r.debug = DebugView::ShadeMap;
-    else if (o.debug == "albedo")
-        r.debug = DebugView::Albedo;
-    else if (o.debug == "u") {
-        r.debug = DebugView::IndirectRadiance;
-        if (p.lighting != LightingMode::Global)
-            throw InputError("--debug u needs --lighting global (U is the indirect light)");
-    } else
-        throw InputError("--debug must be none, ambient, v, u, key, normals, pyramid, shade or albedo (got '" +
-                         o.debug + "')");
+    p.lighting = lightingOf(o.lighting);
+    r.shadow = shadowOf(o.shadow);
+    r.debug = debugOf(o.debug);
+    if (r.debug == render::DebugView::IndirectRadiance && p.lighting != engine::LightingMode::Global)
+        throw InputError("--debug u needs --lighting global (U is the indirect light)");
     r.exposure = o.exposure;
     p.verticalExaggeration = o.exaggeration;
     r.lodPixelError = o.lodPixelError;
+    // the options on their own, before any scene is read: a bad --key, --sun
+    // or camera key fails here
+    checkLightOptions(o.lights);
+    checkCameraOptions(o.camera);
+}
+
+void applyScene(const RenderOptions& o, const SceneSettings& scene, engine::PipelineSettings& p,
+                render::RenderSettings& r) {
+    if (!o.giIncremental && scene.gi.incremental) p.gi.incremental = *scene.gi.incremental;
+    if (!o.giTolerance && scene.gi.tolerance) {
+        checkRange(gi::ranges::kTolerance, *scene.gi.tolerance, o.scene + ": 'gi.tolerance'");
+        p.gi.tolerance = *scene.gi.tolerance;
+    }
+    if (!o.giRefresh && scene.gi.refreshEvery) {
+        checkRange(widened(gi::ranges::kRefreshEvery), *scene.gi.refreshEvery, o.scene + ": 'gi.refresh'");
+        p.gi.refreshEvery = static_cast<int>(*scene.gi.refreshEvery);
+    }
     r.camera = cameraOfFrame(scene.camera, 0);
 }
+
+namespace {
+
+// No NaN or Inf reaches an image: the arrays a frame uploads are checked
+// whenever they change, so a run fails at the frame where they went wrong.
+class FrameGuard {
+public:
+    void check(const engine::FrameData& f, int frame) {
+        if (f.heightsVersion != heights_) require(f.heights, "the terrain", frame);
+        if (f.shadeVersion != shade_) {
+            require(f.shade, "the lighting", frame);
+            require(f.key, "the lighting", frame);
+            require(f.receiver, "the lighting", frame);
+        }
+        heights_ = f.heightsVersion;
+        shade_ = f.shadeVersion;
+    }
+
+private:
+    static void require(const std::vector<float>& v, const char* what, int frame) {
+        for (float x : v)
+            if (!std::isfinite(x))
+                throw InputError("frame " + std::to_string(frame) + ": " + what +
+                                 " is not finite (NaN or Inf); the scene's values are out of their physical range");
+    }
+    std::int64_t heights_ = -1, shade_ = -1;
+};
+
+// What the frames took, stage by stage (printSummary's columns).
+struct FrameStats {
+    std::vector<std::vector<double>> stage = std::vector<std::vector<double>>(7);
+    double recomputed = 0.0;          // receivers whose visibility the frames recomputed, summed over frames
+    double indirectRecomputed = 0.0;  // the same for the indirect light
+};
+
+FrameStats renderFrames(const RenderOptions& o, const char* label, const SceneSettings& scene,
+                        engine::FramePipeline& pipeline, render::Renderer& renderer, render::RenderSettings& rs) {
+    FrameStats stats;
+    FrameGuard guard;
+    std::vector<std::uint8_t> rgb;
+    Progress progress(label, o.frames, !o.quiet);
+    for (int f = 0; f < o.frames; ++f) {
+        pipeline.advance();
+        pipeline.light();
+        guard.check(pipeline.frame(), f);
+        auto t = Clock::now();
+        rs.camera = cameraOfFrame(scene.camera, f);
+        renderer.upload(pipeline.frame());
+        renderer.drawToImage(rs, o.width, o.height, rgb);
+        const double renderMs = msSince(t);
+        t = Clock::now();
+        char name[48];
+        std::snprintf(name, sizeof name, "frame_%04d.png", f);
+        writePngRgb((std::filesystem::path(o.out) / name).string(), o.width, o.height, rgb);
+        const double writeMs = msSince(t);
+        const engine::StageTimings& tm = pipeline.timings();
+        stats.recomputed += pipeline.giState().receiversRecomputed;
+        stats.indirectRecomputed += pipeline.giState().indirectRecomputed;
+        const double values[7] = {tm.sim, tm.pyramids, tm.scan, tm.integrate, tm.shade, renderMs, writeMs};
+        for (int i = 0; i < 7; ++i) stats.stage[static_cast<std::size_t>(i)].push_back(values[i]);
+        progress.update(f + 1);
+    }
+    progress.finish();
+    return stats;
+}
+
+}  // namespace
 
 int runHeadlessRender(const RenderOptions& o, const char* label) {
     engine::PipelineSettings ps;
     render::RenderSettings rs;
-    // Everything that can fail on bad input fails before any file is written.
+    // Every option, then the scene, fails on bad input before any file is read or written.
+    toSettings(o, ps, rs);
     const SceneSettings scene = resolveRenderScene(o);
-    toSettings(o, scene, ps, rs);
-    if (!o.video.empty() && std::filesystem::path(o.video).extension() != ".mp4")
-        throw InputError("--video must name an .mp4 file (got '" + o.video + "')");
+    applyScene(o, scene, ps, rs);
     std::unique_ptr<render::GlContext> context = render::createHeadlessContext();
     return withThreads(o.threads, [&] {
         render::Gl gl;
@@ -249,35 +347,10 @@ int runHeadlessRender(const RenderOptions& o, const char* label) {
                 static_cast<double>(pipeline.frame().zMin), static_cast<double>(pipeline.frame().zMax), o.frames,
                 pipeline.ticksPerFrame(), o.width, o.height, render::glDescription(gl).c_str());
         }
-        std::vector<std::vector<double>> stage(7);
-        double recomputed = 0.0;          // receivers whose visibility the frames recomputed, summed over frames
-        double indirectRecomputed = 0.0;  // the same for the indirect light
-        std::vector<std::uint8_t> rgb;
-        Progress progress(label, o.frames, !o.quiet);
-        for (int f = 0; f < o.frames; ++f) {
-            pipeline.advance();
-            pipeline.light();
-            auto t = Clock::now();
-            rs.camera = cameraOfFrame(scene.camera, f);
-            renderer.upload(pipeline.frame());
-            renderer.drawToImage(rs, o.width, o.height, rgb);
-            const double renderMs = msSince(t);
-            t = Clock::now();
-            char name[48];
-            std::snprintf(name, sizeof name, "frame_%04d.png", f);
-            writePngRgb((std::filesystem::path(o.out) / name).string(), o.width, o.height, rgb);
-            const double writeMs = msSince(t);
-            const engine::StageTimings& tm = pipeline.timings();
-            recomputed += pipeline.giState().receiversRecomputed;
-            indirectRecomputed += pipeline.giState().indirectRecomputed;
-            const double values[7] = {tm.sim, tm.pyramids, tm.scan, tm.integrate, tm.shade, renderMs, writeMs};
-            for (int i = 0; i < 7; ++i) stage[static_cast<std::size_t>(i)].push_back(values[i]);
-            progress.update(f + 1);
-        }
-        progress.finish();
+        const FrameStats stats = renderFrames(o, label, scene, pipeline, renderer, rs);
         const std::string dir = std::filesystem::absolute(o.out).lexically_normal().string();
         if (!o.quiet) {
-            printSummary(label, o, ps, stage, recomputed, indirectRecomputed);
+            printSummary(label, o, ps, stats.stage, stats.recomputed, stats.indirectRecomputed);
             std::printf("%s: %d frames written to %s\n", label, o.frames, dir.c_str());
         }
         if (!o.video.empty()) encodeVideo(o, dir, label);

@@ -1,15 +1,18 @@
 // `terrain sim`: run a scene headless, print state hashes, write frames.
-#include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "app/commands.h"
+#include "app/option_ranges.h"
 #include "app/progress.h"
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/png_io.h"
 #include "sim/scene.h"
+#include "sim/scene_ranges.h"
 #include "sim/vdb_io.h"
 
 namespace terrain::app {
@@ -17,19 +20,54 @@ namespace {
 
 struct SimOptions {
     std::string scene = "erosion";
-    int size = 256;
-    long long ticks = 100;
-    long long seed = 1;
+    // given on the command line: over the scene's own (a built-in's default
+    // otherwise: 256 cells, seed 1, the CFL step)
+    std::optional<int> size;
+    std::optional<std::int64_t> seed;
+    std::optional<double> dt;
+    std::int64_t ticks = 100;
     int threads = 0;
-    long long hashEvery = 0;
+    std::int64_t hashEvery = 0;
     std::string out;
-    long long outEvery = 0;
+    std::int64_t outEvery = 0;
     std::string format = "vdb";
-    double dt = 0.0;
     bool quiet = false;
 };
 
+// Everything about the options that can be wrong, before any input is read.
+void checkOptions(const SimOptions& o) {
+    namespace r = option_ranges;
+    checkRange(r::kTicks, o.ticks);
+    checkRange(r::kHashEvery, o.hashEvery);
+    checkRange(r::kOutEvery, o.outEvery);
+    checkRange(r::kThreads, o.threads);
+    if (o.format != "vdb" && o.format != "png" && o.format != "both")
+        throw InputError("--format must be vdb, png or both (got '" + o.format + "')");
+    if (o.size) checkRange(scene_ranges::kSize, *o.size, "--size");
+    if (o.seed) checkRange(scene_ranges::kSeed, *o.seed, "--seed");
+    if (o.dt) checkRange(widened(scene_ranges::kDt), *o.dt, "--dt");
+}
+
+SceneOverrides overridesOf(const SimOptions& o) {
+    SceneOverrides over;
+    over.size = o.size;
+    if (o.seed) over.seed = static_cast<std::uint64_t>(*o.seed);
+    if (o.dt) over.dt = static_cast<float>(*o.dt);
+    return over;
+}
+
+// No NaN or Inf leaves the simulation: checked before a state is hashed or
+// written, so a diverging scene fails at the tick it diverged.
+void checkDiverged(const TerrainState& s) {
+    try {
+        checkFinite(s);
+    } catch (const InputError& e) {
+        throw InputError("the simulation diverged by tick " + std::to_string(s.tick) + ": " + e.what());
+    }
+}
+
 void writeFrame(const std::string& dir, const TerrainState& s, const std::string& format, float zScale, float zOffset) {
+    checkDiverged(s);
     char name[64];
     std::snprintf(name, sizeof name, "frame_%06lld", static_cast<long long>(s.tick));
     const std::filesystem::path base = std::filesystem::path(dir) / name;
@@ -41,52 +79,58 @@ void writeFrame(const std::string& dir, const TerrainState& s, const std::string
     }
 }
 
+// The scene's summary and any notice, on stdout: stderr carries errors only.
+void printSummary(const SimOptions& o, const Simulation& sim) {
+    const SceneSettings& settings = sim.settings();
+    if (sim.dtClamped())
+        std::printf("terrain sim: requested dt %.6g s is above the stability limit %.6g s; clamped\n",
+                    static_cast<double>(settings.dt), static_cast<double>(sim.dtLimit()));
+    const TerrainState& s = sim.state();
+    if (!o.quiet)
+        std::printf("scene %s: %d x %d cells of %.4g m, dt %.4g s, stages:%s%s%s\n", settings.name.c_str(), s.nx, s.ny,
+                    static_cast<double>(s.cellSize), static_cast<double>(sim.dt()),
+                    settings.hydraulic ? " hydraulic" : "", settings.thermal ? " thermal" : "",
+                    settings.waves ? " waves" : "");
+    std::fflush(stdout);
+}
+
+// PNG frames share one height range (from the first frame, with margin).
+void pngRange(const TerrainState& s, float& zScale, float& zOffset) {
+    Grid h;
+    s.groundHeight(h);
+    pngRangeFor(h, zScale, zOffset);
+    const float span = zScale * 65535.0f;
+    zOffset -= 0.1f * span;
+    zScale *= 1.2f;
+}
+
 int runSim(const SimOptions& o) {
-    if (o.ticks < 0) throw InputError("--ticks must be >= 0");
-    if (o.hashEvery < 0 || o.outEvery < 0) throw InputError("--hash-every and --out-every must be >= 0");
-    if (o.format != "vdb" && o.format != "png" && o.format != "both")
-        throw InputError("--format must be vdb, png or both (got '" + o.format + "')");
-    if (o.threads < 0 || o.threads > 256) throw InputError("--threads must be 0 (all) .. 256");
-    if (!o.out.empty()) ensureWritableDirectory(o.out);
+    checkOptions(o);
     return withThreads(o.threads, [&] {
-        SceneSettings settings = resolveScene(o.scene, o.size, static_cast<std::uint64_t>(o.seed));
-        settings.dt = static_cast<float>(o.dt);
-        Simulation sim(settings);
-        if (sim.dtClamped())
-            std::fprintf(stderr, "terrain sim: requested dt %.6g s is above the stability limit %.6g s; clamped\n",
-                         o.dt, static_cast<double>(sim.dtLimit()));
+        // the scene and its inputs (a DEM) are read and checked before any output is made
+        Simulation sim(resolveScene(o.scene, overridesOf(o)));
+        if (!o.out.empty()) ensureWritableDirectory(o.out);
+        printSummary(o, sim);
         const TerrainState& s = sim.state();
-        if (!o.quiet)
-            std::fprintf(stderr, "scene %s: %d x %d cells of %.4g m, dt %.4g s, stages:%s%s%s\n", settings.name.c_str(),
-                         s.nx, s.ny, static_cast<double>(s.cellSize), static_cast<double>(sim.dt()),
-                         settings.hydraulic ? " hydraulic" : "", settings.thermal ? " thermal" : "",
-                         settings.waves ? " waves" : "");
-        // PNG frames share one height range (from the first frame, with margin)
         float zScale = 1.0f, zOffset = 0.0f;
-        {
-            Grid h;
-            s.groundHeight(h);
-            pngRangeFor(h, zScale, zOffset);
-            const float span = zScale * 65535.0f;
-            zOffset -= 0.1f * span;
-            zScale *= 1.2f;
-        }
-        const long long outEvery = o.outEvery > 0 ? o.outEvery : (o.hashEvery > 0 ? o.hashEvery : o.ticks);
+        pngRange(s, zScale, zOffset);
+        const std::int64_t outEvery = o.outEvery > 0 ? o.outEvery : (o.hashEvery > 0 ? o.hashEvery : o.ticks);
         if (!o.out.empty()) writeFrame(o.out, s, o.format, zScale, zOffset);
         Progress progress("sim", o.ticks, !o.quiet);
-        for (long long t = 1; t <= o.ticks; ++t) {
+        for (std::int64_t t = 1; t <= o.ticks; ++t) {
             sim.tick();
             if (o.hashEvery > 0 && t % o.hashEvery == 0) {
+                checkDiverged(s);
                 progress.clear();
-                std::printf("tick %lld hash %s\n", t, hashHex(hashState(s)).c_str());
+                std::printf("tick %lld hash %s\n", static_cast<long long>(t), hashHex(hashState(s)).c_str());
                 std::fflush(stdout);
             }
             if (!o.out.empty() && outEvery > 0 && t % outEvery == 0) writeFrame(o.out, s, o.format, zScale, zOffset);
             progress.update(t);
         }
         progress.finish();
-        checkFinite(s);
-        if (!o.out.empty() && !o.quiet) std::fprintf(stderr, "frames written to %s\n", o.out.c_str());
+        checkDiverged(s);
+        if (!o.out.empty() && !o.quiet) std::printf("frames written to %s\n", o.out.c_str());
         return 0;
     });
 }
@@ -95,22 +139,23 @@ int runSim(const SimOptions& o) {
 
 Runner addSimCommand(CLI::App& app) {
     auto opt = std::make_shared<SimOptions>();
+    namespace r = option_ranges;
+    namespace sr = scene_ranges;
     CLI::App* sub = app.add_subcommand("sim", "Run a scene's simulation headless; print state hashes, write frames");
     sub->add_option("--scene", opt->scene, "Built-in scene (erosion, waves, dem) or a .toml scene file")
         ->capture_default_str();
-    sub->add_option("--size", opt->size, "Grid side in cells (the scene keeps its extent)")->capture_default_str();
-    sub->add_option("--ticks", opt->ticks, "Number of fixed time steps")->capture_default_str();
-    sub->add_option("--seed", opt->seed, "Seed for the scene generator")->capture_default_str();
-    sub->add_option("--threads", opt->threads, "Worker threads (0 = all cores)")->capture_default_str();
-    sub->add_option("--hash-every", opt->hashEvery,
-                    "Print 'tick <t> hash <16 hex digits>' every E ticks (hash over the whole state; 0 = never)")
-        ->capture_default_str();
+    sub->add_option("--size", opt->size,
+                    describe(sr::kSize) + " (default: the scene file's size, which keeps its extent; else 256)");
+    sub->add_option("--ticks", opt->ticks, describe(r::kTicks))->capture_default_str();
+    sub->add_option("--seed", opt->seed, describe(sr::kSeed) + " (default: the scene file's, else 1)");
+    sub->add_option("--threads", opt->threads, describe(r::kThreads))->capture_default_str();
+    sub->add_option("--hash-every", opt->hashEvery, describe(r::kHashEvery))->capture_default_str();
     sub->add_option("--out", opt->out, "Write frames to this folder (created if missing)");
-    sub->add_option("--out-every", opt->outEvery, "Write a frame every F ticks (default: --hash-every, else the last)");
+    sub->add_option("--out-every", opt->outEvery, describe(r::kOutEvery));
     sub->add_option("--format", opt->format, "Frame format: vdb (all layers), png (16-bit height) or both")
         ->capture_default_str();
-    sub->add_option("--dt", opt->dt, "Time step in s (default: derived from the CFL limits; larger is clamped)");
-    sub->add_flag("--quiet", opt->quiet, "No progress or summary on stderr");
+    sub->add_option("--dt", opt->dt, describe(sr::kDt) + " (default: the scene file's, else 0)");
+    sub->add_flag("--quiet", opt->quiet, "No progress or summary");
     return [opt] { return runSim(*opt); };
 }
 

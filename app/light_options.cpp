@@ -1,9 +1,11 @@
 #include "app/light_options.h"
 
+#include <cmath>
 #include <filesystem>
 
 #include "core/error.h"
 #include "core/parse.h"
+#include "sim/scene_ranges.h"
 
 namespace terrain::app {
 namespace {
@@ -52,8 +54,12 @@ void applySun(const std::string& text, SunSpec& sun) {
     if (v.size() > 1) sun.hoursPerFrame = v[1];
     if (v.size() > 2) sun.latitudeDeg = v[2];
     if (v.size() > 3) {
-        if (v[3] != static_cast<float>(static_cast<int>(v[3])))
-            throw InputError("--sun: the day of the year is a whole number");
+        // in its range before it is converted to an integer
+        const SettingRange<int>& days = scene_ranges::kDayOfYear;
+        checkRange(
+            SettingRange<double>{days.name, static_cast<double>(days.lo), static_cast<double>(days.hi), days.what},
+            static_cast<double>(v[3]), "--sun: the day of the year");
+        if (v[3] != std::floor(v[3])) throw InputError("--sun: the day of the year is a whole number");
         sun.dayOfYear = static_cast<int>(v[3]);
     }
 }
@@ -94,6 +100,11 @@ void applyLightOptions(const LightOptions& o, LightSet& lights) {
     } catch (const InputError& e) {
         throw InputError(std::string(e.what()) + " (--light, --key, --sun or the scene's [lights])");
     }
+}
+
+void checkLightOptions(const LightOptions& o) {
+    LightSet none;
+    applyLightOptions(o, none);
 }
 
 }  // namespace terrain::app

@@ -28,4 +28,8 @@ void addLightOptions(CLI::App* sub, LightOptions& o, const std::string& defaults
 /// light) and validates the result. Throws InputError naming the option.
 void applyLightOptions(const LightOptions& o, LightSet& lights);
 
+/// The options on their own, before a scene is read: applied to a set with
+/// no lights, they must give a valid one. Throws InputError naming the option.
+void checkLightOptions(const LightOptions& o);
+
 }  // namespace terrain::app

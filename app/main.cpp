@@ -24,16 +24,21 @@ int main(int argc, char** argv) {
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e);
+        // --help and --help-all print the help and succeed; any other parse
+        // error is one line and exit 1, like every error of ours
+        if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);
+        std::fprintf(stderr, "terrain: error: %s\n", terrain::oneLine(e.what()).c_str());
+        return 1;
     }
     try {
         for (auto& [sub, run] : commands)
             if (sub->parsed()) return run();
     } catch (const terrain::Error& e) {
-        std::fprintf(stderr, "terrain: error: %s\n", e.what());
+        // ours, short already; kept to one line whatever a file name holds
+        std::fprintf(stderr, "terrain: error: %s\n", terrain::oneLine(e.what(), 1000).c_str());
         return 1;
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "terrain: error: %s\n", e.what());
+        std::fprintf(stderr, "terrain: error: %s\n", terrain::oneLine(e.what()).c_str());
         return 1;
     }
     return 1;

@@ -20,7 +20,7 @@ double nowSeconds() {
 Progress::Progress(std::string label, long long total, bool enabled)
     : label_(std::move(label)), total_(total), start_(nowSeconds()) {
     const char* env = std::getenv("TERRAIN_PROGRESS");
-    enabled_ = enabled && total > 0 && (isatty(2) || (env && env[0] == '1'));
+    enabled_ = enabled && total > 0 && (isatty(1) || (env && env[0] == '1'));
 }
 
 void Progress::update(long long done) {
@@ -34,20 +34,20 @@ void Progress::update(long long done) {
     const int filled = percent * width / 100;
     std::string bar(static_cast<std::size_t>(filled), '#');
     bar.append(static_cast<std::size_t>(width - filled), '.');
-    std::fprintf(stderr, "\r%s [%s] %3d%% %lld/%lld  %.1fs elapsed, %.1fs left ", label_.c_str(), bar.c_str(), percent,
-                 done, total_, elapsed, eta);
-    std::fflush(stderr);
+    std::printf("\r%s [%s] %3d%% %lld/%lld  %.1fs elapsed, %.1fs left ", label_.c_str(), bar.c_str(), percent, done,
+                total_, elapsed, eta);
+    std::fflush(stdout);
 }
 
 void Progress::clear() {
     if (enabled_ && lastPercent_ >= 0) {
-        std::fprintf(stderr, "\r%*s\r", 90, "");
+        std::printf("\r%*s\r", 90, "");
         lastPercent_ = -1;
     }
 }
 
 void Progress::finish() {
-    if (enabled_) std::fprintf(stderr, "\n");
+    if (enabled_) std::printf("\n");
     enabled_ = false;
 }
 
@@ -63,6 +63,15 @@ void ensureWritableDirectory(const std::string& dir) {
         throw IoError(dir, "the output folder is not writable");
     }
     std::filesystem::remove(probe, ec);
+}
+
+void checkWritableFile(const std::string& file) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(file, ec)) throw IoError(file, "is a folder, not a file");
+    std::filesystem::path dir = std::filesystem::path(file).parent_path();
+    if (dir.empty()) dir = ".";
+    if (!std::filesystem::is_directory(dir, ec)) throw IoError(file, "its folder does not exist");
+    if (access(dir.c_str(), W_OK) != 0) throw IoError(file, "its folder is not writable");
 }
 
 }  // namespace terrain::app

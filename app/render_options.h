@@ -1,6 +1,7 @@
 #pragma once
 // Options shared by `terrain render` and `terrain demo` (its headless
 // fallback), and the headless render both run.
+#include <cstdint>
 #include <optional>
 #include <string>
 
@@ -8,20 +9,28 @@
 
 #include "app/camera_options.h"
 #include "app/light_options.h"
+#include "core/setting_range.h"
 #include "engine/pipeline.h"
 #include "render/renderer.h"
+#include "render/terrain_lod.h"
 
 namespace terrain::app {
+
+/// --lod's range: up to the renderer's largest screen-space error.
+inline constexpr SettingRange<float> kLodRange{"--lod", 0.0f, render::kMaxLodPixelError,
+                                               "Level of detail: the mesh's largest screen-space error in pixels"};
 
 /// Options shared by `terrain render` and the demo (its headless fallback).
 struct RenderOptions {
     std::string scene = "erosion";
-    int size = 256;
+    // given on the command line: over the scene's own (a built-in's default
+    // otherwise: 256 cells, seed 1)
+    std::optional<int> size;
+    std::optional<std::int64_t> seed;
     int frames = 24;
     int width = 1280, height = 720;
     std::string out = "out/render";
     std::string video;  // .mp4 through ffmpeg, when installed
-    long long seed = 1;
     int threads = 0;
     int ticksPerFrame = 0;            // 0 = the scene's pacing
     int subsample = 2;                // GI receivers every 1, 2 or 4 cells
@@ -45,13 +54,18 @@ struct RenderOptions {
 /// Adds the options above (except the scene) to a subcommand.
 void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize);
 
-/// The scene the options name, with the light and camera options over its own.
+/// Checks every option on its own (ranges, modes and their combinations)
+/// and turns them into pipeline and renderer settings; reads no file, so a
+/// bad option fails before any input is read. Throws InputError naming it.
+void toSettings(const RenderOptions& o, engine::PipelineSettings& pipeline, render::RenderSettings& renderer);
+
+/// The scene the options name (a scene file is read here), with the size,
+/// seed, light and camera options over its own.
 SceneSettings resolveRenderScene(const RenderOptions& o);
 
-/// Checks the options and turns them into pipeline and renderer settings
-/// (throws InputError naming the bad option); the scene's GI hints apply
-/// where the command line is silent.
-void toSettings(const RenderOptions& o, const SceneSettings& scene, engine::PipelineSettings& pipeline,
+/// The scene's GI hints where the command line is silent (checked against
+/// the GI's ranges, naming the key), and the camera of the first frame.
+void applyScene(const RenderOptions& o, const SceneSettings& scene, engine::PipelineSettings& pipeline,
                 render::RenderSettings& renderer);
 
 /// The headless render: PNG frames in o.out (atomic writes), a progress bar,

@@ -1,8 +1,10 @@
 #pragma once
 // Typed exceptions for the boundaries (files, scene files, CLI, GL context).
 // main() turns any of them into one line on stderr and a non-zero exit.
+#include <cstddef>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace terrain {
 
@@ -27,5 +29,15 @@ class InputError : public Error {
 public:
     using Error::Error;
 };
+
+/// A third-party message fit for one line of ours: line breaks become
+/// spaces, and beyond `max` characters it is cut short with "...".
+inline std::string oneLine(std::string_view text, std::size_t max = 200) {
+    std::string s(text.substr(0, max));
+    for (char& c : s)
+        if (c == '\n' || c == '\r') c = ' ';
+    while (!s.empty() && s.back() == ' ') s.pop_back();
+    return text.size() > max ? s + "..." : s;
+}
 
 }  // namespace terrain

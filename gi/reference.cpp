@@ -148,7 +148,7 @@ void shadeReferenceTexel(const ReferenceTexels& t, int x, int y) {
         }
 }
 
-// Prints "reference: N%" to stderr every 5 % of the rows.
+// Prints "reference: N%" to stdout every 5 % of the rows.
 class RowProgress {
 public:
     explicit RowProgress(int rowsTotal) : rowsTotal_(rowsTotal) {}
@@ -158,7 +158,7 @@ public:
         const int prevPct = static_cast<int>(100LL * (done - 1) / std::max(rowsTotal_, 1));
         if (pct / 5 != prevPct / 5) {
             std::lock_guard<std::mutex> lock(printMutex_);
-            std::fprintf(stderr, "reference: %d%%\n", pct);
+            std::printf("reference: %d%%\n", pct);
         }
     }
 

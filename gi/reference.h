@@ -30,7 +30,7 @@ struct ReferenceSettings {
     int azimuths = 256;     // M (>= 256 for the accuracy claims)
     int border = 0;         // texels left out at each border (their outputs are 0)
     int stride = 1;         // compute every stride-th texel in x and y (others 0)
-    bool progress = false;  // print progress to stderr on long runs
+    bool progress = false;  // print progress to stdout on long runs
 };
 
 struct ReferenceResult {

@@ -175,7 +175,7 @@ void gatherReferenceBounce(ConstGridView heights, float cellSize, const std::arr
             }
             const int done = ++rowsDone;
             if (s.progress && (done % 16 == 0 || done == ny))
-                std::fprintf(stderr, "\rreference indirect: %3d%%%s", 100 * done / ny, done == ny ? "\n" : "");
+                std::printf("\rreference indirect: %3d%%%s", 100 * done / ny, done == ny ? "\n" : "");
         }
     });
 }
@@ -210,7 +210,7 @@ void renderReferenceGi(ConstGridView heights, float cellSize, const ShRgb& light
     }
     std::array<Grid, 3> prev = out.direct, next;
     for (int b = 1; b <= s.bounces; ++b) {
-        if (s.progress) std::fprintf(stderr, "reference: bounce %d of %d\n", b, s.bounces);
+        if (s.progress) std::printf("reference: bounce %d of %d\n", b, s.bounces);
         gatherReferenceBounce(heights, cellSize, prev, albedo, s, next);
         for (int c = 0; c < 3; ++c) {
             for (std::size_t i = 0; i < next[c].v.size(); ++i) out.indirect[c].v[i] += next[c].v[i];

@@ -28,7 +28,7 @@ struct ReferenceGiSettings {
     int bounces = 1;         // indirect bounces after the direct one
     int azimuths = 256;      // of the direct (bounce 0) reference
     float marchStep = 0.5f;  // march step along the ray, in cells
-    bool progress = false;   // progress on stderr
+    bool progress = false;   // progress on stdout
     // Key lights as exact spherical caps (radiance RGB / sin^2(radius) inside
     // the cap, 0 outside): exact visibility per azimuth across the cap's
     // azimuthal extent and the exact elevation integral of the cap's chord

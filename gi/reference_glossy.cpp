@@ -352,7 +352,7 @@ void renderReferenceGlossy(ConstGridView heights, float cellSize, const ShRgb& l
             basis(dirs[k][0], dirs[k][1], dirs[k][2], &dirBasis[k * kShCount]);
         const GlossyGather gather{surf, hCopy, hMax, cellSize, s, dirs, dirBasis, 4.0 * kPi / s.directions, ws, wd};
         for (int b = 1; b <= s.bounces; ++b) {
-            if (s.progress) std::fprintf(stderr, "glossy reference: bounce %d of %d\n", b, s.bounces);
+            if (s.progress) std::printf("glossy reference: bounce %d of %d\n", b, s.bounces);
             parallelFor(0, ny, 1, [&](int y0, int y1) {
                 for (int y = y0; y < y1; ++y)
                     for (int x = 0; x < nx; ++x) gatherTexel(gather, prevD, prevI, x, y, nextD, nextI);

@@ -1,33 +1,15 @@
 #pragma once
-// The range of every numeric GI setting, declared once (in the manner of
-// Halide's GeneratorParam: name, bounds and meaning together). validateGiSettings
-// (gi/settings.h) checks them, the command line prints them in its help, and
-// the benchmark tables can name them; nothing else writes a bound down.
-#include <string>
+// The range of every numeric GI setting, declared once (core/setting_range.h:
+// name, bounds and meaning together). validateGiSettings (gi/settings.h)
+// checks them, the command line prints them in its help, and the benchmark
+// tables can name them; nothing else writes a bound down.
+#include "core/setting_range.h"
 
 namespace terrain::gi {
 
-/// A numeric setting: its name in messages, its closed range [lo, hi] and
-/// what it means. `zeroMeansDefault`: 0 is also accepted and stands for "the
-/// value derived from another setting" (say which in `what`).
-template <class T>
-struct SettingRange {
-    const char* name;
-    T lo, hi;
-    const char* what;
-    bool zeroMeansDefault = false;
-
-    bool contains(T v) const { return (zeroMeansDefault && v == T(0)) || (v >= lo && v <= hi); }
-};
-
-/// "what [lo, hi]" (or "what: 0 or [lo, hi]"), for command-line help.
-std::string describe(const SettingRange<int>& r);
-std::string describe(const SettingRange<float>& r);
-
-/// Throws InputError "<name> must be in [lo, hi] (got v)" unless r.contains(v)
-/// (NaN is never contained).
-void checkRange(const SettingRange<int>& r, int v);
-void checkRange(const SettingRange<float>& r, float v);
+using terrain::checkRange;
+using terrain::describe;
+using terrain::SettingRange;
 
 namespace ranges {
 

@@ -4,6 +4,7 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "sim/scene_ranges.h"
 #include "sim/terrain.h"
 
 namespace terrain {
@@ -53,9 +54,13 @@ float gradientNoise(float x, float y, std::uint64_t seed) {
 
 void generateNoise(Grid& out, int nx, int ny, float cellSize, std::uint64_t seed, const NoiseSettings& s) {
     checkDimensions(nx, ny, cellSize);
-    if (!(s.wavelength > 0.0f) || s.octaves < 1 || s.octaves > 24 || !(s.lacunarity > 1.0f) ||
-        !std::isfinite(s.amplitude) || !std::isfinite(s.gain) || !std::isfinite(s.offset))
-        throw InputError("noise settings out of range (wavelength > 0, 1..24 octaves, lacunarity > 1)");
+    namespace r = scene_ranges;
+    checkRange(r::kAltitude, s.amplitude, "noise amplitude");
+    checkRange(r::kLength, s.wavelength, "noise wavelength");
+    checkRange(r::kOctaves, s.octaves, "noise octaves");
+    checkRange(r::kLacunarity, s.lacunarity, "noise lacunarity");
+    checkRange(r::kFraction, s.gain, "noise gain");
+    checkRange(r::kAltitude, s.offset, "noise offset");
     out.resize(nx, ny);
     parallelForRows(ny, nx, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y)
@@ -88,8 +93,12 @@ void generateNoise(Grid& out, int nx, int ny, float cellSize, std::uint64_t seed
 
 void generateShape(Grid& out, int nx, int ny, float cellSize, const ShapeSettings& s) {
     checkDimensions(nx, ny, cellSize);
-    if (!std::isfinite(s.base) || !std::isfinite(s.height) || !(s.radius > 0.0f) || !(s.wavelength > 0.0f))
-        throw InputError("shape settings out of range (finite heights, radius > 0, wavelength > 0)");
+    namespace r = scene_ranges;
+    checkRange(r::kAltitude, s.base, "shape base");
+    checkRange(r::kAltitude, s.height, "shape height");
+    checkRange(r::kLength, s.radius, "shape radius");
+    checkRange(r::kLength, s.wavelength, "shape ridge wavelength");
+    checkRange(r::kAngle, s.angleDeg, "shape angle");
     out.resize(nx, ny, s.base);
     const float cx = 0.5f * static_cast<float>(nx - 1) * cellSize;
     const float cy = 0.5f * static_cast<float>(ny - 1) * cellSize;

@@ -8,6 +8,7 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "sim/heightmap_io.h"
+#include "sim/scene_ranges.h"
 
 #ifndef TERRAIN_DATA_DIR
 #define TERRAIN_DATA_DIR "../shared/data"
@@ -46,6 +47,10 @@ Grid resampleBilinear(const Grid& in, int nx, int ny) {
     return out;
 }
 
+// Tiles of `tile` cells covering `cells`, the last one partial; in 64 bits,
+// so that no tile size can overflow the sum.
+int tilesAlong(int cells, int tile) { return static_cast<int>((static_cast<std::int64_t>(cells) + tile - 1) / tile); }
+
 // Noise terrain `extent` metres across at any resolution.
 void noiseTerrain(SceneSettings& s, float extent, const NoiseSettings& noise) {
     s.cellSize = extent / static_cast<float>(s.nx);
@@ -58,8 +63,7 @@ void noiseTerrain(SceneSettings& s, float extent, const NoiseSettings& noise) {
 std::vector<std::string> builtinSceneNames() { return {"erosion", "waves", "dem"}; }
 
 SceneSettings builtinScene(const std::string& name, int size, std::uint64_t seed) {
-    if (size < 1 || size > 16384)
-        throw InputError("scene size " + std::to_string(size) + " is out of range (1..16384)");
+    checkRange(scene_ranges::kSize, size, "scene size");
     SceneSettings s;
     s.name = name;
     s.nx = s.ny = size;
@@ -125,21 +129,30 @@ SceneSettings builtinScene(const std::string& name, int size, std::uint64_t seed
     return s;
 }
 
-SceneSettings resolveScene(const std::string& nameOrFile, int size, std::uint64_t seed) {
+SceneSettings resolveScene(const std::string& nameOrFile, const SceneOverrides& over) {
     const auto names = builtinSceneNames();
-    if (std::find(names.begin(), names.end(), nameOrFile) != names.end()) return builtinScene(nameOrFile, size, seed);
-    if (nameOrFile.size() > 5 && nameOrFile.substr(nameOrFile.size() - 5) == ".toml") {
-        SceneSettings s = loadSceneFile(nameOrFile);
-        if (size > 0 && (s.nx != size || s.ny != size)) {
-            // --size overrides the file's size, keeping the extent
-            const float extent = s.cellSize * static_cast<float>(std::max(s.nx, s.ny));
-            s.nx = s.ny = size;
-            s.cellSize = extent / static_cast<float>(size);
-        }
-        s.seed = seed;
+    const bool isFile = std::find(names.begin(), names.end(), nameOrFile) == names.end() && nameOrFile.size() > 5 &&
+                        nameOrFile.substr(nameOrFile.size() - 5) == ".toml";
+    if (!isFile) {  // a built-in, or an error with the list of names
+        SceneSettings s = builtinScene(nameOrFile, over.size.value_or(256), over.seed.value_or(1));
+        if (over.dt) s.dt = *over.dt;
         return s;
     }
-    return builtinScene(nameOrFile, size, seed);  // throws with the list of names
+    SceneSettings s = loadSceneFile(nameOrFile);
+    if (over.size && (s.nx != *over.size || s.ny != *over.size)) {
+        checkRange(scene_ranges::kSize, *over.size, "scene size");
+        // the grid changes, the extent stays
+        const float extent = s.cellSize * static_cast<float>(std::max(s.nx, s.ny));
+        s.nx = s.ny = *over.size;
+        s.cellSize = extent / static_cast<float>(*over.size);
+    }
+    if (over.seed) s.seed = *over.seed;
+    if (over.dt) s.dt = *over.dt;
+    return s;
+}
+
+SceneSettings resolveScene(const std::string& nameOrFile, int size, std::uint64_t seed) {
+    return resolveScene(nameOrFile, SceneOverrides{.size = size, .seed = seed});
 }
 
 void buildInitialTerrain(const SceneSettings& s, TerrainState& state) {
@@ -194,9 +207,8 @@ void buildInitialTerrain(const SceneSettings& s, TerrainState& state) {
 }
 
 Simulation::Simulation(const SceneSettings& settings) : settings_(settings) {
-    if (settings_.changeTile < 1) throw InputError("change-tracking tile size must be at least 1");
-    if (!(settings_.dt >= 0.0f) || !std::isfinite(settings_.dt))
-        throw InputError("time step " + std::to_string(settings_.dt) + " s is not a finite non-negative number");
+    checkRange(scene_ranges::kChangeTile, settings_.changeTile, "change-tracking tile size");
+    checkRange(scene_ranges::kDt, settings_.dt, "time step");
     buildInitialTerrain(settings_, state_);
     settings_.nx = state_.nx;
     settings_.ny = state_.ny;
@@ -209,8 +221,8 @@ Simulation::Simulation(const SceneSettings& settings) : settings_(settings) {
         dt_ = dtLimit_;
     }
     changes_.tileSize = settings_.changeTile;
-    changes_.tilesX = (state_.nx + settings_.changeTile - 1) / settings_.changeTile;
-    changes_.tilesY = (state_.ny + settings_.changeTile - 1) / settings_.changeTile;
+    changes_.tilesX = tilesAlong(state_.nx, settings_.changeTile);
+    changes_.tilesY = tilesAlong(state_.ny, settings_.changeTile);
     changes_.dirty.assign(static_cast<std::size_t>(changes_.tilesX) * changes_.tilesY, 1);
     changes_.dirtyCount = changes_.tilesX * changes_.tilesY;
     // Ground and water as of the last tick: updateChanges compares against

@@ -35,11 +35,12 @@ struct TerrainSource {
 
 /// How a scene asks to be lit by the GI (a scene file's [gi] table). Unset
 /// values leave the engine's defaults; command-line options override both.
-/// Plain values: the GI checks their ranges when it applies them.
+/// Plain values: the GI checks their ranges when it applies them (the
+/// refresh interval as read, before it is narrowed).
 struct SceneGiHints {
-    std::optional<bool> incremental;  // change-driven GI frames (GiSettings::incremental)
-    std::optional<float> tolerance;   // GiSettings::tolerance, shade units
-    std::optional<int> refreshEvery;  // GiSettings::refreshEvery, frames
+    std::optional<bool> incremental;           // change-driven GI frames (GiSettings::incremental)
+    std::optional<float> tolerance;            // GiSettings::tolerance, shade units
+    std::optional<std::int64_t> refreshEvery;  // GiSettings::refreshEvery, frames
 };
 
 struct SceneSettings {
@@ -82,7 +83,19 @@ std::vector<std::string> builtinSceneNames();
 /// and set anything a built-in sets. Unknown keys are errors.
 SceneSettings loadSceneFile(const std::string& file);
 
-/// A built-in name, or a path to a .toml scene file.
+/// What the command line sets over a scene: only the values it was given,
+/// so a scene file keeps every value no flag names.
+struct SceneOverrides {
+    std::optional<int> size;  // grid side (nx = ny); a file's scene keeps its extent
+    std::optional<std::uint64_t> seed;
+    std::optional<float> dt;  // s; 0 = from the CFL limits
+};
+
+/// A built-in name (size 256 and seed 1 unless overridden), or a path to a
+/// .toml scene file, with the overrides over it.
+SceneSettings resolveScene(const std::string& nameOrFile, const SceneOverrides& overrides);
+
+/// The same with the size and the seed given.
 SceneSettings resolveScene(const std::string& nameOrFile, int size, std::uint64_t seed);
 
 /// What changed in the last tick: per change tile whether the ground moved,

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "sim/scene_ranges.h"
 
 namespace terrain {
 namespace {
@@ -48,18 +49,18 @@ CameraKey cameraAt(const CameraPath& path, double frame) {
 }
 
 void validateCameraPath(const CameraPath& path) {
-    if (!(path.fovYDeg >= 1.0f && path.fovYDeg <= 170.0f))
-        throw InputError("camera: field of view must be in [1, 170] degrees");
+    namespace r = scene_ranges;
+    checkRange(r::kFieldOfView, path.fovYDeg, "camera: field of view");
     for (std::size_t i = 0; i < path.keys.size(); ++i) {
         const CameraKey& k = path.keys[i];
-        const std::string which = "camera key " + std::to_string(i + 1);
-        for (float v : {k.frame, k.yawDeg, k.pitchDeg, k.distance, k.target[0], k.target[1], k.target[2]})
-            if (!std::isfinite(v)) throw InputError(which + ": values must be finite");
+        const std::string which = "camera key " + std::to_string(i + 1) + ": ";
+        checkRange(r::kCameraFrame, k.frame, which + "frame");
         if (i > 0 && !(k.frame > path.keys[i - 1].frame))
-            throw InputError(which + ": frames must increase from key to key");
-        if (k.pitchDeg < -89.0f || k.pitchDeg > 89.0f) throw InputError(which + ": pitch must be in [-89, 89] degrees");
-        if (!(k.distance > 0.0f && k.distance <= 100.0f))
-            throw InputError(which + ": distance must be in (0, 100] terrain extents");
+            throw InputError(which + "frames must increase from key to key");
+        checkRange(r::kAngle, k.yawDeg, which + "yaw");
+        checkRange(r::kPitch, k.pitchDeg, which + "pitch");
+        checkRange(r::kDistance, k.distance, which + "distance");
+        for (float t : k.target) checkRange(r::kTarget, t, which + "target");
     }
 }
 

@@ -31,9 +31,9 @@ struct CameraPath {
 /// first key and after the last. Requires at least one key.
 CameraKey cameraAt(const CameraPath& path, double frame);
 
-/// Throws InputError naming the first bad key (frames not increasing,
-/// pitch outside [-89, 89], distance outside (0, 100], a non-finite value,
-/// a field of view outside [1, 170]).
+/// Throws InputError naming the first value outside its range
+/// (sim/scene_ranges.h: pitch in [-89, 89], distance up to 100 extents, a
+/// field of view in [1, 170], every value finite) or frames not increasing.
 void validateCameraPath(const CameraPath& path);
 
 }  // namespace terrain

@@ -29,17 +29,23 @@
 //   [camera] fov = 40   [[camera.key]] frame, yaw, pitch, distance, target = [x, y(, z)]   # sim/scene_camera.h
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <set>
 #include <span>
+#include <system_error>
 
 #include <toml++/toml.h>
 
 #include "core/error.h"
 #include "sim/scene.h"
+#include "sim/scene_ranges.h"
 
 namespace terrain {
 namespace {
+
+namespace ranges = scene_ranges;
 
 // Reads keys from one TOML table, remembering which were used.
 class TableReader {
@@ -47,21 +53,27 @@ public:
     TableReader(const toml::table& t, std::string file, std::string path)
         : t_(t), file_(std::move(file)), path_(std::move(path)) {}
 
+    // A finite number; its range is checked by the table's validation
+    // (materials, camera), which sees the values together.
     void num(const char* key, float& out) {
         if (const toml::node* n = get(key)) {
-            if (auto v = n->value<double>())
-                out = static_cast<float>(*v);
-            else
-                fail(key, "a number");
-            if (!std::isfinite(out)) fail(key, "a finite number");
+            out = static_cast<float>(finite(key, *n));
+            if (!std::isfinite(out)) fail(key, "a finite number (as a float)");
         }
     }
-    void num(const char* key, double& out) {
+    // A number in its declared range (sim/scene_ranges.h), checked before it
+    // is narrowed to a float.
+    void num(const char* key, float& out, const SettingRange<float>& range) {
         if (const toml::node* n = get(key)) {
-            if (auto v = n->value<double>())
-                out = *v;
-            else
-                fail(key, "a number");
+            const double v = finite(key, *n);
+            inRange(widened(range), v, key);
+            out = static_cast<float>(v);
+        }
+    }
+    void num(const char* key, double& out, const SettingRange<double>& range) {
+        if (const toml::node* n = get(key)) {
+            out = finite(key, *n);
+            inRange(range, out, key);
         }
     }
     // An array of lo..hi finite numbers into the first entries of out.
@@ -79,13 +91,34 @@ public:
     void rgb(const char* key, std::array<float, 3>& out) {
         numbers(key, out, 3, "an array of three numbers [r, g, b]");
     }
-    void integer(const char* key, int& out) {
+    // Each of r, g, b in the range.
+    void rgb(const char* key, std::array<float, 3>& out, const SettingRange<float>& range) {
+        std::array<float, 3> v = out;
+        rgb(key, v);
+        for (float c : v) inRange(range, c, key);
+        out = v;
+    }
+    // An integer in its declared range, checked before it is narrowed.
+    void integer(const char* key, int& out, const SettingRange<int>& range) {
+        std::int64_t v = out;
+        integer(key, v, widened(range));
+        out = static_cast<int>(v);
+    }
+    void integer(const char* key, std::int64_t& out, const SettingRange<std::int64_t>& range) {
         if (const toml::node* n = get(key)) {
             if (auto v = n->value<std::int64_t>())
-                out = static_cast<int>(*v);
+                out = *v;
             else
                 fail(key, "an integer");
+            inRange(range, out, key);
         }
+    }
+    // A grid side: the integer node n (the value of `key` or one of its
+    // entries) in its range.
+    int side(const char* key, const toml::node& n) const {
+        const std::int64_t v = n.value<std::int64_t>().value_or(0);
+        inRange(widened(ranges::kSize), v, key);
+        return static_cast<int>(v);
     }
     void flag(const char* key, bool& out) {
         if (const toml::node* n = get(key)) {
@@ -156,6 +189,22 @@ public:
     const std::string& file() const { return file_; }
 
 private:
+    double finite(const char* key, const toml::node& n) const {
+        const std::optional<double> v = n.value<double>();
+        if (!v) fail(key, "a number");
+        if (!std::isfinite(*v)) fail(key, "a finite number");
+        return *v;
+    }
+    // The range's check, as an error of this file naming the key.
+    template <class T>
+    void inRange(const SettingRange<T>& range, T v, const std::string& key) const {
+        try {
+            checkRange(range, v, "'" + path_ + key + "'");
+        } catch (const InputError& e) {
+            throw IoError(file_, e.what());
+        }
+    }
+
     const toml::table& t_;
     std::string file_;
     std::string path_;
@@ -201,13 +250,13 @@ void readTerrain(TableReader& r, SceneSettings& s) {
             r.fail("kind", "\"noise\", \"shape\" or \"dem\"");
     }
     NoiseSettings& n = s.terrain.noise;
-    r.num("amplitude", n.amplitude);
-    r.num("wavelength", n.wavelength);
-    r.integer("octaves", n.octaves);
-    r.num("lacunarity", n.lacunarity);
-    r.num("gain", n.gain);
+    r.num("amplitude", n.amplitude, ranges::kAltitude);
+    r.num("wavelength", n.wavelength, ranges::kLength);
+    r.integer("octaves", n.octaves, ranges::kOctaves);
+    r.num("lacunarity", n.lacunarity, ranges::kLacunarity);
+    r.num("gain", n.gain, ranges::kFraction);
     r.flag("ridged", n.ridged);
-    r.num("offset", n.offset);
+    r.num("offset", n.offset, ranges::kAltitude);
     ShapeSettings& sh = s.terrain.shape;
     std::string shape;
     r.text("shape", shape);
@@ -218,53 +267,53 @@ void readTerrain(TableReader& r, SceneSettings& s) {
             throw IoError(r.file(), std::string("terrain.shape: ") + e.what());
         }
     }
-    r.num("base", sh.base);
-    r.num("height", sh.height);
-    r.num("radius", sh.radius);
-    r.num("ridge_wavelength", sh.wavelength);
-    r.num("angle", sh.angleDeg);
+    r.num("base", sh.base, ranges::kAltitude);
+    r.num("height", sh.height, ranges::kAltitude);
+    r.num("radius", sh.radius, ranges::kLength);
+    r.num("ridge_wavelength", sh.wavelength, ranges::kLength);
+    r.num("angle", sh.angleDeg, ranges::kAngle);
     std::string file;
     r.text("file", file);
     if (!file.empty()) s.terrain.demFile = besideFile(r.file(), file);
-    r.num("z_scale", s.terrain.demZScale);
-    r.num("z_offset", s.terrain.demZOffset);
-    r.num("cell_size", s.terrain.demCellSize);
+    r.num("z_scale", s.terrain.demZScale, ranges::kDemZScale);
+    r.num("z_offset", s.terrain.demZOffset, ranges::kAltitude);
+    r.num("cell_size", s.terrain.demCellSize, ranges::kDemCellSize);
     r.flag("resample", s.terrain.demResample);
-    r.num("ramp_start", s.terrain.rampStart);
-    r.num("ramp_end", s.terrain.rampEnd);
+    r.num("ramp_start", s.terrain.rampStart, ranges::kAltitude);
+    r.num("ramp_end", s.terrain.rampEnd, ranges::kAltitude);
 }
 
 void readHydraulic(TableReader& r, SceneSettings& s) {
     HydraulicSettings& h = s.hydraulicSettings;
     r.flag("enabled", s.hydraulic);
-    r.num("gravity", h.gravity);
-    r.num("pipe_area", h.pipeArea);
-    r.num("rain_rate", h.rainRate);
-    r.num("capacity", h.capacity);
-    r.num("dissolve", h.dissolve);
-    r.num("deposit", h.deposit);
-    r.num("evaporation", h.evaporation);
-    r.num("min_tilt", h.minTilt);
-    r.num("bedrock_hardness", h.bedrockHardness);
-    r.num("max_erosion_depth", h.maxErosionDepth);
+    r.num("gravity", h.gravity, ranges::kGravity);
+    r.num("pipe_area", h.pipeArea, ranges::kPipeArea);
+    r.num("rain_rate", h.rainRate, ranges::kRainRate);
+    r.num("capacity", h.capacity, ranges::kCapacity);
+    r.num("dissolve", h.dissolve, ranges::kRate);
+    r.num("deposit", h.deposit, ranges::kRate);
+    r.num("evaporation", h.evaporation, ranges::kRate);
+    r.num("min_tilt", h.minTilt, ranges::kFraction);
+    r.num("bedrock_hardness", h.bedrockHardness, ranges::kFraction);
+    r.num("max_erosion_depth", h.maxErosionDepth, ranges::kDepth);
     r.flag("closed_boundary", h.closedBoundary);
 }
 
 void readThermal(TableReader& r, SceneSettings& s) {
     r.flag("enabled", s.thermal);
-    r.num("talus_deg", s.thermalSettings.talusAngleDeg);
-    r.num("rate", s.thermalSettings.rate);
+    r.num("talus_deg", s.thermalSettings.talusAngleDeg, ranges::kTalus);
+    r.num("rate", s.thermalSettings.rate, ranges::kRate);
     r.flag("erode_bedrock", s.thermalSettings.erodeBedrock);
 }
 
 void readWaves(TableReader& r, SceneSettings& s) {
     WaveSettings& w = s.waveSettings;
     r.flag("enabled", s.waves);
-    r.num("gravity", w.gravity);
-    r.num("courant", w.courant);
-    r.num("max_courant", w.maxCourant);
-    r.num("dry_depth", w.dryDepth);
-    r.num("friction", w.friction);
+    r.num("gravity", w.gravity, ranges::kGravity);
+    r.num("courant", w.courant, ranges::kCourant);
+    r.num("max_courant", w.maxCourant, ranges::kMaxCourant);
+    r.num("dry_depth", w.dryDepth, ranges::kDryDepth);
+    r.num("friction", w.friction, ranges::kManning);
     r.flag("advection", w.advection);
     r.child("swell", [&](TableReader& q) {
         w.swell.enabled = true;
@@ -272,20 +321,20 @@ void readWaves(TableReader& r, SceneSettings& s) {
         std::string edge;
         q.text("edge", edge);
         if (!edge.empty()) w.swell.edge = parseEdge(r.file(), edge);
-        q.num("amplitude", w.swell.amplitude);
-        q.num("period", w.swell.period);
+        q.num("amplitude", w.swell.amplitude, ranges::kSwellAmplitude);
+        q.num("period", w.swell.period, ranges::kSwellPeriod);
         w.swell.seaLevel = s.waterLevel;  // default: the scene's water level
-        q.num("sea_level", w.swell.seaLevel);
-        q.num("ramp_periods", w.swell.rampPeriods);
+        q.num("sea_level", w.swell.seaLevel, ranges::kAltitude);
+        q.num("ramp_periods", w.swell.rampPeriods, ranges::kRampPeriods);
     });
     std::vector<WaveDrop> drops;
     const bool given = r.children("drops", [&](TableReader& q) {
         WaveDrop drop;
-        q.num("time", drop.time);
-        q.num("x", drop.x);
-        q.num("y", drop.y);
-        q.num("radius", drop.radius);
-        q.num("height", drop.height);
+        q.num("time", drop.time, ranges::kDropTime);
+        q.num("x", drop.x, ranges::kPosition);
+        q.num("y", drop.y, ranges::kPosition);
+        q.num("radius", drop.radius, ranges::kLength);
+        q.num("height", drop.height, ranges::kAltitude);
         drops.push_back(drop);
     });
     if (given) w.drops = std::move(drops);
@@ -353,25 +402,25 @@ void readEnvironment(TableReader& r, EnvironmentSpec& e) {
         e.kind = EnvironmentSpec::Kind::Image;
         e.file = besideFile(r.file(), kind);
     }
-    r.num("intensity", e.intensity);
-    r.num("visibility", e.visibility);
+    r.num("intensity", e.intensity, ranges::kRadiance);
+    r.num("visibility", e.visibility, ranges::kVisibility);
     r.child("sky", [&](TableReader& q) {
-        q.rgb("zenith", e.zenith);
-        q.rgb("horizon", e.horizon);
-        q.rgb("ground", e.ground);
+        q.rgb("zenith", e.zenith, ranges::kRadiance);
+        q.rgb("horizon", e.horizon, ranges::kRadiance);
+        q.rgb("ground", e.ground, ranges::kRadiance);
     });
 }
 
 void readSun(TableReader& q, SunSpec& sun) {
     sun.enabled = true;
     q.flag("enabled", sun.enabled);
-    q.num("latitude", sun.latitudeDeg);
-    q.integer("day", sun.dayOfYear);
-    q.num("hour", sun.hour);
-    q.num("hours_per_frame", sun.hoursPerFrame);
-    q.num("north", sun.northAzimuthDeg);
-    q.num("radius", sun.radiusDeg);
-    q.rgb("rgb", sun.rgb);
+    q.num("latitude", sun.latitudeDeg, ranges::kLatitude);
+    q.integer("day", sun.dayOfYear, ranges::kDayOfYear);
+    q.num("hour", sun.hour, ranges::kHour);
+    q.num("hours_per_frame", sun.hoursPerFrame, ranges::kHoursPerFrame);
+    q.num("north", sun.northAzimuthDeg, ranges::kAngle);
+    q.num("radius", sun.radiusDeg, ranges::kLightRadius);
+    q.rgb("rgb", sun.rgb, ranges::kRadiance);
 }
 
 // [[lights.key]] tables replace the base scene's key lights.
@@ -380,10 +429,10 @@ void readLights(TableReader& r, LightSet& lights) {
     std::vector<KeyLightSpec> keys;
     const bool given = r.children("key", [&](TableReader& q) {
         KeyLightSpec k;
-        q.num("azimuth", k.azimuthDeg);
-        q.num("elevation", k.elevationDeg);
-        q.num("radius", k.radiusDeg);
-        q.rgb("rgb", k.rgb);
+        q.num("azimuth", k.azimuthDeg, ranges::kAngle);
+        q.num("elevation", k.elevationDeg, ranges::kElevation);
+        q.num("radius", k.radiusDeg, ranges::kLightRadius);
+        q.rgb("rgb", k.rgb, ranges::kRadiance);
         keys.push_back(k);
     });
     if (given) lights.keys = std::move(keys);
@@ -406,6 +455,7 @@ void readCamera(TableReader& r, CameraPath& path) {
     if (given) path.keys = std::move(keys);
 }
 
+// Plain values: the GI checks their ranges when it applies them (app/).
 void readGi(TableReader& r, SceneSettings& s) {
     if (r.get("incremental")) {
         bool on = true;
@@ -415,43 +465,74 @@ void readGi(TableReader& r, SceneSettings& s) {
     if (r.get("tolerance")) {
         float tolerance = 0.0f;
         r.num("tolerance", tolerance);
-        if (tolerance < 0.0f) r.fail("tolerance", "a number >= 0");
         s.gi.tolerance = tolerance;
     }
-    if (r.get("refresh")) {
-        int every = 0;
-        r.integer("refresh", every);
-        s.gi.refreshEvery = every;
+    if (const toml::node* n = r.get("refresh")) {
+        const std::optional<std::int64_t> every = n->value<std::int64_t>();
+        if (!every) r.fail("refresh", "an integer");
+        s.gi.refreshEvery = *every;
     }
 }
 
-}  // namespace
-
-SceneSettings loadSceneFile(const std::string& file) {
-    if (!std::filesystem::exists(file)) throw IoError(file, "cannot open: no such file");
+// The file's table; a file that sets nothing is a mistake, not the default scene.
+toml::table parseSceneFile(const std::string& file) {
+    std::error_code ec;
+    if (!std::filesystem::exists(file, ec)) throw IoError(file, "cannot open: no such file");
+    if (!std::filesystem::is_regular_file(file, ec)) throw IoError(file, "is not a file");
     toml::table root;
     try {
         root = toml::parse_file(file);
     } catch (const toml::parse_error& e) {
         const auto& b = e.source().begin;
         throw IoError(file, "TOML syntax error at line " + std::to_string(b.line) + ", column " +
-                                std::to_string(b.column) + ": " + std::string(e.description()));
+                                std::to_string(b.column) + ": " + oneLine(e.description()));
     }
+    if (root.empty()) throw IoError(file, "the scene file sets nothing (start with base = \"erosion\", say)");
+    return root;
+}
+
+// `size = n` or `size = [nx, ny]`, each side checked before it is narrowed.
+std::array<int, 2> readSize(TableReader& r) {
+    std::array<int, 2> n{256, 256};
+    const toml::node* sz = r.get("size");
+    if (!sz) return n;
+    if (sz->value<std::int64_t>()) {
+        n[0] = n[1] = r.side("size", *sz);
+    } else if (const toml::array* a = sz->as_array();
+               a && a->size() == 2 && a->get(0)->is_integer() && a->get(1)->is_integer()) {
+        n[0] = r.side("size", *a->get(0));
+        n[1] = r.side("size", *a->get(1));
+    } else {
+        r.fail("size", "an integer or [nx, ny]");
+    }
+    return n;
+}
+
+// The keys at the top of the file, after `base` and `size`.
+void readTopLevel(TableReader& r, SceneSettings& s) {
+    r.text("name", s.name);
+    r.num("cell_size", s.cellSize, ranges::kCellSize);
+    std::int64_t seed = static_cast<std::int64_t>(s.seed);
+    r.integer("seed", seed, ranges::kSeed);
+    s.seed = static_cast<std::uint64_t>(seed);
+    r.num("dt", s.dt, ranges::kDt);
+    r.num("spin_up", s.spinUp, ranges::kSpinUp);
+    r.integer("change_tile", s.changeTile, ranges::kChangeTile);
+    r.num("soil_depth", s.soilDepth, ranges::kDepth);
+    if (r.get("water_level")) {
+        s.hasWaterLevel = true;
+        r.num("water_level", s.waterLevel, ranges::kAltitude);
+    }
+}
+
+}  // namespace
+
+SceneSettings loadSceneFile(const std::string& file) {
+    const toml::table root = parseSceneFile(file);
     TableReader r(root, file, "");
     std::string base;
     r.text("base", base);
-    int nx = 256, ny = 256;
-    if (const toml::node* sz = r.get("size")) {
-        if (auto v = sz->value<std::int64_t>())
-            nx = ny = static_cast<int>(*v);
-        else if (const toml::array* a = sz->as_array();
-                 a && a->size() == 2 && a->get(0)->is_integer() && a->get(1)->is_integer()) {
-            nx = static_cast<int>(*a->get(0)->value<std::int64_t>());
-            ny = static_cast<int>(*a->get(1)->value<std::int64_t>());
-        } else {
-            r.fail("size", "an integer or [nx, ny]");
-        }
-    }
+    const auto [nx, ny] = readSize(r);
     SceneSettings s;
     if (!base.empty()) {
         try {
@@ -465,20 +546,7 @@ SceneSettings loadSceneFile(const std::string& file) {
     s.nx = nx;
     s.ny = ny;
     s.name = std::filesystem::path(file).stem().string();
-    r.text("name", s.name);
-    r.num("cell_size", s.cellSize);
-    int seed = static_cast<int>(s.seed);
-    r.integer("seed", seed);
-    s.seed = static_cast<std::uint64_t>(seed);
-    r.num("dt", s.dt);
-    r.num("spin_up", s.spinUp);
-    if (!(s.spinUp >= 0.0f) || s.spinUp > 1.0e6f) r.fail("spin_up", "a time in [0, 1e6] s");
-    r.integer("change_tile", s.changeTile);
-    r.num("soil_depth", s.soilDepth);
-    if (r.get("water_level")) {
-        s.hasWaterLevel = true;
-        r.num("water_level", s.waterLevel);
-    }
+    readTopLevel(r, s);
     r.child("terrain", [&](TableReader& q) { readTerrain(q, s); });
     r.child("hydraulic", [&](TableReader& q) { readHydraulic(q, s); });
     r.child("thermal", [&](TableReader& q) { readThermal(q, s); });
@@ -491,6 +559,8 @@ SceneSettings loadSceneFile(const std::string& file) {
     if (r.child("camera", [&](TableReader& q) { readCamera(q, s.camera); }))
         checkIn(file, [&] { validateCameraPath(s.camera); });
     r.finish();
+    if (s.terrain.kind == TerrainSource::Kind::Dem && s.terrain.demFile.empty())
+        throw IoError(file, "'terrain.file' is missing: a \"dem\" terrain needs a heightmap (.png or .vdb)");
     checkIn(file, [&] { checkDimensions(s.nx, s.ny, s.cellSize); });
     return s;
 }

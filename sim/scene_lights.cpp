@@ -3,28 +3,22 @@
 #include <cmath>
 
 #include "core/error.h"
-#include "core/parse.h"
+#include "sim/scene_ranges.h"
 
 namespace terrain {
 namespace {
 
-void requireRadiance(const std::string& what, const std::array<float, 3>& rgb) {
-    for (float v : rgb)
-        if (!(v >= 0.0f) || !std::isfinite(v))
-            throw InputError("lights: " + what + " must be finite and >= 0 (R, G, B)");
-}
+namespace r = scene_ranges;
 
-void requireIn(const std::string& what, float v, float lo, float hi) {
-    if (!(v >= lo && v <= hi))
-        throw InputError("lights: " + what + " = " + formatNumber(v) + " is out of range [" + formatNumber(lo) + ", " +
-                         formatNumber(hi) + "]");
+void requireRadiance(const std::string& what, const std::array<float, 3>& rgb) {
+    for (float v : rgb) checkRange(r::kRadiance, v, "lights: " + what);
 }
 
 void validateKey(const std::string& what, float azimuth, float elevation, float radius,
                  const std::array<float, 3>& rgb) {
-    if (!std::isfinite(azimuth)) throw InputError("lights: " + what + " azimuth must be finite");
-    requireIn(what + " elevation", elevation, -90.0f, 90.0f);
-    if (!(radius > 0.0f && radius < 90.0f)) throw InputError("lights: " + what + " radius must be in (0, 90) degrees");
+    checkRange(r::kAngle, azimuth, "lights: " + what + " azimuth");
+    checkRange(r::kElevation, elevation, "lights: " + what + " elevation");
+    checkRange(r::kLightRadius, radius, "lights: " + what + " radius");
     requireRadiance(what + " rgb", rgb);
 }
 
@@ -45,13 +39,11 @@ LightSet builtinLights(const std::string& scene) {
 
 void validateLights(const LightSet& l) {
     const EnvironmentSpec& e = l.environment;
-    if (!(e.intensity >= 0.0f) || !std::isfinite(e.intensity))
-        throw InputError("lights: environment intensity must be finite and >= 0");
+    checkRange(r::kRadiance, e.intensity, "lights: environment intensity");
     requireRadiance("sky zenith", e.zenith);
     requireRadiance("sky horizon", e.horizon);
     requireRadiance("sky ground", e.ground);
-    if (!(e.visibility >= 0.0f) || !std::isfinite(e.visibility))
-        throw InputError("lights: visibility must be finite and >= 0 m (0: no haze)");
+    checkRange(r::kVisibility, e.visibility, "lights: visibility");
     if (e.kind == EnvironmentSpec::Kind::Image && e.file.empty())
         throw InputError("lights: an image environment needs a file (.exr or .hdr)");
     for (std::size_t k = 0; k < l.keys.size(); ++k) {
@@ -60,10 +52,10 @@ void validateLights(const LightSet& l) {
     }
     const SunSpec& s = l.sun;
     if (!s.enabled) return;
-    requireIn("sun latitude", s.latitudeDeg, -90.0f, 90.0f);
-    if (s.dayOfYear < 1 || s.dayOfYear > 366) throw InputError("lights: sun day of the year must be in 1..366");
-    requireIn("sun hour", s.hour, 0.0f, 24.0f);
-    requireIn("sun hours per frame", s.hoursPerFrame, -24.0f, 24.0f);
+    checkRange(r::kLatitude, s.latitudeDeg, "lights: sun latitude");
+    checkRange(r::kDayOfYear, s.dayOfYear, "lights: sun day of the year");
+    checkRange(r::kHour, s.hour, "lights: sun hour");
+    checkRange(r::kHoursPerFrame, s.hoursPerFrame, "lights: sun hours per frame");
     validateKey("sun", s.northAzimuthDeg, 0.0f, s.radiusDeg, s.rgb);
 }
 

@@ -64,10 +64,10 @@ struct LightSet {
 /// clear alpine day.
 LightSet builtinLights(const std::string& scene);
 
-/// Throws InputError naming the first bad value (negative or non-finite
-/// radiance, a key light's elevation outside [-90, 90] or radius outside
-/// (0, 90), latitude outside [-90, 90], day outside 1..366, hour outside
-/// [0, 24], an image environment without a file).
+/// Throws InputError naming the first value outside its range
+/// (sim/scene_ranges.h: radiance and intensity finite, >= 0 and bounded, a key
+/// light's elevation in [-90, 90], its radius, the sun's latitude, day and
+/// hour) or an image environment without a file.
 void validateLights(const LightSet& lights);
 
 }  // namespace terrain

@@ -5,19 +5,16 @@
 #include <cstring>
 
 #include "core/error.h"
+#include "core/finite.h"
 #include "core/parallel.h"
+#include "sim/scene_ranges.h"
 
 namespace terrain {
 
 void checkDimensions(int nx, int ny, float cellSize) {
-    constexpr int kMaxSide = 16384;
-    if (nx < 1 || ny < 1)
-        throw InputError("grid size " + std::to_string(nx) + " x " + std::to_string(ny) + " is empty or negative");
-    if (nx > kMaxSide || ny > kMaxSide)
-        throw InputError("grid size " + std::to_string(nx) + " x " + std::to_string(ny) + " exceeds the limit of " +
-                         std::to_string(kMaxSide) + " per side");
-    if (!std::isfinite(cellSize) || cellSize <= 0.0f || cellSize > 1e6f)
-        throw InputError("cell size " + std::to_string(cellSize) + " m is not a positive finite size up to 1e6 m");
+    checkRange(scene_ranges::kSize, nx, "grid width");
+    checkRange(scene_ranges::kSize, ny, "grid height");
+    checkRange(scene_ranges::kCellSize, cellSize, "cell size");
 }
 
 void TerrainState::allocate(int w, int h, float cell, const LayerSet& layers) {
@@ -60,17 +57,7 @@ void checkFinite(const TerrainState& s) {
     } layers[] = {{"bedrock", &s.bedrock}, {"soil", &s.soil},   {"water", &s.water}, {"suspended", &s.suspended},
                   {"fluxL", &s.fluxL},     {"fluxR", &s.fluxR}, {"fluxT", &s.fluxT}, {"fluxB", &s.fluxB},
                   {"velX", &s.velX},       {"velY", &s.velY},   {"faceU", &s.faceU}, {"faceV", &s.faceV}};
-    for (const auto& l : layers) {
-        const Grid& g = *l.g;
-        for (std::size_t i = 0; i < g.v.size(); ++i) {
-            if (!std::isfinite(g.v[i])) {
-                const int x = static_cast<int>(i % static_cast<std::size_t>(g.nx));
-                const int y = static_cast<int>(i / static_cast<std::size_t>(g.nx));
-                throw InputError(std::string("layer '") + l.name + "' has a non-finite value (" +
-                                 std::to_string(g.v[i]) + ") at x=" + std::to_string(x) + ", y=" + std::to_string(y));
-            }
-        }
-    }
+    for (const auto& l : layers) requireFinite(*l.g, std::string("layer '") + l.name + "'");
 }
 
 namespace {

@@ -57,8 +57,8 @@ struct TerrainState {
 /// Throws InputError naming the layer when any value is NaN or Inf.
 void checkFinite(const TerrainState& s);
 
-/// Throws InputError when a grid size or cell size is absurd (0 or negative
-/// sizes, more than 16384 per side, non-finite or non-positive cell size).
+/// Throws InputError when a grid side or the cell size is outside its range
+/// (sim/scene_ranges.h: 1..16384 cells, 1 mm..1000 km).
 void checkDimensions(int nx, int ny, float cellSize);
 
 /// 64-bit hash over every byte of the simulation state (all layers, sizes,

@@ -33,18 +33,18 @@ done
   && [ "$(ls "$tmp/frames"/*.vdb | wc -l)" = 3 ] && [ "$(ls "$tmp/frames"/*.png | wc -l)" = 3 ] && ok || bad "sim --out frames"
 ls "$tmp/frames" | grep -q tmp && bad "temporary files left in the output folder" || ok
 
-# a requested step above the limit is reported and clamped
-"$T" sim --scene waves --size 32 --ticks 1 --dt 100 --quiet >/dev/null 2>"$tmp/err" && grep -q "clamped" "$tmp/err" && ok \
-  || bad "dt clamp message: $(cat "$tmp/err")"
+# a requested step above the limit is reported (on stdout: stderr carries errors only) and clamped
+"$T" sim --scene waves --size 32 --ticks 1 --dt 100 --quiet >"$tmp/out" 2>"$tmp/err" && grep -q "clamped" "$tmp/out" \
+  && [ ! -s "$tmp/err" ] && ok || bad "dt clamp message: $(cat "$tmp/out" "$tmp/err")"
 
-# one clear error line and a non-zero exit on bad input
+# one clear error line, exit 1, on bad input
 expect_error() {  # description, pattern, command...
   local what=$1 pattern=$2
   shift 2
   "$@" >"$tmp/o" 2>"$tmp/e"
   local rc=$?
-  if [ $rc -ne 0 ] && [ "$(wc -l <"$tmp/e")" = 1 ] && grep -q -- "$pattern" "$tmp/e"; then ok
-  else bad "$what: rc=$rc stderr=$(cat "$tmp/e")"; fi
+  if [ $rc -eq 1 ] && [ "$(wc -l <"$tmp/e")" = 1 ] && grep -q "^terrain: error: " "$tmp/e" && grep -q -- "$pattern" "$tmp/e"
+  then ok; else bad "$what: rc=$rc stderr=$(cat "$tmp/e")"; fi
 }
 expect_error "bad scene" "unknown scene" "$T" sim --scene volcano --ticks 1
 expect_error "absurd size" "size" "$T" sim --scene erosion --size 100000 --ticks 1
@@ -89,12 +89,90 @@ for k in sh blocker; do
 done
 expect_error "bad indirect kernel" "indirect-kernel" "$T" gi --heightmap "$hm24" --cell-size 10 --bounces 1 --indirect-kernel cosine
 expect_error "retired indirect kernel" "indirect-kernel" "$T" gi --heightmap "$hm24" --cell-size 10 --bounces 1 --indirect-kernel exact
-expect_error "bad indirect azimuths" "indirect azimuths" "$T" gi --heightmap "$hm24" --cell-size 10 --bounces 1 --indirect-azimuths 2
-expect_error "GI tolerance out of range" "GI tolerance" "$T" gi --heightmap "$hm24" --cell-size 10 --gi-tolerance 2
+expect_error "bad indirect azimuths" "--indirect-azimuths must be 0 or" "$T" gi --heightmap "$hm24" --cell-size 10 --bounces 1 --indirect-azimuths 2
+expect_error "GI tolerance out of range" "--gi-tolerance must be in" "$T" gi --heightmap "$hm24" --cell-size 10 --gi-tolerance 2
 # the same field twice: the second frame of incremental GI does nothing, and the outputs equal a full frame's
 "$T" gi --heightmap "$hm24" --cell-size 10 --bounces 1 --frames 2 --out-indirect "$tmp/inc_on.npy" >/dev/null 2>&1 &&
   "$T" gi --heightmap "$hm24" --cell-size 10 --bounces 1 --frames 2 --gi-incremental off --out-indirect "$tmp/inc_off.npy" >/dev/null 2>&1 &&
   cmp -s "$tmp/inc_on.npy" "$tmp/inc_off.npy" && ok || bad "gi --gi-incremental on and off differ"
+
+# gi: numbers out of range fail before any input is read; results are finite or not written
+gi24=("$T" gi --heightmap "$hm24")
+"${gi24[@]}" --cell-size 20 --out-ambient "$tmp/o.npy" >"$tmp/o" 2>"$tmp/e" && [ -s "$tmp/o.npy" ] && [ ! -s "$tmp/e" ] \
+  && grep -q "terrain gi: .*24 x 24 cells" "$tmp/o" && ok || bad "gi: info on stdout, nothing on stderr: $(cat "$tmp/e")"
+cp "$tmp/o.npy" "$tmp/o.good"
+expect_error "tiny cell size" "--cell-size must be 0 or \[0.001, 1e+06\] (got 1e-38)" "${gi24[@]}" --cell-size 1e-38 --out-ambient "$tmp/o.npy"
+expect_error "negative cell size" "--cell-size" "${gi24[@]}" --cell-size -10 --out-ambient "$tmp/o.npy"
+expect_error "huge key light" "key light 1 rgb must be in \[0, 1e+06\]" "${gi24[@]}" --cell-size 10 --bounces 1 \
+  --key 0,45,3,1e38,1e38,1e38 --out-ambient "$tmp/o.npy"
+expect_error "nan key light" "'nan' is not finite" "${gi24[@]}" --cell-size 10 --key 0,45,3,nan,1,1 --out-ambient "$tmp/o.npy"
+expect_error "huge sky" "environment intensity" "${gi24[@]}" --cell-size 10 --light-intensity 1e30 --out-ambient "$tmp/o.npy"
+expect_error "nan exposure" "--exposure" "${gi24[@]}" --cell-size 10 --exposure nan --out-shade "$tmp/s.png"
+expect_error "huge z scale" "--z-scale" "${gi24[@]}" --cell-size 10 --z-scale 1e30 --out-ambient "$tmp/o.npy"
+expect_error "negative level offset" "--level-offset must be in \[0, 32\] (got -2)" "${gi24[@]}" --cell-size 10 --level-offset -2
+expect_error "negative indirect azimuths" "--indirect-azimuths must be 0 or" "${gi24[@]}" --cell-size 10 --bounces 1 \
+  --indirect-azimuths -5
+expect_error "indirect without bounces" "needs --bounces" "${gi24[@]}" --cell-size 10 --out-ambient "$tmp/o.npy" \
+  --out-indirect "$tmp/i.npy"
+expect_error "indirect into a missing folder" "folder does not exist" "${gi24[@]}" --cell-size 10 --bounces 1 \
+  --out-ambient "$tmp/o.npy" --out-indirect "$tmp/nowhere/i.npy"
+mkdir -p "$tmp/adir.npy"
+expect_error "output that is a folder" "is a folder" "${gi24[@]}" --cell-size 10 --out-ambient "$tmp/adir.npy"
+cmp -s "$tmp/o.npy" "$tmp/o.good" && ok || bad "a failing gi run changed o.npy"
+[ ! -e "$tmp/i.npy" ] && ok || bad "a failing gi run wrote i.npy"
+
+# command-line parse errors: one line and exit 1, like every error; --help still prints help and exits 0
+expect_error "unknown flag" "not expected: --bogus" "$T" sim --bogus
+expect_error "size that is not a number" "--size" "$T" sim --size abc
+expect_error "size past 32 bits" "--size" "$T" sim --size 4294967328
+expect_error "no subcommand" "subcommand" "$T"
+long=$(printf 'x%.0s' $(seq 1 5000))
+expect_error "huge argument" "not expected" "$T" sim "$long"
+[ "$(wc -c <"$tmp/e")" -lt 400 ] && ok || bad "a huge argument gives a huge error line"
+"$T" sim --help >"$tmp/o" 2>"$tmp/e" && grep -q -- "--scene" "$tmp/o" && ok || bad "sim --help"
+
+# flags and the values they check before anything is read or written
+expect_error "negative seed" "--seed must be in" "$T" sim --scene erosion --size 16 --seed -1 --ticks 1
+expect_error "dt nan" "--dt must be in" "$T" sim --scene erosion --size 16 --dt nan --ticks 1
+expect_error "dt negative" "--dt must be in" "$T" sim --scene erosion --size 16 --dt -1 --ticks 1
+expect_error "threads" "--threads must be in" "$T" sim --scene erosion --size 16 --threads 1000 --ticks 1
+expect_error "hash every" "--hash-every must be in" "$T" sim --scene erosion --size 16 --hash-every -2 --ticks 1
+
+# a scene file's size, seed and dt apply unless a flag is given (then the flag wins)
+"$T" sim --scene "$SRC/scenes/pit-lake.toml" --ticks 0 >"$tmp/o" 2>"$tmp/e" && grep -q "128 x 128 cells of 1 m" "$tmp/o" \
+  && [ ! -s "$tmp/e" ] && ok || bad "pit-lake's own size: $(cat "$tmp/o" "$tmp/e")"
+"$T" sim --scene "$SRC/scenes/pit-lake.toml" --ticks 0 --size 64 >"$tmp/o" 2>&1 && grep -q "64 x 64 cells of 2 m" "$tmp/o" \
+  && ok || bad "--size over pit-lake: $(cat "$tmp/o")"
+printf 'base = "erosion"\nsize = [30, 20]\nseed = 4\ndt = 0.125\n' >"$tmp/s4.toml"
+printf 'base = "erosion"\nsize = [30, 20]\nseed = 5\ndt = 0.125\n' >"$tmp/s5.toml"
+"$T" sim --scene "$tmp/s4.toml" --ticks 0 >"$tmp/o" 2>&1 && grep -q "30 x 20 cells of .* dt 0.125 s" "$tmp/o" && ok \
+  || bad "scene size and dt: $(cat "$tmp/o")"
+"$T" sim --scene "$tmp/s4.toml" --ticks 0 --dt 0.25 >"$tmp/o" 2>&1 && grep -q "dt 0.25 s" "$tmp/o" && ok || bad "--dt over the scene: $(cat "$tmp/o")"
+h4=$("$T" sim --scene "$tmp/s4.toml" --ticks 1 --hash-every 1 --quiet)
+h5=$("$T" sim --scene "$tmp/s5.toml" --ticks 1 --hash-every 1 --quiet)
+h54=$("$T" sim --scene "$tmp/s5.toml" --ticks 1 --hash-every 1 --quiet --seed 4)
+[ -n "$h4" ] && [ "$h4" != "$h5" ] && ok || bad "scene seeds 4 and 5 give the same hash"
+[ "$h54" = "$h4" ] && ok || bad "--seed 4 over the seed-5 scene differs from the seed-4 scene"
+
+# scene values out of their physical range: one line naming the key; no output folder made
+scene_error() {  # description, pattern, scene text
+  printf "$3" >"$tmp/bad.toml"
+  rm -rf "$tmp/never"
+  expect_error "$1" "$2" "$T" sim --scene "$tmp/bad.toml" --ticks 2 --out "$tmp/never"
+  [ ! -e "$tmp/never" ] && ok || bad "$1: the output folder was made"
+}
+scene_error "huge rain" "'hydraulic.rain_rate' must be in \[0, 0.01\] (got 1e+30)" 'base = "erosion"\n[hydraulic]\nrain_rate = 1e30\n'
+scene_error "negative gravity" "'hydraulic.gravity'" 'base = "erosion"\nsize = 16\n[hydraulic]\ngravity = -9.81\n'
+scene_error "negative dry depth" "'waves.dry_depth'" 'base = "waves"\n[waves]\ndry_depth = -1.0\n'
+scene_error "negative soil" "'soil_depth'" 'base = "erosion"\nsoil_depth = -5.0\n'
+scene_error "nan dt" "'dt' must be a finite number" 'base = "erosion"\ndt = nan\n'
+scene_error "size past 32 bits" "'size' must be in \[1, 16384\] (got 4294967328)" 'base = "erosion"\nsize = 4294967328\n'
+scene_error "seed below 0" "'seed'" 'base = "erosion"\nseed = -3\n'
+scene_error "change tile overflow" "'change_tile'" 'base = "erosion"\nchange_tile = 2147483647\n'
+scene_error "dem without a file" "'terrain.file' is missing" 'size = 16\n[terrain]\nkind = "dem"\n'
+scene_error "empty scene file" "sets nothing" ''
+mkdir -p "$tmp/folder.toml"
+expect_error "a folder as the scene" "is not a file" "$T" sim --scene "$tmp/folder.toml" --ticks 1
 
 echo "cli: $pass passed, $fail failed"
 [ $fail -eq 0 ]

@@ -74,7 +74,8 @@ expect_error() {  # description, pattern, output folder, command...
   shift 3
   "$@" >"$tmp/o" 2>"$tmp/e"
   local rc=$?
-  if [ $rc -ne 0 ] && [ "$(wc -l <"$tmp/e")" = 1 ] && grep -q -- "$pattern" "$tmp/e" && [ -z "$(ls -A "$out" 2>/dev/null)" ]; then ok
+  if [ $rc -eq 1 ] && [ "$(wc -l <"$tmp/e")" = 1 ] && grep -q "^terrain: error: " "$tmp/e" && grep -q -- "$pattern" "$tmp/e" \
+     && [ -z "$(ls -A "$out" 2>/dev/null)" ]; then ok
   else bad "$what: rc=$rc stderr=$(cat "$tmp/e") files=$(ls -A "$out" 2>/dev/null)"; fi
 }
 expect_error "bad scene" "unknown scene" "$tmp/e1" "$T" render --scene volcano "${small[@]}" --frames 1 --out "$tmp/e1"
@@ -98,7 +99,7 @@ printf 'base = "erosion"\nsize = 32\n[gi]\nincremental = false\ntolerance = 0.02
 "$T" render --scene "$tmp/gi.toml" "${small[@]}" --frames 2 --out "$tmp/g2" --gi-incremental on --gi-tolerance 0 >"$tmp/o" 2>&1 \
   && grep -q "incremental GI on, tolerance 0)" "$tmp/o" && ok || bad "command line over [gi]: $(cat "$tmp/o")"
 printf 'base = "erosion"\nsize = 32\n[gi]\ntolerance = 3.0\n' >"$tmp/gi_bad.toml"
-expect_error "scene [gi] tolerance out of range" "GI tolerance" "$tmp/g3" "$T" render --scene "$tmp/gi_bad.toml" "${small[@]}" --frames 1 --out "$tmp/g3"
+expect_error "scene [gi] tolerance out of range" "gi_bad.toml: 'gi.tolerance' must be in" "$tmp/g3" "$T" render --scene "$tmp/gi_bad.toml" "${small[@]}" --frames 1 --out "$tmp/g3"
 printf 'base = "erosion"\nsize = 32\n[gi]\ntolerence = 0.1\n' >"$tmp/gi_typo.toml"
 expect_error "scene [gi] unknown key" "unknown key 'gi.tolerence'" "$tmp/g4" "$T" render --scene "$tmp/gi_typo.toml" "${small[@]}" --frames 1 --out "$tmp/g4"
 
@@ -117,7 +118,7 @@ expect_error "bad sun hour" "sun hour" "$tmp/l2" "$T" demo --headless "${small[@
 expect_error "missing environment image" "nowhere.exr" "$tmp/l3" "$T" render "${small[@]}" --light "$tmp/nowhere.exr" --frames 1 --out "$tmp/l3"
 expect_error "bad environment" "--light must be" "$tmp/l4" "$T" render "${small[@]}" --light cloudy --out "$tmp/l4"
 printf 'base = "erosion"\nsize = 32\n[lights.sun]\nday = 0\n' >"$tmp/sun_bad.toml"
-expect_error "scene [lights] bad day" "day of the year" "$tmp/l5" "$T" render --scene "$tmp/sun_bad.toml" "${small[@]}" --frames 1 --out "$tmp/l5"
+expect_error "scene [lights] bad day" "'lights.sun.day' must be in" "$tmp/l5" "$T" render --scene "$tmp/sun_bad.toml" "${small[@]}" --frames 1 --out "$tmp/l5"
 
 # camera keyframes: the frames follow the path; bad keys are one-line errors
 "$T" render --scene erosion "${small[@]}" --frames 3 --out "$tmp/c1" --quiet --camera-key 0,200,30,1.2 --camera-key 2,300,20,0.8,0.4,0.6 \
@@ -126,6 +127,31 @@ expect_error "bad camera key" "expected FRAME" "$tmp/c2" "$T" render "${small[@]
 expect_error "camera keys out of order" "frames must increase" "$tmp/c3" "$T" render "${small[@]}" --camera-key 5,0,30,1 --camera-key 2,0,30,1 --out "$tmp/c3"
 expect_error "bad level of detail" "lod" "$tmp/c5" "$T" render "${small[@]}" --lod -1 --out "$tmp/c5"
 expect_error "bad pitch" "pitch" "$tmp/c4" "$T" render "${small[@]}" --pitch 95 --out "$tmp/c4"
+
+printf 'base = "erosion"\nsize = 32\n[gi]\nrefresh = 4294967297\n' >"$tmp/gi_refresh.toml"
+expect_error "scene [gi] refresh past 32 bits" "'gi.refresh' must be in" "$tmp/g5" "$T" render --scene "$tmp/gi_refresh.toml" "${small[@]}" --frames 1 --out "$tmp/g5"
+
+# a scene file's size and seed apply unless the flags are given
+printf 'base = "erosion"\nsize = 24\nseed = 4\n' >"$tmp/s24.toml"
+"$T" render --scene "$tmp/s24.toml" --width 160 --height 90 --threads 2 --frames 1 --out "$tmp/z1" >"$tmp/o" 2>"$tmp/e" \
+  && grep -q "24 x 24 cells" "$tmp/o" && [ ! -s "$tmp/e" ] && ok || bad "render: the scene's size: $(cat "$tmp/o" "$tmp/e")"
+"$T" render --scene "$tmp/s24.toml" "${small[@]}" --frames 1 --out "$tmp/z2" >"$tmp/o" 2>&1 && grep -q "32 x 32 cells" "$tmp/o" \
+  && ok || bad "render: --size over the scene's: $(cat "$tmp/o")"
+"$T" render --scene "$tmp/s24.toml" --width 160 --height 90 --threads 2 --frames 1 --out "$tmp/z3" --seed 5 --quiet \
+  && ! cmp -s "$tmp/z1/frame_0000.png" "$tmp/z3/frame_0000.png" && ok || bad "render: --seed over the scene's changes nothing"
+
+# numbers out of range and parse errors: one line, exit 1, nothing written
+expect_error "nan yaw" "yaw must be in" "$tmp/n1" "$T" render "${small[@]}" --yaw nan --out "$tmp/n1"
+expect_error "huge yaw (demo)" "yaw must be in" "$tmp/n2" "$T" demo --headless "${small[@]}" --yaw 1e30 --out "$tmp/n2"
+expect_error "negative pyramid level" "--pyramid-level must be in" "$tmp/n3" "$T" render "${small[@]}" --pyramid-level -5 --out "$tmp/n3"
+expect_error "zero exposure" "--exposure must be in" "$tmp/n4" "$T" render "${small[@]}" --exposure 0 --out "$tmp/n4"
+expect_error "negative seed" "--seed must be in" "$tmp/n5" "$T" render "${small[@]}" --seed -1 --out "$tmp/n5"
+expect_error "huge key light" "key light 1 rgb" "$tmp/n6" "$T" render "${small[@]}" --key 0,45,3,1e38,1,1 --out "$tmp/n6"
+expect_error "sun day past an int" "day of the year must be in" "$tmp/n10" "$T" render "${small[@]}" --sun 12,0,45,1e30 --out "$tmp/n10"
+expect_error "unknown flag" "not expected" "$tmp/n7" "$T" render "${small[@]}" --bogus --out "$tmp/n7"
+expect_error "width not a number" "--width" "$tmp/n8" "$T" render "${small[@]}" --width wide --out "$tmp/n8"
+expect_error "bad option before a bad scene" "--exposure" "$tmp/n9" "$T" render --scene "$tmp/missing.toml" "${small[@]}" \
+  --exposure -1 --out "$tmp/n9"
 
 echo "render_cli: $pass passed, $fail failed"
 [ $fail -eq 0 ]

@@ -52,7 +52,8 @@ TEST_CASE("sim.terrain: state hash sees every layer and ignores nothing") {
 
 TEST_CASE("sim.terrain: absurd sizes are rejected with a clear error") {
     TerrainState s;
-    CHECK_THROWS_WITH_AS(s.allocate(0, 10, 1.0f, {}), doctest::Contains("empty"), InputError);
+    CHECK_THROWS_WITH_AS(s.allocate(0, 10, 1.0f, {}), doctest::Contains("grid width must be in [1, 16384] (got 0)"),
+                         InputError);
     CHECK_THROWS_AS(s.allocate(100000, 10, 1.0f, {}), InputError);
     CHECK_THROWS_AS(s.allocate(10, 10, -1.0f, {}), InputError);
     s.allocate(1, 1, 1.0f, {});

@@ -266,3 +266,39 @@ TEST_CASE("sim.scene: every example scene file in scenes/ loads and runs") {
     }
     CHECK(count >= 2);
 }
+
+TEST_CASE("sim.scene: a scene file's size, seed and dt apply unless the command line gives its own") {
+    const fs::path dir = scratch();
+    writeText(dir / "rect.toml", "base = \"erosion\"\nsize = [30, 20]\ncell_size = 5.0\nseed = 4\ndt = 0.25\n");
+    const std::string file = (dir / "rect.toml").string();
+    // nothing given: the file's values, none replaced by a command-line default
+    const SceneSettings own = resolveScene(file, SceneOverrides{});
+    CHECK(own.nx == 30);
+    CHECK(own.ny == 20);
+    CHECK(own.cellSize == 5.0f);
+    CHECK(own.seed == 4);
+    CHECK(own.dt == 0.25f);
+    // each one given wins, the rest stay the file's
+    const SceneSettings sized = resolveScene(file, SceneOverrides{.size = 60});
+    CHECK(sized.nx == 60);
+    CHECK(sized.ny == 60);
+    CHECK(sized.cellSize == doctest::Approx(2.5));  // the extent is kept
+    CHECK(sized.seed == 4);
+    CHECK(sized.dt == 0.25f);
+    const SceneSettings seeded = resolveScene(file, SceneOverrides{.seed = 5, .dt = 0.5f});
+    CHECK(seeded.nx == 30);
+    CHECK(seeded.seed == 5);
+    CHECK(seeded.dt == 0.5f);
+    // and the file's seed reaches the terrain: seeds 4 and 5 differ
+    CHECK(hashState(Simulation(own).state()) != hashState(Simulation(seeded).state()));
+    // a built-in's defaults: 256 cells, seed 1
+    const SceneSettings builtin = resolveScene("waves", SceneOverrides{});
+    CHECK(builtin.nx == 256);
+    CHECK(builtin.seed == 1);
+    CHECK(resolveScene("waves", SceneOverrides{.size = 32, .seed = 7}).nx == 32);
+    // the example scene keeps its 128 cells of 1 m
+    const SceneSettings pit = resolveScene(std::string(TERRAIN_SOURCE_DIR) + "/scenes/pit-lake.toml", SceneOverrides{});
+    CHECK(pit.nx == 128);
+    CHECK(pit.cellSize == 1.0f);
+    fs::remove_all(dir);
+}
