@@ -1,7 +1,6 @@
 #pragma once
-// The range of a numeric setting, declared once with its name and meaning
-// (in the manner of Halide's GeneratorParam: name, bounds and meaning
-// together). Each library declares the ranges of its own values beside them
+// The range of a numeric setting, declared once with its name and meaning.
+// Each library declares the ranges of its own values beside them
 // (gi/settings_ranges.h, sim/scene_ranges.h, app/option_ranges.h); the
 // checks, the help texts and the error messages read them, and nothing else
 // writes a bound down.
