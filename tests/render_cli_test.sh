@@ -51,11 +51,16 @@ env -u DISPLAY -u WAYLAND_DISPLAY "$T" demo --scene waves "${small[@]}" --frames
 
 # the window under Xvfb
 if command -v xvfb-run >/dev/null; then
-  timeout 120 xvfb-run -a "$T" demo --scene erosion --size 32 --frames 3 --width 320 --height 200 >"$tmp/o" 2>&1 \
+  # In a sanitizer build, leak checking is off for the windowed runs only: the
+  # GLX driver leaks a few blocks and unloads itself at exit, so its leaks
+  # carry no module a suppression could name (the headless runs above keep
+  # leak checking, over the same renderer).
+  window_asan="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0"
+  timeout 120 env ASAN_OPTIONS="$window_asan" xvfb-run -a "$T" demo --scene erosion --size 32 --frames 3 --width 320 --height 200 >"$tmp/o" 2>&1 \
     && grep -q "3 frames shown" "$tmp/o" && ok || bad "demo window under Xvfb: $(cat "$tmp/o")"
   # its keys, pressed for real (xdotool): pause, single step, screenshot, reload, hide the panel, resume
   if command -v xdotool >/dev/null; then
-    timeout 120 xvfb-run -a -s "-screen 0 1024x768x24" bash "$(dirname "$0")/window_keys.sh" "$T" "$tmp/k" "$tmp/klog"
+    timeout 120 env ASAN_OPTIONS="$window_asan" xvfb-run -a -s "-screen 0 1024x768x24" bash "$(dirname "$0")/window_keys.sh" "$T" "$tmp/k" "$tmp/klog"
     for line in "demo: paused at tick" "demo: stepped to tick" "demo: screenshot .*/k/screenshot_0001.png" \
                 "demo: reloaded scene erosion" "demo: running at tick" "300 frames shown"; do
       grep -q "$line" "$tmp/klog" && ok || bad "window keys: no '$line' in: $(cat "$tmp/klog")"
