@@ -6,16 +6,16 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "core/size_limits.h"
 
 namespace terrain {
 
 void checkDimensions(int nx, int ny, float cellSize) {
-    constexpr int kMaxSide = 16384;
     if (nx < 1 || ny < 1)
         throw InputError("grid size " + std::to_string(nx) + " x " + std::to_string(ny) + " is empty or negative");
-    if (nx > kMaxSide || ny > kMaxSide)
+    if (nx > kMaxGridSide || ny > kMaxGridSide)
         throw InputError("grid size " + std::to_string(nx) + " x " + std::to_string(ny) + " exceeds the limit of " +
-                         std::to_string(kMaxSide) + " per side");
+                         std::to_string(kMaxGridSide) + " per side");
     if (!std::isfinite(cellSize) || cellSize <= 0.0f || cellSize > 1e6f)
         throw InputError("cell size " + std::to_string(cellSize) + " m is not a positive finite size up to 1e6 m");
 }

@@ -58,7 +58,8 @@ struct TerrainState {
 void checkFinite(const TerrainState& s);
 
 /// Throws InputError when a grid size or cell size is absurd (0 or negative
-/// sizes, more than 16384 per side, non-finite or non-positive cell size).
+/// sizes, more than kMaxGridSide (core/size_limits.h) per side, non-finite or
+/// non-positive cell size).
 void checkDimensions(int nx, int ny, float cellSize);
 
 /// 64-bit hash over every byte of the simulation state (all layers, sizes,
