@@ -105,6 +105,15 @@ expect_short_error() {  # description, pattern, command...
   if [ $rc = 1 ] && [ "$(wc -l <"$tmp/e")" = 1 ] && [ "$(wc -c <"$tmp/e")" -le 400 ] && grep -q -- "$pattern" "$tmp/e"; then ok
   else bad "$what: rc=$rc stderr=$(head -c 600 "$tmp/e")"; fi
 }
+vdb="$tmp/frames/frame_000000.vdb"
+head -c 8192 "$vdb" >"$tmp/cut.vdb"
+expect_short_error "truncated VDB heightmap" "cut.vdb: truncated: grid 'height' ends at byte" "$T" gi --heightmap "$tmp/cut.vdb" --cell-size 10
+cp "$vdb" "$tmp/grids.vdb"
+printf '\377\377\377\177' | dd of="$tmp/grids.vdb" bs=1 seek=61 conv=notrunc 2>/dev/null
+expect_short_error "VDB declaring 2^31 grids" "2147483647 grids" "$T" gi --heightmap "$tmp/grids.vdb" --cell-size 10
+cp "$vdb" "$tmp/mutant.vdb"
+printf '\377\377' | dd of="$tmp/mutant.vdb" bs=1 seek=$(( $(wc -c <"$vdb") / 2 )) conv=notrunc 2>/dev/null
+expect_short_error "damaged VDB heightmap" "mutant.vdb" "$T" gi --heightmap "$tmp/mutant.vdb" --cell-size 10
 # a 68-byte PNG declaring 60000 x 60000 pixels; a 1 x 1 PNG; an 8-bit grey PNG
 echo 'iVBORw0KGgoAAAANSUhEUgAA6mAAAOpgEAAAAAD1KfbdAAAAC0lEQVR4nGNggAAAAAgAAbdYc5UAAAAASUVORK5CYII=' | base64 -d >"$tmp/huge.png"
 expect_short_error "PNG declaring 60000 x 60000" "60000 x 60000 pixels" "$T" gi --heightmap "$tmp/huge.png" --cell-size 10
@@ -123,7 +132,7 @@ expect_short_error "frame path is a folder" "frame_000000.vdb: cannot move" "$T"
 # frames already in the folder keep their bytes, with no temporary left
 "$T" sim --scene erosion --size 40 --ticks 1 --out "$tmp/full" --format both --quiet >/dev/null 2>&1
 cp -r "$tmp/full" "$tmp/full_before"
-for fmt in png; do
+for fmt in vdb png; do
   (trap '' XFSZ; ulimit -f 1; "$T" sim --scene erosion --size 40 --ticks 1 --seed 9 --out "$tmp/full" --format $fmt --quiet) \
     >/dev/null 2>"$tmp/e"
   rc=$?

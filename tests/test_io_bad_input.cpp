@@ -258,6 +258,7 @@ TEST_CASE("io.bad: every writer reports a full disk and keeps the previous file"
     Grid h;
     s.groundHeight(h);
     const std::vector<std::pair<std::string, std::function<void(const std::string&)>>> writers = {
+        {"frame.vdb", [&](const std::string& f) { writeVdb(f, s); }},
         {"frame.png", [&](const std::string& f) { writePngHeightmap(f, h, 0.01f, 0.0f); }},
         {"frame.exr",
          [&](const std::string& f) {
@@ -290,6 +291,73 @@ TEST_CASE("io.bad: writing onto a folder fails and leaves the folder") {
     CHECK_THROWS_AS(writeNpy((dir / "out.npy").string(), g), IoError);
     CHECK(fs::is_directory(dir / "out.npy"));
     CHECK(filesIn(dir) == 0);
+    fs::remove_all(dir);
+}
+
+// ---------------------------------------------------------------------------
+// OpenVDB
+// ---------------------------------------------------------------------------
+TEST_CASE("io.bad: truncated VDB frames fail quickly at every length") {
+    const fs::path dir = scratchDir("vdbcut");
+    const fs::path good = dir / "good.vdb", cut = dir / "cut.vdb";
+    writeVdb(good.string(), smallTerrain(12, 10));
+    const std::string bytes = readBytes(good);
+    const CostGuard cost;
+    for (std::size_t length = 0; length < bytes.size(); length += (length < 400 ? 1 : 211)) {
+        CAPTURE(length);
+        writeBytes(cut, bytes.substr(0, length));
+        TerrainState r;
+        CHECK(readsOrFailsCleanly(cut, [&] { readVdb(cut.string(), r, {}); }));
+    }
+    fs::remove_all(dir);
+}
+
+TEST_CASE("io.bad: 300 damaged VDB frames each read back or fail cleanly") {
+    const fs::path dir = scratchDir("vdbmut");
+    const fs::path good = dir / "good.vdb", bad = dir / "bad.vdb";
+    const TerrainState s = smallTerrain(12, 10);
+    writeVdb(good.string(), s);
+    const CostGuard cost;
+    int failed = 0;
+    for (const std::string& m : mutants(readBytes(good), 300, 1200)) {
+        writeBytes(bad, m);
+        TerrainState r;
+        failed += readsOrFailsCleanly(bad, [&] {
+            readVdb(bad.string(), r, LayerSet{.water = true, .sediment = true});
+            checkFinite(r);
+        });
+    }
+    MESSAGE(failed << " of 300 damaged frames rejected");
+    CHECK(failed > 0);
+    fs::remove_all(dir);
+}
+
+TEST_CASE("io.bad: a VDB file that is not a frame is rejected with one line") {
+    const fs::path dir = scratchDir("vdbnot");
+    const fs::path good = dir / "good.vdb", bad = dir / "bad.vdb";
+    writeVdb(good.string(), smallTerrain(12, 10));
+    const std::string bytes = readBytes(good);
+    auto patched = [&](std::size_t at, std::uint32_t value) {
+        std::string b = bytes;
+        std::memcpy(&b[at], &value, 4);
+        writeBytes(bad, b);
+        TerrainState r;
+        try {
+            readVdb(bad.string(), r, {});
+        } catch (const IoError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    CHECK(patched(8, 225).find("format 225 is not supported") != std::string::npos);  // version
+    const std::size_t gridCountAt = 8 + 4 + 8 + 1 + 36 + 4;                           // after an empty file metadata
+    CHECK(patched(gridCountAt, 0x7fffffff).find("2147483647 grids") != std::string::npos);  // grid count
+    CHECK(patched(gridCountAt, 0).find("contains no grids") != std::string::npos);
+    std::string stream = bytes;
+    stream[20] = 0;  // the grid offsets flag io::Stream writes
+    writeBytes(bad, stream);
+    TerrainState r;
+    CHECK_THROWS_WITH_AS(readVdb(bad.string(), r, {}), doctest::Contains("stream"), IoError);
     fs::remove_all(dir);
 }
 
