@@ -146,6 +146,13 @@ GreySamples decodeGrey(std::FILE* f, const std::string& file, const PngHeader& h
     return out;
 }
 
+// A number for a message: "%g", not std::to_string's 40 digits of 1e38.
+std::string shortNumber(float v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", static_cast<double>(v));
+    return text;
+}
+
 const char* colourTypeName(int colorType) {
     switch (colorType) {
         case PNG_COLOR_TYPE_RGB:
@@ -175,8 +182,8 @@ Grid readPngHeightmap(const std::string& file, float zScale, float zOffset, int*
     if (!f) throw IoError(file, std::string("cannot open: ") + std::strerror(errno));
     const PngHeader header = peekHeader(f.get(), file);
     if (header.colorType != PNG_COLOR_TYPE_GRAY && header.colorType != PNG_COLOR_TYPE_GRAY_ALPHA)
-        throw IoError(file, std::string("is a ") + colourTypeName(header.colorType) +
-                                " PNG; a heightmap must be a greyscale PNG (16-bit for full precision)");
+        throw IoError(file, std::string("is a colour PNG (") + colourTypeName(header.colorType) +
+                                "); a heightmap must be a greyscale PNG (16-bit for full precision)");
     const GreySamples samples = decodeGrey(f.get(), file, header);
     Grid g(header.width, header.height);
     for (std::size_t i = 0; i < g.v.size(); ++i) {
@@ -188,8 +195,8 @@ Grid readPngHeightmap(const std::string& file, float zScale, float zOffset, int*
         g.v[i] = zOffset + zScale * static_cast<float>(value);
         if (!std::isfinite(g.v[i]))
             throw IoError(file, "pixel (" + std::to_string(i % header.width) + ", " + std::to_string(i / header.width) +
-                                    ") maps to a non-finite height (z-scale " + std::to_string(zScale) + ", z-offset " +
-                                    std::to_string(zOffset) + ")");
+                                    ") maps to a non-finite height (z-scale " + shortNumber(zScale) + ", z-offset " +
+                                    shortNumber(zOffset) + ")");
     }
     if (sourceBitDepth) *sourceBitDepth = header.bitDepth;
     return g;

@@ -420,7 +420,7 @@ TEST_CASE("io.bad: 8-bit grey PNGs are read at 16-bit scale, colour PNGs rejecte
     std::string rgb;
     for (int y = 0; y < 3; ++y) rgb += std::string(1, '\0') + std::string(12, 'a');
     writeBytes(file, pngFile(4, 3, 8, 2, rgb));
-    CHECK_THROWS_WITH_AS(readPngHeightmap(file.string()), doctest::Contains("is a RGB PNG"), IoError);
+    CHECK_THROWS_WITH_AS(readPngHeightmap(file.string()), doctest::Contains("is a colour PNG (RGB)"), IoError);
     fs::remove_all(dir);
 }
 
