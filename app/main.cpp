@@ -27,7 +27,7 @@ int main(int argc, char** argv) {
         // --help and --help-all print the help and succeed; any other parse
         // error is one line and exit 1, like every error of ours
         if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);
-        std::fprintf(stderr, "terrain: error: %s\n", terrain::oneLine(e.what()).c_str());
+        std::fprintf(stderr, "terrain: error: %s\n", terrain::boundedLine(e.what()).c_str());
         return 1;
     }
     try {
@@ -35,10 +35,10 @@ int main(int argc, char** argv) {
             if (sub->parsed()) return run();
     } catch (const terrain::Error& e) {
         // ours, short already; kept to one line whatever a file name holds
-        std::fprintf(stderr, "terrain: error: %s\n", terrain::oneLine(e.what(), 1000).c_str());
+        std::fprintf(stderr, "terrain: error: %s\n", terrain::boundedLine(e.what(), 1000).c_str());
         return 1;
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "terrain: error: %s\n", terrain::oneLine(e.what()).c_str());
+        std::fprintf(stderr, "terrain: error: %s\n", terrain::boundedLine(e.what()).c_str());
         return 1;
     }
     return 1;

@@ -19,10 +19,12 @@ std::vector<float> parseNumberList(const std::string& text, const std::string& o
             v.push_back(std::stof(item, &used));
             if (used != item.size()) throw std::invalid_argument(item);
         } catch (const std::exception&) {
-            throw InputError(option + " '" + oneLine(text, 80) + "': '" + oneLine(item, 40) + "' is not a number");
+            throw InputError(option + " '" + boundedLine(text, 80) + "': '" + boundedLine(item, 40) +
+                             "' is not a number");
         }
         if (!std::isfinite(v.back()))
-            throw InputError(option + " '" + oneLine(text, 80) + "': '" + oneLine(item, 40) + "' is not finite");
+            throw InputError(option + " '" + boundedLine(text, 80) + "': '" + boundedLine(item, 40) +
+                             "' is not finite");
     }
     return v;
 }

@@ -35,6 +35,12 @@ AlbedoMap loadAlbedo(const std::string& spec, int nx, int ny) {
             m.channel[static_cast<std::size_t>(c)].resize(nx, ny, v[static_cast<std::size_t>(c)]);
         return m;
     }
+    // the header first: the size must match before anything is allocated
+    const PngHeader header = peekPngHeader(spec);
+    if (header.width != nx || header.height != ny)
+        throw InputError("--albedo " + spec + ": " + std::to_string(header.width) + " x " +
+                         std::to_string(header.height) + " pixels, the height field has " + std::to_string(nx) + " x " +
+                         std::to_string(ny));
     png_image img;
     std::memset(&img, 0, sizeof img);
     img.version = PNG_IMAGE_VERSION;
@@ -43,8 +49,7 @@ AlbedoMap loadAlbedo(const std::string& spec, int nx, int ny) {
     img.format = PNG_FORMAT_RGB;
     if (static_cast<int>(img.width) != nx || static_cast<int>(img.height) != ny) {
         png_image_free(&img);
-        throw InputError("--albedo " + spec + ": " + std::to_string(img.width) + " x " + std::to_string(img.height) +
-                         " pixels, the height field has " + std::to_string(nx) + " x " + std::to_string(ny));
+        throw IoError(spec, "the PNG changed while it was being read");
     }
     std::vector<std::uint8_t> px(PNG_IMAGE_SIZE(img));
     if (!png_image_finish_read(&img, nullptr, px.data(), 0, nullptr))
@@ -60,10 +65,13 @@ void loadPhongExponentMap(const std::string& file, int nx, int ny, float lo, flo
     if (!(lo >= kMinPhongExponent && hi <= kMaxPhongExponent && lo <= hi))
         throw InputError("--phong-exponent-range: need " + std::to_string(kMinPhongExponent) +
                          " <= MIN <= MAX <= " + std::to_string(kMaxPhongExponent));
+    const PngHeader header = peekPngHeader(file);  // the size must match before the image is decoded
+    if (header.width != nx || header.height != ny)
+        throw InputError("--phong-exponent " + file + ": " + std::to_string(header.width) + " x " +
+                         std::to_string(header.height) + " pixels, the height field has " + std::to_string(nx) + " x " +
+                         std::to_string(ny));
     const Grid raw = readPngHeightmap(file, 1.0f, 0.0f);
-    if (raw.nx != nx || raw.ny != ny)
-        throw InputError("--phong-exponent " + file + ": " + std::to_string(raw.nx) + " x " + std::to_string(raw.ny) +
-                         " pixels, the height field has " + std::to_string(nx) + " x " + std::to_string(ny));
+    if (raw.nx != nx || raw.ny != ny) throw IoError(file, "the PNG changed while it was being read");
     Grid s(nx, ny);
     const double ratio = static_cast<double>(hi) / lo;
     for (std::size_t i = 0; i < s.v.size(); ++i) {

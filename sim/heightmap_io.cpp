@@ -1,8 +1,10 @@
-// Heightmaps by file extension: 16-bit PNG or OpenVDB.
+// Heightmaps by file extension: greyscale PNG or OpenVDB.
 #include "sim/heightmap_io.h"
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 #include "core/error.h"
@@ -10,21 +12,51 @@
 #include "sim/vdb_io.h"
 
 namespace terrain {
+namespace {
+
+Grid readPng(const std::string& file, float zScale, float zOffset) {
+    int bitDepth = 16;
+    Grid g = readPngHeightmap(file, zScale, zOffset, &bitDepth);
+    if (bitDepth < 16)
+        std::fprintf(stderr,
+                     "terrain: warning: %s is a %d-bit PNG: at most 256 height levels, so slopes show as terraces "
+                     "(a 16-bit greyscale PNG keeps 65536)\n",
+                     file.c_str(), bitDepth);
+    return g;
+}
+
+Grid readVdbHeights(const std::string& file, float* cellSizeOut) {
+    TerrainState s;
+    readVdb(file, s, LayerSet{});
+    if (cellSizeOut) *cellSizeOut = s.cellSize;
+    Grid g;
+    s.groundHeight(g);
+    return g;
+}
+
+}  // namespace
 
 Grid readHeightmap(const std::string& file, float zScale, float zOffset, float* cellSizeOut) {
     const std::string ext = std::filesystem::path(file).extension().string();
     std::string lower = ext;
     std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
-    if (lower == ".png") return readPngHeightmap(file, zScale, zOffset);
-    if (lower == ".vdb") {
-        TerrainState s;
-        readVdb(file, s, LayerSet{});
-        if (cellSizeOut) *cellSizeOut = s.cellSize;
-        Grid g;
-        s.groundHeight(g);
-        return g;
-    }
-    throw IoError(file, "unknown heightmap format '" + ext + "' (use .png or .vdb)");
+    Grid g;
+    if (lower == ".png")
+        g = readPng(file, zScale, zOffset);
+    else if (lower == ".vdb")
+        g = readVdbHeights(file, cellSizeOut);
+    else
+        throw IoError(file, "unknown heightmap format '" + ext + "' (use .png or .vdb)");
+    if (g.nx < kMinHeightmapSide || g.ny < kMinHeightmapSide)
+        throw IoError(file, "heightmap of " + std::to_string(g.nx) + " x " + std::to_string(g.ny) +
+                                " cells; a heightmap needs at least " + std::to_string(kMinHeightmapSide) + " x " +
+                                std::to_string(kMinHeightmapSide));
+    // the readers reject non-finite values; bedrock + soil can still overflow
+    for (std::size_t i = 0; i < g.v.size(); ++i)
+        if (!std::isfinite(g.v[i]))
+            throw IoError(file, "cell (" + std::to_string(i % g.nx) + ", " + std::to_string(i / g.nx) +
+                                    ") has a non-finite height");
+    return g;
 }
 
 }  // namespace terrain

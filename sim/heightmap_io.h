@@ -1,5 +1,5 @@
 #pragma once
-// Heightmaps by file extension: 16-bit PNG (core/png_io.h) or OpenVDB
+// Heightmaps by file extension: greyscale PNG (core/png_io.h) or OpenVDB
 // (sim/vdb_io.h).
 #include <string>
 
@@ -7,8 +7,16 @@
 
 namespace terrain {
 
+/// Fewest cells per side of a heightmap: slopes, normals and flow all need a
+/// neighbour on each axis, so a 1-cell-wide field has no terrain to shade or
+/// erode.
+inline constexpr int kMinHeightmapSide = 2;
+
 /// Reads a heightmap by extension: .png (with zScale/zOffset) or .vdb
-/// (cellSize taken from the file when cellSizeOut is given).
+/// (cellSize taken from the file when cellSizeOut is given). IoError when it
+/// is smaller than kMinHeightmapSide per side or a height is NaN or Inf
+/// (naming the first such cell). An 8-bit or lower-depth greyscale PNG is
+/// read, with a one-line warning on stderr that it has only 256 levels.
 Grid readHeightmap(const std::string& file, float zScale, float zOffset, float* cellSizeOut = nullptr);
 
 }  // namespace terrain

@@ -485,7 +485,7 @@ toml::table parseSceneFile(const std::string& file) {
     } catch (const toml::parse_error& e) {
         const auto& b = e.source().begin;
         throw IoError(file, "TOML syntax error at line " + std::to_string(b.line) + ", column " +
-                                std::to_string(b.column) + ": " + oneLine(e.description()));
+                                std::to_string(b.column) + ": " + boundedLine(e.description()));
     }
     if (root.empty()) throw IoError(file, "the scene file sets nothing (start with base = \"erosion\", say)");
     return root;

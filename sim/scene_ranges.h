@@ -10,6 +10,7 @@
 #include <limits>
 
 #include "core/setting_range.h"
+#include "core/size_limits.h"
 
 namespace terrain::scene_ranges {
 
@@ -23,8 +24,8 @@ inline constexpr float kMaxLength = 1.0e8f;  // m
 // height differences into slopes beyond what the GI's single-precision
 // gradients can hold.
 inline constexpr float kMinLength = 1.0e-3f;  // m
-// Grid side: 16384 cells (a 1 GiB float layer); the grid's cell at most 1000 km.
-inline constexpr int kMaxSide = 16384;
+// Grid side: the engine's largest (core/size_limits.h); the grid's cell at most 1000 km.
+inline constexpr int kMaxSide = kMaxGridSide;
 inline constexpr float kMaxCellSize = 1.0e6f;  // m
 // Gravity: from a dwarf planet's (Ceres 0.28 m/s^2) to four times Jupiter's (24.8 m/s^2).
 inline constexpr float kMinGravity = 0.1f, kMaxGravity = 100.0f;  // m/s^2

@@ -1,21 +1,25 @@
-// OpenVDB read/write of terrain layers, kept in one translation unit because
-// the OpenVDB headers are expensive to compile .
+// OpenVDB frames of the terrain's layers. Writing goes through OpenVDB (the
+// OpenVDB headers stay in this translation unit: they are expensive to
+// compile); reading parses the engine's own layout (sim/vdb_read.h).
 //
 // Layout: each layer is a 2-D openvdb::FloatGrid, voxel (x, y, 0) = cell
-// (x, y), background 0, with a uniform linear transform whose voxel size is
-// the cell size. Grids: `height` (bedrock + soil), `bedrock`, `soil`, and
-// `water`, `sediment` when the terrain has them.
+// (x, y), every cell active, background 0, with a uniform linear transform
+// whose voxel size is the cell size, and int32 metadata terrain_nx and
+// terrain_ny. Grids: `height` (bedrock + soil), `bedrock`, `soil`, and
+// `water`, `sediment` when the terrain has them. Blosc-compressed.
 #include "sim/vdb_io.h"
 
 #include <cmath>
-#include <filesystem>
 #include <mutex>
+#include <sstream>
 
-#include <openvdb/io/File.h>
+#include <openvdb/io/Archive.h>
 #include <openvdb/openvdb.h>
 
 #include "core/error.h"
 #include "core/file_io.h"
+#include "core/size_limits.h"
+#include "sim/vdb_read.h"
 
 namespace terrain {
 namespace {
@@ -24,6 +28,19 @@ void initVdb() {
     static std::once_flag once;
     std::call_once(once, [] { openvdb::initialize(); });
 }
+
+// io::File::write streams into an std::ofstream whose failures it never
+// checks, so a full disk gave a short file and no error. This writes the
+// bytes io::File writes (its header, with grid offsets) into memory instead;
+// writeFileAtomic then puts them on disk with every step checked.
+class MemoryArchive : public openvdb::io::Archive {
+public:
+    std::string encode(const openvdb::GridPtrVec& grids) const {
+        std::ostringstream out(std::ios_base::binary);
+        Archive::write(out, grids, /*seekable=*/true);
+        return std::move(out).str();
+    }
+};
 
 openvdb::FloatGrid::Ptr toVdb(const Grid& g, const std::string& name, float cellSize) {
     auto grid = openvdb::FloatGrid::create(0.0f);
@@ -38,17 +55,42 @@ openvdb::FloatGrid::Ptr toVdb(const Grid& g, const std::string& name, float cell
     return grid;
 }
 
-void fromVdb(const std::string& file, const openvdb::FloatGrid& grid, int nx, int ny, Grid& out) {
-    out.resize(nx, ny);
-    auto acc = grid.getConstAccessor();
+// The size of the reference layer. Its active voxels must fill exactly
+// nx x ny cells at z = 0 from (0, 0), as writeVdb writes them; that also
+// bounds what is allocated by what the file holds (a leaf's mask alone
+// takes a byte per cell). The size is the engine's metadata when present,
+// which must agree.
+void layerSize(const std::string& file, const vdb::FloatGrid& g, int& nx, int& ny) {
+    const vdb::ActiveVoxels& a = g.topology.active;
+    if (a.count == 0) throw IoError(file, "grid '" + g.name + "' has no active voxels");
+    if (a.minX != 0 || a.minY != 0) throw IoError(file, "grid '" + g.name + "' does not start at voxel (0, 0)");
+    checkDeclaredSize(file, a.maxX + 1, a.maxY + 1, "cells");
+    nx = static_cast<int>(a.maxX + 1);
+    ny = static_cast<int>(a.maxY + 1);
+    if ((g.declaredNx != 0 || g.declaredNy != 0) && (g.declaredNx != nx || g.declaredNy != ny))
+        throw IoError(file, "grid '" + g.name + "' declares " + std::to_string(g.declaredNx) + " x " +
+                                std::to_string(g.declaredNy) + " cells but its active voxels span " +
+                                std::to_string(nx) + " x " + std::to_string(ny));
+    if (a.count != std::int64_t{nx} * ny)
+        throw IoError(file, "grid '" + g.name + "' has " + std::to_string(a.count) + " active voxels in its " +
+                                std::to_string(nx) + " x " + std::to_string(ny) +
+                                " box; a height field has one per cell");
+}
+
+float cellSizeOf(const std::string& file, const vdb::FloatGrid& g) {
+    if (!(g.voxelX > 0.0) || std::abs(g.voxelX - g.voxelY) > 1e-6 * g.voxelX)
+        throw IoError(file, "grid '" + g.name + "' has non-uniform or non-positive voxels");
+    return static_cast<float>(g.voxelX);
+}
+
+void readLayer(const std::string& file, const vdb::FileReader& reader, const vdb::FloatGrid& g, int nx, int ny,
+               Grid& out) {
+    reader.readValues(g, nx, ny, out);
     for (int y = 0; y < ny; ++y)
-        for (int x = 0; x < nx; ++x) {
-            const float v = acc.getValue(openvdb::Coord(x, y, 0));
-            if (!std::isfinite(v))
-                throw IoError(file, "grid '" + grid.getName() + "' has a non-finite value at x=" + std::to_string(x) +
+        for (int x = 0; x < nx; ++x)
+            if (!std::isfinite(out(x, y)))
+                throw IoError(file, "grid '" + g.name + "' has a non-finite value at x=" + std::to_string(x) +
                                         ", y=" + std::to_string(y));
-            out(x, y) = v;
-        }
 }
 
 }  // namespace
@@ -63,83 +105,40 @@ void writeVdb(const std::string& file, const TerrainState& s) {
     grids.push_back(toVdb(s.soil, "soil", s.cellSize));
     if (!s.water.empty()) grids.push_back(toVdb(s.water, "water", s.cellSize));
     if (!s.suspended.empty()) grids.push_back(toVdb(s.suspended, "sediment", s.cellSize));
-    const std::string tmp = temporaryNameFor(file);
+    std::string bytes;
     try {
-        openvdb::io::File out(tmp);
-        out.setCompression(openvdb::io::COMPRESS_BLOSC);
-        out.write(grids);
-        out.close();
+        MemoryArchive archive;
+        archive.setCompression(openvdb::io::COMPRESS_BLOSC);
+        bytes = archive.encode(grids);
     } catch (const openvdb::Exception& e) {
-        std::remove(tmp.c_str());
-        throw IoError(file, std::string("OpenVDB write failed: ") + e.what());
+        throw IoError(file, std::string("OpenVDB could not encode the frame: ") + e.what());
     }
-    commitTemporary(tmp, file);
+    writeFileAtomic(file, bytes);
 }
 
 void readVdb(const std::string& file, TerrainState& s, const LayerSet& layers) {
-    initVdb();
-    if (!std::filesystem::exists(file)) throw IoError(file, "cannot open: no such file");
-    openvdb::GridPtrVecPtr grids;
-    try {
-        openvdb::io::File in(file);
-        in.open();
-        grids = in.getGrids();
-        in.close();
-    } catch (const std::exception& e) {
-        throw IoError(file, std::string("corrupt, truncated or not an OpenVDB file: ") + e.what());
-    }
-    if (!grids || grids->empty()) throw IoError(file, "contains no grids");
-    auto find = [&](const std::string& name) -> openvdb::FloatGrid::Ptr {
-        for (auto& g : *grids)
-            if (g->getName() == name) {
-                auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
-                if (!f) throw IoError(file, "grid '" + name + "' is a " + g->valueType() + " grid, not a float grid");
-                return f;
-            }
-        return nullptr;
-    };
-    openvdb::FloatGrid::Ptr bedrock = find("bedrock");
-    openvdb::FloatGrid::Ptr soil = find("soil");
-    openvdb::FloatGrid::Ptr height = find("height");
-    if (!height && !bedrock) {
-        for (auto& g : *grids)
-            if ((height = openvdb::gridPtrCast<openvdb::FloatGrid>(g))) break;
-        if (!height) throw IoError(file, "has no float grid (expected one named 'height')");
-    }
-    const openvdb::FloatGrid& ref = bedrock ? *bedrock : *height;
-    // size from our metadata, or else from the active bounding box
+    const vdb::FileReader reader(file);
+    const vdb::GridEntry* bedrock = reader.find("bedrock");
+    const vdb::GridEntry* height = reader.find("height");
+    const vdb::GridEntry* base = bedrock ? bedrock : (height ? height : reader.firstFloatGrid());
+    if (!base) throw IoError(file, "has no float grid (expected one named 'height')");
+    const vdb::FloatGrid ref = reader.readGrid(*base);
     int nx = 0, ny = 0;
-    const openvdb::CoordBBox box = ref.evalActiveVoxelBoundingBox();
-    if (auto m = ref.getMetadata<openvdb::Int32Metadata>("terrain_nx")) nx = m->value();
-    if (auto m = ref.getMetadata<openvdb::Int32Metadata>("terrain_ny")) ny = m->value();
-    if (nx == 0 || ny == 0) {
-        if (box.empty()) throw IoError(file, "grid '" + ref.getName() + "' has no active voxels");
-        if (box.min().x() != 0 || box.min().y() != 0)
-            throw IoError(file, "grid '" + ref.getName() + "' does not start at voxel (0, 0)");
-        nx = box.max().x() + 1;
-        ny = box.max().y() + 1;
-    }
-    if (!box.empty() && (box.min().z() != 0 || box.max().z() != 0))
-        throw IoError(file, "grid '" + ref.getName() + "' is 3-D; a height field is one z layer");
-    const openvdb::Vec3d vs = ref.voxelSize();
-    if (!ref.transform().isLinear() || std::abs(vs.x() - vs.y()) > 1e-6 * vs.x())
-        throw IoError(file, "grid '" + ref.getName() + "' has non-uniform or non-linear voxels");
+    layerSize(file, ref, nx, ny);
+    const float cell = cellSizeOf(file, ref);
     try {
-        checkDimensions(nx, ny, static_cast<float>(vs.x()));
+        checkDimensions(nx, ny, cell);
     } catch (const InputError& e) {
         throw IoError(file, e.what());
     }
-    s.allocate(nx, ny, static_cast<float>(vs.x()), layers);
-    if (bedrock) {
-        fromVdb(file, *bedrock, nx, ny, s.bedrock);
-        if (soil) fromVdb(file, *soil, nx, ny, s.soil);
-    } else {
-        fromVdb(file, *height, nx, ny, s.bedrock);
-    }
-    if (!s.water.empty())
-        if (auto w = find("water")) fromVdb(file, *w, nx, ny, s.water);
-    if (!s.suspended.empty())
-        if (auto sd = find("sediment")) fromVdb(file, *sd, nx, ny, s.suspended);
+    s.allocate(nx, ny, cell, layers);
+    readLayer(file, reader, ref, nx, ny, s.bedrock);
+    auto readOptional = [&](const char* name, Grid& out) {
+        if (const vdb::GridEntry* e = reader.find(name)) readLayer(file, reader, reader.readGrid(*e), nx, ny, out);
+    };
+    if (bedrock) readOptional("soil", s.soil);
+    if (!s.water.empty()) readOptional("water", s.water);
+    if (!s.suspended.empty()) readOptional("sediment", s.suspended);
 }
 
 }  // namespace terrain

@@ -174,5 +174,50 @@ scene_error "empty scene file" "sets nothing" ''
 mkdir -p "$tmp/folder.toml"
 expect_error "a folder as the scene" "is not a file" "$T" sim --scene "$tmp/folder.toml" --ticks 1
 
+# hostile inputs: one short error line, quickly (unit tests: tests/test_io_bad_input.cpp)
+expect_short_error() {  # description, pattern, command...
+  local what=$1 pattern=$2
+  shift 2
+  timeout 60 "$@" >"$tmp/o" 2>"$tmp/e"
+  local rc=$?
+  if [ $rc = 1 ] && [ "$(wc -l <"$tmp/e")" = 1 ] && [ "$(wc -c <"$tmp/e")" -le 400 ] && grep -q -- "$pattern" "$tmp/e"; then ok
+  else bad "$what: rc=$rc stderr=$(head -c 600 "$tmp/e")"; fi
+}
+vdb="$tmp/frames/frame_000000.vdb"
+head -c 8192 "$vdb" >"$tmp/cut.vdb"
+expect_short_error "truncated VDB heightmap" "cut.vdb: truncated: grid 'height' ends at byte" "$T" gi --heightmap "$tmp/cut.vdb" --cell-size 10
+cp "$vdb" "$tmp/grids.vdb"
+printf '\377\377\377\177' | dd of="$tmp/grids.vdb" bs=1 seek=61 conv=notrunc 2>/dev/null
+expect_short_error "VDB declaring 2^31 grids" "2147483647 grids" "$T" gi --heightmap "$tmp/grids.vdb" --cell-size 10
+cp "$vdb" "$tmp/mutant.vdb"
+printf '\377\377' | dd of="$tmp/mutant.vdb" bs=1 seek=$(( $(wc -c <"$vdb") / 2 )) conv=notrunc 2>/dev/null
+expect_short_error "damaged VDB heightmap" "mutant.vdb" "$T" gi --heightmap "$tmp/mutant.vdb" --cell-size 10
+# a 68-byte PNG declaring 60000 x 60000 pixels; a 1 x 1 PNG; an 8-bit grey PNG
+echo 'iVBORw0KGgoAAAANSUhEUgAA6mAAAOpgEAAAAAD1KfbdAAAAC0lEQVR4nGNggAAAAAgAAbdYc5UAAAAASUVORK5CYII=' | base64 -d >"$tmp/huge.png"
+expect_short_error "PNG declaring 60000 x 60000" "60000 x 60000 pixels" "$T" gi --heightmap "$tmp/huge.png" --cell-size 10
+echo 'iVBORw0KGgoAAAANSUhEUgAAAAEAAAABEAAAAABq7kcWAAAAC0lEQVR4nGMQMgEAAFsAR5b7G2UAAAAASUVORK5CYII=' | base64 -d >"$tmp/one.png"
+expect_short_error "1 x 1 heightmap" "at least 2 x 2" "$T" gi --heightmap "$tmp/one.png" --cell-size 10
+echo 'iVBORw0KGgoAAAANSUhEUgAAAAQAAAAECAAAAACMmsGiAAAAHElEQVR4nGNgsKnYwsDl1rSPQSSg5wSDXNS0SwA5HAaR4OH8SgAAAABJRU5ErkJggg==' | base64 -d >"$tmp/grey8.png"
+"$T" gi --heightmap "$tmp/grey8.png" --cell-size 10 --out-ambient "$tmp/grey8.npy" >/dev/null 2>"$tmp/e" && [ -s "$tmp/grey8.npy" ] \
+  && [ "$(grep -c 'warning: .*8-bit PNG' "$tmp/e")" = 1 ] && ok || bad "8-bit PNG heightmap: $(cat "$tmp/e")"
+printf '#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 4 +X 30000\n' >"$tmp/wide.hdr"
+expect_short_error "HDR declaring 30000 pixels wide" "30000 x 4 pixels" "$T" gi --heightmap "$hm24" --cell-size 10 --light "$tmp/wide.hdr"
+mkdir -p "$tmp/fdir/frame_000000.vdb"
+expect_short_error "frame path is a folder" "frame_000000.vdb: cannot move" "$T" sim --scene erosion --size 16 --ticks 1 \
+  --out "$tmp/fdir" --format vdb --quiet
+[ -d "$tmp/fdir/frame_000000.vdb" ] && [ "$(ls -A "$tmp/fdir" | wc -l)" = 1 ] && ok || bad "frame path is a folder: $(ls "$tmp/fdir")"
+# a full disk (a file size limit): the run fails naming the frame, and the
+# frames already in the folder keep their bytes, with no temporary left
+"$T" sim --scene erosion --size 40 --ticks 1 --out "$tmp/full" --format both --quiet >/dev/null 2>&1
+cp -r "$tmp/full" "$tmp/full_before"
+for fmt in vdb png; do
+  (trap '' XFSZ; ulimit -f 1; "$T" sim --scene erosion --size 40 --ticks 1 --seed 9 --out "$tmp/full" --format $fmt --quiet) \
+    >/dev/null 2>"$tmp/e"
+  rc=$?
+  if [ $rc = 1 ] && [ "$(wc -l <"$tmp/e")" = 1 ] && grep -q "frame_000000.$fmt: .*write failed.*File too large" "$tmp/e"; then ok
+  else bad "full disk ($fmt): rc=$rc $(cat "$tmp/e")"; fi
+done
+diff -r "$tmp/full_before" "$tmp/full" >/dev/null && ok || bad "a failed write changed the frames or left files behind"
+
 echo "cli: $pass passed, $fail failed"
 [ $fail -eq 0 ]
