@@ -19,7 +19,7 @@ std::vector<float> parseNumberList(const std::string& text, const std::string& o
             v.push_back(std::stof(item, &used));
             if (used != item.size()) throw std::invalid_argument(item);
         } catch (const std::exception&) {
-            throw InputError(option + " '" + text + "': '" + item + "' is not a number");
+            throw InputError(option + " " + quoteForMessage(text) + ": " + quoteForMessage(item) + " is not a number");
         }
     }
     return v;
@@ -29,6 +29,27 @@ std::string formatNumber(double v) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%g", v);
     return buf;
+}
+
+std::string quoteForMessage(std::string_view text) {
+    std::string out = "'";
+    std::size_t shown = 0;
+    for (char c : text) {
+        if (shown == kMaxQuotedChars) {
+            out += "...";
+            break;
+        }
+        const auto byte = static_cast<unsigned char>(c);
+        if (byte >= 0x20 && byte < 0x7f) {
+            out += c;
+        } else {
+            char hex[5];
+            std::snprintf(hex, sizeof hex, "\\x%02x", byte);
+            out += hex;
+        }
+        ++shown;
+    }
+    return out + "'";
 }
 
 }  // namespace terrain
