@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <sstream>
 
 #include "core/error.h"
@@ -32,24 +33,18 @@ std::string formatNumber(double v) {
 }
 
 std::string quoteForMessage(std::string_view text) {
-    std::string out = "'";
-    std::size_t shown = 0;
+    std::string quoted;
     for (char c : text) {
-        if (shown == kMaxQuotedChars) {
-            out += "...";
+        const auto byte = static_cast<unsigned char>(c);
+        char shown[5] = {c, 0};
+        if (byte < 0x20 || byte >= 0x7f) std::snprintf(shown, sizeof shown, "\\x%02x", byte);
+        if (quoted.size() + std::strlen(shown) > kMaxQuotedChars) {
+            quoted += "...";
             break;
         }
-        const auto byte = static_cast<unsigned char>(c);
-        if (byte >= 0x20 && byte < 0x7f) {
-            out += c;
-        } else {
-            char hex[5];
-            std::snprintf(hex, sizeof hex, "\\x%02x", byte);
-            out += hex;
-        }
-        ++shown;
+        quoted += shown;
     }
-    return out + "'";
+    return "'" + quoted + "'";
 }
 
 }  // namespace terrain

@@ -45,4 +45,9 @@ TEST_CASE("core.parse: quoteForMessage") {
     const std::string cut = quoteForMessage(std::string(kMaxQuotedChars, 'a') + "b");
     CHECK(cut == "'" + std::string(kMaxQuotedChars, 'a') + "...'");
     CHECK(quoteForMessage(std::string(kMaxQuotedChars, 'a')) == "'" + std::string(kMaxQuotedChars, 'a') + "'");
+    // the limit holds for the escaped form: 60 control bytes show as 15 escapes
+    // (found by the fuzz target: escapes had made the message 4 times as long)
+    const std::string escapes = quoteForMessage(std::string(kMaxQuotedChars, '\x1e'));
+    CHECK(escapes.size() == kMaxQuotedChars + 5);
+    CHECK(escapes.substr(0, 9) == "'\\x1e\\x1e");
 }
