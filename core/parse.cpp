@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <sstream>
 
 #include "core/error.h"
@@ -19,12 +20,10 @@ std::vector<float> parseNumberList(const std::string& text, const std::string& o
             v.push_back(std::stof(item, &used));
             if (used != item.size()) throw std::invalid_argument(item);
         } catch (const std::exception&) {
-            throw InputError(option + " '" + boundedLine(text, 80) + "': '" + boundedLine(item, 40) +
-                             "' is not a number");
+            throw InputError(option + " " + quoteForMessage(text) + ": " + quoteForMessage(item) + " is not a number");
         }
         if (!std::isfinite(v.back()))
-            throw InputError(option + " '" + boundedLine(text, 80) + "': '" + boundedLine(item, 40) +
-                             "' is not finite");
+            throw InputError(option + " " + quoteForMessage(text) + ": " + quoteForMessage(item) + " is not finite");
     }
     return v;
 }
@@ -33,6 +32,21 @@ std::string formatNumber(double v) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%g", v);
     return buf;
+}
+
+std::string quoteForMessage(std::string_view text) {
+    std::string quoted;
+    for (char c : text) {
+        const auto byte = static_cast<unsigned char>(c);
+        char shown[5] = {c, 0};
+        if (byte < 0x20 || byte >= 0x7f) std::snprintf(shown, sizeof shown, "\\x%02x", byte);
+        if (quoted.size() + std::strlen(shown) > kMaxQuotedChars) {
+            quoted += "...";
+            break;
+        }
+        quoted += shown;
+    }
+    return "'" + quoted + "'";
 }
 
 }  // namespace terrain

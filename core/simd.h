@@ -57,12 +57,26 @@ struct LaneTraits<F8> {
 template <class V>
 inline constexpr int kLaneCount = LaneTraits<V>::n;
 
+// The 8-wide sqrt and sign mask work on the two 4-wide halves with SSE2
+// builtins: an AVX builtin would need the helper to be an AVX function, and
+// Clang rejects a call that passes F8 from a function without AVX (the F8
+// kernel instance, which only its AVX2 wrapper makes AVX code by inlining it)
+// to one with AVX. Inlined into the wrapper they become VEX instructions.
+[[gnu::always_inline]] inline F4 lowHalf(F8 x) { return __builtin_shufflevector(x, x, 0, 1, 2, 3); }
+[[gnu::always_inline]] inline F4 highHalf(F8 x) { return __builtin_shufflevector(x, x, 4, 5, 6, 7); }
+[[gnu::always_inline]] inline F8 joinHalves(F4 lo, F4 hi) {
+    return __builtin_shufflevector(lo, hi, 0, 1, 2, 3, 4, 5, 6, 7);
+}
+
 [[gnu::always_inline]] inline float sqrtv(float x) { return std::sqrt(x); }
 [[gnu::always_inline]] inline F4 sqrtv(F4 x) { return __builtin_ia32_sqrtps(x); }
-[[gnu::target("avx")]] inline F8 sqrtv(F8 x) { return __builtin_ia32_sqrtps256(x); }
+[[gnu::always_inline]] inline F8 sqrtv(F8 x) { return joinHalves(sqrtv(lowHalf(x)), sqrtv(highHalf(x))); }
 /// One bit per lane: the lane's sign bit (a comparison mask's "true").
 [[gnu::always_inline]] inline int laneBits(I4 m) { return __builtin_ia32_movmskps(reinterpret_cast<F4>(m)); }
-[[gnu::target("avx")]] inline int laneBits(I8 m) { return __builtin_ia32_movmskps256(reinterpret_cast<F8>(m)); }
+[[gnu::always_inline]] inline int laneBits(I8 m) {
+    const F8 f = reinterpret_cast<F8>(m);
+    return laneBits(reinterpret_cast<I4>(lowHalf(f))) | laneBits(reinterpret_cast<I4>(highHalf(f))) << 4;
+}
 
 template <class T>
 [[gnu::always_inline]] inline T load(const float* p) {

@@ -140,7 +140,7 @@ struct CastingRow {
         } else {
             const V f = load<V>(F + X0);
             const V fNew = half * (sNew * sNew) - gl * (half * (atanv(tc) + sNew * r));
-            const V fv = nw & (tc >= gl) ? fNew : f;  // below the receiver's plane: nothing
+            const V fv = (nw & (tc >= gl)) ? fNew : f;  // below the receiver's plane: nothing
             mo[0] = fv - f;
             store(F + X0, fv);
         }

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <string>
 #include <type_traits>
+#include <utility>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -52,24 +53,27 @@ using namespace simd;
 constexpr int kMaxShadingLights = 8;  // lights per incident pass (more are folded in several passes)
 
 // ---- algorithm: horizontal SH interpolation (Fig. 7), L texels x .. x+L-1 ----
+// Lane l of the result is lane l / S + K of a: with K = 0 the sample left of
+// texel S X + l, with K = 1 the one right of it. The indices are constants
+// (a shuffle, which GCC and Clang both spell __builtin_shufflevector).
+template <int S, int K, class V, int... L>
+[[gnu::always_inline]] inline V spreadLanes(V a, std::integer_sequence<int, L...>) {
+    return __builtin_shufflevector(a, a, (L / S + K)...);
+}
+
 // Texel x = s X + k reads v[X] + (k / s) (v[X + 1] - v[X]), as the scalar code.
 template <class V, int S>
 [[gnu::always_inline]] inline V expandV(const float* v, int x) {
-    using I = typename LaneTraits<V>::I;
     constexpr int L = LaneTraits<V>::n;
     if constexpr (S == 1) {
         return load<V>(v + x);
     } else {
         // lane l reads X0 + l / S and X0 + l / S + 1 with the weight (l % S) / S
-        I lo{}, fr{};
         V f{};
-        for (int l = 0; l < L; ++l) {
-            lo[l] = l / S;
-            fr[l] = l / S + 1;
-            f[l] = static_cast<float>(l % S) / static_cast<float>(S);
-        }
+        for (int l = 0; l < L; ++l) f[l] = static_cast<float>(l % S) / static_cast<float>(S);
         const V a = load<V>(v + x / S);
-        const V vlo = __builtin_shuffle(a, lo), vhi = __builtin_shuffle(a, fr);
+        const V vlo = spreadLanes<S, 0>(a, std::make_integer_sequence<int, L>{});
+        const V vhi = spreadLanes<S, 1>(a, std::make_integer_sequence<int, L>{});
         return vlo + f * (vhi - vlo);
     }
 }

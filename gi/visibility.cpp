@@ -142,7 +142,7 @@ struct SampleMaxVisitor {
         for (int k = 0; k < NV; ++k) m[k] = m[k] > s[k] ? m[k] : s[k];
     }
     void some(int, const V* s, const I* valid, const I*) {
-        for (int k = 0; k < NV; ++k) m[k] = valid[k] & (s[k] > m[k]) ? s[k] : m[k];
+        for (int k = 0; k < NV; ++k) m[k] = (valid[k] & (s[k] > m[k])) ? s[k] : m[k];
     }
     void result(float* out) const {
         for (int k = 0; k < NV; ++k) store(out + LaneTraits<V>::n * k, m[k]);
@@ -183,10 +183,10 @@ struct BsplineMaxVisitor {
             if (i == 0) {
                 p1[k] = p2[k] = p3[k] = v;  // invalid lanes: empty sequence, stays kNoBlocker
             }
-            m[k] = valid[k] & (v > m[k]) ? v : m[k];
+            m[k] = (valid[k] & (v > m[k])) ? v : m[k];
             if (i >= 2) {
                 const V md = mid(p3[k], p2[k], p1[k], v);
-                m[k] = (iv <= steps[k]) & (md > m[k]) ? md : m[k];
+                m[k] = ((iv <= steps[k]) & (md > m[k])) ? md : m[k];
             }
             p3[k] = p2[k];
             p2[k] = p1[k];

@@ -400,7 +400,11 @@ void momentumRows(const Views& w, const StepConsts& c, int y0, int y1) {
     const std::size_t su = w.su(), sc = w.sc();
     const int nx = w.nx, ny = w.ny;
     for (int y = y0; y < y1; ++y) {
-        const auto [r, h, bed, soil] = w.cellRow(y);
+        // Plain locals rather than a structured binding: the lambda below
+        // captures them, which Clang before 16 does not allow for bindings.
+        const Views::CellRow cells = w.cellRow(y);
+        const std::size_t r = cells.r;
+        const float *h = cells.h, *bed = cells.bed, *soil = cells.soil;
 
         // ---- u faces of row y: face x between cells x-1 and x, x in [1, nx) ----
         const float* u = w.u + y * su;

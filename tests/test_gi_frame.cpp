@@ -36,7 +36,8 @@ double worstDeviation(const Grid& g, float value) {
 TEST_CASE("gi.frame: a flat plane under a uniform unit sky: ambient and shade 1 within 1e-6, indirect exactly 0") {
     for (int settingsKind = 0; settingsKind < 2; ++settingsKind)
         for (int s : {1, 2, 4})
-            for (auto [nx, ny] : {std::pair{64, 64}, std::pair{37, 29}}) {
+            for (const auto& size : {std::pair{64, 64}, std::pair{37, 29}}) {
+                const int nx = size.first, ny = size.second;  // plain locals: INFO captures them
                 const GiSettings settings = withBounces(settingsKind == 0 ? paperGiSettings() : GiSettings{}, s, 1);
                 const Grid h(nx, ny, 312.5f);
                 const AlbedoMap a = uniformAlbedo(nx, ny, 0.6f);

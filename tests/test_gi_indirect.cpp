@@ -197,7 +197,8 @@ TEST_CASE("gi.indirect: hard cases stay finite") {
             GiState st;
             const AlbedoMap a = uniformAlbedo(g.nx, g.ny, 0.8f);
             runGiFrame(g.view(), 1.0f, GiLighting{}, indirectSettings(2, s), st, &a);
-            INFO(name << " at " << s << "x");
+            const std::string& caseName = name;  // INFO captures it: a plain reference, not the binding
+            INFO(caseName << " at " << s << "x");
             CHECK(finite(st));
         }
 }

@@ -126,9 +126,10 @@ TEST_CASE("gi.pyramid: a constant field: octaves and level 0 exactly the constan
     // from octave 1 on may drift by a few ulp (measured: up to 3).
     const std::pair<int, int> sizes[] = {{64, 64}, {37, 23}, {5, 9}, {2, 2}, {1, 1}};
     for (float value : {123.456f, -7.3f})
-        for (auto [nx, ny] : sizes)
+        for (const auto& size : sizes)
             for (int s : {1, 2, 4})
                 for (float blend : {0.0f, 0.5f, 1.0f}) {
+                    const int nx = size.first, ny = size.second;  // plain locals: INFO captures them
                     const Grid g(nx, ny, value);
                     HeightPyramid p;
                     buildHeightPyramid(g.cview(), 1.0f, s, pyramidSettings(4, 0, blend), p);
@@ -255,8 +256,9 @@ TEST_CASE("gi.pyramid: a single spike: mean octaves divide it by 4^o, max octave
 
 TEST_CASE("gi.pyramid: sizes of non-square, non-power-of-two and tiny fields at 1x/2x/4x; raw phases and level 0") {
     const std::pair<int, int> sizes[] = {{37, 23}, {64, 48}, {33, 65}, {5, 1}, {1, 7}, {2, 2}, {1, 1}};
-    for (auto [nx, ny] : sizes)
+    for (const auto& size : sizes)
         for (int s : {1, 2, 4}) {
+            const int nx = size.first, ny = size.second;  // plain locals: INFO captures them
             const Grid g = gridOf(nx, ny, [](int x, int y) {
                 return static_cast<float>(3 * x - 2 * y) + 0.25f * static_cast<float>(x * y % 7);
             });

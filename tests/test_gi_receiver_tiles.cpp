@@ -240,7 +240,8 @@ TEST_CASE("gi.tiles: visibility recomputes the dirty tiles bit-identically and l
                         CAPTURE(s);
                         CAPTURE(key);
                         CAPTURE(tileSize);
-                        CAPTURE(name);
+                        const std::string& pattern = name;  // CAPTURE takes it: a plain reference, not the binding
+                        CAPTURE(pattern);
                         tiles.dirty = dirty;
                         checkVisibilityTiles(b, cb, fullA, fullB, tiles);
                     }
@@ -286,7 +287,8 @@ TEST_CASE("gi.tiles: the Lambert scans recompute the dirty tiles' receivers bit-
                         CAPTURE(s);
                         CAPTURE(kindName(kind));
                         CAPTURE(tileSize);
-                        CAPTURE(name);
+                        const std::string& pattern = name;  // CAPTURE takes it: a plain reference, not the binding
+                        CAPTURE(pattern);
                         tiles.dirty = dirty;
                         IndirectState st = stA;  // A's full result, then B over the tiles
                         const std::vector<float> got = scanOutputs(b, kind, st, &tiles);

@@ -189,7 +189,8 @@ TEST_CASE("gi.visibility: hard cases give finite output") {
             settings.subsample = s;
             GiState st;
             runGiFrame(g.cview(), 1.0f, light, settings, st);
-            INFO(name << " subsample " << s);
+            const char* caseName = name;  // INFO captures it: a plain variable, not the binding
+            INFO(caseName << " subsample " << s);
             CHECK(allFinite(st));
             for (float v : st.shade.ambient.v) CHECK((v > -0.2f && v < 1.2f));
         }

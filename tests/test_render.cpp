@@ -380,8 +380,9 @@ TEST_CASE("render.lod: every stitch variant of a chunk tiles it, its borders mat
 }
 
 TEST_CASE("render.lod: chunk errors match a brute-force computation, for any thread count") {
-    for (const auto& [nx, ny] : {std::pair{33, 33}, std::pair{40, 45}, std::pair{66, 66}, std::pair{97, 90}})
+    for (const auto& size : {std::pair{33, 33}, std::pair{40, 45}, std::pair{66, 66}, std::pair{97, 90}})
         for (int quads : {4, 8}) {
+            const int nx = size.first, ny = size.second;  // plain locals: CAPTURE and the lambdas take them
             CAPTURE(nx);
             CAPTURE(ny);
             CAPTURE(quads);

@@ -445,8 +445,9 @@ TEST_CASE("sim.waves: bit-identical results for 1, 2, 3 and 8 threads") {
     // Non-power-of-two grids with a drop and a swell. 307 x 211 spans several
     // row chunks of parallelForRows (16384 cells each), so the threads really
     // split the work; 67 x 45 is a single chunk.
-    for (auto [nx, ny] : {std::pair{307, 211}, std::pair{67, 45}}) {
-        auto run = [nx = nx, ny = ny] {
+    for (const auto& size : {std::pair{307, 211}, std::pair{67, 45}}) {
+        const int nx = size.first, ny = size.second;  // plain locals: INFO and the lambda capture them
+        auto run = [nx, ny] {
             TerrainState s = makeWaterState(nx, ny, 1.5f);
             setGround(s, [](int x, int y) { return -4.0f + 0.05f * static_cast<float>(x) + 2.0f * hash01(x, y, 11); });
             fillToLevel(s, 0.0f);

@@ -1,0 +1,121 @@
+#!/usr/bin/env bash
+# Runs the fuzz targets of a TERRAIN_FUZZ build: first every input saved in
+# fuzz/regressions/<target>/ (each once: a fixed finding must stay fixed),
+# then each target for SECONDS from its seeds in fuzz/corpus/<target>/.
+# Fails when any input crashes, trips ASan or UBSan, leaks (fuzz/lsan.supp
+# lists the third-party leaks not counted), runs out of time or memory (but
+# see library_ooms below), or breaks a target's checks (fuzz/fuzz_input.h).
+#
+#   CC=clang CXX=clang++ cmake -S . -B build-fuzz -DTERRAIN_FUZZ=ON \
+#     -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTERRAIN_BUILD_TESTS=OFF -DTERRAIN_BUILD_BENCH=OFF
+#   cmake --build build-fuzz -j2 --target fuzz
+#   fuzz/run.sh build-fuzz 30        # 30 s per target; 0: the regressions only
+#
+# Inputs the fuzzer finds (crash-*, leak-*, timeout-*, oom-*) are kept in
+# BUILD_DIR/fuzz-findings/<target>/ until the next run. To keep one as a
+# regression, minimise it (BUILD_DIR/fuzz/<target> -minimize_crash=1
+# -runs=20000 FILE), name it for what it does and add it under
+# fuzz/regressions/<target>/ with the fix.
+# New coverage-increasing inputs stay in BUILD_DIR/fuzz-corpus/, not in git.
+# Usage: fuzz/run.sh BUILD_DIR [SECONDS [TARGET...]]   (default: every target)
+set -uo pipefail
+SRC=$(cd "$(dirname "$0")/.." && pwd)
+BUILD=$(realpath "$1")
+SECONDS_EACH=${2:-30}
+shift $(($# < 2 ? $# : 2))
+
+# Largest input per target: room for the seeds and some growth, small enough
+# that a multi-gigabyte allocation can only come from a size the file declares.
+declare -A max_len=(
+  [albedo_png]=16384 [equirect_exr]=16384 [equirect_hdr]=16384 [exponent_png]=16384
+  [number_list]=4096 [png_heightmap]=16384 [scene_toml]=8192 [vdb]=131072
+)
+# An allocation over 1 GiB (the largest legitimate one from such small files is
+# a few MB) or a process over 2 GiB is a finding, as is an input taking 10 s.
+limits=(-rss_limit_mb=2048 -malloc_limit_mb=1024 -timeout=10)
+# OpenVDB 10 and OpenEXR 3.1 allocate what a file's header declares (metadata,
+# names, attributes, compressed blocks) inside their open and read calls,
+# before our readers see a size. Their targets fuzz in fork mode past every
+# finding; then each saved input is replayed, and only those that run out of
+# memory are kept without failing the run. Their regressions run strictly.
+library_ooms=" equirect_exr vdb "
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1}
+export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$SRC/fuzz/lsan.supp:print_suppressions=0}
+
+# Fuzzes $target for SECONDS_EACH; fails on a finding.
+fuzz_target() {
+  local args=("${limits[@]}" -max_len="${max_len[$target]}" -max_total_time="$SECONDS_EACH"
+    -artifact_prefix="$findings/$target/" -print_final_stats=1 "$corpus" "$SRC/fuzz/corpus/$target")
+  if [[ $library_ooms != *" $target "* ]]; then
+    "$bin" "${args[@]}" >"$log" 2>&1
+    return
+  fi
+  "$bin" -fork=1 -ignore_crashes=1 -ignore_ooms=1 "${args[@]}" >"$log" 2>&1
+  local input replay found=0
+  for input in "$findings/$target"/*; do
+    [ -e "$input" ] || continue
+    replay=$("$bin" "${limits[@]}" -runs=1 "$input" 2>&1)
+    if grep -aqE "out-of-memory|allocation-size-too-big" <<<"$replay"; then
+      ooms=$((ooms + 1))
+    else
+      echo "$input: $(grep -aE -m 1 "ERROR|runtime error|terrain fuzz" <<<"$replay" | cut -c 1-300)" >>"$log.findings"
+      found=1
+    fi
+  done
+  return $found
+}
+
+findings=$BUILD/fuzz-findings
+mkdir -p "$findings"
+fail=0
+targets=("$@")
+((${#targets[@]})) || targets=($(printf '%s\n' "${!max_len[@]}" | sort))
+for target in "${targets[@]}"; do
+  if [ -z "${max_len[$target]:-}" ]; then
+    echo "fuzz: no target $target (targets: ${!max_len[*]})"
+    fail=1
+    continue
+  fi
+  bin=$BUILD/fuzz/$target
+  if [ ! -x "$bin" ]; then
+    echo "fuzz: $bin is missing (build the target fuzz of a TERRAIN_FUZZ build)"
+    fail=1
+    continue
+  fi
+  # each regression input on its own, so that every failing one is named
+  passed=0
+  for input in "$SRC/fuzz/regressions/$target"/*; do
+    [ -e "$input" ] || continue
+    log=$findings/$target-regression-$(basename "$input").log
+    if "$bin" "${limits[@]}" "$input" >"$log" 2>&1; then
+      rm "$log"
+      passed=$((passed + 1))
+    else
+      echo "fuzz: $target: regression $(basename "$input") fails (log: $log):"
+      grep -aE "ERROR|SUMMARY|runtime error|terrain fuzz" "$log" | head -n 4 | cut -c 1-300
+      fail=1
+    fi
+  done
+  [ $passed = 0 ] || echo "fuzz: $target: $passed regression inputs pass"
+  [ "$SECONDS_EACH" = 0 ] && continue
+  log=$findings/$target.log
+  corpus=$BUILD/fuzz-corpus/$target
+  mkdir -p "$corpus"
+  rm -rf "$findings/$target" "$log.findings"  # the saved inputs of an earlier run
+  mkdir -p "$findings/$target"
+  ooms=0
+  if fuzz_target; then
+    runs=$(grep -aoE 'stat::number_of_executed_units: *[0-9]*|^#[0-9]+' "$log" | tail -n 1 | grep -oE '[0-9]+$')
+    echo "fuzz: $target: $SECONDS_EACH s, $runs inputs, no finding$([ $ooms = 0 ] || echo " ($ooms out-of-memory inputs kept)")"
+  else
+    echo "fuzz: $target: FINDING (log: $log):"
+    if [ -e "$log.findings" ]; then
+      head -n 12 "$log.findings"
+    else
+      grep -aE "ERROR|SUMMARY|runtime error|terrain fuzz|Test unit written" "$log" | head -n 12
+    fi
+    fail=1
+  fi
+done
+exit $fail
