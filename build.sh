@@ -4,11 +4,16 @@
 #
 #   ./build.sh          install + build
 #   ./build.sh demo     install + build + run the animated demo
-#   ./build.sh test     install + build + run every test
+#   ./build.sh test     install + build + run every test: the suite on the
+#                       Release build, then on a Clang build (with the GCC /
+#                       Clang byte comparison), on an ASan + UBSan build, and
+#                       every fuzz target (TEST_STAGES picks, see below)
 #   ./build.sh bench    install + build + run the benchmarks (minutes)
 #
 # Environment: BUILD_DIR (default build), SANITIZE=1 for an ASan+UBSan build,
-# JOBS (default: number of cores).
+# JOBS (default: number of cores), TEST_STAGES (default "release clang
+# sanitize fuzz"; "release" alone for a quick run), FUZZ_SECONDS (default 30,
+# per fuzz target).
 set -euo pipefail
 cd "$(dirname "$0")"
 
@@ -18,6 +23,7 @@ PACKAGES=(
   libopenvdb-dev libboost-dev libboost-iostreams-dev libtbb-dev libimath-dev libopenexr-dev libblosc-dev
   doctest-dev libpng-dev libtomlplusplus-dev libcli11-dev libimgui-dev
   xvfb xauth xdotool
+  clang libclang-rt-14-dev
 )
 
 missing=()
@@ -48,8 +54,28 @@ case "${1:-}" in
   test)
     shift
     # the sanitizer build: third-party leaks at exit (Mesa) are not ours
-    if [ "${SANITIZE:-0}" = 1 ]; then export LSAN_OPTIONS="suppressions=$PWD/tests/lsan.supp:print_suppressions=0${LSAN_OPTIONS:+:$LSAN_OPTIONS}"; fi
-    cd "$BUILD_DIR" && exec ctest --output-on-failure "$@" ;;
+    export LSAN_OPTIONS="suppressions=$PWD/tests/lsan.supp:print_suppressions=0${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
+    for stage in ${TEST_STAGES:-release clang sanitize fuzz}; do
+      echo "build.sh test: stage $stage"
+      case "$stage" in
+        release) (cd "$BUILD_DIR" && ctest --output-on-failure "$@") ;;
+        clang)  # a second compiler: warning-free, and the same bytes as the GCC build (ctest compiler_determinism)
+          CC=clang CXX=clang++ cmake -S . -B build-clang -DCMAKE_BUILD_TYPE=Release -DTERRAIN_BUILD_BENCH=OFF \
+            -DTERRAIN_COMPARE_BUILD="$PWD/$BUILD_DIR" >/dev/null
+          cmake --build build-clang -j "$JOBS"
+          (cd build-clang && ctest --output-on-failure "$@") ;;
+        sanitize)  # every test but the long run (its 2 000 ticks take minutes under ASan; the unit tests cover each stage)
+          cmake -S . -B build-asan -DTERRAIN_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+          cmake --build build-asan -j "$JOBS"
+          (cd build-asan && ctest --output-on-failure -E '^long_run$' "$@") ;;
+        fuzz)  # each libFuzzer target: its saved regressions, then FUZZ_SECONDS from its seeds
+          CC=clang CXX=clang++ cmake -S . -B build-fuzz -DTERRAIN_FUZZ=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+            -DTERRAIN_BUILD_TESTS=OFF -DTERRAIN_BUILD_BENCH=OFF >/dev/null
+          cmake --build build-fuzz -j "$JOBS" --target fuzz
+          bash fuzz/run.sh build-fuzz "${FUZZ_SECONDS:-30}" ;;
+        *) echo "build.sh: unknown test stage '$stage' (use: release clang sanitize fuzz)" >&2; exit 2 ;;
+      esac
+    done ;;
   bench) shift; exec bash bench/run.sh "$BUILD_DIR" "$@" ;;
   *) echo "build.sh: unknown command '$1' (use: demo, test, bench)" >&2; exit 2 ;;
 esac
