@@ -192,6 +192,11 @@ expect_short_error "VDB declaring 2^31 grids" "2147483647 grids" "$T" gi --heigh
 cp "$vdb" "$tmp/mutant.vdb"
 printf '\377\377' | dd of="$tmp/mutant.vdb" bs=1 seek=$(( $(wc -c <"$vdb") / 2 )) conv=notrunc 2>/dev/null
 expect_short_error "damaged VDB heightmap" "mutant.vdb" "$T" gi --heightmap "$tmp/mutant.vdb" --cell-size 10
+: >"$tmp/empty.png"
+expect_short_error "empty heightmap file" "empty.png: not a PNG file" "$T" gi --heightmap "$tmp/empty.png" --cell-size 10
+echo "1 2 3" >"$tmp/heights.txt"
+expect_short_error "heightmap of another format" "unknown heightmap format '.txt'" "$T" gi --heightmap "$tmp/heights.txt" --cell-size 10
+expect_short_error "output onto a device" "must end in .npy or .exr" "$T" gi --heightmap "$hm24" --cell-size 10 --out-ambient /dev/full
 # a 68-byte PNG declaring 60000 x 60000 pixels; a 1 x 1 PNG; an 8-bit grey PNG
 echo 'iVBORw0KGgoAAAANSUhEUgAA6mAAAOpgEAAAAAD1KfbdAAAAC0lEQVR4nGNggAAAAAgAAbdYc5UAAAAASUVORK5CYII=' | base64 -d >"$tmp/huge.png"
 expect_short_error "PNG declaring 60000 x 60000" "60000 x 60000 pixels" "$T" gi --heightmap "$tmp/huge.png" --cell-size 10

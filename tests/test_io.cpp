@@ -16,28 +16,18 @@
 #include "sim/heightmap_io.h"
 #include "sim/terrain.h"
 #include "sim/vdb_io.h"
+#include "tests/scratch_files.h"
 
 using namespace terrain;
 namespace fs = std::filesystem;
+using terrain::test::readBytes;
+using terrain::test::scratchDir;
+using terrain::test::writeBytes;
 
-namespace {
-fs::path scratchDir() {
-    fs::path p = fs::temp_directory_path() / ("terrain_io_test_" + std::to_string(::getpid()));
-    fs::create_directories(p);
-    return p;
-}
-std::string readBytes(const fs::path& p) {
-    std::ifstream f(p, std::ios::binary);
-    return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-}
-void writeBytes(const fs::path& p, const std::string& b) {
-    std::ofstream f(p, std::ios::binary);
-    f.write(b.data(), static_cast<std::streamsize>(b.size()));
-}
-}  // namespace
+namespace {}  // namespace
 
 TEST_CASE("sim.io: 16-bit PNG round trip is exact to the 16-bit step") {
-    const fs::path dir = scratchDir();
+    const fs::path dir = scratchDir("io");
     Grid h;
     generateNoise(h, 67, 45, 10.0f, 3, NoiseSettings{});
     float scale = 0.0f, offset = 0.0f;
@@ -80,7 +70,7 @@ TEST_CASE("sim.io: the real DEM loads with its height mapping") {
 }
 
 TEST_CASE("sim.io: corrupt, truncated and wrong-typed PNGs are rejected with the file name") {
-    const fs::path dir = scratchDir();
+    const fs::path dir = scratchDir("io");
     Grid h(20, 10, 5.0f);
     const std::string good = (dir / "good.png").string();
     writePngHeightmap(good, h, 1.0f, 0.0f);
@@ -102,7 +92,7 @@ TEST_CASE("sim.io: corrupt, truncated and wrong-typed PNGs are rejected with the
 }
 
 TEST_CASE("sim.io: VDB round trip is bit-exact for every layer") {
-    const fs::path dir = scratchDir();
+    const fs::path dir = scratchDir("io");
     TerrainState s;
     s.allocate(37, 23, 2.5f, LayerSet{.water = true, .sediment = true});
     Grid h;
@@ -135,7 +125,7 @@ TEST_CASE("sim.io: VDB round trip is bit-exact for every layer") {
 }
 
 TEST_CASE("sim.io: corrupt or truncated VDB files and NaN heights are rejected") {
-    const fs::path dir = scratchDir();
+    const fs::path dir = scratchDir("io");
     TerrainState s;
     s.allocate(16, 16, 1.0f, {});
     s.bedrock(4, 4) = 7.0f;
@@ -158,7 +148,7 @@ TEST_CASE("sim.io: corrupt or truncated VDB files and NaN heights are rejected")
 }
 
 TEST_CASE("sim.io: a failed write leaves the previous file in place") {
-    const fs::path dir = scratchDir();
+    const fs::path dir = scratchDir("io");
     Grid h(8, 8, 3.0f);
     const std::string file = (dir / "keep.png").string();
     writePngHeightmap(file, h, 1.0f, 0.0f);

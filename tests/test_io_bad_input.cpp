@@ -29,29 +29,15 @@
 #include "sim/heightmap_io.h"
 #include "sim/terrain.h"
 #include "sim/vdb_io.h"
+#include "tests/scratch_files.h"
 
 using namespace terrain;
 namespace fs = std::filesystem;
+using terrain::test::readBytes;
+using terrain::test::scratchDir;
+using terrain::test::writeBytes;
 
 namespace {
-
-fs::path scratchDir(const char* tag) {
-    fs::path p =
-        fs::temp_directory_path() / ("terrain_bad_input_" + std::string(tag) + "_" + std::to_string(::getpid()));
-    fs::remove_all(p);
-    fs::create_directories(p);
-    return p;
-}
-
-std::string readBytes(const fs::path& p) {
-    std::ifstream f(p, std::ios::binary);
-    return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-}
-
-void writeBytes(const fs::path& p, const std::string& b) {
-    std::ofstream f(p, std::ios::binary | std::ios::trunc);
-    f.write(b.data(), static_cast<std::streamsize>(b.size()));
-}
 
 int filesIn(const fs::path& dir) {
     int n = 0;

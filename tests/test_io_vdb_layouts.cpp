@@ -15,6 +15,7 @@
 #include "core/error.h"
 #include "sim/terrain.h"
 #include "sim/vdb_io.h"
+#include "tests/scratch_files.h"
 
 using namespace terrain;
 namespace fs = std::filesystem;
@@ -22,13 +23,10 @@ using openvdb::Coord;
 
 namespace {
 
-fs::path scratchDir(const char* tag) {
-    fs::path p =
-        fs::temp_directory_path() / ("terrain_vdb_layout_" + std::string(tag) + "_" + std::to_string(::getpid()));
-    fs::remove_all(p);
-    fs::create_directories(p);
+// A scratch folder, with OpenVDB's grid types registered for the test's own writes.
+fs::path vdbScratchDir(const char* tag) {
     openvdb::initialize();
-    return p;
+    return terrain::test::scratchDir(std::string("vdb_layout_") + tag);
 }
 
 void writeGrids(const fs::path& file, const openvdb::GridPtrVec& grids, std::uint32_t compression) {
@@ -101,7 +99,7 @@ std::string readError(const fs::path& file) {
 }  // namespace
 
 TEST_CASE("io.vdb: files OpenVDB writes in the engine's layout read back bit-identically") {
-    const fs::path dir = scratchDir("same");
+    const fs::path dir = vdbScratchDir("same");
     const int nx = 200, ny = 150;
     using namespace openvdb::io;
     const std::uint32_t compressions[] = {COMPRESS_NONE,
@@ -136,7 +134,7 @@ TEST_CASE("io.vdb: files OpenVDB writes in the engine's layout read back bit-ide
 }
 
 TEST_CASE("io.vdb: grids that are not a height field are rejected with one line") {
-    const fs::path dir = scratchDir("other");
+    const fs::path dir = vdbScratchDir("other");
     const fs::path file = dir / "f.vdb";
     auto check = [&](openvdb::GridBase::Ptr grid, const std::string& expected) {
         CAPTURE(expected);

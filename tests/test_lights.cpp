@@ -13,17 +13,12 @@
 #include "engine/light_rig.h"
 #include "engine/pipeline.h"
 #include "sim/scene.h"
+#include "tests/scratch_files.h"
 
 using namespace terrain;
 using namespace terrain::engine;
 
 namespace {
-
-std::filesystem::path scratchDir() {
-    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "terrain_test_lights";
-    std::filesystem::create_directories(dir);
-    return dir;
-}
 
 double angleBetween(double a, double b) { return std::fabs(std::remainder(a - b, 360.0)); }
 
@@ -110,7 +105,7 @@ TEST_CASE("lights: the sun is the first key light, moves each frame and sets") {
 }
 
 TEST_CASE("lights: an image environment projects as gi/ does, scaled by its intensity") {
-    const std::filesystem::path dir = scratchDir();
+    const std::filesystem::path dir = terrain::test::scratchDir("lights");
     Grid r(32, 16), g(32, 16), b(32, 16);
     for (int y = 0; y < 16; ++y)
         for (int x = 0; x < 32; ++x) {
@@ -140,7 +135,7 @@ TEST_CASE("lights: an image environment projects as gi/ does, scaled by its inte
 }
 
 TEST_CASE("lights: scene files set the lights and reject bad ones") {
-    const std::filesystem::path dir = scratchDir();
+    const std::filesystem::path dir = terrain::test::scratchDir("lights");
     auto write = [&](const char* name, const char* text) {
         std::ofstream(dir / name) << text;
         return (dir / name).string();
