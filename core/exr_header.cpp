@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <string_view>
 
 #include "core/byte_reader.h"
 #include "core/error.h"
@@ -30,7 +31,14 @@ int linesPerChunk(int compression) {
 int countChannels(ByteReader& r, std::size_t end, std::size_t maxName) {
     int count = 0;
     while (r.position() < end) {
-        if (r.cString(maxName, "channel name").empty()) return count;
+        if (r.cString(maxName, "channel name").empty()) {
+            // OpenEXR reads the list up to its terminator, whatever the
+            // attribute's size: a list that ends elsewhere would make it
+            // read the rest of the header out of step with this check
+            if (r.position() != end)
+                throw IoError(r.file(), "corrupt EXR: the channel list does not fill its attribute");
+            return count;
+        }
         r.skip(16, "channel description");  // pixel type, pLinear + reserved, x and y sampling
         if (++count > kMaxChannels)
             throw IoError(r.file(), "EXR has more than " + std::to_string(kMaxChannels) + " channels");
@@ -44,6 +52,64 @@ struct ExrAttributes {
     std::uint32_t tileWidth = 0, tileHeight = 0;
 };
 
+// Bytes of the value of each fixed-size attribute type OpenEXR reads by its
+// layout rather than by the size the file declares (0: not such a type).
+std::size_t fixedValueSize(std::string_view type) {
+    struct Fixed {
+        std::string_view type;
+        std::size_t bytes;
+    };
+    static constexpr Fixed kFixed[] = {
+        {"box2i", 16},
+        {"box2f", 16},
+        {"chromaticities", 32},
+        {"compression", 1},
+        {"deepImageState", 1},
+        {"double", 8},
+        {"envmap", 1},
+        {"float", 4},
+        {"int", 4},
+        {"keycode", 28},
+        {"lineOrder", 1},
+        {"m33f", 36},
+        {"m33d", 72},
+        {"m44f", 64},
+        {"m44d", 128},
+        {"rational", 8},
+        {"tiledesc", 9},
+        {"timecode", 8},
+        {"v2i", 8},
+        {"v2f", 8},
+        {"v2d", 16},
+        {"v3i", 12},
+        {"v3f", 12},
+        {"v3d", 24},
+    };
+    for (const Fixed& f : kFixed)
+        if (f.type == type) return f.bytes;
+    return 0;
+}
+
+// The types whose value holds sizes of its own, checked against the
+// attribute's size before OpenEXR allocates what they declare: a preview
+// image (width x height RGBA bytes) and a vector of strings (a length before
+// each).
+void checkSizedValue(ByteReader& r, std::string_view type, std::size_t end) {
+    if (type == "preview") {
+        if (end - r.position() < 8) throw IoError(r.file(), "corrupt EXR: a preview image without its size");
+        const auto w = r.read<std::uint32_t>("preview width"), h = r.read<std::uint32_t>("preview height");
+        if (std::uint64_t{w} * h * 4 != end - r.position())
+            throw IoError(r.file(), "corrupt EXR: the preview image does not fill its attribute");
+    } else if (type == "stringvector") {
+        while (r.position() < end) {
+            const auto n = r.read<std::int32_t>("string length");
+            if (n < 0 || static_cast<std::size_t>(n) > end - r.position())
+                throw IoError(r.file(), "corrupt EXR: a string runs past its attribute");
+            r.skip(static_cast<std::size_t>(n), "string");
+        }
+    }
+}
+
 ExrAttributes readAttributes(ByteReader& r, std::size_t maxName) {
     ExrAttributes a;
     for (;;) {
@@ -55,6 +121,11 @@ ExrAttributes readAttributes(ByteReader& r, std::size_t maxName) {
             throw IoError(r.file(), "corrupt EXR: attribute '" + std::string(name) + "' declares " +
                                         std::to_string(size) + " bytes, " + std::to_string(r.remaining()) + " left");
         const std::size_t end = r.position() + static_cast<std::size_t>(size);
+        const std::size_t fixed = fixedValueSize(type);
+        if (fixed != 0 && fixed != static_cast<std::size_t>(size))
+            throw IoError(r.file(), "corrupt EXR: attribute '" + std::string(name) + "' of type " + std::string(type) +
+                                        " declares " + std::to_string(size) + " bytes, not " + std::to_string(fixed));
+        checkSizedValue(r, type, end);
         if (name == "dataWindow" && type == "box2i" && size == 16) {
             ExrDataWindow w;
             w.x0 = r.read<std::int32_t>("data window");
@@ -67,7 +138,8 @@ ExrAttributes readAttributes(ByteReader& r, std::size_t maxName) {
         } else if (name == "tiles" && type == "tiledesc" && size == 9) {
             a.tileWidth = r.read<std::uint32_t>("tile width");
             a.tileHeight = r.read<std::uint32_t>("tile height");
-        } else if (name == "channels" && type == "chlist") {
+        } else if (type == "chlist") {
+            // every channel list, whatever its name: OpenEXR reads each by its layout
             countChannels(r, end, maxName);
         }
         r.seek(end, "attribute");

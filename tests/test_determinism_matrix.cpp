@@ -143,7 +143,10 @@ std::vector<std::pair<std::string, SceneSettings>> everyScene() {
 
 TEST_CASE("determinism: every scene x GI mode gives the same bytes for 1, 2, 3 and 8 threads") {
     int runs = 0;
-    for (const auto& [name, declared] : everyScene()) {
+    for (const auto& named : everyScene()) {
+        // plain locals: Clang 14 lambdas (doctest's INFO) cannot capture structured bindings
+        const std::string& name = named.first;
+        const SceneSettings& declared = named.second;
         if (!demPresent(declared)) {
             MESSAGE("skipped " << name << ": its elevation file is not here (" << declared.terrain.demFile << ")");
             continue;

@@ -253,7 +253,10 @@ TEST_CASE("io.bad: every writer reports a full disk and keeps the previous file"
         {"frame.npy", [&](const std::string& f) { writeNpy(f, h); }},
         {"frame.txt", [&](const std::string& f) { writeFileAtomic(f, std::string(100000, 't')); }},
     };
-    for (const auto& [name, write] : writers) {
+    for (const auto& writer : writers) {
+        // plain locals: Clang 14 lambdas (doctest's CAPTURE) cannot capture structured bindings
+        const std::string& name = writer.first;
+        const auto& write = writer.second;
         CAPTURE(name);
         const std::string file = (dir / name).string();
         writeBytes(file, std::string(64, 'k'));  // the previous, good file
