@@ -13,7 +13,8 @@
 # Environment: BUILD_DIR (default build), SANITIZE=1 for an ASan+UBSan build,
 # JOBS (default: number of cores), TEST_STAGES (default "release clang
 # sanitize fuzz"; "release" alone for a quick run), FUZZ_SECONDS (default 30,
-# per fuzz target).
+# per fuzz target), FUZZ_SEED (default 1: every run fuzzes the same inputs, see
+# fuzz/run.sh; "random" explores for FUZZ_SECONDS each instead).
 set -euo pipefail
 cd "$(dirname "$0")"
 
@@ -68,11 +69,13 @@ case "${1:-}" in
           cmake -S . -B build-asan -DTERRAIN_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
           cmake --build build-asan -j "$JOBS"
           (cd build-asan && ctest --output-on-failure -E '^long_run$' "$@") ;;
-        fuzz)  # each libFuzzer target: its saved regressions, then FUZZ_SECONDS from its seeds
+        fuzz)  # each libFuzzer target: its saved regressions, then a reproducible FUZZ_SECONDS from its seeds
           CC=clang CXX=clang++ cmake -S . -B build-fuzz -DTERRAIN_FUZZ=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
             -DTERRAIN_BUILD_TESTS=OFF -DTERRAIN_BUILD_BENCH=OFF >/dev/null
           cmake --build build-fuzz -j "$JOBS" --target fuzz
-          bash fuzz/run.sh build-fuzz "${FUZZ_SECONDS:-30}" ;;
+          seed=${FUZZ_SEED:-1}
+          [ "$seed" = random ] && seed=
+          FUZZ_SEED=$seed bash fuzz/run.sh build-fuzz "${FUZZ_SECONDS:-30}" ;;
         *) echo "build.sh: unknown test stage '$stage' (use: release clang sanitize fuzz)" >&2; exit 2 ;;
       esac
     done ;;

@@ -11,22 +11,24 @@
 #include <string>
 #include <system_error>
 
-#include <unistd.h>
-
 #include "core/error.h"
 
 namespace terrain::fuzz {
 
 /// A file holding the current input, named with the extension the reader
-/// dispatches on. In /dev/shm (memory, no disk traffic) where there is one;
-/// one per process, so parallel fuzzing jobs do not share it.
+/// dispatches on. In /dev/shm (memory, no disk traffic) where there is one.
+/// The name is the same on every run and machine: readers compare and quote
+/// the path, libFuzzer learns from those comparisons, and a seeded run must
+/// see the same bytes to fuzz the same inputs. Parallel jobs (-jobs=N) set
+/// TERRAIN_FUZZ_JOB to a name of their own.
 class InputFile {
 public:
     explicit InputFile(const std::string& extension) {
         std::error_code ec;
         std::filesystem::path dir = "/dev/shm";
         if (!std::filesystem::is_directory(dir, ec)) dir = std::filesystem::temp_directory_path();
-        path_ = (dir / ("terrain-fuzz-" + std::to_string(::getpid()) + extension)).string();
+        const char* job = std::getenv("TERRAIN_FUZZ_JOB");
+        path_ = (dir / ("terrain-fuzz-input" + std::string(job ? job : "") + extension)).string();
     }
     ~InputFile() { std::remove(path_.c_str()); }
     InputFile(const InputFile&) = delete;

@@ -47,6 +47,20 @@ namespace {
 
 namespace ranges = scene_ranges;
 
+// The node as a 64-bit integer: an integer, or a float with an integral value
+// (`size = 256.0`) that a 64-bit integer holds. toml++'s own float -> integer
+// conversion casts first and checks after, which is undefined behaviour for a
+// float beyond 2^63 (`seed = 3e83`).
+std::optional<std::int64_t> integerOf(const toml::node& n) {
+    if (const auto* i = n.as_integer()) return i->get();
+    const auto* f = n.as_floating_point();
+    if (!f) return std::nullopt;
+    const double v = f->get();
+    constexpr double kTwo63 = 9223372036854775808.0;
+    if (!(v >= -kTwo63 && v < kTwo63) || v != std::trunc(v)) return std::nullopt;
+    return static_cast<std::int64_t>(v);
+}
+
 // Reads keys from one TOML table, remembering which were used.
 class TableReader {
 public:
@@ -106,7 +120,7 @@ public:
     }
     void integer(const char* key, std::int64_t& out, const SettingRange<std::int64_t>& range) {
         if (const toml::node* n = get(key)) {
-            if (auto v = n->value<std::int64_t>())
+            if (auto v = integerOf(*n))
                 out = *v;
             else
                 fail(key, "an integer");
@@ -116,7 +130,7 @@ public:
     // A grid side: the integer node n (the value of `key` or one of its
     // entries) in its range.
     int side(const char* key, const toml::node& n) const {
-        const std::int64_t v = n.value<std::int64_t>().value_or(0);
+        const std::int64_t v = integerOf(n).value_or(0);
         inRange(widened(ranges::kSize), v, key);
         return static_cast<int>(v);
     }
@@ -468,7 +482,7 @@ void readGi(TableReader& r, SceneSettings& s) {
         s.gi.tolerance = tolerance;
     }
     if (const toml::node* n = r.get("refresh")) {
-        const std::optional<std::int64_t> every = n->value<std::int64_t>();
+        const std::optional<std::int64_t> every = integerOf(*n);
         if (!every) r.fail("refresh", "an integer");
         s.gi.refreshEvery = *every;
     }
@@ -496,7 +510,7 @@ std::array<int, 2> readSize(TableReader& r) {
     std::array<int, 2> n{256, 256};
     const toml::node* sz = r.get("size");
     if (!sz) return n;
-    if (sz->value<std::int64_t>()) {
+    if (integerOf(*sz)) {
         n[0] = n[1] = r.side("size", *sz);
     } else if (const toml::array* a = sz->as_array();
                a && a->size() == 2 && a->get(0)->is_integer() && a->get(1)->is_integer()) {

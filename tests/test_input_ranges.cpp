@@ -139,6 +139,21 @@ TEST_CASE("input ranges: scene integers are checked before they are narrowed") {
     fs::remove_all(scratch());
 }
 
+TEST_CASE("input ranges: a float where an integer belongs is read only when it is one") {
+    // beyond 64 bits: an error, not an undefined conversion (fuzz regressions
+    // float-seed-beyond-int64, float-refresh-beyond-int64 under UBSan)
+    expectSceneError("base = \"erosion\"\nseed = 3.33333e83\n", "'seed' must be an integer");
+    expectSceneError("base = \"erosion\"\n[gi]\nrefresh = -4e300\n", "'gi.refresh' must be an integer");
+    expectSceneError("base = \"erosion\"\nsize = 9.3e18\n", "'size'");
+    expectSceneError("base = \"erosion\"\nseed = 2.5\n", "'seed' must be an integer");
+    expectSceneError("base = \"erosion\"\nseed = nan\n", "'seed' must be an integer");
+    // an integral float is the integer it spells
+    const SceneSettings s = loadSceneFile(write("float-size.toml", "base = \"erosion\"\nsize = 64.0\nseed = 7.0\n"));
+    CHECK(s.nx == 64);
+    CHECK(s.seed == 7u);
+    fs::remove_all(scratch());
+}
+
 TEST_CASE("input ranges: a scene file that is empty, a folder, or a dem without its file is an error") {
     expectSceneError("", "sets nothing");
     expectSceneError("# only a comment\n", "sets nothing");
