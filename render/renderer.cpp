@@ -123,10 +123,11 @@ ImageDifference compareImages(const std::vector<std::uint8_t>& a, const std::vec
 Renderer::Renderer(const Gl& gl) : gl_(gl), sky_(gl) {
     using namespace shaders;
     const char* version = "#version 330 core\n";
-    terrainProgram_ = link(gl_, {kMeshVertex}, {version, kCommon, kTerrainFragment}, "terrain");
-    waterProgram_ = link(gl_, {kMeshVertex}, {version, kCommon, kWaterFragment}, "water");
+    pointsProgram_ = link(gl_, {kMeshVertex}, {kSurfacePointFragment}, "surface points");
+    terrainProgram_ = link(gl_, {kFullScreenVertex}, {version, kCommon, kTerrainFragment}, "terrain");
+    waterProgram_ = link(gl_, {kFullScreenVertex}, {version, kCommon, kWaterFragment}, "water");
     shadowProgram_ = link(gl_, {kMeshVertex}, {kShadowFragment}, "shadow");
-    postProgram_ = link(gl_, {kPostVertex}, {kPostFragment}, "post");
+    postProgram_ = link(gl_, {kFullScreenVertex}, {kPostFragment}, "post");
     gl_.GenVertexArrays(1, &vao_);
     gl_.GenBuffers(1, &indexBuffer_);
     // One chunk's 16 stitch variants, one after another (render/terrain_lod.h).
@@ -147,8 +148,7 @@ Renderer::Renderer(const Gl& gl) : gl_(gl), sky_(gl) {
 }
 
 Renderer::~Renderer() {
-    releaseTarget(hdr_);
-    releaseTarget(sceneCopy_);
+    deferred_.release(gl_);
     releaseTarget(ldr_);
     releaseTarget(shadow_);
     const GLuint textures[] = {heightTex_, shadeTex_, keyTex_, receiverTex_, albedoTex_};
@@ -156,7 +156,8 @@ Renderer::~Renderer() {
     gl_.DeleteBuffers(1, &indexBuffer_);
     gl_.DeleteBuffers(1, &chunkIndexBuffer_);
     gl_.DeleteVertexArrays(1, &vao_);
-    for (GLuint p : {terrainProgram_, waterProgram_, shadowProgram_, postProgram_}) gl_.DeleteProgram(p);
+    for (GLuint p : {pointsProgram_, terrainProgram_, waterProgram_, shadowProgram_, postProgram_})
+        gl_.DeleteProgram(p);
 }
 
 void Renderer::ensureTexture(GLuint& tex, int& w, int& h, int nw, int nh, GLenum internal, GLenum format, bool linear) {
@@ -309,7 +310,7 @@ void Renderer::releaseTarget(Target& t) {
 struct Renderer::FrameViews {
     glm::vec3 eye;
     glm::mat4 viewProj;
-    float nearPlane, farPlane;
+    glm::vec3 viewAxis;  // unit, from the eye towards the target
     glm::vec3 keyDir;
     glm::mat4 lightViewProj;  // orthographic, covering the terrain
 };
@@ -364,7 +365,7 @@ Renderer::FrameViews Renderer::frameViews(const OrbitCamera& cam, int width, int
     const glm::vec3 up = std::abs(keyDir.z) > 0.99f ? glm::vec3(0, 1, 0) : glm::vec3(0, 0, 1);
     const glm::mat4 lightViewProj = glm::ortho(-radius, radius, -radius, radius, 0.0f, 4.0f * radius) *
                                     glm::lookAt(centre + keyDir * (2.0f * radius), centre, up);
-    return {eye, viewProj, nearPlane, farPlane, keyDir, lightViewProj};
+    return {eye, viewProj, glm::normalize(target - eye), keyDir, lightViewProj};
 }
 
 namespace {
@@ -400,17 +401,20 @@ void Renderer::draw(const RenderSettings& s, int width, int height, GLuint frame
         selectChunks(lodTree_, view, lodSelection_);
     }
     const bool debug = s.debug != DebugView::None;
+    const bool water = s.water && meta_.hasWater && !debug;
     gl_.BindVertexArray(vao_);
     const bool wantShadowMap = s.shadow == ShadowMode::ShadowMap && !debug;
     // Targets first: creating one binds its textures to the active unit.
     const int shadowSide = std::clamp(s.shadowMapSize, 256, 8192);
     if (wantShadowMap) ensureTarget(shadow_, shadowSide, shadowSide, 0, true);
-    ensureTarget(hdr_, width, height, GL_RGBA16F, true);
+    deferred_.ensure(gl_, width, height);
     gl_.ActiveTexture(GL_TEXTURE0);
     gl_.BindTexture(GL_TEXTURE_2D, heightTex_);
     if (wantShadowMap) drawShadowMap(v, lod);
-    drawSurfaces(s, v, width, height, wantShadowMap, lod);
-    drawPost(s, v, width, height, framebuffer);
+    gl_.Viewport(0, 0, width, height);
+    drawSurfacePoints(v, lod, water);
+    shadeSurfaces(s, v, wantShadowMap, water);
+    drawPost(s, v, width, height, framebuffer, water);
     gl_.BindVertexArray(0);
     gl_.ActiveTexture(GL_TEXTURE0);
     checkGlError(gl_, "draw");
@@ -435,77 +439,101 @@ void Renderer::drawShadowMap(const FrameViews& v, bool lod) {
     gl_.Disable(GL_POLYGON_OFFSET_FILL);
 }
 
-// ---- terrain and water into the HDR target ------------------------------------------
-// The water reflects the terrain drawn so far (kWaterFragment's screen-space
-// reflection): its colour and depth are copied to textures it can read
-// while it draws into the target they came from. Leaves hdr_ bound, the
-// copies on texture units 7 and 8.
-void Renderer::copySceneForReflections(int width, int height) {
-    gl_.ActiveTexture(GL_TEXTURE8);  // what follows binds textures: keep the surfaces' units 0-6
-    ensureTarget(sceneCopy_, width, height, GL_RGBA16F, true);
-    gl_.BindTexture(GL_TEXTURE_2D, sceneCopy_.depth);
-    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_NONE);  // read as distances, not compared
-    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    gl_.BindFramebuffer(GL_READ_FRAMEBUFFER, hdr_.fbo);
-    gl_.BindFramebuffer(GL_DRAW_FRAMEBUFFER, sceneCopy_.fbo);
-    gl_.BlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT,
-                        GL_NEAREST);
-    gl_.BindFramebuffer(GL_FRAMEBUFFER, hdr_.fbo);
-    gl_.ActiveTexture(GL_TEXTURE7);
-    gl_.BindTexture(GL_TEXTURE_2D, sceneCopy_.color);
-    gl_.ActiveTexture(GL_TEXTURE8);
-    gl_.BindTexture(GL_TEXTURE_2D, sceneCopy_.depth);
-}
-
-void Renderer::drawSurfaces(const RenderSettings& s, const FrameViews& v, int width, int height, bool wantShadowMap,
-                            bool lod) {
-    const engine::FrameData& f = meta_;
-    gl_.BindFramebuffer(GL_FRAMEBUFFER, hdr_.fbo);
-    gl_.Viewport(0, 0, width, height);
+// ---- the mesh passes: surface points ------------------------------------------------
+// The terrain's points, then the water's where it is in front of the terrain,
+// each marking the stencil with its surface (render/deferred_targets.h). The
+// water writes no depth: the depth buffer keeps the terrain's, so that the
+// water is tested against the terrain alone (where two water surfaces
+// overlap on screen, the last drawn shows).
+void Renderer::drawSurfacePoints(const FrameViews& v, bool lod, bool water) {
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, deferred_.pointsFbo);
+    // The terrain's points need their clear (the water's march reads them
+    // anywhere); the water's are read only where its stencil was set.
+    // One draw buffer at a time: the points shader's one output goes to it.
+    const GLenum terrainPoints = GL_COLOR_ATTACHMENT0, waterPoints = GL_COLOR_ATTACHMENT1;
+    gl_.DrawBuffers(1, &terrainPoints);
     gl_.ClearColor(0, 0, 0, 0);
     gl_.ClearDepth(1.0);
-    gl_.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    gl_.ClearStencil(0);
+    gl_.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
     gl_.Enable(GL_DEPTH_TEST);
     gl_.DepthFunc(GL_LESS);
     gl_.Disable(GL_CULL_FACE);
-    const GLuint textures[] = {heightTex_,       shadeTex_,     keyTex_,   receiverTex_,
-                               sky_.shTexture(), shadow_.depth, albedoTex_};
-    for (int i = 0; i < 7; ++i) {
+    gl_.Enable(GL_STENCIL_TEST);
+    gl_.StencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
+    gl_.StencilFunc(GL_ALWAYS, kTerrainStencil, 0xff);
+    gl_.UseProgram(pointsProgram_);
+    meshUniforms(gl_, meta_, pointsProgram_, v.viewProj, 0);
+    const MeshCount terrain = drawMesh(pointsProgram_, glm::value_ptr(v.viewProj), lod);
+    stats_.terrainTriangles = terrain.triangles;
+    stats_.terrainChunks = terrain.chunks;
+    if (water) {
+        gl_.DrawBuffers(1, &waterPoints);
+        gl_.StencilFunc(GL_ALWAYS, kWaterStencil, 0xff);
+        gl_.Uniform1i(gl_.GetUniformLocation(pointsProgram_, "uWater"), 1);
+        gl_.DepthMask(GL_FALSE);
+        drawMesh(pointsProgram_, glm::value_ptr(v.viewProj), lod, true);  // the terrain's chunks that show water
+        gl_.DepthMask(GL_TRUE);
+    }
+    gl_.Disable(GL_DEPTH_TEST);
+}
+
+// ---- the shading passes: one full-screen triangle each --------------------------------
+// The terrain's pass lights every pixel with a terrain point (under the water
+// too: the water's march reflects it); the water's lights the water's pixels.
+// Each writes its own HDR target, cleared first; drawPost puts them together.
+void Renderer::shadeSurfaces(const RenderSettings& s, const FrameViews& v, bool wantShadowMap, bool water) {
+    const GLuint textures[] = {heightTex_,
+                               shadeTex_,
+                               keyTex_,
+                               receiverTex_,
+                               sky_.shTexture(),
+                               shadow_.depth,
+                               albedoTex_,
+                               deferred_.terrainPoints,
+                               deferred_.waterPoints,
+                               deferred_.terrainColor};
+    for (int i = 0; i < 10; ++i) {
         gl_.ActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + i));
         gl_.BindTexture(GL_TEXTURE_2D, textures[i]);
     }
-    surfaceUniforms(terrainProgram_, 0, s, v, wantShadowMap);
-    const MeshCount terrain = drawMesh(terrainProgram_, glm::value_ptr(v.viewProj), lod);
-    stats_.terrainTriangles = terrain.triangles;
-    stats_.terrainChunks = terrain.chunks;
-    if (s.water && f.hasWater && s.debug == DebugView::None) {
-        copySceneForReflections(width, height);
-        surfaceUniforms(waterProgram_, 1, s, v, wantShadowMap);
+    gl_.StencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, deferred_.terrainFbo);
+    gl_.Clear(GL_COLOR_BUFFER_BIT);
+    gl_.StencilFunc(GL_LEQUAL, kTerrainStencil, 0xff);  // terrain, or water over it
+    shadingUniforms(terrainProgram_, s, v, wantShadowMap);
+    Uniforms{gl_, terrainProgram_}.i("uSurface", 7);
+    gl_.DrawArrays(GL_TRIANGLES, 0, 3);
+    if (water) {
+        gl_.BindFramebuffer(GL_FRAMEBUFFER, deferred_.waterFbo);
+        gl_.Clear(GL_COLOR_BUFFER_BIT);
+        gl_.StencilFunc(GL_EQUAL, kWaterStencil, 0xff);
+        shadingUniforms(waterProgram_, s, v, wantShadowMap);
         Uniforms u{gl_, waterProgram_};
-        u.i("uSceneColor", 7);
-        u.i("uSceneDepth", 8);
-        u.f2("uNearFar", v.nearPlane, v.farPlane);
-        gl_.Enable(GL_BLEND);
-        gl_.BlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-        gl_.DepthMask(GL_FALSE);
-        drawMesh(waterProgram_, glm::value_ptr(v.viewProj), lod, true);  // the terrain's chunks that show water
-        gl_.DepthMask(GL_TRUE);
-        gl_.Disable(GL_BLEND);
+        u.i("uSurface", 8);
+        u.i("uTerrainPoints", 7);
+        u.i("uSceneColor", 9);
+        u.m4("uViewProj", v.viewProj);
+        u.v3("uViewAxis", v.viewAxis);
+        gl_.DrawArrays(GL_TRIANGLES, 0, 3);
     }
+    gl_.Disable(GL_STENCIL_TEST);
 }
 
-void Renderer::surfaceUniforms(GLuint p, int water, const RenderSettings& s, const FrameViews& v, bool wantShadowMap) {
+void Renderer::shadingUniforms(GLuint p, const RenderSettings& s, const FrameViews& v, bool wantShadowMap) {
     const engine::FrameData& f = meta_;
     gl_.UseProgram(p);
-    meshUniforms(gl_, f, p, v.viewProj, water);
     Uniforms u{gl_, p};
+    u.i("uHeight", 0);
     u.i("uShade", 1);
     u.i("uKey", 2);
     u.i("uReceiver", 3);
     u.i("uEnv", 4);
     u.i("uShadowMap", 5);
     u.i("uAlbedo", 6);
+    u.i2("uGrid", f.nx, f.ny);
+    u.f("uCell", f.cellSize);
+    u.f("uExag", f.exaggeration);
     u.f("uHaze", f.lights.hazeExtinction);
     u.i2("uReceiverGrid", f.nxr, f.nyr);
     u.i("uSubsample", f.subsample);
@@ -524,16 +552,21 @@ void Renderer::surfaceUniforms(GLuint p, int water, const RenderSettings& s, con
 }
 
 // ---- tone mapping + sRGB into the output --------------------------------------------
-void Renderer::drawPost(const RenderSettings& s, const FrameViews& v, int width, int height, GLuint framebuffer) {
+void Renderer::drawPost(const RenderSettings& s, const FrameViews& v, int width, int height, GLuint framebuffer,
+                        bool water) {
     gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffer);
     gl_.Viewport(0, 0, width, height);
     gl_.Disable(GL_DEPTH_TEST);
     gl_.UseProgram(postProgram_);
     gl_.ActiveTexture(GL_TEXTURE0);
-    gl_.BindTexture(GL_TEXTURE_2D, hdr_.color);
+    gl_.BindTexture(GL_TEXTURE_2D, deferred_.terrainColor);
+    gl_.ActiveTexture(GL_TEXTURE3);
+    gl_.BindTexture(GL_TEXTURE_2D, deferred_.waterColor);
     sky_.setBackground(postProgram_, meta_.lights, 1, 2);
     Uniforms u{gl_, postProgram_};
     u.i("uHdr", 0);
+    u.i("uWaterHdr", 3);
+    u.i("uWaterDrawn", water ? 1 : 0);
     u.m4("uInvViewProj", glm::inverse(v.viewProj));
     u.v3("uEye", v.eye);
     u.f2("uSize", static_cast<float>(width), static_cast<float>(height));

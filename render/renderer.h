@@ -4,9 +4,12 @@
 // Per frame: upload the heights (one RG32F texture: ground, water depth) and
 // the GI textures of FrameData; draw the terrain mesh (chunks whose
 // resolution follows the screen-space error, render/terrain_lod.h; positions
-// fetched from the height texture by gl_VertexID) into an HDR target; draw
-// water as a second surface (ground + depth, the same chunks) blended over
-// the lit terrain; tone map and encode sRGB.
+// fetched from the height texture by gl_VertexID) and the water as a second
+// surface (ground + depth, the same chunks) with deferred shading
+// (render/deferred_targets.h): the mesh passes record only the surface point
+// each pixel sees, then one full-screen pass lights the terrain's pixels and
+// one the water's (which reflects the lit terrain); tone map and encode sRGB
+// with the sky behind.
 //
 // Materials (Heidrich & Seidel 1999): Torrance-Sparrow specular for the key light
 // (Beckmann distribution, Smith geometry term, Schlick's Fresnel), modulated
@@ -20,6 +23,7 @@
 #include <vector>
 
 #include "engine/frame_data.h"
+#include "render/deferred_targets.h"
 #include "render/gl.h"
 #include "render/sky.h"
 #include "render/terrain_lod.h"
@@ -116,14 +120,14 @@ private:
     MeshCount drawMesh(GLuint program, const float* cullViewProj, bool lod, bool waterOnly = false);
     /// The full grid's index buffer, bound to the vertex array of draw().
     void ensureFullGrid();
-    void copySceneForReflections(int width, int height);
-    void drawSurfaces(const RenderSettings& s, const FrameViews& v, int width, int height, bool wantShadowMap,
-                      bool lod);
-    void surfaceUniforms(GLuint p, int water, const RenderSettings& s, const FrameViews& v, bool wantShadowMap);
-    void drawPost(const RenderSettings& s, const FrameViews& v, int width, int height, GLuint framebuffer);
+    void drawSurfacePoints(const FrameViews& v, bool lod, bool water);
+    void shadeSurfaces(const RenderSettings& s, const FrameViews& v, bool wantShadowMap, bool water);
+    void shadingUniforms(GLuint p, const RenderSettings& s, const FrameViews& v, bool wantShadowMap);
+    void drawPost(const RenderSettings& s, const FrameViews& v, int width, int height, GLuint framebuffer, bool water);
 
     const Gl& gl_;
-    GLuint terrainProgram_ = 0, waterProgram_ = 0, shadowProgram_ = 0, postProgram_ = 0;
+    // pointsProgram_: the mesh passes; terrainProgram_, waterProgram_: the shading passes
+    GLuint pointsProgram_ = 0, terrainProgram_ = 0, waterProgram_ = 0, shadowProgram_ = 0, postProgram_ = 0;
     GLuint vao_ = 0, indexBuffer_ = 0;
     std::int64_t indexCount_ = 0;  // of the full grid, built on its first draw
     int meshNx_ = 0, meshNy_ = 0;
@@ -139,7 +143,8 @@ private:
         albedoW_ = 0, albedoH_ = 0;
     // FrameData's versions of what was uploaded last
     std::int64_t heightsVersion_ = -1, albedoVersion_ = -1, shadeVersion_ = -1;
-    Target hdr_, ldr_, shadow_, sceneCopy_;
+    Target ldr_, shadow_;
+    DeferredTargets deferred_;
     engine::FrameData meta_;  // the uploaded frame's sizes, lights and modes (no per-texel arrays)
     Sky sky_;
 };
