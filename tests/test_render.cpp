@@ -245,6 +245,50 @@ TEST_CASE("render.shadow: the shadow map and the engine's soft visibility both s
     CHECK(none > map + 30.0);
 }
 
+TEST_CASE("render.water: each pixel shows the surface in front: the water where it is wet, else the terrain") {
+    // A ramp rising along +x through the water level: wet where x < 315 m
+    // (the image's left half from above), dry beyond.
+    SceneSettings scene = builtinScene("erosion", 64, 1);
+    scene.hydraulic = scene.thermal = false;
+    scene.soilDepth = 0.0f;
+    scene.cellSize = 10.0f;
+    scene.hasWaterLevel = true;
+    scene.waterLevel = 0.0f;
+    PipelineSettings ps;
+    ps.verticalExaggeration = 1.0f;
+    FramePipeline pipeline(scene, ps);
+    TerrainState& st = pipeline.simulation().state();
+    REQUIRE(st.hasWater());
+    for (int y = 0; y < st.ny; ++y)
+        for (int x = 0; x < st.nx; ++x) {
+            st.bedrock(x, y) = (static_cast<float>(x) * st.cellSize - 315.0f) * 0.05f;
+            st.soil(x, y) = 0.0f;
+            st.water(x, y) = std::max(0.0f, -st.bedrock(x, y));
+        }
+    pipeline.terrainReplaced();
+    pipeline.advance();
+    pipeline.light();
+    gpu().renderer->upload(pipeline.frame());
+    RenderSettings rs = topDown();
+    std::vector<std::uint8_t> wet, dry;
+    gpu().renderer->drawToImage(rs, kW, kH, wet);
+    rs.water = false;
+    gpu().renderer->drawToImage(rs, kW, kH, dry);
+    // Boxes well inside the water, well inside the dry land, and the sky.
+    auto differing = [&](int x0, int x1, int y0, int y1) {
+        int n = 0;
+        for (int y = y0; y < y1; ++y)
+            for (int x = x0; x < x1; ++x) {
+                const std::size_t i = (static_cast<std::size_t>(y) * kW + x) * 3;
+                n += std::equal(wet.begin() + i, wet.begin() + i + 3, dry.begin() + i) ? 0 : 1;
+            }
+        return n;
+    };
+    CHECK(differing(kW / 2 - 24, kW / 2 - 6, kH / 2 - 10, kH / 2 + 10) == 18 * 20);  // water over the terrain
+    CHECK(differing(kW / 2 + 6, kW / 2 + 24, kH / 2 - 10, kH / 2 + 10) == 0);        // the terrain alone
+    CHECK(differing(0, 8, 0, 8) == 0);                                               // the sky
+}
+
 TEST_CASE("render.determinism: the same scene gives the same image bytes, for any thread count") {
     for (const char* scene : {"erosion", "waves"}) {
         const std::uint64_t a = renderSceneHash(scene, 1);
