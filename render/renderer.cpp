@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <optional>
 #include <string>
@@ -12,6 +13,7 @@
 
 #include "render/context.h"
 #include "render/shaders.h"
+#include "render/water_triangles.h"
 
 namespace terrain::render {
 namespace {
@@ -122,27 +124,24 @@ ImageDifference compareImages(const std::vector<std::uint8_t>& a, const std::vec
 
 Renderer::Renderer(const Gl& gl) : gl_(gl), sky_(gl) {
     using namespace shaders;
-    const char* version = "#version 330 core\n";
     pointsProgram_ = link(gl_, {kMeshVertex}, {kSurfacePointFragment}, "surface points");
-    terrainProgram_ = link(gl_, {kFullScreenVertex}, {version, kCommon, kTerrainFragment}, "terrain");
-    waterProgram_ = link(gl_, {kFullScreenVertex}, {version, kCommon, kWaterFragment}, "water");
     shadowProgram_ = link(gl_, {kMeshVertex}, {kShadowFragment}, "shadow");
     postProgram_ = link(gl_, {kFullScreenVertex}, {kPostFragment}, "post");
     gl_.GenVertexArrays(1, &vao_);
     gl_.GenBuffers(1, &indexBuffer_);
     // One chunk's 16 stitch variants, one after another (render/terrain_lod.h).
-    std::vector<std::uint16_t> chunkIndices;
     for (int stitched = 0; stitched < kStitchVariants; ++stitched) {
-        chunkFirst_[stitched] = static_cast<int>(chunkIndices.size());
+        chunkFirst_[stitched] = static_cast<int>(chunkIndices_.size());
         for (const ChunkTriangle& t : chunkTriangles(kChunkQuads, stitched))
-            chunkIndices.insert(chunkIndices.end(), t.begin(), t.end());
-        chunkCount_[stitched] = static_cast<int>(chunkIndices.size()) - chunkFirst_[stitched];
+            chunkIndices_.insert(chunkIndices_.end(), t.begin(), t.end());
+        chunkCount_[stitched] = static_cast<int>(chunkIndices_.size()) - chunkFirst_[stitched];
     }
     gl_.GenBuffers(1, &chunkIndexBuffer_);
+    gl_.GenBuffers(1, &waterIndexBuffer_);
     gl_.BindVertexArray(vao_);
     gl_.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, chunkIndexBuffer_);
-    gl_.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(chunkIndices.size() * sizeof(std::uint16_t)),
-                   chunkIndices.data(), GL_STATIC_DRAW);
+    gl_.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(chunkIndices_.size() * sizeof(std::uint16_t)),
+                   chunkIndices_.data(), GL_STATIC_DRAW);
     gl_.BindVertexArray(0);
     checkGlError(gl_, "renderer set-up");
 }
@@ -155,9 +154,10 @@ Renderer::~Renderer() {
     gl_.DeleteTextures(5, textures);
     gl_.DeleteBuffers(1, &indexBuffer_);
     gl_.DeleteBuffers(1, &chunkIndexBuffer_);
+    gl_.DeleteBuffers(1, &waterIndexBuffer_);
     gl_.DeleteVertexArrays(1, &vao_);
-    for (GLuint p : {pointsProgram_, terrainProgram_, waterProgram_, shadowProgram_, postProgram_})
-        gl_.DeleteProgram(p);
+    for (GLuint p : {pointsProgram_, shadowProgram_, postProgram_}) gl_.DeleteProgram(p);
+    for (const auto& [key, p] : shadingPrograms_) gl_.DeleteProgram(p);
 }
 
 void Renderer::ensureTexture(GLuint& tex, int& w, int& h, int nw, int nh, GLenum internal, GLenum format, bool linear) {
@@ -184,6 +184,7 @@ void Renderer::upload(const engine::FrameData& f) {
     if (newHeights) {
         streamTexture(heightTex_, heightW_, heightH_, f.nx, f.ny, GL_RG32F, GL_RG, f.heights.data());
         heightsVersion_ = f.heightsVersion;
+        if (f.hasWater) markShownWater(f.heights, shownWater_);
     }
     if (f.shadeVersion != shadeVersion_ || shadeW_ != f.nx || shadeH_ != f.ny || recvW_ != f.nxr || recvH_ != f.nyr) {
         streamTexture(shadeTex_, shadeW_, shadeH_, f.nx, f.ny, GL_RGBA32F, GL_RGBA, f.shade.data());
@@ -269,7 +270,7 @@ void Renderer::ensureFullGrid() {
     meshNy_ = ny;
 }
 
-Renderer::MeshCount Renderer::drawMesh(GLuint program, const float* cullViewProj, bool lod, bool waterOnly) {
+Renderer::MeshCount Renderer::drawMesh(GLuint program, const float* cullViewProj, bool lod) {
     const GLint origin = gl_.GetUniformLocation(program, "uOrigin"), step = gl_.GetUniformLocation(program, "uStep"),
                 row = gl_.GetUniformLocation(program, "uRow");
     MeshCount n;
@@ -285,7 +286,7 @@ Renderer::MeshCount Renderer::drawMesh(GLuint program, const float* cullViewProj
         gl_.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, chunkIndexBuffer_);
         gl_.Uniform1i(row, kChunkQuads + 1);
         for (const LodChunk& c : lodSelection_.chunks) {
-            if ((waterOnly && !c.wet) || !boxInClipVolume(cullViewProj, c.boxMin, c.boxMax)) continue;
+            if (!boxInClipVolume(cullViewProj, c.boxMin, c.boxMax)) continue;
             gl_.Uniform2i(origin, c.x0, c.y0);
             gl_.Uniform1i(step, 1 << c.level);
             const auto offset = static_cast<std::uintptr_t>(chunkFirst_[c.stitched]) * sizeof(std::uint16_t);
@@ -294,6 +295,56 @@ Renderer::MeshCount Renderer::drawMesh(GLuint program, const float* cullViewProj
             n.triangles += chunkCount_[c.stitched] / 3;
             ++n.chunks;
         }
+    }
+    stats_.triangles += n.triangles;
+    return n;
+}
+
+// The chunks' (or the full grid's) triangles that can show water, gathered
+// into one stream index buffer, drawn in the same order as drawMesh's.
+Renderer::MeshCount Renderer::drawWaterMesh(GLuint program, const float* cullViewProj, bool lod) {
+    const GLint origin = gl_.GetUniformLocation(program, "uOrigin"), step = gl_.GetUniformLocation(program, "uStep"),
+                row = gl_.GetUniformLocation(program, "uRow");
+    gl_.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, waterIndexBuffer_);
+    MeshCount n;
+    if (!lod) {
+        shownGridTriangles(meta_.nx, meta_.ny, shownWater_, waterGridIndices_);
+        gl_.BufferData(GL_ELEMENT_ARRAY_BUFFER,
+                       static_cast<GLsizeiptr>(waterGridIndices_.size() * sizeof(std::uint32_t)),
+                       waterGridIndices_.data(), GL_STREAM_DRAW);
+        gl_.Uniform2i(origin, 0, 0);
+        gl_.Uniform1i(step, 1);
+        gl_.Uniform1i(row, meta_.nx);
+        gl_.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(waterGridIndices_.size()), GL_UNSIGNED_INT, nullptr);
+        n.triangles = static_cast<std::int64_t>(waterGridIndices_.size()) / 3;
+        stats_.triangles += n.triangles;
+        return n;
+    }
+    struct Piece {
+        int x0, y0, step;
+        std::size_t first;
+        std::int64_t count;
+    };
+    std::vector<Piece> pieces;
+    waterChunkIndices_.clear();
+    for (const LodChunk& c : lodSelection_.chunks) {
+        if (!c.wet || !boxInClipVolume(cullViewProj, c.boxMin, c.boxMax)) continue;
+        const MeshPlacement p{c.x0, c.y0, 1 << c.level, kChunkQuads + 1, meta_.nx, meta_.ny};
+        const std::size_t first = waterChunkIndices_.size();
+        const std::int64_t count = appendShownTriangles(chunkIndices_.data() + chunkFirst_[c.stitched],
+                                                        chunkCount_[c.stitched], p, shownWater_, waterChunkIndices_);
+        if (count > 0) pieces.push_back({c.x0, c.y0, p.step, first, count});
+    }
+    gl_.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(waterChunkIndices_.size() * sizeof(std::uint16_t)),
+                   waterChunkIndices_.data(), GL_STREAM_DRAW);
+    gl_.Uniform1i(row, kChunkQuads + 1);
+    for (const Piece& piece : pieces) {
+        gl_.Uniform2i(origin, piece.x0, piece.y0);
+        gl_.Uniform1i(step, piece.step);
+        gl_.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(piece.count), GL_UNSIGNED_SHORT,
+                         reinterpret_cast<const void*>(piece.first * sizeof(std::uint16_t)));
+        n.triangles += piece.count / 3;
+        ++n.chunks;
     }
     stats_.triangles += n.triangles;
     return n;
@@ -472,7 +523,7 @@ void Renderer::drawSurfacePoints(const FrameViews& v, bool lod, bool water) {
         gl_.StencilFunc(GL_ALWAYS, kWaterStencil, 0xff);
         gl_.Uniform1i(gl_.GetUniformLocation(pointsProgram_, "uWater"), 1);
         gl_.DepthMask(GL_FALSE);
-        drawMesh(pointsProgram_, glm::value_ptr(v.viewProj), lod, true);  // the terrain's chunks that show water
+        drawWaterMesh(pointsProgram_, glm::value_ptr(v.viewProj), lod);
         gl_.DepthMask(GL_TRUE);
     }
     gl_.Disable(GL_DEPTH_TEST);
@@ -501,15 +552,17 @@ void Renderer::shadeSurfaces(const RenderSettings& s, const FrameViews& v, bool 
     gl_.BindFramebuffer(GL_FRAMEBUFFER, deferred_.terrainFbo);
     gl_.Clear(GL_COLOR_BUFFER_BIT);
     gl_.StencilFunc(GL_LEQUAL, kTerrainStencil, 0xff);  // terrain, or water over it
-    shadingUniforms(terrainProgram_, s, v, wantShadowMap);
-    Uniforms{gl_, terrainProgram_}.i("uSurface", 7);
+    const GLuint terrainProgram = shadingProgram(false, s, wantShadowMap);
+    shadingUniforms(terrainProgram, v);
+    Uniforms{gl_, terrainProgram}.i("uSurface", 7);
     gl_.DrawArrays(GL_TRIANGLES, 0, 3);
     if (water) {
         gl_.BindFramebuffer(GL_FRAMEBUFFER, deferred_.waterFbo);
         gl_.Clear(GL_COLOR_BUFFER_BIT);
         gl_.StencilFunc(GL_EQUAL, kWaterStencil, 0xff);
-        shadingUniforms(waterProgram_, s, v, wantShadowMap);
-        Uniforms u{gl_, waterProgram_};
+        const GLuint waterProgram = shadingProgram(true, s, wantShadowMap);
+        shadingUniforms(waterProgram, v);
+        Uniforms u{gl_, waterProgram};
         u.i("uSurface", 8);
         u.i("uTerrainPoints", 7);
         u.i("uSceneColor", 9);
@@ -520,7 +573,27 @@ void Renderer::shadeSurfaces(const RenderSettings& s, const FrameViews& v, bool 
     gl_.Disable(GL_STENCIL_TEST);
 }
 
-void Renderer::shadingUniforms(GLuint p, const RenderSettings& s, const FrameViews& v, bool wantShadowMap) {
+GLuint Renderer::shadingProgram(bool water, const RenderSettings& s, bool wantShadowMap) {
+    const engine::FrameData& f = meta_;
+    const int lighting =
+        f.lighting == engine::LightingMode::KeyOnly ? 0 : (f.lighting == engine::LightingMode::Direct ? 1 : 2);
+    const int shadow = s.shadow == ShadowMode::SoftVisibility ? 0 : (wantShadowMap ? 1 : 2);
+    const int specular = s.specular ? 1 : 0, debug = static_cast<int>(s.debug);
+    const int key = (((water ? 1 : 0) * 3 + lighting) * 3 + shadow) * 2 * 16 + specular * 16 + debug;
+    if (const auto found = shadingPrograms_.find(key); found != shadingPrograms_.end()) return found->second;
+    const std::string constants = "#version 330 core\nconst int uLighting = " + std::to_string(lighting) +
+                                  ";\nconst int uShadowMode = " + std::to_string(shadow) +
+                                  ";\nconst int uSpecular = " + std::to_string(specular) +
+                                  ";\nconst int uDebug = " + std::to_string(debug) + ";\n";
+    const GLuint p =
+        link(gl_, {shaders::kFullScreenVertex},
+             {constants.c_str(), shaders::kCommon, water ? shaders::kWaterFragment : shaders::kTerrainFragment},
+             water ? "water" : "terrain");
+    shadingPrograms_.emplace(key, p);
+    return p;
+}
+
+void Renderer::shadingUniforms(GLuint p, const FrameViews& v) {
     const engine::FrameData& f = meta_;
     gl_.UseProgram(p);
     Uniforms u{gl_, p};
@@ -541,11 +614,6 @@ void Renderer::shadingUniforms(GLuint p, const RenderSettings& s, const FrameVie
     u.v3("uKeyDir", v.keyDir);
     const gi::KeyLight sun = sunOf(f.lights);
     u.v3("uKeyRgb", glm::vec3(sun.rgb[0], sun.rgb[1], sun.rgb[2]));
-    u.i("uLighting",
-        f.lighting == engine::LightingMode::KeyOnly ? 0 : (f.lighting == engine::LightingMode::Direct ? 1 : 2));
-    u.i("uShadowMode", s.shadow == ShadowMode::SoftVisibility ? 0 : (wantShadowMap ? 1 : 2));
-    u.i("uSpecular", s.specular ? 1 : 0);
-    u.i("uDebug", static_cast<int>(s.debug));
     u.f2("uZRange", f.zMin, f.zMax);
     u.m4("uLightViewProj", v.lightViewProj);
     u.f("uShadowTexel", shadow_.w > 0 ? 1.0f / static_cast<float>(shadow_.w) : 0.0f);

@@ -20,6 +20,7 @@
 // (Section 4.4), L_d the water body and the lit terrain seen through it.
 #include <array>
 #include <cstdint>
+#include <map>
 #include <vector>
 
 #include "engine/frame_data.h"
@@ -115,26 +116,38 @@ private:
         int chunks = 0;
     };
     /// The terrain mesh with `program`: the full grid, or (lod) the selected
-    /// chunks inside the clip volume of `cullViewProj` (column-major 4 x 4),
-    /// only those that show water if `waterOnly`.
-    MeshCount drawMesh(GLuint program, const float* cullViewProj, bool lod, bool waterOnly = false);
+    /// chunks inside the clip volume of `cullViewProj` (column-major 4 x 4).
+    MeshCount drawMesh(GLuint program, const float* cullViewProj, bool lod);
+    /// The same mesh's triangles that can show water (render/water_triangles.h).
+    MeshCount drawWaterMesh(GLuint program, const float* cullViewProj, bool lod);
     /// The full grid's index buffer, bound to the vertex array of draw().
     void ensureFullGrid();
     void drawSurfacePoints(const FrameViews& v, bool lod, bool water);
     void shadeSurfaces(const RenderSettings& s, const FrameViews& v, bool wantShadowMap, bool water);
-    void shadingUniforms(GLuint p, const RenderSettings& s, const FrameViews& v, bool wantShadowMap);
+    /// The terrain's or the water's shading program for these settings,
+    /// compiled on first use.
+    GLuint shadingProgram(bool water, const RenderSettings& s, bool wantShadowMap);
+    void shadingUniforms(GLuint p, const FrameViews& v);
     void drawPost(const RenderSettings& s, const FrameViews& v, int width, int height, GLuint framebuffer, bool water);
 
     const Gl& gl_;
-    // pointsProgram_: the mesh passes; terrainProgram_, waterProgram_: the shading passes
-    GLuint pointsProgram_ = 0, terrainProgram_ = 0, waterProgram_ = 0, shadowProgram_ = 0, postProgram_ = 0;
+    // pointsProgram_: the mesh passes; shadingPrograms_: the shading passes' variants
+    GLuint pointsProgram_ = 0, shadowProgram_ = 0, postProgram_ = 0;
+    std::map<int, GLuint> shadingPrograms_;
     GLuint vao_ = 0, indexBuffer_ = 0;
     std::int64_t indexCount_ = 0;  // of the full grid, built on its first draw
     int meshNx_ = 0, meshNy_ = 0;
     // Chunked LOD: the 16 stitch variants of one chunk's indices (16 bits,
     // one after another), the uploaded heights' chunk tree, the frame's chunks.
     GLuint chunkIndexBuffer_ = 0;
+    std::vector<std::uint16_t> chunkIndices_;  // what chunkIndexBuffer_ holds
     int chunkFirst_[kStitchVariants] = {}, chunkCount_[kStitchVariants] = {};
+    // The water pass's triangles: where the uploaded heights show water, and
+    // the frame's triangles (one draw per chunk, or the full grid's).
+    std::vector<std::uint8_t> shownWater_;
+    GLuint waterIndexBuffer_ = 0;
+    std::vector<std::uint16_t> waterChunkIndices_;
+    std::vector<std::uint32_t> waterGridIndices_;
     ChunkTree lodTree_;
     ChunkSelection lodSelection_;
     DrawStats stats_;

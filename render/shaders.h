@@ -55,7 +55,9 @@ in vec2 vCell;
 in float vDepth;
 out vec4 surfacePoint;
 void main() {
-    if (uWater == 1 && vDepth < 0.02) discard;  // a dry point of the water surface
+    // A dry point of the water surface (render/water_triangles.h skips the
+    // triangles where every fragment would end here).
+    if (uWater == 1 && vDepth < 0.02) discard;
     surfacePoint = vec4(vCell, vWorld.z, 1.0);
 }
 )";
@@ -79,10 +81,13 @@ uniform float uExag;
 uniform vec3 uEye;
 uniform vec3 uKeyDir;         // unit, towards the key light
 uniform vec3 uKeyRgb;         // unshadowed key shade of a white surface facing the light
-uniform int uLighting;        // 0 key only, 1 direct (sky + key), 2 global
-uniform int uShadowMode;      // 0 soft visibility (engine), 1 shadow map, 2 none
-uniform int uSpecular;
-uniform int uDebug;
+// Constants of the program variant (Renderer::shadingProgram), not uniforms,
+// so that the compiler drops the branches a frame does not take: llvmpipe
+// runs both sides of a branch on a block of pixels.
+//   uLighting:   0 key only, 1 direct (sky + key), 2 global
+//   uShadowMode: 0 soft visibility (engine), 1 shadow map, 2 none
+//   uSpecular:   1 specular highlights and glints
+//   uDebug:      a DebugView (0: none)
 uniform vec2 uZRange;
 uniform mat4 uLightViewProj;
 uniform float uShadowTexel;
