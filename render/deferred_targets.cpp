@@ -44,19 +44,21 @@ void DeferredTargets::ensure(const Gl& gl, int width, int height) {
     waterPoints = newTexture(gl, GL_RGBA32F, width, height, GL_RGBA, GL_FLOAT);
     terrainColor = newTexture(gl, GL_RGBA16F, width, height, GL_RGBA, GL_FLOAT);
     waterColor = newTexture(gl, GL_RGBA16F, width, height, GL_RGBA, GL_FLOAT);
+    displayColor = newTexture(gl, GL_RGBA8, width, height, GL_RGBA, GL_UNSIGNED_BYTE);
     depthStencil = newTexture(gl, GL_DEPTH24_STENCIL8, width, height, GL_DEPTH_STENCIL, GL_UNSIGNED_INT_24_8);
     pointsFbo = newFramebuffer(gl, {terrainPoints, waterPoints}, depthStencil, width, height);
     terrainFbo = newFramebuffer(gl, {terrainColor}, depthStencil, width, height);
     waterFbo = newFramebuffer(gl, {waterColor}, depthStencil, width, height);
+    displayFbo = newFramebuffer(gl, {displayColor}, depthStencil, width, height);
     w = width;
     h = height;
 }
 
 void DeferredTargets::release(const Gl& gl) {
-    const GLuint fbos[] = {pointsFbo, terrainFbo, waterFbo};
-    const GLuint textures[] = {terrainPoints, waterPoints, terrainColor, waterColor, depthStencil};
-    if (pointsFbo) gl.DeleteFramebuffers(3, fbos);
-    if (terrainPoints) gl.DeleteTextures(5, textures);
+    const GLuint fbos[] = {pointsFbo, terrainFbo, waterFbo, displayFbo};
+    const GLuint textures[] = {terrainPoints, waterPoints, terrainColor, waterColor, displayColor, depthStencil};
+    if (pointsFbo) gl.DeleteFramebuffers(4, fbos);
+    if (terrainPoints) gl.DeleteTextures(6, textures);
     *this = {};
 }
 

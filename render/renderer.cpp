@@ -126,7 +126,9 @@ Renderer::Renderer(const Gl& gl) : gl_(gl), sky_(gl) {
     using namespace shaders;
     pointsProgram_ = link(gl_, {kMeshVertex}, {kSurfacePointFragment}, "surface points");
     shadowProgram_ = link(gl_, {kMeshVertex}, {kShadowFragment}, "shadow");
-    postProgram_ = link(gl_, {kFullScreenVertex}, {kPostFragment}, "post");
+    const char* version = "#version 330 core\n";
+    displayProgram_ = link(gl_, {kFullScreenVertex}, {version, kToneMap, kDisplayFragment}, "display");
+    skyProgram_ = link(gl_, {kFullScreenVertex}, {version, kToneMap, kSkyFragment}, "sky");
     gl_.GenVertexArrays(1, &vao_);
     gl_.GenBuffers(1, &indexBuffer_);
     // One chunk's 16 stitch variants, one after another (render/terrain_lod.h).
@@ -148,7 +150,6 @@ Renderer::Renderer(const Gl& gl) : gl_(gl), sky_(gl) {
 
 Renderer::~Renderer() {
     deferred_.release(gl_);
-    releaseTarget(ldr_);
     releaseTarget(shadow_);
     const GLuint textures[] = {heightTex_, shadeTex_, keyTex_, receiverTex_, albedoTex_};
     gl_.DeleteTextures(5, textures);
@@ -156,7 +157,7 @@ Renderer::~Renderer() {
     gl_.DeleteBuffers(1, &chunkIndexBuffer_);
     gl_.DeleteBuffers(1, &waterIndexBuffer_);
     gl_.DeleteVertexArrays(1, &vao_);
-    for (GLuint p : {pointsProgram_, shadowProgram_, postProgram_}) gl_.DeleteProgram(p);
+    for (GLuint p : {pointsProgram_, shadowProgram_, displayProgram_, skyProgram_}) gl_.DeleteProgram(p);
     for (const auto& [key, p] : shadingPrograms_) gl_.DeleteProgram(p);
 }
 
@@ -435,6 +436,15 @@ void meshUniforms(const Gl& gl, const engine::FrameData& f, GLuint p, const glm:
 }  // namespace
 
 void Renderer::draw(const RenderSettings& s, int width, int height, GLuint framebuffer) {
+    drawFrame(s, width, height);
+    gl_.BindFramebuffer(GL_READ_FRAMEBUFFER, deferred_.displayFbo);
+    gl_.BindFramebuffer(GL_DRAW_FRAMEBUFFER, framebuffer);
+    gl_.BlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    checkGlError(gl_, "draw");
+}
+
+void Renderer::drawFrame(const RenderSettings& s, int width, int height) {
     if (width < 1 || height < 1 || width > 16384 || height > 16384)
         throw InputError("image size must be 1..16384 pixels per side");
     if (!heightTex_) throw ContextError("renderer: draw before upload");
@@ -465,10 +475,9 @@ void Renderer::draw(const RenderSettings& s, int width, int height, GLuint frame
     gl_.Viewport(0, 0, width, height);
     drawSurfacePoints(v, lod, water);
     shadeSurfaces(s, v, wantShadowMap, water);
-    drawPost(s, v, width, height, framebuffer, water);
+    drawDisplay(s, v, water);
     gl_.BindVertexArray(0);
     gl_.ActiveTexture(GL_TEXTURE0);
-    checkGlError(gl_, "draw");
 }
 
 // ---- key light shadow map -----------------------------------------------------------
@@ -532,7 +541,7 @@ void Renderer::drawSurfacePoints(const FrameViews& v, bool lod, bool water) {
 // ---- the shading passes: one full-screen triangle each --------------------------------
 // The terrain's pass lights every pixel with a terrain point (under the water
 // too: the water's march reflects it); the water's lights the water's pixels.
-// Each writes its own HDR target, cleared first; drawPost puts them together.
+// Each writes its own HDR target, read only under its stencil (drawDisplay).
 void Renderer::shadeSurfaces(const RenderSettings& s, const FrameViews& v, bool wantShadowMap, bool water) {
     const GLuint textures[] = {heightTex_,
                                shadeTex_,
@@ -550,7 +559,6 @@ void Renderer::shadeSurfaces(const RenderSettings& s, const FrameViews& v, bool 
     }
     gl_.StencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
     gl_.BindFramebuffer(GL_FRAMEBUFFER, deferred_.terrainFbo);
-    gl_.Clear(GL_COLOR_BUFFER_BIT);
     gl_.StencilFunc(GL_LEQUAL, kTerrainStencil, 0xff);  // terrain, or water over it
     const GLuint terrainProgram = shadingProgram(false, s, wantShadowMap);
     shadingUniforms(terrainProgram, v);
@@ -558,7 +566,6 @@ void Renderer::shadeSurfaces(const RenderSettings& s, const FrameViews& v, bool 
     gl_.DrawArrays(GL_TRIANGLES, 0, 3);
     if (water) {
         gl_.BindFramebuffer(GL_FRAMEBUFFER, deferred_.waterFbo);
-        gl_.Clear(GL_COLOR_BUFFER_BIT);
         gl_.StencilFunc(GL_EQUAL, kWaterStencil, 0xff);
         const GLuint waterProgram = shadingProgram(true, s, wantShadowMap);
         shadingUniforms(waterProgram, v);
@@ -619,37 +626,52 @@ void Renderer::shadingUniforms(GLuint p, const FrameViews& v) {
     u.f("uShadowTexel", shadow_.w > 0 ? 1.0f / static_cast<float>(shadow_.w) : 0.0f);
 }
 
-// ---- tone mapping + sRGB into the output --------------------------------------------
-void Renderer::drawPost(const RenderSettings& s, const FrameViews& v, int width, int height, GLuint framebuffer,
-                        bool water) {
-    gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffer);
-    gl_.Viewport(0, 0, width, height);
-    gl_.Disable(GL_DEPTH_TEST);
-    gl_.UseProgram(postProgram_);
-    gl_.ActiveTexture(GL_TEXTURE0);
-    gl_.BindTexture(GL_TEXTURE_2D, deferred_.terrainColor);
-    gl_.ActiveTexture(GL_TEXTURE3);
-    gl_.BindTexture(GL_TEXTURE_2D, deferred_.waterColor);
-    sky_.setBackground(postProgram_, meta_.lights, 1, 2);
-    Uniforms u{gl_, postProgram_};
+// ---- the display passes: tone mapping + sRGB, and the sky --------------------------------
+// Each surface's HDR colour where its stencil is, then the sky where no
+// surface was drawn (the debug views: black).
+void Renderer::drawDisplay(const RenderSettings& s, const FrameViews& v, bool water) {
+    const bool debug = s.debug != DebugView::None;
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, deferred_.displayFbo);
+    if (debug) {
+        gl_.ClearColor(0, 0, 0, 1);
+        gl_.Clear(GL_COLOR_BUFFER_BIT);
+    }
+    gl_.Enable(GL_STENCIL_TEST);
+    gl_.StencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
+    gl_.UseProgram(displayProgram_);
+    Uniforms u{gl_, displayProgram_};
     u.i("uHdr", 0);
-    u.i("uWaterHdr", 3);
-    u.i("uWaterDrawn", water ? 1 : 0);
-    u.m4("uInvViewProj", glm::inverse(v.viewProj));
-    u.v3("uEye", v.eye);
-    u.f2("uSize", static_cast<float>(width), static_cast<float>(height));
     u.f("uExposure", s.exposure);
-    u.i("uTonemap", s.debug != DebugView::None ? 0 : 1);
-    gl_.DrawArrays(GL_TRIANGLES, 0, 3);
+    u.i("uTonemap", debug ? 0 : 1);
+    gl_.ActiveTexture(GL_TEXTURE0);
+    for (const auto& [stencil, color] :
+         {std::pair{kTerrainStencil, deferred_.terrainColor}, std::pair{kWaterStencil, deferred_.waterColor}}) {
+        if (stencil == kWaterStencil && !water) continue;
+        gl_.BindTexture(GL_TEXTURE_2D, color);
+        gl_.StencilFunc(GL_EQUAL, stencil, 0xff);
+        gl_.DrawArrays(GL_TRIANGLES, 0, 3);
+    }
+    if (!debug) {
+        gl_.UseProgram(skyProgram_);
+        sky_.setBackground(skyProgram_, meta_.lights, 1, 2);
+        Uniforms k{gl_, skyProgram_};
+        k.f("uExposure", s.exposure);
+        k.i("uTonemap", 1);
+        k.m4("uInvViewProj", glm::inverse(v.viewProj));
+        k.v3("uEye", v.eye);
+        k.f2("uSize", static_cast<float>(deferred_.w), static_cast<float>(deferred_.h));
+        gl_.StencilFunc(GL_EQUAL, 0, 0xff);
+        gl_.DrawArrays(GL_TRIANGLES, 0, 3);
+    }
+    gl_.Disable(GL_STENCIL_TEST);
 }
 
 void Renderer::drawToImage(const RenderSettings& s, int width, int height, std::vector<std::uint8_t>& rgb) {
     if (width < 1 || height < 1 || width > 16384 || height > 16384)
         throw InputError("image size must be 1..16384 pixels per side");
-    ensureTarget(ldr_, width, height, GL_RGBA8, false);
-    draw(s, width, height, ldr_.fbo);
+    drawFrame(s, width, height);
     std::vector<std::uint8_t> rgba(static_cast<std::size_t>(width) * height * 4);
-    gl_.BindFramebuffer(GL_FRAMEBUFFER, ldr_.fbo);
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, deferred_.displayFbo);
     gl_.ReadBuffer(GL_COLOR_ATTACHMENT0);
     gl_.PixelStorei(GL_PACK_ALIGNMENT, 1);
     gl_.ReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());

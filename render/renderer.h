@@ -128,11 +128,13 @@ private:
     /// compiled on first use.
     GLuint shadingProgram(bool water, const RenderSettings& s, bool wantShadowMap);
     void shadingUniforms(GLuint p, const FrameViews& v);
-    void drawPost(const RenderSettings& s, const FrameViews& v, int width, int height, GLuint framebuffer, bool water);
+    /// Every pass of draw(); the image is left in deferred_.displayColor.
+    void drawFrame(const RenderSettings& s, int width, int height);
+    void drawDisplay(const RenderSettings& s, const FrameViews& v, bool water);
 
     const Gl& gl_;
     // pointsProgram_: the mesh passes; shadingPrograms_: the shading passes' variants
-    GLuint pointsProgram_ = 0, shadowProgram_ = 0, postProgram_ = 0;
+    GLuint pointsProgram_ = 0, shadowProgram_ = 0, displayProgram_ = 0, skyProgram_ = 0;
     std::map<int, GLuint> shadingPrograms_;
     GLuint vao_ = 0, indexBuffer_ = 0;
     std::int64_t indexCount_ = 0;  // of the full grid, built on its first draw
@@ -156,7 +158,7 @@ private:
         albedoW_ = 0, albedoH_ = 0;
     // FrameData's versions of what was uploaded last
     std::int64_t heightsVersion_ = -1, albedoVersion_ = -1, shadeVersion_ = -1;
-    Target ldr_, shadow_;
+    Target shadow_;
     DeferredTargets deferred_;
     engine::FrameData meta_;  // the uploaded frame's sizes, lights and modes (no per-texel arrays)
     Sky sky_;

@@ -292,14 +292,32 @@ void main() {
 }
 )";
 
-// Tone mapping (ACES fit) and sRGB encoding of the water where it was drawn,
-// else the terrain, else the sky (render/sky.h): the sky model, the HDR image
-// or the SH map, and a disc for each key light.
-inline constexpr const char* kPostFragment = R"(#version 330 core
+// The displayed colour of an HDR radiance: tone mapping (ACES fit) and sRGB
+// encoding (uTonemap 0, the debug views: clamped, not tone mapped).
+inline constexpr const char* kToneMap = R"(
+uniform float uExposure;
+uniform int uTonemap;
+out vec4 fragColor;
+vec3 aces(vec3 x) { return clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0); }
+vec3 srgb(vec3 c) {
+    return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+}
+vec4 displayed(vec3 c) {
+    vec3 x = uTonemap == 1 ? aces(c * uExposure) : clamp(c, 0.0, 1.0);
+    return vec4(srgb(x), 1.0);
+}
+)";
+
+// A shading pass's pixels, displayed (under its surface's stencil test).
+inline constexpr const char* kDisplayFragment = R"(
+uniform sampler2D uHdr;  // the terrain's or the water's shading pass
+void main() { fragColor = displayed(texelFetch(uHdr, ivec2(gl_FragCoord.xy), 0).rgb); }
+)";
+
+// The sky where no surface was drawn (render/sky.h): the sky model, the HDR
+// image or the SH map, and a disc for each key light.
+inline constexpr const char* kSkyFragment = R"(
 const float PI = 3.14159265358979;
-uniform sampler2D uHdr;       // the terrain shading pass (alpha 0: no terrain)
-uniform sampler2D uWaterHdr;  // the water shading pass (alpha 0: no water)
-uniform int uWaterDrawn;
 uniform sampler2D uEnv;       // the environment's SH, baked
 uniform sampler2D uSkyImage;  // the HDR environment image (uSkyKind 2)
 uniform int uSkyKind;         // 0 SH, 1 gradient, 2 image
@@ -312,13 +330,6 @@ uniform vec3 uDiscRadiance[4];
 uniform mat4 uInvViewProj;
 uniform vec3 uEye;
 uniform vec2 uSize;
-uniform float uExposure;
-uniform int uTonemap;
-out vec4 fragColor;
-vec3 aces(vec3 x) { return clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0); }
-vec3 srgb(vec3 c) {
-    return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
-}
 // Column = azimuth from +x towards +y, row 0 = zenith.
 vec2 equirect(vec3 d) { return vec2(atan(d.y, d.x) / (2.0 * PI), 0.5 - asin(clamp(d.z, -1.0, 1.0)) / PI); }
 vec3 background(vec3 d) {
@@ -337,18 +348,8 @@ vec3 background(vec3 d) {
     return c;
 }
 void main() {
-    vec4 c = texelFetch(uHdr, ivec2(gl_FragCoord.xy), 0);
-    if (uWaterDrawn == 1) {
-        vec4 w = texelFetch(uWaterHdr, ivec2(gl_FragCoord.xy), 0);
-        if (w.a > 0.0) c = w;
-    }
-    if (c.a <= 0.0) {
-        if (uTonemap == 0) { fragColor = vec4(0.0, 0.0, 0.0, 1.0); return; }
-        vec4 p = uInvViewProj * vec4(gl_FragCoord.xy / uSize * 2.0 - 1.0, 1.0, 1.0);
-        c.rgb = background(normalize(p.xyz / p.w - uEye));
-    }
-    vec3 x = uTonemap == 1 ? aces(c.rgb * uExposure) : clamp(c.rgb, 0.0, 1.0);
-    fragColor = vec4(srgb(x), 1.0);
+    vec4 p = uInvViewProj * vec4(gl_FragCoord.xy / uSize * 2.0 - 1.0, 1.0, 1.0);
+    fragColor = displayed(background(normalize(p.xyz / p.w - uEye)));
 }
 )";
 
