@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <optional>
 #include <string>
@@ -12,6 +13,7 @@
 
 #include "render/context.h"
 #include "render/shaders.h"
+#include "render/water_triangles.h"
 
 namespace terrain::render {
 namespace {
@@ -122,41 +124,41 @@ ImageDifference compareImages(const std::vector<std::uint8_t>& a, const std::vec
 
 Renderer::Renderer(const Gl& gl) : gl_(gl), sky_(gl) {
     using namespace shaders;
-    const char* version = "#version 330 core\n";
-    terrainProgram_ = link(gl_, {kMeshVertex}, {version, kCommon, kTerrainFragment}, "terrain");
-    waterProgram_ = link(gl_, {kMeshVertex}, {version, kCommon, kWaterFragment}, "water");
+    pointsProgram_ = link(gl_, {kMeshVertex}, {kSurfacePointFragment}, "surface points");
     shadowProgram_ = link(gl_, {kMeshVertex}, {kShadowFragment}, "shadow");
-    postProgram_ = link(gl_, {kPostVertex}, {kPostFragment}, "post");
+    const char* version = "#version 330 core\n";
+    displayProgram_ = link(gl_, {kFullScreenVertex}, {version, kToneMap, kDisplayFragment}, "display");
+    skyProgram_ = link(gl_, {kFullScreenVertex}, {version, kToneMap, kSkyFragment}, "sky");
     gl_.GenVertexArrays(1, &vao_);
     gl_.GenBuffers(1, &indexBuffer_);
     // One chunk's 16 stitch variants, one after another (render/terrain_lod.h).
-    std::vector<std::uint16_t> chunkIndices;
     for (int stitched = 0; stitched < kStitchVariants; ++stitched) {
-        chunkFirst_[stitched] = static_cast<int>(chunkIndices.size());
+        chunkFirst_[stitched] = static_cast<int>(chunkIndices_.size());
         for (const ChunkTriangle& t : chunkTriangles(kChunkQuads, stitched))
-            chunkIndices.insert(chunkIndices.end(), t.begin(), t.end());
-        chunkCount_[stitched] = static_cast<int>(chunkIndices.size()) - chunkFirst_[stitched];
+            chunkIndices_.insert(chunkIndices_.end(), t.begin(), t.end());
+        chunkCount_[stitched] = static_cast<int>(chunkIndices_.size()) - chunkFirst_[stitched];
     }
     gl_.GenBuffers(1, &chunkIndexBuffer_);
+    gl_.GenBuffers(1, &waterIndexBuffer_);
     gl_.BindVertexArray(vao_);
     gl_.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, chunkIndexBuffer_);
-    gl_.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(chunkIndices.size() * sizeof(std::uint16_t)),
-                   chunkIndices.data(), GL_STATIC_DRAW);
+    gl_.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(chunkIndices_.size() * sizeof(std::uint16_t)),
+                   chunkIndices_.data(), GL_STATIC_DRAW);
     gl_.BindVertexArray(0);
     checkGlError(gl_, "renderer set-up");
 }
 
 Renderer::~Renderer() {
-    releaseTarget(hdr_);
-    releaseTarget(sceneCopy_);
-    releaseTarget(ldr_);
+    deferred_.release(gl_);
     releaseTarget(shadow_);
     const GLuint textures[] = {heightTex_, shadeTex_, keyTex_, receiverTex_, albedoTex_};
     gl_.DeleteTextures(5, textures);
     gl_.DeleteBuffers(1, &indexBuffer_);
     gl_.DeleteBuffers(1, &chunkIndexBuffer_);
+    gl_.DeleteBuffers(1, &waterIndexBuffer_);
     gl_.DeleteVertexArrays(1, &vao_);
-    for (GLuint p : {terrainProgram_, waterProgram_, shadowProgram_, postProgram_}) gl_.DeleteProgram(p);
+    for (GLuint p : {pointsProgram_, shadowProgram_, displayProgram_, skyProgram_}) gl_.DeleteProgram(p);
+    for (const auto& [key, p] : shadingPrograms_) gl_.DeleteProgram(p);
 }
 
 void Renderer::ensureTexture(GLuint& tex, int& w, int& h, int nw, int nh, GLenum internal, GLenum format, bool linear) {
@@ -183,6 +185,7 @@ void Renderer::upload(const engine::FrameData& f) {
     if (newHeights) {
         streamTexture(heightTex_, heightW_, heightH_, f.nx, f.ny, GL_RG32F, GL_RG, f.heights.data());
         heightsVersion_ = f.heightsVersion;
+        if (f.hasWater) markShownWater(f.heights, shownWater_);
     }
     if (f.shadeVersion != shadeVersion_ || shadeW_ != f.nx || shadeH_ != f.ny || recvW_ != f.nxr || recvH_ != f.nyr) {
         streamTexture(shadeTex_, shadeW_, shadeH_, f.nx, f.ny, GL_RGBA32F, GL_RGBA, f.shade.data());
@@ -268,7 +271,7 @@ void Renderer::ensureFullGrid() {
     meshNy_ = ny;
 }
 
-Renderer::MeshCount Renderer::drawMesh(GLuint program, const float* cullViewProj, bool lod, bool waterOnly) {
+Renderer::MeshCount Renderer::drawMesh(GLuint program, const float* cullViewProj, bool lod) {
     const GLint origin = gl_.GetUniformLocation(program, "uOrigin"), step = gl_.GetUniformLocation(program, "uStep"),
                 row = gl_.GetUniformLocation(program, "uRow");
     MeshCount n;
@@ -284,7 +287,7 @@ Renderer::MeshCount Renderer::drawMesh(GLuint program, const float* cullViewProj
         gl_.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, chunkIndexBuffer_);
         gl_.Uniform1i(row, kChunkQuads + 1);
         for (const LodChunk& c : lodSelection_.chunks) {
-            if ((waterOnly && !c.wet) || !boxInClipVolume(cullViewProj, c.boxMin, c.boxMax)) continue;
+            if (!boxInClipVolume(cullViewProj, c.boxMin, c.boxMax)) continue;
             gl_.Uniform2i(origin, c.x0, c.y0);
             gl_.Uniform1i(step, 1 << c.level);
             const auto offset = static_cast<std::uintptr_t>(chunkFirst_[c.stitched]) * sizeof(std::uint16_t);
@@ -293,6 +296,56 @@ Renderer::MeshCount Renderer::drawMesh(GLuint program, const float* cullViewProj
             n.triangles += chunkCount_[c.stitched] / 3;
             ++n.chunks;
         }
+    }
+    stats_.triangles += n.triangles;
+    return n;
+}
+
+// The chunks' (or the full grid's) triangles that can show water, gathered
+// into one stream index buffer, drawn in the same order as drawMesh's.
+Renderer::MeshCount Renderer::drawWaterMesh(GLuint program, const float* cullViewProj, bool lod) {
+    const GLint origin = gl_.GetUniformLocation(program, "uOrigin"), step = gl_.GetUniformLocation(program, "uStep"),
+                row = gl_.GetUniformLocation(program, "uRow");
+    gl_.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, waterIndexBuffer_);
+    MeshCount n;
+    if (!lod) {
+        shownGridTriangles(meta_.nx, meta_.ny, shownWater_, waterGridIndices_);
+        gl_.BufferData(GL_ELEMENT_ARRAY_BUFFER,
+                       static_cast<GLsizeiptr>(waterGridIndices_.size() * sizeof(std::uint32_t)),
+                       waterGridIndices_.data(), GL_STREAM_DRAW);
+        gl_.Uniform2i(origin, 0, 0);
+        gl_.Uniform1i(step, 1);
+        gl_.Uniform1i(row, meta_.nx);
+        gl_.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(waterGridIndices_.size()), GL_UNSIGNED_INT, nullptr);
+        n.triangles = static_cast<std::int64_t>(waterGridIndices_.size()) / 3;
+        stats_.triangles += n.triangles;
+        return n;
+    }
+    struct Piece {
+        int x0, y0, step;
+        std::size_t first;
+        std::int64_t count;
+    };
+    std::vector<Piece> pieces;
+    waterChunkIndices_.clear();
+    for (const LodChunk& c : lodSelection_.chunks) {
+        if (!c.wet || !boxInClipVolume(cullViewProj, c.boxMin, c.boxMax)) continue;
+        const MeshPlacement p{c.x0, c.y0, 1 << c.level, kChunkQuads + 1, meta_.nx, meta_.ny};
+        const std::size_t first = waterChunkIndices_.size();
+        const std::int64_t count = appendShownTriangles(chunkIndices_.data() + chunkFirst_[c.stitched],
+                                                        chunkCount_[c.stitched], p, shownWater_, waterChunkIndices_);
+        if (count > 0) pieces.push_back({c.x0, c.y0, p.step, first, count});
+    }
+    gl_.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(waterChunkIndices_.size() * sizeof(std::uint16_t)),
+                   waterChunkIndices_.data(), GL_STREAM_DRAW);
+    gl_.Uniform1i(row, kChunkQuads + 1);
+    for (const Piece& piece : pieces) {
+        gl_.Uniform2i(origin, piece.x0, piece.y0);
+        gl_.Uniform1i(step, piece.step);
+        gl_.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(piece.count), GL_UNSIGNED_SHORT,
+                         reinterpret_cast<const void*>(piece.first * sizeof(std::uint16_t)));
+        n.triangles += piece.count / 3;
+        ++n.chunks;
     }
     stats_.triangles += n.triangles;
     return n;
@@ -309,7 +362,7 @@ void Renderer::releaseTarget(Target& t) {
 struct Renderer::FrameViews {
     glm::vec3 eye;
     glm::mat4 viewProj;
-    float nearPlane, farPlane;
+    glm::vec3 viewAxis;  // unit, from the eye towards the target
     glm::vec3 keyDir;
     glm::mat4 lightViewProj;  // orthographic, covering the terrain
 };
@@ -364,7 +417,7 @@ Renderer::FrameViews Renderer::frameViews(const OrbitCamera& cam, int width, int
     const glm::vec3 up = std::abs(keyDir.z) > 0.99f ? glm::vec3(0, 1, 0) : glm::vec3(0, 0, 1);
     const glm::mat4 lightViewProj = glm::ortho(-radius, radius, -radius, radius, 0.0f, 4.0f * radius) *
                                     glm::lookAt(centre + keyDir * (2.0f * radius), centre, up);
-    return {eye, viewProj, nearPlane, farPlane, keyDir, lightViewProj};
+    return {eye, viewProj, glm::normalize(target - eye), keyDir, lightViewProj};
 }
 
 namespace {
@@ -383,6 +436,15 @@ void meshUniforms(const Gl& gl, const engine::FrameData& f, GLuint p, const glm:
 }  // namespace
 
 void Renderer::draw(const RenderSettings& s, int width, int height, GLuint framebuffer) {
+    drawFrame(s, width, height);
+    gl_.BindFramebuffer(GL_READ_FRAMEBUFFER, deferred_.displayFbo);
+    gl_.BindFramebuffer(GL_DRAW_FRAMEBUFFER, framebuffer);
+    gl_.BlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    checkGlError(gl_, "draw");
+}
+
+void Renderer::drawFrame(const RenderSettings& s, int width, int height) {
     if (width < 1 || height < 1 || width > 16384 || height > 16384)
         throw InputError("image size must be 1..16384 pixels per side");
     if (!heightTex_) throw ContextError("renderer: draw before upload");
@@ -400,20 +462,22 @@ void Renderer::draw(const RenderSettings& s, int width, int height, GLuint frame
         selectChunks(lodTree_, view, lodSelection_);
     }
     const bool debug = s.debug != DebugView::None;
+    const bool water = s.water && meta_.hasWater && !debug;
     gl_.BindVertexArray(vao_);
     const bool wantShadowMap = s.shadow == ShadowMode::ShadowMap && !debug;
     // Targets first: creating one binds its textures to the active unit.
     const int shadowSide = std::clamp(s.shadowMapSize, 256, 8192);
     if (wantShadowMap) ensureTarget(shadow_, shadowSide, shadowSide, 0, true);
-    ensureTarget(hdr_, width, height, GL_RGBA16F, true);
+    deferred_.ensure(gl_, width, height);
     gl_.ActiveTexture(GL_TEXTURE0);
     gl_.BindTexture(GL_TEXTURE_2D, heightTex_);
     if (wantShadowMap) drawShadowMap(v, lod);
-    drawSurfaces(s, v, width, height, wantShadowMap, lod);
-    drawPost(s, v, width, height, framebuffer);
+    gl_.Viewport(0, 0, width, height);
+    drawSurfacePoints(v, lod, water);
+    shadeSurfaces(s, v, wantShadowMap, water);
+    drawDisplay(s, v, water);
     gl_.BindVertexArray(0);
     gl_.ActiveTexture(GL_TEXTURE0);
-    checkGlError(gl_, "draw");
 }
 
 // ---- key light shadow map -----------------------------------------------------------
@@ -435,77 +499,121 @@ void Renderer::drawShadowMap(const FrameViews& v, bool lod) {
     gl_.Disable(GL_POLYGON_OFFSET_FILL);
 }
 
-// ---- terrain and water into the HDR target ------------------------------------------
-// The water reflects the terrain drawn so far (kWaterFragment's screen-space
-// reflection): its colour and depth are copied to textures it can read
-// while it draws into the target they came from. Leaves hdr_ bound, the
-// copies on texture units 7 and 8.
-void Renderer::copySceneForReflections(int width, int height) {
-    gl_.ActiveTexture(GL_TEXTURE8);  // what follows binds textures: keep the surfaces' units 0-6
-    ensureTarget(sceneCopy_, width, height, GL_RGBA16F, true);
-    gl_.BindTexture(GL_TEXTURE_2D, sceneCopy_.depth);
-    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_NONE);  // read as distances, not compared
-    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    gl_.BindFramebuffer(GL_READ_FRAMEBUFFER, hdr_.fbo);
-    gl_.BindFramebuffer(GL_DRAW_FRAMEBUFFER, sceneCopy_.fbo);
-    gl_.BlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT,
-                        GL_NEAREST);
-    gl_.BindFramebuffer(GL_FRAMEBUFFER, hdr_.fbo);
-    gl_.ActiveTexture(GL_TEXTURE7);
-    gl_.BindTexture(GL_TEXTURE_2D, sceneCopy_.color);
-    gl_.ActiveTexture(GL_TEXTURE8);
-    gl_.BindTexture(GL_TEXTURE_2D, sceneCopy_.depth);
-}
-
-void Renderer::drawSurfaces(const RenderSettings& s, const FrameViews& v, int width, int height, bool wantShadowMap,
-                            bool lod) {
-    const engine::FrameData& f = meta_;
-    gl_.BindFramebuffer(GL_FRAMEBUFFER, hdr_.fbo);
-    gl_.Viewport(0, 0, width, height);
+// ---- the mesh passes: surface points ------------------------------------------------
+// The terrain's points, then the water's where it is in front of the terrain,
+// each marking the stencil with its surface (render/deferred_targets.h). The
+// water writes no depth: the depth buffer keeps the terrain's, so that the
+// water is tested against the terrain alone (where two water surfaces
+// overlap on screen, the last drawn shows).
+void Renderer::drawSurfacePoints(const FrameViews& v, bool lod, bool water) {
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, deferred_.pointsFbo);
+    // The terrain's points need their clear (the water's march reads them
+    // anywhere); the water's are read only where its stencil was set.
+    // One draw buffer at a time: the points shader's one output goes to it.
+    const GLenum terrainPoints = GL_COLOR_ATTACHMENT0, waterPoints = GL_COLOR_ATTACHMENT1;
+    gl_.DrawBuffers(1, &terrainPoints);
     gl_.ClearColor(0, 0, 0, 0);
     gl_.ClearDepth(1.0);
-    gl_.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    gl_.ClearStencil(0);
+    gl_.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
     gl_.Enable(GL_DEPTH_TEST);
     gl_.DepthFunc(GL_LESS);
     gl_.Disable(GL_CULL_FACE);
-    const GLuint textures[] = {heightTex_,       shadeTex_,     keyTex_,   receiverTex_,
-                               sky_.shTexture(), shadow_.depth, albedoTex_};
-    for (int i = 0; i < 7; ++i) {
+    gl_.Enable(GL_STENCIL_TEST);
+    gl_.StencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
+    gl_.StencilFunc(GL_ALWAYS, kTerrainStencil, 0xff);
+    gl_.UseProgram(pointsProgram_);
+    meshUniforms(gl_, meta_, pointsProgram_, v.viewProj, 0);
+    const MeshCount terrain = drawMesh(pointsProgram_, glm::value_ptr(v.viewProj), lod);
+    stats_.terrainTriangles = terrain.triangles;
+    stats_.terrainChunks = terrain.chunks;
+    if (water) {
+        gl_.DrawBuffers(1, &waterPoints);
+        gl_.StencilFunc(GL_ALWAYS, kWaterStencil, 0xff);
+        gl_.Uniform1i(gl_.GetUniformLocation(pointsProgram_, "uWater"), 1);
+        gl_.DepthMask(GL_FALSE);
+        drawWaterMesh(pointsProgram_, glm::value_ptr(v.viewProj), lod);
+        gl_.DepthMask(GL_TRUE);
+    }
+    gl_.Disable(GL_DEPTH_TEST);
+}
+
+// ---- the shading passes: one full-screen triangle each --------------------------------
+// The terrain's pass lights every pixel with a terrain point (under the water
+// too: the water's march reflects it); the water's lights the water's pixels.
+// Each writes its own HDR target, read only under its stencil (drawDisplay).
+void Renderer::shadeSurfaces(const RenderSettings& s, const FrameViews& v, bool wantShadowMap, bool water) {
+    const GLuint textures[] = {heightTex_,
+                               shadeTex_,
+                               keyTex_,
+                               receiverTex_,
+                               sky_.shTexture(),
+                               shadow_.depth,
+                               albedoTex_,
+                               deferred_.terrainPoints,
+                               deferred_.waterPoints,
+                               deferred_.terrainColor};
+    for (int i = 0; i < 10; ++i) {
         gl_.ActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + i));
         gl_.BindTexture(GL_TEXTURE_2D, textures[i]);
     }
-    surfaceUniforms(terrainProgram_, 0, s, v, wantShadowMap);
-    const MeshCount terrain = drawMesh(terrainProgram_, glm::value_ptr(v.viewProj), lod);
-    stats_.terrainTriangles = terrain.triangles;
-    stats_.terrainChunks = terrain.chunks;
-    if (s.water && f.hasWater && s.debug == DebugView::None) {
-        copySceneForReflections(width, height);
-        surfaceUniforms(waterProgram_, 1, s, v, wantShadowMap);
-        Uniforms u{gl_, waterProgram_};
-        u.i("uSceneColor", 7);
-        u.i("uSceneDepth", 8);
-        u.f2("uNearFar", v.nearPlane, v.farPlane);
-        gl_.Enable(GL_BLEND);
-        gl_.BlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-        gl_.DepthMask(GL_FALSE);
-        drawMesh(waterProgram_, glm::value_ptr(v.viewProj), lod, true);  // the terrain's chunks that show water
-        gl_.DepthMask(GL_TRUE);
-        gl_.Disable(GL_BLEND);
+    gl_.StencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, deferred_.terrainFbo);
+    gl_.StencilFunc(GL_LEQUAL, kTerrainStencil, 0xff);  // terrain, or water over it
+    const GLuint terrainProgram = shadingProgram(false, s, wantShadowMap);
+    shadingUniforms(terrainProgram, v);
+    Uniforms{gl_, terrainProgram}.i("uSurface", 7);
+    gl_.DrawArrays(GL_TRIANGLES, 0, 3);
+    if (water) {
+        gl_.BindFramebuffer(GL_FRAMEBUFFER, deferred_.waterFbo);
+        gl_.StencilFunc(GL_EQUAL, kWaterStencil, 0xff);
+        const GLuint waterProgram = shadingProgram(true, s, wantShadowMap);
+        shadingUniforms(waterProgram, v);
+        Uniforms u{gl_, waterProgram};
+        u.i("uSurface", 8);
+        u.i("uTerrainPoints", 7);
+        u.i("uSceneColor", 9);
+        u.m4("uViewProj", v.viewProj);
+        u.v3("uViewAxis", v.viewAxis);
+        gl_.DrawArrays(GL_TRIANGLES, 0, 3);
     }
+    gl_.Disable(GL_STENCIL_TEST);
 }
 
-void Renderer::surfaceUniforms(GLuint p, int water, const RenderSettings& s, const FrameViews& v, bool wantShadowMap) {
+GLuint Renderer::shadingProgram(bool water, const RenderSettings& s, bool wantShadowMap) {
+    const engine::FrameData& f = meta_;
+    const int lighting =
+        f.lighting == engine::LightingMode::KeyOnly ? 0 : (f.lighting == engine::LightingMode::Direct ? 1 : 2);
+    const int shadow = s.shadow == ShadowMode::SoftVisibility ? 0 : (wantShadowMap ? 1 : 2);
+    const int specular = s.specular ? 1 : 0, debug = static_cast<int>(s.debug);
+    const int key = (((water ? 1 : 0) * 3 + lighting) * 3 + shadow) * 2 * 16 + specular * 16 + debug;
+    if (const auto found = shadingPrograms_.find(key); found != shadingPrograms_.end()) return found->second;
+    const std::string constants = "#version 330 core\nconst int uLighting = " + std::to_string(lighting) +
+                                  ";\nconst int uShadowMode = " + std::to_string(shadow) +
+                                  ";\nconst int uSpecular = " + std::to_string(specular) +
+                                  ";\nconst int uDebug = " + std::to_string(debug) + ";\n";
+    const GLuint p =
+        link(gl_, {shaders::kFullScreenVertex},
+             {constants.c_str(), shaders::kCommon, water ? shaders::kWaterFragment : shaders::kTerrainFragment},
+             water ? "water" : "terrain");
+    shadingPrograms_.emplace(key, p);
+    return p;
+}
+
+void Renderer::shadingUniforms(GLuint p, const FrameViews& v) {
     const engine::FrameData& f = meta_;
     gl_.UseProgram(p);
-    meshUniforms(gl_, f, p, v.viewProj, water);
     Uniforms u{gl_, p};
+    u.i("uHeight", 0);
     u.i("uShade", 1);
     u.i("uKey", 2);
     u.i("uReceiver", 3);
     u.i("uEnv", 4);
     u.i("uShadowMap", 5);
     u.i("uAlbedo", 6);
+    u.i2("uGrid", f.nx, f.ny);
+    u.f("uCell", f.cellSize);
+    u.f("uExag", f.exaggeration);
     u.f("uHaze", f.lights.hazeExtinction);
     u.i2("uReceiverGrid", f.nxr, f.nyr);
     u.i("uSubsample", f.subsample);
@@ -513,42 +621,57 @@ void Renderer::surfaceUniforms(GLuint p, int water, const RenderSettings& s, con
     u.v3("uKeyDir", v.keyDir);
     const gi::KeyLight sun = sunOf(f.lights);
     u.v3("uKeyRgb", glm::vec3(sun.rgb[0], sun.rgb[1], sun.rgb[2]));
-    u.i("uLighting",
-        f.lighting == engine::LightingMode::KeyOnly ? 0 : (f.lighting == engine::LightingMode::Direct ? 1 : 2));
-    u.i("uShadowMode", s.shadow == ShadowMode::SoftVisibility ? 0 : (wantShadowMap ? 1 : 2));
-    u.i("uSpecular", s.specular ? 1 : 0);
-    u.i("uDebug", static_cast<int>(s.debug));
     u.f2("uZRange", f.zMin, f.zMax);
     u.m4("uLightViewProj", v.lightViewProj);
     u.f("uShadowTexel", shadow_.w > 0 ? 1.0f / static_cast<float>(shadow_.w) : 0.0f);
 }
 
-// ---- tone mapping + sRGB into the output --------------------------------------------
-void Renderer::drawPost(const RenderSettings& s, const FrameViews& v, int width, int height, GLuint framebuffer) {
-    gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffer);
-    gl_.Viewport(0, 0, width, height);
-    gl_.Disable(GL_DEPTH_TEST);
-    gl_.UseProgram(postProgram_);
-    gl_.ActiveTexture(GL_TEXTURE0);
-    gl_.BindTexture(GL_TEXTURE_2D, hdr_.color);
-    sky_.setBackground(postProgram_, meta_.lights, 1, 2);
-    Uniforms u{gl_, postProgram_};
+// ---- the display passes: tone mapping + sRGB, and the sky --------------------------------
+// Each surface's HDR colour where its stencil is, then the sky where no
+// surface was drawn (the debug views: black).
+void Renderer::drawDisplay(const RenderSettings& s, const FrameViews& v, bool water) {
+    const bool debug = s.debug != DebugView::None;
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, deferred_.displayFbo);
+    if (debug) {
+        gl_.ClearColor(0, 0, 0, 1);
+        gl_.Clear(GL_COLOR_BUFFER_BIT);
+    }
+    gl_.Enable(GL_STENCIL_TEST);
+    gl_.StencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
+    gl_.UseProgram(displayProgram_);
+    Uniforms u{gl_, displayProgram_};
     u.i("uHdr", 0);
-    u.m4("uInvViewProj", glm::inverse(v.viewProj));
-    u.v3("uEye", v.eye);
-    u.f2("uSize", static_cast<float>(width), static_cast<float>(height));
     u.f("uExposure", s.exposure);
-    u.i("uTonemap", s.debug != DebugView::None ? 0 : 1);
-    gl_.DrawArrays(GL_TRIANGLES, 0, 3);
+    u.i("uTonemap", debug ? 0 : 1);
+    gl_.ActiveTexture(GL_TEXTURE0);
+    for (const auto& [stencil, color] :
+         {std::pair{kTerrainStencil, deferred_.terrainColor}, std::pair{kWaterStencil, deferred_.waterColor}}) {
+        if (stencil == kWaterStencil && !water) continue;
+        gl_.BindTexture(GL_TEXTURE_2D, color);
+        gl_.StencilFunc(GL_EQUAL, stencil, 0xff);
+        gl_.DrawArrays(GL_TRIANGLES, 0, 3);
+    }
+    if (!debug) {
+        gl_.UseProgram(skyProgram_);
+        sky_.setBackground(skyProgram_, meta_.lights, 1, 2);
+        Uniforms k{gl_, skyProgram_};
+        k.f("uExposure", s.exposure);
+        k.i("uTonemap", 1);
+        k.m4("uInvViewProj", glm::inverse(v.viewProj));
+        k.v3("uEye", v.eye);
+        k.f2("uSize", static_cast<float>(deferred_.w), static_cast<float>(deferred_.h));
+        gl_.StencilFunc(GL_EQUAL, 0, 0xff);
+        gl_.DrawArrays(GL_TRIANGLES, 0, 3);
+    }
+    gl_.Disable(GL_STENCIL_TEST);
 }
 
 void Renderer::drawToImage(const RenderSettings& s, int width, int height, std::vector<std::uint8_t>& rgb) {
     if (width < 1 || height < 1 || width > 16384 || height > 16384)
         throw InputError("image size must be 1..16384 pixels per side");
-    ensureTarget(ldr_, width, height, GL_RGBA8, false);
-    draw(s, width, height, ldr_.fbo);
+    drawFrame(s, width, height);
     std::vector<std::uint8_t> rgba(static_cast<std::size_t>(width) * height * 4);
-    gl_.BindFramebuffer(GL_FRAMEBUFFER, ldr_.fbo);
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, deferred_.displayFbo);
     gl_.ReadBuffer(GL_COLOR_ATTACHMENT0);
     gl_.PixelStorei(GL_PACK_ALIGNMENT, 1);
     gl_.ReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());

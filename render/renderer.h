@@ -4,9 +4,12 @@
 // Per frame: upload the heights (one RG32F texture: ground, water depth) and
 // the GI textures of FrameData; draw the terrain mesh (chunks whose
 // resolution follows the screen-space error, render/terrain_lod.h; positions
-// fetched from the height texture by gl_VertexID) into an HDR target; draw
-// water as a second surface (ground + depth, the same chunks) blended over
-// the lit terrain; tone map and encode sRGB.
+// fetched from the height texture by gl_VertexID) and the water as a second
+// surface (ground + depth, the same chunks) with deferred shading
+// (render/deferred_targets.h): the mesh passes record only the surface point
+// each pixel sees, then one full-screen pass lights the terrain's pixels and
+// one the water's (which reflects the lit terrain); tone map and encode sRGB
+// with the sky behind.
 //
 // Materials (Heidrich & Seidel 1999): Torrance-Sparrow specular for the key light
 // (Beckmann distribution, Smith geometry term, Schlick's Fresnel), modulated
@@ -17,9 +20,11 @@
 // (Section 4.4), L_d the water body and the lit terrain seen through it.
 #include <array>
 #include <cstdint>
+#include <map>
 #include <vector>
 
 #include "engine/frame_data.h"
+#include "render/deferred_targets.h"
 #include "render/gl.h"
 #include "render/sky.h"
 #include "render/terrain_lod.h"
@@ -111,26 +116,40 @@ private:
         int chunks = 0;
     };
     /// The terrain mesh with `program`: the full grid, or (lod) the selected
-    /// chunks inside the clip volume of `cullViewProj` (column-major 4 x 4),
-    /// only those that show water if `waterOnly`.
-    MeshCount drawMesh(GLuint program, const float* cullViewProj, bool lod, bool waterOnly = false);
+    /// chunks inside the clip volume of `cullViewProj` (column-major 4 x 4).
+    MeshCount drawMesh(GLuint program, const float* cullViewProj, bool lod);
+    /// The same mesh's triangles that can show water (render/water_triangles.h).
+    MeshCount drawWaterMesh(GLuint program, const float* cullViewProj, bool lod);
     /// The full grid's index buffer, bound to the vertex array of draw().
     void ensureFullGrid();
-    void copySceneForReflections(int width, int height);
-    void drawSurfaces(const RenderSettings& s, const FrameViews& v, int width, int height, bool wantShadowMap,
-                      bool lod);
-    void surfaceUniforms(GLuint p, int water, const RenderSettings& s, const FrameViews& v, bool wantShadowMap);
-    void drawPost(const RenderSettings& s, const FrameViews& v, int width, int height, GLuint framebuffer);
+    void drawSurfacePoints(const FrameViews& v, bool lod, bool water);
+    void shadeSurfaces(const RenderSettings& s, const FrameViews& v, bool wantShadowMap, bool water);
+    /// The terrain's or the water's shading program for these settings,
+    /// compiled on first use.
+    GLuint shadingProgram(bool water, const RenderSettings& s, bool wantShadowMap);
+    void shadingUniforms(GLuint p, const FrameViews& v);
+    /// Every pass of draw(); the image is left in deferred_.displayColor.
+    void drawFrame(const RenderSettings& s, int width, int height);
+    void drawDisplay(const RenderSettings& s, const FrameViews& v, bool water);
 
     const Gl& gl_;
-    GLuint terrainProgram_ = 0, waterProgram_ = 0, shadowProgram_ = 0, postProgram_ = 0;
+    // pointsProgram_: the mesh passes; shadingPrograms_: the shading passes' variants
+    GLuint pointsProgram_ = 0, shadowProgram_ = 0, displayProgram_ = 0, skyProgram_ = 0;
+    std::map<int, GLuint> shadingPrograms_;
     GLuint vao_ = 0, indexBuffer_ = 0;
     std::int64_t indexCount_ = 0;  // of the full grid, built on its first draw
     int meshNx_ = 0, meshNy_ = 0;
     // Chunked LOD: the 16 stitch variants of one chunk's indices (16 bits,
     // one after another), the uploaded heights' chunk tree, the frame's chunks.
     GLuint chunkIndexBuffer_ = 0;
+    std::vector<std::uint16_t> chunkIndices_;  // what chunkIndexBuffer_ holds
     int chunkFirst_[kStitchVariants] = {}, chunkCount_[kStitchVariants] = {};
+    // The water pass's triangles: where the uploaded heights show water, and
+    // the frame's triangles (one draw per chunk, or the full grid's).
+    std::vector<std::uint8_t> shownWater_;
+    GLuint waterIndexBuffer_ = 0;
+    std::vector<std::uint16_t> waterChunkIndices_;
+    std::vector<std::uint32_t> waterGridIndices_;
     ChunkTree lodTree_;
     ChunkSelection lodSelection_;
     DrawStats stats_;
@@ -139,7 +158,8 @@ private:
         albedoW_ = 0, albedoH_ = 0;
     // FrameData's versions of what was uploaded last
     std::int64_t heightsVersion_ = -1, albedoVersion_ = -1, shadeVersion_ = -1;
-    Target hdr_, ldr_, shadow_, sceneCopy_;
+    Target shadow_;
+    DeferredTargets deferred_;
     engine::FrameData meta_;  // the uploaded frame's sizes, lights and modes (no per-texel arrays)
     Sky sky_;
 };

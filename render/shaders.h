@@ -1,5 +1,10 @@
 #pragma once
 // GLSL 3.30 core sources of the renderer (render/renderer.h describes the passes).
+//
+// Deferred shading: the mesh passes (kMeshVertex + kSurfacePointFragment)
+// only record which surface point each pixel sees; the shading passes
+// (kFullScreenVertex + kCommon + kTerrainFragment or kWaterFragment) then
+// shade every pixel once, whatever the overdraw and the triangles' size.
 
 namespace terrain::render::shaders {
 
@@ -38,9 +43,29 @@ inline constexpr const char* kShadowFragment = R"(#version 330 core
 void main() {}
 )";
 
-// Functions shared by the terrain and water fragment shaders.
+// The mesh passes' fragment shader: the surface point this pixel sees, its
+// grid coordinate and its height as the mesh has it (LOD may have coarsened
+// it), alpha 1 (0, the clear value: no surface). Kept trivial on purpose: a
+// software rasteriser pays a fragment shader per partly covered block of
+// pixels, so small triangles and overdraw must find nothing to shade here.
+inline constexpr const char* kSurfacePointFragment = R"(#version 330 core
+uniform int uWater;
+in vec3 vWorld;
+in vec2 vCell;
+in float vDepth;
+out vec4 surfacePoint;
+void main() {
+    // A dry point of the water surface (render/water_triangles.h skips the
+    // triangles where every fragment would end here).
+    if (uWater == 1 && vDepth < 0.02) discard;
+    surfacePoint = vec4(vCell, vWorld.z, 1.0);
+}
+)";
+
+// Functions shared by the terrain and water shading passes.
 inline constexpr const char* kCommon = R"(
 const float PI = 3.14159265358979;
+uniform sampler2D uSurface;   // RGBA32F: the mesh pass's surface points (kSurfacePointFragment)
 uniform sampler2D uHeight;
 uniform sampler2D uShade;     // RGBA32F: reflected sky and indirect light RGB (with the albedo), key visibility
 uniform sampler2D uKey;       // RGBA32F: key shade RGB of a white surface, ambient
@@ -56,18 +81,27 @@ uniform float uExag;
 uniform vec3 uEye;
 uniform vec3 uKeyDir;         // unit, towards the key light
 uniform vec3 uKeyRgb;         // unshadowed key shade of a white surface facing the light
-uniform int uLighting;        // 0 key only, 1 direct (sky + key), 2 global
-uniform int uShadowMode;      // 0 soft visibility (engine), 1 shadow map, 2 none
-uniform int uSpecular;
-uniform int uDebug;
+// Constants of the program variant (Renderer::shadingProgram), not uniforms,
+// so that the compiler drops the branches a frame does not take: llvmpipe
+// runs both sides of a branch on a block of pixels.
+//   uLighting:   0 key only, 1 direct (sky + key), 2 global
+//   uShadowMode: 0 soft visibility (engine), 1 shadow map, 2 none
+//   uSpecular:   1 specular highlights and glints
+//   uDebug:      a DebugView (0: none)
 uniform vec2 uZRange;
 uniform mat4 uLightViewProj;
 uniform float uShadowTexel;
 uniform float uHaze;          // extinction per metre of view distance (0: clear air)
-in vec3 vWorld;
-in vec2 vCell;
-in float vDepth;
 out vec4 fragColor;
+
+// The surface point under this pixel: its grid coordinate and world position
+// (x, y from the grid coordinate, z as the mesh drew it). The stencil test
+// runs a shading pass only on pixels where its surface was drawn.
+void surfacePointHere(out vec2 cell, out vec3 world) {
+    vec4 p = texelFetch(uSurface, ivec2(gl_FragCoord.xy), 0);
+    cell = p.xy;
+    world = vec3(p.xy * uCell, p.z);
+}
 
 vec2 uvOf(vec2 cell) { return (cell + 0.5) / vec2(uGrid); }
 float surfaceAt(vec2 cell, bool water) {
@@ -125,13 +159,13 @@ float shadowMapVisibility(vec3 world) {
 }
 
 // Key light: soft visibility, and the diffuse shade of a white surface.
-void keyLight(vec2 uv, vec3 n, out float vis, out vec3 diffuse) {
+void keyLight(vec2 uv, vec3 n, vec3 world, out float vis, out vec3 diffuse) {
     float nl = max(dot(n, uKeyDir), 0.0);
     if (uShadowMode == 0) {
         vis = texture(uShade, uv).a;
         diffuse = texture(uKey, uv).rgb;
     } else if (uShadowMode == 1) {
-        vis = shadowMapVisibility(vWorld);
+        vis = shadowMapVisibility(world);
         diffuse = uKeyRgb * nl * vis;
     } else {
         vis = 1.0;
@@ -141,9 +175,9 @@ void keyLight(vec2 uv, vec3 n, out float vis, out vec3 diffuse) {
 vec3 skyShade(vec2 uv) { return uLighting == 0 ? vec3(0.0) : texture(uShade, uv).rgb; }
 // Aerial perspective: the surface's radiance fades along the view ray into
 // the sky's radiance at the horizon in that direction (Beer-Lambert).
-vec3 hazed(vec3 c) {
+vec3 hazed(vec3 c, vec3 world) {
     if (uHaze <= 0.0) return c;
-    vec3 ray = vWorld - uEye;
+    vec3 ray = world - uEye;
     float t = exp(-uHaze * length(ray));
     vec2 h = length(ray.xy) > 0.0 ? normalize(ray.xy) : vec2(1.0, 0.0);
     return c * t + environment(vec3(h, 0.0)) * (1.0 - t);
@@ -155,11 +189,14 @@ float roughness(float exponent) { return sqrt(2.0 / (exponent + 2.0)); }
 
 inline constexpr const char* kTerrainFragment = R"(
 void main() {
-    vec2 uv = uvOf(vCell);
-    vec3 n = normalAt(vCell, false);
+    vec2 cell;
+    vec3 world;
+    surfacePointHere(cell, world);
+    vec2 uv = uvOf(cell);
+    vec3 n = normalAt(cell, false);
     if (uDebug != 0) {
         vec3 c;
-        vec3 r = texture(uReceiver, receiverUv(vCell)).rgb;
+        vec3 r = texture(uReceiver, receiverUv(cell)).rgb;
         if (uDebug == 1) c = vec3(texture(uKey, uv).a);
         else if (uDebug == 2) c = vec3(r.r);
         else if (uDebug == 3) c = vec3(texture(uShade, uv).a);
@@ -173,29 +210,31 @@ void main() {
     }
     float vis;
     vec3 keyDiffuse;
-    keyLight(uv, n, vis, keyDiffuse);
+    keyLight(uv, n, world, vis, keyDiffuse);
     // the GI bounced light off this albedo already: only the key light's share needs it
     vec4 material = texture(uAlbedo, uv);
     vec3 c = skyShade(uv) + material.rgb * keyDiffuse;
     if (uSpecular == 1)
-        c += 0.35 * uKeyRgb * vis * torranceSparrow(n, normalize(uEye - vWorld), uKeyDir, roughness(material.a), 0.04);
-    fragColor = vec4(hazed(c), 1.0);
+        c += 0.35 * uKeyRgb * vis * torranceSparrow(n, normalize(uEye - world), uKeyDir, roughness(material.a), 0.04);
+    fragColor = vec4(hazed(c, world), 1.0);
 }
 )";
 
 inline constexpr const char* kWaterFragment = R"(
-uniform sampler2D uSceneColor;  // the terrain pass's HDR colour, copied before the water
-uniform sampler2D uSceneDepth;  // and its depth
+uniform sampler2D uSceneColor;     // the terrain shading pass's HDR colour
+uniform sampler2D uTerrainPoints;  // the terrain mesh pass's surface points
 uniform mat4 uViewProj;
-uniform vec2 uNearFar;          // the projection's near and far distances
-float viewDistance(float depth) {  // window depth -> distance along the view axis
-    float z = depth * 2.0 - 1.0;
-    return 2.0 * uNearFar.x * uNearFar.y / (uNearFar.y + uNearFar.x - z * (uNearFar.y - uNearFar.x));
+uniform vec3 uViewAxis;            // unit: the camera's viewing direction
+// Distance along the view axis to the terrain drawn at uv (none: far away).
+float terrainDistance(vec2 uv) {
+    vec4 p = texture(uTerrainPoints, uv);
+    return p.a > 0.0 ? dot(vec3(p.xy * uCell, p.z) - uEye, uViewAxis) : 1e30;
 }
 // Screen-space reflection: march the reflected ray from p in growing steps,
 // project each point and stop where it passes just behind the terrain drawn
 // there; rgb is that terrain's colour, a its weight (0: no hit, fading out
-// towards the screen's edges where the march loses sight of it).
+// towards the screen's edges where the march loses sight of it). A clip
+// position's w is its distance along the view axis.
 vec4 terrainReflection(vec3 p, vec3 r) {
     float t = 0.004 * length(uEye - p);
     for (int i = 0; i < 16; ++i) {
@@ -204,8 +243,8 @@ vec4 terrainReflection(vec3 p, vec3 r) {
         vec3 ndc = c.xyz / c.w;
         if (abs(ndc.x) > 1.0 || abs(ndc.y) > 1.0 || ndc.z > 1.0) break;
         vec2 uv = ndc.xy * 0.5 + 0.5;
-        float scene = viewDistance(texture(uSceneDepth, uv).r);
-        float ray = viewDistance(ndc.z * 0.5 + 0.5);
+        float scene = terrainDistance(uv);
+        float ray = c.w;
         if (ray > scene && ray - scene < 0.5 * t + 0.01 * ray) {
             vec2 edge = smoothstep(1.0, 0.85, abs(ndc.xy));
             return vec4(texture(uSceneColor, uv).rgb, edge.x * edge.y);
@@ -215,23 +254,25 @@ vec4 terrainReflection(vec3 p, vec3 r) {
     return vec4(0.0);
 }
 void main() {
-    if (vDepth < 0.02 || uDebug != 0) discard;
-    vec2 uv = uvOf(vCell);
-    vec3 n = normalAt(vCell, true);
-    vec3 v = normalize(uEye - vWorld);
+    vec2 cell;
+    vec3 world;
+    surfacePointHere(cell, world);
+    vec2 uv = uvOf(cell);
+    vec3 n = normalAt(cell, true);
+    vec3 v = normalize(uEye - world);
     float vis;
     vec3 keyDiffuse;
-    keyLight(uv, n, vis, keyDiffuse);
+    keyLight(uv, n, world, vis, keyDiffuse);
     // Mirror term: the terrain where the reflected ray meets it on screen,
     // else the prefiltered environment in that direction, dimmed by how much
     // of the sky the water sees.
     vec3 r = reflect(-v, n);
-    float skyVis = clamp(texture(uReceiver, receiverUv(vCell)).r, 0.0, 1.0);
+    float skyVis = clamp(texture(uReceiver, receiverUv(cell)).r, 0.0, 1.0);
     float f = schlick(max(dot(n, v), 0.0), 0.02);  // water, n = 1.33
     // The march is the water's dearest part: it runs only where Fresnel lets
     // the reflection show (grazing views), fading in over f = 0.05 .. 0.1.
     float reflective = smoothstep(0.05, 0.1, f);
-    vec4 terrain = reflective > 0.0 ? terrainReflection(vWorld, r) : vec4(0.0);
+    vec4 terrain = reflective > 0.0 ? terrainReflection(world, r) : vec4(0.0);
     vec3 mirror = mix(environment(r) * skyVis, terrain.rgb, terrain.a * reflective);
     vec4 material = texture(uAlbedo, uv);
     vec3 glint = uSpecular == 1 ? uKeyRgb * vis * torranceSparrow(n, v, uKeyDir, roughness(material.a), 0.02) : vec3(0.0);
@@ -239,23 +280,44 @@ void main() {
     // in the GI's map (engine/material_maps.h), lit like the terrain.
     vec3 body = skyShade(uv) + material.rgb * keyDiffuse;
     vec3 c = f * mirror + glint + (1.0 - f) * body;
-    fragColor = vec4(hazed(c), 1.0);  // opaque: the bed is in the body's albedo
+    fragColor = vec4(hazed(c, world), 1.0);  // opaque: the bed is in the body's albedo
 }
 )";
 
-inline constexpr const char* kPostVertex = R"(#version 330 core
+// Every full-screen pass: one triangle over the screen.
+inline constexpr const char* kFullScreenVertex = R"(#version 330 core
 void main() {
     vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);  // one triangle over the screen
     gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
 }
 )";
 
-// Tone mapping (ACES fit) and sRGB encoding; the sky where no terrain was
-// drawn (render/sky.h): the sky model, the HDR image or the SH map, and a
-// disc for each key light.
-inline constexpr const char* kPostFragment = R"(#version 330 core
+// The displayed colour of an HDR radiance: tone mapping (ACES fit) and sRGB
+// encoding (uTonemap 0, the debug views: clamped, not tone mapped).
+inline constexpr const char* kToneMap = R"(
+uniform float uExposure;
+uniform int uTonemap;
+out vec4 fragColor;
+vec3 aces(vec3 x) { return clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0); }
+vec3 srgb(vec3 c) {
+    return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+}
+vec4 displayed(vec3 c) {
+    vec3 x = uTonemap == 1 ? aces(c * uExposure) : clamp(c, 0.0, 1.0);
+    return vec4(srgb(x), 1.0);
+}
+)";
+
+// A shading pass's pixels, displayed (under its surface's stencil test).
+inline constexpr const char* kDisplayFragment = R"(
+uniform sampler2D uHdr;  // the terrain's or the water's shading pass
+void main() { fragColor = displayed(texelFetch(uHdr, ivec2(gl_FragCoord.xy), 0).rgb); }
+)";
+
+// The sky where no surface was drawn (render/sky.h): the sky model, the HDR
+// image or the SH map, and a disc for each key light.
+inline constexpr const char* kSkyFragment = R"(
 const float PI = 3.14159265358979;
-uniform sampler2D uHdr;
 uniform sampler2D uEnv;       // the environment's SH, baked
 uniform sampler2D uSkyImage;  // the HDR environment image (uSkyKind 2)
 uniform int uSkyKind;         // 0 SH, 1 gradient, 2 image
@@ -268,13 +330,6 @@ uniform vec3 uDiscRadiance[4];
 uniform mat4 uInvViewProj;
 uniform vec3 uEye;
 uniform vec2 uSize;
-uniform float uExposure;
-uniform int uTonemap;
-out vec4 fragColor;
-vec3 aces(vec3 x) { return clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0); }
-vec3 srgb(vec3 c) {
-    return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
-}
 // Column = azimuth from +x towards +y, row 0 = zenith.
 vec2 equirect(vec3 d) { return vec2(atan(d.y, d.x) / (2.0 * PI), 0.5 - asin(clamp(d.z, -1.0, 1.0)) / PI); }
 vec3 background(vec3 d) {
@@ -293,14 +348,8 @@ vec3 background(vec3 d) {
     return c;
 }
 void main() {
-    vec4 c = texelFetch(uHdr, ivec2(gl_FragCoord.xy), 0);
-    if (c.a <= 0.0) {
-        if (uTonemap == 0) { fragColor = vec4(0.0, 0.0, 0.0, 1.0); return; }
-        vec4 p = uInvViewProj * vec4(gl_FragCoord.xy / uSize * 2.0 - 1.0, 1.0, 1.0);
-        c.rgb = background(normalize(p.xyz / p.w - uEye));
-    }
-    vec3 x = uTonemap == 1 ? aces(c.rgb * uExposure) : clamp(c.rgb, 0.0, 1.0);
-    fragColor = vec4(srgb(x), 1.0);
+    vec4 p = uInvViewProj * vec4(gl_FragCoord.xy / uSize * 2.0 - 1.0, 1.0, 1.0);
+    fragColor = displayed(background(normalize(p.xyz / p.w - uEye)));
 }
 )";
 

@@ -29,7 +29,7 @@ public:
     /// The baked SH environment (equirectangular, RGB32F, wraps in azimuth).
     GLuint shTexture() const { return shTex_; }
     /// Binds the textures to units shUnit and imageUnit and sets `program`'s
-    /// background uniforms (kPostFragment's sky block) for `lights`.
+    /// background uniforms (kSkyFragment) for `lights`.
     void setBackground(GLuint program, const engine::SceneLights& lights, int shUnit, int imageUnit) const;
 
 private:

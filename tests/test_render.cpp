@@ -20,6 +20,7 @@
 #include "render/gl.h"
 #include "render/renderer.h"
 #include "render/terrain_lod.h"
+#include "render/water_triangles.h"
 #include "sim/scene.h"
 
 using namespace terrain;
@@ -243,6 +244,50 @@ TEST_CASE("render.shadow: the shadow map and the engine's soft visibility both s
                                                        << map);
     CHECK(none > soft + 30.0);
     CHECK(none > map + 30.0);
+}
+
+TEST_CASE("render.water: each pixel shows the surface in front: the water where it is wet, else the terrain") {
+    // A ramp rising along +x through the water level: wet where x < 315 m
+    // (the image's left half from above), dry beyond.
+    SceneSettings scene = builtinScene("erosion", 64, 1);
+    scene.hydraulic = scene.thermal = false;
+    scene.soilDepth = 0.0f;
+    scene.cellSize = 10.0f;
+    scene.hasWaterLevel = true;
+    scene.waterLevel = 0.0f;
+    PipelineSettings ps;
+    ps.verticalExaggeration = 1.0f;
+    FramePipeline pipeline(scene, ps);
+    TerrainState& st = pipeline.simulation().state();
+    REQUIRE(st.hasWater());
+    for (int y = 0; y < st.ny; ++y)
+        for (int x = 0; x < st.nx; ++x) {
+            st.bedrock(x, y) = (static_cast<float>(x) * st.cellSize - 315.0f) * 0.05f;
+            st.soil(x, y) = 0.0f;
+            st.water(x, y) = std::max(0.0f, -st.bedrock(x, y));
+        }
+    pipeline.terrainReplaced();
+    pipeline.advance();
+    pipeline.light();
+    gpu().renderer->upload(pipeline.frame());
+    RenderSettings rs = topDown();
+    std::vector<std::uint8_t> wet, dry;
+    gpu().renderer->drawToImage(rs, kW, kH, wet);
+    rs.water = false;
+    gpu().renderer->drawToImage(rs, kW, kH, dry);
+    // Boxes well inside the water, well inside the dry land, and the sky.
+    auto differing = [&](int x0, int x1, int y0, int y1) {
+        int n = 0;
+        for (int y = y0; y < y1; ++y)
+            for (int x = x0; x < x1; ++x) {
+                const std::size_t i = (static_cast<std::size_t>(y) * kW + x) * 3;
+                n += std::equal(wet.begin() + i, wet.begin() + i + 3, dry.begin() + i) ? 0 : 1;
+            }
+        return n;
+    };
+    CHECK(differing(kW / 2 - 24, kW / 2 - 6, kH / 2 - 10, kH / 2 + 10) == 18 * 20);  // water over the terrain
+    CHECK(differing(kW / 2 + 6, kW / 2 + 24, kH / 2 - 10, kH / 2 + 10) == 0);        // the terrain alone
+    CHECK(differing(0, 8, 0, 8) == 0);                                               // the sky
 }
 
 TEST_CASE("render.determinism: the same scene gives the same image bytes, for any thread count") {
@@ -586,4 +631,56 @@ TEST_CASE("render.lod: a 2048^2 field renders") {
     const std::uint8_t* corner = rgb.data();
     const std::uint8_t* centre = rgb.data() + (static_cast<std::size_t>(180) * 640 + 320) * 3;
     CHECK((centre[0] != corner[0] || centre[1] != corner[1] || centre[2] != corner[2]));
+}
+
+TEST_CASE("render.water: the water pass keeps, in order, exactly the triangles with a corner deep enough to show") {
+    // Depths from 0 to 0.022 m on a 70 x 50 grid, a tenth deep enough to show (2 floats per point: ground, depth).
+    const int nx = 70, ny = 50;
+    std::vector<float> heights(static_cast<std::size_t>(nx) * ny * 2);
+    for (std::size_t i = 0; i < heights.size() / 2; ++i) {
+        heights[2 * i] = 1.0f;
+        heights[2 * i + 1] = 0.022f * static_cast<float>((i * 2654435761u) % 1000u) / 1000.0f;
+    }
+    std::vector<std::uint8_t> shown;
+    markShownWater(heights, shown);
+    auto deep = [&](int x, int y) { return heights[2 * (static_cast<std::size_t>(y) * nx + x) + 1] >= 0.0199f; };
+    // The full grid: the split of the full grid's index buffer, filtered corner by corner.
+    std::vector<std::uint32_t> grid, expected;
+    shownGridTriangles(nx, ny, shown, grid);
+    for (int y = 0; y + 1 < ny; ++y)
+        for (int x = 0; x + 1 < nx; ++x) {
+            const auto id = [&](int i, int j) { return static_cast<std::uint32_t>((y + j) * nx + x + i); };
+            if (deep(x, y) || deep(x + 1, y) || deep(x + 1, y + 1))
+                expected.insert(expected.end(), {id(0, 0), id(1, 0), id(1, 1)});
+            if (deep(x, y) || deep(x + 1, y + 1) || deep(x, y + 1))
+                expected.insert(expected.end(), {id(0, 0), id(1, 1), id(0, 1)});
+        }
+    CHECK(grid == expected);
+    CHECK(grid.size() < 2u * 69 * 49 * 3);  // some triangles are dropped
+    // A chunk of every stitch variant, at step 2 over the grid's edge (clamped corners).
+    const int quads = 8;
+    for (int stitched = 0; stitched < kStitchVariants; ++stitched) {
+        std::vector<std::uint16_t> all;
+        for (const ChunkTriangle& t : chunkTriangles(quads, stitched)) all.insert(all.end(), t.begin(), t.end());
+        const MeshPlacement p{60, 40, 2, quads + 1, nx, ny};
+        std::vector<std::uint16_t> kept;
+        const std::int64_t n = appendShownTriangles(all.data(), static_cast<std::int64_t>(all.size()), p, shown, kept);
+        CHECK(n == static_cast<std::int64_t>(kept.size()));
+        std::size_t next = 0, dropped = 0;
+        for (std::size_t t = 0; t < all.size(); t += 3) {
+            bool anyDeep = false;
+            for (std::size_t c = 0; c < 3; ++c)
+                anyDeep = anyDeep || deep(std::min(60 + all[t + c] % (quads + 1) * 2, nx - 1),
+                                          std::min(40 + all[t + c] / (quads + 1) * 2, ny - 1));
+            const bool isNext =
+                next < kept.size() && std::equal(all.begin() + t, all.begin() + t + 3, kept.begin() + next);
+            CHECK(anyDeep == isNext);
+            if (isNext)
+                next += 3;
+            else
+                ++dropped;
+        }
+        CHECK(next == kept.size());
+        CHECK(dropped > 0);
+    }
 }
