@@ -140,9 +140,10 @@ private:
 void printCase(const CaseResult& r) {
     std::printf(
         "%-28s %5d^2 tol %.3g: full %7.2f ms, incremental %7.2f ms (%5.1f %%), recomputed V %5.1f %% I %5.1f %%, "
-        "rms %.2e, max %.2e\n",
+        "rms %.2e, max %.2e, stages %.1f / %.1f / %.1f / %.1f / %.1f ms\n",
         r.name.c_str(), r.size, static_cast<double>(r.tolerance), r.fullMs, r.incrementalMs,
-        100.0 * r.incrementalMs / r.fullMs, 100.0 * r.visibility, 100.0 * r.indirect, r.diff.rms, r.diff.maxRel);
+        100.0 * r.incrementalMs / r.fullMs, 100.0 * r.visibility, 100.0 * r.indirect, r.diff.rms, r.diff.maxRel,
+        r.stages.geometry, r.stages.visibility, r.stages.keys, r.stages.shading, r.stages.indirect);
     std::fflush(stdout);
 }
 
