@@ -167,7 +167,8 @@ void measureFrame(Track& t, const gi::GiSettings& settings, float cell, float to
     for (std::size_t i = 0; i < t.heights.v.size(); ++i)
         t.dh.push_back(std::fabs(static_cast<double>(t.heights.v[i]) - t.lastHeights.v[i]));
     gi::VisibilityCache cache;  // a fresh drift: after one plan it holds the frame's bound per tile
-    gi::planVisibilityTiles(t.lastHeights.cview(), t.heights.cview(), t.now.pyramid, settings.visibility, 1e30f, cache);
+    gi::planVisibilityTiles(t.lastHeights.cview(), t.heights.cview(), t.now.pyramid, settings.visibility, {}, 1e30f,
+                            cache);
     gi::ShadeMaps cached;
     ambientWithCachedV(t.now, t.last, settings, cached);
     const int s = settings.subsample;

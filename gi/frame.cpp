@@ -42,7 +42,7 @@ const ReceiverTiles* planIndirect(const GiSettings& settings, const FrameChange&
     const IndirectPlanInputs in{.source = st.shade.rgb,
                                 .heights = st.pyramid,
                                 .lastPyramid = st.indirect.radiance,
-                                .geometryTiles = change.geometry ? &st.visibilityCache.keyTiles : nullptr,
+                                .geometryTiles = change.geometry ? &st.visibilityCache.geometryTiles : nullptr,
                                 .azimuths = azimuths,
                                 .tolerance = settings.tolerance};
     return planIndirectTiles(in, st.indirectCache);
@@ -303,16 +303,28 @@ struct GeometryPlan {
     bool withinTolerance = false;  // tiled, and no tile's V drifted beyond the tolerance
 };
 
-GeometryPlan planGeometry(ConstGridView heights, const GiSettings& settings, const FrameChange& change, GiState& st) {
+// The azimuths each key light's visibility reads.
+std::vector<AzimuthRange> keyAzimuthRanges(const GiLighting& lighting) {
+    std::vector<AzimuthRange> out;
+    for (const KeyLight& k : lighting.keys) {
+        const KeyLightExtent e = keyLightExtent(k);
+        out.push_back({e.phiStart, e.phiEnd});
+    }
+    return out;
+}
+
+GeometryPlan planGeometry(ConstGridView heights, const GiLighting& lighting, const GiSettings& settings,
+                          const FrameChange& change, GiState& st) {
     GeometryPlan plan;
     if (!change.geometry) return plan;
     const auto t = Clock::now();
     plan.tiled = change.heightsOnly && !st.lastInputs.heights.empty() && shouldPlanTiles(st.visibilityCache);
     if (plan.tiled) {
         VisibilityCache& cache = st.visibilityCache;
-        planVisibilityTiles(st.lastInputs.heights.cview(), heights, st.pyramid, settings.visibility, settings.tolerance,
-                            cache);
-        plan.withinTolerance = cache.tiles.dirtyCount() == 0 && cache.keyTiles.dirtyCount() == 0;
+        planVisibilityTiles(st.lastInputs.heights.cview(), heights, st.pyramid, settings.visibility,
+                            keyAzimuthRanges(lighting), settings.tolerance, cache);
+        plan.withinTolerance =
+            cache.tiles.dirtyCount() == 0 && cache.keyTiles.dirtyCount() == 0 && cache.geometryTiles.dirtyCount() == 0;
     }
     st.timings.visibility = msSince(t);
     return plan;
@@ -385,7 +397,7 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
         st.timings.total = msSince(t0);
         return;
     }
-    const GeometryPlan plan = planGeometry(heights, settings, change, st);
+    const GeometryPlan plan = planGeometry(heights, lighting, settings, change, st);
     if (settings.incremental) st.geometryChanged = change.geometry && !plan.withinTolerance;
     planAmortisation(heights, settings, st);
     if (!st.directUpdated) {
