@@ -31,6 +31,8 @@ struct IncrementalOptions {
     std::vector<float> tolerances = {0.0f, 0.02f, 0.05f};
     int longFrames = 300;
     std::vector<float> longTolerances = {0.005f, 0.01f, 0.02f, 0.05f};
+    std::string only;  // run only the cases whose name contains it, print them, write no report
+    bool wanted(const std::string& name) const { return only.empty() || name.find(only) != std::string::npos; }
 };
 
 // Largest difference of an incremental result from the full one over the
@@ -138,9 +140,10 @@ private:
 void printCase(const CaseResult& r) {
     std::printf(
         "%-28s %5d^2 tol %.3g: full %7.2f ms, incremental %7.2f ms (%5.1f %%), recomputed V %5.1f %% I %5.1f %%, "
-        "rms %.2e, max %.2e\n",
+        "rms %.2e, max %.2e, stages %.1f / %.1f / %.1f / %.1f / %.1f ms\n",
         r.name.c_str(), r.size, static_cast<double>(r.tolerance), r.fullMs, r.incrementalMs,
-        100.0 * r.incrementalMs / r.fullMs, 100.0 * r.visibility, 100.0 * r.indirect, r.diff.rms, r.diff.maxRel);
+        100.0 * r.incrementalMs / r.fullMs, 100.0 * r.visibility, 100.0 * r.indirect, r.diff.rms, r.diff.maxRel,
+        r.stages.geometry, r.stages.visibility, r.stages.keys, r.stages.shading, r.stages.indirect);
     std::fflush(stdout);
 }
 
@@ -210,10 +213,17 @@ std::vector<CaseResult> runCases(const IncrementalOptions& o, const Grid& dem, f
     std::vector<CaseResult> rows;
     for (float tol : o.tolerances) {
         for (int size : {256, 512, 1024}) {
+            if (!o.wanted("erosion " + std::to_string(size))) continue;
             std::shared_ptr<Simulation> sim;
             const NextFrame next = animated("erosion", size, sim);
             const int frames = size == 1024 ? std::max(3, o.frames / 3) : o.frames;
             rows.push_back(runCase("erosion", size, sim->state().cellSize, tol, frames, next));
+        }
+        if (!o.only.empty()) {
+            // a filtered run: the DEM cases whose name matches
+            if (o.wanted("dem, 16x16 crater"))
+                rows.push_back(runCase("dem, 16x16 crater", 512, cell, tol, kEventFrames, demWithPit(dem, 16)));
+            continue;
         }
         std::shared_ptr<Simulation> sim;
         const NextFrame waves = animated("waves", 512, sim);
@@ -241,6 +251,7 @@ std::vector<CaseResult> runSweep(const IncrementalOptions& o, const Grid& dem, f
     std::vector<CaseResult> rows;
     for (float tol : o.tolerances)
         for (int side : {5, 16, 51, 102, 229, 512}) {
+            if (!o.wanted("dem, " + std::to_string(side) + "² pit")) continue;
             rows.push_back(
                 runCase("dem, " + std::to_string(side) + "² pit", 512, cell, tol, kEventFrames, demWithPit(dem, side)));
             pts.push_back({static_cast<double>(side) * side / (512.0 * 512.0), tol,
@@ -385,6 +396,9 @@ Runner addGiIncrementalSuite(CLI::App& app, const BenchContext& ctx) {
         ->check(CLI::Range(0, 100000))
         ->capture_default_str();
     sub->add_option("--long-tolerances", o->longTolerances, "GI tolerances of the long runs")->capture_default_str();
+    sub->add_option("--only", o->only,
+                    "Run only the cases whose name contains this (e.g. 'pit', 'erosion 512', 'long run'), print "
+                    "them and write no report");
     return [o, &ctx] {
         float cell = 0.0f;
         const Grid dem = alpsCentreCrop(ctx.dataDir, 512, cell);
@@ -392,10 +406,13 @@ Runner addGiIncrementalSuite(CLI::App& app, const BenchContext& ctx) {
         std::vector<CostPoint> pts;
         const std::vector<CaseResult> sweep = runSweep(*o, dem, cell, pts);
         std::filesystem::create_directories(ctx.outDir);
-        incrementalCostPlot(pts, (std::filesystem::path(ctx.outDir) / "gi_incremental_cost.png").string());
+        if (o->only.empty())
+            incrementalCostPlot(pts, (std::filesystem::path(ctx.outDir) / "gi_incremental_cost.png").string());
         std::vector<LongRun> longRuns;
         if (o->longFrames > 1)
-            for (const char* scene : {"erosion", "waves"}) longRuns.push_back(runLong(scene, 256, *o));
+            for (const char* scene : {"erosion", "waves"})
+                if (o->wanted(std::string(scene) + ", long run")) longRuns.push_back(runLong(scene, 256, *o));
+        if (!o->only.empty()) return 0;  // a filtered run writes no report
         writeReport(rows, sweep, longRuns, *o, ctx);
         return 0;
     };

@@ -209,18 +209,46 @@ float boundOfTileFrom(const MaxChangePyramid& dh, const HeightPyramid& pyr, int 
     return roundUp(best);
 }
 
-// Cells within reach of step i's samples along direction (c, sn) from any
-// receiver of the tile: the tile's cells swept from t'_min to t'_max along the
-// direction, dilated by the reach plus one cell, and cut to the box of all
+// The directions a bound covers: cos and sin of the azimuths range over
+// [cMin, cMax] x [sMin, sMax] (one azimuth: a point).
+struct Directions {
+    double cMin, cMax, sMin, sMax;
+};
+
+Directions oneDirection(double cs, double sn) { return {cs, cs, sn, sn}; }
+
+// The cos and sin ranges over the azimuths [phi0, phi1] (radians, phi0 <= phi1):
+// the ends, and the extremes of the multiples of pi / 2 between them.
+Directions directionsOver(double phi0, double phi1) {
+    constexpr double kHalfPi = 1.57079632679489661923;
+    Directions d{std::min(std::cos(phi0), std::cos(phi1)), std::max(std::cos(phi0), std::cos(phi1)),
+                 std::min(std::sin(phi0), std::sin(phi1)), std::max(std::sin(phi0), std::sin(phi1))};
+    for (long k = static_cast<long>(std::ceil(phi0 / kHalfPi));
+         k * kHalfPi <= phi1 && k <= std::ceil(phi0 / kHalfPi) + 4; ++k) {
+        const long q = ((k % 4) + 4) % 4;  // 0: +x, 1: +y, 2: -x, 3: -y
+        if (q == 0) d.cMax = 1.0;
+        if (q == 1) d.sMax = 1.0;
+        if (q == 2) d.cMin = -1.0;
+        if (q == 3) d.sMin = -1.0;
+    }
+    return d;
+}
+
+// Cells within reach of step i's samples along any of the directions from
+// any receiver of the tile: the tile's cells swept from t'_min to t'_max
+// along them, dilated by the reach plus one cell, and cut to the box of all
 // azimuths (changeWithinStep), which holds the samples too.
-CellBox stepBoxAlong(const StepExtent& e, const CellBox& c, double cs, double sn) {
-    const double xa = e.tauMin * cs, xb = e.tauMax * cs, ya = e.tauMin * sn, yb = e.tauMax * sn;
+CellBox stepBoxOver(const StepExtent& e, const CellBox& c, const Directions& dir) {
+    const double x0 = std::min(e.tauMin * dir.cMin, e.tauMax * dir.cMin);
+    const double x1 = std::max(e.tauMin * dir.cMax, e.tauMax * dir.cMax);
+    const double y0 = std::min(e.tauMin * dir.sMin, e.tauMax * dir.sMin);
+    const double y1 = std::max(e.tauMin * dir.sMax, e.tauMax * dir.sMax);
     const double r = e.reach + 1.0;
     const int d = static_cast<int>(std::ceil(e.tauMax + e.reach));
-    return {c.x0 + std::max(-d, static_cast<int>(std::floor(std::min(xa, xb) - r))),
-            c.y0 + std::max(-d, static_cast<int>(std::floor(std::min(ya, yb) - r))),
-            c.x1 + std::min(d, static_cast<int>(std::ceil(std::max(xa, xb) + r))),
-            c.y1 + std::min(d, static_cast<int>(std::ceil(std::max(ya, yb) + r)))};
+    return {c.x0 + std::max(-d, static_cast<int>(std::floor(x0 - r))),
+            c.y0 + std::max(-d, static_cast<int>(std::floor(y0 - r))),
+            c.x1 + std::min(d, static_cast<int>(std::ceil(x1 + r))),
+            c.y1 + std::min(d, static_cast<int>(std::ceil(y1 + r)))};
 }
 
 // The finer octave a level step reads (0 for raw steps: the heights themselves).
@@ -311,13 +339,13 @@ double filteredChange(const MaxChangePyramid& dh, const StepTable& t, int i, con
 
 // Steps before `first` see no change from any azimuth (lastQuietStep).
 double azimuthBoundFrom(const MaxChangePyramid& dh, const HeightPyramid& pyr, const StepTable& steps, const CellBox& c,
-                        double m0, int first, double cs, double sn, double lipschitz) {
+                        double m0, int first, const Directions& dir, double lipschitz) {
     const double mAll = maxChangeAll(dh), cellSize = pyr.cellSize;
     double best = 0.0;
     for (std::size_t i = static_cast<std::size_t>(first); i < steps.extent.size(); ++i) {
         // no later step can beat best even if it sees the largest change anywhere
         if ((lipschitz * mAll + m0) / (steps.tauMinFrom[i] * cellSize) <= best) break;
-        const CellBox box = stepBoxAlong(steps.extent[i], c, cs, sn);
+        const CellBox box = stepBoxOver(steps.extent[i], c, dir);
         const double d = filteredChange(dh, steps, static_cast<int>(i), box);
         best = std::max(best, (d + m0) / (steps.extent[i].tauMin * cellSize));
     }
@@ -343,7 +371,7 @@ double sampleBoundFrom(const MaxChangePyramid& dv, const StepTable& steps, const
     const double mAll = maxChangeAll(dv);
     double best = 0.0;
     for (std::size_t i = static_cast<std::size_t>(first); i < steps.extent.size() && best < mAll; ++i) {
-        const CellBox box = stepBoxAlong(steps.extent[i], c, cs, sn);
+        const CellBox box = stepBoxOver(steps.extent[i], c, oneDirection(cs, sn));
         best = std::max(best, filteredChange(dv, steps, static_cast<int>(i), box));
     }
     return best;
@@ -519,8 +547,8 @@ float azimuthBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, i
                          double phi) {
     const CellBox c = tileCells(pyr, tileReceivers, tx, ty);
     const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
-    return roundUp(azimuthBoundFrom(dh, pyr, stepTable(pyr), c, m0, firstBusyStep(dh, pyr, c, m0), std::cos(phi),
-                                    std::sin(phi), heightFilterLipschitz(pyr)));
+    return roundUp(azimuthBoundFrom(dh, pyr, stepTable(pyr), c, m0, firstBusyStep(dh, pyr, c, m0),
+                                    oneDirection(std::cos(phi), std::sin(phi)), heightFilterLipschitz(pyr)));
 }
 
 void boundSlopeChangePerAzimuth(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int azimuths,
@@ -533,7 +561,7 @@ void boundSlopeChangePerAzimuth(const MaxChangePyramid& dh, const HeightPyramid&
             const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
             const int first = firstBusyStep(dh, pyr, c, m0);
             for (std::size_t j = 0; j < cs.size(); ++j)
-                out[j] = roundUp(azimuthBoundFrom(dh, pyr, steps, c, m0, first, cs[j], sn[j], lipschitz));
+                out[j] = roundUp(azimuthBoundFrom(dh, pyr, steps, c, m0, first, oneDirection(cs[j], sn[j]), lipschitz));
         });
 }
 
@@ -556,6 +584,28 @@ float ambientChangeBoundPerAzimuth(const float* slopeBound, int azimuths, float 
     for (int j = 0; j < azimuths; ++j) sum += std::max<double>(slopeBound[j], g);
     const double v = maxSkyRadiance * (kShadePerSlope * sum / azimuths + (withNormals ? kShadePerNormal * g : 0.0));
     return roundUp(v);
+}
+
+float rangeBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int tx, int ty,
+                       double phi0, double phi1) {
+    const CellBox c = tileCells(pyr, tileReceivers, tx, ty);
+    const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
+    return roundUp(azimuthBoundFrom(dh, pyr, stepTable(pyr), c, m0, firstBusyStep(dh, pyr, c, m0),
+                                    directionsOver(phi0, phi1), heightFilterLipschitz(pyr)));
+}
+
+void boundSlopeChangeOverRange(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, double phi0,
+                               double phi1, std::vector<float>& tileBound) {
+    requireSameSize(dh, pyr, tileReceivers);
+    if (!(phi0 <= phi1)) throw InputError("change bound: an azimuth range needs phi0 <= phi1");
+    const StepTable steps = stepTable(pyr);
+    const double lipschitz = heightFilterLipschitz(pyr);
+    const Directions dir = directionsOver(phi0, phi1);
+    forEachTile(pyr, tileReceivers, tileBound, [&](int tx, int ty) {
+        const CellBox c = tileCells(pyr, tileReceivers, tx, ty);
+        const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
+        return roundUp(azimuthBoundFrom(dh, pyr, steps, c, m0, firstBusyStep(dh, pyr, c, m0), dir, lipschitz));
+    });
 }
 
 }  // namespace terrain::gi

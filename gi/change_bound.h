@@ -172,6 +172,24 @@ float azimuthBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, i
 void boundSlopeChangePerAzimuth(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int azimuths,
                                 std::vector<float>& tileBound);
 
+// A key light's visibility reads only the azimuths of its region of the
+// sky, [phi0, phi1]: the sample points of every such azimuth lie in the tile's
+// cells swept from t'_min to t'_max along the directions, whose bounding box
+// spans t' times the ranges of cos phi and sin phi over [phi0, phi1] (the
+// ends, and +-1 where a multiple of pi / 2 lies between); dilated and
+// weighed as above, it bounds every blocking slope of those azimuths, and it
+// is never larger than the tile's bound over all azimuths.
+
+/// Bound on |change| of every blocking slope of tile (tx, ty) along the
+/// azimuths [phi0, phi1] (radians, phi0 <= phi1).
+float rangeBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int tx, int ty,
+                       double phi0, double phi1);
+
+/// rangeBoundOfTile of every tile, row-major as boundSlopeChange (same
+/// errors; InputError when phi0 > phi1).
+void boundSlopeChangeOverRange(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, double phi0,
+                               double phi1, std::vector<float>& tileBound);
+
 /// How much the maximum blocking slope can move per unit of the per-step
 /// bound: 1 for the sample maximum, 20 / 16 for Eq. 16's midpoints.
 float blockingMaxLipschitz(BlockingMax rule);

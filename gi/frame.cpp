@@ -8,6 +8,7 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "gi/indirect_bounces.h"
+#include "gi/shading_rows.h"
 
 namespace terrain::gi {
 
@@ -41,7 +42,7 @@ const ReceiverTiles* planIndirect(const GiSettings& settings, const FrameChange&
     const IndirectPlanInputs in{.source = st.shade.rgb,
                                 .heights = st.pyramid,
                                 .lastPyramid = st.indirect.radiance,
-                                .geometryTiles = change.geometry ? &st.visibilityCache.keyTiles : nullptr,
+                                .geometryTiles = change.geometry ? &st.visibilityCache.geometryTiles : nullptr,
                                 .azimuths = azimuths,
                                 .tolerance = settings.tolerance};
     return planIndirectTiles(in, st.indirectCache);
@@ -75,7 +76,8 @@ void runIndirectStage(const GiSettings& settings, const FrameChange& change, GiS
 // albedo RGB f max(0, N . l) to the shade, f = visible fraction of the light's
 // region, bilinear from the receiver grid like the SH vectors (Fig. 7).
 void addKeyLightExactCosine(const KeyLight& light, const VisibilityField& v, int s, const AlbedoMap* albedo,
-                            const GiState& st, std::array<Grid, 3>& out) {
+                            const GiState& st, std::array<Grid, 3>& out,
+                            const std::vector<std::uint8_t>* rows = nullptr) {
     const KeyLightExtent ext = keyLightExtent(light);
     const double solidAngle = (ext.phiEnd - ext.phiStart) * (static_cast<double>(ext.sinHigh) - ext.sinLow);
     if (!(solidAngle > 0.0)) return;
@@ -89,6 +91,7 @@ void addKeyLightExactCosine(const KeyLight& light, const VisibilityField& v, int
     const float invS = 1.0f / static_cast<float>(s);
     parallelForRows(ny, nx, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
+            if (rows && (*rows)[static_cast<std::size_t>(y)] == 0) continue;  // shaded with the rest of its row
             const int Y0 = std::min(y / s, nyr - 1), Y1 = std::min(Y0 + 1, nyr - 1);
             const float fy = Y1 == Y0 ? 0.0f : static_cast<float>(y - s * Y0) * invS;
             const float* r0 = v0 + static_cast<std::size_t>(Y0) * nxr;
@@ -269,8 +272,10 @@ void keyLightVisibility(const GiLighting& lighting, const GiSettings& settings, 
 
 // Direct light at every texel: the lighting's SH product matrices once per
 // frame, then the shading (Section 7); key lights through the SH clamped
-// cosine, or with the exact cosine (GiSettings::keyLightExactCosine).
-void directShading(const GiLighting& lighting, const GiSettings& settings, const AlbedoMap* albedo, GiState& st) {
+// cosine, or with the exact cosine (GiSettings::keyLightExactCosine). With
+// `rows` only those texel rows, the others keep the last frame's light.
+void directShading(const GiLighting& lighting, const GiSettings& settings, const AlbedoMap* albedo, GiState& st,
+                   const std::vector<std::uint8_t>* rows) {
     const std::size_t nKeys = lighting.keys.size();
     const bool exactKeys = settings.keyLightExactCosine;
     st.shadingLights.resize(1 + (exactKeys ? 0 : nKeys));
@@ -281,10 +286,11 @@ void directShading(const GiLighting& lighting, const GiSettings& settings, const
     for (std::size_t k = 0; k < (exactKeys ? 0 : nKeys); ++k)
         st.shadingLights[k + 1] = keyShadingLight(lighting.keys[k], st.keyVisibility[k]);
     shadeTexels(st.gradX.cview(), st.gradY.cview(), settings.subsample, st.envVisibility, st.shadingLights.data(),
-                static_cast<int>(st.shadingLights.size()), albedo, settings.shading, st.shade);
+                static_cast<int>(st.shadingLights.size()), albedo, settings.shading, st.shade, true, rows);
     if (exactKeys)
         for (std::size_t k = 0; k < nKeys; ++k)
-            addKeyLightExactCosine(lighting.keys[k], st.keyVisibility[k], settings.subsample, albedo, st, st.shade.rgb);
+            addKeyLightExactCosine(lighting.keys[k], st.keyVisibility[k], settings.subsample, albedo, st, st.shade.rgb,
+                                   rows);
 }
 
 // Which receivers' visibility the frame recomputes, planned before any stage
@@ -297,19 +303,47 @@ struct GeometryPlan {
     bool withinTolerance = false;  // tiled, and no tile's V drifted beyond the tolerance
 };
 
-GeometryPlan planGeometry(ConstGridView heights, const GiSettings& settings, const FrameChange& change, GiState& st) {
+// The azimuths each key light's visibility reads.
+std::vector<AzimuthRange> keyAzimuthRanges(const GiLighting& lighting) {
+    std::vector<AzimuthRange> out;
+    for (const KeyLight& k : lighting.keys) {
+        const KeyLightExtent e = keyLightExtent(k);
+        out.push_back({e.phiStart, e.phiEnd});
+    }
+    return out;
+}
+
+GeometryPlan planGeometry(ConstGridView heights, const GiLighting& lighting, const GiSettings& settings,
+                          const FrameChange& change, GiState& st) {
     GeometryPlan plan;
     if (!change.geometry) return plan;
     const auto t = Clock::now();
     plan.tiled = change.heightsOnly && !st.lastInputs.heights.empty() && shouldPlanTiles(st.visibilityCache);
     if (plan.tiled) {
         VisibilityCache& cache = st.visibilityCache;
-        planVisibilityTiles(st.lastInputs.heights.cview(), heights, st.pyramid, settings.visibility, settings.tolerance,
-                            cache);
-        plan.withinTolerance = cache.tiles.dirtyCount() == 0 && cache.keyTiles.dirtyCount() == 0;
+        planVisibilityTiles(st.lastInputs.heights.cview(), heights, st.pyramid, settings.visibility,
+                            keyAzimuthRanges(lighting), settings.tolerance, cache);
+        plan.withinTolerance =
+            cache.tiles.dirtyCount() == 0 && cache.keyTiles.dirtyCount() == 0 && cache.geometryTiles.dirtyCount() == 0;
     }
     st.timings.visibility = msSince(t);
     return plan;
+}
+
+// The texel rows whose direct light can differ from the last frame's
+// (gi/shading_rows.h), or null for every row: only when the heights alone
+// changed, the visibility was recomputed by tiles and the last direct
+// shading is of the recorded inputs.
+const std::vector<std::uint8_t>* shadingRows(ConstGridView heights, const FrameChange& change, const GeometryPlan& plan,
+                                             GiState& st) {
+    const bool keyRegions = std::find(change.keyRegion.begin(), change.keyRegion.end(), true) != change.keyRegion.end();
+    if (!plan.tiled || change.radiance || keyRegions || st.directStale || !st.lastInputs.valid ||
+        st.shade.nx != heights.nx || st.shade.ny != heights.ny || st.lastInputs.heights.nx != heights.nx ||
+        st.lastInputs.heights.ny != heights.ny)
+        return nullptr;
+    changedShadingRows(st.lastInputs.heights.cview(), heights, st.visibilityCache.tiles, st.visibilityCache.keyTiles,
+                       st.pyramid.subsample, st.shadingRows);
+    return &st.shadingRows;
 }
 
 // The direct light's stages: geometry (gradient, pyramid, environment V)
@@ -338,7 +372,7 @@ void runDirectStages(ConstGridView heights, float cellSize, const GiLighting& li
     keyLightVisibility(lighting, settings, change, keyOnly, st);
     st.timings.keyVisibility = msSince(t);
     t = Clock::now();
-    directShading(lighting, settings, albedo, st);
+    directShading(lighting, settings, albedo, st, shadingRows(heights, change, plan, st));
     st.timings.shading = msSince(t);
 }
 
@@ -363,7 +397,7 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
         st.timings.total = msSince(t0);
         return;
     }
-    const GeometryPlan plan = planGeometry(heights, settings, change, st);
+    const GeometryPlan plan = planGeometry(heights, lighting, settings, change, st);
     if (settings.incremental) st.geometryChanged = change.geometry && !plan.withinTolerance;
     planAmortisation(heights, settings, st);
     if (!st.directUpdated) {

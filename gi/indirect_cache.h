@@ -12,10 +12,10 @@
 //    radiance move by at most that much, in shade units). The sum of these
 //    bounds since the tile's cached result was computed bounds its drift
 //    (triangle inequality); beyond the tolerance, the tile re-gathers.
-//  - the geometry within reach: the tiles whose key-light visibility
-//    recomputes this frame (VisibilityCache::keyTiles, the bound over every
-//    azimuth, so it covers the indirect azimuths): their casting sets have
-//    drifted beyond the tolerance in the ambient map's units.
+//  - the geometry within reach: the tiles whose geometry drifted beyond the
+//    tolerance this frame (VisibilityCache::geometryTiles, the bound over
+//    every azimuth, so it covers the indirect azimuths): their casting sets
+//    have drifted beyond the tolerance in the ambient map's units.
 // Tolerance 0 re-gathers every tile where either bound is not 0, which gives
 // the full recompute bit for bit. More than one bounce, or another strategy:
 // every receiver (no per-bounce cache).

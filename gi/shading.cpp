@@ -437,7 +437,7 @@ AlbedoMap uniformAlbedo(int nx, int ny, float albedo) {
 
 void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const VisibilityField& env,
                  const ShadingLight* lights, int lightCount, const AlbedoMap* albedo, const ShadingSettings& settings,
-                 ShadeMaps& out, bool ambient) {
+                 ShadeMaps& out, bool ambient, const std::vector<std::uint8_t>* rows) {
     const int nx = gradX.nx, ny = gradX.ny;
     const int nxr = env.nxr, nyr = env.nyr;
     const std::size_t planeR = static_cast<std::size_t>(nxr) * nyr;
@@ -449,12 +449,25 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
     sizeShadeMaps(nx, ny, planeR * 3 * nCoef, ambient, static_cast<std::size_t>(nBlocks) * nPlanes * (nxrS + nx),
                   static_cast<std::size_t>(nBlocks) * 24 * nx, out);
 
+    if (rows && rows->size() != static_cast<std::size_t>(ny))
+        throw InputError("shading: one row flag per texel row expected");
     // ---- algorithm, receivers: incident radiance I_c = sum_L T_{L,c} V_L ------
+    // (with `rows`: at the receiver rows the shaded texel rows read)
+    std::vector<std::uint8_t>& receiverRows = out.receiverRows;
+    if (rows) {
+        receiverRows.assign(static_cast<std::size_t>(nyr), 0);
+        for (int y = 0; y < ny; ++y)
+            if ((*rows)[static_cast<std::size_t>(y)] != 0) {
+                const ReceiverLerp r = receiverLerp(y, s, nyr);
+                receiverRows[static_cast<std::size_t>(r.i0)] = receiverRows[static_cast<std::size_t>(r.i1)] = 1;
+            }
+    }
     buildIncidentTerms(lights, lightCount, nCoef, out);
     const bool wide = simd::wideEnabled();
     parallelForRows(nyr, nxr * 16, [&](int y0, int y1) {
         for (int Y = y0; Y < y1; ++Y)
-            (wide ? incidentRowAvx2 : incidentRowSse)(lights, lightCount, nCoef, nxr, planeR, out, Y);
+            if (!rows || receiverRows[static_cast<std::size_t>(Y)] != 0)
+                (wide ? incidentRowAvx2 : incidentRowSse)(lights, lightCount, nCoef, nxr, planeR, out, Y);
     });
 
     // ---- interpolation tables (receiver X sits at column s X) -----------------
@@ -483,6 +496,7 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
             const int yBegin = static_cast<int>(static_cast<long long>(ny) * block / nBlocks);
             const int yEnd = static_cast<int>(static_cast<long long>(ny) * (block + 1) / nBlocks);
             for (int y = yBegin; y < yEnd; ++y) {
+                if (rows && (*rows)[static_cast<std::size_t>(y)] == 0) continue;  // keeps its last values
                 if (!phong) {
                     lambertShadeRow(lambertJob, vert, gradX.row(y), gradY.row(y), y);
                     continue;

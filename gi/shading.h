@@ -16,6 +16,7 @@
 // The ambient map is lam(N) . V_env / pi: the direct-only irradiance / pi
 // under a uniform unit sky, i.e. the normal-weighted sky-view factor.
 #include <array>
+#include <cstdint>
 #include <vector>
 
 #include "core/grid.h"
@@ -133,18 +134,22 @@ struct ShadeMaps {
         float value;  // the matrix entry
         int index;    // light * 16 + k
     };
-    std::vector<Term> incidentTerms;     // non-zero matrix entries per output coefficient
-    std::vector<int> incidentTermStart;  // 3 x coefficients + 1
-    std::vector<float> rowScratch;       // per row block: interpolated SH planes of one row
-    std::vector<float> basisScratch;     // per row block: rotated BRDF coefficients of one row
+    std::vector<Term> incidentTerms;         // non-zero matrix entries per output coefficient
+    std::vector<int> incidentTermStart;      // 3 x coefficients + 1
+    std::vector<float> rowScratch;           // per row block: interpolated SH planes of one row
+    std::vector<float> basisScratch;         // per row block: rotated BRDF coefficients of one row
+    std::vector<std::uint8_t> receiverRows;  // per receiver row: its incident radiance is updated (restricted rows)
 };
 
 /// Shades every texel. envVisibility supplies the ambient map (with ambient
 /// false none is made and out.ambient is left empty: the indirect bounces);
 /// lights the incident radiance. gradX/gradY are the full resolution height
-/// derivatives.
+/// derivatives. `rows` (one flag per texel row; null: every row): only the
+/// flagged rows are shaded, the others keep what `out` holds, which must be
+/// a result of the same size and settings (which rows may keep theirs is the
+/// caller's: gi/shading_rows.h). Each row's values do not depend on the rows.
 void shadeTexels(ConstGridView gradX, ConstGridView gradY, int subsample, const VisibilityField& envVisibility,
                  const ShadingLight* lights, int lightCount, const AlbedoMap* albedo, const ShadingSettings& settings,
-                 ShadeMaps& out, bool ambient = true);
+                 ShadeMaps& out, bool ambient = true, const std::vector<std::uint8_t>* rows = nullptr);
 
 }  // namespace terrain::gi

@@ -19,8 +19,10 @@ bool addDrift(float bound, float tolerance, float& drift) {
 void resetVisibilityCache(const HeightPyramid& pyr, VisibilityCache& cache) {
     cache.tiles.reset(pyr.nxr, pyr.nyr, kVisibilityTile, true);
     cache.keyTiles.reset(pyr.nxr, pyr.nyr, kVisibilityTile, true);
+    cache.geometryTiles.reset(pyr.nxr, pyr.nyr, kVisibilityTile, true);
     cache.drift.assign(cache.tiles.dirty.size(), 0.0f);
     cache.keyDrift.assign(cache.tiles.dirty.size(), 0.0f);
+    cache.geometryDrift.assign(cache.tiles.dirty.size(), 0.0f);
 }
 
 bool shouldPlanTiles(VisibilityCache& cache) {
@@ -29,14 +31,30 @@ bool shouldPlanTiles(VisibilityCache& cache) {
     return false;
 }
 
+namespace {
+
+// Per tile, the largest slope bound over the key lights' azimuth ranges (0 without key lights).
+void boundKeyRanges(const HeightPyramid& pyr, const std::vector<AzimuthRange>& keyRanges, VisibilityCache& cache) {
+    cache.keyBound.assign(cache.slopeBound.size(), 0.0f);
+    for (const AzimuthRange& r : keyRanges) {
+        boundSlopeChangeOverRange(cache.change, pyr, kVisibilityTile, r.phi0, r.phi1, cache.rangeBound);
+        for (std::size_t t = 0; t < cache.keyBound.size(); ++t)
+            cache.keyBound[t] = std::max(cache.keyBound[t], cache.rangeBound[t]);
+    }
+}
+
+}  // namespace
+
 void planVisibilityTiles(ConstGridView before, ConstGridView after, const HeightPyramid& pyr,
-                         const VisibilitySettings& vis, float tolerance, VisibilityCache& cache) {
+                         const VisibilitySettings& vis, const std::vector<AzimuthRange>& keyRanges, float tolerance,
+                         VisibilityCache& cache) {
     if (cache.tiles.nxr != pyr.nxr || cache.tiles.nyr != pyr.nyr || cache.drift.size() != cache.tiles.dirty.size())
         resetVisibilityCache(pyr, cache);
     buildMaxChangePyramid(before, after, cache.change);
     boundSlopeChange(cache.change, pyr, kVisibilityTile, cache.slopeBound);
     boundSlopeChangePerAzimuth(cache.change, pyr, kVisibilityTile, vis.azimuths, cache.azimuthBound);
     boundGradientChange(cache.change, pyr, kVisibilityTile, cache.gradBound);
+    boundKeyRanges(pyr, keyRanges, cache);
     // V depends on the heights through the maximum blocking slope and, below
     // it, the tangent plane's slope along the azimuth (moving by at most
     // sqrt2 times a gradient component's bound); shading reruns at the new
@@ -50,11 +68,13 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
         const float env =
             ambientChangeBoundPerAzimuth(perAzimuth.data(), vis.azimuths, cache.gradBound[t], 1.0f, false);
         cache.tiles.dirty[t] = addDrift(env, tolerance, cache.drift[t]) ? 1 : 0;
-        const float key = ambientChangeBound(lipschitz * cache.slopeBound[t], cache.gradBound[t], 1.0f, false);
+        const float key = ambientChangeBound(lipschitz * cache.keyBound[t], cache.gradBound[t], 1.0f, false);
         cache.keyTiles.dirty[t] = addDrift(key, tolerance, cache.keyDrift[t]) ? 1 : 0;
+        const float any = ambientChangeBound(lipschitz * cache.slopeBound[t], cache.gradBound[t], 1.0f, false);
+        cache.geometryTiles.dirty[t] = addDrift(any, tolerance, cache.geometryDrift[t]) ? 1 : 0;
     }
     const int all = static_cast<int>(cache.drift.size());
-    if (cache.tiles.dirtyCount() == all && cache.keyTiles.dirtyCount() == all)
+    if (cache.tiles.dirtyCount() == all && cache.geometryTiles.dirtyCount() == all)
         cache.framesWithoutPlan = kFramesWithoutPlan;
 }
 

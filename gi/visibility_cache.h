@@ -14,9 +14,13 @@
 // change (triangle inequality), so slow changes over many frames are caught
 // too.
 //
-// Key lights sample their own azimuths, between the environment's: their
-// tiles (keyTiles) keep a drift of their own from the bound over all
-// azimuths, the full-circle form (kShadePerSlope times the largest move).
+// Key lights sample their own azimuths, between the environment's, within
+// their region of the sky: their tiles (keyTiles) keep a drift of their own
+// from the bound over the azimuth ranges of the key lights
+// (boundSlopeChangeOverRange, the largest over the lights), in the
+// full-circle form (kShadePerSlope times the largest move). The geometry
+// tiles (geometryTiles) do the same with the bound over every azimuth: what
+// the indirect light's casting sets may have moved (gi/indirect_cache.h).
 #include <vector>
 
 #include "core/grid.h"
@@ -37,14 +41,22 @@ inline constexpr int kVisibilityTile = 32;
 /// tolerance, and the choice depends on the frames alone (deterministic).
 inline constexpr int kFramesWithoutPlan = 7;
 
+/// The azimuths [phi0, phi1] (radians) a key light's visibility reads.
+struct AzimuthRange {
+    double phi0 = 0.0, phi1 = 0.0;
+};
+
 struct VisibilityCache {
     MaxChangePyramid change;                   // |dh| of this frame
     std::vector<float> slopeBound, gradBound;  // this frame's bounds per tile (all azimuths)
     std::vector<float> azimuthBound;           // per tile and environment azimuth (tile-major)
+    std::vector<float> keyBound, rangeBound;   // per tile: over the key lights' azimuths; scratch: one light's
     std::vector<float> drift, keyDrift;        // per tile: ambient-map change allowed since its V was computed
+    std::vector<float> geometryDrift;          // per tile: the same over every azimuth
     std::vector<float> tileAzimuths;           // scratch: one tile's per-azimuth slope bounds
     ReceiverTiles tiles;                       // this frame's tiles to recompute (environment)
     ReceiverTiles keyTiles;                    // the same for the key lights
+    ReceiverTiles geometryTiles;               // tiles whose geometry moved beyond the tolerance along any azimuth
     int framesWithoutPlan = 0;                 // frames left that recompute everything unplanned
 };
 
@@ -59,9 +71,11 @@ void resetVisibilityCache(const HeightPyramid& pyr, VisibilityCache& cache);
 /// Adds the change from `before` to the pyramid's heights `after` to every
 /// tile's drifts and marks the tiles whose drift exceeds `tolerance` (their
 /// drift reset to 0): cache.tiles for the environment's V (`vis`: its
-/// azimuths and maximum rule), cache.keyTiles for the key lights'. `pyr` is
-/// the pyramid of `after`.
+/// azimuths and maximum rule), cache.keyTiles for the key lights' (reading
+/// `keyRanges`, one per light; none: no key tile), cache.geometryTiles over
+/// every azimuth. `pyr` is the pyramid of `after`.
 void planVisibilityTiles(ConstGridView before, ConstGridView after, const HeightPyramid& pyr,
-                         const VisibilitySettings& vis, float tolerance, VisibilityCache& cache);
+                         const VisibilitySettings& vis, const std::vector<AzimuthRange>& keyRanges, float tolerance,
+                         VisibilityCache& cache);
 
 }  // namespace terrain::gi

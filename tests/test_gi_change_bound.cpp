@@ -442,3 +442,79 @@ TEST_CASE("gi.change_bound: no change gives zero bounds, a distant change a smal
     buildMaxChangePyramid(gridOf(10, 10, [](int, int) { return 1.0f; }).cview(), small);
     CHECK_THROWS_AS(boundGradientChange(small, pyr, 8, grad), InputError);
 }
+
+TEST_CASE("gi.change_bound: azimuth-range bounds hold for a key light's slopes and stay below the tile's") {
+    // key lights of several regions: across the +x axis (a wrapped range), a
+    // large one facing -y, a small one
+    const float azimuths[] = {2.0f, 250.0f, 130.0f};
+    const float radii[] = {12.0f, 40.0f, 3.0f};
+    const Config configs[] = {{97, 70, 1, 8, false}, {120, 83, 2, 8, false}, {80, 96, 1, 6, true}};
+    double worst = 0.0;
+    int smallerTiles = 0;
+    for (const Config& cfg : configs)
+        for (int k = 0; k < 3; ++k) {
+            GiSettings settings = cfg.paper ? paperGiSettings() : GiSettings{};
+            settings.subsample = cfg.subsample;
+            settings.indirect.bounces = 0;
+            GiLighting light;
+            KeyLight key;
+            key.azimuthDeg = azimuths[k];
+            key.elevationDeg = 20.0f;
+            key.radiusDeg = radii[k];
+            light.keys.push_back(key);
+            const KeyLightExtent ext = keyLightExtent(key);
+            const float lipschitz = blockingMaxLipschitz(settings.visibility.blockingMax);
+            const Grid base = baseTerrain(cfg.nx, cfg.ny);
+            GiState before, after;
+            runGiFrame(base.cview(), kCell, light, settings, before);
+            for (Change change :
+                 {Change::Bump, Change::Noise, Change::CliffCollapse, Change::Spike, Change::EdgeSpikes}) {
+                const Grid h = perturbed(base, change, 9u + static_cast<unsigned>(change));
+                runGiFrame(h.cview(), kCell, light, settings, after);
+                MaxChangePyramid dh;
+                buildMaxChangePyramid(base.cview(), h.cview(), dh);
+                std::vector<float> range, all;
+                boundSlopeChangeOverRange(dh, before.pyramid, cfg.tile, ext.phiStart, ext.phiEnd, range);
+                boundSlopeChange(dh, before.pyramid, cfg.tile, all);
+                INFO(cfg.nx << " x " << cfg.ny << " s=" << cfg.subsample << ", key at " << azimuths[k] << ", "
+                            << nameOf(change));
+                const HeightPyramid& p = before.pyramid;
+                const int nxr = p.nxr, nyr = p.nyr, tilesX = tileCount(nxr, cfg.tile);
+                const VisibilityField &va = before.keyVisibility[0], &vb = after.keyVisibility[0];
+                const int m = static_cast<int>(va.maxSlope.size() / (static_cast<std::size_t>(nxr) * nyr));
+                REQUIRE(m == settings.keyLightAzimuths);
+                const double heightUlps = 64.0 * FLT_EPSILON * std::max(maxAbs(base), maxAbs(h)) / kCell;
+                int over = 0;
+                for (int Y = 0; Y < nyr; ++Y)
+                    for (int X = 0; X < nxr; ++X) {
+                        const std::size_t t =
+                            static_cast<std::size_t>(Y / cfg.tile) * tilesX + static_cast<std::size_t>(X / cfg.tile);
+                        const double b = lipschitz * range[t];
+                        for (int j = 0; j < m; ++j) {
+                            const std::size_t i = (static_cast<std::size_t>(j) * nyr + Y) * nxr + X;
+                            const double s0 = va.maxSlope[i], s1 = vb.maxSlope[i];
+                            const double allowance =
+                                heightUlps + 4.0 * FLT_EPSILON * std::max(std::fabs(s0), std::fabs(s1));
+                            over += std::fabs(s1 - s0) > b + allowance;
+                            if (b > 0.0) worst = std::max(worst, std::fabs(s1 - s0) / b);
+                        }
+                    }
+                CHECK(over == 0);
+                for (std::size_t t = 0; t < range.size(); ++t) {
+                    CHECK(range[t] <= all[t]);
+                    smallerTiles += range[t] < all[t];
+                }
+                CHECK(rangeBoundOfTile(dh, p, cfg.tile, 1, 1, ext.phiStart, ext.phiEnd) == range[tilesX + 1]);
+            }
+        }
+    MESSAGE("key-light slopes: worst change / range bound " << worst << "; " << smallerTiles
+                                                            << " tile bounds below the bound over every azimuth");
+    CHECK(smallerTiles > 0);
+    MaxChangePyramid dh;
+    const Grid flat = baseTerrain(40, 40);
+    buildMaxChangePyramid(flat.cview(), flat.cview(), dh);
+    GiState st;
+    runGiFrame(flat.cview(), kCell, GiLighting{}, GiSettings{}, st);
+    std::vector<float> range;
+    CHECK_THROWS_AS(boundSlopeChangeOverRange(dh, st.pyramid, 8, 1.0, 0.5, range), InputError);
+}

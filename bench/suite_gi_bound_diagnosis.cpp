@@ -1,0 +1,318 @@
+// `terrain_bench gi-bound-diagnosis`: how far the change bounds of
+// incremental GI frames are from the true changes, per visibility tile. Per
+// frame (full GI frames, uniform unit sky: shade units are the
+// tolerance's): the one-frame bound of gi/visibility_cache.h on the change
+// of a tile's ambient map (the environment's V at the new normals) against
+// the true change (the ambient map shaded at the new normals with the cached
+// V against the new V, largest over the tile's texels), and the radiance
+// bound of gi/indirect_cache.h against the true change of the one-bounce
+// indirect light. An animated scene (the lit surface, ground + water, and the
+// ground alone) and the Mont Blanc DEM with pits dropped and filled.
+// Writes gi_bound_diagnosis.md.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bench/suites.h"
+#include "core/parallel.h"
+#include "gi/frame.h"
+#include "sim/scene.h"
+
+namespace terrain::bench {
+namespace {
+
+struct DiagnosisOptions {
+    std::string scene = "erosion";
+    int size = 512;
+    int frames = 6;
+    int ticksPerFrame = 60;
+    float tolerance = 0.02f;
+    std::vector<int> pits = {16, 51};  // then the DEM with a pit of each side
+};
+
+double quantile(std::vector<double> v, double q) {
+    if (v.empty()) return 0.0;
+    const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())));
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+    return v[k];
+}
+
+double share(const std::vector<double>& v, double above) {
+    double n = 0.0;
+    for (double x : v) n += x > above ? 1.0 : 0.0;
+    return v.empty() ? 0.0 : n / static_cast<double>(v.size());
+}
+
+using GiState = gi::GiState;
+
+// Largest |a - b| per visibility tile over the texels of its receivers (any channel).
+std::vector<double> perTile(const std::vector<const Grid*>& a, const std::vector<const Grid*>& b, const GiState& st,
+                            int s) {
+    const int tilesX = gi::tileCount(st.pyramid.nxr, gi::kVisibilityTile);
+    std::vector<double> out(static_cast<std::size_t>(tilesX) * gi::tileCount(st.pyramid.nyr, gi::kVisibilityTile), 0.0);
+    for (std::size_t c = 0; c < a.size(); ++c)
+        for (int y = 0; y < a[c]->ny; ++y)
+            for (int x = 0; x < a[c]->nx; ++x) {
+                const int tx = std::min(x / s, st.pyramid.nxr - 1) / gi::kVisibilityTile;
+                const int ty = std::min(y / s, st.pyramid.nyr - 1) / gi::kVisibilityTile;
+                double& t = out[static_cast<std::size_t>(ty) * tilesX + tx];
+                t = std::max(t, std::fabs(static_cast<double>((*b[c])(x, y)) - (*a[c])(x, y)));
+            }
+    return out;
+}
+
+// One surface sequence (lit or ground only): its GI state and the last frame's.
+struct Track {
+    std::string name;
+    GiState now, last;
+    Grid heights, lastHeights;
+    std::vector<double> bound, vChange, indirectBound, indirectChange, dh;
+    // An oracle that knows the true results: per tile it keeps its cached V
+    // and indirect light until they are more than the tolerance from the
+    // truth. The share of tiles it recomputes per frame is what any
+    // conservative bound recomputes at least.
+    gi::VisibilityField oracleV;
+    std::array<Grid, 3> oracleIndirect;
+    std::vector<double> oracleVShare, oracleIndirectShare;
+};
+
+// Copies the receivers (V) or texels (indirect light) of the tiles whose
+// deviation exceeds the tolerance from the truth into the oracle's cache;
+// returns the share of such tiles.
+double refreshTiles(const std::vector<double>& deviation, float tolerance, const GiState& now, int s,
+                    gi::VisibilityField* v, std::array<Grid, 3>* indirect) {
+    const int tilesX = gi::tileCount(now.pyramid.nxr, gi::kVisibilityTile), T = gi::kVisibilityTile;
+    double dirty = 0.0;
+    for (std::size_t t = 0; t < deviation.size(); ++t) {
+        if (!(deviation[t] > tolerance)) continue;
+        dirty += 1.0;
+        const int tx = static_cast<int>(t) % tilesX, ty = static_cast<int>(t) / tilesX;
+        const int X1 = std::min(now.pyramid.nxr, T * tx + T), Y1 = std::min(now.pyramid.nyr, T * ty + T);
+        for (int Y = T * ty; Y < Y1; ++Y)
+            for (int X = T * tx; X < X1; ++X) {
+                if (v)
+                    for (int k = 0; k < 16; ++k)
+                        v->plane(k)[static_cast<std::size_t>(Y) * v->nxr + X] =
+                            now.envVisibility.plane(k)[static_cast<std::size_t>(Y) * v->nxr + X];
+                if (!indirect) continue;
+                // the texels that map to this receiver (the last ones take the edge)
+                const int xEnd = X + 1 == now.pyramid.nxr ? now.gradX.nx : s * X + s;
+                const int yEnd = Y + 1 == now.pyramid.nyr ? now.gradX.ny : s * Y + s;
+                for (std::size_t c = 0; c < 3; ++c)
+                    for (int y = s * Y; y < yEnd; ++y)
+                        for (int x = s * X; x < xEnd; ++x) (*indirect)[c](x, y) = now.indirect.indirect[c](x, y);
+            }
+    }
+    return deviation.empty() ? 0.0 : dirty / static_cast<double>(deviation.size());
+}
+
+// One frame of the oracle (the first frame fills its caches).
+void oracleFrame(Track& t, const gi::GiSettings& settings, float tolerance) {
+    if (t.oracleV.sh.empty()) {
+        t.oracleV = t.now.envVisibility;
+        t.oracleIndirect = t.now.indirect.indirect;
+        return;
+    }
+    const int s = settings.subsample;
+    gi::ShadeMaps cached;
+    gi::ShadingLight env = t.now.shadingLights[0];
+    env.visibility = &t.oracleV;
+    gi::shadeTexels(t.now.gradX.cview(), t.now.gradY.cview(), s, t.oracleV, &env, 1, nullptr, settings.shading, cached);
+    const std::vector<double> v = perTile({&cached.ambient}, {&t.now.shade.ambient}, t.now, s);
+    t.oracleVShare.push_back(refreshTiles(v, tolerance, t.now, s, &t.oracleV, nullptr));
+    const std::vector<double> ind =
+        perTile({&t.oracleIndirect[0], &t.oracleIndirect[1], &t.oracleIndirect[2]},
+                {&t.now.indirect.indirect[0], &t.now.indirect.indirect[1], &t.now.indirect.indirect[2]}, t.now, s);
+    t.oracleIndirectShare.push_back(refreshTiles(ind, tolerance, t.now, s, nullptr, &t.oracleIndirect));
+}
+
+// Per tile, the radiance bound of gi/indirect_cache.h for the change of the
+// direct light from the last frame to this one (the largest over the
+// indirect azimuths of boundSampleChangePerAzimuth).
+std::vector<double> indirectRadianceBound(const GiState& now, const GiState& last, int azimuths) {
+    const std::array<ConstGridView, 3> before{last.shade.rgb[0].cview(), last.shade.rgb[1].cview(),
+                                              last.shade.rgb[2].cview()};
+    const std::array<ConstGridView, 3> after{now.shade.rgb[0].cview(), now.shade.rgb[1].cview(),
+                                             now.shade.rgb[2].cview()};
+    gi::MaxChangePyramid change;
+    gi::buildMaxChangePyramid(before, after, change);
+    std::vector<float> perAzimuth;
+    gi::boundSampleChangePerAzimuth(change, now.indirect.radiance.fields[0], gi::kVisibilityTile, azimuths, perAzimuth);
+    std::vector<double> out(perAzimuth.size() / static_cast<std::size_t>(azimuths), 0.0);
+    for (std::size_t i = 0; i < perAzimuth.size(); ++i) {
+        double& t = out[i / static_cast<std::size_t>(azimuths)];
+        t = std::max(t, static_cast<double>(perAzimuth[i]));
+    }
+    return out;
+}
+
+// The ambient map at the new normals with the last frame's environment V.
+void ambientWithCachedV(const GiState& now, const GiState& last, const gi::GiSettings& settings, gi::ShadeMaps& out) {
+    gi::ShadingLight env = now.shadingLights[0];
+    env.visibility = &last.envVisibility;
+    gi::shadeTexels(now.gradX.cview(), now.gradY.cview(), settings.subsample, last.envVisibility, &env, 1, nullptr,
+                    settings.shading, out);
+}
+
+void measureFrame(Track& t, const gi::GiSettings& settings, float cell, float tolerance) {
+    const gi::GiLighting sky;  // uniform unit sky
+    gi::runGiFrame(t.heights.cview(), cell, sky, settings, t.now);
+    oracleFrame(t, settings, tolerance);
+    if (t.lastHeights.empty()) return;
+    for (std::size_t i = 0; i < t.heights.v.size(); ++i)
+        t.dh.push_back(std::fabs(static_cast<double>(t.heights.v[i]) - t.lastHeights.v[i]));
+    gi::VisibilityCache cache;  // a fresh drift: after one plan it holds the frame's bound per tile
+    gi::planVisibilityTiles(t.lastHeights.cview(), t.heights.cview(), t.now.pyramid, settings.visibility, {}, 1e30f,
+                            cache);
+    gi::ShadeMaps cached;
+    ambientWithCachedV(t.now, t.last, settings, cached);
+    const int s = settings.subsample;
+    const std::vector<double> v = perTile({&cached.ambient}, {&t.now.shade.ambient}, t.now, s);
+    const std::vector<double> ind =
+        perTile({&t.last.indirect.indirect[0], &t.last.indirect.indirect[1], &t.last.indirect.indirect[2]},
+                {&t.now.indirect.indirect[0], &t.now.indirect.indirect[1], &t.now.indirect.indirect[2]}, t.now, s);
+    const std::vector<double> indBound = indirectRadianceBound(t.now, t.last, settings.indirect.azimuths);
+    t.indirectBound.insert(t.indirectBound.end(), indBound.begin(), indBound.end());
+    t.bound.insert(t.bound.end(), cache.drift.begin(), cache.drift.end());
+    t.vChange.insert(t.vChange.end(), v.begin(), v.end());
+    t.indirectChange.insert(t.indirectChange.end(), ind.begin(), ind.end());
+}
+
+const char* kIntro =
+    "Full GI frames (2x, one bounce, uniform unit sky: shade units are the tolerance's, 2 threads), consecutive "
+    "frames compared per visibility tile (32 x 32 receivers). One-frame V bound: the drift "
+    "gi/visibility_cache.h adds for the frame (environment, per azimuth, V alone). True change of the cached V: "
+    "the ambient map at the new normals shaded with the last frame's V against the new V, largest over the tile's "
+    "texels. Radiance bound of the indirect light: what gi/indirect_cache.h adds for the frame's change of the "
+    "direct light (the largest over the indirect azimuths of boundSampleChangePerAzimuth); the true change of the "
+    "indirect light is that of the whole frame (sources and geometry), largest over the tile's texels and "
+    "channels. Quantiles over every tile of every frame after the first. The oracle knows the true results: per "
+    "tile it keeps its cached V (or indirect light) until the tile's texels are more than the tolerance from the "
+    "truth, then takes the truth; the share of tiles it recomputes per frame is about the least any conservative "
+    "bound can recompute.\n";
+
+// One row per quantity: its quantiles and the share of tiles (or cells) above the tolerance.
+std::string row(const std::string& what, const std::vector<double>& v, double above) {
+    char buf[400];
+    std::snprintf(buf, sizeof buf, "| %s | %.3g | %.3g | %.3g | %.3g | %.1f %% |\n", what.c_str(), quantile(v, 0.1),
+                  quantile(v, 0.5), quantile(v, 0.9), quantile(v, 1.0), 100.0 * share(v, above));
+    return buf;
+}
+
+std::string report(const Track& t, float tolerance) {
+    std::vector<double> ratio;
+    for (std::size_t i = 0; i < t.bound.size(); ++i)
+        if (t.vChange[i] > 0.0) ratio.push_back(t.bound[i] / t.vChange[i]);
+    return "\n### " + t.name +
+           "\n\n| quantity | p10 | median | p90 | max | share above the tolerance |\n|---|---|---|---|---|---|\n" +
+           row("\\|dh\\| per cell (m; share above 1 cm)", t.dh, 0.01) +
+           row("per tile: one-frame bound on the cached V's ambient change", t.bound, tolerance) +
+           row("per tile: true change of the cached V's ambient", t.vChange, tolerance) +
+           row("per tile: V bound / true change (share above 1)", ratio, 1.0) +
+           row("per tile: one-frame radiance bound of the indirect light", t.indirectBound, tolerance) +
+           row("per tile: true change of the indirect light", t.indirectChange, tolerance) +
+           row("oracle: share of the tiles whose V it recomputes, per frame (share above 0)", t.oracleVShare, 0.0) +
+           row("oracle: share of the tiles whose indirect light it recomputes, per frame (share above 0)",
+               t.oracleIndirectShare, 0.0);
+}
+
+gi::GiSettings diagnosisSettings() {
+    gi::GiSettings settings;
+    settings.subsample = 2;
+    settings.indirect.bounces = 1;
+    settings.incremental = false;
+    return settings;
+}
+
+void runTracks(const std::vector<Track*>& tracks, float cell, int frames, float tolerance,
+               const std::function<void(int frame)>& nextSurfaces) {
+    const gi::GiSettings settings = diagnosisSettings();
+    withThreads(2, [&] {
+        for (int f = 0; f <= frames; ++f) {
+            nextSurfaces(f);
+            for (Track* t : tracks) {
+                measureFrame(*t, settings, cell, tolerance);
+                t->last = t->now;
+                t->lastHeights = t->heights;
+            }
+        }
+    });
+}
+
+// The scene at its pacing: the lit surface and the ground alone.
+std::string diagnoseScene(const DiagnosisOptions& o) {
+    Simulation sim(builtinScene(o.scene, o.size, 1));
+    Track lit{"lit surface (ground + water)"}, ground{"ground alone"};
+    runTracks({&lit, &ground}, sim.state().cellSize, o.frames, o.tolerance, [&](int f) {
+        if (f > 0)
+            for (int k = 0; k < o.ticksPerFrame; ++k) sim.tick();
+        const TerrainState& s = sim.state();
+        lit.heights.ensureSize(s.nx, s.ny);
+        ground.heights.ensureSize(s.nx, s.ny);
+        for (int y = 0; y < s.ny; ++y)
+            for (int x = 0; x < s.nx; ++x) {
+                ground.heights(x, y) = s.ground(x, y);
+                lit.heights(x, y) = s.ground(x, y) + (s.hasWater() ? s.water(x, y) : 0.0f);
+            }
+    });
+    char head[200];
+    std::snprintf(head, sizeof head, "\n## %s %d², %d frames of %d ticks\n", o.scene.c_str(), o.size, o.frames,
+                  o.ticksPerFrame);
+    return head + report(lit, o.tolerance) + report(ground, o.tolerance);
+}
+
+// The central crop of the Mont Blanc DEM with a square pit of `side` cells
+// lowered by 30 m at its centre on odd frames (gi-incremental's pit cases).
+std::string diagnosePit(const DiagnosisOptions& o, int side, const BenchContext& ctx) {
+    float cell = 0.0f;
+    const Grid dem = alpsCentreCrop(ctx.dataDir, o.size, cell);
+    side = std::min(side, o.size);
+    Track pit{"dem, " + std::to_string(side) + "² pit"};
+    runTracks({&pit}, cell, o.frames, o.tolerance, [&](int f) {
+        pit.heights = dem;
+        const int x0 = (dem.nx - side) / 2, y0 = (dem.ny - side) / 2;
+        if (f % 2 == 1)
+            for (int y = y0; y < y0 + side; ++y)
+                for (int x = x0; x < x0 + side; ++x) pit.heights(x, y) -= 30.0f;
+    });
+    char head[200];
+    std::snprintf(head, sizeof head, "\n## Mont Blanc DEM %d², a %d² pit dropped and filled, %d frames\n", o.size, side,
+                  o.frames);
+    return head + report(pit, o.tolerance);
+}
+
+}  // namespace
+
+Runner addGiBoundDiagnosisSuite(CLI::App& app, const BenchContext& ctx) {
+    auto o = std::make_shared<DiagnosisOptions>();
+    CLI::App* sub = app.add_subcommand(
+        "gi-bound-diagnosis",
+        "Per visibility tile of an animated scene: the one-frame change bound against the true change (prints)");
+    sub->add_option("--scene", o->scene, "Built-in scene")->capture_default_str();
+    sub->add_option("--size", o->size, "Grid side")->check(CLI::Range(64, 2048))->capture_default_str();
+    sub->add_option("--frames", o->frames, "Frames measured")->check(CLI::Range(1, 1000))->capture_default_str();
+    sub->add_option("--ticks", o->ticksPerFrame, "Simulation ticks per frame")
+        ->check(CLI::Range(1, 100000))
+        ->capture_default_str();
+    sub->add_option("--tolerance", o->tolerance, "Tolerance the shares are counted against")->capture_default_str();
+    sub->add_option("--pits", o->pits, "Then the DEM with a square pit of each of these sides (cells, at most --size)")
+        ->check(CLI::Range(1, 2048))
+        ->capture_default_str();
+    return [o, &ctx] {
+        std::string text =
+            "# Change bounds against true changes, per visibility tile\n\nMachine: " + machineDescription() +
+            ".\n\nCommand: `" + ctx.command + "`.\n\n" + kIntro;
+        text += diagnoseScene(*o);
+        for (int side : o->pits) text += diagnosePit(*o, side, ctx);
+        std::fputs(text.c_str(), stdout);
+        writeResult(ctx.outDir, "gi_bound_diagnosis.md", text);
+        return 0;
+    };
+}
+
+}  // namespace terrain::bench
