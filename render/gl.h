@@ -14,42 +14,76 @@ using GlProc = void (*)();
 using GlGetProcAddress = GlProc (*)(const char* name);  // same alias as in render/context.h
 
 // X(member, PFN name part): member `Clear` is loaded from "glClear" with type PFNGLCLEARPROC.
-#define TERRAIN_GL_FUNCTIONS(X)                                                                                       \
-    X(ActiveTexture, ACTIVETEXTURE)                                                                                   \
-    X(ClearStencil, CLEARSTENCIL)                                                                                     \
-    X(StencilFunc, STENCILFUNC)                                                                                       \
-    X(StencilOp, STENCILOP)                                                                                           \
-    X(AttachShader, ATTACHSHADER)                                                                                     \
-    X(BindBuffer, BINDBUFFER)                                                                                         \
-    X(BindFramebuffer, BINDFRAMEBUFFER)                                                                               \
-    X(BlitFramebuffer, BLITFRAMEBUFFER)                                                                               \
-    X(BindTexture, BINDTEXTURE) X(BindVertexArray, BINDVERTEXARRAY) X(BlendFunc, BLENDFUNC) X(BufferData, BUFFERDATA) \
-        X(CheckFramebufferStatus, CHECKFRAMEBUFFERSTATUS) X(Clear, CLEAR) X(ClearColor, CLEARCOLOR) X(                \
-            ClearDepth, CLEARDEPTH) X(CompileShader, COMPILESHADER) X(CreateProgram, CREATEPROGRAM)                   \
-            X(CreateShader, CREATESHADER) X(CullFace, CULLFACE) X(DeleteBuffers, DELETEBUFFERS) X(                    \
-                DeleteFramebuffers, DELETEFRAMEBUFFERS) X(DeleteProgram, DELETEPROGRAM) X(DeleteShader, DELETESHADER) \
-                X(DeleteTextures, DELETETEXTURES) X(DeleteVertexArrays, DELETEVERTEXARRAYS) X(DepthFunc, DEPTHFUNC)   \
-                    X(DepthMask, DEPTHMASK) X(Disable, DISABLE) X(DrawArrays, DRAWARRAYS) X(DrawBuffers, DRAWBUFFERS) \
-                        X(DrawElements, DRAWELEMENTS) X(Enable, ENABLE) X(Finish, FINISH)                             \
-                            X(FramebufferTexture2D, FRAMEBUFFERTEXTURE2D) X(GenBuffers, GENBUFFERS) X(                \
-                                GenFramebuffers, GENFRAMEBUFFERS) X(GenTextures, GENTEXTURES)                         \
-                                X(GenVertexArrays, GENVERTEXARRAYS) X(GetError, GETERROR) X(GetIntegerv, GETINTEGERV) \
-                                    X(GetProgramInfoLog, GETPROGRAMINFOLOG) X(GetProgramiv, GETPROGRAMIV)             \
-                                        X(GetShaderInfoLog, GETSHADERINFOLOG) X(GetShaderiv, GETSHADERIV)             \
-                                            X(GetString, GETSTRING) X(GetUniformLocation, GETUNIFORMLOCATION)         \
-                                                X(LinkProgram, LINKPROGRAM) X(PixelStorei, PIXELSTOREI)               \
-                                                    X(PolygonOffset, POLYGONOFFSET) X(ReadBuffer, READBUFFER)         \
-                                                        X(ReadPixels, READPIXELS) X(ShaderSource, SHADERSOURCE) X(    \
-                                                            TexImage2D, TEXIMAGE2D) X(TexParameteri, TEXPARAMETERI)   \
-                                                            X(TexParameterfv, TEXPARAMETERFV) X(                      \
-                                                                TexSubImage2D, TEXSUBIMAGE2D) X(Uniform1f, UNIFORM1F) \
-                                                                X(Uniform1i, UNIFORM1I) X(Uniform2f, UNIFORM2F)       \
-                                                                    X(Uniform2i, UNIFORM2I) X(Uniform3f, UNIFORM3F)   \
-                                                                        X(Uniform3fv, UNIFORM3FV)                     \
-                                                                            X(Uniform4f, UNIFORM4F)                   \
-                                                                                X(UniformMatrix4fv, UNIFORMMATRIX4FV) \
-                                                                                    X(UseProgram, USEPROGRAM)         \
-                                                                                        X(Viewport, VIEWPORT)
+// clang-format off (one entry a line, sorted; the formatter would reflow the list)
+#define TERRAIN_GL_FUNCTIONS(X)                       \
+    X(ActiveTexture, ACTIVETEXTURE)                   \
+    X(AttachShader, ATTACHSHADER)                     \
+    X(BindBuffer, BINDBUFFER)                         \
+    X(BindFramebuffer, BINDFRAMEBUFFER)               \
+    X(BindTexture, BINDTEXTURE)                       \
+    X(BindVertexArray, BINDVERTEXARRAY)               \
+    X(BlendFunc, BLENDFUNC)                           \
+    X(BlitFramebuffer, BLITFRAMEBUFFER)               \
+    X(BufferData, BUFFERDATA)                         \
+    X(CheckFramebufferStatus, CHECKFRAMEBUFFERSTATUS) \
+    X(Clear, CLEAR)                                   \
+    X(ClearColor, CLEARCOLOR)                         \
+    X(ClearDepth, CLEARDEPTH)                         \
+    X(ClearStencil, CLEARSTENCIL)                     \
+    X(CompileShader, COMPILESHADER)                   \
+    X(CreateProgram, CREATEPROGRAM)                   \
+    X(CreateShader, CREATESHADER)                     \
+    X(CullFace, CULLFACE)                             \
+    X(DeleteBuffers, DELETEBUFFERS)                   \
+    X(DeleteFramebuffers, DELETEFRAMEBUFFERS)         \
+    X(DeleteProgram, DELETEPROGRAM)                   \
+    X(DeleteShader, DELETESHADER)                     \
+    X(DeleteTextures, DELETETEXTURES)                 \
+    X(DeleteVertexArrays, DELETEVERTEXARRAYS)         \
+    X(DepthFunc, DEPTHFUNC)                           \
+    X(DepthMask, DEPTHMASK)                           \
+    X(Disable, DISABLE)                               \
+    X(DrawArrays, DRAWARRAYS)                         \
+    X(DrawBuffers, DRAWBUFFERS)                       \
+    X(DrawElements, DRAWELEMENTS)                     \
+    X(Enable, ENABLE)                                 \
+    X(Finish, FINISH)                                 \
+    X(FramebufferTexture2D, FRAMEBUFFERTEXTURE2D)     \
+    X(GenBuffers, GENBUFFERS)                         \
+    X(GenFramebuffers, GENFRAMEBUFFERS)               \
+    X(GenTextures, GENTEXTURES)                       \
+    X(GenVertexArrays, GENVERTEXARRAYS)               \
+    X(GetError, GETERROR)                             \
+    X(GetIntegerv, GETINTEGERV)                       \
+    X(GetProgramInfoLog, GETPROGRAMINFOLOG)           \
+    X(GetProgramiv, GETPROGRAMIV)                     \
+    X(GetShaderInfoLog, GETSHADERINFOLOG)             \
+    X(GetShaderiv, GETSHADERIV)                       \
+    X(GetString, GETSTRING)                           \
+    X(GetUniformLocation, GETUNIFORMLOCATION)         \
+    X(LinkProgram, LINKPROGRAM)                       \
+    X(PixelStorei, PIXELSTOREI)                       \
+    X(PolygonOffset, POLYGONOFFSET)                   \
+    X(ReadBuffer, READBUFFER)                         \
+    X(ReadPixels, READPIXELS)                         \
+    X(ShaderSource, SHADERSOURCE)                     \
+    X(StencilFunc, STENCILFUNC)                       \
+    X(StencilOp, STENCILOP)                           \
+    X(TexImage2D, TEXIMAGE2D)                         \
+    X(TexParameterfv, TEXPARAMETERFV)                 \
+    X(TexParameteri, TEXPARAMETERI)                   \
+    X(TexSubImage2D, TEXSUBIMAGE2D)                   \
+    X(Uniform1f, UNIFORM1F)                           \
+    X(Uniform1i, UNIFORM1I)                           \
+    X(Uniform2f, UNIFORM2F)                           \
+    X(Uniform2i, UNIFORM2I)                           \
+    X(Uniform3f, UNIFORM3F)                           \
+    X(Uniform3fv, UNIFORM3FV)                         \
+    X(Uniform4f, UNIFORM4F)                           \
+    X(UniformMatrix4fv, UNIFORMMATRIX4FV)             \
+    X(UseProgram, USEPROGRAM)                         \
+    X(Viewport, VIEWPORT)
+// clang-format on
 
 /// Every GL entry point the renderer calls: gl.Clear(...) is glClear(...).
 struct Gl {
