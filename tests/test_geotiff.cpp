@@ -242,6 +242,31 @@ TEST_CASE("geotiff: the same heights light the same as the PNG given the GeoTIFF
     CHECK(sameBits(a.shade.ambient, b.shade.ambient));
 }
 
+TEST_CASE("geotiff: the Mont Blanc DEM as a GeoTIFF lights the same as its PNG (when the data are here)") {
+    const SceneSettings dem = builtinScene("dem", 64, 1);
+    const std::string png = dem.terrain.demFile;
+    if (!std::filesystem::exists(png)) {
+        MESSAGE("skipped: the Mont Blanc DEM is not here (" << png << "; set TERRAIN_DATA)");
+        return;
+    }
+    const Grid fromPng = readHeightmap(png, dem.terrain.demZScale, dem.terrain.demZOffset);
+    const double cell = dem.terrain.demCellSize;
+    GeoReference geo;
+    geo.transform = {330000.0, cell, 0.0, 5090000.0, 0.0, -cell};
+    geo.crsWkt = wktOf(kUtm32N);
+    const auto dir = test::scratchDir("geotiff_montblanc");
+    const std::string tif = (dir / "montblanc.tif").string();
+    writeGeoTiff(tif, std::span<const Grid>(&fromPng, 1), geo);
+    float tifCell = 0.0f;
+    const Grid fromTif = readHeightmap(tif, 1.0f, 0.0f, &tifCell);
+    REQUIRE(sameBits(fromTif, fromPng));
+    REQUIRE(tifCell == static_cast<float>(cell));
+    gi::GiState a, b;
+    gi::runGiFrame(fromPng.cview(), static_cast<float>(cell), gi::GiLighting{}, gi::GiSettings{}, a);
+    gi::runGiFrame(fromTif.cview(), tifCell, gi::GiLighting{}, gi::GiSettings{}, b);
+    CHECK(sameBits(a.shade.ambient, b.shade.ambient));
+}
+
 TEST_CASE("geotiff: a scene's DEM takes the file's cell size, and its frames its place") {
     const auto dir = test::scratchDir("geotiff_scene");
     TiffSpec spec;
