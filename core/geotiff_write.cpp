@@ -66,8 +66,8 @@ void writeGeoTiff(const std::string& file, std::span<const Grid> bands, const Ge
     const Grid& g = bands[0];
     for (const Grid& b : bands)
         if (b.nx != g.nx || b.ny != g.ny) throw IoError(file, "bands of different sizes");
+    gdal::ErrorCapture errors;  // first: registering the drivers may report too
     gdal::ensureRegistered();
-    gdal::ErrorCapture errors;
     GDALDriverH driver = GDALGetDriverByName("GTiff");
     if (!driver) throw IoError(file, "GDAL has no GeoTIFF driver");
     TemporaryGuard tmp{temporaryNameFor(file)};
