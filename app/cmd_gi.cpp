@@ -17,6 +17,7 @@
 #include "app/progress.h"
 #include "core/error.h"
 #include "core/finite.h"
+#include "core/geotiff_io.h"
 #include "core/parallel.h"
 #include "core/parse.h"
 #include "engine/light_rig.h"
@@ -196,6 +197,11 @@ void checkOptions(const GiOptions& o) {
     checkRange(widened(sr::kDemCellSize), o.cellSize, "--cell-size");
     checkRange(widened(sr::kDemZScale), o.zScale, "--z-scale");
     checkRange(widened(sr::kAltitude), o.zOffset, "--z-offset");
+    // said rather than ignored: a user giving them expects them applied
+    if (isGeoTiffPath(o.heightmap) && (o.zScale != 1.0 || o.zOffset != 0.0))
+        throw InputError(
+            "--z-scale and --z-offset apply to PNG heightmaps; a GeoTIFF's heights are used as stored, "
+            "in metres");
     checkGiFlags(o.settings);
     checkLightOptions(o.lights);
     checkOutputs(o);

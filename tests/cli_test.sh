@@ -240,6 +240,7 @@ hand_geotiff "$tmp/wgs84.tif" 24 20 wgs84
 "$T" gi --heightmap "$tmp/holes.tif" --out-ambient "$tmp/holes.npy" >/dev/null 2>"$tmp/e" \
   && [ "$(grep -c 'warning: .*holes.tif: 20 nodata cells filled with the nearest valid height' "$tmp/e")" = 1 ] \
   && ok || bad "GeoTIFF nodata: $(cat "$tmp/e")"
+expect_error "--z-scale with a GeoTIFF" "z-scale and --z-offset apply to PNG" "$T" gi --heightmap "$tmp/dem.tif" --z-scale 2
 expect_error "GeoTIFF in degrees" "wgs84.tif: has a geographic CRS in degrees.*gdalwarp" "$T" gi --heightmap "$tmp/wgs84.tif"
 head -c 300 "$tmp/dem.tif" >"$tmp/cut.tif"
 expect_error "truncated GeoTIFF" "cut.tif: " "$T" gi --heightmap "$tmp/cut.tif"
