@@ -22,6 +22,7 @@ PACKAGES=(
   build-essential cmake pkg-config ccache git
   libglm-dev libglfw3-dev libosmesa6-dev libgl-dev
   libopenvdb-dev libboost-dev libboost-iostreams-dev libtbb-dev libimath-dev libopenexr-dev libblosc-dev
+  libgdal-dev
   doctest-dev libpng-dev libtomlplusplus-dev libcli11-dev libimgui-dev
   xvfb xauth xdotool
   clang libclang-rt-14-dev

@@ -17,6 +17,7 @@
 #include "app/progress.h"
 #include "core/error.h"
 #include "core/finite.h"
+#include "core/geotiff_io.h"
 #include "core/parallel.h"
 #include "core/parse.h"
 #include "engine/light_rig.h"
@@ -169,13 +170,16 @@ void checkGiFlags(const gi::GiSettings& s) {
 
 // The output files, before any work: each must be a file in a folder we can write to.
 void checkOutputs(const GiOptions& o) {
-    if (!o.outShade.empty() && extensionOf(o.outShade) != ".png" && extensionOf(o.outShade) != ".exr")
-        throw InputError("--out-shade must end in .png or .exr (got '" + o.outShade + "')");
-    if (!o.outAmbient.empty() && extensionOf(o.outAmbient) != ".npy" && extensionOf(o.outAmbient) != ".exr")
-        throw InputError("--out-ambient must end in .npy or .exr (got '" + o.outAmbient + "')");
-    const std::string indirectExt = extensionOf(o.outIndirect);
-    if (!o.outIndirect.empty() && indirectExt != ".npy" && indirectExt != ".exr" && indirectExt != ".png")
-        throw InputError("--out-indirect must end in .npy, .exr or .png (got '" + o.outIndirect + "')");
+    const auto oneOf = [](const std::string& file, std::initializer_list<const char*> exts) {
+        const std::string ext = extensionOf(file);
+        return file.empty() || isGeoTiffPath(file) || std::find(exts.begin(), exts.end(), ext) != exts.end();
+    };
+    if (!oneOf(o.outShade, {".png", ".exr"}))
+        throw InputError("--out-shade must end in .png, .exr or .tif (got '" + o.outShade + "')");
+    if (!oneOf(o.outAmbient, {".npy", ".exr"}))
+        throw InputError("--out-ambient must end in .npy, .exr or .tif (got '" + o.outAmbient + "')");
+    if (!oneOf(o.outIndirect, {".npy", ".exr", ".png"}))
+        throw InputError("--out-indirect must end in .npy, .exr, .png or .tif (got '" + o.outIndirect + "')");
     if (!o.outIndirect.empty() && o.settings.indirect.bounces == 0 && !o.reference)
         throw InputError("--out-indirect needs --bounces >= 1");
     for (const std::string* out : {&o.outShade, &o.outAmbient, &o.outIndirect})
@@ -193,6 +197,11 @@ void checkOptions(const GiOptions& o) {
     checkRange(widened(sr::kDemCellSize), o.cellSize, "--cell-size");
     checkRange(widened(sr::kDemZScale), o.zScale, "--z-scale");
     checkRange(widened(sr::kAltitude), o.zOffset, "--z-offset");
+    // said rather than ignored: a user giving them expects them applied
+    if (isGeoTiffPath(o.heightmap) && (o.zScale != 1.0 || o.zOffset != 0.0))
+        throw InputError(
+            "--z-scale and --z-offset apply to PNG heightmaps; a GeoTIFF's heights are used as stored, "
+            "in metres");
     checkGiFlags(o.settings);
     checkLightOptions(o.lights);
     checkOutputs(o);
@@ -202,6 +211,7 @@ void checkOptions(const GiOptions& o) {
 struct GiInputs {
     Grid heights;
     double cell = 0.0;
+    GeoReference geo;  // a GeoTIFF input's place and CRS, given to .tif outputs
     gi::AlbedoMap albedoMap;
     const gi::AlbedoMap* albedo = nullptr;
     std::unique_ptr<engine::LightRig> lights;  // frame f is lit by lights->at(f)
@@ -215,9 +225,13 @@ GiInputs readInputs(const GiOptions& o, const ExponentSource& exponent) {
     in.lights = std::make_unique<engine::LightRig>(lights);
     in.lighting = engine::giLighting(in.lights->at(0));
     float cellFromFile = 0.0f;
-    in.heights = readHeightmap(o.heightmap, static_cast<float>(o.zScale), static_cast<float>(o.zOffset), &cellFromFile);
+    in.heights =
+        readHeightmap(o.heightmap, static_cast<float>(o.zScale), static_cast<float>(o.zOffset), &cellFromFile, &in.geo);
+    // --cell-size overrides the file's own (a .tif's geotransform, a .vdb's voxel size)
     in.cell = o.cellSize > 0.0 ? o.cellSize : cellFromFile;
     if (!(in.cell > 0.0)) throw InputError("--cell-size is needed for a PNG heightmap (metres between grid points)");
+    // the outputs keep the input's origin; an overriding --cell-size rescales their pixels
+    if (in.geo.georeferenced() && o.cellSize > 0.0) in.geo = in.geo.withCellSize(o.cellSize);
     checkRange(scene_ranges::kCellSize, static_cast<float>(in.cell), o.heightmap + ": cell size");
     if (!o.albedo.empty()) in.albedoMap = gi::loadAlbedo(o.albedo, in.heights.nx, in.heights.ny);
     if (exponent.fromFile)
@@ -235,7 +249,7 @@ struct GiResults {
 
 // Every result is checked finite before any file is written: no NaN or Inf
 // leaves the command, and a failing run leaves earlier files as they were.
-void writeResults(const GiOptions& o, const GiResults& r) {
+void writeResults(const GiOptions& o, const GiResults& r, const GeoReference& geo) {
     try {
         for (const Grid& g : *r.shade) requireFinite(g, "the shade map");
         requireFinite(*r.ambient, "the ambient map");
@@ -244,9 +258,9 @@ void writeResults(const GiOptions& o, const GiResults& r) {
     } catch (const InputError& e) {
         throw InputError(std::string(e.what()) + "; nothing written");
     }
-    if (!o.outShade.empty()) writeShade(o.outShade, *r.shade, o.exposure);
-    if (!o.outAmbient.empty()) writeAmbient(o.outAmbient, *r.ambient);
-    if (!o.outIndirect.empty()) writeIndirect(o.outIndirect, *r.indirect);
+    if (!o.outShade.empty()) writeShade(o.outShade, *r.shade, o.exposure, geo);
+    if (!o.outAmbient.empty()) writeAmbient(o.outAmbient, *r.ambient, geo);
+    if (!o.outIndirect.empty()) writeIndirect(o.outIndirect, *r.indirect, geo);
 }
 
 using Clock = std::chrono::steady_clock;
@@ -269,7 +283,7 @@ int runReference(const GiOptions& o, const gi::GiSettings& settings, const GiInp
         gi::renderReferenceGi(in.heights.cview(), static_cast<float>(in.cell), in.lighting.environment, in.albedo, gs,
                               gr);
         if (o.time) std::printf("reference: %.1f ms\n", msSince(t0));
-        writeResults(o, {&gr.total, &gr.ambient, &gr.indirect});
+        writeResults(o, {&gr.total, &gr.ambient, &gr.indirect}, in.geo);
         return 0;
     }
     gi::ReferenceSettings rs;
@@ -277,7 +291,7 @@ int runReference(const GiOptions& o, const gi::GiSettings& settings, const GiInp
     gi::ReferenceResult rr;
     gi::renderReference(in.heights.cview(), static_cast<float>(in.cell), &in.lighting.environment, in.albedo, rs, rr);
     if (o.time) std::printf("reference: %.1f ms\n", msSince(t0));
-    writeResults(o, {&rr.rgb, &rr.ambient, nullptr});
+    writeResults(o, {&rr.rgb, &rr.ambient, nullptr}, in.geo);
     return 0;
 }
 
@@ -310,8 +324,10 @@ int runFastPath(const GiOptions& o, const gi::GiSettings& settings, const GiInpu
         std::sort(totals.begin(), totals.end());
         std::printf("%.2f ms per frame\n", totals[totals.size() / 2]);
     }
-    writeResults(o, {bounces > 0 ? &state.indirect.total : &state.shade.rgb, &state.shade.ambient,
-                     bounces > 0 ? &state.indirect.indirect : nullptr});
+    writeResults(o,
+                 {bounces > 0 ? &state.indirect.total : &state.shade.rgb, &state.shade.ambient,
+                  bounces > 0 ? &state.indirect.indirect : nullptr},
+                 in.geo);
     return 0;
 }
 
@@ -354,10 +370,10 @@ Runner addGiCommand(CLI::App& app) {
     sub->add_option("--interp", o->interp, "Azimuthal interpolation: linear | bspline");
     sub->add_option("--threads", o->threads, describe(opt::kThreads))->capture_default_str();
     sub->add_flag("--reference", o->reference, "Ground truth instead of the fast path (slow)");
-    sub->add_option("--out-shade", o->outShade, "RGB shade map (.png sRGB 8-bit, or .exr)");
+    sub->add_option("--out-shade", o->outShade, "RGB shade map (.png sRGB 8-bit, or .exr / .tif float32)");
     sub->add_option("--exposure", o->exposure, describe(opt::kExposure) + " (of the .png shade map, before sRGB)")
         ->capture_default_str();
-    sub->add_option("--out-ambient", o->outAmbient, "Ambient (sky-view) map (.npy float32, or .exr)");
+    sub->add_option("--out-ambient", o->outAmbient, "Ambient (sky-view) map (.npy float32, .exr or .tif)");
     sub->add_option("--frames", o->frames,
                     describe(opt::kFrames) + ": run the frame N times on the same field (first = warm-up)")
         ->capture_default_str();
@@ -373,9 +389,10 @@ Runner addGiCommand(CLI::App& app) {
     sub->add_option("--gi-refresh", gs.refreshEvery, gi::describe(r::kRefreshEvery))->capture_default_str();
     sub->add_flag("--amortise", gs.indirect.amortise,
                   "With --frames on static geometry: alternate direct and indirect updates");
-    sub->add_option("--out-indirect", o->outIndirect,
-                    "Indirect light alone, RGB (.npy float32 (rows, columns, 3), .exr, or .png: its luminance in false "
-                    "colour, black to white at its 99th percentile)");
+    sub->add_option(
+        "--out-indirect", o->outIndirect,
+        "Indirect light alone, RGB (.npy float32 (rows, columns, 3), .exr, .tif, or .png: its luminance in false "
+        "colour, black to white at its 99th percentile)");
     sub->add_option("--radiance-levels-per-octave", gs.indirect.radiance.levelsPerOctave,
                     gi::describe(r::kRadianceLevelsPerOctave) + " (paper 4)")
         ->capture_default_str();

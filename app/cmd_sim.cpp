@@ -9,6 +9,7 @@
 #include "app/option_ranges.h"
 #include "app/progress.h"
 #include "core/error.h"
+#include "core/geotiff_io.h"
 #include "core/parallel.h"
 #include "core/png_io.h"
 #include "sim/scene.h"
@@ -41,8 +42,8 @@ void checkOptions(const SimOptions& o) {
     checkRange(r::kHashEvery, o.hashEvery);
     checkRange(r::kOutEvery, o.outEvery);
     checkRange(r::kThreads, o.threads);
-    if (o.format != "vdb" && o.format != "png" && o.format != "both")
-        throw InputError("--format must be vdb, png or both (got '" + o.format + "')");
+    if (o.format != "vdb" && o.format != "png" && o.format != "tif" && o.format != "both")
+        throw InputError("--format must be vdb, png, tif or both (got '" + o.format + "')");
     if (o.size) checkRange(scene_ranges::kSize, *o.size, "--size");
     if (o.seed) checkRange(scene_ranges::kSeed, *o.seed, "--seed");
     if (o.dt) checkRange(widened(scene_ranges::kDt), *o.dt, "--dt");
@@ -66,7 +67,10 @@ void checkDiverged(const TerrainState& s) {
     }
 }
 
-void writeFrame(const std::string& dir, const TerrainState& s, const std::string& format, float zScale, float zOffset) {
+// A .tif frame is float32 heights in metres, carrying the place and CRS of a
+// GeoTIFF DEM the scene started from.
+void writeFrame(const std::string& dir, const Simulation& sim, const std::string& format, float zScale, float zOffset) {
+    const TerrainState& s = sim.state();
     checkDiverged(s);
     char name[64];
     std::snprintf(name, sizeof name, "frame_%06lld", static_cast<long long>(s.tick));
@@ -76,6 +80,11 @@ void writeFrame(const std::string& dir, const TerrainState& s, const std::string
         Grid h;
         s.groundHeight(h);
         writePngHeightmap(base.string() + ".png", h, zScale, zOffset);
+    }
+    if (format == "tif") {
+        Grid h;
+        s.groundHeight(h);
+        writeGeoTiff(base.string() + ".tif", std::span<const Grid>(&h, 1), sim.geoReference());
     }
 }
 
@@ -115,7 +124,7 @@ int runSim(const SimOptions& o) {
         float zScale = 1.0f, zOffset = 0.0f;
         pngRange(s, zScale, zOffset);
         const std::int64_t outEvery = o.outEvery > 0 ? o.outEvery : (o.hashEvery > 0 ? o.hashEvery : o.ticks);
-        if (!o.out.empty()) writeFrame(o.out, s, o.format, zScale, zOffset);
+        if (!o.out.empty()) writeFrame(o.out, sim, o.format, zScale, zOffset);
         Progress progress("sim", o.ticks, !o.quiet);
         for (std::int64_t t = 1; t <= o.ticks; ++t) {
             sim.tick();
@@ -125,7 +134,7 @@ int runSim(const SimOptions& o) {
                 std::printf("tick %lld hash %s\n", static_cast<long long>(t), hashHex(hashState(s)).c_str());
                 std::fflush(stdout);
             }
-            if (!o.out.empty() && outEvery > 0 && t % outEvery == 0) writeFrame(o.out, s, o.format, zScale, zOffset);
+            if (!o.out.empty() && outEvery > 0 && t % outEvery == 0) writeFrame(o.out, sim, o.format, zScale, zOffset);
             progress.update(t);
         }
         progress.finish();
@@ -152,7 +161,9 @@ Runner addSimCommand(CLI::App& app) {
     sub->add_option("--hash-every", opt->hashEvery, describe(r::kHashEvery))->capture_default_str();
     sub->add_option("--out", opt->out, "Write frames to this folder (created if missing)");
     sub->add_option("--out-every", opt->outEvery, describe(r::kOutEvery));
-    sub->add_option("--format", opt->format, "Frame format: vdb (all layers), png (16-bit height) or both")
+    sub->add_option(
+           "--format", opt->format,
+           "Frame format: vdb (all layers), png (16-bit height), tif (float32 height GeoTIFF) or both (vdb and png)")
         ->capture_default_str();
     sub->add_option("--dt", opt->dt, describe(sr::kDt) + " (default: the scene file's, else 0)");
     sub->add_flag("--quiet", opt->quiet, "No progress or summary");

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/geotiff_io.h"
 #include "core/image_io.h"
 #include "core/png_io.h"
 
@@ -58,39 +59,47 @@ std::string extensionOf(const std::string& f) {
     return e;
 }
 
-void writeShade(const std::string& file, const std::array<Grid, 3>& rgb, float exposure) {
+void writeShade(const std::string& file, const std::array<Grid, 3>& rgb, float exposure, const GeoReference& geo) {
     const std::string ext = extensionOf(file);
     if (ext == ".exr") {
         writeExr(file, {&rgb[0], &rgb[1], &rgb[2]});
         return;
     }
-    if (ext != ".png") throw InputError("--out-shade must end in .png or .exr (got '" + file + "')");
+    if (isGeoTiffPath(file)) {
+        writeGeoTiff(file, rgb, geo);
+        return;
+    }
+    if (ext != ".png") throw InputError("--out-shade must end in .png, .exr or .tif (got '" + file + "')");
     std::vector<std::uint8_t> px(rgb[0].size() * 3);
     for (std::size_t i = 0; i < rgb[0].size(); ++i)
         for (std::size_t c = 0; c < 3; ++c) px[i * 3 + c] = srgbByte(exposure * rgb[c].v[i]);
     writePngRgb(file, rgb[0].nx, rgb[0].ny, px, 3);
 }
 
-void writeAmbient(const std::string& file, const Grid& ambient) {
+void writeAmbient(const std::string& file, const Grid& ambient, const GeoReference& geo) {
     const std::string ext = extensionOf(file);
     if (ext == ".npy")
         writeNpy(file, ambient);
     else if (ext == ".exr")
         writeExr(file, {&ambient});
+    else if (isGeoTiffPath(file))
+        writeGeoTiff(file, std::span<const Grid>(&ambient, 1), geo);
     else
-        throw InputError("--out-ambient must end in .npy or .exr (got '" + file + "')");
+        throw InputError("--out-ambient must end in .npy, .exr or .tif (got '" + file + "')");
 }
 
-void writeIndirect(const std::string& file, const std::array<Grid, 3>& rgb) {
+void writeIndirect(const std::string& file, const std::array<Grid, 3>& rgb, const GeoReference& geo) {
     const std::string ext = extensionOf(file);
-    if (ext == ".npy")
+    if (isGeoTiffPath(file))
+        writeGeoTiff(file, rgb, geo);
+    else if (ext == ".npy")
         writeNpyRgb(file, rgb);
     else if (ext == ".exr")
         writeExr(file, {&rgb[0], &rgb[1], &rgb[2]});
     else if (ext == ".png")
         writeFalseColour(file, rgb);
     else
-        throw InputError("--out-indirect must end in .npy, .exr or .png (got '" + file + "')");
+        throw InputError("--out-indirect must end in .npy, .exr, .png or .tif (got '" + file + "')");
 }
 
 }  // namespace terrain::app

@@ -1,10 +1,13 @@
 #pragma once
 // The images `terrain gi` writes: the shade map (.png sRGB after an
-// exposure, or .exr linear), the ambient map (.npy or .exr) and the indirect
-// light alone (.npy, .exr, or .png in false colour).
+// exposure, or .exr / .tif linear), the ambient map (.npy, .exr or .tif) and
+// the indirect light alone (.npy, .exr, .tif, or .png in false colour). A
+// .tif is a float32 GeoTIFF carrying `geo` (the input's place and CRS when
+// the heightmap was a GeoTIFF), so it overlays the input in a GIS.
 #include <array>
 #include <string>
 
+#include "core/geotiff_io.h"
 #include "core/grid.h"
 
 namespace terrain::app {
@@ -12,16 +15,18 @@ namespace terrain::app {
 /// Lower-case extension with its dot ("" when none).
 std::string extensionOf(const std::string& file);
 
-/// RGB shade: .exr as is; .png times `exposure`, clamped, sRGB-encoded.
-void writeShade(const std::string& file, const std::array<Grid, 3>& rgb, float exposure);
+/// RGB shade: .exr and .tif (three bands) as is; .png times `exposure`,
+/// clamped, sRGB-encoded.
+void writeShade(const std::string& file, const std::array<Grid, 3>& rgb, float exposure, const GeoReference& geo);
 
-/// The ambient map: .npy or .exr.
-void writeAmbient(const std::string& file, const Grid& ambient);
+/// The ambient map: .npy, .exr or .tif (one band).
+void writeAmbient(const std::string& file, const Grid& ambient, const GeoReference& geo);
 
-/// The indirect light: .npy (rows, columns, 3) or .exr as is; .png as a
+/// The indirect light: .npy (rows, columns, 3), .exr or .tif (three bands)
+/// as is; .png as a
 /// false-colour map of its luminance from 0 (black) to its 99th percentile
 /// (white), through blue, magenta, orange and yellow, so that small
 /// differences of a dim light show.
-void writeIndirect(const std::string& file, const std::array<Grid, 3>& rgb);
+void writeIndirect(const std::string& file, const std::array<Grid, 3>& rgb, const GeoReference& geo);
 
 }  // namespace terrain::app

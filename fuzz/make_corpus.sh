@@ -10,7 +10,7 @@ T=$(realpath "$1")
 cd "$(dirname "$0")"
 C=corpus
 rm -rf "$C"
-mkdir -p "$C"/{albedo_png,equirect_exr,equirect_hdr,exponent_png,number_list,png_heightmap,scene_toml,vdb}
+mkdir -p "$C"/{albedo_png,equirect_exr,equirect_hdr,exponent_png,geotiff,number_list,png_heightmap,scene_toml,vdb}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
@@ -34,6 +34,17 @@ hm=(--heightmap "$C/png_heightmap/erosion-16x16.png" --cell-size 10 --z-scale 0.
 cp "$tmp/shade.png" "$C/albedo_png/shade-16x16.png"
 cp "$tmp/shade.exr" "$C/equirect_exr/shade-rgb.exr"
 cp "$tmp/ambient.exr" "$C/equirect_exr/ambient-y.exr"
+
+# GeoTIFF: int16 DEMs written by hand (tests/hand_geotiff.sh), one with
+# nodata cells and one in degrees (the CRS error path), and what the engine
+# writes from them: a DEFLATE-compressed, tiled float32 ambient map and RGB
+# shade carrying the DEM's georeferencing
+source ../tests/hand_geotiff.sh
+hand_geotiff "$C/geotiff/dem-int16-12x10.tif" 12 10 utm32n
+hand_geotiff "$C/geotiff/nodata-int16-8x8.tif" 8 8 utm32n -9999
+hand_geotiff "$C/geotiff/wgs84-int16-4x4.tif" 4 4 wgs84
+"$T" gi --heightmap "$C/geotiff/dem-int16-12x10.tif" --out-ambient "$C/geotiff/ambient-float32-12x10.tif" \
+  --out-shade "$C/geotiff/shade-rgb-12x10.tif" >/dev/null
 
 # Radiance RGBE: 2 x 4 flat pixels, and 16 x 2 run-length encoded scanlines
 # (per channel: a run of 16 equal bytes, or 16 literal bytes)

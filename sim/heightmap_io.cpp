@@ -1,4 +1,4 @@
-// Heightmaps by file extension: greyscale PNG or OpenVDB.
+// Heightmaps by file extension: greyscale PNG, GeoTIFF or OpenVDB.
 #include "sim/heightmap_io.h"
 
 #include <algorithm>
@@ -34,19 +34,31 @@ Grid readVdbHeights(const std::string& file, float* cellSizeOut) {
     return g;
 }
 
+Grid readGeoTiff(const std::string& file, float* cellSizeOut, GeoReference* geoOut) {
+    GeoTiffHeights tiff = readGeoTiffHeights(file);
+    if (tiff.nodataFilled > 0)
+        std::fprintf(stderr, "terrain: warning: %s: %lld nodata cells filled with the nearest valid height\n",
+                     file.c_str(), static_cast<long long>(tiff.nodataFilled));
+    if (cellSizeOut) *cellSizeOut = static_cast<float>(tiff.cellSize);
+    if (geoOut) *geoOut = tiff.geo;
+    return std::move(tiff.heights);
+}
+
 }  // namespace
 
-Grid readHeightmap(const std::string& file, float zScale, float zOffset, float* cellSizeOut) {
+Grid readHeightmap(const std::string& file, float zScale, float zOffset, float* cellSizeOut, GeoReference* geoOut) {
     const std::string ext = std::filesystem::path(file).extension().string();
     std::string lower = ext;
     std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
     Grid g;
     if (lower == ".png")
         g = readPng(file, zScale, zOffset);
+    else if (lower == ".tif" || lower == ".tiff")
+        g = readGeoTiff(file, cellSizeOut, geoOut);
     else if (lower == ".vdb")
         g = readVdbHeights(file, cellSizeOut);
     else
-        throw IoError(file, "unknown heightmap format '" + ext + "' (use .png or .vdb)");
+        throw IoError(file, "unknown heightmap format '" + ext + "' (use .png, .tif or .vdb)");
     if (g.nx < kMinHeightmapSide || g.ny < kMinHeightmapSide)
         throw IoError(file, "heightmap of " + std::to_string(g.nx) + " x " + std::to_string(g.ny) +
                                 " cells; a heightmap needs at least " + std::to_string(kMinHeightmapSide) + " x " +

@@ -155,7 +155,7 @@ SceneSettings resolveScene(const std::string& nameOrFile, int size, std::uint64_
     return resolveScene(nameOrFile, SceneOverrides{.size = size, .seed = seed});
 }
 
-void buildInitialTerrain(const SceneSettings& s, TerrainState& state) {
+void buildInitialTerrain(const SceneSettings& s, TerrainState& state, GeoReference* geoOut) {
     LayerSet layers;
     layers.water = s.hydraulic || s.waves || s.hasWaterLevel;
     layers.sediment = s.hydraulic;
@@ -173,8 +173,10 @@ void buildInitialTerrain(const SceneSettings& s, TerrainState& state) {
             break;
         case TerrainSource::Kind::Dem: {
             float fileCell = s.terrain.demCellSize;
+            // a cell_size in [terrain] overrides the file's own (a .tif's geotransform, a .vdb's voxels)
+            GeoReference geo;
             Grid dem = readHeightmap(s.terrain.demFile, s.terrain.demZScale, s.terrain.demZOffset,
-                                     fileCell > 0.0f ? nullptr : &fileCell);
+                                     fileCell > 0.0f ? nullptr : &fileCell, &geo);
             if (!(fileCell > 0.0f))
                 throw InputError("DEM " + s.terrain.demFile + " needs a cell size (set cell_size in [terrain])");
             if (s.terrain.demResample && (dem.nx != nx || dem.ny != ny)) {
@@ -187,6 +189,7 @@ void buildInitialTerrain(const SceneSettings& s, TerrainState& state) {
                 ny = ground.ny;
                 cellSize = fileCell;
             }
+            if (geoOut && geo.georeferenced()) *geoOut = geo.withCellSize(cellSize);
             break;
         }
     }
@@ -209,7 +212,7 @@ void buildInitialTerrain(const SceneSettings& s, TerrainState& state) {
 Simulation::Simulation(const SceneSettings& settings) : settings_(settings) {
     checkRange(scene_ranges::kChangeTile, settings_.changeTile, "change-tracking tile size");
     checkRange(scene_ranges::kDt, settings_.dt, "time step");
-    buildInitialTerrain(settings_, state_);
+    buildInitialTerrain(settings_, state_, &geo_);
     settings_.nx = state_.nx;
     settings_.ny = state_.ny;
     settings_.cellSize = state_.cellSize;

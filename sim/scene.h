@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "core/geotiff_io.h"
 #include "sim/generators.h"
 #include "sim/hydraulic.h"
 #include "sim/materials.h"
@@ -123,6 +124,8 @@ public:
     TerrainState& state() { return state_; }
     const SceneSettings& settings() const { return settings_; }
     const ChangeReport& changes() const { return changes_; }
+    /// Where the terrain lies when it came from a GeoTIFF DEM (else unreferenced).
+    const GeoReference& geoReference() const { return geo_; }
     float dt() const { return dt_; }
     /// The CFL-derived limit at start, and whether the requested dt was clamped to it.
     float dtLimit() const { return dtLimit_; }
@@ -136,6 +139,7 @@ private:
 
     SceneSettings settings_;
     TerrainState state_;
+    GeoReference geo_;
     HydraulicScratch hydraulicScratch_;
     ThermalScratch thermalScratch_;
     WaveScratch waveScratch_;
@@ -148,7 +152,10 @@ private:
     int lastSubsteps_ = 1;
 };
 
-/// Builds the initial ground for a scene (exposed for tests and tools).
-void buildInitialTerrain(const SceneSettings& s, TerrainState& state);
+/// Builds the initial ground for a scene (exposed for tests and tools). A
+/// DEM read from a GeoTIFF gives its place and CRS through geoOut (its
+/// pixel size the scene's cell size, after any resampling); any other
+/// terrain leaves geoOut unreferenced.
+void buildInitialTerrain(const SceneSettings& s, TerrainState& state, GeoReference* geoOut = nullptr);
 
 }  // namespace terrain

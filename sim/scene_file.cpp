@@ -39,6 +39,7 @@
 #include <toml++/toml.h>
 
 #include "core/error.h"
+#include "core/geotiff_io.h"
 #include "sim/scene.h"
 #include "sim/scene_ranges.h"
 
@@ -289,6 +290,9 @@ void readTerrain(TableReader& r, SceneSettings& s) {
     std::string file;
     r.text("file", file);
     if (!file.empty()) s.terrain.demFile = besideFile(r.file(), file);
+    // a GeoTIFF knows its cell size: a base scene's (the Mont Blanc PNG's)
+    // gives way to it unless this table sets cell_size too
+    if (!file.empty() && isGeoTiffPath(file)) s.terrain.demCellSize = 0.0f;
     r.num("z_scale", s.terrain.demZScale, ranges::kDemZScale);
     r.num("z_offset", s.terrain.demZOffset, ranges::kAltitude);
     r.num("cell_size", s.terrain.demCellSize, ranges::kDemCellSize);

@@ -196,7 +196,7 @@ expect_short_error "damaged VDB heightmap" "mutant.vdb" "$T" gi --heightmap "$tm
 expect_short_error "empty heightmap file" "empty.png: not a PNG file" "$T" gi --heightmap "$tmp/empty.png" --cell-size 10
 echo "1 2 3" >"$tmp/heights.txt"
 expect_short_error "heightmap of another format" "unknown heightmap format '.txt'" "$T" gi --heightmap "$tmp/heights.txt" --cell-size 10
-expect_short_error "output onto a device" "must end in .npy or .exr" "$T" gi --heightmap "$hm24" --cell-size 10 --out-ambient /dev/full
+expect_short_error "output onto a device" "must end in .npy, .exr or .tif" "$T" gi --heightmap "$hm24" --cell-size 10 --out-ambient /dev/full
 # a 68-byte PNG declaring 60000 x 60000 pixels; a 1 x 1 PNG; an 8-bit grey PNG
 echo 'iVBORw0KGgoAAAANSUhEUgAA6mAAAOpgEAAAAAD1KfbdAAAAC0lEQVR4nGNggAAAAAgAAbdYc5UAAAAASUVORK5CYII=' | base64 -d >"$tmp/huge.png"
 expect_short_error "PNG declaring 60000 x 60000" "60000 x 60000 pixels" "$T" gi --heightmap "$tmp/huge.png" --cell-size 10
@@ -223,6 +223,43 @@ for fmt in vdb png; do
   else bad "full disk ($fmt): rc=$rc $(cat "$tmp/e")"; fi
 done
 diff -r "$tmp/full_before" "$tmp/full" >/dev/null && ok || bad "a failed write changed the frames or left files behind"
+
+# GeoTIFF: heights and cell size from the file, outputs that carry its place
+source "$SRC/tests/hand_geotiff.sh"
+hand_geotiff "$tmp/dem.tif" 24 20 utm32n
+hand_geotiff "$tmp/holes.tif" 24 20 utm32n -9999
+hand_geotiff "$tmp/wgs84.tif" 24 20 wgs84
+"$T" gi --heightmap "$tmp/dem.tif" --out-ambient "$tmp/dem_ambient.tif" --out-shade "$tmp/dem_shade.tif" >"$tmp/o" 2>"$tmp/e" \
+  && grep -q "24 x 20 cells of 30 m" "$tmp/o" && [ ! -s "$tmp/e" ] && ok || bad "gi on a GeoTIFF: $(cat "$tmp/o" "$tmp/e")"
+# an output read back as a heightmap: still georeferenced, same size and cell
+"$T" gi --heightmap "$tmp/dem_ambient.tif" --out-ambient "$tmp/again.npy" 2>&1 | grep -q "24 x 20 cells of 30 m" \
+  && ok || bad "a GeoTIFF output keeps the input's georeferencing"
+# --cell-size overrides the file's own
+"$T" gi --heightmap "$tmp/dem.tif" --cell-size 12 --out-ambient "$tmp/dem12.npy" 2>&1 | grep -q "cells of 12 m" \
+  && ok || bad "--cell-size over a GeoTIFF"
+"$T" gi --heightmap "$tmp/holes.tif" --out-ambient "$tmp/holes.npy" >/dev/null 2>"$tmp/e" \
+  && [ "$(grep -c 'warning: .*holes.tif: 20 nodata cells filled with the nearest valid height' "$tmp/e")" = 1 ] \
+  && ok || bad "GeoTIFF nodata: $(cat "$tmp/e")"
+expect_error "--z-scale with a GeoTIFF" "z-scale and --z-offset apply to PNG" "$T" gi --heightmap "$tmp/dem.tif" --z-scale 2
+expect_error "GeoTIFF in degrees" "wgs84.tif: has a geographic CRS in degrees.*gdalwarp" "$T" gi --heightmap "$tmp/wgs84.tif"
+head -c 300 "$tmp/dem.tif" >"$tmp/cut.tif"
+expect_error "truncated GeoTIFF" "cut.tif: " "$T" gi --heightmap "$tmp/cut.tif"
+printf 'II*\x00garbage' >"$tmp/garbage.tif"
+expect_error "garbage GeoTIFF" "garbage.tif: not a readable GeoTIFF" "$T" gi --heightmap "$tmp/garbage.tif"
+# a scene from the GeoTIFF: its cell size, and frames that overlay it
+printf 'base = "dem"\n[terrain]\nfile = "dem.tif"\nresample = false\n' >"$tmp/dem.toml"
+"$T" sim --scene "$tmp/dem.toml" --ticks 1 --out "$tmp/demframes" --format tif >"$tmp/o" 2>&1 \
+  && grep -q "24 x 20 cells of 30 m" "$tmp/o" && ok || bad "sim on a GeoTIFF scene: $(cat "$tmp/o")"
+"$T" gi --heightmap "$tmp/demframes/frame_000001.tif" --out-ambient "$tmp/f.npy" 2>&1 | grep -q "24 x 20 cells of 30 m" \
+  && ok || bad "sim's GeoTIFF frames keep the DEM's georeferencing"
+# a failed GeoTIFF write keeps the earlier file, and leaves no temporary
+cp "$tmp/dem_ambient.tif" "$tmp/dem_ambient_before.tif"
+(trap '' XFSZ; ulimit -f 1; "$T" gi --heightmap "$tmp/dem.tif" --out-ambient "$tmp/dem_ambient.tif" --light sunsky) \
+  >/dev/null 2>"$tmp/e"
+rc=$?
+[ $rc = 1 ] && [ "$(wc -l <"$tmp/e")" = 1 ] && grep -q "dem_ambient.tif: " "$tmp/e" && ok || bad "full disk (tif): rc=$rc $(cat "$tmp/e")"
+cmp -s "$tmp/dem_ambient.tif" "$tmp/dem_ambient_before.tif" && ok || bad "a failed GeoTIFF write changed the file"
+ls "$tmp" | grep -q 'dem_ambient.tif.*tmp\|tmp.*dem_ambient' && bad "GeoTIFF temporary left behind" || ok
 
 echo "cli: $pass passed, $fail failed"
 [ $fail -eq 0 ]
