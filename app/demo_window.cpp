@@ -204,7 +204,12 @@ int runWindowDemo(WindowContext& window, const Gl& gl, const WindowDemoSetup& se
     double fpsAvg = 0.0;
     auto last = Clock::now();
     while (!window.shouldClose() && (setup.maxFrames <= 0 || frames < setup.maxFrames)) {
-        window.pollEvents();
+        // Paused, a frame changes only with input: wait for it (a 60 Hz redraw
+        // at most), rather than redraw as fast as a display without vsync lets.
+        if (paused)
+            window.waitEvents(1.0 / 60.0);
+        else
+            window.pollEvents();
         ImGui_ImplOpenGL3_NewFrame();
         ImGui_ImplGlfw_NewFrame();
         ImGui::NewFrame();

@@ -7,6 +7,9 @@
 #include "core/error.h"
 
 int main(int argc, char** argv) {
+    // Progress and status lines reach a log or a pipe as they happen, not
+    // when a buffer fills (a script that watches the demo's log acts on them).
+    std::setvbuf(stdout, nullptr, _IOLBF, 0);
     CLI::App app{"terrain: a dynamic terrain engine (erosion, waves, global illumination on height fields)"};
     app.require_subcommand(1);
     app.set_help_all_flag("--help-all", "Print help for every subcommand");

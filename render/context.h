@@ -39,6 +39,8 @@ public:
     virtual bool shouldClose() const = 0;
     virtual void swapBuffers() = 0;
     virtual void pollEvents() = 0;
+    /// Waits for input for at most `seconds`, then handles it like pollEvents.
+    virtual void waitEvents(double seconds) = 0;
     virtual void framebufferSize(int& w, int& h) const = 0;
     /// The GLFWwindow*, for input callbacks and ImGui.
     virtual void* nativeHandle() const = 0;

@@ -46,6 +46,7 @@ public:
     bool shouldClose() const override { return glfwWindowShouldClose(window_); }
     void swapBuffers() override { glfwSwapBuffers(window_); }
     void pollEvents() override { glfwPollEvents(); }
+    void waitEvents(double seconds) override { glfwWaitEventsTimeout(seconds); }
     void framebufferSize(int& w, int& h) const override { glfwGetFramebufferSize(window_, &w, &h); }
     void* nativeHandle() const override { return window_; }
 
