@@ -155,7 +155,9 @@ struct CastingRow {
         }
     }
 
-    // Step i (iv) for the group at X0; false once the group is done.
+    // Step i (iv) for the group at X0; false once the group is done: no lane
+    // has a step i + 1 in its prefix (step i + 1's samples may lie outside the
+    // field then, past its padding), or none can gain a member.
     [[gnu::always_inline]] bool stepGroup(const StepTaps<V>& tp, I iv, V hMax, int X0) {
         I stp;
         std::memcpy(&stp, steps + X0, sizeof stp);
@@ -168,13 +170,13 @@ struct CastingRow {
             // past the point where even the field's highest height would not
             // beat any lane's running maximum, no new member can come: the
             // group is done (lanes whose ray has left the domain are done too)
-            const I done = (iv >= stp) | (m >= (hMax - h0) * tp.inv);
+            const I done = (iv + 1 >= stp) | (m >= (hMax - h0) * tp.inv);
             return laneBits(~done) != 0;
         }
         m = nw ? t : m;
         store(M + X0, m);
         addSegments(tp, nw, t, X0);
-        return true;
+        return laneBits(iv + 1 < stp) != 0;
     }
 
     // The walk: steps in order, the groups still walking at each.
