@@ -100,6 +100,19 @@ bool sameBits(const Grid& a, const Grid& b) {
     return a.nx == b.nx && a.ny == b.ny && std::memcmp(a.v.data(), b.v.data(), a.v.size() * sizeof(float)) == 0;
 }
 
+// The GeoTIFF at `tif` reads as the same heights and cell size as the PNG's
+// field, and a GI frame lights both bit for bit alike.
+void requireLitAlike(const std::string& tif, const Grid& fromPng, double cell) {
+    float tifCell = 0.0f;
+    const Grid fromTif = readHeightmap(tif, 1.0f, 0.0f, &tifCell);
+    REQUIRE(sameBits(fromTif, fromPng));
+    REQUIRE(tifCell == static_cast<float>(cell));
+    gi::GiState a, b;
+    gi::runGiFrame(fromPng.cview(), static_cast<float>(cell), gi::GiLighting{}, gi::GiSettings{}, a);
+    gi::runGiFrame(fromTif.cview(), tifCell, gi::GiLighting{}, gi::GiSettings{}, b);
+    CHECK(sameBits(a.shade.ambient, b.shade.ambient));
+}
+
 }  // namespace
 
 TEST_CASE("geotiff: every integer and float type reads as its heights, cell size and place") {
@@ -232,14 +245,7 @@ TEST_CASE("geotiff: the same heights light the same as the PNG given the GeoTIFF
     spec.transform = {300000.0, cell, 0.0, 5100000.0, 0.0, -cell};
     const std::string tif = (dir / "dem.tif").string();
     makeTiff(tif, nx, ny, heights, spec);
-    float tifCell = 0.0f;
-    const Grid fromTif = readHeightmap(tif, 1.0f, 0.0f, &tifCell);
-    REQUIRE(sameBits(fromTif, fromPng));
-    REQUIRE(tifCell == static_cast<float>(cell));
-    gi::GiState a, b;
-    gi::runGiFrame(fromPng.cview(), static_cast<float>(cell), gi::GiLighting{}, gi::GiSettings{}, a);
-    gi::runGiFrame(fromTif.cview(), tifCell, gi::GiLighting{}, gi::GiSettings{}, b);
-    CHECK(sameBits(a.shade.ambient, b.shade.ambient));
+    requireLitAlike(tif, fromPng, cell);
 }
 
 TEST_CASE("geotiff: the Mont Blanc DEM as a GeoTIFF lights the same as its PNG (when the data are here)") {
@@ -257,14 +263,7 @@ TEST_CASE("geotiff: the Mont Blanc DEM as a GeoTIFF lights the same as its PNG (
     const auto dir = test::scratchDir("geotiff_montblanc");
     const std::string tif = (dir / "montblanc.tif").string();
     writeGeoTiff(tif, std::span<const Grid>(&fromPng, 1), geo);
-    float tifCell = 0.0f;
-    const Grid fromTif = readHeightmap(tif, 1.0f, 0.0f, &tifCell);
-    REQUIRE(sameBits(fromTif, fromPng));
-    REQUIRE(tifCell == static_cast<float>(cell));
-    gi::GiState a, b;
-    gi::runGiFrame(fromPng.cview(), static_cast<float>(cell), gi::GiLighting{}, gi::GiSettings{}, a);
-    gi::runGiFrame(fromTif.cview(), tifCell, gi::GiLighting{}, gi::GiSettings{}, b);
-    CHECK(sameBits(a.shade.ambient, b.shade.ambient));
+    requireLitAlike(tif, fromPng, cell);
 }
 
 TEST_CASE("geotiff: a scene's DEM takes the file's cell size, and its frames its place") {
