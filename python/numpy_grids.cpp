@@ -29,10 +29,10 @@ void checkSides(const py::array& a, const std::string& what, int minSide) {
 
 py::array readOnlyView(const Grid& g, py::handle owner) {
     const py::ssize_t row = static_cast<py::ssize_t>(g.nx) * static_cast<py::ssize_t>(sizeof(float));
-    // pybind11 takes a non-const pointer; the array is marked read-only below
+    // pybind11 takes a non-const pointer; the array is made read-only at once
     py::array view(py::dtype::of<float>(), {static_cast<py::ssize_t>(g.ny), static_cast<py::ssize_t>(g.nx)},
                    {row, static_cast<py::ssize_t>(sizeof(float))}, const_cast<float*>(g.data()), owner);
-    py::detail::array_proxy(view.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+    view.attr("flags").attr("writeable") = false;
     return view;
 }
 
@@ -69,14 +69,17 @@ Grid gridFromArray(const py::handle& object, const std::string& what, int minSid
     const py::array a = checkedFloat32(object, 2, what);
     checkSides(a, what, minSide);
     Grid g(static_cast<int>(a.shape(1)), static_cast<int>(a.shape(0)));
+    const bool cOrder = (a.flags() & py::array::c_style) != 0;
+    if (cOrder)
+        std::memcpy(g.data(), a.data(), g.size() * sizeof(float));
+    else
+        for (int y = 0; y < g.ny; ++y)
+            for (int x = 0; x < g.nx; ++x) g(x, y) = at(a, y, x);
     for (int y = 0; y < g.ny; ++y)
-        for (int x = 0; x < g.nx; ++x) {
-            const float v = at(a, y, x);
-            if (!std::isfinite(v))
-                throw py::value_error(what + ": value " + std::to_string(v) + " at row " + std::to_string(y) +
+        for (int x = 0; x < g.nx; ++x)
+            if (!std::isfinite(g(x, y)))
+                throw py::value_error(what + ": value " + std::to_string(g(x, y)) + " at row " + std::to_string(y) +
                                       ", column " + std::to_string(x) + " is not finite");
-            g(x, y) = v;
-        }
     return g;
 }
 

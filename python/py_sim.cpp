@@ -9,6 +9,7 @@
 
 #include <pybind11/stl.h>
 
+#include "app/option_ranges.h"
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/setting_range.h"
@@ -82,7 +83,7 @@ void checkDiverged(const TerrainState& s) {
 
 void tick(Simulation& sim, std::int64_t n, int threads) {
     if (n < 0) throw py::value_error("tick(n): n must be >= 0 (got " + std::to_string(n) + ")");
-    if (threads < 0) throw py::value_error("tick(): threads must be >= 0 (got " + std::to_string(threads) + ")");
+    checkRange(app::option_ranges::kThreads, threads, "threads");
     py::gil_scoped_release unlocked;  // the ticks run on TBB's threads and touch no Python object
     withThreads(threads, [&] {
         for (std::int64_t t = 0; t < n; ++t) sim.tick();

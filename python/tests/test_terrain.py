@@ -207,6 +207,9 @@ class ErrorsAreExceptions(unittest.TestCase):
             sim.layer("lava")
         with self.assertRaises(ValueError):
             sim.tick(-1)
+        with self.assertRaisesRegex(ValueError, "threads"):
+            sim.tick(1, threads=-1)
+        self.assertEqual(sim.tick_count, 0)
 
 
 if __name__ == "__main__":
