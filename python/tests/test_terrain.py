@@ -53,6 +53,14 @@ class SimulationMatchesCli(unittest.TestCase):
             sim.tick()
         self.assertEqual(sim.state_hash(), cli_hash("waves", 48, 6))
 
+    def test_scene_file_hash(self):
+        path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scenes", "pit-lake.toml")
+        sim = terrain.Simulation(terrain.load_scene(path, size=40, seed=3))
+        sim.tick(5)
+        out = cli("sim", "--scene", path, "--size", "40", "--seed", "3", "--ticks", "5", "--hash-every", "5",
+                  "--quiet")
+        self.assertIn(f"tick 5 hash {sim.state_hash()}", out)
+
     def test_scene_properties(self):
         scene = terrain.builtin_scene("erosion", size=32, seed=7)
         self.assertEqual((scene.name, scene.nx, scene.ny, scene.seed), ("erosion", 32, 32, 7))
