@@ -24,6 +24,7 @@ PACKAGES=(
   libopenvdb-dev libboost-dev libboost-iostreams-dev libtbb-dev libimath-dev libopenexr-dev libblosc-dev
   libgdal-dev
   doctest-dev libpng-dev libtomlplusplus-dev libcli11-dev libimgui-dev
+  python3-dev pybind11-dev python3-numpy
   xvfb xauth xdotool
   clang libclang-rt-14-dev
 )

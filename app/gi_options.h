@@ -1,0 +1,63 @@
+#pragma once
+// The options of `terrain gi` that say how a height field is lit and what is
+// written, shared by the command line and the Python module (python/): both
+// register the same CLI11 flags, check them the same way and build the
+// frame's settings from them with the same functions, so a frame run from
+// either is the same frame.
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "app/light_options.h"
+#include "gi/settings.h"
+
+namespace terrain::app {
+
+struct GiOptions {
+    std::string heightmap;  // the input's name (a file, or what the caller calls it) in messages
+    double cellSize = 0.0;
+    double zScale = 1.0;
+    double zOffset = 0.0;
+    LightOptions lights;  // over a uniform sky of radiance 1 and no key light
+    // The numeric settings bind straight into the engine's settings: their
+    // defaults and ranges are the engine's own (gi/settings.h).
+    gi::GiSettings settings = gi::GiSettings{};
+    std::string indirectKernel;
+    std::string interp;
+    int threads = 0;
+    bool reference = false;
+    bool progress = true;  // the reference's progress line on stderr (no flag: the Python module turns it off)
+    std::string outShade, outAmbient;
+    float exposure = 1.0f;  // of the .png shade map
+    int frames = 1;
+    bool time = false;
+    // indirect light
+    std::string brdf = "lambert";
+    std::string albedo;
+    std::string outIndirect;
+    int referenceDirections = 2048;
+    std::string glossy;         // vector | scalar (glossy indirect light)
+    std::string phongExponent;  // VALUE or a 16-bit PNG
+    std::string phongExponentRange = "1,1000";
+};
+
+/// Registers every flag of `terrain gi` but those naming the input
+/// (--heightmap, --cell-size, --z-scale, --z-offset) on `sub`, bound to `o`.
+void addGiOptions(CLI::App* sub, GiOptions& o);
+
+/// Everything about the options that can be wrong, before any input is
+/// read. Throws InputError naming the flag.
+void checkGiOptions(const GiOptions& o);
+
+/// Where the Phong exponent comes from: a constant (in the settings), or a
+/// 16-bit PNG mapped to [lo, hi].
+struct ExponentSource {
+    bool fromFile = false;
+    float lo = 1.0f, hi = 1000.0f;
+};
+
+/// The frame's settings from the options: the modes named by strings, then
+/// one range check of everything (gi/settings.h). Throws InputError.
+gi::GiSettings giSettingsFrom(const GiOptions& o, ExponentSource& exponent);
+
+}  // namespace terrain::app
