@@ -52,6 +52,7 @@ struct GiOptions {
     std::string brdf = "lambert";
     std::string albedo;
     std::string outIndirect;
+    std::string outExr;  // every map as channels of one float32 EXR
     int referenceDirections = 2048;
     std::string glossy;         // vector | scalar (glossy indirect light)
     std::string phongExponent;  // VALUE or a 16-bit PNG
@@ -180,9 +181,11 @@ void checkOutputs(const GiOptions& o) {
         throw InputError("--out-ambient must end in .npy, .exr or .tif (got '" + o.outAmbient + "')");
     if (!oneOf(o.outIndirect, {".npy", ".exr", ".png"}))
         throw InputError("--out-indirect must end in .npy, .exr, .png or .tif (got '" + o.outIndirect + "')");
+    if (!o.outExr.empty() && extensionOf(o.outExr) != ".exr")
+        throw InputError("--out-exr must end in .exr (got '" + o.outExr + "')");
     if (!o.outIndirect.empty() && o.settings.indirect.bounces == 0 && !o.reference)
         throw InputError("--out-indirect needs --bounces >= 1");
-    for (const std::string* out : {&o.outShade, &o.outAmbient, &o.outIndirect})
+    for (const std::string* out : {&o.outShade, &o.outAmbient, &o.outIndirect, &o.outExr})
         if (!out->empty()) checkWritableFile(*out);
 }
 
@@ -202,6 +205,9 @@ void checkOptions(const GiOptions& o) {
         throw InputError(
             "--z-scale and --z-offset apply to PNG heightmaps; a GeoTIFF's heights are used as stored, "
             "in metres");
+    if (extensionOf(o.heightmap) == ".exr" && (o.zScale != 1.0 || o.zOffset != 0.0))
+        throw InputError(
+            "--z-scale and --z-offset apply to PNG heightmaps; an EXR's heights are used as stored, in metres");
     checkGiFlags(o.settings);
     checkLightOptions(o.lights);
     checkOutputs(o);
@@ -229,7 +235,8 @@ GiInputs readInputs(const GiOptions& o, const ExponentSource& exponent) {
         readHeightmap(o.heightmap, static_cast<float>(o.zScale), static_cast<float>(o.zOffset), &cellFromFile, &in.geo);
     // --cell-size overrides the file's own (a .tif's geotransform, a .vdb's voxel size)
     in.cell = o.cellSize > 0.0 ? o.cellSize : cellFromFile;
-    if (!(in.cell > 0.0)) throw InputError("--cell-size is needed for a PNG heightmap (metres between grid points)");
+    if (!(in.cell > 0.0))
+        throw InputError("--cell-size is needed for a PNG or EXR heightmap (metres between grid points)");
     // the outputs keep the input's origin; an overriding --cell-size rescales their pixels
     if (in.geo.georeferenced() && o.cellSize > 0.0) in.geo = in.geo.withCellSize(o.cellSize);
     checkRange(scene_ranges::kCellSize, static_cast<float>(in.cell), o.heightmap + ": cell size");
@@ -249,7 +256,8 @@ struct GiResults {
 
 // Every result is checked finite before any file is written: no NaN or Inf
 // leaves the command, and a failing run leaves earlier files as they were.
-void writeResults(const GiOptions& o, const GiResults& r, const GeoReference& geo) {
+void writeResults(const GiOptions& o, const GiInputs& in, const GiResults& r) {
+    const GeoReference& geo = in.geo;
     try {
         for (const Grid& g : *r.shade) requireFinite(g, "the shade map");
         requireFinite(*r.ambient, "the ambient map");
@@ -261,6 +269,8 @@ void writeResults(const GiOptions& o, const GiResults& r, const GeoReference& ge
     if (!o.outShade.empty()) writeShade(o.outShade, *r.shade, o.exposure, geo);
     if (!o.outAmbient.empty()) writeAmbient(o.outAmbient, *r.ambient, geo);
     if (!o.outIndirect.empty()) writeIndirect(o.outIndirect, *r.indirect, geo);
+    if (!o.outExr.empty())
+        writeGiExr(o.outExr, in.heights, static_cast<float>(in.cell), *r.shade, *r.ambient, r.indirect);
 }
 
 using Clock = std::chrono::steady_clock;
@@ -283,7 +293,7 @@ int runReference(const GiOptions& o, const gi::GiSettings& settings, const GiInp
         gi::renderReferenceGi(in.heights.cview(), static_cast<float>(in.cell), in.lighting.environment, in.albedo, gs,
                               gr);
         if (o.time) std::printf("reference: %.1f ms\n", msSince(t0));
-        writeResults(o, {&gr.total, &gr.ambient, &gr.indirect}, in.geo);
+        writeResults(o, in, {&gr.total, &gr.ambient, &gr.indirect});
         return 0;
     }
     gi::ReferenceSettings rs;
@@ -291,7 +301,7 @@ int runReference(const GiOptions& o, const gi::GiSettings& settings, const GiInp
     gi::ReferenceResult rr;
     gi::renderReference(in.heights.cview(), static_cast<float>(in.cell), &in.lighting.environment, in.albedo, rs, rr);
     if (o.time) std::printf("reference: %.1f ms\n", msSince(t0));
-    writeResults(o, {&rr.rgb, &rr.ambient, nullptr}, in.geo);
+    writeResults(o, in, {&rr.rgb, &rr.ambient, nullptr});
     return 0;
 }
 
@@ -324,10 +334,9 @@ int runFastPath(const GiOptions& o, const gi::GiSettings& settings, const GiInpu
         std::sort(totals.begin(), totals.end());
         std::printf("%.2f ms per frame\n", totals[totals.size() / 2]);
     }
-    writeResults(o,
+    writeResults(o, in,
                  {bounces > 0 ? &state.indirect.total : &state.shade.rgb, &state.shade.ambient,
-                  bounces > 0 ? &state.indirect.indirect : nullptr},
-                 in.geo);
+                  bounces > 0 ? &state.indirect.indirect : nullptr});
     return 0;
 }
 
@@ -350,7 +359,8 @@ Runner addGiCommand(CLI::App& app) {
     auto o = std::make_shared<GiOptions>();
     CLI::App* sub =
         app.add_subcommand("gi", "Global illumination of a height field: soft shadows from sky and key lights");
-    sub->add_option("--heightmap", o->heightmap, "16-bit PNG (height = O + S * value) or .vdb")->required();
+    sub->add_option("--heightmap", o->heightmap, "16-bit PNG (height = O + S * value), .tif, float .exr or .vdb")
+        ->required();
     namespace sr = scene_ranges;
     namespace opt = option_ranges;
     sub->add_option("--cell-size", o->cellSize, describe(sr::kDemCellSize) + " (required for PNG)");
@@ -374,6 +384,9 @@ Runner addGiCommand(CLI::App& app) {
     sub->add_option("--exposure", o->exposure, describe(opt::kExposure) + " (of the .png shade map, before sRGB)")
         ->capture_default_str();
     sub->add_option("--out-ambient", o->outAmbient, "Ambient (sky-view) map (.npy float32, .exr or .tif)");
+    sub->add_option("--out-exr", o->outExr,
+                    "Every map as float32 channels of one .exr: height, ambient, shade.R/G/B and, with bounces, "
+                    "indirect.R/G/B");
     sub->add_option("--frames", o->frames,
                     describe(opt::kFrames) + ": run the frame N times on the same field (first = warm-up)")
         ->capture_default_str();
