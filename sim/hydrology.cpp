@@ -1,6 +1,7 @@
 // Hydrology maps (definitions and units in sim/hydrology.h).
 #include "sim/hydrology.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 
@@ -31,6 +32,22 @@ void centreVelocity(const TerrainState& s, int x, int y, float& u, float& v) {
     v = (s.faceV(x, y) + s.faceV(x, y + 1)) * 0.5f;
 }
 
+// One row of the ground sums. Both heights are floats, so their difference
+// is exact in double and the sums telescope to the total change. Branch-free
+// so that the compiler vectorises it: the pass runs every tick.
+void addGroundChange(const float* bed, const float* soil, const float* before, double* erosion, double* deposition,
+                     int n) {
+    for (int x = 0; x < n; ++x) {
+        const double change = static_cast<double>(bed[x] + soil[x]) - static_cast<double>(before[x]);
+        erosion[x] += std::max(-change, 0.0);
+        deposition[x] += std::max(change, 0.0);
+    }
+}
+
+void countWet(const float* water, std::uint32_t* wetTicks, int n) {
+    for (int x = 0; x < n; ++x) wetTicks[x] += water[x] >= kWetDepth ? 1u : 0u;
+}
+
 }  // namespace
 
 void HydrologyAccumulator::start(const TerrainState& s, bool trackGround, bool trackWater) {
@@ -45,24 +62,17 @@ void HydrologyAccumulator::start(const TerrainState& s, bool trackGround, bool t
 
 void HydrologyAccumulator::accumulate(const TerrainState& s, const Grid& groundBefore) {
     ++ticks_;
-    if (!tracksGround() && !tracksWater()) return;
+    const bool ground = tracksGround(), water = tracksWater();
+    if (!ground && !water) return;
     const int nx = nx_;
     parallelForRows(ny_, nx, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y)
-            for (int x = 0; x < nx; ++x) {
-                const std::size_t i = cellIndex(x, y, nx);
-                if (tracksGround()) {
-                    // both heights are floats, so their difference is exact in
-                    // double and the sums telescope to the total change
-                    const double change =
-                        static_cast<double>(s.bedrock.v[i] + s.soil.v[i]) - static_cast<double>(groundBefore.v[i]);
-                    if (change < 0.0)
-                        erosion_[i] -= change;
-                    else
-                        deposition_[i] += change;
-                }
-                if (tracksWater() && s.water.v[i] >= kWetDepth) ++wetTicks_[i];
-            }
+        for (int y = y0; y < y1; ++y) {
+            const std::size_t row = cellIndex(0, y, nx);
+            if (ground)
+                addGroundChange(s.bedrock.data() + row, s.soil.data() + row, groundBefore.data() + row,
+                                erosion_.data() + row, deposition_.data() + row, nx);
+            if (water) countWet(s.water.data() + row, wetTicks_.data() + row, nx);
+        }
     });
 }
 

@@ -68,7 +68,7 @@ private:
     int nx_ = 0, ny_ = 0;
     std::int64_t ticks_ = 0;
     std::vector<double> erosion_, deposition_;
-    std::vector<std::int64_t> wetTicks_;
+    std::vector<std::uint32_t> wetTicks_;  // a run of 2^32 ticks would take years
 };
 
 /// Whether the state carries the water flow the per-frame maps need (the
