@@ -56,7 +56,8 @@ Grid readExrHeights(const std::string& file, float* cellSizeOut) {
         throw IoError(file, "EXR has no 'height' channel and more than one other (" + list +
                                 "); a heightmap EXR has a channel named height or a single channel");
     }
-    if (cellSizeOut && exr.cellSize > 0.0f) *cellSizeOut = exr.cellSize;
+    // a hostile attribute (NaN, Inf, negative) counts as none: the cell size is then given as for a PNG
+    if (cellSizeOut && std::isfinite(exr.cellSize) && exr.cellSize > 0.0f) *cellSizeOut = exr.cellSize;
     return std::move(exr.grids[0]);
 }
 

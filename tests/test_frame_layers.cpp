@@ -150,6 +150,11 @@ TEST_CASE("frame layers: a float EXR is a heightmap: its height channel, or its 
     cell = 0.0f;
     CHECK(sameBits(readHeightmap(single, 1.0f, 0.0f, &cell), h));
     CHECK(cell == 0.0f);  // no attribute: the cell size is given as for a PNG
+    const std::string infinite = (dir / "inf.exr").string();
+    writeExrChannels(infinite, {"height"}, {&h}, std::numeric_limits<float>::infinity());
+    cell = 0.0f;
+    CHECK(sameBits(readHeightmap(infinite, 1.0f, 0.0f, &cell), h));
+    CHECK(cell == 0.0f);  // an infinite cell size counts as none
     const std::string two = (dir / "two.exr").string();
     writeExrChannels(two, {"R", "G"}, {&h, &other});
     CHECK(readErrorOf(two).find("no 'height' channel and more than one other (G, R)") != std::string::npos);
