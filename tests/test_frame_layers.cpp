@@ -3,6 +3,7 @@
 // OpenVDB frame carries the new grids, and a float EXR reads as a heightmap.
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <limits>
@@ -176,4 +177,24 @@ TEST_CASE("frame layers: a truncated or damaged EXR heightmap gets one line nami
     const std::string empty = (dir / "empty.exr").string();
     test::writeBytes(empty, "");
     CHECK(readErrorOf(empty).find("empty.exr") != std::string::npos);
+}
+
+TEST_CASE("frame layers: an EXR declaring more pixels than its bytes can hold is refused before they are allocated") {
+    const auto dir = test::scratchDir("exr_declared");
+    Grid h(8, 8, 1.0f);
+    const std::string small = (dir / "small.exr").string();
+    writeExrChannels(small, {"height"}, {&h});
+    std::string bytes = test::readBytes(small);
+    // the data window's corners follow the attribute's name, type and size
+    const std::string attribute("dataWindow\0box2i\0", 17);
+    const std::size_t at = bytes.find(attribute);
+    REQUIRE(at != std::string::npos);
+    const std::int32_t corners[4] = {0, 0, 16383, 16383};
+    bytes.replace(at + attribute.size() + 4, sizeof corners, reinterpret_cast<const char*>(corners), sizeof corners);
+    bytes.append(9000, '\0');  // room for the offset table the header check asks of 16384 rows
+    const std::string big = (dir / "big.exr").string();
+    test::writeBytes(big, bytes);
+    const std::string error = readErrorOf(big);
+    CHECK(error.find("big.exr: 1 EXR channels of 16384 x 16384 pixels in") != std::string::npos);
+    CHECK(error.find("more than the file can hold") != std::string::npos);
 }
