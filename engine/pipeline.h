@@ -28,6 +28,9 @@ struct PipelineSettings {
     // all see the same surface); 0 = automatic: relief at least 15 % of the
     // extent (the waves bay is 512 m wide and 18 m deep).
     float verticalExaggeration = 0.0f;
+    // Pack the hydrology maps for the debug views (FrameData::hydrology);
+    // off by default: it costs a pass over the grid per tick drawn.
+    bool hydrologyMaps = false;
 };
 
 /// Milliseconds of one frame per stage.
