@@ -220,6 +220,7 @@ void FramePipeline::terrainReplaced() {
     autoExaggeration_ = std::clamp(0.15f * extent / (frame_.zMax - frame_.zMin), 1.0f, 10.0f);
     mapsTick_ = -1;
     heightsTick_ = -1;
+    hydrologyTick_ = -1;
 }
 
 void FramePipeline::setLights(const LightSet& lights) { rig_ = LightRig(lights, &rig_); }
@@ -299,8 +300,12 @@ void FramePipeline::light() {
     if (heightsTick_ != s.tick) {
         packHeights(s, f);
         f.heightsVersion = nextVersion();
-        if (settings_.hydrologyMaps) packHydrology(sim_, f);
         heightsTick_ = s.tick;
+    }
+    // also when the views were just asked for, on a paused scene
+    if (settings_.hydrologyMaps && hydrologyTick_ != s.tick) {
+        packHydrology(sim_, f);
+        hydrologyTick_ = s.tick;
     }
     if (newMaps) packAlbedo(maps_, f);
     const bool giUpdated = gi_.directUpdated || gi_.indirectUpdated;
