@@ -32,7 +32,7 @@ int runGi(const GiOptions& o) {
     std::printf("terrain gi: %s, %d x %d cells of %.4g m\n", o.heightmap.c_str(), in.heights.nx, in.heights.ny,
                 in.cell);
     std::fflush(stdout);
-    writeGiMaps(o, runGiFrames(o, settings, in), in.geo);
+    writeGiMaps(o, in, runGiFrames(o, settings, in));
     return 0;
 }
 
@@ -42,7 +42,8 @@ Runner addGiCommand(CLI::App& app) {
     auto o = std::make_shared<GiOptions>();
     CLI::App* sub =
         app.add_subcommand("gi", "Global illumination of a height field: soft shadows from sky and key lights");
-    sub->add_option("--heightmap", o->heightmap, "16-bit PNG (height = O + S * value) or .vdb")->required();
+    sub->add_option("--heightmap", o->heightmap, "16-bit PNG (height = O + S * value), .tif, float .exr or .vdb")
+        ->required();
     namespace sr = scene_ranges;
     sub->add_option("--cell-size", o->cellSize, describe(sr::kDemCellSize) + " (required for PNG)");
     sub->add_option("--z-scale", o->zScale, describe(sr::kDemZScale) + " (S)")->capture_default_str();

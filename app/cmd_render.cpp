@@ -152,7 +152,8 @@ void addRenderOptions(CLI::App* sub, RenderOptions& o, bool withSize) {
         ->capture_default_str();
     sub->add_option(
            "--debug", o.debug,
-           "Debug view: none | ambient | v | u (with --lighting global) | key | normals | pyramid | shade | albedo")
+           "Debug view: none | ambient | v | u (with --lighting global) | key | normals | pyramid | shade | albedo | "
+           "discharge | velocity | net-erosion | wetness (the hydrology maps, each over its largest value)")
         ->capture_default_str();
     sub->add_option("--pyramid-level", o.pyramidLevel, describe(r::kPyramidLevel))->capture_default_str();
     sub->add_option("--exposure", o.exposure, describe(r::kExposure))->capture_default_str();
@@ -206,13 +207,17 @@ render::ShadowMode shadowOf(const std::string& text) {
 render::DebugView debugOf(const std::string& text) {
     using render::DebugView;
     static const std::pair<const char*, DebugView> views[] = {
-        {"none", DebugView::None},         {"ambient", DebugView::Ambient}, {"v", DebugView::SkyVisibility},
-        {"key", DebugView::KeyVisibility}, {"normals", DebugView::Normals}, {"pyramid", DebugView::PyramidLevel},
-        {"shade", DebugView::ShadeMap},    {"albedo", DebugView::Albedo},   {"u", DebugView::IndirectRadiance}};
+        {"none", DebugView::None},           {"ambient", DebugView::Ambient},   {"v", DebugView::SkyVisibility},
+        {"key", DebugView::KeyVisibility},   {"normals", DebugView::Normals},   {"pyramid", DebugView::PyramidLevel},
+        {"shade", DebugView::ShadeMap},      {"albedo", DebugView::Albedo},     {"u", DebugView::IndirectRadiance},
+        {"discharge", DebugView::Discharge}, {"velocity", DebugView::Velocity}, {"net-erosion", DebugView::NetErosion},
+        {"wetness", DebugView::Wetness}};
     for (const auto& [name, view] : views)
         if (text == name) return view;
-    throw InputError("--debug must be none, ambient, v, u, key, normals, pyramid, shade or albedo (got '" + text +
-                     "')");
+    throw InputError(
+        "--debug must be none, ambient, v, u, key, normals, pyramid, shade, albedo, discharge, velocity, net-erosion "
+        "or wetness (got '" +
+        text + "')");
 }
 
 }  // namespace
@@ -232,6 +237,9 @@ void toSettings(const RenderOptions& o, engine::PipelineSettings& p, render::Ren
     p.lighting = lightingOf(o.lighting);
     r.shadow = shadowOf(o.shadow);
     r.debug = debugOf(o.debug);
+    // the hydrology maps are packed only for their views (a pass per tick drawn)
+    p.hydrologyMaps = r.debug == render::DebugView::Discharge || r.debug == render::DebugView::Velocity ||
+                      r.debug == render::DebugView::NetErosion || r.debug == render::DebugView::Wetness;
     if (r.debug == render::DebugView::IndirectRadiance && p.lighting != engine::LightingMode::Global)
         throw InputError("--debug u needs --lighting global (U is the indirect light)");
     r.exposure = o.exposure;

@@ -4,14 +4,18 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "app/commands.h"
 #include "app/option_ranges.h"
 #include "app/progress.h"
 #include "core/error.h"
 #include "core/geotiff_io.h"
+#include "core/image_io.h"
 #include "core/parallel.h"
 #include "core/png_io.h"
+#include "sim/frame_layers.h"
 #include "sim/scene.h"
 #include "sim/scene_ranges.h"
 #include "sim/vdb_io.h"
@@ -42,8 +46,8 @@ void checkOptions(const SimOptions& o) {
     checkRange(r::kHashEvery, o.hashEvery);
     checkRange(r::kOutEvery, o.outEvery);
     checkRange(r::kThreads, o.threads);
-    if (o.format != "vdb" && o.format != "png" && o.format != "tif" && o.format != "both")
-        throw InputError("--format must be vdb, png, tif or both (got '" + o.format + "')");
+    if (o.format != "vdb" && o.format != "png" && o.format != "tif" && o.format != "exr" && o.format != "both")
+        throw InputError("--format must be vdb, png, tif, exr or both (got '" + o.format + "')");
     if (o.size) checkRange(scene_ranges::kSize, *o.size, "--size");
     if (o.seed) checkRange(scene_ranges::kSeed, *o.seed, "--seed");
     if (o.dt) checkRange(widened(scene_ranges::kDt), *o.dt, "--dt");
@@ -67,25 +71,34 @@ void checkDiverged(const TerrainState& s) {
     }
 }
 
-// A .tif frame is float32 heights in metres, carrying the place and CRS of a
-// GeoTIFF DEM the scene started from.
+// The frame's layers (sim/frame_layers.h) as a GeoTIFF's float32 bands,
+// named by their descriptions, with the place and CRS of a GeoTIFF DEM the
+// scene started from.
+void writeTifFrame(const std::string& file, FrameLayers frame, const GeoReference& geo) {
+    const std::vector<std::string> names = frame.names();
+    std::vector<Grid> bands;
+    bands.reserve(frame.layers.size());
+    for (FrameLayer& layer : frame.layers) bands.push_back(std::move(layer.grid));
+    writeGeoTiff(file, bands, geo, names);
+}
+
+// vdb, exr and tif frames carry every layer; png the ground height alone.
 void writeFrame(const std::string& dir, const Simulation& sim, const std::string& format, float zScale, float zOffset) {
     const TerrainState& s = sim.state();
     checkDiverged(s);
     char name[64];
     std::snprintf(name, sizeof name, "frame_%06lld", static_cast<long long>(s.tick));
-    const std::filesystem::path base = std::filesystem::path(dir) / name;
-    if (format == "vdb" || format == "both") writeVdb(base.string() + ".vdb", s);
+    const std::string base = (std::filesystem::path(dir) / name).string();
     if (format == "png" || format == "both") {
         Grid h;
         s.groundHeight(h);
-        writePngHeightmap(base.string() + ".png", h, zScale, zOffset);
+        writePngHeightmap(base + ".png", h, zScale, zOffset);
     }
-    if (format == "tif") {
-        Grid h;
-        s.groundHeight(h);
-        writeGeoTiff(base.string() + ".tif", std::span<const Grid>(&h, 1), sim.geoReference());
-    }
+    if (format == "png") return;
+    FrameLayers frame = frameLayers(sim);
+    if (format == "vdb" || format == "both") writeVdbLayers(base + ".vdb", frame);
+    if (format == "exr") writeExrChannels(base + ".exr", frame.names(), frame.grids(), frame.cellSize);
+    if (format == "tif") writeTifFrame(base + ".tif", std::move(frame), sim.geoReference());
 }
 
 // The scene's summary and any notice, on stdout: stderr carries errors only.
@@ -163,7 +176,8 @@ Runner addSimCommand(CLI::App& app) {
     sub->add_option("--out-every", opt->outEvery, describe(r::kOutEvery));
     sub->add_option(
            "--format", opt->format,
-           "Frame format: vdb (all layers), png (16-bit height), tif (float32 height GeoTIFF) or both (vdb and png)")
+           "Frame format: vdb (all layers as grids), exr (all layers as float32 channels), tif (all layers as float32 "
+           "GeoTIFF bands), png (16-bit height) or both (vdb and png)")
         ->capture_default_str();
     sub->add_option("--dt", opt->dt, describe(sr::kDt) + " (default: the scene file's, else 0)");
     sub->add_flag("--quiet", opt->quiet, "No progress or summary");

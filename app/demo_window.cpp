@@ -106,8 +106,19 @@ void drawMaterialControls(FramePipeline& pipeline) {
 void drawPanel(FramePipeline& pipeline, RenderSettings& rs, bool& paused, const StageTimings& avg, double fpsAvg) {
     const char* lightingNames[] = {"key light only", "direct (sky + key)", "global (direct + bounces)"};
     const char* shadowNames[] = {"engine soft visibility", "shadow map", "none"};
-    const char* debugNames[] = {"none",          "ambient",      "V (sky visibility)",   "key visibility",    "normals",
-                                "pyramid level", "GI shade map", "U (indirect, global)", "albedo (materials)"};
+    const char* debugNames[] = {"none",
+                                "ambient",
+                                "V (sky visibility)",
+                                "key visibility",
+                                "normals",
+                                "pyramid level",
+                                "GI shade map",
+                                "U (indirect, global)",
+                                "albedo (materials)",
+                                "discharge",
+                                "velocity",
+                                "net erosion",
+                                "wetness"};
     PipelineSettings& ps = pipeline.settings();
     ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
     ImGui::Begin("terrain");
@@ -139,7 +150,9 @@ void drawPanel(FramePipeline& pipeline, RenderSettings& rs, bool& paused, const 
     int shadow = static_cast<int>(rs.shadow);
     if (ImGui::Combo("key shadow", &shadow, shadowNames, 3)) rs.shadow = static_cast<ShadowMode>(shadow);
     int debug = static_cast<int>(rs.debug);
-    if (ImGui::Combo("view", &debug, debugNames, 9)) rs.debug = static_cast<DebugView>(debug);
+    if (ImGui::Combo("view", &debug, debugNames, 13)) rs.debug = static_cast<DebugView>(debug);
+    // the hydrology maps are packed only while one of their views shows
+    ps.hydrologyMaps = rs.debug >= DebugView::Discharge;
     ImGui::SliderInt("pyramid level", &ps.pyramidLevel, 0, 16);
     ImGui::Checkbox("water", &rs.water);
     ImGui::SameLine();

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "core/error.h"
@@ -100,6 +101,17 @@ void writeIndirect(const std::string& file, const std::array<Grid, 3>& rgb, cons
         writeFalseColour(file, rgb);
     else
         throw InputError("--out-indirect must end in .npy, .exr, .png or .tif (got '" + file + "')");
+}
+
+void writeGiExr(const std::string& file, const Grid& heights, float cellSize, const std::array<Grid, 3>& shade,
+                const Grid& ambient, const std::array<Grid, 3>* indirect) {
+    std::vector<std::string> names{"height", "ambient", "shade.R", "shade.G", "shade.B"};
+    std::vector<const Grid*> grids{&heights, &ambient, &shade[0], &shade[1], &shade[2]};
+    if (indirect) {
+        names.insert(names.end(), {"indirect.R", "indirect.G", "indirect.B"});
+        grids.insert(grids.end(), {&(*indirect)[0], &(*indirect)[1], &(*indirect)[2]});
+    }
+    writeExrChannels(file, names, grids, cellSize);
 }
 
 }  // namespace terrain::app

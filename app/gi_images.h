@@ -29,4 +29,12 @@ void writeAmbient(const std::string& file, const Grid& ambient, const GeoReferen
 /// differences of a dim light show.
 void writeIndirect(const std::string& file, const std::array<Grid, 3>& rgb, const GeoReference& geo);
 
+/// Every map of a frame as float32 channels of one EXR (core/image_io.h):
+/// `height` (m), `ambient`, `shade.R`, `shade.G`, `shade.B` and, when
+/// computed, `indirect.R`, `indirect.G`, `indirect.B` (linear): an RGB map is
+/// a layer of R, G, B channels, as OpenImageIO and Houdini name layers. The
+/// cell size goes into the `terrain:cellSize` attribute.
+void writeGiExr(const std::string& file, const Grid& heights, float cellSize, const std::array<Grid, 3>& shade,
+                const Grid& ambient, const std::array<Grid, 3>* indirect);
+
 }  // namespace terrain::app

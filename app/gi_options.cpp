@@ -102,9 +102,11 @@ void checkOutputs(const GiOptions& o) {
         throw InputError("--out-ambient must end in .npy, .exr or .tif (got '" + o.outAmbient + "')");
     if (!oneOf(o.outIndirect, {".npy", ".exr", ".png"}))
         throw InputError("--out-indirect must end in .npy, .exr, .png or .tif (got '" + o.outIndirect + "')");
+    if (!o.outExr.empty() && extensionOf(o.outExr) != ".exr")
+        throw InputError("--out-exr must end in .exr (got '" + o.outExr + "')");
     if (!o.outIndirect.empty() && o.settings.indirect.bounces == 0 && !o.reference)
         throw InputError("--out-indirect needs --bounces >= 1");
-    for (const std::string* out : {&o.outShade, &o.outAmbient, &o.outIndirect})
+    for (const std::string* out : {&o.outShade, &o.outAmbient, &o.outIndirect, &o.outExr})
         if (!out->empty()) checkWritableFile(*out);
 }
 
@@ -151,6 +153,9 @@ void addLightTransportFlags(CLI::App* sub, GiOptions& o) {
     sub->add_option("--gi-refresh", gs.refreshEvery, gi::describe(r::kRefreshEvery))->capture_default_str();
     sub->add_flag("--amortise", gs.indirect.amortise,
                   "With --frames on static geometry: alternate direct and indirect updates");
+    sub->add_option("--out-exr", o.outExr,
+                    "Every map as float32 channels of one .exr: height, ambient, shade.R/G/B and, with bounces, "
+                    "indirect.R/G/B");
     sub->add_option(
         "--out-indirect", o.outIndirect,
         "Indirect light alone, RGB (.npy float32 (rows, columns, 3), .exr, .tif, or .png: its luminance in false "
@@ -203,6 +208,9 @@ void checkGiOptions(const GiOptions& o) {
         throw InputError(
             "--z-scale and --z-offset apply to PNG heightmaps; a GeoTIFF's heights are used as stored, "
             "in metres");
+    if (extensionOf(o.heightmap) == ".exr" && (o.zScale != 1.0 || o.zOffset != 0.0))
+        throw InputError(
+            "--z-scale and --z-offset apply to PNG heightmaps; an EXR's heights are used as stored, in metres");
     checkGiFlags(o.settings);
     checkLightOptions(o.lights);
     checkOutputs(o);

@@ -35,6 +35,7 @@ struct GiOptions {
     std::string brdf = "lambert";
     std::string albedo;
     std::string outIndirect;
+    std::string outExr;  // every map as channels of one float32 EXR
     int referenceDirections = 2048;
     std::string glossy;         // vector | scalar (glossy indirect light)
     std::string phongExponent;  // VALUE or a 16-bit PNG

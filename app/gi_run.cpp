@@ -108,7 +108,8 @@ GiInputs giInputsFor(const GiOptions& o, const ExponentSource& exponent, Grid he
     in.geo = std::move(geo);
     // --cell-size overrides the source's own (a .tif's geotransform, a .vdb's voxel size)
     in.cell = o.cellSize > 0.0 ? o.cellSize : cellFromSource;
-    if (!(in.cell > 0.0)) throw InputError("--cell-size is needed for a PNG heightmap (metres between grid points)");
+    if (!(in.cell > 0.0))
+        throw InputError("--cell-size is needed for a PNG or EXR heightmap (metres between grid points)");
     // the outputs keep the input's origin; an overriding --cell-size rescales their pixels
     if (in.geo.georeferenced() && o.cellSize > 0.0) in.geo = in.geo.withCellSize(o.cellSize);
     checkRange(scene_ranges::kCellSize, static_cast<float>(in.cell), o.heightmap + ": cell size");
@@ -126,7 +127,8 @@ GiMaps runGiFrames(const GiOptions& o, const gi::GiSettings& settings, const GiI
 
 // No NaN or Inf leaves the command, and a failing run leaves earlier files
 // as they were.
-void writeGiMaps(const GiOptions& o, const GiMaps& maps, const GeoReference& geo) {
+void writeGiMaps(const GiOptions& o, const GiInputs& in, const GiMaps& maps) {
+    const GeoReference& geo = in.geo;
     try {
         for (const Grid& g : maps.shade) requireFinite(g, "the shade map");
         requireFinite(maps.ambient, "the ambient map");
@@ -138,6 +140,9 @@ void writeGiMaps(const GiOptions& o, const GiMaps& maps, const GeoReference& geo
     if (!o.outShade.empty()) writeShade(o.outShade, maps.shade, o.exposure, geo);
     if (!o.outAmbient.empty()) writeAmbient(o.outAmbient, maps.ambient, geo);
     if (!o.outIndirect.empty()) writeIndirect(o.outIndirect, maps.indirect, geo);
+    if (!o.outExr.empty())
+        writeGiExr(o.outExr, in.heights, static_cast<float>(in.cell), maps.shade, maps.ambient,
+                   maps.hasIndirect ? &maps.indirect : nullptr);
 }
 
 }  // namespace terrain::app

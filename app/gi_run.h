@@ -47,7 +47,8 @@ struct GiMaps {
 GiMaps runGiFrames(const GiOptions& o, const gi::GiSettings& settings, const GiInputs& in);
 
 /// Checks every map finite (InputError, nothing written, otherwise), then
-/// writes the --out-shade, --out-ambient and --out-indirect files given.
-void writeGiMaps(const GiOptions& o, const GiMaps& maps, const GeoReference& geo);
+/// writes the --out-shade, --out-ambient, --out-indirect and --out-exr files
+/// given (with the input's georeferencing, heights and cell size).
+void writeGiMaps(const GiOptions& o, const GiInputs& in, const GiMaps& maps);
 
 }  // namespace terrain::app

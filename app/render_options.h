@@ -41,7 +41,8 @@ struct RenderOptions {
     std::optional<float> giTolerance;
     std::optional<int> giRefresh;
     std::string shadow = "soft";  // soft | map | none
-    std::string debug = "none";   // none | ambient | v | key | normals | pyramid | shade | u
+    std::string debug =
+        "none";  // none | ambient | v | key | normals | pyramid | shade | u | albedo | discharge | velocity | net-erosion | wetness
     int pyramidLevel = 4;
     float exposure = 1.0f;
     float exaggeration = 0.0f;   // 0 = automatic

@@ -48,9 +48,11 @@ GeoTiffHeights readGeoTiffHeights(const std::string& file);
 /// Writes each grid as a float32 band (one for a height or ambient map,
 /// three for an RGB map, in order), DEFLATE-compressed, to `file`
 /// atomically (a temporary beside it, renamed after a checked close and a
-/// sync): with `geo`'s transform and CRS when it is georeferenced. The
-/// bands must share one size. IoError on any failure, the target left as
-/// it was.
-void writeGeoTiff(const std::string& file, std::span<const Grid> bands, const GeoReference& geo);
+/// sync): with `geo`'s transform and CRS when it is georeferenced, and each
+/// band's description set to its name when names are given (one per band).
+/// The bands must share one size. IoError on any failure, the target left
+/// as it was.
+void writeGeoTiff(const std::string& file, std::span<const Grid> bands, const GeoReference& geo,
+                  std::span<const std::string> names = {});
 
 }  // namespace terrain

@@ -36,7 +36,8 @@ void syncFile(const std::string& path, const std::string& target) {
 
 // The bands and their place, while the dataset is open; false on a failure
 // (its message is in the error capture).
-bool fillDataset(GDALDatasetH ds, std::span<const Grid> bands, const GeoReference& geo) {
+bool fillDataset(GDALDatasetH ds, std::span<const Grid> bands, std::span<const std::string> names,
+                 const GeoReference& geo) {
     if (geo.georeferenced()) {
         std::array<double, 6> t = geo.transform;
         if (GDALSetGeoTransform(ds, t.data()) != CE_None || GDALSetProjection(ds, geo.crsWkt.c_str()) != CE_None)
@@ -45,6 +46,7 @@ bool fillDataset(GDALDatasetH ds, std::span<const Grid> bands, const GeoReferenc
     for (std::size_t b = 0; b < bands.size(); ++b) {
         const Grid& g = bands[b];
         GDALRasterBandH band = GDALGetRasterBand(ds, static_cast<int>(b) + 1);
+        if (b < names.size()) GDALSetDescription(band, names[b].c_str());
         if (GDALRasterIO(band, GF_Write, 0, 0, g.nx, g.ny, const_cast<float*>(g.v.data()), g.nx, g.ny, GDT_Float32, 0,
                          0) != CE_None)
             return false;
@@ -61,8 +63,10 @@ GeoReference GeoReference::withCellSize(double cell) const {
     return r;
 }
 
-void writeGeoTiff(const std::string& file, std::span<const Grid> bands, const GeoReference& geo) {
+void writeGeoTiff(const std::string& file, std::span<const Grid> bands, const GeoReference& geo,
+                  std::span<const std::string> names) {
     if (bands.empty()) throw IoError(file, "no band to write");
+    if (!names.empty() && names.size() != bands.size()) throw IoError(file, "one name per band, or none");
     const Grid& g = bands[0];
     for (const Grid& b : bands)
         if (b.nx != g.nx || b.ny != g.ny) throw IoError(file, "bands of different sizes");
@@ -76,7 +80,7 @@ void writeGeoTiff(const std::string& file, std::span<const Grid> bands, const Ge
     GDALDatasetH ds = GDALCreate(driver, tmp.path.c_str(), g.nx, g.ny, static_cast<int>(bands.size()), GDT_Float32,
                                  const_cast<char**>(options));
     if (!ds) throw IoError(file, "cannot create: " + errors.message("GDAL failed"));
-    const bool filled = fillDataset(ds, bands, geo);
+    const bool filled = fillDataset(ds, bands, names, geo);
     GDALClose(ds);  // the data reach the file here; a failure shows as an error message
     if (!filled || errors.failed()) throw IoError(file, "cannot write: " + errors.message("GDAL failed"));
     syncFile(tmp.path, file);

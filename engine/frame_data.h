@@ -76,7 +76,14 @@ struct FrameData {
     std::vector<float> shade;             // 4 per texel: sky RGB, key visibility
     std::vector<float> key;               // 4 per texel: key RGB, ambient
     int nxr = 0, nyr = 0, subsample = 1;  // receiver grid
-    std::vector<float> receiver;          // 4 per receiver: sky visibility fraction, pyramid level height,
+    // 4 per texel when PipelineSettings::hydrologyMaps is on (else empty):
+    // discharge (m^3/s), velocity (m/s), net erosion (m), wetness
+    // (sim/hydrology.h), each 0 where the scene has no such map; and each
+    // map's largest magnitude, which the debug views scale by.
+    std::vector<float> hydrology;
+    std::array<float, 4> hydrologyMax{};
+    std::int64_t hydrologyVersion = 0;
+    std::vector<float> receiver;  // 4 per receiver: sky visibility fraction, pyramid level height,
         // mean incident indirect radiance (U's constant term, or the irradiance E / pi where the kernel keeps no U; 0 without bounces), 0
     int pyramidLevel = -1;  // level in `receiver` (-1: none built)
     SceneLights lights;

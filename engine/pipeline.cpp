@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "sim/hydrology.h"
 
 namespace terrain::engine {
 namespace {
@@ -31,6 +32,29 @@ void exaggeratedSurface(const TerrainState& s, float exag, Grid& surface) {
 std::int64_t nextVersion() {
     static std::atomic<std::int64_t> versions{0};
     return ++versions;
+}
+
+// The hydrology maps of the debug views, 4 per texel (engine/frame_data.h),
+// and each map's largest magnitude; a map the scene lacks stays 0.
+void packHydrology(const Simulation& sim, FrameData& f) {
+    const TerrainState& s = sim.state();
+    const HydrologyAccumulator& h = sim.hydrology();
+    std::array<Grid, 4> maps;
+    for (Grid& g : maps) g.resize(s.nx, s.ny);
+    if (hasWaterFlow(s)) {
+        dischargeMap(s, maps[0]);
+        velocityMap(s, maps[1]);
+    }
+    if (h.tracksGround()) h.netErosionMap(maps[2]);
+    if (h.tracksWater()) h.wetnessMap(maps[3]);
+    f.hydrology.resize(4 * maps[0].size());
+    f.hydrologyMax = {};
+    for (std::size_t i = 0; i < maps[0].size(); ++i)
+        for (std::size_t m = 0; m < 4; ++m) {
+            f.hydrology[4 * i + m] = maps[m].v[i];
+            f.hydrologyMax[m] = std::max(f.hydrologyMax[m], std::fabs(maps[m].v[i]));
+        }
+    f.hydrologyVersion = nextVersion();
 }
 
 // Ground and water depth of every texel (they may move apart while their
@@ -196,6 +220,7 @@ void FramePipeline::terrainReplaced() {
     autoExaggeration_ = std::clamp(0.15f * extent / (frame_.zMax - frame_.zMin), 1.0f, 10.0f);
     mapsTick_ = -1;
     heightsTick_ = -1;
+    hydrologyTick_ = -1;
 }
 
 void FramePipeline::setLights(const LightSet& lights) { rig_ = LightRig(lights, &rig_); }
@@ -276,6 +301,11 @@ void FramePipeline::light() {
         packHeights(s, f);
         f.heightsVersion = nextVersion();
         heightsTick_ = s.tick;
+    }
+    // also when the views were just asked for, on a paused scene
+    if (settings_.hydrologyMaps && hydrologyTick_ != s.tick) {
+        packHydrology(sim_, f);
+        hydrologyTick_ = s.tick;
     }
     if (newMaps) packAlbedo(maps_, f);
     const bool giUpdated = gi_.directUpdated || gi_.indirectUpdated;

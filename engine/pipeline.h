@@ -28,6 +28,9 @@ struct PipelineSettings {
     // all see the same surface); 0 = automatic: relief at least 15 % of the
     // extent (the waves bay is 512 m wide and 18 m deep).
     float verticalExaggeration = 0.0f;
+    // Pack the hydrology maps for the debug views (FrameData::hydrology);
+    // off by default: it costs a pass over the grid per tick drawn.
+    bool hydrologyMaps = false;
 };
 
 /// Milliseconds of one frame per stage.
@@ -91,8 +94,9 @@ private:
     Grid surface_;                    // ground + water: what the light sees
     MaterialSet materials_;
     MaterialMaps maps_;
-    std::int64_t mapsTick_ = -1;     // the tick the maps were derived at (-1: to derive)
-    std::int64_t heightsTick_ = -1;  // the tick frame_.heights holds (-1: to pack)
+    std::int64_t mapsTick_ = -1;       // the tick the maps were derived at (-1: to derive)
+    std::int64_t heightsTick_ = -1;    // the tick frame_.heights holds (-1: to pack)
+    std::int64_t hydrologyTick_ = -1;  // the tick frame_.hydrology holds (-1: to pack)
     gi::GiState gi_;
     gi::ShadeMaps keyScratch_;     // buffers of the key light's own shading
     std::array<Grid, 3> keyOnly_;  // the key light's shade alone (white albedo)

@@ -10,7 +10,7 @@ T=$(realpath "$1")
 cd "$(dirname "$0")"
 C=corpus
 rm -rf "$C"
-mkdir -p "$C"/{albedo_png,equirect_exr,equirect_hdr,exponent_png,geotiff,number_list,png_heightmap,scene_toml,vdb}
+mkdir -p "$C"/{albedo_png,equirect_exr,equirect_hdr,exponent_png,exr_heightmap,geotiff,number_list,png_heightmap,scene_toml,vdb}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
@@ -21,6 +21,9 @@ for scene in erosion waves; do
   "$T" sim --scene $scene --size 8 --ticks 2 --seed 3 --out "$tmp/$scene-vdb" --format vdb --quiet
   cp "$tmp/$scene/frame_000002.png" "$C/png_heightmap/$scene-16x16.png"
   cp "$tmp/$scene-vdb/frame_000002.vdb" "$C/vdb/$scene-8x8.vdb"
+  # a float32 EXR frame: every layer a channel, `height` among them
+  "$T" sim --scene $scene --size 8 --ticks 2 --seed 3 --out "$tmp/$scene-exr" --format exr --quiet
+  cp "$tmp/$scene-exr/frame_000002.exr" "$C/exr_heightmap/$scene-8x8.exr"
 done
 "$T" sim --scene erosion --size 7 --ticks 1 --out "$tmp/small" --format png --quiet
 cp "$tmp/small/frame_000001.png" "$C/png_heightmap/erosion-7x7.png"
@@ -34,6 +37,7 @@ hm=(--heightmap "$C/png_heightmap/erosion-16x16.png" --cell-size 10 --z-scale 0.
 cp "$tmp/shade.png" "$C/albedo_png/shade-16x16.png"
 cp "$tmp/shade.exr" "$C/equirect_exr/shade-rgb.exr"
 cp "$tmp/ambient.exr" "$C/equirect_exr/ambient-y.exr"
+cp "$tmp/ambient.exr" "$C/exr_heightmap/ambient-half-y.exr"  # a single half-float channel
 
 # GeoTIFF: int16 DEMs written by hand (tests/hand_geotiff.sh), one with
 # nodata cells and one in degrees (the CRS error path), and what the engine

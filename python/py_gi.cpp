@@ -70,7 +70,7 @@ py::dict runGi(const py::object& heights, double cellSize, const py::kwargs& opt
     {
         py::gil_scoped_release unlocked;  // the frame runs on TBB's threads and touches no Python object
         maps = app::runGiFrames(o, settings, in);
-        app::writeGiMaps(o, maps, in.geo);
+        app::writeGiMaps(o, in, maps);
     }
     py::dict out;
     out["shade"] = interleaveRgb(maps.shade);

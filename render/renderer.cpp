@@ -151,8 +151,8 @@ Renderer::Renderer(const Gl& gl) : gl_(gl), sky_(gl) {
 Renderer::~Renderer() {
     deferred_.release(gl_);
     releaseTarget(shadow_);
-    const GLuint textures[] = {heightTex_, shadeTex_, keyTex_, receiverTex_, albedoTex_};
-    gl_.DeleteTextures(5, textures);
+    const GLuint textures[] = {heightTex_, shadeTex_, keyTex_, receiverTex_, albedoTex_, hydrologyTex_};
+    gl_.DeleteTextures(6, textures);
     gl_.DeleteBuffers(1, &indexBuffer_);
     gl_.DeleteBuffers(1, &chunkIndexBuffer_);
     gl_.DeleteBuffers(1, &waterIndexBuffer_);
@@ -197,6 +197,11 @@ void Renderer::upload(const engine::FrameData& f) {
         streamTexture(albedoTex_, albedoW_, albedoH_, f.nx, f.ny, GL_RGBA32F, GL_RGBA, f.albedo.data());
         albedoVersion_ = f.albedoVersion;
     }
+    if (!f.hydrology.empty() &&
+        (f.hydrologyVersion != hydrologyVersion_ || hydrologyW_ != f.nx || hydrologyH_ != f.ny)) {
+        streamTexture(hydrologyTex_, hydrologyW_, hydrologyH_, f.nx, f.ny, GL_RGBA32F, GL_RGBA, f.hydrology.data());
+        hydrologyVersion_ = f.hydrologyVersion;
+    }
 
     sky_.upload(f.lights);
 
@@ -215,6 +220,7 @@ void Renderer::upload(const engine::FrameData& f) {
     meta_.exaggeration = f.exaggeration;
     meta_.lights = f.lights;
     meta_.lighting = f.lighting;
+    meta_.hydrologyMax = f.hydrologyMax;
     checkGlError(gl_, "upload");
 }
 
@@ -552,8 +558,9 @@ void Renderer::shadeSurfaces(const RenderSettings& s, const FrameViews& v, bool 
                                albedoTex_,
                                deferred_.terrainPoints,
                                deferred_.waterPoints,
-                               deferred_.terrainColor};
-    for (int i = 0; i < 10; ++i) {
+                               deferred_.terrainColor,
+                               hydrologyTex_};
+    for (int i = 0; i < 11; ++i) {
         gl_.ActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + i));
         gl_.BindTexture(GL_TEXTURE_2D, textures[i]);
     }
@@ -611,6 +618,9 @@ void Renderer::shadingUniforms(GLuint p, const FrameViews& v) {
     u.i("uEnv", 4);
     u.i("uShadowMap", 5);
     u.i("uAlbedo", 6);
+    u.i("uHydrology", 10);
+    u.f2("uHydrologyMaxFlow", f.hydrologyMax[0], f.hydrologyMax[1]);
+    u.f2("uHydrologyMaxGround", f.hydrologyMax[2], f.hydrologyMax[3]);
     u.i2("uGrid", f.nx, f.ny);
     u.f("uCell", f.cellSize);
     u.f("uExag", f.exaggeration);

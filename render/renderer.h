@@ -43,6 +43,12 @@ enum class DebugView {
     ShadeMap,          // the GI's diffuse result: sky, key light and indirect light, with the albedo
     IndirectRadiance,  // U: mean incident indirect radiance (U's constant term, or E / pi without U), receiver grid
     Albedo,            // the materials' albedo map: the GI's albedo and the base colour
+    // the hydrology maps (sim/hydrology.h), each over its largest magnitude
+    // in the frame; they need PipelineSettings::hydrologyMaps
+    Discharge,   // sqrt(discharge / max): black to blue, so small streams show beside rivers
+    Velocity,    // velocity / max, grey
+    NetErosion,  // net erosion / max |net erosion|: white unchanged, red eroded, blue deposited
+    Wetness,     // fraction of ticks wet: sand to blue
 };
 
 struct OrbitCamera {
@@ -153,11 +159,11 @@ private:
     ChunkTree lodTree_;
     ChunkSelection lodSelection_;
     DrawStats stats_;
-    GLuint heightTex_ = 0, shadeTex_ = 0, keyTex_ = 0, receiverTex_ = 0, albedoTex_ = 0;
+    GLuint heightTex_ = 0, shadeTex_ = 0, keyTex_ = 0, receiverTex_ = 0, albedoTex_ = 0, hydrologyTex_ = 0;
     int heightW_ = 0, heightH_ = 0, shadeW_ = 0, shadeH_ = 0, keyW_ = 0, keyH_ = 0, recvW_ = 0, recvH_ = 0,
-        albedoW_ = 0, albedoH_ = 0;
+        albedoW_ = 0, albedoH_ = 0, hydrologyW_ = 0, hydrologyH_ = 0;
     // FrameData's versions of what was uploaded last
-    std::int64_t heightsVersion_ = -1, albedoVersion_ = -1, shadeVersion_ = -1;
+    std::int64_t heightsVersion_ = -1, albedoVersion_ = -1, shadeVersion_ = -1, hydrologyVersion_ = -1;
     Target shadow_;
     DeferredTargets deferred_;
     engine::FrameData meta_;  // the uploaded frame's sizes, lights and modes (no per-texel arrays)

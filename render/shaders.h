@@ -70,6 +70,8 @@ uniform sampler2D uHeight;
 uniform sampler2D uShade;     // RGBA32F: reflected sky and indirect light RGB (with the albedo), key visibility
 uniform sampler2D uKey;       // RGBA32F: key shade RGB of a white surface, ambient
 uniform sampler2D uAlbedo;    // RGBA32F: linear albedo RGB (the GI's albedo map), Phong exponent
+uniform sampler2D uHydrology; // RGBA32F: discharge, velocity, net erosion, wetness (hydrology debug views only)
+uniform vec2 uHydrologyMaxFlow, uHydrologyMaxGround;  // each map's largest magnitude
 uniform sampler2D uReceiver;  // RG32F at the receiver grid: sky visibility, pyramid level
 uniform sampler2D uEnv;       // RGB32F equirectangular environment (prefiltered: order-4 SH)
 uniform sampler2DShadow uShadowMap;
@@ -204,6 +206,16 @@ void main() {
         else if (uDebug == 5) c = vec3((r.g - uZRange.x) / max(uZRange.y - uZRange.x, 1e-3));
         else if (uDebug == 7) c = vec3(r.b * 2.0);
         else if (uDebug == 8) c = texture(uAlbedo, uv).rgb;
+        else if (uDebug >= 9) {
+            vec4 hy = texture(uHydrology, uv);
+            vec4 maxima = max(vec4(uHydrologyMaxFlow, uHydrologyMaxGround), vec4(1e-30));
+            if (uDebug == 9) c = vec3(0.3, 0.7, 1.0) * sqrt(hy.r / maxima.r);
+            else if (uDebug == 10) c = vec3(hy.g / maxima.g);
+            else if (uDebug == 11) {
+                float t = clamp(hy.b / maxima.b, -1.0, 1.0);
+                c = t > 0.0 ? vec3(1.0, 1.0 - t, 1.0 - t) : vec3(1.0 + t, 1.0 + t, 1.0);
+            } else c = mix(vec3(0.9, 0.8, 0.6), vec3(0.0, 0.2, 0.8), hy.a);
+        }
         else c = texture(uShade, uv).rgb + texture(uAlbedo, uv).rgb * texture(uKey, uv).rgb;
         fragColor = vec4(clamp(c, 0.0, 1.0), 1.0);
         return;

@@ -1,4 +1,4 @@
-// Heightmaps by file extension: greyscale PNG, GeoTIFF or OpenVDB.
+// Heightmaps by file extension: greyscale PNG, GeoTIFF, float EXR or OpenVDB.
 #include "sim/heightmap_io.h"
 
 #include <algorithm>
@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "core/error.h"
+#include "core/image_io.h"
 #include "core/png_io.h"
 #include "sim/vdb_io.h"
 
@@ -44,6 +45,22 @@ Grid readGeoTiff(const std::string& file, float* cellSizeOut, GeoReference* geoO
     return std::move(tiff.heights);
 }
 
+// The channel named `height`, else the file's only channel (Y, R, ...): a
+// file of several other channels has no one height.
+Grid readExrHeights(const std::string& file, float* cellSizeOut) {
+    ExrChannels exr = readExrChannels(file, "height");
+    if (exr.grids.empty() && exr.available.size() == 1) exr = readExrChannels(file, exr.available[0]);
+    if (exr.grids.empty()) {
+        std::string list;
+        for (const std::string& n : exr.available) list += (list.empty() ? "" : ", ") + n;
+        throw IoError(file, "EXR has no 'height' channel and more than one other (" + list +
+                                "); a heightmap EXR has a channel named height or a single channel");
+    }
+    // a hostile attribute (NaN, Inf, negative) counts as none: the cell size is then given as for a PNG
+    if (cellSizeOut && std::isfinite(exr.cellSize) && exr.cellSize > 0.0f) *cellSizeOut = exr.cellSize;
+    return std::move(exr.grids[0]);
+}
+
 }  // namespace
 
 Grid readHeightmap(const std::string& file, float zScale, float zOffset, float* cellSizeOut, GeoReference* geoOut) {
@@ -57,8 +74,10 @@ Grid readHeightmap(const std::string& file, float zScale, float zOffset, float* 
         g = readGeoTiff(file, cellSizeOut, geoOut);
     else if (lower == ".vdb")
         g = readVdbHeights(file, cellSizeOut);
+    else if (lower == ".exr")
+        g = readExrHeights(file, cellSizeOut);
     else
-        throw IoError(file, "unknown heightmap format '" + ext + "' (use .png, .tif or .vdb)");
+        throw IoError(file, "unknown heightmap format '" + ext + "' (use .png, .tif, .exr or .vdb)");
     if (g.nx < kMinHeightmapSide || g.ny < kMinHeightmapSide)
         throw IoError(file, "heightmap of " + std::to_string(g.nx) + " x " + std::to_string(g.ny) +
                                 " cells; a heightmap needs at least " + std::to_string(kMinHeightmapSide) + " x " +

@@ -1,6 +1,6 @@
 #pragma once
 // Heightmaps by file extension: greyscale PNG (core/png_io.h), GeoTIFF
-// (core/geotiff_io.h) or OpenVDB (sim/vdb_io.h).
+// (core/geotiff_io.h), float EXR (core/image_io.h) or OpenVDB (sim/vdb_io.h).
 #include <string>
 
 #include "core/geotiff_io.h"
@@ -14,8 +14,11 @@ namespace terrain {
 inline constexpr int kMinHeightmapSide = 2;
 
 /// Reads a heightmap by extension: .png (with zScale/zOffset), .tif/.tiff
-/// (heights in metres as stored, zScale and zOffset unused) or .vdb; for the
-/// last two the cell size is taken from the file when cellSizeOut is given,
+/// (heights in metres as stored, zScale and zOffset unused), .exr (metres as
+/// stored: the channel `height`, else the file's only channel; its cell size
+/// from a `terrain:cellSize` attribute when it has one, otherwise given as
+/// for a PNG) or .vdb; for .tif and .vdb the cell size is taken from the
+/// file when cellSizeOut is given,
 /// and a GeoTIFF's georeferencing is returned through geoOut (left
 /// unreferenced for the other formats). IoError when it
 /// is smaller than kMinHeightmapSide per side or a height is NaN or Inf

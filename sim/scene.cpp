@@ -232,6 +232,7 @@ Simulation::Simulation(const SceneSettings& settings) : settings_(settings) {
     // them and writes the new values back in the same pass.
     state_.groundHeight(prevGround_);
     if (!state_.water.empty()) prevWater_ = state_.water;
+    hydrology_.start(state_, settings_.hydraulic || settings_.thermal, settings_.hydraulic || settings_.waves);
 }
 
 float Simulation::stableDt() const {
@@ -253,6 +254,7 @@ void Simulation::tick() {
     state_.time += static_cast<double>(dt_);
     lastSubsteps_ = settings_.waves ? waveScratch_.lastSubsteps : 1;
     state_.tick += 1;
+    hydrology_.accumulate(state_, prevGround_);  // before updateChanges moves prevGround_ on
     if (simulates)
         updateChanges();
     else {

@@ -10,6 +10,7 @@
 #include "core/geotiff_io.h"
 #include "sim/generators.h"
 #include "sim/hydraulic.h"
+#include "sim/hydrology.h"
 #include "sim/materials.h"
 #include "sim/scene_camera.h"
 #include "sim/scene_lights.h"
@@ -124,6 +125,10 @@ public:
     TerrainState& state() { return state_; }
     const SceneSettings& settings() const { return settings_; }
     const ChangeReport& changes() const { return changes_; }
+    /// Erosion, deposition and wetness accumulated since the first tick
+    /// (sim/hydrology.h): ground maps when the scene erodes (hydraulic or
+    /// thermal), wetness when it moves water (hydraulic or waves).
+    const HydrologyAccumulator& hydrology() const { return hydrology_; }
     /// Where the terrain lies when it came from a GeoTIFF DEM (else unreferenced).
     const GeoReference& geoReference() const { return geo_; }
     float dt() const { return dt_; }
@@ -146,6 +151,7 @@ private:
     Grid prevGround_, prevWater_;
     std::vector<float> tileGround_, tileWater_;  // per-tile max |dh| of the last tick
     ChangeReport changes_;
+    HydrologyAccumulator hydrology_;
     float dt_ = 0.0f;
     float dtLimit_ = 0.0f;
     bool dtClamped_ = false;

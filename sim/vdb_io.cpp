@@ -5,8 +5,9 @@
 // Layout: each layer is a 2-D openvdb::FloatGrid, voxel (x, y, 0) = cell
 // (x, y), every cell active, background 0, with a uniform linear transform
 // whose voxel size is the cell size, and int32 metadata terrain_nx and
-// terrain_ny. Grids: `height` (bedrock + soil), `bedrock`, `soil`, and
-// `water`, `sediment` when the terrain has them. Blosc-compressed.
+// terrain_ny. Grids: a frame's layers in order (sim/frame_layers.h): `height`
+// (bedrock + soil), `bedrock`, `soil`, `water` and `sediment` when the
+// terrain has them, then a simulation's hydrology maps. Blosc-compressed.
 #include "sim/vdb_io.h"
 
 #include <cmath>
@@ -95,16 +96,12 @@ void readLayer(const std::string& file, const vdb::FileReader& reader, const vdb
 
 }  // namespace
 
-void writeVdb(const std::string& file, const TerrainState& s) {
+void writeVdb(const std::string& file, const TerrainState& s) { writeVdbLayers(file, stateLayers(s)); }
+
+void writeVdbLayers(const std::string& file, const FrameLayers& frame) {
     initVdb();
     openvdb::GridPtrVec grids;
-    Grid height;
-    s.groundHeight(height);
-    grids.push_back(toVdb(height, "height", s.cellSize));
-    grids.push_back(toVdb(s.bedrock, "bedrock", s.cellSize));
-    grids.push_back(toVdb(s.soil, "soil", s.cellSize));
-    if (!s.water.empty()) grids.push_back(toVdb(s.water, "water", s.cellSize));
-    if (!s.suspended.empty()) grids.push_back(toVdb(s.suspended, "sediment", s.cellSize));
+    for (const FrameLayer& layer : frame.layers) grids.push_back(toVdb(layer.grid, layer.name, frame.cellSize));
     std::string bytes;
     try {
         MemoryArchive archive;

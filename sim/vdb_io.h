@@ -3,6 +3,7 @@
 // sim/vdb_io.cpp: they are expensive to compile.
 #include <string>
 
+#include "sim/frame_layers.h"
 #include "sim/terrain.h"
 
 namespace terrain {
@@ -11,6 +12,10 @@ namespace terrain {
 /// (bedrock + soil), `bedrock`, `water`, `sediment` (suspended, when present),
 /// with the cell size in the transform (voxel size), z index 0.
 void writeVdb(const std::string& file, const TerrainState& s);
+
+/// Writes each layer of a frame as such a grid, named as the layer, in the
+/// frame's order (writeVdb is this with stateLayers(s)).
+void writeVdbLayers(const std::string& file, const FrameLayers& frame);
 
 /// Reads a .vdb written by writeVdb (or any file with a FloatGrid named
 /// `height`, or else the first FloatGrid): fills bedrock (and soil = 0, or the

@@ -190,7 +190,11 @@ cp "$vdb" "$tmp/grids.vdb"
 printf '\377\377\377\177' | dd of="$tmp/grids.vdb" bs=1 seek=61 conv=notrunc 2>/dev/null
 expect_short_error "VDB declaring 2^31 grids" "2147483647 grids" "$T" gi --heightmap "$tmp/grids.vdb" --cell-size 10
 cp "$vdb" "$tmp/mutant.vdb"
-printf '\377\377' | dd of="$tmp/mutant.vdb" bs=1 seek=$(( $(wc -c <"$vdb") / 2 )) conv=notrunc 2>/dev/null
+# two bytes in the middle of the bedrock grid (the layer a heightmap reads),
+# which lies between its name and the next grid's
+bedrock_at=$(grep -abo bedrock "$vdb" | tail -1 | cut -d: -f1)
+soil_at=$(grep -abo soil "$vdb" | head -1 | cut -d: -f1)
+printf '\377\377' | dd of="$tmp/mutant.vdb" bs=1 seek=$(( (bedrock_at + soil_at) / 2 )) conv=notrunc 2>/dev/null
 expect_short_error "damaged VDB heightmap" "mutant.vdb" "$T" gi --heightmap "$tmp/mutant.vdb" --cell-size 10
 : >"$tmp/empty.png"
 expect_short_error "empty heightmap file" "empty.png: not a PNG file" "$T" gi --heightmap "$tmp/empty.png" --cell-size 10
@@ -260,6 +264,18 @@ rc=$?
 [ $rc = 1 ] && [ "$(wc -l <"$tmp/e")" = 1 ] && grep -q "dem_ambient.tif: " "$tmp/e" && ok || bad "full disk (tif): rc=$rc $(cat "$tmp/e")"
 cmp -s "$tmp/dem_ambient.tif" "$tmp/dem_ambient_before.tif" && ok || bad "a failed GeoTIFF write changed the file"
 ls "$tmp" | grep -q 'dem_ambient.tif.*tmp\|tmp.*dem_ambient' && bad "GeoTIFF temporary left behind" || ok
+
+# EXR frames: every layer a float32 channel; a frame is a heightmap again
+# (its height channel and cell size); the GI maps as channels of one EXR
+"$T" sim --scene erosion --size 24 --ticks 3 --out "$tmp/exrframes" --format exr --quiet \
+  && [ "$(ls "$tmp/exrframes"/*.exr | wc -l)" = 2 ] && ok || bad "sim --format exr"
+"$T" gi --heightmap "$tmp/exrframes/frame_000003.exr" --out-exr "$tmp/gi.exr" --bounces 1 >"$tmp/o" 2>&1 \
+  && grep -q "24 x 24 cells of" "$tmp/o" && [ -s "$tmp/gi.exr" ] && ok || bad "gi on an EXR frame: $(cat "$tmp/o")"
+"$T" gi --heightmap "$tmp/gi.exr" --out-ambient "$tmp/gi_again.npy" >/dev/null 2>&1 && ok || bad "a gi --out-exr file is a heightmap"
+expect_error "--out-exr of another type" "--out-exr must end in .exr" "$T" gi --heightmap "$tmp/dem.tif" --out-exr "$tmp/x.png"
+expect_error "--z-scale with an EXR" "an EXR's heights are used as stored" "$T" gi --heightmap "$tmp/gi.exr" --z-scale 2
+head -c 600 "$tmp/exrframes/frame_000003.exr" >"$tmp/cut.exr"
+expect_short_error "truncated EXR heightmap" "cut.exr: " "$T" gi --heightmap "$tmp/cut.exr" --cell-size 10
 
 echo "cli: $pass passed, $fail failed"
 [ $fail -eq 0 ]

@@ -30,10 +30,18 @@ grep -q "frames written to" "$tmp/log" && ok || bad "render does not print the f
 # every mode renders
 for mode in "--lighting key" "--lighting global --bounces 2" "--shadow map" "--shadow none" "--subsample 1" "--subsample 4" \
             "--debug ambient" "--debug v" "--debug key" "--debug normals" "--debug pyramid" "--debug shade" \
-            "--lighting global --debug u" "--lighting global --amortise" "--lod 0" "--lod 4"; do
+            "--lighting global --debug u" "--lighting global --amortise" "--lod 0" "--lod 4" \
+            "--debug discharge" "--debug velocity" "--debug net-erosion" "--debug wetness"; do
   # shellcheck disable=SC2086
   "$T" render --scene waves "${small[@]}" --frames 1 --out "$tmp/m" --quiet $mode >"$tmp/o" 2>&1 && [ -s "$tmp/m/frame_0000.png" ] && ok || bad "render $mode: $(cat "$tmp/o")"
 done
+
+# the hydrology views show maps of their own: each image differs from the others and from the lit frame
+for view in none discharge velocity net-erosion wetness; do
+  "$T" render --scene erosion "${small[@]}" --frames 2 --out "$tmp/hv_$view" --quiet --debug $view >"$tmp/o" 2>&1 \
+    || bad "render --debug $view: $(cat "$tmp/o")"
+done
+[ "$(md5sum "$tmp"/hv_*/frame_0001.png | cut -d' ' -f1 | sort -u | wc -l)" = 5 ] && ok || bad "hydrology views not distinct"
 
 # video: an mp4 with ffmpeg, else a clear message and exit 0
 "$T" render --scene erosion "${small[@]}" --frames 2 --out "$tmp/v" --video "$tmp/v.mp4" >"$tmp/o" 2>&1

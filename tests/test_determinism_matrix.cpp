@@ -21,6 +21,7 @@
 
 #include "core/parallel.h"
 #include "engine/pipeline.h"
+#include "sim/frame_layers.h"
 #include "sim/scene.h"
 
 using namespace terrain;
@@ -101,10 +102,13 @@ void appendVector(std::vector<std::uint8_t>& out, const std::vector<T>& v) {
 }
 
 // Every byte a frame hands on: the simulation state (as its hash over all
-// layers) and each array the renderer uploads.
+// layers), the frame's layers a frame file carries (hydrology maps included)
+// and each array the renderer uploads.
 void appendFrame(std::vector<std::uint8_t>& out, const FramePipeline& p) {
     const std::uint64_t state = hashState(p.simulation().state());
     appendBytes(out, &state, sizeof state);
+    for (const FrameLayer& layer : frameLayers(p.simulation()).layers)
+        appendBytes(out, layer.grid.data(), layer.grid.size() * sizeof(float));
     const FrameData& f = p.frame();
     appendVector(out, f.heights);
     appendVector(out, f.albedo);
