@@ -270,6 +270,42 @@ void keyLightVisibility(const GiLighting& lighting, const GiSettings& settings, 
     }
 }
 
+// The environment as the SH shading stage sees it: its SH radiance, or with
+// splitSky all but its constant part, which goes to `constant` (RGB
+// radiance) instead.
+ShadingLight environmentShadingLight(const ShRgb& environment, const VisibilityField& v, bool splitSky,
+                                     float constant[3]) {
+    ShadingLight out;
+    out.visibility = &v;
+    for (std::size_t ch = 0; ch < 3; ++ch) {
+        ShVector radiance = environment.c[ch];
+        constant[ch] = splitSky ? static_cast<float>(radiance[0] * kShY00) : 0.0f;
+        if (splitSky) radiance[0] = 0.0;
+        out.product[ch] = shProductMatrix(radiance);
+    }
+    return out;
+}
+
+// The ambient map from the environment scan's horizons (gi/ambient_horizon.h),
+// over the environment's azimuths (the scan's own table holds the last key
+// light's by now).
+void exactAmbient(const GiSettings& settings, GiState& st, const std::vector<std::uint8_t>* rows) {
+    const std::vector<double>& phi = st.envOperator.phi;
+    st.envCosSin.resize(2 * phi.size());
+    for (std::size_t j = 0; j < phi.size(); ++j) {
+        st.envCosSin[2 * j] = static_cast<float>(std::cos(phi[j]));
+        st.envCosSin[2 * j + 1] = static_cast<float>(std::sin(phi[j]));
+    }
+    const bool footprint = settings.subsample > 1 && settings.visibility.footprintTangent;
+    const AmbientInputs in{.gradX = st.gradX.cview(),
+                           .gradY = st.gradY.cview(),
+                           .subsample = settings.subsample,
+                           .env = &st.envVisibility,
+                           .cosSin = st.envCosSin,
+                           .footprint = footprint ? &st.footprint : nullptr};
+    ambientFromHorizons(in, st.shade.ambient, st.ambientScratch, rows);
+}
+
 // Direct light at every texel: the lighting's SH product matrices once per
 // frame, then the shading (Section 7); key lights through the SH clamped
 // cosine, or with the exact cosine (GiSettings::keyLightExactCosine). With
@@ -279,14 +315,18 @@ void directShading(const GiLighting& lighting, const GiSettings& settings, const
     const std::size_t nKeys = lighting.keys.size();
     const bool exactKeys = settings.keyLightExactCosine;
     st.shadingLights.resize(1 + (exactKeys ? 0 : nKeys));
-    st.shadingLights[0].visibility = &st.envVisibility;
-    for (int ch = 0; ch < 3; ++ch)
-        st.shadingLights[0].product[static_cast<std::size_t>(ch)] =
-            shProductMatrix(lighting.environment.c[static_cast<std::size_t>(ch)]);
+    // With the exact ambient a Lambert shade takes the sky's constant part
+    // from it (addConstantSky) and the SH product only the rest.
+    const bool shAmbient = settings.ambient == AmbientMethod::ShProduct;
+    const bool splitSky = !shAmbient && settings.shading.brdf == Brdf::Lambert;
+    float skyConstant[3] = {0.0f, 0.0f, 0.0f};
+    st.shadingLights[0] = environmentShadingLight(lighting.environment, st.envVisibility, splitSky, skyConstant);
     for (std::size_t k = 0; k < (exactKeys ? 0 : nKeys); ++k)
         st.shadingLights[k + 1] = keyShadingLight(lighting.keys[k], st.keyVisibility[k]);
     shadeTexels(st.gradX.cview(), st.gradY.cview(), settings.subsample, st.envVisibility, st.shadingLights.data(),
-                static_cast<int>(st.shadingLights.size()), albedo, settings.shading, st.shade, true, rows);
+                static_cast<int>(st.shadingLights.size()), albedo, settings.shading, st.shade, shAmbient, rows);
+    if (!shAmbient) exactAmbient(settings, st, rows);
+    if (splitSky) addConstantSky(st.shade.ambient, skyConstant, albedo, st.shade.rgb, rows);
     if (exactKeys)
         for (std::size_t k = 0; k < nKeys; ++k)
             addKeyLightExactCosine(lighting.keys[k], st.keyVisibility[k], settings.subsample, albedo, st, st.shade.rgb,
@@ -424,6 +464,10 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
     else if (st.directUpdated)
         recordFrameInputs(heights, cellSize, lighting, settings, albedo, change, st.lastInputs);
     st.timings.total = msSince(t0);
+}
+
+void shadeDirect(const GiLighting& lighting, const GiSettings& settings, const AlbedoMap* albedo, GiState& st) {
+    directShading(lighting, settings, albedo, st, nullptr);
 }
 
 void shadeKeyLight(const GiState& st, const GiSettings& settings, const GiLighting& lighting, int k, ShadeMaps& scratch,

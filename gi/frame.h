@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/grid.h"
+#include "gi/ambient_horizon.h"
 #include "gi/frame_change.h"
 #include "gi/indirect.h"
 #include "gi/indirect_cache.h"
@@ -43,6 +44,8 @@ struct GiState {
     std::vector<VisibilityField> keyVisibility;
     std::vector<ShadingLight> shadingLights;
     ShadeMaps shade;
+    std::vector<float> envCosSin;  // cos, sin of each environment azimuth (the exact ambient's)
+    AmbientScratch ambientScratch;
     GiTimings timings;
     // Indirect light (gi/indirect.h): indirect.indirect and indirect.total
     // (= shade.rgb + indirect) are valid when settings.indirect.bounces > 0.
@@ -82,6 +85,11 @@ void computeGradient(ConstGridView heights, float cellSize, Grid& gradX, Grid& g
 
 /// Throws InputError naming the first NaN/Inf height.
 void checkHeightsFinite(ConstGridView heights);
+
+/// Redoes the direct light of every texel (and the ambient map) from the
+/// visibility `st` holds, as the last frame's shading stage would with every
+/// row: what a frame's shading gives, apart from the rows it kept.
+void shadeDirect(const GiLighting& lighting, const GiSettings& settings, const AlbedoMap* albedo, GiState& st);
 
 /// The shade key light k alone gives every texel (white albedo) in the last
 /// frame run on `st`, the way that frame computed it (exact cosine times the

@@ -33,16 +33,17 @@
 namespace terrain::gi {
 
 // Defaults: the engine's (gi/settings.h), measured on real DEMs against the
-// exact reference (bench/results/gi_accuracy.md, gi_convergence.md). The mean
-// filter lowers distant peaks, which ends casting sets early and lifts the
-// ambient light (the paper settings' positive bias): a level offset of 3 and
-// max-decimated octaves blended into the mean ones keep the peaks at the same
-// cost. Half and half, because the ambient light alone prefers a little less
-// blend but the indirect light needs the peaks (bench/results/gi_indirect_accuracy.md).
+// exact reference (bench/results/gi_ambient_dems.md, gi_explore.csv,
+// gi_indirect_accuracy.md). The mean filter lowers distant peaks, which ends
+// casting sets early and lifts the ambient light (the paper settings'
+// positive bias): a level offset of 3 and max-decimated octaves keep the
+// peaks at the same cost. All max: the ambient integrated exactly above the
+// horizons (gi/ambient_horizon.h) has no SH truncation left to offset a
+// lowered horizon, and the indirect light's casting sets need the peaks.
 struct PyramidSettings {
     int levelsPerOctave = 4;  // k_v (paper: 4)
     int levelOffset = 3;      // o_v in octaves (paper: 2)
-    float peakBlend = 0.5f;   // 0 = mean pyramid (paper); 1 = max-decimated octaves
+    float peakBlend = 1.0f;   // 0 = mean pyramid (paper); 1 = max-decimated octaves
     bool operator==(const PyramidSettings&) const = default;
 };
 

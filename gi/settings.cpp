@@ -15,6 +15,7 @@ GiSettings paperGiSettings() {
     s.visibility.footprintTangent = false;
     s.keyLightAzimuths = 3;
     s.keyLightExactCosine = false;
+    s.ambient = AmbientMethod::ShProduct;
     s.indirect.radiance.levelsPerOctave = 4;
     s.indirect.radiance.levelOffset = 2;
     s.indirect.lambert = LambertIndirect::ShKernel;

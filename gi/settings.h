@@ -5,6 +5,7 @@
 // settings of Nowrouzezahrai & Snyder 2009 for comparison. Every numeric
 // range is declared once in gi/settings_ranges.h and checked by
 // validateGiSettings, which the frame, the pipeline and the command line call.
+#include "gi/ambient_horizon.h"
 #include "gi/indirect.h"
 #include "gi/pyramid.h"
 #include "gi/settings_ranges.h"
@@ -24,6 +25,10 @@ struct GiSettings {
     // the order-4 SH clamped cosine (whose band-2 truncation is off for a
     // small light: measured in bench/results/gi_indirect_accuracy.md).
     bool keyLightExactCosine = true;  // paper: false
+    // The ambient map integrated exactly above each azimuth's horizon
+    // (gi/ambient_horizon.h) instead of lam(N) . V_env / pi, whose order-4
+    // SH truncation is a floor on its error (bench/results/gi_accuracy.md).
+    AmbientMethod ambient = AmbientMethod::Horizons;  // paper: ShProduct
     ShadingSettings shading;
     IndirectSettings indirect;  // bounces, radiance pyramid, amortisation
     // Incremental frames (gi/frame_change.h): a stage reruns only when its

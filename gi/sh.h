@@ -17,6 +17,8 @@ namespace terrain::gi {
 inline constexpr int kShOrder = 4;
 inline constexpr int kShCount = 16;
 inline constexpr double kPi = 3.14159265358979323846;
+/// Y_0^0 = 1 / (2 sqrt(pi)): a constant radiance L has band-0 coefficient L / Y_0^0.
+inline constexpr double kShY00 = 0.28209479177387814;
 
 using ShVector = std::array<double, kShCount>;
 /// Row-major 16 x 16 matrix.

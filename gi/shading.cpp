@@ -272,10 +272,7 @@ void sizeShadeMaps(int nx, int ny, std::size_t incidentSize, bool ambient, std::
     out.nx = nx;
     out.ny = ny;
     for (Grid& g : out.rgb) g.ensureSize(nx, ny);
-    if (!ambient)
-        out.ambient = Grid{};
-    else
-        out.ambient.ensureSize(nx, ny);
+    if (ambient) out.ambient.ensureSize(nx, ny);
     out.incident.resize(incidentSize);
     out.rowScratch.resize(rowScratchSize);
     out.basisScratch.resize(basisScratchSize);

@@ -142,7 +142,8 @@ struct ShadeMaps {
 };
 
 /// Shades every texel. envVisibility supplies the ambient map (with ambient
-/// false none is made and out.ambient is left empty: the indirect bounces);
+/// false none is made and out.ambient is left as it is: the indirect bounces,
+/// the exact ambient of gi/ambient_horizon.h);
 /// lights the incident radiance. gradX/gradY are the full resolution height
 /// derivatives. `rows` (one flag per texel row; null: every row): only the
 /// flagged rows are shaded, the others keep what `out` holds, which must be

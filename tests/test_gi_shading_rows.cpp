@@ -64,19 +64,9 @@ TEST_CASE("gi.shading_rows: the rows of changed heights, their neighbours and th
 // The direct light of the state's current inputs (cached or new V, the
 // gradients, the lights), shaded over every row.
 std::array<Grid, 3> reshadeEveryRow(const GiState& st, const GiSettings& settings, const GiLighting& light) {
-    ShadeMaps fresh;
-    shadeTexels(st.gradX.cview(), st.gradY.cview(), settings.subsample, st.envVisibility, st.shadingLights.data(),
-                static_cast<int>(st.shadingLights.size()), nullptr, settings.shading, fresh);
-    if (settings.keyLightExactCosine)
-        for (int k = 0; k < static_cast<int>(light.keys.size()); ++k) {
-            ShadeMaps scratch;
-            std::array<Grid, 3> key;
-            shadeKeyLight(st, settings, light, k, scratch, key);
-            for (std::size_t c = 0; c < 3; ++c)
-                for (std::size_t i = 0; i < key[c].v.size(); ++i)
-                    if (key[c].v[i] != 0.0f) fresh.rgb[c].v[i] += key[c].v[i];
-        }
-    return fresh.rgb;
+    GiState fresh = st;
+    shadeDirect(light, settings, nullptr, fresh);
+    return fresh.shade.rgb;
 }
 
 bool sameRgb(const std::array<Grid, 3>& a, const std::array<Grid, 3>& b) {

@@ -1,0 +1,181 @@
+#include "gi/ambient_horizon.h"
+
+#include <algorithm>
+
+#include "core/error.h"
+#include "core/parallel.h"
+#include "core/simd.h"
+#include "gi/shading.h"
+
+namespace terrain::gi {
+
+namespace {
+
+using simd::atanv;
+using simd::load;
+using simd::splat;
+using simd::store;
+
+constexpr float kHalfPi = 1.57079632679489661923f;
+
+// What one row block needs, fixed for the frame.
+struct AmbientJob {
+    const AmbientInputs& in;
+    int nx, ny, nxr, nyr, m;
+    int rowFloats;  // scratch floats per row buffer (nx rounded up, or nxr)
+    float* scratch;
+    const std::vector<std::uint8_t>* rows;
+    Grid& out;
+};
+
+// acc[x] += -g (pi/2 - sigma - sin sigma cos sigma) + cos^2 sigma over
+// [x0, x1) for one azimuth (c, sn), t the texels' horizon slopes before the
+// tangent plane is applied; sin sigma cos sigma = t / (1 + t^2) and
+// cos^2 sigma = 1 / (1 + t^2).
+template <class V>
+[[gnu::always_inline]] inline void addAzimuth(const float* gx, const float* gy, const float* horizon, float c, float sn,
+                                              float* acc, int x0, int x1) {
+    constexpr int L = simd::kLaneCount<V>;
+    const V vc = splat<V>(c), vs = splat<V>(sn), one = splat<V>(1.0f), halfPi = splat<V>(kHalfPi);
+    for (int x = x0; x + L <= x1; x += L) {
+        const V g = load<V>(gx + x) * vc + load<V>(gy + x) * vs;
+        const V h = load<V>(horizon + x);
+        const V t = h > g ? h : g;
+        const V r2 = one / (one + t * t);
+        const V term = (-g) * (halfPi - atanv(t) - t * r2) + r2;
+        store(acc + x, load<V>(acc + x) + term);
+    }
+}
+
+// The texel range [0, nx) of a row: whole vectors, then the rest through one
+// zero-padded vector (the same lane arithmetic, so a texel's value does not
+// depend on where it falls).
+template <class V>
+void addAzimuthRow(const float* gx, const float* gy, const float* horizon, float c, float sn, float* acc, int nx) {
+    constexpr int L = simd::kLaneCount<V>;
+    const int vecEnd = nx / L * L;
+    addAzimuth<V>(gx, gy, horizon, c, sn, acc, 0, vecEnd);
+    if (vecEnd == nx) return;
+    alignas(32) float tail[4][L] = {};
+    const int n = nx - vecEnd;
+    std::copy(gx + vecEnd, gx + nx, tail[0]);
+    std::copy(gy + vecEnd, gy + nx, tail[1]);
+    std::copy(horizon + vecEnd, horizon + nx, tail[2]);
+    std::copy(acc + vecEnd, acc + nx, tail[3]);
+    addAzimuth<V>(tail[0], tail[1], tail[2], c, sn, tail[3], 0, L);
+    std::copy(tail[3], tail[3] + n, acc + vecEnd);
+}
+[[gnu::target("avx2"), gnu::flatten]] void addAzimuthRowAvx2(const float* gx, const float* gy, const float* horizon,
+                                                             float c, float sn, float* acc, int nx) {
+    addAzimuthRow<simd::F8>(gx, gy, horizon, c, sn, acc, nx);
+}
+
+// Receiver (X, Y)'s horizon slope raised to its lowest tangent slope along
+// (c, sn): the footprint box's when there is one, else its own.
+float receiverHorizon(const AmbientJob& j, int X, int Y, int a, float c, float sn) {
+    const std::size_t i = static_cast<std::size_t>(Y) * j.nxr + X;
+    const float h = j.in.env->maxSlope[static_cast<std::size_t>(a) * j.nxr * j.nyr + i];
+    float tangent;
+    if (const FootprintBox* f = j.in.footprint) {
+        tangent = (c >= 0.0f ? f->loX[i] : f->hiX[i]) * c + (sn >= 0.0f ? f->loY[i] : f->hiY[i]) * sn;
+    } else {
+        const int s = j.in.subsample, x = std::min(s * X, j.nx - 1), y = std::min(s * Y, j.ny - 1);
+        tangent = j.in.gradX(x, y) * c + j.in.gradY(x, y) * sn;
+    }
+    return std::max(h, tangent);
+}
+
+// Horizon slopes of azimuth a at the texels of row y, bilinear from the
+// receivers (Fig. 7). vert: nxr floats of scratch.
+void interpolatedHorizons(const AmbientJob& j, int y, int a, float c, float sn, float* vert, float* out) {
+    const int s = j.in.subsample;
+    const ReceiverLerp ry = receiverLerp(y, s, j.nyr);
+    for (int X = 0; X < j.nxr; ++X) {
+        const float t0 = receiverHorizon(j, X, ry.i0, a, c, sn), t1 = receiverHorizon(j, X, ry.i1, a, c, sn);
+        vert[X] = t0 + ry.f * (t1 - t0);
+    }
+    for (int x = 0; x < j.nx; ++x) {
+        const ReceiverLerp rx = receiverLerp(x, s, j.nxr);
+        out[x] = vert[rx.i0] + rx.f * (vert[rx.i1] - vert[rx.i0]);
+    }
+}
+
+void ambientRow(const AmbientJob& j, int y, float* buffers) {
+    float* acc = buffers;
+    float* horizon = buffers + j.rowFloats;
+    float* vert = buffers + 2 * static_cast<std::size_t>(j.rowFloats);
+    std::fill(acc, acc + j.nx, 0.0f);
+    const float* gx = j.in.gradX.row(y);
+    const float* gy = j.in.gradY.row(y);
+    const bool wide = simd::wideEnabled();
+    for (int a = 0; a < j.m; ++a) {
+        const float c = j.in.cosSin[2 * static_cast<std::size_t>(a)];
+        const float sn = j.in.cosSin[2 * static_cast<std::size_t>(a) + 1];
+        const float* h;
+        if (j.in.subsample == 1) {
+            h = j.in.env->maxSlope.data() + (static_cast<std::size_t>(a) * j.ny + y) * j.nx;
+        } else {
+            interpolatedHorizons(j, y, a, c, sn, vert, horizon);
+            h = horizon;
+        }
+        (wide ? addAzimuthRowAvx2 : addAzimuthRow<simd::F4>)(gx, gy, h, c, sn, acc, j.nx);
+    }
+    const float perAzimuth = 1.0f / static_cast<float>(j.m);
+    float* out = j.out.data() + static_cast<std::size_t>(y) * j.nx;
+    for (int x = 0; x < j.nx; ++x) out[x] = acc[x] * perAzimuth / std::sqrt(1.0f + gx[x] * gx[x] + gy[x] * gy[x]);
+}
+
+void checkInputs(const AmbientInputs& in, int m, const std::vector<std::uint8_t>* rows) {
+    const VisibilityField& env = *in.env;
+    const int s = in.subsample;
+    if (in.gradY.nx != in.gradX.nx || in.gradY.ny != in.gradX.ny || s < 1 || env.nxr != (in.gradX.nx + s - 1) / s ||
+        env.nyr != (in.gradX.ny + s - 1) / s ||
+        env.maxSlope.size() != static_cast<std::size_t>(m) * env.nxr * env.nyr || in.cosSin.size() != 2u * m)
+        throw InputError("ambient: the horizons are not of this grid, sub-sampling and azimuth count");
+    if (rows && rows->size() != static_cast<std::size_t>(in.gradX.ny))
+        throw InputError("ambient: one row flag per texel row expected");
+}
+
+}  // namespace
+
+void ambientFromHorizons(const AmbientInputs& in, Grid& ambient, AmbientScratch& scratch,
+                         const std::vector<std::uint8_t>* rows) {
+    const int m = static_cast<int>(in.cosSin.size() / 2);
+    checkInputs(in, m, rows);
+    const int nx = in.gradX.nx, ny = in.gradX.ny;
+    ambient.ensureSize(nx, ny);
+    const int nBlocks = std::max(1, std::min(ny, 64));
+    const int rowFloats = std::max(nx, in.env->nxr);
+    scratch.rows.resize(static_cast<std::size_t>(nBlocks) * 3 * rowFloats);
+    const AmbientJob job{in, nx, ny, in.env->nxr, in.env->nyr, m, rowFloats, scratch.rows.data(), rows, ambient};
+    parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
+        for (int block = b0; block < b1; ++block) {
+            float* buffers = job.scratch + static_cast<std::size_t>(block) * 3 * rowFloats;
+            const int yBegin = static_cast<int>(static_cast<long long>(ny) * block / nBlocks);
+            const int yEnd = static_cast<int>(static_cast<long long>(ny) * (block + 1) / nBlocks);
+            for (int y = yBegin; y < yEnd; ++y)
+                if (!rows || (*rows)[static_cast<std::size_t>(y)] != 0) ambientRow(job, y, buffers);
+        }
+    });
+}
+
+void addConstantSky(const Grid& ambient, const float radiance[3], const AlbedoMap* albedo, std::array<Grid, 3>& shade,
+                    const std::vector<std::uint8_t>* rows) {
+    const int nx = ambient.nx, ny = ambient.ny;
+    parallelForRows(ny, nx, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y) {
+            if (rows && (*rows)[static_cast<std::size_t>(y)] == 0) continue;
+            const std::size_t row = static_cast<std::size_t>(y) * nx;
+            for (std::size_t c = 0; c < 3; ++c) {
+                const bool mapped = albedo && !albedo->channel[c].empty();
+                float* out = shade[c].data() + row;
+                for (int x = 0; x < nx; ++x) {
+                    const float a = mapped ? albedo->channel[c].v[row + x] : 1.0f;
+                    out[x] += a * radiance[c] * ambient.v[row + x];
+                }
+            }
+        }
+    });
+}
+
+}  // namespace terrain::gi
