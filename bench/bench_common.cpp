@@ -15,6 +15,7 @@
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/png_io.h"
+#include "sim/scene.h"
 
 namespace terrain::bench {
 
@@ -85,6 +86,32 @@ Dem loadPerdu(const std::string& dataDir) {
     d.name = "mtperdu_20m";
     d.heights = readPngHeightmap(dataDir + "/mtperdu_20m.png", 0.1f, 0.0f);
     d.cell = 20.0f;
+    return d;
+}
+
+Dem boxDownsample(const Dem& d, int factor, const std::string& tag) {
+    Dem out;
+    out.name = d.name + "-" + tag;
+    out.cell = d.cell * static_cast<float>(factor);
+    out.heights = Grid(d.heights.nx / factor, d.heights.ny / factor);
+    for (int y = 0; y < out.heights.ny; ++y)
+        for (int x = 0; x < out.heights.nx; ++x) {
+            double sum = 0.0;
+            for (int j = 0; j < factor; ++j)
+                for (int i = 0; i < factor; ++i) sum += d.heights(factor * x + i, factor * y + j);
+            out.heights(x, y) = static_cast<float>(sum / (factor * factor));
+        }
+    return out;
+}
+
+Dem erodedScene(int size, int ticks) {
+    Simulation sim(builtinScene("erosion", size, 1));
+    for (int t = 0; t < ticks; ++t) sim.tick();
+    Dem d;
+    d.name = "erosion";
+    d.note = "builtinScene(\"erosion\", " + std::to_string(size) + ", 1) after " + std::to_string(ticks) + " ticks";
+    d.cell = sim.state().cellSize;
+    sim.state().groundHeight(d.heights);
     return d;
 }
 

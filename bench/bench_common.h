@@ -60,6 +60,13 @@ Dem loadPerdu(const std::string& dataDir);
 /// The central size^2 texels of g.
 Grid centreCrop(const Grid& g, int size);
 
+/// The mean of each factor x factor block (the last partial blocks left out):
+/// the DEM at factor times its cell size, named name + "-" + tag.
+Dem boxDownsample(const Dem& d, int factor, const std::string& tag);
+
+/// The ground of builtinScene("erosion", size, 1) after `ticks` ticks (name "erosion").
+Dem erodedScene(int size, int ticks);
+
 /// The central size^2 crop of alps-montblanc at true scale; sets cell.
 Grid alpsCentreCrop(const std::string& dataDir, int size, float& cell);
 

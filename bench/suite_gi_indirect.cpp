@@ -45,17 +45,6 @@ Dem alpsCrop(const std::string& dataDir, int size) {
     return d;
 }
 
-Dem erodedScene(int size, int ticks) {
-    Simulation sim(builtinScene("erosion", size, 1));
-    for (int t = 0; t < ticks; ++t) sim.tick();
-    Dem d;
-    d.name = "erosion";
-    d.note = "builtinScene(\"erosion\", " + std::to_string(size) + ", 1) after " + std::to_string(ticks) + " ticks";
-    d.cell = sim.state().cellSize;
-    sim.state().groundHeight(d.heights);
-    return d;
-}
-
 template <class T>
 std::size_t bytesOf(const std::vector<T>& v) {
     return v.capacity() * sizeof(T);
