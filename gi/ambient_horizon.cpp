@@ -24,6 +24,9 @@ struct AmbientJob {
     int nx, ny, nxr, nyr, m;
     int rowFloats;  // scratch floats per row buffer (nx rounded up, or nxr)
     float* scratch;
+    const int* col0;  // per texel column: left receiver, right receiver, fraction towards it
+    const int* col1;
+    const float* colFrac;
     const std::vector<std::uint8_t>* rows;
     Grid& out;
 };
@@ -70,40 +73,47 @@ void addAzimuthRow(const float* gx, const float* gy, const float* horizon, float
     addAzimuthRow<simd::F8>(gx, gy, horizon, c, sn, acc, nx);
 }
 
-// Receiver (X, Y)'s horizon slope raised to its lowest tangent slope along
-// (c, sn): the footprint box's when there is one, else its own.
-float receiverHorizon(const AmbientJob& j, int X, int Y, int a, float c, float sn) {
-    const std::size_t i = static_cast<std::size_t>(Y) * j.nxr + X;
-    const float h = j.in.env->maxSlope[static_cast<std::size_t>(a) * j.nxr * j.nyr + i];
-    float tangent;
+// The horizon slopes of receiver row Y along azimuth a (c, sn), each raised
+// to the receiver's lowest tangent slope: the footprint box's when there is
+// one, else its own.
+void receiverRowHorizons(const AmbientJob& j, int Y, int a, float c, float sn, float* out) {
+    const std::size_t row = static_cast<std::size_t>(Y) * j.nxr;
+    const float* h = j.in.env->maxSlope.data() + static_cast<std::size_t>(a) * j.nxr * j.nyr + row;
     if (const FootprintBox* f = j.in.footprint) {
-        tangent = (c >= 0.0f ? f->loX[i] : f->hiX[i]) * c + (sn >= 0.0f ? f->loY[i] : f->hiY[i]) * sn;
-    } else {
-        const int s = j.in.subsample, x = std::min(s * X, j.nx - 1), y = std::min(s * Y, j.ny - 1);
-        tangent = j.in.gradX(x, y) * c + j.in.gradY(x, y) * sn;
+        const float* tx = (c >= 0.0f ? f->loX.data() : f->hiX.data()) + row;
+        const float* ty = (sn >= 0.0f ? f->loY.data() : f->hiY.data()) + row;
+        for (int X = 0; X < j.nxr; ++X) out[X] = std::max(h[X], tx[X] * c + ty[X] * sn);
+        return;
     }
-    return std::max(h, tangent);
+    const int s = j.in.subsample, y = std::min(s * Y, j.ny - 1);
+    const float* gx = j.in.gradX.row(y);
+    const float* gy = j.in.gradY.row(y);
+    for (int X = 0; X < j.nxr; ++X) {
+        const int x = std::min(s * X, j.nx - 1);
+        out[X] = std::max(h[X], gx[x] * c + gy[x] * sn);
+    }
 }
 
 // Horizon slopes of azimuth a at the texels of row y, bilinear from the
-// receivers (Fig. 7). vert: nxr floats of scratch.
-void interpolatedHorizons(const AmbientJob& j, int y, int a, float c, float sn, float* vert, float* out) {
-    const int s = j.in.subsample;
-    const ReceiverLerp ry = receiverLerp(y, s, j.nyr);
-    for (int X = 0; X < j.nxr; ++X) {
-        const float t0 = receiverHorizon(j, X, ry.i0, a, c, sn), t1 = receiverHorizon(j, X, ry.i1, a, c, sn);
-        vert[X] = t0 + ry.f * (t1 - t0);
-    }
+// receivers (Fig. 7). rows: 3 x nxr floats of scratch.
+void interpolatedHorizons(const AmbientJob& j, int y, int a, float c, float sn, float* rows, float* out) {
+    const ReceiverLerp ry = receiverLerp(y, j.in.subsample, j.nyr);
+    float* t0 = rows;
+    float* t1 = rows + j.nxr;
+    float* vert = rows + 2 * static_cast<std::size_t>(j.nxr);
+    receiverRowHorizons(j, ry.i0, a, c, sn, t0);
+    receiverRowHorizons(j, ry.i1, a, c, sn, t1);
+    for (int X = 0; X < j.nxr; ++X) vert[X] = t0[X] + ry.f * (t1[X] - t0[X]);
     for (int x = 0; x < j.nx; ++x) {
-        const ReceiverLerp rx = receiverLerp(x, s, j.nxr);
-        out[x] = vert[rx.i0] + rx.f * (vert[rx.i1] - vert[rx.i0]);
+        const float v0 = vert[j.col0[x]], v1 = vert[j.col1[x]];
+        out[x] = v0 + j.colFrac[x] * (v1 - v0);
     }
 }
 
 void ambientRow(const AmbientJob& j, int y, float* buffers) {
     float* acc = buffers;
     float* horizon = buffers + j.rowFloats;
-    float* vert = buffers + 2 * static_cast<std::size_t>(j.rowFloats);
+    float* receiverRows = buffers + 2 * static_cast<std::size_t>(j.rowFloats);
     std::fill(acc, acc + j.nx, 0.0f);
     const float* gx = j.in.gradX.row(y);
     const float* gy = j.in.gradY.row(y);
@@ -115,7 +125,7 @@ void ambientRow(const AmbientJob& j, int y, float* buffers) {
         if (j.in.subsample == 1) {
             h = j.in.env->maxSlope.data() + (static_cast<std::size_t>(a) * j.ny + y) * j.nx;
         } else {
-            interpolatedHorizons(j, y, a, c, sn, vert, horizon);
+            interpolatedHorizons(j, y, a, c, sn, receiverRows, horizon);
             h = horizon;
         }
         (wide ? addAzimuthRowAvx2 : addAzimuthRow<simd::F4>)(gx, gy, h, c, sn, acc, j.nx);
@@ -146,11 +156,33 @@ void ambientFromHorizons(const AmbientInputs& in, Grid& ambient, AmbientScratch&
     ambient.ensureSize(nx, ny);
     const int nBlocks = std::max(1, std::min(ny, 64));
     const int rowFloats = std::max(nx, in.env->nxr);
-    scratch.rows.resize(static_cast<std::size_t>(nBlocks) * 3 * rowFloats);
-    const AmbientJob job{in, nx, ny, in.env->nxr, in.env->nyr, m, rowFloats, scratch.rows.data(), rows, ambient};
+    constexpr int kRowsPerBlock = 5;  // acc, horizon, two receiver rows, their vertical blend
+    scratch.rows.resize(static_cast<std::size_t>(nBlocks) * kRowsPerBlock * rowFloats);
+    scratch.col0.resize(static_cast<std::size_t>(nx));
+    scratch.col1.resize(static_cast<std::size_t>(nx));
+    scratch.colFrac.resize(static_cast<std::size_t>(nx));
+    for (int x = 0; x < nx; ++x) {
+        const ReceiverLerp r = receiverLerp(x, in.subsample, in.env->nxr);
+        scratch.col0[static_cast<std::size_t>(x)] = r.i0;
+        scratch.col1[static_cast<std::size_t>(x)] = r.i1;
+        scratch.colFrac[static_cast<std::size_t>(x)] = r.f;
+    }
+    const AmbientJob job{in,
+                         nx,
+                         ny,
+                         in.env->nxr,
+                         in.env->nyr,
+                         m,
+                         rowFloats,
+                         scratch.rows.data(),
+                         scratch.col0.data(),
+                         scratch.col1.data(),
+                         scratch.colFrac.data(),
+                         rows,
+                         ambient};
     parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
         for (int block = b0; block < b1; ++block) {
-            float* buffers = job.scratch + static_cast<std::size_t>(block) * 3 * rowFloats;
+            float* buffers = job.scratch + static_cast<std::size_t>(block) * kRowsPerBlock * rowFloats;
             const int yBegin = static_cast<int>(static_cast<long long>(ny) * block / nBlocks);
             const int yEnd = static_cast<int>(static_cast<long long>(ny) * (block + 1) / nBlocks);
             for (int y = yBegin; y < yEnd; ++y)

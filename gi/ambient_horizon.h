@@ -53,6 +53,8 @@ struct AmbientInputs {
 /// Per-block rows of the computation, reused across frames.
 struct AmbientScratch {
     std::vector<float> rows;
+    std::vector<int> col0, col1;  // per texel column: the receivers it lies between
+    std::vector<float> colFrac;   // and the fraction towards the second
 };
 
 /// Adds the light of a sky of constant radiance `radiance` (RGB) to a
