@@ -15,6 +15,7 @@
 #include "core/setting_range.h"
 #include "python/bindings.h"
 #include "python/numpy_grids.h"
+#include "sim/frame_layers.h"
 #include "sim/scene.h"
 #include "sim/scene_ranges.h"
 #include "sim/vdb_io.h"
@@ -193,12 +194,26 @@ void addSimulation(py::module_& m) {
             },
             "A new float32 array of the ground height, bedrock + soil (m), shape (rows, columns)")
         .def(
+            "frame_layers",
+            [](const Simulation& s) {
+                py::dict out;
+                for (FrameLayer& layer : frameLayers(s).layers)
+                    out[py::str(layer.name)] = adoptGrid(std::move(layer.grid));
+                return out;
+            },
+            "The layers a frame file holds, by name, in the frame writers' order, as new float32 arrays of shape "
+            "(rows, columns): height, bedrock, soil, water, sediment and the hydrology maps the scene has "
+            "(discharge, velocity, sediment_flux, erosion, deposition, net_erosion, wetness; README, \"Frame "
+            "layers\").")
+        .def(
             "write_vdb",
             [](const Simulation& s, const std::string& path) {
                 checkDiverged(s.state());
-                writeVdb(path, s.state());
+                writeVdbLayers(path, frameLayers(s));
             },
-            py::arg("path"), "Writes every layer to an OpenVDB file, as `terrain sim --format vdb` writes a frame");
+            py::arg("path"),
+            "Writes the frame's layers (frame_layers()) to an OpenVDB file, as `terrain sim --format vdb` writes a "
+            "frame");
 }
 
 }  // namespace terrain::python

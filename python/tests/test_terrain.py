@@ -104,6 +104,27 @@ class LayersAreViews(unittest.TestCase):
         self.assertNotIn("suspended", waves)
 
 
+class FrameLayersMatchCli(unittest.TestCase):
+    def test_frame_layers_are_the_frames_the_cli_writes(self):
+        sim = terrain.Simulation(terrain.builtin_scene("erosion", size=32))
+        sim.tick(20)
+        layers = sim.frame_layers()
+        self.assertEqual(list(layers), ["height", "bedrock", "soil", "water", "sediment", "discharge", "velocity",
+                                        "sediment_flux", "erosion", "deposition", "net_erosion", "wetness"])
+        self.assertTrue(np.all((layers["wetness"] >= 0.0) & (layers["wetness"] <= 1.0)))
+        self.assertTrue(np.array_equal(layers["height"], sim.ground()))
+        with tempfile.TemporaryDirectory() as tmp:
+            cli("sim", "--scene", "erosion", "--size", "32", "--ticks", "20", "--out", tmp, "--format", "exr",
+                "--quiet")
+            height, cell = terrain.read_heightmap(os.path.join(tmp, "frame_000020.exr"))
+            self.assertTrue(np.array_equal(height, layers["height"]))
+            self.assertEqual(cell, sim.scene.cell_size)
+            vdb = os.path.join(tmp, "python.vdb")
+            sim.write_vdb(vdb)
+            height, cell = terrain.read_heightmap(vdb)
+            self.assertTrue(np.array_equal(height, layers["height"]))
+
+
 class GiMatchesCli(unittest.TestCase):
     def setUp(self):
         self.dir = tempfile.TemporaryDirectory()
