@@ -87,8 +87,9 @@ template <class V, int S>
 [[gnu::always_inline]] inline void lambertRowS(const float* vert, int nxrS, int nxr, int nCoef, const float* gxr,
                                                const float* gyr, const int* colIndex, const float* colFrac,
                                                const LambertFactors& lf, float diffuseWeight, const AlbedoMap* albedo,
-                                               int y, int nx, ShadeMaps& out) {
-    float* amb = out.ambient.empty() ? nullptr : out.ambient.data() + static_cast<std::size_t>(y) * nx;
+                                               bool ambient, int y, int nx, ShadeMaps& out) {
+    // out.ambient may hold another method's map (gi/ambient_horizon.h) of another size: written only when asked
+    float* amb = ambient ? out.ambient.data() + static_cast<std::size_t>(y) * nx : nullptr;
     float* rgb[3];
     const float* alb[3];
     for (int ch = 0; ch < 3; ++ch) {
@@ -192,7 +193,7 @@ template <class V>
     auto row = [&](auto sTag) {
         constexpr int S = decltype(sTag)::value;
         lambertRowS<V, S>(vert, j.nxrS, j.nxr, j.nCoef, gxr, gyr, j.colIndex, j.colFrac, j.lf, j.diffuseWeight,
-                          j.albedo, y, j.nx, *j.out);
+                          j.albedo, j.env != nullptr, y, j.nx, *j.out);
     };
     if (j.s == 1)
         row(std::integral_constant<int, 1>{});

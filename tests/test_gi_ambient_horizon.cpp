@@ -118,6 +118,21 @@ TEST_CASE("gi.ambient_horizon: on rough terrain it is closer to the ground truth
     }
 }
 
+TEST_CASE("gi.ambient_horizon: a state reused for a field of another size gives what a fresh state gives") {
+    // the SH shading must not write the exact ambient's map (once of another size)
+    const Grid small = gridOf(24, 20, [](int x, int y) { return 0.3f * x - 0.2f * y; });
+    const Grid large = gi_test::bumpy(72, 60);
+    for (int s : {1, 2}) {
+        GiSettings settings;
+        settings.subsample = s;
+        GiState reused, fresh;
+        runGiFrame(small.cview(), 2.0f, GiLighting{}, settings, reused);
+        runGiFrame(large.cview(), 2.0f, gi_test::sunSkyAndKey(), settings, reused);
+        runGiFrame(large.cview(), 2.0f, gi_test::sunSkyAndKey(), settings, fresh);
+        CHECK(gi_test::sameOutputs(reused, fresh));
+    }
+}
+
 TEST_CASE("gi.ambient_horizon: horizons of another grid or azimuth count are refused") {
     const Grid g = gridOf(16, 16, [](int x, int y) { return 0.1f * x * y; });
     GiState st;
