@@ -102,11 +102,13 @@ void checkOutputs(const GiOptions& o) {
         throw InputError("--out-ambient must end in .npy, .exr or .tif (got '" + o.outAmbient + "')");
     if (!oneOf(o.outIndirect, {".npy", ".exr", ".png"}))
         throw InputError("--out-indirect must end in .npy, .exr, .png or .tif (got '" + o.outIndirect + "')");
+    if (!oneOf(o.outSvf, {".npy", ".exr"}))
+        throw InputError("--out-svf must end in .npy, .exr or .tif (got '" + o.outSvf + "')");
     if (!o.outExr.empty() && extensionOf(o.outExr) != ".exr")
         throw InputError("--out-exr must end in .exr (got '" + o.outExr + "')");
     if (!o.outIndirect.empty() && o.settings.indirect.bounces == 0 && !o.reference)
         throw InputError("--out-indirect needs --bounces >= 1");
-    for (const std::string* out : {&o.outShade, &o.outAmbient, &o.outIndirect, &o.outExr})
+    for (const std::string* out : {&o.outShade, &o.outAmbient, &o.outIndirect, &o.outExr, &o.outSvf})
         if (!out->empty()) checkWritableFile(*out);
 }
 
@@ -153,6 +155,10 @@ void addLightTransportFlags(CLI::App* sub, GiOptions& o) {
     sub->add_option("--gi-refresh", gs.refreshEvery, gi::describe(r::kRefreshEvery))->capture_default_str();
     sub->add_flag("--amortise", gs.indirect.amortise,
                   "With --frames on static geometry: alternate direct and indirect updates");
+    sub->add_option("--out-svf", o.outSvf,
+                    "Sky-view factor as GIS tools define it: the open fraction of the upper hemisphere over the "
+                    "horizontal plane, 1 - mean sin(horizon elevation) (.npy float32, .exr or .tif; --out-ambient is "
+                    "the normal-weighted one)");
     sub->add_option("--out-exr", o.outExr,
                     "Every map as float32 channels of one .exr: height, ambient, shade.R/G/B and, with bounces, "
                     "indirect.R/G/B");

@@ -36,6 +36,7 @@ struct GiOptions {
     std::string albedo;
     std::string outIndirect;
     std::string outExr;  // every map as channels of one float32 EXR
+    std::string outSvf;  // the plain sky-view factor (gi/sky_view.h)
     int referenceDirections = 2048;
     std::string glossy;         // vector | scalar (glossy indirect light)
     std::string phongExponent;  // VALUE or a 16-bit PNG

@@ -14,6 +14,7 @@
 #include "gi/frame.h"
 #include "gi/reference.h"
 #include "gi/reference_gi.h"
+#include "gi/sky_view.h"
 #include "sim/scene_ranges.h"
 
 namespace terrain::app {
@@ -92,6 +93,8 @@ GiMaps runFastPath(const GiOptions& o, const gi::GiSettings& settings, const GiI
         maps.indirect = std::move(state.indirect.indirect);
         maps.hasIndirect = true;
     }
+    if (!o.outSvf.empty())
+        gi::skyViewFactor(state.envVisibility, settings.subsample, in.heights.nx, in.heights.ny, maps.svf);
     return maps;
 }
 
@@ -121,8 +124,14 @@ GiInputs giInputsFor(const GiOptions& o, const ExponentSource& exponent, Grid he
 }
 
 GiMaps runGiFrames(const GiOptions& o, const gi::GiSettings& settings, const GiInputs& in) {
-    return withThreads(o.threads,
-                       [&] { return o.reference ? runReference(o, settings, in) : runFastPath(o, settings, in); });
+    return withThreads(o.threads, [&] {
+        if (!o.reference) return runFastPath(o, settings, in);
+        GiMaps maps = runReference(o, settings, in);
+        if (!o.outSvf.empty())
+            gi::referenceSkyViewFactor(in.heights.cview(), static_cast<float>(in.cell),
+                                       gi::ReferenceSettings{}.azimuths, maps.svf);
+        return maps;
+    });
 }
 
 // No NaN or Inf leaves the command, and a failing run leaves earlier files
@@ -132,6 +141,7 @@ void writeGiMaps(const GiOptions& o, const GiInputs& in, const GiMaps& maps) {
     try {
         for (const Grid& g : maps.shade) requireFinite(g, "the shade map");
         requireFinite(maps.ambient, "the ambient map");
+        if (!o.outSvf.empty()) requireFinite(maps.svf, "the sky-view factor");
         if (maps.hasIndirect)
             for (const Grid& g : maps.indirect) requireFinite(g, "the indirect light");
     } catch (const InputError& e) {
@@ -140,6 +150,7 @@ void writeGiMaps(const GiOptions& o, const GiInputs& in, const GiMaps& maps) {
     if (!o.outShade.empty()) writeShade(o.outShade, maps.shade, o.exposure, geo);
     if (!o.outAmbient.empty()) writeAmbient(o.outAmbient, maps.ambient, geo);
     if (!o.outIndirect.empty()) writeIndirect(o.outIndirect, maps.indirect, geo);
+    if (!o.outSvf.empty()) writeAmbient(o.outSvf, maps.svf, geo);
     if (!o.outExr.empty())
         writeGiExr(o.outExr, in.heights, static_cast<float>(in.cell), maps.shade, maps.ambient,
                    maps.hasIndirect ? &maps.indirect : nullptr);

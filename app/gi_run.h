@@ -39,6 +39,7 @@ struct GiMaps {
     Grid ambient;
     std::array<Grid, 3> indirect;
     bool hasIndirect = false;
+    Grid svf;  // with --out-svf: the plain sky-view factor
 };
 
 /// The fast path (o.frames times on the same field, the first a warm-up;
