@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "app/commands.h"
+#include "app/named_choice.h"
 #include "app/option_ranges.h"
 #include "app/progress.h"
 #include "app/render_options.h"
@@ -190,34 +191,34 @@ void checkRenderRanges(const RenderOptions& o) {
 
 engine::LightingMode lightingOf(const std::string& text) {
     using engine::LightingMode;
-    if (text == "key") return LightingMode::KeyOnly;
-    if (text == "direct") return LightingMode::Direct;
-    if (text == "global") return LightingMode::Global;
-    throw InputError("--lighting must be key, direct or global (got '" + text + "')");
+    return namedChoice<LightingMode>(
+        "--lighting", text,
+        {{"key", LightingMode::KeyOnly}, {"direct", LightingMode::Direct}, {"global", LightingMode::Global}});
 }
 
 render::ShadowMode shadowOf(const std::string& text) {
     using render::ShadowMode;
-    if (text == "soft") return ShadowMode::SoftVisibility;
-    if (text == "map") return ShadowMode::ShadowMap;
-    if (text == "none") return ShadowMode::None;
-    throw InputError("--shadow must be soft, map or none (got '" + text + "')");
+    return namedChoice<ShadowMode>(
+        "--shadow", text,
+        {{"soft", ShadowMode::SoftVisibility}, {"map", ShadowMode::ShadowMap}, {"none", ShadowMode::None}});
 }
 
 render::DebugView debugOf(const std::string& text) {
     using render::DebugView;
-    static const std::pair<const char*, DebugView> views[] = {
-        {"none", DebugView::None},           {"ambient", DebugView::Ambient},   {"v", DebugView::SkyVisibility},
-        {"key", DebugView::KeyVisibility},   {"normals", DebugView::Normals},   {"pyramid", DebugView::PyramidLevel},
-        {"shade", DebugView::ShadeMap},      {"albedo", DebugView::Albedo},     {"u", DebugView::IndirectRadiance},
-        {"discharge", DebugView::Discharge}, {"velocity", DebugView::Velocity}, {"net-erosion", DebugView::NetErosion},
-        {"wetness", DebugView::Wetness}};
-    for (const auto& [name, view] : views)
-        if (text == name) return view;
-    throw InputError(
-        "--debug must be none, ambient, v, u, key, normals, pyramid, shade, albedo, discharge, velocity, net-erosion "
-        "or wetness (got '" +
-        text + "')");
+    return namedChoice<DebugView>("--debug", text,
+                                  {{"none", DebugView::None},
+                                   {"ambient", DebugView::Ambient},
+                                   {"v", DebugView::SkyVisibility},
+                                   {"u", DebugView::IndirectRadiance},
+                                   {"key", DebugView::KeyVisibility},
+                                   {"normals", DebugView::Normals},
+                                   {"pyramid", DebugView::PyramidLevel},
+                                   {"shade", DebugView::ShadeMap},
+                                   {"albedo", DebugView::Albedo},
+                                   {"discharge", DebugView::Discharge},
+                                   {"velocity", DebugView::Velocity},
+                                   {"net-erosion", DebugView::NetErosion},
+                                   {"wetness", DebugView::Wetness}});
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "app/gi_images.h"
+#include "app/named_choice.h"
 #include "app/option_ranges.h"
 #include "app/progress.h"
 #include "core/error.h"
@@ -227,31 +228,18 @@ void checkGiOptions(const GiOptions& o) {
 gi::GiSettings giSettingsFrom(const GiOptions& o, ExponentSource& exponent) {
     gi::GiSettings settings = o.settings;
     parseBrdf(o.brdf, settings.shading);
-    if (!o.glossy.empty()) {
-        if (o.glossy == "vector")
-            settings.indirect.glossy = gi::GlossyIndirect::VectorPyramid;
-        else if (o.glossy == "scalar")
-            settings.indirect.glossy = gi::GlossyIndirect::ScalarPyramid;
-        else
-            throw InputError("--glossy must be vector or scalar (got '" + o.glossy + "')");
-    }
+    if (!o.glossy.empty())
+        settings.indirect.glossy = namedChoice<gi::GlossyIndirect>(
+            "--glossy", o.glossy,
+            {{"vector", gi::GlossyIndirect::VectorPyramid}, {"scalar", gi::GlossyIndirect::ScalarPyramid}});
     exponent = parsePhongExponent(o, settings);
-    if (!o.indirectKernel.empty()) {
-        if (o.indirectKernel == "sh")
-            settings.indirect.lambert = gi::LambertIndirect::ShKernel;
-        else if (o.indirectKernel == "blocker")
-            settings.indirect.lambert = gi::LambertIndirect::BlockerRadiance;
-        else
-            throw InputError("--indirect-kernel must be blocker or sh (got '" + o.indirectKernel + "')");
-    }
-    if (!o.interp.empty()) {
-        if (o.interp == "linear")
-            settings.visibility.interp = gi::AzimuthInterp::Linear;
-        else if (o.interp == "bspline")
-            settings.visibility.interp = gi::AzimuthInterp::Bspline;
-        else
-            throw InputError("--interp must be linear or bspline (got '" + o.interp + "')");
-    }
+    if (!o.indirectKernel.empty())
+        settings.indirect.lambert = namedChoice<gi::LambertIndirect>(
+            "--indirect-kernel", o.indirectKernel,
+            {{"blocker", gi::LambertIndirect::BlockerRadiance}, {"sh", gi::LambertIndirect::ShKernel}});
+    if (!o.interp.empty())
+        settings.visibility.interp = namedChoice<gi::AzimuthInterp>(
+            "--interp", o.interp, {{"linear", gi::AzimuthInterp::Linear}, {"bspline", gi::AzimuthInterp::Bspline}});
     gi::validateGiSettings(settings);
     return settings;
 }

@@ -226,6 +226,12 @@ void environmentVisibility(const GiSettings& settings, const ReceiverTiles* only
         st.envOperator = foldFullCircle(settings.visibility.azimuths, settings.visibility.interp);
         st.envOperatorAzimuths = settings.visibility.azimuths;
         st.envOperatorInterp = settings.visibility.interp;
+        const std::vector<double>& phi = st.envOperator.phi;
+        st.envCosSin.resize(2 * phi.size());
+        for (std::size_t j = 0; j < phi.size(); ++j) {
+            st.envCosSin[2 * j] = static_cast<float>(std::cos(phi[j]));
+            st.envCosSin[2 * j + 1] = static_cast<float>(std::sin(phi[j]));
+        }
     }
     const bool footprint = settings.subsample > 1 && settings.visibility.footprintTangent;
     if (footprint) computeFootprintBox(st.gradX.cview(), st.gradY.cview(), settings.subsample, st.footprint);
@@ -290,12 +296,6 @@ ShadingLight environmentShadingLight(const ShRgb& environment, const VisibilityF
 // over the environment's azimuths (the scan's own table holds the last key
 // light's by now).
 void exactAmbient(const GiSettings& settings, GiState& st, const std::vector<std::uint8_t>* rows) {
-    const std::vector<double>& phi = st.envOperator.phi;
-    st.envCosSin.resize(2 * phi.size());
-    for (std::size_t j = 0; j < phi.size(); ++j) {
-        st.envCosSin[2 * j] = static_cast<float>(std::cos(phi[j]));
-        st.envCosSin[2 * j + 1] = static_cast<float>(std::sin(phi[j]));
-    }
     const bool footprint = settings.subsample > 1 && settings.visibility.footprintTangent;
     const AmbientInputs in{.gradX = st.gradX.cview(),
                            .gradY = st.gradY.cview(),

@@ -44,7 +44,7 @@ struct GiState {
     std::vector<VisibilityField> keyVisibility;
     std::vector<ShadingLight> shadingLights;
     ShadeMaps shade;
-    std::vector<float> envCosSin;  // cos, sin of each environment azimuth (the exact ambient's)
+    std::vector<float> envCosSin;  // cos, sin of each envOperator azimuth (the exact ambient's), built with it
     AmbientScratch ambientScratch;
     GiTimings timings;
     // Indirect light (gi/indirect.h): indirect.indirect and indirect.total

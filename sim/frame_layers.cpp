@@ -50,9 +50,13 @@ FrameLayers frameLayers(const Simulation& sim) {
         f.layers.push_back(std::move(l));
     };
     if (hasWaterFlow(s)) {
-        add("discharge", "m^3/s", [&](Grid& g) { dischargeMap(s, g); });
+        FrameLayer discharge{"discharge", "m^3/s", Grid{}};
+        dischargeMap(s, discharge.grid);
+        Grid sedimentFlux;  // carried by that discharge
+        if (!s.suspended.empty()) sedimentFluxMap(s, discharge.grid, sedimentFlux);
+        f.layers.push_back(std::move(discharge));
         add("velocity", "m/s", [&](Grid& g) { velocityMap(s, g); });
-        if (!s.suspended.empty()) add("sediment_flux", "m^3/s", [&](Grid& g) { sedimentFluxMap(s, g); });
+        if (!s.suspended.empty()) f.layers.push_back({"sediment_flux", "m^3/s", std::move(sedimentFlux)});
     }
     const HydrologyAccumulator& h = sim.hydrology();
     if (h.tracksGround()) {

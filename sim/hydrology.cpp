@@ -60,20 +60,12 @@ void HydrologyAccumulator::start(const TerrainState& s, bool trackGround, bool t
     wetTicks_.assign(trackWater && s.hasWater() ? n : 0, 0);
 }
 
-void HydrologyAccumulator::accumulate(const TerrainState& s, const Grid& groundBefore) {
-    ++ticks_;
-    const bool ground = tracksGround(), water = tracksWater();
-    if (!ground && !water) return;
-    const int nx = nx_;
-    parallelForRows(ny_, nx, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y) {
-            const std::size_t row = cellIndex(0, y, nx);
-            if (ground)
-                addGroundChange(s.bedrock.data() + row, s.soil.data() + row, groundBefore.data() + row,
-                                erosion_.data() + row, deposition_.data() + row, nx);
-            if (water) countWet(s.water.data() + row, wetTicks_.data() + row, nx);
-        }
-    });
+void HydrologyAccumulator::accumulateRow(int y, const float* bedrock, const float* soil, const float* groundBefore,
+                                         const float* water) {
+    const std::size_t row = cellIndex(0, y, nx_);
+    if (tracksGround())
+        addGroundChange(bedrock, soil, groundBefore, erosion_.data() + row, deposition_.data() + row, nx_);
+    if (tracksWater() && water) countWet(water, wetTicks_.data() + row, nx_);
 }
 
 void HydrologyAccumulator::erosionMap(Grid& out) const {
@@ -142,13 +134,11 @@ void velocityMap(const TerrainState& s, Grid& out) {
     });
 }
 
-void sedimentFluxMap(const TerrainState& s, Grid& out) {
+void sedimentFluxMap(const TerrainState& s, const Grid& discharge, Grid& out) {
     fillMap(s.nx, s.ny, out, [&](std::size_t i) {
         const float depth = s.water.v[i];
         if (s.suspended.empty() || depth < kWetDepth) return 0.0f;
-        float qx = 0.0f, qy = 0.0f;
-        cellDischarge(s, static_cast<int>(i % s.nx), static_cast<int>(i / s.nx), qx, qy);
-        return std::sqrt(qx * qx + qy * qy) * (s.suspended.v[i] / depth);
+        return discharge.v[i] * (s.suspended.v[i] / depth);
     });
 }
 

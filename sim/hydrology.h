@@ -46,9 +46,12 @@ public:
     /// wet ticks when it has water; neither = tracks nothing.
     void start(const TerrainState& s, bool trackGround, bool trackWater);
 
-    /// Adds one tick: groundBefore is bedrock + soil before the tick, s the
-    /// state after it. Call before groundBefore is overwritten.
-    void accumulate(const TerrainState& s, const Grid& groundBefore);
+    /// Adds row y of one tick: groundBefore is bedrock + soil before the
+    /// tick, the others the layers after it (water null without water). The
+    /// Simulation calls it from the pass that already streams these rows for
+    /// its change report, then countTick() once.
+    void accumulateRow(int y, const float* bedrock, const float* soil, const float* groundBefore, const float* water);
+    void countTick() { ++ticks_; }
 
     bool tracksGround() const { return !erosion_.empty(); }
     bool tracksWater() const { return !wetTicks_.empty(); }
@@ -92,6 +95,7 @@ void cellDischarge(const TerrainState& s, int x, int y, float& qx, float& qy);
 /// Per-frame maps (resized to nx x ny); require hasWaterFlow(s).
 void dischargeMap(const TerrainState& s, Grid& out);
 void velocityMap(const TerrainState& s, Grid& out);
-void sedimentFluxMap(const TerrainState& s, Grid& out);
+/// Sediment flux from the discharge map dischargeMap(s) gave.
+void sedimentFluxMap(const TerrainState& s, const Grid& discharge, Grid& out);
 
 }  // namespace terrain

@@ -254,7 +254,7 @@ void Simulation::tick() {
     state_.time += static_cast<double>(dt_);
     lastSubsteps_ = settings_.waves ? waveScratch_.lastSubsteps : 1;
     state_.tick += 1;
-    hydrology_.accumulate(state_, prevGround_);  // before updateChanges moves prevGround_ on
+    hydrology_.countTick();
     if (simulates)
         updateChanges();
     else {
@@ -280,6 +280,7 @@ void Simulation::updateChanges() {
                 float* p = prevGround_.data() + static_cast<std::size_t>(y) * nx;
                 const float* w = prevWater_.empty() ? nullptr : state_.water.data() + static_cast<std::size_t>(y) * nx;
                 float* pw = prevWater_.empty() ? nullptr : prevWater_.data() + static_cast<std::size_t>(y) * nx;
+                hydrology_.accumulateRow(y, b, so, p, w);  // before p moves on to this tick's ground
                 for (int tx = 0; tx < changes_.tilesX; ++tx) {
                     float mg = 0.0f, mw = 0.0f;
                     const int x1 = std::min(nx, (tx + 1) * ts);
