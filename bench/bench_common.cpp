@@ -115,6 +115,19 @@ Dem erodedScene(int size, int ticks) {
     return d;
 }
 
+Dem cropDem(const Dem& src, int size, const std::string& tag) {
+    Dem d;
+    d.name = src.name + "-" + tag;
+    d.cell = src.cell;
+    d.heights = centreCrop(src.heights, size);
+    return d;
+}
+
+std::vector<Dem> realDems(const std::string& dataDir) {
+    const Dem perdu = loadPerdu(dataDir);
+    return {loadAlps(dataDir), cropDem(perdu, 512, "c512"), boxDownsample(perdu, 4, "80m"), erodedScene(256, 2000)};
+}
+
 Grid centreCrop(const Grid& g, int size) {
     Grid c(size, size);
     const int x0 = (g.nx - size) / 2, y0 = (g.ny - size) / 2;

@@ -60,6 +60,14 @@ Dem loadPerdu(const std::string& dataDir);
 /// The central size^2 texels of g.
 Grid centreCrop(const Grid& g, int size);
 
+/// The central size^2 texels of a DEM, named name + "-" + tag.
+Dem cropDem(const Dem& src, int size, const std::string& tag);
+
+/// Every real DEM the ambient and sky accuracy are measured on: Mont Blanc,
+/// a 512^2 crop of Mont Perdu at 20 m, Mont Perdu downsampled to 80 m, and
+/// an `erosion` frame (256^2 after 2000 ticks).
+std::vector<Dem> realDems(const std::string& dataDir);
+
 /// The mean of each factor x factor block (the last partial blocks left out):
 /// the DEM at factor times its cell size, named name + "-" + tag.
 Dem boxDownsample(const Dem& d, int factor, const std::string& tag);

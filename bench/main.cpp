@@ -42,6 +42,7 @@ int main(int argc, char** argv) {
     add(&addGiIndirectSuite);
     add(&addGiGlossySuite);
     add(&addGiIncrementalSuite);
+    add(&addGiSunSkySuite);
     add(&addGiBoundDiagnosisSuite);
     add(&addLongRunSuite);
     try {

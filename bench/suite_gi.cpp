@@ -46,14 +46,6 @@ struct ErrorStats {
     long count = 0;
 };
 
-Dem crop(const Dem& src, int size, const std::string& tag) {
-    Dem d;
-    d.name = src.name + "-" + tag;
-    d.cell = src.cell;
-    d.heights = centreCrop(src.heights, size);
-    return d;
-}
-
 ErrorStats compare(const Grid& fast, const Grid& ref, int stride, int border) {
     ErrorStats e;
     double s2 = 0.0, s1 = 0.0;
@@ -298,9 +290,7 @@ GiSettings engineBeforeExactAmbient() {
 }
 
 void GiSuite::dems() const {
-    const Dem perdu = loadPerdu(ctx_.dataDir);
-    const std::vector<Dem> dems = {loadAlps(ctx_.dataDir), crop(perdu, 512, "c512"), boxDownsample(perdu, 4, "80m"),
-                                   erodedScene(256, 2000)};
+    const std::vector<Dem> dems = realDems(ctx_.dataDir);
     std::string md = "# The ambient map on real DEMs\n\n";
     md +=
         "Ambient = normal-weighted sky-view factor (direct irradiance / pi under a uniform unit sky), against "
@@ -410,7 +400,7 @@ void GiSuite::explore() const {
 // ---------------------------------------------------------------------------
 void GiSuite::convergence() const {
     const Dem alps = loadAlps(ctx_.dataDir);
-    const Dem small = crop(alps, 256, "c256");
+    const Dem small = cropDem(alps, 256, "c256");
     const int border = small.heights.nx / 10;
     const Grid ref = referenceAmbient(small, 1, border);
     std::vector<Row> rows;
@@ -517,9 +507,9 @@ void GiSuite::timing() const {
         std::string source;
     };
     std::vector<Size> sizes;
-    sizes.push_back({crop(alps, 256, "c256"), "alps c256"});
-    sizes.push_back({crop(alps, 512, "c512"), "alps c512"});
-    sizes.push_back({crop(perdu, 1024, "c1024"), "mtperdu c1024"});
+    sizes.push_back({cropDem(alps, 256, "c256"), "alps c256"});
+    sizes.push_back({cropDem(alps, 512, "c512"), "alps c512"});
+    sizes.push_back({cropDem(perdu, 1024, "c1024"), "mtperdu c1024"});
     const GiLighting light = sunSkyAndKey();
     std::string md = "# GI time per frame\n\n";
     md +=
@@ -621,7 +611,7 @@ void GiSuite::stages() const {
         int s;
         const char* which;
     };
-    const Dem c512 = crop(alps, 512, "c512");
+    const Dem c512 = cropDem(alps, 512, "c512");
     int caseIndex = -1;
     for (const Case& c :
          {Case{&c512, 2, "engine"}, Case{&c512, 2, "paper"}, Case{&alps, 1, "engine"}, Case{&alps, 1, "paper"}}) {
@@ -664,7 +654,7 @@ double threadCpuMs() {
 
 void GiSuite::cpuStages() const {
     const Dem alps = loadAlps(ctx_.dataDir);
-    const Dem c512 = crop(alps, 512, "c512");
+    const Dem c512 = cropDem(alps, 512, "c512");
     const GiLighting light = sunSkyAndKey();
     struct Case {
         const Dem* dem;
@@ -730,7 +720,7 @@ void pickDirtyTiles(double fraction, bool clustered, std::mt19937& rng, Receiver
 }
 
 void GiSuite::tileTiming() const {
-    const Dem c512 = crop(loadAlps(ctx_.dataDir), 512, "c512");
+    const Dem c512 = cropDem(loadAlps(ctx_.dataDir), 512, "c512");
     GiSettings set = engineDefaults();
     set.subsample = 2;
     GiState st;

@@ -19,6 +19,7 @@ Runner addGiSuite(CLI::App& app, const BenchContext& ctx);
 Runner addGiIndirectSuite(CLI::App& app, const BenchContext& ctx);
 Runner addGiGlossySuite(CLI::App& app, const BenchContext& ctx);
 Runner addGiIncrementalSuite(CLI::App& app, const BenchContext& ctx);
+Runner addGiSunSkySuite(CLI::App& app, const BenchContext& ctx);
 Runner addGiBoundDiagnosisSuite(CLI::App& app, const BenchContext& ctx);
 Runner addLongRunSuite(CLI::App& app, const BenchContext& ctx);
 

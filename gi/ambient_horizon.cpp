@@ -24,9 +24,11 @@ struct AmbientJob {
     int nx, ny, nxr, nyr, m;
     int rowFloats;  // scratch floats per row buffer (nx rounded up, or nxr)
     float* scratch;
+    float* raised;    // azimuths x receivers (sub-sampling only)
     const int* col0;  // per texel column: left receiver, right receiver, fraction towards it
     const int* col1;
     const float* colFrac;
+    const NearFieldStep* nearSteps;  // azimuths x subsample
     const std::vector<std::uint8_t>* rows;
     Grid& out;
 };
@@ -94,15 +96,28 @@ void receiverRowHorizons(const AmbientJob& j, int Y, int a, float c, float sn, f
     }
 }
 
+// The raised horizons of every receiver row flagged in `receiverRows`, each
+// azimuth's plane (the receivers' lowest tangent slopes applied once per
+// frame, not once per texel row that reads them).
+void raiseReceiverHorizons(const AmbientJob& j, const std::vector<std::uint8_t>& receiverRows) {
+    parallelForRows(j.nyr, j.nxr * j.m, [&](int y0, int y1) {
+        for (int Y = y0; Y < y1; ++Y) {
+            if (receiverRows[static_cast<std::size_t>(Y)] == 0) continue;
+            for (int a = 0; a < j.m; ++a) {
+                const float c = j.in.cosSin[2 * static_cast<std::size_t>(a)];
+                const float sn = j.in.cosSin[2 * static_cast<std::size_t>(a) + 1];
+                receiverRowHorizons(j, Y, a, c, sn, j.raised + (static_cast<std::size_t>(a) * j.nyr + Y) * j.nxr);
+            }
+        }
+    });
+}
+
 // Horizon slopes of azimuth a at the texels of row y, bilinear from the
-// receivers (Fig. 7). rows: 3 x nxr floats of scratch.
-void interpolatedHorizons(const AmbientJob& j, int y, int a, float c, float sn, float* rows, float* out) {
+// raised receivers (Fig. 7). vert: nxr floats of scratch.
+void interpolatedHorizons(const AmbientJob& j, int y, int a, float* vert, float* out) {
     const ReceiverLerp ry = receiverLerp(y, j.in.subsample, j.nyr);
-    float* t0 = rows;
-    float* t1 = rows + j.nxr;
-    float* vert = rows + 2 * static_cast<std::size_t>(j.nxr);
-    receiverRowHorizons(j, ry.i0, a, c, sn, t0);
-    receiverRowHorizons(j, ry.i1, a, c, sn, t1);
+    const float* t0 = j.raised + (static_cast<std::size_t>(a) * j.nyr + ry.i0) * j.nxr;
+    const float* t1 = j.raised + (static_cast<std::size_t>(a) * j.nyr + ry.i1) * j.nxr;
     for (int X = 0; X < j.nxr; ++X) vert[X] = t0[X] + ry.f * (t1[X] - t0[X]);
     for (int x = 0; x < j.nx; ++x) {
         const float v0 = vert[j.col0[x]], v1 = vert[j.col1[x]];
@@ -110,10 +125,60 @@ void interpolatedHorizons(const AmbientJob& j, int y, int a, float c, float sn, 
     }
 }
 
+// Raises the horizon slopes of row y along azimuth a to the texels' own
+// blocking slopes at their near-field samples (those inside the field).
+void raiseToNearField(const AmbientJob& j, int y, int a, float* horizon) {
+    const int s = j.in.subsample;
+    const float* h0 = j.in.heights.row(y);
+    for (int k = 0; k < s; ++k) {
+        const NearFieldStep& st = j.nearSteps[static_cast<std::size_t>(a) * s + k];
+        if (std::min(y + st.ay, y + st.by) < 0 || std::max(y + st.ay, y + st.by) >= j.ny) continue;
+        const int x0 = std::max({0, -st.ax, -st.bx});
+        const int x1 = std::min({j.nx, j.nx - st.ax, j.nx - st.bx});
+        const float* hA = j.in.heights.row(y + st.ay) + st.ax;
+        const float* hB = j.in.heights.row(y + st.by) + st.bx;
+        const float wA = st.wA, wB = st.wB, inv = st.invTau;
+        for (int x = x0; x < x1; ++x) {
+            const float slope = (wA * hA[x] + wB * hB[x] - h0[x]) * inv;
+            horizon[x] = horizon[x] > slope ? horizon[x] : slope;
+        }
+    }
+}
+
+// The near-field samples of every azimuth: for k = 1..s the ray's k-th
+// crossing with the grid lines across its major axis, at distance
+// k / |major component| cells, linear between the two texels on that line.
+void buildNearSteps(const AmbientInputs& in, int m, std::vector<NearFieldStep>& out) {
+    const int s = in.subsample;
+    out.assign(static_cast<std::size_t>(m) * s, NearFieldStep{});
+    for (int a = 0; a < m; ++a) {
+        const double c = in.cosSin[2 * static_cast<std::size_t>(a)];
+        const double sn = in.cosSin[2 * static_cast<std::size_t>(a) + 1];
+        const bool xMajor = std::abs(c) >= std::abs(sn);
+        const double major = xMajor ? std::abs(c) : std::abs(sn), minor = xMajor ? sn : c;
+        for (int k = 1; k <= s; ++k) {
+            const double t = k / major;
+            double offset = t * minor;
+            if (std::abs(offset - std::round(offset)) < 1e-6) offset = std::round(offset);  // on a texel
+            const int i = static_cast<int>(std::floor(offset));
+            const double w = offset - i;
+            const int along = (xMajor ? c : sn) > 0.0 ? k : -k;
+            NearFieldStep& st = out[static_cast<std::size_t>(a) * s + (k - 1)];
+            (xMajor ? st.ax : st.ay) = along;
+            (xMajor ? st.bx : st.by) = along;
+            (xMajor ? st.ay : st.ax) = i;
+            (xMajor ? st.by : st.bx) = w > 0.0 ? i + 1 : i;
+            st.wA = static_cast<float>(1.0 - w);
+            st.wB = static_cast<float>(w);
+            st.invTau = static_cast<float>(1.0 / (t * in.cellSize));
+        }
+    }
+}
+
 void ambientRow(const AmbientJob& j, int y, float* buffers) {
     float* acc = buffers;
     float* horizon = buffers + j.rowFloats;
-    float* receiverRows = buffers + 2 * static_cast<std::size_t>(j.rowFloats);
+    float* vert = buffers + 2 * static_cast<std::size_t>(j.rowFloats);
     std::fill(acc, acc + j.nx, 0.0f);
     const float* gx = j.in.gradX.row(y);
     const float* gy = j.in.gradY.row(y);
@@ -125,7 +190,8 @@ void ambientRow(const AmbientJob& j, int y, float* buffers) {
         if (j.in.subsample == 1) {
             h = j.in.env->maxSlope.data() + (static_cast<std::size_t>(a) * j.ny + y) * j.nx;
         } else {
-            interpolatedHorizons(j, y, a, c, sn, receiverRows, horizon);
+            interpolatedHorizons(j, y, a, vert, horizon);
+            raiseToNearField(j, y, a, horizon);
             h = horizon;
         }
         (wide ? addAzimuthRowAvx2 : addAzimuthRow<simd::F4>)(gx, gy, h, c, sn, acc, j.nx);
@@ -142,8 +208,33 @@ void checkInputs(const AmbientInputs& in, int m, const std::vector<std::uint8_t>
         env.nyr != (in.gradX.ny + s - 1) / s ||
         env.maxSlope.size() != static_cast<std::size_t>(m) * env.nxr * env.nyr || in.cosSin.size() != 2u * m)
         throw InputError("ambient: the horizons are not of this grid, sub-sampling and azimuth count");
+    if (s > 1 && (in.heights.nx != in.gradX.nx || in.heights.ny != in.gradX.ny || !(in.cellSize > 0.0f)))
+        throw InputError("ambient: sub-sampling needs the field's heights and cell size");
     if (rows && rows->size() != static_cast<std::size_t>(in.gradX.ny))
         throw InputError("ambient: one row flag per texel row expected");
+}
+
+// The receiver rows the flagged texel rows interpolate between.
+void flagReceiverRows(int ny, int s, int nyr, const std::vector<std::uint8_t>* rows, std::vector<std::uint8_t>& out) {
+    out.assign(static_cast<std::size_t>(nyr), 0);
+    for (int y = 0; y < ny; ++y) {
+        if (rows && (*rows)[static_cast<std::size_t>(y)] == 0) continue;
+        const ReceiverLerp r = receiverLerp(y, s, nyr);
+        out[static_cast<std::size_t>(r.i0)] = out[static_cast<std::size_t>(r.i1)] = 1;
+    }
+}
+
+// Per texel column: the receivers it lies between and the fraction towards the second.
+void buildColumnLerps(int nx, int s, int nxr, AmbientScratch& scratch) {
+    scratch.col0.resize(static_cast<std::size_t>(nx));
+    scratch.col1.resize(static_cast<std::size_t>(nx));
+    scratch.colFrac.resize(static_cast<std::size_t>(nx));
+    for (int x = 0; x < nx; ++x) {
+        const ReceiverLerp r = receiverLerp(x, s, nxr);
+        scratch.col0[static_cast<std::size_t>(x)] = r.i0;
+        scratch.col1[static_cast<std::size_t>(x)] = r.i1;
+        scratch.colFrac[static_cast<std::size_t>(x)] = r.f;
+    }
 }
 
 }  // namespace
@@ -156,30 +247,33 @@ void ambientFromHorizons(const AmbientInputs& in, Grid& ambient, AmbientScratch&
     ambient.ensureSize(nx, ny);
     const int nBlocks = std::max(1, std::min(ny, 64));
     const int rowFloats = std::max(nx, in.env->nxr);
-    constexpr int kRowsPerBlock = 5;  // acc, horizon, two receiver rows, their vertical blend
+    constexpr int kRowsPerBlock = 3;  // acc, horizon, the receivers' vertical blend
     scratch.rows.resize(static_cast<std::size_t>(nBlocks) * kRowsPerBlock * rowFloats);
-    scratch.col0.resize(static_cast<std::size_t>(nx));
-    scratch.col1.resize(static_cast<std::size_t>(nx));
-    scratch.colFrac.resize(static_cast<std::size_t>(nx));
-    for (int x = 0; x < nx; ++x) {
-        const ReceiverLerp r = receiverLerp(x, in.subsample, in.env->nxr);
-        scratch.col0[static_cast<std::size_t>(x)] = r.i0;
-        scratch.col1[static_cast<std::size_t>(x)] = r.i1;
-        scratch.colFrac[static_cast<std::size_t>(x)] = r.f;
+    const int s = in.subsample, nxr = in.env->nxr, nyr = in.env->nyr;
+    buildColumnLerps(nx, s, nxr, scratch);
+    if (s > 1) {
+        scratch.raised.resize(in.env->maxSlope.size());
+        buildNearSteps(in, m, scratch.nearSteps);
     }
     const AmbientJob job{in,
                          nx,
                          ny,
-                         in.env->nxr,
-                         in.env->nyr,
+                         nxr,
+                         nyr,
                          m,
                          rowFloats,
                          scratch.rows.data(),
+                         scratch.raised.data(),
                          scratch.col0.data(),
                          scratch.col1.data(),
                          scratch.colFrac.data(),
+                         scratch.nearSteps.data(),
                          rows,
                          ambient};
+    if (s > 1) {
+        flagReceiverRows(ny, s, nyr, rows, scratch.receiverRows);
+        raiseReceiverHorizons(job, scratch.receiverRows);
+    }
     parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
         for (int block = b0; block < b1; ++block) {
             float* buffers = job.scratch + static_cast<std::size_t>(block) * kRowsPerBlock * rowFloats;

@@ -21,7 +21,13 @@
 // Sub-sampling (Fig. 7): the horizon slope of each receiver is first raised
 // to its lowest tangent slope (the footprint box's, as the SH visibility
 // does, or the receiver's own), interpolated bilinearly to the texel, and
-// raised to the texel's own tangent slope there.
+// raised to the texel's own tangent slope there. The receivers' scans start
+// one receiver spacing out (gi/pyramid.h), so what lies within s cells of a
+// texel between receivers (a gully one cell wide, a ridge crest) is in no
+// interpolated horizon: each texel also takes its own blocking slopes at the
+// first s crossings of its ray with the grid lines across the ray's major
+// axis (where the bilinear field is linear between two texels, as the scan
+// samples) and keeps the highest.
 #include <array>
 #include <cstdint>
 #include <span>
@@ -44,17 +50,29 @@ enum class AmbientMethod {
 /// resolution gradients, and the footprint boxes when sub-sampling uses them.
 struct AmbientInputs {
     ConstGridView gradX, gradY;
+    ConstGridView heights;  // full resolution (read for the near field when subsample > 1)
+    float cellSize = 1.0f;  // metres
     int subsample = 1;
     const VisibilityField* env = nullptr;
     std::span<const float> cosSin;            // azimuths x 2
     const FootprintBox* footprint = nullptr;  // null: the receivers' own tangent planes
 };
 
-/// Per-block rows of the computation, reused across frames.
+/// One near-field sample of a sub-sampled texel (x, y) along one azimuth:
+/// wA h(x + ax, y + ay) + wB h(x + bx, y + by) at distance 1 / invTau metres.
+struct NearFieldStep {
+    int ax = 0, ay = 0, bx = 0, by = 0;
+    float wA = 1.0f, wB = 0.0f, invTau = 0.0f;
+};
+
+/// Buffers of the computation, reused across frames.
 struct AmbientScratch {
-    std::vector<float> rows;
-    std::vector<int> col0, col1;  // per texel column: the receivers it lies between
-    std::vector<float> colFrac;   // and the fraction towards the second
+    std::vector<float> rows;                 // per row block
+    std::vector<float> raised;               // azimuths x receivers: horizons raised to the lowest tangent slope
+    std::vector<std::uint8_t> receiverRows;  // the receiver rows this call reads
+    std::vector<int> col0, col1;             // per texel column: the receivers it lies between
+    std::vector<float> colFrac;              // and the fraction towards the second
+    std::vector<NearFieldStep> nearSteps;    // azimuths x subsample
 };
 
 /// Adds the light of a sky of constant radiance `radiance` (RGB) to a

@@ -294,11 +294,15 @@ ShadingLight environmentShadingLight(const ShRgb& environment, const VisibilityF
 
 // The ambient map from the environment scan's horizons (gi/ambient_horizon.h),
 // over the environment's azimuths (the scan's own table holds the last key
-// light's by now).
-void exactAmbient(const GiSettings& settings, GiState& st, const std::vector<std::uint8_t>* rows) {
+// light's by now). It depends on the geometry alone: the frames recompute it
+// where the environment's V was recomputed, not when only the lights change.
+void exactAmbient(ConstGridView heights, float cellSize, const GiSettings& settings, GiState& st,
+                  const std::vector<std::uint8_t>* rows) {
     const bool footprint = settings.subsample > 1 && settings.visibility.footprintTangent;
     const AmbientInputs in{.gradX = st.gradX.cview(),
                            .gradY = st.gradY.cview(),
+                           .heights = heights,
+                           .cellSize = cellSize,
                            .subsample = settings.subsample,
                            .env = &st.envVisibility,
                            .cosSin = st.envCosSin,
@@ -325,7 +329,6 @@ void directShading(const GiLighting& lighting, const GiSettings& settings, const
         st.shadingLights[k + 1] = keyShadingLight(lighting.keys[k], st.keyVisibility[k]);
     shadeTexels(st.gradX.cview(), st.gradY.cview(), settings.subsample, st.envVisibility, st.shadingLights.data(),
                 static_cast<int>(st.shadingLights.size()), albedo, settings.shading, st.shade, shAmbient, rows);
-    if (!shAmbient) exactAmbient(settings, st, rows);
     if (splitSky) addConstantSky(st.shade.ambient, skyConstant, albedo, st.shade.rgb, rows);
     if (exactKeys)
         for (std::size_t k = 0; k < nKeys; ++k)
@@ -412,7 +415,10 @@ void runDirectStages(ConstGridView heights, float cellSize, const GiLighting& li
     keyLightVisibility(lighting, settings, change, keyOnly, st);
     st.timings.keyVisibility = msSince(t);
     t = Clock::now();
-    directShading(lighting, settings, albedo, st, shadingRows(heights, change, plan, st));
+    const std::vector<std::uint8_t>* rows = shadingRows(heights, change, plan, st);
+    if (change.geometry && settings.ambient == AmbientMethod::Horizons)
+        exactAmbient(heights, cellSize, settings, st, rows);
+    directShading(lighting, settings, albedo, st, rows);
     st.timings.shading = msSince(t);
 }
 

@@ -37,13 +37,17 @@ namespace terrain::gi {
 // gi_indirect_accuracy.md). The mean filter lowers distant peaks, which ends
 // casting sets early and lifts the ambient light (the paper settings'
 // positive bias): a level offset of 3 and max-decimated octaves keep the
-// peaks at the same cost. All max: the ambient integrated exactly above the
-// horizons (gi/ambient_horizon.h) has no SH truncation left to offset a
-// lowered horizon, and the indirect light's casting sets need the peaks.
+// peaks at the same cost. Nearly all max: the ambient integrated exactly
+// above the horizons (gi/ambient_horizon.h) has no SH truncation left to
+// offset a lowered horizon, and the indirect light's casting sets need the
+// peaks; but the maximum over a level's footprint also lifts a horizon above
+// what the ray itself meets, most on rough fine-celled DEMs (the ambient
+// turns dark), so a tenth of the mean is kept: the blend with the smallest
+// ambient bias across the DEMs measured.
 struct PyramidSettings {
     int levelsPerOctave = 4;  // k_v (paper: 4)
     int levelOffset = 3;      // o_v in octaves (paper: 2)
-    float peakBlend = 1.0f;   // 0 = mean pyramid (paper); 1 = max-decimated octaves
+    float peakBlend = 0.9f;   // 0 = mean pyramid (paper); 1 = max-decimated octaves
     bool operator==(const PyramidSettings&) const = default;
 };
 

@@ -8,6 +8,7 @@
 #include <mutex>
 #include <vector>
 
+#include "core/error.h"
 #include "core/parallel.h"
 #include "gi/frame.h"
 #include "gi/visibility.h"
@@ -102,12 +103,41 @@ struct ReferenceTexels {
     const Grid& gy;
     double heightMax;
     const ReferenceAzimuths& az;
-    const ElevationTables* tables;  // null: ambient only
+    const ElevationTables* tables;  // SH lighting (null: none)
     const ShRgb* lighting;
+    const SunSkySettings* gradient;  // the sky gradient's function (null: none)
     const AlbedoMap* albedo;
     double dphi;  // 2 pi / M
     ReferenceResult& out;
 };
+
+// Adds the integral over the visible elevations [lo, pi/2] of the sky
+// gradient's radiance L(w) times (N . d) cos w, d = (cos w cos phi,
+// cos w sin phi, sin w), N . d = nh cos w + nz sin w, per channel
+// (antiderivatives in gi/reference.h, renderReferenceSkyGradient).
+void addGradientElevationIntegral(const SunSkySettings& sky, double lo, double nh, double nz, double rgb[3]) {
+    auto cos2 = [](double w) { return 0.5 * w + 0.25 * std::sin(2.0 * w); };
+    auto sinCos = [](double w) { return 0.5 * std::sin(w) * std::sin(w); };
+    auto sinCos2 = [](double w) { return -std::pow(std::cos(w), 3) / 3.0; };
+    auto sin2Cos = [](double w) { return std::pow(std::sin(w), 3) / 3.0; };
+    const double top = 0.5 * kPi, a = std::max(lo, 0.0), b = std::min(lo, 0.0);
+    // above the horizontal: horizon + (zenith - horizon) sin w; below: ground
+    const double flat = nh * (cos2(top) - cos2(a)) + nz * (sinCos(top) - sinCos(a));
+    const double rising = nh * (sinCos2(top) - sinCos2(a)) + nz * (sin2Cos(top) - sin2Cos(a));
+    const double below = nh * (cos2(0.0) - cos2(b)) + nz * (sinCos(0.0) - sinCos(b));
+    for (int ch = 0; ch < 3; ++ch)
+        rgb[ch] += sky.horizon[ch] * flat + (sky.zenith[ch] - sky.horizon[ch]) * rising + sky.ground[ch] * below;
+}
+
+// The Lambert shade of texel (x, y) from its azimuth sums: albedo x sum x dphi / pi.
+void writeReferenceShade(const ReferenceTexels& t, int x, int y, const double sum[3]) {
+    for (int ch = 0; ch < 3; ++ch) {
+        const float alb = t.albedo && !t.albedo->channel[static_cast<std::size_t>(ch)].empty()
+                              ? t.albedo->channel[static_cast<std::size_t>(ch)](x, y)
+                              : 1.0f;
+        t.out.rgb[static_cast<std::size_t>(ch)](x, y) = static_cast<float>(alb * sum[ch] * t.dphi / kPi);
+    }
+}
 
 // The ambient (and, with lighting, the Lambert shade) of texel (x, y): per
 // azimuth the exact blocking slope, then the elevation integrals above
@@ -119,6 +149,7 @@ void shadeReferenceTexel(const ReferenceTexels& t, int x, int y) {
     const double nxv = -gxv * inv, nyv = -gyv * inv, nzv = inv;
     double amb = 0.0;
     double transfer[kShCount] = {};
+    double skyRgb[3] = {};
     for (int a = 0; a < M; ++a) {
         const double c = t.az.cosA[static_cast<std::size_t>(a)], s = t.az.sinA[static_cast<std::size_t>(a)];
         const double slope = referenceMaxSlope(t.heights, t.cellSize, x, y, c, s, t.heightMax);
@@ -127,6 +158,7 @@ void shadeReferenceTexel(const ReferenceTexels& t, int x, int y) {
         const double horiz = nxv * c + nyv * s;
         const double sl = std::sin(lo), cl = std::cos(lo);
         amb += horiz * (0.5 * kPi - lo - sl * cl) * 0.5 + nzv * cl * cl * 0.5;
+        if (t.gradient) addGradientElevationIntegral(*t.gradient, lo, horiz, nzv, skyRgb);
         if (t.tables) {
             double P[kShCount], Q[kShCount];
             t.tables->lookup(lo, P, Q);
@@ -137,15 +169,10 @@ void shadeReferenceTexel(const ReferenceTexels& t, int x, int y) {
     }
     t.out.ambient(x, y) = static_cast<float>(amb * t.dphi / kPi);
     if (t.tables)
-        for (int ch = 0; ch < 3; ++ch) {
-            double e = 0.0;
+        for (int ch = 0; ch < 3; ++ch)
             for (int i = 0; i < kShCount; ++i)
-                e += t.lighting->c[static_cast<std::size_t>(ch)][static_cast<std::size_t>(i)] * transfer[i];
-            const float alb = t.albedo && !t.albedo->channel[static_cast<std::size_t>(ch)].empty()
-                                  ? t.albedo->channel[static_cast<std::size_t>(ch)](x, y)
-                                  : 1.0f;
-            t.out.rgb[static_cast<std::size_t>(ch)](x, y) = static_cast<float>(alb * e * t.dphi / kPi);
-        }
+                skyRgb[ch] += t.lighting->c[static_cast<std::size_t>(ch)][static_cast<std::size_t>(i)] * transfer[i];
+    if (t.tables || t.gradient) writeReferenceShade(t, x, y, skyRgb);
 }
 
 // Prints "reference: N%" to stdout every 5 % of the rows.
@@ -203,12 +230,15 @@ double referenceMaxSlope(ConstGridView h, float cellSize, int x, int y, double c
     return best;
 }
 
-void renderReference(ConstGridView heights, float cellSize, const ShRgb* lighting, const AlbedoMap* albedo,
-                     const ReferenceSettings& rs, ReferenceResult& out) {
+namespace {
+
+// Every texel of the interior (settings' border and stride), rows in parallel.
+void renderTexels(ConstGridView heights, float cellSize, const ShRgb* lighting, const SunSkySettings* gradient,
+                  const AlbedoMap* albedo, const ReferenceSettings& rs, ReferenceResult& out) {
     const int nx = heights.nx, ny = heights.ny;
     const int M = std::max(rs.azimuths, 1);
     out.ambient.resize(nx, ny, 0.0f);
-    if (lighting)
+    if (lighting || gradient)
         for (Grid& g : out.rgb) g.resize(nx, ny, 0.0f);
     Grid gx, gy;
     computeGradient(heights, cellSize, gx, gy);  // the fast path's normals
@@ -216,9 +246,18 @@ void renderReference(ConstGridView heights, float cellSize, const ShRgb* lightin
     for (int y = 0; y < ny; ++y)
         for (int x = 0; x < nx; ++x) heightMax = std::max(heightMax, static_cast<double>(heights(x, y)));
     const ReferenceAzimuths azimuths(M);
-    const ReferenceTexels texels{
-        heights, cellSize,      gx, gy, heightMax, azimuths, lighting ? &elevationTables() : nullptr, lighting,
-        albedo,  2.0 * kPi / M, out};
+    const ReferenceTexels texels{heights,
+                                 cellSize,
+                                 gx,
+                                 gy,
+                                 heightMax,
+                                 azimuths,
+                                 lighting ? &elevationTables() : nullptr,
+                                 lighting,
+                                 gradient,
+                                 albedo,
+                                 2.0 * kPi / M,
+                                 out};
     const int stride = std::max(rs.stride, 1);
     const int yBegin = rs.border, yEnd = ny - rs.border;
     const int rowsTotal = std::max(0, (yEnd - yBegin + stride - 1) / stride);
@@ -231,6 +270,21 @@ void renderReference(ConstGridView heights, float cellSize, const ShRgb* lightin
             if (rs.progress) progress.rowDone();
         }
     });
+}
+
+}  // namespace
+
+void renderReference(ConstGridView heights, float cellSize, const ShRgb* lighting, const AlbedoMap* albedo,
+                     const ReferenceSettings& rs, ReferenceResult& out) {
+    renderTexels(heights, cellSize, lighting, nullptr, albedo, rs, out);
+}
+
+void renderReferenceSkyGradient(ConstGridView heights, float cellSize, const SunSkySettings& sky,
+                                const AlbedoMap* albedo, const ReferenceSettings& rs, ReferenceResult& out) {
+    for (float s : sky.sun)
+        if (s != 0.0f)
+            throw InputError("sky reference: the gradient has a sun lobe; integrate the sun as a key light instead");
+    renderTexels(heights, cellSize, nullptr, &sky, albedo, rs, out);
 }
 
 }  // namespace terrain::gi

@@ -42,6 +42,19 @@ struct ReferenceResult {
 void renderReference(ConstGridView heights, float cellSize, const ShRgb* lighting, const AlbedoMap* albedo,
                      const ReferenceSettings& settings, ReferenceResult& out);
 
+/// The ground truth of the analytic sky's Lambert shade (out.rgb; out.ambient
+/// as renderReference), integrating its radiance function, not its SH
+/// projection: above the horizontal L(w) = horizon + (zenith - horizon) sin w,
+/// below it `ground` (gi::sunSkyLight's gradient). Per azimuth, over the
+/// visible elevations [lo, pi/2] (lo = max(horizon, tangent plane)), the
+/// integral of L(w) (N . d) cos w is closed form:
+///   int cos^2 = w/2 + sin 2w / 4,   int sin cos = sin^2 w / 2,
+///   int sin cos^2 = -cos^3 w / 3,   int sin^2 cos = sin^3 w / 3.
+/// Throws InputError when `sky` has a sun lobe (integrate the sun as a key
+/// light: addReferenceKeyLight, gi/reference_gi.h).
+void renderReferenceSkyGradient(ConstGridView heights, float cellSize, const SunSkySettings& sky,
+                                const AlbedoMap* albedo, const ReferenceSettings& settings, ReferenceResult& out);
+
 /// Exact maximum blocking slope of the bilinear height field from grid point
 /// (x, y) along unit direction (c, s) (cells), or kNoBlocker when the ray
 /// leaves the domain at once. heightMax: the grid's maximum (early exit).

@@ -118,6 +118,27 @@ TEST_CASE("gi.ambient_horizon: on rough terrain it is closer to the ground truth
     }
 }
 
+TEST_CASE("gi.ambient_horizon: at sub-sampling a texel between receivers sees its own near field") {
+    // ridges on the even columns (the receivers at 2x), one-cell valleys on
+    // the odd ones: the receivers see open sky across the ridges, a valley
+    // texel a wall of slope 2 one cell away on either side
+    const Grid g = gridOf(48, 48, [](int x, int) { return x % 2 == 0 ? 2.0f : 0.0f; });
+    ReferenceResult ref;
+    ReferenceSettings rs;
+    rs.border = 8;
+    renderReference(g.cview(), 1.0f, nullptr, nullptr, rs, ref);
+    GiSettings settings;
+    settings.subsample = 2;
+    GiState st;
+    runGiFrame(g.cview(), 1.0f, GiLighting{}, settings, st);
+    for (int x : {23, 25}) {
+        const double fast = st.shade.ambient(x, 24), exact = ref.ambient(x, 24);
+        MESSAGE("valley texel " << x << ": 2x " << fast << ", reference " << exact);
+        CHECK(exact < 0.5);
+        CHECK(fast == doctest::Approx(exact).epsilon(0.05));
+    }
+}
+
 TEST_CASE("gi.ambient_horizon: a state reused for a field of another size gives what a fresh state gives") {
     // the SH shading must not write the exact ambient's map (once of another size)
     const Grid small = gridOf(24, 20, [](int x, int y) { return 0.3f * x - 0.2f * y; });
