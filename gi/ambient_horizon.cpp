@@ -56,7 +56,8 @@ template <class V>
 // zero-padded vector (the same lane arithmetic, so a texel's value does not
 // depend on where it falls).
 template <class V>
-void addAzimuthRow(const float* gx, const float* gy, const float* horizon, float c, float sn, float* acc, int nx) {
+[[gnu::always_inline]] inline void addAzimuthRow(const float* gx, const float* gy, const float* horizon, float c,
+                                                 float sn, float* acc, int nx) {
     constexpr int L = simd::kLaneCount<V>;
     const int vecEnd = nx / L * L;
     addAzimuth<V>(gx, gy, horizon, c, sn, acc, 0, vecEnd);
@@ -70,11 +71,6 @@ void addAzimuthRow(const float* gx, const float* gy, const float* horizon, float
     addAzimuth<V>(tail[0], tail[1], tail[2], c, sn, tail[3], 0, L);
     std::copy(tail[3], tail[3] + n, acc + vecEnd);
 }
-[[gnu::target("avx2"), gnu::flatten]] void addAzimuthRowAvx2(const float* gx, const float* gy, const float* horizon,
-                                                             float c, float sn, float* acc, int nx) {
-    addAzimuthRow<simd::F8>(gx, gy, horizon, c, sn, acc, nx);
-}
-
 // The horizon slopes of receiver row Y along azimuth a (c, sn), each raised
 // to the receiver's lowest tangent slope: the footprint box's when there is
 // one, else its own.
@@ -112,6 +108,25 @@ void raiseReceiverHorizons(const AmbientJob& j, const std::vector<std::uint8_t>&
     });
 }
 
+// out[x] = v0 + f (v1 - v0) between the receivers around texel column x
+// (receiverLerp): S texels per receiver interval with the fractions k / S,
+// unrolled so that the compiler vectorises the runs; the columns past the
+// last whole interval from the tables.
+template <int S>
+void horizontalLerp(const AmbientJob& j, const float* vert, float* out) {
+    float frac[S];
+    for (int k = 0; k < S; ++k) frac[k] = static_cast<float>(k) / static_cast<float>(S);
+    const int intervals = std::max(0, j.nxr - 1);
+    for (int X = 0; X < intervals; ++X) {
+        const float v0 = vert[X], d = vert[X + 1] - vert[X];
+        for (int k = 0; k < S; ++k) out[S * X + k] = v0 + frac[k] * d;
+    }
+    for (int x = std::min(S * intervals, j.nx); x < j.nx; ++x) {
+        const float v0 = vert[j.col0[x]], v1 = vert[j.col1[x]];
+        out[x] = v0 + j.colFrac[x] * (v1 - v0);
+    }
+}
+
 // Horizon slopes of azimuth a at the texels of row y, bilinear from the
 // raised receivers (Fig. 7). vert: nxr floats of scratch.
 void interpolatedHorizons(const AmbientJob& j, int y, int a, float* vert, float* out) {
@@ -119,9 +134,16 @@ void interpolatedHorizons(const AmbientJob& j, int y, int a, float* vert, float*
     const float* t0 = j.raised + (static_cast<std::size_t>(a) * j.nyr + ry.i0) * j.nxr;
     const float* t1 = j.raised + (static_cast<std::size_t>(a) * j.nyr + ry.i1) * j.nxr;
     for (int X = 0; X < j.nxr; ++X) vert[X] = t0[X] + ry.f * (t1[X] - t0[X]);
-    for (int x = 0; x < j.nx; ++x) {
-        const float v0 = vert[j.col0[x]], v1 = vert[j.col1[x]];
-        out[x] = v0 + j.colFrac[x] * (v1 - v0);
+    switch (j.in.subsample) {
+        case 2:
+            return horizontalLerp<2>(j, vert, out);
+        case 4:
+            return horizontalLerp<4>(j, vert, out);
+        default:
+            for (int x = 0; x < j.nx; ++x) {
+                const float v0 = vert[j.col0[x]], v1 = vert[j.col1[x]];
+                out[x] = v0 + j.colFrac[x] * (v1 - v0);
+            }
     }
 }
 
@@ -175,14 +197,16 @@ void buildNearSteps(const AmbientInputs& in, int m, std::vector<NearFieldStep>& 
     }
 }
 
-void ambientRow(const AmbientJob& j, int y, float* buffers) {
+// One texel row: every azimuth's horizons (at sub-sampling interpolated and
+// raised to the near field) into the integral, V the lane type.
+template <class V>
+[[gnu::always_inline]] inline void ambientRowWith(const AmbientJob& j, int y, float* buffers) {
     float* acc = buffers;
     float* horizon = buffers + j.rowFloats;
     float* vert = buffers + 2 * static_cast<std::size_t>(j.rowFloats);
     std::fill(acc, acc + j.nx, 0.0f);
     const float* gx = j.in.gradX.row(y);
     const float* gy = j.in.gradY.row(y);
-    const bool wide = simd::wideEnabled();
     for (int a = 0; a < j.m; ++a) {
         const float c = j.in.cosSin[2 * static_cast<std::size_t>(a)];
         const float sn = j.in.cosSin[2 * static_cast<std::size_t>(a) + 1];
@@ -194,11 +218,22 @@ void ambientRow(const AmbientJob& j, int y, float* buffers) {
             raiseToNearField(j, y, a, horizon);
             h = horizon;
         }
-        (wide ? addAzimuthRowAvx2 : addAzimuthRow<simd::F4>)(gx, gy, h, c, sn, acc, j.nx);
+        addAzimuthRow<V>(gx, gy, h, c, sn, acc, j.nx);
     }
     const float perAzimuth = 1.0f / static_cast<float>(j.m);
     float* out = j.out.data() + static_cast<std::size_t>(y) * j.nx;
     for (int x = 0; x < j.nx; ++x) out[x] = acc[x] * perAzimuth / std::sqrt(1.0f + gx[x] * gx[x] + gy[x] * gy[x]);
+}
+
+// The AVX2 build of the row: 8-wide lanes in the integral and the compiler's
+// 32-byte vectors in the interpolation and the near field (element-wise
+// float arithmetic in the same order: the same bits as the SSE2 build).
+[[gnu::target("avx2"), gnu::flatten]] void ambientRowAvx2(const AmbientJob& j, int y, float* buffers) {
+    ambientRowWith<simd::F8>(j, y, buffers);
+}
+
+void ambientRow(const AmbientJob& j, int y, float* buffers) {
+    (simd::wideEnabled() ? ambientRowAvx2 : ambientRowWith<simd::F4>)(j, y, buffers);
 }
 
 void checkInputs(const AmbientInputs& in, int m, const std::vector<std::uint8_t>* rows) {
