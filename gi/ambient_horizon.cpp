@@ -5,6 +5,7 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/simd.h"
+#include "gi/near_field.h"
 #include "gi/shading.h"
 
 namespace terrain::gi {
@@ -147,56 +148,6 @@ void interpolatedHorizons(const AmbientJob& j, int y, int a, float* vert, float*
     }
 }
 
-// Raises the horizon slopes of row y along azimuth a to the texels' own
-// blocking slopes at their near-field samples (those inside the field).
-void raiseToNearField(const AmbientJob& j, int y, int a, float* horizon) {
-    const int s = j.in.subsample;
-    const float* h0 = j.in.heights.row(y);
-    for (int k = 0; k < s; ++k) {
-        const NearFieldStep& st = j.nearSteps[static_cast<std::size_t>(a) * s + k];
-        if (std::min(y + st.ay, y + st.by) < 0 || std::max(y + st.ay, y + st.by) >= j.ny) continue;
-        const int x0 = std::max({0, -st.ax, -st.bx});
-        const int x1 = std::min({j.nx, j.nx - st.ax, j.nx - st.bx});
-        const float* hA = j.in.heights.row(y + st.ay) + st.ax;
-        const float* hB = j.in.heights.row(y + st.by) + st.bx;
-        const float wA = st.wA, wB = st.wB, inv = st.invTau;
-        for (int x = x0; x < x1; ++x) {
-            const float slope = (wA * hA[x] + wB * hB[x] - h0[x]) * inv;
-            horizon[x] = horizon[x] > slope ? horizon[x] : slope;
-        }
-    }
-}
-
-// The near-field samples of every azimuth: for k = 1..s the ray's k-th
-// crossing with the grid lines across its major axis, at distance
-// k / |major component| cells, linear between the two texels on that line.
-void buildNearSteps(const AmbientInputs& in, int m, std::vector<NearFieldStep>& out) {
-    const int s = in.subsample;
-    out.assign(static_cast<std::size_t>(m) * s, NearFieldStep{});
-    for (int a = 0; a < m; ++a) {
-        const double c = in.cosSin[2 * static_cast<std::size_t>(a)];
-        const double sn = in.cosSin[2 * static_cast<std::size_t>(a) + 1];
-        const bool xMajor = std::abs(c) >= std::abs(sn);
-        const double major = xMajor ? std::abs(c) : std::abs(sn), minor = xMajor ? sn : c;
-        for (int k = 1; k <= s; ++k) {
-            const double t = k / major;
-            double offset = t * minor;
-            if (std::abs(offset - std::round(offset)) < 1e-6) offset = std::round(offset);  // on a texel
-            const int i = static_cast<int>(std::floor(offset));
-            const double w = offset - i;
-            const int along = (xMajor ? c : sn) > 0.0 ? k : -k;
-            NearFieldStep& st = out[static_cast<std::size_t>(a) * s + (k - 1)];
-            (xMajor ? st.ax : st.ay) = along;
-            (xMajor ? st.bx : st.by) = along;
-            (xMajor ? st.ay : st.ax) = i;
-            (xMajor ? st.by : st.bx) = w > 0.0 ? i + 1 : i;
-            st.wA = static_cast<float>(1.0 - w);
-            st.wB = static_cast<float>(w);
-            st.invTau = static_cast<float>(1.0 / (t * in.cellSize));
-        }
-    }
-}
-
 // One texel row: every azimuth's horizons (at sub-sampling interpolated and
 // raised to the near field) into the integral, V the lane type.
 template <class V>
@@ -215,7 +166,10 @@ template <class V>
             h = j.in.env->maxSlope.data() + (static_cast<std::size_t>(a) * j.ny + y) * j.nx;
         } else {
             interpolatedHorizons(j, y, a, vert, horizon);
-            raiseToNearField(j, y, a, horizon);
+            raiseToNearField(
+                j.in.heights, y,
+                {j.nearSteps + static_cast<std::size_t>(a) * j.in.subsample, static_cast<std::size_t>(j.in.subsample)},
+                horizon);
             h = horizon;
         }
         addAzimuthRow<V>(gx, gy, h, c, sn, acc, j.nx);
@@ -288,7 +242,7 @@ void ambientFromHorizons(const AmbientInputs& in, Grid& ambient, AmbientScratch&
     buildColumnLerps(nx, s, nxr, scratch);
     if (s > 1) {
         scratch.raised.resize(in.env->maxSlope.size());
-        buildNearSteps(in, m, scratch.nearSteps);
+        buildNearFieldSteps(in.cosSin, s, in.cellSize, scratch.nearSteps);
     }
     const AmbientJob job{in,
                          nx,

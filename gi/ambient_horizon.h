@@ -21,19 +21,15 @@
 // Sub-sampling (Fig. 7): the horizon slope of each receiver is first raised
 // to its lowest tangent slope (the footprint box's, as the SH visibility
 // does, or the receiver's own), interpolated bilinearly to the texel, and
-// raised to the texel's own tangent slope there. The receivers' scans start
-// one receiver spacing out (gi/pyramid.h), so what lies within s cells of a
-// texel between receivers (a gully one cell wide, a ridge crest) is in no
-// interpolated horizon: each texel also takes its own blocking slopes at the
-// first s crossings of its ray with the grid lines across the ray's major
-// axis (where the bilinear field is linear between two texels, as the scan
-// samples) and keeps the highest.
+// raised to the texel's own tangent slope there, and to the texel's own near
+// field (gi/near_field.h).
 #include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
 
 #include "core/grid.h"
+#include "gi/near_field.h"
 #include "gi/shading.h"
 #include "gi/visibility.h"
 
@@ -56,13 +52,6 @@ struct AmbientInputs {
     const VisibilityField* env = nullptr;
     std::span<const float> cosSin;            // azimuths x 2
     const FootprintBox* footprint = nullptr;  // null: the receivers' own tangent planes
-};
-
-/// One near-field sample of a sub-sampled texel (x, y) along one azimuth:
-/// wA h(x + ax, y + ay) + wB h(x + bx, y + by) at distance 1 / invTau metres.
-struct NearFieldStep {
-    int ax = 0, ay = 0, bx = 0, by = 0;
-    float wA = 1.0f, wB = 0.0f, invTau = 0.0f;
 };
 
 /// Buffers of the computation, reused across frames.
