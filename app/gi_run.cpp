@@ -93,8 +93,7 @@ GiMaps runFastPath(const GiOptions& o, const gi::GiSettings& settings, const GiI
         maps.indirect = std::move(state.indirect.indirect);
         maps.hasIndirect = true;
     }
-    if (!o.outSvf.empty())
-        gi::skyViewFactor(state.envVisibility, settings.subsample, in.heights.nx, in.heights.ny, maps.svf);
+    if (!o.outSvf.empty()) gi::skyViewFactor(state, in.heights.cview(), maps.svf);
     return maps;
 }
 

@@ -13,16 +13,18 @@
 // visible sky at each texel's own normal / pi) is the engine's ambient map
 // (gi/ambient_horizon.h).
 #include "core/grid.h"
-#include "gi/visibility.h"
+#include "gi/frame.h"
 
 namespace terrain::gi {
 
-/// The plain sky-view factor from the environment scan's horizons
-/// (VisibilityField::maxSlope, m azimuths), at full resolution nx x ny:
-/// at sub-sampling each receiver's horizon slope, raised to 0, is
-/// interpolated bilinearly to the texels (Fig. 7 of Nowrouzezahrai & Snyder
-/// 2009). Throws InputError when the field is not of that grid.
-void skyViewFactor(const VisibilityField& env, int subsample, int nx, int ny, Grid& out);
+/// The plain sky-view factor from the last frame's environment scan
+/// (st.envVisibility's horizons along st.envCosSin's azimuths), at full
+/// resolution; `heights`: that frame's. At sub-sampling each receiver's
+/// horizon slope, raised to 0, is interpolated bilinearly to the texels (Fig.
+/// 7 of Nowrouzezahrai & Snyder 2009) and raised to the texel's own near
+/// field (gi/near_field.h). Throws InputError when the state holds no frame of
+/// these heights.
+void skyViewFactor(const GiState& st, ConstGridView heights, Grid& out);
 
 /// The same from the exact horizons of the bilinear field (referenceMaxSlope,
 /// gi/reference.h) along `azimuths` evenly spaced azimuths (phi = 2 pi (j +
