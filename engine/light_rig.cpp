@@ -161,6 +161,7 @@ gi::GiLighting giLighting(const SceneLights& lights) {
     gi::GiLighting g;
     g.environment = lights.sky;
     g.keys = lights.keys;
+    if (lights.skyKind == SkyKind::Gradient) g.gradient = gi::SkyGradient{lights.zenith, lights.horizon, lights.ground};
     return g;
 }
 

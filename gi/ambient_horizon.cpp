@@ -15,6 +15,7 @@ namespace {
 using simd::atanv;
 using simd::load;
 using simd::splat;
+using simd::sqrtv;
 using simd::store;
 
 constexpr float kHalfPi = 1.57079632679489661923f;
@@ -31,47 +32,62 @@ struct AmbientJob {
     const float* colFrac;
     const NearFieldStep* nearSteps;  // azimuths x subsample
     const std::vector<std::uint8_t>* rows;
-    Grid& out;
+    const AmbientOutputs& out;
 };
 
-// acc[x] += -g (pi/2 - sigma - sin sigma cos sigma) + cos^2 sigma over
-// [x0, x1) for one azimuth (c, sn), t the texels' horizon slopes before the
-// tangent plane is applied; sin sigma cos sigma = t / (1 + t^2) and
-// cos^2 sigma = 1 / (1 + t^2).
-template <class V>
+// Per texel of [x0, x1) and one azimuth (c, sn), t the texels' horizon
+// slopes before the tangent plane is applied (sin sigma cos sigma =
+// t / (1 + t^2), cos^2 sigma = 1 / (1 + t^2)):
+//   acc[0] += -g (pi/2 - sigma - sin sigma cos sigma) + cos^2 sigma,
+// and with the sky gradient's parts (gi/ambient_horizon.h), a = max(sigma, 0):
+//   acc[1] += that minus its value at sigma = 0 (1 - g pi/2) when sigma < 0,
+//   acc[2] += 2/3 (1 - sin^3 a - g cos^3 a).
+template <class V, bool Parts>
 [[gnu::always_inline]] inline void addAzimuth(const float* gx, const float* gy, const float* horizon, float c, float sn,
-                                              float* acc, int x0, int x1) {
+                                              float* const acc[3], int x0, int x1) {
     constexpr int L = simd::kLaneCount<V>;
     const V vc = splat<V>(c), vs = splat<V>(sn), one = splat<V>(1.0f), halfPi = splat<V>(kHalfPi);
+    const V zero = splat<V>(0.0f), twoThirds = splat<V>(2.0f / 3.0f);
     for (int x = x0; x + L <= x1; x += L) {
         const V g = load<V>(gx + x) * vc + load<V>(gy + x) * vs;
         const V h = load<V>(horizon + x);
         const V t = h > g ? h : g;
         const V r2 = one / (one + t * t);
         const V term = (-g) * (halfPi - atanv(t) - t * r2) + r2;
-        store(acc + x, load<V>(acc + x) + term);
+        store(acc[0] + x, load<V>(acc[0] + x) + term);
+        if constexpr (Parts) {
+            const V below = t < zero ? term - (one - g * halfPi) : zero;
+            const V ta = t > zero ? t : zero;
+            const V cos2a = t > zero ? r2 : one;
+            const V cos3a = cos2a * sqrtv(cos2a);
+            const V rising = twoThirds * (one - ta * ta * ta * cos3a - g * cos3a);
+            store(acc[1] + x, load<V>(acc[1] + x) + below);
+            store(acc[2] + x, load<V>(acc[2] + x) + rising);
+        }
     }
 }
 
 // The texel range [0, nx) of a row: whole vectors, then the rest through one
 // zero-padded vector (the same lane arithmetic, so a texel's value does not
 // depend on where it falls).
-template <class V>
+template <class V, bool Parts>
 [[gnu::always_inline]] inline void addAzimuthRow(const float* gx, const float* gy, const float* horizon, float c,
-                                                 float sn, float* acc, int nx) {
+                                                 float sn, float* const acc[3], int nx) {
     constexpr int L = simd::kLaneCount<V>;
     const int vecEnd = nx / L * L;
-    addAzimuth<V>(gx, gy, horizon, c, sn, acc, 0, vecEnd);
+    addAzimuth<V, Parts>(gx, gy, horizon, c, sn, acc, 0, vecEnd);
     if (vecEnd == nx) return;
-    alignas(32) float tail[4][L] = {};
-    const int n = nx - vecEnd;
+    alignas(32) float tail[6][L] = {};
+    const int n = nx - vecEnd, rows = Parts ? 3 : 1;
     std::copy(gx + vecEnd, gx + nx, tail[0]);
     std::copy(gy + vecEnd, gy + nx, tail[1]);
     std::copy(horizon + vecEnd, horizon + nx, tail[2]);
-    std::copy(acc + vecEnd, acc + nx, tail[3]);
-    addAzimuth<V>(tail[0], tail[1], tail[2], c, sn, tail[3], 0, L);
-    std::copy(tail[3], tail[3] + n, acc + vecEnd);
+    float* const tailAcc[3] = {tail[3], tail[4], tail[5]};
+    for (int r = 0; r < rows; ++r) std::copy(acc[r] + vecEnd, acc[r] + nx, tailAcc[r]);
+    addAzimuth<V, Parts>(tail[0], tail[1], tail[2], c, sn, tailAcc, 0, L);
+    for (int r = 0; r < rows; ++r) std::copy(tailAcc[r], tailAcc[r] + n, acc[r] + vecEnd);
 }
+
 // The horizon slopes of receiver row Y along azimuth a (c, sn), each raised
 // to the receiver's lowest tangent slope: the footprint box's when there is
 // one, else its own.
@@ -149,13 +165,13 @@ void interpolatedHorizons(const AmbientJob& j, int y, int a, float* vert, float*
 }
 
 // One texel row: every azimuth's horizons (at sub-sampling interpolated and
-// raised to the near field) into the integral, V the lane type.
-template <class V>
+// raised to the near field) into the integrals, V the lane type.
+template <class V, bool Parts>
 [[gnu::always_inline]] inline void ambientRowWith(const AmbientJob& j, int y, float* buffers) {
-    float* acc = buffers;
-    float* horizon = buffers + j.rowFloats;
-    float* vert = buffers + 2 * static_cast<std::size_t>(j.rowFloats);
-    std::fill(acc, acc + j.nx, 0.0f);
+    float* const acc[3] = {buffers, buffers + j.rowFloats, buffers + 2 * static_cast<std::size_t>(j.rowFloats)};
+    float* horizon = buffers + 3 * static_cast<std::size_t>(j.rowFloats);
+    float* vert = buffers + 4 * static_cast<std::size_t>(j.rowFloats);
+    for (int r = 0; r < (Parts ? 3 : 1); ++r) std::fill(acc[r], acc[r] + j.nx, 0.0f);
     const float* gx = j.in.gradX.row(y);
     const float* gy = j.in.gradY.row(y);
     for (int a = 0; a < j.m; ++a) {
@@ -172,22 +188,34 @@ template <class V>
                 horizon);
             h = horizon;
         }
-        addAzimuthRow<V>(gx, gy, h, c, sn, acc, j.nx);
+        addAzimuthRow<V, Parts>(gx, gy, h, c, sn, acc, j.nx);
     }
     const float perAzimuth = 1.0f / static_cast<float>(j.m);
-    float* out = j.out.data() + static_cast<std::size_t>(y) * j.nx;
-    for (int x = 0; x < j.nx; ++x) out[x] = acc[x] * perAzimuth / std::sqrt(1.0f + gx[x] * gx[x] + gy[x] * gy[x]);
+    Grid* const maps[3] = {&j.out.ambient, j.out.below, j.out.rising};
+    for (int r = 0; r < (Parts ? 3 : 1); ++r) {
+        float* out = maps[r]->data() + static_cast<std::size_t>(y) * j.nx;
+        for (int x = 0; x < j.nx; ++x)
+            out[x] = acc[r][x] * perAzimuth / std::sqrt(1.0f + gx[x] * gx[x] + gy[x] * gy[x]);
+    }
 }
 
-// The AVX2 build of the row: 8-wide lanes in the integral and the compiler's
-// 32-byte vectors in the interpolation and the near field (element-wise
-// float arithmetic in the same order: the same bits as the SSE2 build).
+// The AVX2 builds of the row: 8-wide lanes in the integrals and the
+// compiler's 32-byte vectors in the interpolation and the near field
+// (element-wise float arithmetic in the same order: the same bits as the
+// SSE2 build).
 [[gnu::target("avx2"), gnu::flatten]] void ambientRowAvx2(const AmbientJob& j, int y, float* buffers) {
-    ambientRowWith<simd::F8>(j, y, buffers);
+    ambientRowWith<simd::F8, false>(j, y, buffers);
+}
+[[gnu::target("avx2"), gnu::flatten]] void ambientPartsRowAvx2(const AmbientJob& j, int y, float* buffers) {
+    ambientRowWith<simd::F8, true>(j, y, buffers);
 }
 
 void ambientRow(const AmbientJob& j, int y, float* buffers) {
-    (simd::wideEnabled() ? ambientRowAvx2 : ambientRowWith<simd::F4>)(j, y, buffers);
+    const bool parts = j.out.below != nullptr;
+    if (simd::wideEnabled())
+        (parts ? ambientPartsRowAvx2 : ambientRowAvx2)(j, y, buffers);
+    else
+        (parts ? ambientRowWith<simd::F4, true> : ambientRowWith<simd::F4, false>)(j, y, buffers);
 }
 
 void checkInputs(const AmbientInputs& in, int m, const std::vector<std::uint8_t>* rows) {
@@ -228,15 +256,21 @@ void buildColumnLerps(int nx, int s, int nxr, AmbientScratch& scratch) {
 
 }  // namespace
 
-void ambientFromHorizons(const AmbientInputs& in, Grid& ambient, AmbientScratch& scratch,
+void ambientFromHorizons(const AmbientInputs& in, const AmbientOutputs& out, AmbientScratch& scratch,
                          const std::vector<std::uint8_t>* rows) {
     const int m = static_cast<int>(in.cosSin.size() / 2);
     checkInputs(in, m, rows);
+    if ((out.below == nullptr) != (out.rising == nullptr))
+        throw InputError("ambient: the sky gradient's parts come together (below and rising)");
     const int nx = in.gradX.nx, ny = in.gradX.ny;
-    ambient.ensureSize(nx, ny);
+    out.ambient.ensureSize(nx, ny);
+    if (out.below) {
+        out.below->ensureSize(nx, ny);
+        out.rising->ensureSize(nx, ny);
+    }
     const int nBlocks = std::max(1, std::min(ny, 64));
     const int rowFloats = std::max(nx, in.env->nxr);
-    constexpr int kRowsPerBlock = 3;  // acc, horizon, the receivers' vertical blend
+    constexpr int kRowsPerBlock = 5;  // three integrals, horizon, the receivers' vertical blend
     scratch.rows.resize(static_cast<std::size_t>(nBlocks) * kRowsPerBlock * rowFloats);
     const int s = in.subsample, nxr = in.env->nxr, nyr = in.env->nyr;
     buildColumnLerps(nx, s, nxr, scratch);
@@ -258,7 +292,7 @@ void ambientFromHorizons(const AmbientInputs& in, Grid& ambient, AmbientScratch&
                          scratch.colFrac.data(),
                          scratch.nearSteps.data(),
                          rows,
-                         ambient};
+                         out};
     if (s > 1) {
         flagReceiverRows(ny, s, nyr, rows, scratch.receiverRows);
         raiseReceiverHorizons(job, scratch.receiverRows);
@@ -287,6 +321,28 @@ void addConstantSky(const Grid& ambient, const float radiance[3], const AlbedoMa
                 for (int x = 0; x < nx; ++x) {
                     const float a = mapped ? albedo->channel[c].v[row + x] : 1.0f;
                     out[x] += a * radiance[c] * ambient.v[row + x];
+                }
+            }
+        }
+    });
+}
+
+void addGradientSky(const AmbientOutputs& parts, const SkyGradient& sky, const AlbedoMap* albedo,
+                    std::array<Grid, 3>& shade, const std::vector<std::uint8_t>* rows) {
+    const int nx = parts.ambient.nx, ny = parts.ambient.ny;
+    parallelForRows(ny, nx, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y) {
+            if (rows && (*rows)[static_cast<std::size_t>(y)] == 0) continue;
+            const std::size_t row = static_cast<std::size_t>(y) * nx;
+            for (std::size_t c = 0; c < 3; ++c) {
+                const bool mapped = albedo && !albedo->channel[c].empty();
+                const float above = sky.horizon[c], ground = sky.ground[c], rise = sky.zenith[c] - sky.horizon[c];
+                float* out = shade[c].data() + row;
+                for (int x = 0; x < nx; ++x) {
+                    const float a = mapped ? albedo->channel[c].v[row + x] : 1.0f;
+                    const float below = parts.below->v[row + x];
+                    out[x] += a * (above * (parts.ambient.v[row + x] - below) + ground * below +
+                                   rise * parts.rising->v[row + x]);
                 }
             }
         }

@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "core/grid.h"
+#include "gi/lights.h"
 #include "gi/near_field.h"
 #include "gi/shading.h"
 #include "gi/visibility.h"
@@ -74,11 +75,31 @@ struct AmbientScratch {
 void addConstantSky(const Grid& ambient, const float radiance[3], const AlbedoMap* albedo, std::array<Grid, 3>& shade,
                     const std::vector<std::uint8_t>* rows = nullptr);
 
-/// Writes the ambient map (resized to the gradients' size). `rows` (one flag
-/// per texel row; null: every row): only the flagged rows are computed, the
-/// others keep what `ambient` holds. Each row's values do not depend on the
-/// rows or the thread count.
-void ambientFromHorizons(const AmbientInputs& in, Grid& ambient, AmbientScratch& scratch,
+/// What ambientFromHorizons writes: the ambient map and, when `below` and
+/// `rising` are given, the two parts of it that light the analytic sky
+/// (SkyGradient, gi/lights.h) exactly. With a = max(sigma, 0), per azimuth
+///   below:  the integral of (N . w) cos t over [sigma, 0] (0 when sigma >= 0),
+///   rising: the integral of sin t (N . w) cos t over [a, pi/2]
+///         = [1 - sin^3 a - g cos^3 a] / (3 n),
+/// each normalised as the ambient; the sky's Lambert shade is then
+///   albedo [horizon (ambient - below) + ground below + (zenith - horizon) rising].
+struct AmbientOutputs {
+    Grid& ambient;
+    Grid* below = nullptr;
+    Grid* rising = nullptr;
+};
+
+/// Writes the ambient map and the parts asked for (resized to the gradients'
+/// size). `rows` (one flag per texel row; null: every row): only the flagged
+/// rows are computed, the others keep what the maps hold. Each row's values
+/// do not depend on the rows, the thread count, or whether the parts are
+/// computed.
+void ambientFromHorizons(const AmbientInputs& in, const AmbientOutputs& out, AmbientScratch& scratch,
                          const std::vector<std::uint8_t>* rows = nullptr);
+
+/// Adds the Lambert shade of the analytic sky from the ambient's parts
+/// (AmbientOutputs with below and rising). `rows` as for ambientFromHorizons.
+void addGradientSky(const AmbientOutputs& parts, const SkyGradient& sky, const AlbedoMap* albedo,
+                    std::array<Grid, 3>& shade, const std::vector<std::uint8_t>* rows = nullptr);
 
 }  // namespace terrain::gi

@@ -185,6 +185,11 @@ void validateFrameInputs(ConstGridView heights, float cellSize, const GiLighting
     if (!std::isfinite(cellSize) || cellSize <= 0.0f) throw InputError("cell size must be positive and finite");
     validateGiSettings(settings);
     for (const KeyLight& k : lighting.keys) validateKeyLight(k);
+    if (const auto& g = lighting.gradient)
+        for (const std::array<float, 3>* colour : {&g->zenith, &g->horizon, &g->ground})
+            for (float v : *colour)
+                if (!std::isfinite(v) || v < 0.0f)
+                    throw InputError("sky gradient: every colour must be finite and >= 0");
     for (const ShVector& c : lighting.environment.c)
         for (double v : c)
             if (!std::isfinite(v)) throw InputError("environment light: NaN or Inf coefficient");
@@ -296,7 +301,7 @@ ShadingLight environmentShadingLight(const ShRgb& environment, const VisibilityF
 // over the environment's azimuths (the scan's own table holds the last key
 // light's by now). It depends on the geometry alone: the frames recompute it
 // where the environment's V was recomputed, not when only the lights change.
-void exactAmbient(ConstGridView heights, float cellSize, const GiSettings& settings, GiState& st,
+void exactAmbient(ConstGridView heights, float cellSize, const GiSettings& settings, bool withSkyParts, GiState& st,
                   const std::vector<std::uint8_t>* rows) {
     const bool footprint = settings.subsample > 1 && settings.visibility.footprintTangent;
     const AmbientInputs in{.gradX = st.gradX.cview(),
@@ -307,7 +312,10 @@ void exactAmbient(ConstGridView heights, float cellSize, const GiSettings& setti
                            .env = &st.envVisibility,
                            .cosSin = st.envCosSin,
                            .footprint = footprint ? &st.footprint : nullptr};
-    ambientFromHorizons(in, st.shade.ambient, st.ambientScratch, rows);
+    ShadeMaps& sh = st.shade;
+    const AmbientOutputs out{sh.ambient, withSkyParts ? &sh.skyBelow : nullptr, withSkyParts ? &sh.skyRising : nullptr};
+    ambientFromHorizons(in, out, st.ambientScratch, rows);
+    sh.skyParts = withSkyParts;
 }
 
 // Direct light at every texel: the lighting's SH product matrices once per
@@ -323,13 +331,21 @@ void directShading(const GiLighting& lighting, const GiSettings& settings, const
     // from it (addConstantSky) and the SH product only the rest.
     const bool shAmbient = settings.ambient == AmbientMethod::ShProduct;
     const bool splitSky = !shAmbient && settings.shading.brdf == Brdf::Lambert;
+    // The analytic sky's own function, integrated above the horizons, when
+    // the ambient's parts for it are there; then nothing of it goes through SH.
+    const bool exactSky = splitSky && lighting.gradient && st.shade.skyParts;
     float skyConstant[3] = {0.0f, 0.0f, 0.0f};
-    st.shadingLights[0] = environmentShadingLight(lighting.environment, st.envVisibility, splitSky, skyConstant);
+    st.shadingLights[0] =
+        environmentShadingLight(exactSky ? ShRgb{} : lighting.environment, st.envVisibility, splitSky, skyConstant);
     for (std::size_t k = 0; k < (exactKeys ? 0 : nKeys); ++k)
         st.shadingLights[k + 1] = keyShadingLight(lighting.keys[k], st.keyVisibility[k]);
     shadeTexels(st.gradX.cview(), st.gradY.cview(), settings.subsample, st.envVisibility, st.shadingLights.data(),
                 static_cast<int>(st.shadingLights.size()), albedo, settings.shading, st.shade, shAmbient, rows);
-    if (splitSky) addConstantSky(st.shade.ambient, skyConstant, albedo, st.shade.rgb, rows);
+    if (exactSky)
+        addGradientSky({st.shade.ambient, &st.shade.skyBelow, &st.shade.skyRising}, *lighting.gradient, albedo,
+                       st.shade.rgb, rows);
+    else if (splitSky)
+        addConstantSky(st.shade.ambient, skyConstant, albedo, st.shade.rgb, rows);
     if (exactKeys)
         for (std::size_t k = 0; k < nKeys; ++k)
             addKeyLightExactCosine(lighting.keys[k], st.keyVisibility[k], settings.subsample, albedo, st, st.shade.rgb,
@@ -416,8 +432,14 @@ void runDirectStages(ConstGridView heights, float cellSize, const GiLighting& li
     st.timings.keyVisibility = msSince(t);
     t = Clock::now();
     const std::vector<std::uint8_t>* rows = shadingRows(heights, change, plan, st);
-    if (change.geometry && settings.ambient == AmbientMethod::Horizons)
-        exactAmbient(heights, cellSize, settings, st, rows);
+    if (settings.ambient == AmbientMethod::Horizons) {
+        // the sky's parts ride with the ambient; a sky gradient new to this
+        // geometry needs them over the whole field
+        const bool withSkyParts = lighting.gradient.has_value();
+        const bool partsMissing = withSkyParts && !st.shade.skyParts;
+        if (change.geometry || partsMissing)
+            exactAmbient(heights, cellSize, settings, withSkyParts, st, partsMissing ? nullptr : rows);
+    }
     directShading(lighting, settings, albedo, st, rows);
     st.timings.shading = msSince(t);
 }

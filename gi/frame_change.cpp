@@ -64,7 +64,7 @@ FrameChange compareFrameInputs(const FrameInputs& last, ConstGridView heights, f
         c.keyRegion[k] = !known || !sameSkyRegion(lighting.keys[k], last.keys[k]);
         keyRadiance = keyRadiance || !known || !sameKeyRadiance(lighting.keys[k], last.keys[k]);
     }
-    const bool environment = lighting.environment.c != last.environment.c;
+    const bool environment = lighting.environment.c != last.environment.c || lighting.gradient != last.gradient;
     c.radiance = environment || keyRadiance || !sameAlbedo(last, albedo);
     return c;
 }
@@ -75,6 +75,7 @@ void recordFrameInputs(ConstGridView heights, float cellSize, const GiLighting& 
     out.cellSize = cellSize;
     out.settings = settings;
     out.environment = lighting.environment;
+    out.gradient = lighting.gradient;
     out.keys = lighting.keys;
     out.hasAlbedo = albedo != nullptr;
     if (albedo && change.radiance) out.albedo = *albedo;

@@ -28,6 +28,7 @@ struct FrameInputs {
     float cellSize = 0.0f;
     GiSettings settings;
     ShRgb environment;
+    std::optional<SkyGradient> gradient;
     std::vector<KeyLight> keys;
     bool hasAlbedo = false;
     AlbedoMap albedo;

@@ -16,6 +16,7 @@
 // the cap as an SH light (radiance RGB / sin^2(radius)), for folding a key
 // light into an environment (e.g. the reference renderer).
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -77,10 +78,25 @@ inline bool sameSkyRegion(const KeyLight& a, const KeyLight& b) {
     return a.azimuthDeg == b.azimuthDeg && a.elevationDeg == b.elevationDeg && a.radiusDeg == b.radiusDeg;
 }
 
+/// The analytic sky as a function of direction (sunSkyLight's gradient,
+/// without its sun lobe): radiance horizon + (zenith - horizon) sin(elevation)
+/// above the horizontal, `ground` below it.
+struct SkyGradient {
+    std::array<float, 3> zenith{}, horizon{}, ground{};
+    bool operator==(const SkyGradient&) const = default;
+};
+
 /// The lights of a GI frame: an environment and any number of key lights.
 struct GiLighting {
     ShRgb environment = uniformSkyLight(1.0f);
     std::vector<KeyLight> keys;
+    // When the environment is the analytic sky: its function, of which
+    // `environment` is the SH projection (engine::LightRig sets both). A
+    // Lambert shade with the exact ambient (AmbientMethod::Horizons) then
+    // integrates the function itself above each azimuth's horizon
+    // (gi/ambient_horizon.h) instead of its order-4 SH; everything else
+    // reads `environment`.
+    std::optional<SkyGradient> gradient;
 };
 
 }  // namespace terrain::gi

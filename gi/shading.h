@@ -125,6 +125,11 @@ struct ShadeMaps {
     int nx = 0, ny = 0;
     std::array<Grid, 3> rgb;  // outgoing radiance towards the viewer, full resolution
     Grid ambient;             // normal-weighted sky-view factor, full resolution
+    // The ambient's parts that light the analytic sky exactly
+    // (gi/ambient_horizon.h, AmbientOutputs), when skyParts says they hold
+    // this geometry's values.
+    Grid skyBelow, skyRising;
+    bool skyParts = false;
     // receiver-resolution buffers
     std::vector<float> incident;       // 3 x coefficients planes: sum over lights of T_L V
     std::vector<int> colIndex;         // per full-res column: left receiver

@@ -5,6 +5,7 @@
 #include <doctest/doctest.h>
 
 #include "core/error.h"
+#include "core/parallel.h"
 #include "gi/frame.h"
 #include "gi/reference.h"
 #include "tests/gi_test_terrain.h"
@@ -165,8 +166,96 @@ TEST_CASE("gi.ambient_horizon: horizons of another grid or azimuth count are ref
                      .cosSin = st.envCosSin};
     Grid out;
     AmbientScratch scratch;
-    CHECK_THROWS_AS(ambientFromHorizons(in, out, scratch), InputError);
+    CHECK_THROWS_AS(ambientFromHorizons(in, {out}, scratch), InputError);
     in.subsample = 1;
     in.cosSin = std::span<const float>(st.envCosSin).first(4);
-    CHECK_THROWS_AS(ambientFromHorizons(in, out, scratch), InputError);
+    CHECK_THROWS_AS(ambientFromHorizons(in, {out}, scratch), InputError);
+}
+
+namespace {
+
+// The analytic sky as a function and as its SH projection, as engine::LightRig gives them.
+GiLighting gradientSky(float scale) {
+    SunSkySettings f;
+    GiLighting light;
+    SkyGradient g;
+    for (std::size_t c = 0; c < 3; ++c) {
+        g.zenith[c] = f.zenith[c] = scale * (0.15f + 0.1f * c);
+        g.horizon[c] = f.horizon[c] = scale * (0.3f + 0.05f * c);
+        g.ground[c] = f.ground[c] = scale * 0.08f;
+        f.sun[c] = 0.0f;
+    }
+    light.environment = sunSkyLight(f);
+    light.gradient = g;
+    return light;
+}
+
+double relativeRmse(const std::array<Grid, 3>& a, const std::array<Grid, 3>& b, int border) {
+    double se = 0.0, sr = 0.0;
+    for (std::size_t c = 0; c < 3; ++c)
+        for (int y = border; y < a[c].ny - border; ++y)
+            for (int x = border; x < a[c].nx - border; ++x) {
+                const double d = static_cast<double>(a[c](x, y)) - b[c](x, y);
+                se += d * d;
+                sr += static_cast<double>(b[c](x, y)) * b[c](x, y);
+            }
+    return std::sqrt(se / sr);
+}
+
+}  // namespace
+
+TEST_CASE("gi.ambient_horizon: the analytic sky lit by its own function above the horizons, not its SH") {
+    const GiLighting light = gradientSky(1.0f);
+    SunSkySettings f;
+    for (std::size_t c = 0; c < 3; ++c) {
+        f.zenith[c] = light.gradient->zenith[c];
+        f.horizon[c] = light.gradient->horizon[c];
+        f.ground[c] = light.gradient->ground[c];
+        f.sun[c] = 0.0f;
+    }
+    SUBCASE("flat ground: horizon + 2/3 (zenith - horizon)") {
+        GiState st;
+        runGiFrame(Grid(24, 20, 1.0f).cview(), 1.0f, light, GiSettings{}, st);
+        for (std::size_t c = 0; c < 3; ++c)
+            for (float v : st.shade.rgb[c].v)
+                CHECK(v == doctest::Approx(f.horizon[c] + 2.0 / 3.0 * (f.zenith[c] - f.horizon[c])).epsilon(1e-5));
+    }
+    SUBCASE("rough terrain: closer to the sky function's reference than through SH, at 1x and 2x") {
+        const Grid g = gi_test::bumpy(64, 64);
+        ReferenceResult ref;
+        ReferenceSettings rs;
+        rs.border = 6;
+        renderReferenceSkyGradient(g.cview(), 2.0f, f, nullptr, rs, ref);
+        GiLighting shOnly = light;
+        shOnly.gradient.reset();
+        for (int s : {1, 2}) {
+            GiSettings settings;
+            settings.subsample = s;
+            GiState exact, sh;
+            runGiFrame(g.cview(), 2.0f, light, settings, exact);
+            runGiFrame(g.cview(), 2.0f, shOnly, settings, sh);
+            const double eExact = relativeRmse(exact.shade.rgb, ref.rgb, 6);
+            const double eSh = relativeRmse(sh.shade.rgb, ref.rgb, 6);
+            const double eAmbient = relativeRmse({exact.shade.ambient, exact.shade.ambient, exact.shade.ambient},
+                                                 {ref.ambient, ref.ambient, ref.ambient}, 6);
+            MESSAGE(s << "x: sky shade relative RMSE, its function " << eExact << ", its SH " << eSh << "; ambient "
+                      << eAmbient);
+            CHECK(eExact < eSh);
+            // what is left is the horizons' error, which the ambient shows alone
+            CHECK(eExact < 1.1 * eAmbient + 0.002);
+        }
+    }
+    SUBCASE("the same bits for any thread count, and a relit frame equals a fresh one") {
+        const Grid g = gi_test::bumpy(40, 36);
+        GiSettings settings;
+        settings.subsample = 2;
+        GiState one, three;
+        withThreads(1, [&] { return runGiFrame(g.cview(), 2.0f, light, settings, one), 0; });
+        withThreads(3, [&] { return runGiFrame(g.cview(), 2.0f, light, settings, three), 0; });
+        CHECK(gi_test::sameOutputs(one, three));
+        GiState relit;
+        runGiFrame(g.cview(), 2.0f, GiLighting{}, settings, relit);  // no sky parts yet
+        CHECK(gi_test::incrementalMatchesFull(g, 2.0f, gradientSky(0.5f), settings, relit));
+        CHECK(gi_test::incrementalMatchesFull(g, 2.0f, gradientSky(1.5f), settings, relit));
+    }
 }
