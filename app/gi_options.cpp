@@ -184,6 +184,9 @@ void addLightTransportFlags(CLI::App* sub, GiOptions& o) {
     sub->add_option("--glossy", o.glossy,
                     "Glossy indirect light (phong/mix BRDFs): vector (SH radiance-vector pyramid, Fig. 5 middle) | "
                     "scalar (shade pyramid, Fig. 5 right)");
+    sub->add_option("--glossy-positivity", o.glossyPositivity,
+                    "Phong / mix shading and glossy indirect light: clamp (no negative radiance: members send and "
+                    "texels shade max(0, .), engine default) | off (the order-4 SH lobe's linear values, paper)");
     sub->add_option("--phong-exponent", o.phongExponent,
                     "Phong exponent: a constant VALUE, or a 16-bit PNG of the field's size mapped log-uniformly to "
                     "--phong-exponent-range");
@@ -232,6 +235,10 @@ gi::GiSettings giSettingsFrom(const GiOptions& o, ExponentSource& exponent) {
         settings.indirect.glossy = namedChoice<gi::GlossyIndirect>(
             "--glossy", o.glossy,
             {{"vector", gi::GlossyIndirect::VectorPyramid}, {"scalar", gi::GlossyIndirect::ScalarPyramid}});
+    if (!o.glossyPositivity.empty())
+        settings.shading.positivity = namedChoice<gi::GlossyPositivity>(
+            "--glossy-positivity", o.glossyPositivity,
+            {{"clamp", gi::GlossyPositivity::Clamp}, {"off", gi::GlossyPositivity::Off}});
     exponent = parsePhongExponent(o, settings);
     if (!o.indirectKernel.empty())
         settings.indirect.lambert = namedChoice<gi::LambertIndirect>(

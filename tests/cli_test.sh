@@ -71,6 +71,11 @@ hm16="$tmp/g16/frame_000000.png"
   --out-indirect "$tmp/gv.npy" >/dev/null 2>&1 && [ -s "$tmp/gv.npy" ] && ok || bad "gi --glossy vector with an exponent map"
 "$T" gi --heightmap "$hm24" --cell-size 10 --brdf mix:0.5,30 --bounces 1 --reference --reference-directions 128 \
   --out-indirect "$tmp/gr.npy" >/dev/null 2>&1 && [ -s "$tmp/gr.npy" ] && ok || bad "gi --reference with a glossy BRDF"
+# the paper's linear glossy values stay reachable; the clamp (default) differs from them
+"$T" gi --heightmap "$hm24" --cell-size 10 --brdf phong:64 --bounces 1 --glossy vector --glossy-positivity off \
+  --out-indirect "$tmp/goff.npy" >/dev/null 2>&1 && [ -s "$tmp/goff.npy" ] && ok || bad "gi --glossy-positivity off"
+expect_error "bad glossy positivity" "glossy-positivity" "$T" gi --heightmap "$hm24" --cell-size 10 --brdf phong:20 \
+  --glossy-positivity maybe
 expect_error "exponent map of the wrong size" "16 x 16 pixels" "$T" gi --heightmap "$hm24" --cell-size 10 --brdf phong:20 \
   --bounces 1 --phong-exponent "$hm16"
 expect_error "unreadable exponent map" "missing.png" "$T" gi --heightmap "$hm24" --cell-size 10 --brdf phong:20 \
