@@ -181,6 +181,8 @@ void addLightTransportFlags(CLI::App* sub, GiOptions& o) {
         "times each texel's occlusion, engine default) | sh (order-4 SH kernel, paper)");
     sub->add_option("--reference-directions", o.referenceDirections, describe(opt::kReferenceDirections))
         ->capture_default_str();
+    sub->add_option("--reference-lobe-rings", o.referenceLobeRings, describe(opt::kReferenceLobeRings))
+        ->capture_default_str();
     sub->add_option("--glossy", o.glossy,
                     "Glossy indirect light (phong/mix BRDFs): vector (SH radiance-vector pyramid, Fig. 5 middle) | "
                     "scalar (shade pyramid, Fig. 5 right)");
@@ -210,6 +212,7 @@ void checkGiOptions(const GiOptions& o) {
     checkRange(r::kFrames, o.frames);
     checkRange(r::kExposure, o.exposure);
     checkRange(r::kReferenceDirections, o.referenceDirections);
+    checkRange(r::kReferenceLobeRings, o.referenceLobeRings);
     checkRange(widened(sr::kDemCellSize), o.cellSize, "--cell-size");
     checkRange(widened(sr::kDemZScale), o.zScale, "--z-scale");
     checkRange(widened(sr::kAltitude), o.zOffset, "--z-offset");
