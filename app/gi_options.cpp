@@ -181,9 +181,14 @@ void addLightTransportFlags(CLI::App* sub, GiOptions& o) {
         "times each texel's occlusion, engine default) | sh (order-4 SH kernel, paper)");
     sub->add_option("--reference-directions", o.referenceDirections, describe(opt::kReferenceDirections))
         ->capture_default_str();
+    sub->add_option("--reference-lobe-rings", o.referenceLobeRings, describe(opt::kReferenceLobeRings))
+        ->capture_default_str();
     sub->add_option("--glossy", o.glossy,
                     "Glossy indirect light (phong/mix BRDFs): vector (SH radiance-vector pyramid, Fig. 5 middle) | "
                     "scalar (shade pyramid, Fig. 5 right)");
+    sub->add_option("--glossy-positivity", o.glossyPositivity,
+                    "Phong / mix shading and glossy indirect light: clamp (no negative radiance: members send and "
+                    "texels shade max(0, .), engine default) | off (the order-4 SH lobe's linear values, paper)");
     sub->add_option("--phong-exponent", o.phongExponent,
                     "Phong exponent: a constant VALUE, or a 16-bit PNG of the field's size mapped log-uniformly to "
                     "--phong-exponent-range");
@@ -207,6 +212,7 @@ void checkGiOptions(const GiOptions& o) {
     checkRange(r::kFrames, o.frames);
     checkRange(r::kExposure, o.exposure);
     checkRange(r::kReferenceDirections, o.referenceDirections);
+    checkRange(r::kReferenceLobeRings, o.referenceLobeRings);
     checkRange(widened(sr::kDemCellSize), o.cellSize, "--cell-size");
     checkRange(widened(sr::kDemZScale), o.zScale, "--z-scale");
     checkRange(widened(sr::kAltitude), o.zOffset, "--z-offset");
@@ -232,6 +238,10 @@ gi::GiSettings giSettingsFrom(const GiOptions& o, ExponentSource& exponent) {
         settings.indirect.glossy = namedChoice<gi::GlossyIndirect>(
             "--glossy", o.glossy,
             {{"vector", gi::GlossyIndirect::VectorPyramid}, {"scalar", gi::GlossyIndirect::ScalarPyramid}});
+    if (!o.glossyPositivity.empty())
+        settings.shading.positivity = namedChoice<gi::GlossyPositivity>(
+            "--glossy-positivity", o.glossyPositivity,
+            {{"clamp", gi::GlossyPositivity::Clamp}, {"off", gi::GlossyPositivity::Off}});
     exponent = parsePhongExponent(o, settings);
     if (!o.indirectKernel.empty())
         settings.indirect.lambert = namedChoice<gi::LambertIndirect>(

@@ -38,8 +38,10 @@ struct GiOptions {
     std::string outExr;  // every map as channels of one float32 EXR
     std::string outSvf;  // the plain sky-view factor (gi/sky_view.h)
     int referenceDirections = 2048;
-    std::string glossy;         // vector | scalar (glossy indirect light)
-    std::string phongExponent;  // VALUE or a 16-bit PNG
+    int referenceLobeRings = 12;   // glossy reference: lobe quadrature rings (ReferenceGiSettings::lobeRings)
+    std::string glossy;            // vector | scalar (glossy indirect light)
+    std::string glossyPositivity;  // clamp | off (negative Phong radiance clamped, or the paper's linear values)
+    std::string phongExponent;     // VALUE or a 16-bit PNG
     std::string phongExponentRange = "1,1000";
 };
 

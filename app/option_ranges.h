@@ -30,5 +30,7 @@ inline constexpr SettingRange<float> kExaggeration{"--exaggeration", 0.0f, 100.0
                                                    "Vertical exaggeration (0: automatic, relief >= 15% of the extent)"};
 inline constexpr SettingRange<int> kReferenceDirections{"--reference-directions", 16, 1 << 20,
                                                         "Directions of the indirect reference"};
+inline constexpr SettingRange<int> kReferenceLobeRings{
+    "--reference-lobe-rings", 1, 256, "Glossy reference: rings of each Phong lobe's quadrature (2x as many azimuths)"};
 
 }  // namespace terrain::app::option_ranges

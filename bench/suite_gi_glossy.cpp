@@ -1,10 +1,11 @@
 // `terrain_bench gi-glossy`: glossy indirect light - the SH radiance-vector
 // pyramid (GlossyIndirect::VectorPyramid, Fig. 5 middle) and the scalar shade
 // pyramid (ScalarPyramid, Fig. 5 right) against the glossy reference
-// (gi/reference_glossy), and the frame time of the glossy bounce. Writes
-// gi_glossy.md.
+// (gi/reference_glossy, exact), with and without the positivity clamp, and
+// the frame time of the glossy bounce. Writes gi_glossy.md and gi_glossy.csv.
 #include <chrono>
 #include <cmath>
+#include <cstdarg>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -23,7 +24,10 @@ using Clock = std::chrono::steady_clock;
 struct GlossyOptions {
     int runs = 5;
     int size = 96;          // side of the accuracy crop
-    int directions = 2048;  // directions of the reference
+    int directions = 2048;  // directions of the reference (its Lambert part)
+    int lobeRings = 12;     // lobe quadrature of the reference (rings x 2 rings directions per lobe)
+    bool timing = true;     // the frame-time section
+    bool accuracy = true;   // the accuracy section
 };
 
 constexpr float albedo = 0.6f;
@@ -50,53 +54,150 @@ GiLighting sunSkyLighting() {
     return light;
 }
 
-// Accuracy against the glossy reference on the central o.size^2 crop of Mont Blanc.
-std::string accuracySection(const GlossyOptions& o, const BenchContext& ctx) {
-    std::string md;
+std::string strprintf(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
+std::string strprintf(const char* fmt, ...) {
+    char buf[512];
+    va_list args;
+    va_start(args, fmt);
+    std::vsnprintf(buf, sizeof buf, fmt, args);
+    va_end(args);
+    return buf;
+}
+
+// One accuracy row's engine frame: relative RMSE and bias of the indirect
+// light against the reference, and the share of negative indirect values.
+struct EngineError {
+    double rmse, bias, negative;
+};
+
+EngineError engineError(const Grid& h, float cell, const GiLighting& light, const AlbedoMap& a, GiSettings g,
+                        GlossyPositivity positivity, const ReferenceGiResult& ref) {
+    g.shading.positivity = positivity;
+    GiState st;
+    withThreads(2, [&] { runGiFrame(h.cview(), cell, light, g, st, &a); });
+    EngineError e{};
+    e.rmse = relRmse(st.indirect.indirect, ref.indirect, e.bias);
+    long neg = 0, n = 0;
+    for (const Grid& c : st.indirect.indirect)
+        for (float v : c.v) {
+            neg += v < 0.0f;
+            ++n;
+        }
+    e.negative = static_cast<double>(neg) / static_cast<double>(n);
+    return e;
+}
+
+// Accuracy against the exact glossy reference on the central o.size^2 crop of
+// Mont Blanc: both glossy modes, with the positivity clamp (engine default)
+// and without it (paper), 1x and 2x.
+std::string accuracySection(const GlossyOptions& o, const BenchContext& ctx, std::string& csv) {
+    std::string md, diag, azim;
     float cell = 1.0f;
     const Grid h = alpsCentreCrop(ctx.dataDir, o.size, cell);
     const AlbedoMap a = uniformAlbedo(o.size, o.size, albedo);
     const GiLighting light = sunSkyLighting();
     md += "## Accuracy: alps-montblanc, central " + std::to_string(o.size) + "^2 crop at true scale (cell 92.74 m)\n\n";
-    md += "Reference: `renderReferenceGlossy` (" + std::to_string(o.directions) +
-          " fixed directions, 256 azimuths for bounce 0; the same Phong lobe in order-4 SH, exact visibility and first "
-          "hits). "
-          "Relative RMSE and bias of the indirect light (bounce 1, RGB, 10 % border left out).\n\n";
     md +=
-        "| BRDF | S | sub-sampling | vector pyramid RMSE | bias | scalar pyramid RMSE | bias | reference mean indirect "
-        "| reference time (s) |\n";
-    md += "|---|---|---|---|---|---|---|---|---|\n";
-    for (Brdf brdf : {Brdf::Phong, Brdf::LambertPlusPhong})
-        for (float S : {8.0f, 64.0f}) {
-            if (brdf == Brdf::LambertPlusPhong && S != 64.0f) continue;
-            ReferenceGiSettings rs;
-            rs.directions = o.directions;
-            rs.bounces = 1;
-            rs.shading = settingsFor(brdf, S, 1, 1, GlossyIndirect::VectorPyramid).shading;
-            ReferenceGiResult ref;
-            const auto t0 = Clock::now();
-            renderReferenceGi(h.cview(), cell, light.environment, &a, rs, ref);
-            const double refSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
-            double refMean = 0.0;
-            for (const Grid& g : ref.indirect)
-                for (float v : g.v) refMean += v;
-            refMean /= 3.0 * o.size * o.size;
-            for (int s : {1, 2}) {
-                double e[2], b[2];
-                for (int k = 0; k < 2; ++k) {
-                    GiState st;
+        "Reference: `renderReferenceGlossy`, exact: the Phong lobes of the receiver and of every first hit "
+        "integrated against the exact incident radiance (the SH sky through exact horizons at 256 azimuths), " +
+        std::to_string(o.lobeRings) + " x " + std::to_string(2 * o.lobeRings) +
+        " lobe quadrature directions per lobe, " + std::to_string(o.directions) +
+        " fixed directions for the Lambert part. Relative RMSE and bias of the indirect light (bounce 1, RGB, 10 % "
+        "border left out); clamp: `--glossy-positivity clamp` (engine default), off: the paper's linear SH "
+        "values; neg: share of negative indirect values without the clamp (with it: none).\n\n";
+    md +=
+        "| BRDF | S | sub-sampling | vector clamp RMSE | bias | vector off RMSE | bias | vector off neg | scalar clamp "
+        "RMSE | bias | scalar off RMSE | bias | scalar off neg | reference mean indirect | reference time (s) |\n";
+    md += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    csv += "brdf,S,subsample,mode,positivity,rel_rmse,bias,negative_share,reference_mean,reference_seconds\n";
+    struct Row {
+        Brdf brdf;
+        float S;
+    };
+    for (const Row& row : {Row{Brdf::Phong, 8.0f}, Row{Brdf::Phong, 16.0f}, Row{Brdf::Phong, 32.0f},
+                           Row{Brdf::Phong, 64.0f}, Row{Brdf::LambertPlusPhong, 64.0f}}) {
+        ReferenceGiSettings rs;
+        rs.directions = o.directions;
+        rs.lobeRings = o.lobeRings;
+        rs.bounces = 1;
+        rs.shading = settingsFor(row.brdf, row.S, 1, 1, GlossyIndirect::VectorPyramid).shading;
+        ReferenceGiResult ref;
+        const auto t0 = Clock::now();
+        withThreads(2, [&] { renderReferenceGi(h.cview(), cell, light.environment, &a, rs, ref); });
+        const double refSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
+        // the diagnostic reference: receivers shade the SH-projected incident radiance (exact first hits)
+        ReferenceGiSettings rsh = rs;
+        rsh.receiverSh = true;
+        ReferenceGiResult refSh;
+        withThreads(2, [&] { renderReferenceGi(h.cview(), cell, light.environment, &a, rsh, refSh); });
+        double refMean = 0.0;
+        for (const Grid& g : ref.indirect)
+            for (float v : g.v) refMean += v;
+        refMean /= 3.0 * o.size * o.size;
+        for (int s : {1, 2}) {
+            EngineError e[2][2], d[2], az[2];  // [vector, scalar][clamp, off]; vector [clamp, off] against refSh;
+                                               // vector clamp with 16 and 32 scan azimuths
+            for (int k = 0; k < 2; ++k)
+                for (int p = 0; p < 2; ++p) {
                     const GlossyIndirect mode = k == 0 ? GlossyIndirect::VectorPyramid : GlossyIndirect::ScalarPyramid;
-                    withThreads(2,
-                                [&] { runGiFrame(h.cview(), cell, light, settingsFor(brdf, S, s, 1, mode), st, &a); });
-                    e[k] = relRmse(st.indirect.indirect, ref.indirect, b[k]);
+                    const GlossyPositivity pos = p == 0 ? GlossyPositivity::Clamp : GlossyPositivity::Off;
+                    e[k][p] = engineError(h, cell, light, a, settingsFor(row.brdf, row.S, s, 1, mode), pos, ref);
+                    char c[256];
+                    std::snprintf(c, sizeof c, "%s,%g,%d,%s,%s,%.5f,%+.5f,%.4f,%.5f,%.1f\n", brdfName(row.brdf), row.S,
+                                  s, k == 0 ? "vector" : "scalar", p == 0 ? "clamp" : "off", e[k][p].rmse, e[k][p].bias,
+                                  e[k][p].negative, refMean, refSeconds);
+                    csv += c;
                 }
-                char line[512];
-                std::snprintf(line, sizeof line, "| %s | %g | %dx | %.4f | %+.4f | %.4f | %+.4f | %.4f | %.1f |\n",
-                              brdfName(brdf), S, s, e[0], b[0], e[1], b[1], refMean, refSeconds);
-                std::fprintf(stderr, "%s", line);
-                md += line;
+            for (int p = 0; p < 2; ++p) {
+                const GlossyPositivity pos = p == 0 ? GlossyPositivity::Clamp : GlossyPositivity::Off;
+                d[p] = engineError(h, cell, light, a, settingsFor(row.brdf, row.S, s, 1, GlossyIndirect::VectorPyramid),
+                                   pos, refSh);
+                char c[256];
+                std::snprintf(c, sizeof c, "%s,%g,%d,vector vs receiver-SH reference,%s,%.5f,%+.5f,%.4f,%.5f,%.1f\n",
+                              brdfName(row.brdf), row.S, s, p == 0 ? "clamp" : "off", d[p].rmse, d[p].bias,
+                              d[p].negative, refMean, refSeconds);
+                csv += c;
             }
+            for (int k = 0; k < 2; ++k) {
+                GiSettings g = settingsFor(row.brdf, row.S, s, 1, GlossyIndirect::VectorPyramid);
+                g.indirect.azimuths = 16 << k;
+                az[k] = engineError(h, cell, light, a, g, GlossyPositivity::Clamp, ref);
+                char c[256];
+                std::snprintf(c, sizeof c, "%s,%g,%d,vector %d azimuths,clamp,%.5f,%+.5f,%.4f,%.5f,%.1f\n",
+                              brdfName(row.brdf), row.S, s, 16 << k, az[k].rmse, az[k].bias, az[k].negative, refMean,
+                              refSeconds);
+                csv += c;
+            }
+            azim += strprintf("| %s | %g | %dx | %.4f | %.4f | %.4f |\n", brdfName(row.brdf), row.S, s, e[0][0].rmse,
+                              az[0].rmse, az[1].rmse);
+            diag += strprintf("| %s | %g | %dx | %.4f | %+.4f | %.4f | %+.4f |\n", brdfName(row.brdf), row.S, s,
+                              d[0].rmse, d[0].bias, d[1].rmse, d[1].bias);
+            char line[512];
+            std::snprintf(
+                line, sizeof line,
+                "| %s | %g | %dx | %.4f | %+.4f | %.4f | %+.4f | %.1f %% | %.4f | %+.4f | %.4f | %+.4f | %.1f "
+                "%% | %.4f | %.1f |\n",
+                brdfName(row.brdf), row.S, s, e[0][0].rmse, e[0][0].bias, e[0][1].rmse, e[0][1].bias,
+                100.0 * e[0][1].negative, e[1][0].rmse, e[1][0].bias, e[1][1].rmse, e[1][1].bias,
+                100.0 * e[1][1].negative, refMean, refSeconds);
+            std::fprintf(stderr, "%s", line);
+            md += line;
         }
+    }
+    md +=
+        "\nDiagnostic: the vector pyramid against the reference whose first-bounce receivers shade the incident "
+        "radiance projected to order-4 SH with the lobe factors g_l, as the fast path's receivers do "
+        "(`ReferenceGiSettings::receiverSh`; first hits exact): the error of what the casting-set members send, "
+        "without the receivers' order-4 lobe.\n\n";
+    md +=
+        "| BRDF | S | sub-sampling | vector clamp RMSE | bias | vector off RMSE | bias "
+        "|\n|---|---|---|---|---|---|---|\n";
+    md += diag;
+    md += "\nScan azimuths (`IndirectSettings::azimuths`, engine default " +
+          std::to_string(IndirectSettings{}.azimuths) +
+          "): relative RMSE of the vector pyramid (clamp) against the exact reference.\n\n";
+    md += "| BRDF | S | sub-sampling | default | 16 azimuths | 32 azimuths |\n|---|---|---|---|---|---|\n";
+    md += azim;
     return md;
 }
 
@@ -152,9 +253,11 @@ int runGlossy(const GlossyOptions& o, const BenchContext& ctx) {
     md += "Lighting: sun-and-sky SH environment (`sunSkyLight()`), viewer overhead, albedo " +
           std::to_string(albedo).substr(0, 3) +
           " (diffuse part), engine settings (`GiSettings{}`: m = 16, o_v = o_u = 3), 1 bounce.\n\n";
-    md += accuracySection(o, ctx);
-    md += frameTimeSection(o, ctx);
+    std::string csv;
+    if (o.accuracy) md += accuracySection(o, ctx, csv);
+    if (o.timing) md += frameTimeSection(o, ctx);
     writeResult(ctx.outDir, "gi_glossy.md", md);
+    if (o.accuracy) writeResult(ctx.outDir, "gi_glossy.csv", csv);
     return 0;
 }
 
@@ -169,6 +272,12 @@ Runner addGiGlossySuite(CLI::App& app, const BenchContext& ctx) {
     sub->add_option("--directions", o->directions, "Directions of the glossy reference")
         ->check(CLI::Range(64, 1 << 20))
         ->capture_default_str();
+    sub->add_option("--lobe-rings", o->lobeRings,
+                    "Lobe quadrature of the glossy reference (rings; 2x as many azimuths)")
+        ->check(CLI::Range(1, 256))
+        ->capture_default_str();
+    sub->add_flag("!--no-timing", o->timing, "Skip the frame-time section");
+    sub->add_flag("!--no-accuracy", o->accuracy, "Skip the accuracy section");
     return [o, &ctx] { return runGlossy(*o, ctx); };
 }
 

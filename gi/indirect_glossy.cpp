@@ -108,7 +108,7 @@ int walkGroupGlossy(const ScanStep* hTab, const I4* steps, int nAny, int Y, int 
 // at the n steps of pass 1, accumulated with the moments; then Eq. 10's
 // closed form in s. Out: nlp[(c * 4 + l) * pad + X].
 void projectGroupGlossy(const ScanStep* rGeo, const float* const* rFields, int n, int Y, int X0, const GroupScratch& gs,
-                        float* nlp, int pad) {
+                        float* nlp, int pad, bool clamp) {
     const F4* moments = gs.moments;
     const F4* basis = gs.basis;
     const int* list = gs.list;
@@ -137,6 +137,8 @@ void projectGroupGlossy(const ScanStep* rGeo, const float* const* rFields, int n
                     u[k] += v * ba[kShCount * k + f];
                 }
             }
+            if (clamp)  // GlossyPositivity::Clamp: a member sends no negative radiance
+                for (int k = 0; k < kNV; ++k) u[k] = simd::vmax(u[k], zero);
             for (int k = 0; k < kNV; ++k)
                 for (int p = 0; p < 4; ++p) A[k][p] += u[k] * mo[4 * k + p];
         }
@@ -290,7 +292,7 @@ void VectorPyramidIndirect::castAzimuth(int j, int Y, float* scr, int* list) {
         }
         const int n = walkGroupGlossy(st_.heightSteps.data() + base, steps, nAny, Y, X0, row, cosPhi, sinPhi, gsc);
         projectGroupGlossy(gs.steps.data() + base, gs.fields.data() + base * kGlossyFields, n, Y, X0, gsc,
-                           scr + lay.nlp, pad_);
+                           scr + lay.nlp, pad_, in_.shading.positivity == GlossyPositivity::Clamp);
     }
 }
 

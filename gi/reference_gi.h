@@ -42,6 +42,16 @@ struct ReferenceGiSettings {
     // order-4 SH truncation of indirect light (a floor for the fast path).
     bool shLambert = false;
     int keyAzimuths = 48;  // midpoint azimuths across each cap's extent
+    // Glossy reference: quadrature of every Phong lobe it integrates exactly
+    // (n rings x 2n azimuths, gi/reference_glossy_lobe.h), at the receivers
+    // and at each of their rays' first hits.
+    int lobeRings = 12;
+    // Glossy reference diagnostic: the first bounce's receivers shade their
+    // incident radiance projected to order-4 SH with the lobe factors g_l
+    // (as the fast path's receivers do) instead of integrating their lobe
+    // exactly; the first hits stay exact. Separates the error of what the
+    // fast path's casting-set members send from its receivers' order-4 lobe.
+    bool receiverSh = false;
     // BRDF of every texel. Lambert (default): the scalar gathering above.
     // Phong / LambertPlusPhong: the glossy reference (renderReferenceGlossy).
     ShadingSettings shading;
@@ -60,23 +70,30 @@ void renderReferenceGi(ConstGridView heights, float cellSize, const ShRgb& light
                        const ReferenceGiSettings& settings, ReferenceGiResult& out);
 
 /// The glossy reference (ReferenceGiSettings::shading not Lambert): the same
-/// BRDFs and order-4 SH lighting as the fast path (gi/shading.h, Section 7).
-/// Per texel p it keeps the incident radiance projected to order-4 SH, I_b(p)
-/// (RGB x 16), and the isotropic exit radiance D_b(p); the exit radiance
-/// towards a direction w is
-///   L_b(p, w) = D_b(p) + w_s sum_lm g_l(p) I_b,lm(p) Y_lm(R_N(w)),
-/// R_N(w) = 2 (N . w) N - w, g_l = e^{-l^2/(2S)} of p's exponent (the
-/// AlbedoMap's exponent map or ShadingSettings::phongExponent), w_s the
-/// specular weight (1 for Phong); outputs are L_b towards the viewer.
-/// Bounce 0: I_0 = the exact projection of (SH lighting x exact visibility),
-/// I_0,i = sum_j L_j int_visible Y_i Y_j (dense azimuths as gi/reference,
-/// elevation integrals of A_i A_j cos tabulated by Gauss-Legendre);
-/// D_0 = (1 - w_s for Phong: 0) x the exact Lambert shade of gi/reference
-/// + exact-cap key lights (Lambert, like the fast path's exact-cosine keys).
-/// Bounce b: over the fixed direction set w_k with N . w_k > 0 and first hit q_k,
+/// BRDFs as the fast path (gi/shading.h, Section 7), with the Phong lobes of
+/// the direct light and of the first bounce integrated against the exact
+/// incident radiance (no SH projection, gi/reference_glossy_lobe.h). The exit
+/// radiance of a texel p towards w is
+///   L(p, w) = D(p) + w_s int I(p, w') f_p(w' . R_N(w)) dw',
+/// R_N(w) = 2 (N . w) N - w, f_p the normalised Phong lobe of p's exponent
+/// (the AlbedoMap's exponent map or ShadingSettings::phongExponent), w_s the
+/// specular weight (1 for Phong, ShadingSettings::specularWeight for the
+/// mixture), D the isotropic part; outputs are L towards the viewer.
+/// Bounce 0: I = the SH sky through p's exact visibility (horizons of
+/// gi/reference at settings.azimuths), D_0 = (0 for Phong, 1 for the mixture)
+/// x the exact Lambert shade of gi/reference + exact-cap key lights (Lambert,
+/// like the fast path's exact-cosine keys).
+/// Bounce 1: I(p, w) = L_0(q, -w) at the first hit q of the ray from p in
+/// direction w (D_0 and the normal bilinear at q, q's Phong part integrated
+/// exactly against q's own sky); the Phong part samples p's lobe with
+/// lobeRings quadrature rays, the Lambert part D_1 = w_d albedo(p) / pi
+/// 4 pi / K sum_k L_0(q_k, -w_k) (N . w_k) the fixed direction set.
+/// With receiverSh (a diagnostic) the first bounce's receivers shade as in
+/// the bounces after it, from I_1 projected to SH.
+/// Bounces b >= 2 (an approximation): the previous bounce's incident
+/// radiance projected to order-4 SH at every texel,
 ///   I_b(p) = 4 pi / K sum_k L_(b-1)(q_k, -w_k) Y(w_k),
-///   D_b(p) = w_d albedo(p) / pi 4 pi / K sum_k L_(b-1)(q_k, -w_k) (N . w_k),
-/// with D, I, the normal and g bilinear at q_k.
+/// and the Phong part sum_lm g_l I_b,lm Y_lm(R_N(w)), g_l = e^{-l^2/(2S)}.
 void renderReferenceGlossy(ConstGridView heights, float cellSize, const ShRgb& lighting, const AlbedoMap* surface,
                            const ReferenceGiSettings& settings, ReferenceGiResult& out);
 

@@ -1,5 +1,7 @@
 // The glossy ground truth (gi/reference_gi.h, renderReferenceGlossy): exact
-// visibility and first hits, the fast path's BRDFs and order-4 SH lighting.
+// visibility and first hits, the fast path's BRDFs; the Phong lobes of the
+// direct light and of the first bounce integrated by quadrature against the
+// exact incident radiance (gi/reference_glossy_lobe.h).
 // Sections: Nowrouzezahrai & Snyder 2009.
 #include <algorithm>
 #include <atomic>
@@ -11,6 +13,7 @@
 #include "core/parallel.h"
 #include "gi/frame.h"
 #include "gi/reference_gi.h"
+#include "gi/reference_glossy_lobe.h"
 
 namespace terrain::gi {
 
@@ -106,9 +109,15 @@ struct GlossySurface {
     const Grid& gy;
     const AlbedoMap* surface;
     double phUniform[kShOrder];
-    bool lobeMap;
+    bool lobeMap, expMap;
+    double uniformExponent;
     GlossySurface(const Grid& gradX, const Grid& gradY, const AlbedoMap* map, const ShadingSettings& sh)
-        : gx(gradX), gy(gradY), surface(map), lobeMap(map && !map->phongLobe[0].empty()) {
+        : gx(gradX),
+          gy(gradY),
+          surface(map),
+          lobeMap(map && !map->phongLobe[0].empty()),
+          expMap(map && !map->phongExponent.empty()),
+          uniformExponent(sh.phongExponent) {
         float f[kShOrder];
         phongLobeFactors(sh.phongExponent, f);
         for (int l = 0; l < kShOrder; ++l) phUniform[l] = f[l];
@@ -126,6 +135,9 @@ struct GlossySurface {
         for (int l = 0; l < kShOrder; ++l)
             ph[l] = l > 0 && lobeMap ? bl(surface->phongLobe[static_cast<std::size_t>(l - 1)].data()) : phUniform[l];
     }
+    // the exponent S (the map's, bilinear at a first hit, or the uniform one)
+    double exponentAt(std::size_t i) const { return expMap ? surface->phongExponent.v[i] : uniformExponent; }
+    double exponentAt(const Bilinear& bl) const { return expMap ? bl(surface->phongExponent.data()) : uniformExponent; }
     void normalAt(std::size_t i, double n[3]) const {
         const double ddx = gx.v[i], ddy = gy.v[i];
         const double inv = 1.0 / std::sqrt(1.0 + ddx * ddx + ddy * ddy);
@@ -135,12 +147,13 @@ struct GlossySurface {
     }
 };
 
-// Bounce 0: the exact Lambert part and the exact-cap key lights (D_0) and the
-// exact SH incident radiance (I_0); out.ambient from the direct reference,
-// out.direct / indirect sized (indirect zeroed).
+// Bounce 0 at every texel: the exact Lambert part and the exact-cap key
+// lights (D_0); with `withIncident` also the exact SH incident radiance (I_0,
+// read by the SH-projected bounces after the first); out.ambient from the
+// direct reference, out.direct / indirect sized (indirect zeroed).
 void directBounce(ConstGridView heights, float cellSize, const ShRgb& lighting, const AlbedoMap* surface,
-                  const ReferenceGiSettings& s, double wd, ReferenceGiResult& out, std::array<Grid, 3>& prevD,
-                  std::vector<float>& prevI) {
+                  const ReferenceGiSettings& s, double wd, bool withIncident, ReferenceGiResult& out,
+                  std::array<Grid, 3>& prevD, std::vector<float>& prevI) {
     const int nx = heights.nx, ny = heights.ny;
     const std::size_t plane = static_cast<std::size_t>(nx) * ny;
     ReferenceResult d;
@@ -149,7 +162,7 @@ void directBounce(ConstGridView heights, float cellSize, const ShRgb& lighting, 
     std::array<Grid, 3> keys;
     for (Grid& g : keys) g.resize(nx, ny, 0.0f);
     for (const KeyLight& k : s.keys) addReferenceKeyLight(heights, cellSize, k, surface, s.keyAzimuths, keys);
-    referenceIncidentSh(heights, cellSize, lighting, s.azimuths, prevI);
+    if (withIncident) referenceIncidentSh(heights, cellSize, lighting, s.azimuths, prevI);
     for (int c = 0; c < 3; ++c) {
         prevD[c].resize(nx, ny);
         out.direct[c].resize(nx, ny);
@@ -159,7 +172,7 @@ void directBounce(ConstGridView heights, float cellSize, const ShRgb& lighting, 
 }
 
 // Exit radiance towards the viewer of (D, I) at every texel, written to dst
-// (add: added to it).
+// (add: added to it): the SH-projected bounces after the first.
 void towardsViewer(const GlossySurface& surf, const double view[3], double ws, const std::array<Grid, 3>& D,
                    const std::vector<float>& I, std::array<Grid, 3>& dst, bool add) {
     const int nx = surf.gx.nx, ny = surf.gx.ny;
@@ -182,8 +195,29 @@ void towardsViewer(const GlossySurface& surf, const double view[3], double ws, c
     });
 }
 
+// Bounce 0 towards the viewer, exact: D_0 + w_s (the Phong lobe about the
+// viewer's reflection against the exact sky, gi/reference_glossy_lobe.h).
+void directTowardsViewer(const GlossySurface& surf, const SkyHorizons& hz, const ShRgb& lighting, const double view[3],
+                         double ws, int rings, const std::array<Grid, 3>& D, std::array<Grid, 3>& dst) {
+    const int nx = surf.gx.nx, ny = surf.gx.ny;
+    parallelFor(0, ny, 1, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < nx; ++x) {
+                const std::size_t i = static_cast<std::size_t>(y) * nx + x;
+                double n[3], r[3], e[3] = {0.0, 0.0, 0.0};
+                surf.normalAt(i, n);
+                reflect(n, view, r);
+                if (ws != 0.0)
+                    exactLobeRadiance(hz, lighting, static_cast<float>(x), static_cast<float>(y), n, r,
+                                      surf.exponentAt(i), rings, e);
+                for (int c = 0; c < 3; ++c) dst[c].v[i] = static_cast<float>(D[c].v[i] + ws * e[c]);
+            }
+    });
+}
+
 // What one gathering bounce reads: the surface, the height field for the
-// first hits, the fixed directions and their SH basis, weights.
+// first hits, the fixed directions and their SH basis, weights, and the exact
+// sky (horizons, lighting, lobe quadrature) of the first bounce.
 struct GlossyGather {
     const GlossySurface& surf;
     const Grid& heights;
@@ -194,38 +228,50 @@ struct GlossyGather {
     const std::vector<double>& dirBasis;  // Y(dirs[k]), kShCount each
     double weight;                        // 4 pi / directions
     double ws, wd;                        // specular and diffuse weights
+    const SkyHorizons& horizons;
+    const ShRgb& lighting;
 };
 
-// Radiance L[c] leaving the first hit `bl` towards the texel (direction -dir)
-// under the previous bounce (prevD, prevI).
-void radianceFromHit(const GlossyGather& g, const Bilinear& bl, const std::array<float, 3>& dir,
-                     const std::array<Grid, 3>& prevD, const std::vector<float>& prevI, double L[3]) {
+// Radiance L[c] leaving the first hit (qx, qy) towards the texel (direction
+// -dir) under the previous bounce: D bilinear at the hit plus the Phong part,
+// against the exact sky for the first bounce (prevI null), else from the
+// previous bounce's SH incident radiance prevI.
+void radianceFromHit(const GlossyGather& g, float qx, float qy, const double dir[3], const std::array<Grid, 3>& prevD,
+                     const std::vector<float>* prevI, double L[3]) {
     const std::size_t plane = static_cast<std::size_t>(g.heights.nx) * g.heights.ny;
+    const Bilinear bl(g.heights.nx, g.heights.ny, qx, qy);
     // q's normal, lobe and radiance towards p (direction -w)
     const double ddx = bl(g.surf.gx.data()), ddy = bl(g.surf.gy.data());
     const double inv = 1.0 / std::sqrt(1.0 + ddx * ddx + ddy * ddy);
     const double nq[3] = {-ddx * inv, -ddy * inv, inv};
     const double back[3] = {-dir[0], -dir[1], -dir[2]};
-    double r[3], yR[kShCount], ph[kShOrder];
+    double r[3];
     reflect(nq, back, r);
+    for (int c = 0; c < 3; ++c) L[c] = bl(prevD[c].data());
+    if (g.ws == 0.0) return;
+    if (!prevI) {
+        double e[3];
+        exactLobeRadiance(g.horizons, g.lighting, qx, qy, nq, r, g.surf.exponentAt(bl), g.s.lobeRings, e);
+        for (int c = 0; c < 3; ++c) L[c] += g.ws * e[c];
+        return;
+    }
+    double yR[kShCount], ph[kShOrder];
     basis(r[0], r[1], r[2], yR);
     g.surf.lobeAt(bl, ph);
     for (int c = 0; c < 3; ++c) {
-        L[c] = bl(prevD[c].data());
-        if (g.ws != 0.0) {
-            double sp = 0.0;
-            for (int j = 0; j < kShCount; ++j)
-                sp += ph[shBand(j)] * yR[j] * bl(prevI.data() + static_cast<std::size_t>(c * kShCount + j) * plane);
-            L[c] += g.ws * sp;
-        }
+        double sp = 0.0;
+        for (int j = 0; j < kShCount; ++j)
+            sp += ph[shBand(j)] * yR[j] * bl(prevI->data() + static_cast<std::size_t>(c * kShCount + j) * plane);
+        L[c] += g.ws * sp;
     }
 }
 
-// One gathering bounce at texel (x, y): the previous bounce's radiance from
-// the first hits of the fixed directions, projected to SH (nextI) and
-// integrated against the cosine (the Lambert part, nextD).
-void gatherTexel(const GlossyGather& g, const std::array<Grid, 3>& prevD, const std::vector<float>& prevI, int x, int y,
-                 std::array<Grid, 3>& nextD, std::vector<float>& nextI) {
+// One gathering bounce at texel (x, y) over the fixed directions: the
+// previous bounce's radiance from the first hits integrated against the
+// cosine (the Lambert part, nextD) and, when nextI is given, projected to SH
+// (the incident radiance the next bounce reads).
+void gatherTexel(const GlossyGather& g, const std::array<Grid, 3>& prevD, const std::vector<float>* prevI, int x, int y,
+                 std::array<Grid, 3>& nextD, std::vector<float>* nextI) {
     const int nx = g.heights.nx, ny = g.heights.ny;
     const std::size_t plane = static_cast<std::size_t>(nx) * ny;
     const std::size_t i = static_cast<std::size_t>(y) * nx + x;
@@ -239,19 +285,51 @@ void gatherTexel(const GlossyGather& g, const std::array<Grid, 3>& prevD, const 
         float qx, qy;
         if (!referenceFirstHit(g.heights.data(), nx, ny, g.hMax, g.cellSize, x, y, dir, g.s.marchStep, qx, qy))
             continue;
+        const double d[3] = {dir[0], dir[1], dir[2]};
         double L[3];
-        radianceFromHit(g, Bilinear(nx, ny, qx, qy), dir, prevD, prevI, L);
+        radianceFromHit(g, qx, qy, d, prevD, prevI, L);
         const double* yw = &g.dirBasis[k * kShCount];
         for (int c = 0; c < 3; ++c) {
-            for (int j = 0; j < kShCount; ++j) I[c][j] += L[c] * yw[j];
+            for (int j = 0; j < kShCount && nextI; ++j) I[c][j] += L[c] * yw[j];
             E[c] += L[c] * cosine;
         }
     }
     for (int c = 0; c < 3; ++c) {
-        for (int j = 0; j < kShCount; ++j)
-            nextI[static_cast<std::size_t>(c * kShCount + j) * plane + i] = static_cast<float>(g.weight * I[c][j]);
+        for (int j = 0; j < kShCount && nextI; ++j)
+            (*nextI)[static_cast<std::size_t>(c * kShCount + j) * plane + i] = static_cast<float>(g.weight * I[c][j]);
         nextD[c].v[i] = static_cast<float>(g.wd * g.surf.albedoAt(c, i) / kPi * g.weight * E[c]);
     }
+}
+
+// The first bounce's Phong part towards the viewer at texel (x, y), exact:
+// the texel's lobe about the viewer's reflection sampled by the lobe
+// quadrature (gi/reference_glossy_lobe.h), each ray's first hit sending its
+// exact exit radiance; rays below the tangent plane carry nothing, rays that
+// escape see the sky (direct light, bounce 0).
+void firstBouncePhong(const GlossyGather& g, const std::array<Grid, 3>& prevD, const double view[3], int x, int y,
+                      double out[3]) {
+    const int nx = g.heights.nx, ny = g.heights.ny, n = g.s.lobeRings;
+    const std::size_t i = static_cast<std::size_t>(y) * nx + x;
+    double nrm[3], r[3], t[3], b[3], acc[3] = {0.0, 0.0, 0.0};
+    g.surf.normalAt(i, nrm);
+    reflect(nrm, view, r);
+    lobeFrame(r, t, b);
+    const double S = g.surf.exponentAt(i);
+    for (int a = 0; a < n; ++a)
+        for (int j = 0; j < 2 * n; ++j) {
+            double w[3];
+            lobeDirection(r, t, b, S, n, a, j, w);
+            if (nrm[0] * w[0] + nrm[1] * w[1] + nrm[2] * w[2] <= 0.0) continue;
+            const std::array<float, 3> dir = {static_cast<float>(w[0]), static_cast<float>(w[1]),
+                                              static_cast<float>(w[2])};
+            float qx, qy;
+            if (!referenceFirstHit(g.heights.data(), nx, ny, g.hMax, g.cellSize, x, y, dir, g.s.marchStep, qx, qy))
+                continue;
+            double L[3];
+            radianceFromHit(g, qx, qy, w, prevD, nullptr, L);
+            for (int c = 0; c < 3; ++c) acc[c] += L[c];
+        }
+    for (int c = 0; c < 3; ++c) out[c] = g.ws * acc[c] / (2.0 * n * n);
 }
 
 }  // namespace
@@ -328,18 +406,22 @@ void renderReferenceGlossy(ConstGridView heights, float cellSize, const ShRgb& l
     const double ws = specularWeightOf(sh);
     const double wd = sh.brdf == Brdf::Phong ? 0.0 : 1.0;
     const double view[3] = {sh.viewDir[0], sh.viewDir[1], sh.viewDir[2]};
+    if (s.lobeRings < 1) throw InputError("glossy reference: lobeRings must be at least 1");
     Grid gx, gy;
     computeGradient(heights, cellSize, gx, gy);
     const GlossySurface surf(gx, gy, surface, sh);
+    SkyHorizons horizons;
+    buildSkyHorizons(heights, cellSize, s.azimuths, horizons);
 
-    // ---- bounce 0: exact Lambert part + exact-cap keys (D_0), exact SH incident (I_0)
-    std::vector<float> prevI, nextI(plane * 3 * kShCount);
+    // ---- bounce 0: exact Lambert part + exact-cap keys (D_0), exact Phong part
+    // towards the viewer; I_0 (SH) only for the bounces after the first
+    std::vector<float> prevI, nextI;
     std::array<Grid, 3> prevD, nextD;
-    directBounce(heights, cellSize, lighting, surface, s, wd, out, prevD, prevI);
-    for (int c = 0; c < 3; ++c) nextD[c].resize(nx, ny);
-    towardsViewer(surf, view, ws, prevD, prevI, out.direct, false);
+    directBounce(heights, cellSize, lighting, surface, s, wd, s.bounces >= 2, out, prevD, prevI);
+    for (int c = 0; c < 3; ++c) nextD[c].resize(nx, ny, 0.0f);
+    directTowardsViewer(surf, horizons, lighting, view, ws, s.lobeRings, prevD, out.direct);
 
-    // ---- bounces 1..B: gather (D, I) of the previous bounce at the first hits
+    // ---- bounce 1 exact; bounces 2..B gather (D, I) of the previous bounce in SH
     if (nx >= 2 && ny >= 2 && s.bounces > 0) {
         Grid hCopy(nx, ny);
         for (int y = 0; y < ny; ++y)
@@ -350,14 +432,27 @@ void renderReferenceGlossy(ConstGridView heights, float cellSize, const ShRgb& l
         std::vector<double> dirBasis(dirs.size() * kShCount);
         for (std::size_t k = 0; k < dirs.size(); ++k)
             basis(dirs[k][0], dirs[k][1], dirs[k][2], &dirBasis[k * kShCount]);
-        const GlossyGather gather{surf, hCopy, hMax, cellSize, s, dirs, dirBasis, 4.0 * kPi / s.directions, ws, wd};
+        const GlossyGather gather{surf, hCopy, hMax,     cellSize, s, dirs, dirBasis, 4.0 * kPi / s.directions,
+                                  ws,   wd,    horizons, lighting};
         for (int b = 1; b <= s.bounces; ++b) {
             if (s.progress) std::printf("glossy reference: bounce %d of %d\n", b, s.bounces);
+            // SH incident radiance: for the next bounce, and for towardsViewer after the first
+            const bool exact = b == 1, needI = b < s.bounces || !exact || s.receiverSh;
+            if (needI) nextI.assign(plane * 3 * kShCount, 0.0f);
             parallelFor(0, ny, 1, [&](int y0, int y1) {
                 for (int y = y0; y < y1; ++y)
-                    for (int x = 0; x < nx; ++x) gatherTexel(gather, prevD, prevI, x, y, nextD, nextI);
+                    for (int x = 0; x < nx; ++x) {
+                        if (wd != 0.0 || needI)
+                            gatherTexel(gather, prevD, exact ? nullptr : &prevI, x, y, nextD, needI ? &nextI : nullptr);
+                        if (!exact || s.receiverSh) continue;
+                        double phong[3] = {0.0, 0.0, 0.0};
+                        if (ws != 0.0) firstBouncePhong(gather, prevD, view, x, y, phong);
+                        const std::size_t i = static_cast<std::size_t>(y) * nx + x;
+                        for (int c = 0; c < 3; ++c)
+                            out.indirect[c].v[i] += static_cast<float>(nextD[c].v[i] + phong[c]);
+                    }
             });
-            towardsViewer(surf, view, ws, nextD, nextI, out.indirect, true);
+            if (!exact || s.receiverSh) towardsViewer(surf, view, ws, nextD, nextI, out.indirect, true);
             std::swap(prevI, nextI);
             std::swap(prevD, nextD);
         }

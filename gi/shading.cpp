@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -320,6 +321,7 @@ struct PhongRowJob {
     float phUniform[kShOrder];  // the uniform lobe factors (phongLobeFactors of the settings)
     float specWeight;
     float view[3];  // unit vector towards the viewer
+    bool clamp;     // GlossyPositivity::Clamp: shades below 0 become 0
 };
 
 // ---- algorithm: SH vectors interpolated to row y (Fig. 7) ----
@@ -421,7 +423,8 @@ void phongShadeRow(const PhongRowJob& j, const float* __restrict gxr, const floa
                             : nullptr;
         for (int x = 0; x < nx; ++x) o[x] *= j.base.diffuseWeight * (a ? (*a)(x, y) : 1.0f);
         addPhongLobe(j, gxr, gyr, up, ch, y, o);
-        for (int x = 0; x < nx; ++x) o[x] = std::isfinite(o[x]) ? o[x] : 0.0f;
+        const float floor = j.clamp ? 0.0f : -std::numeric_limits<float>::infinity();
+        for (int x = 0; x < nx; ++x) o[x] = std::isfinite(o[x]) ? std::max(o[x], floor) : 0.0f;
     }
 }
 
@@ -481,8 +484,11 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
         out.incident.data(), ambient ? &env : nullptr, planeR, nxr,           nyr,    nxrS, s, nCoef, nx,
         out.colIndex.data(), out.colFrac.data(),       lf,     diffuseWeight, albedo, &out};
     const auto lambertShadeRow = wide ? lambertShadeRowAvx2 : lambertShadeRowSse;
-    PhongRowJob phongJob{
-        lambertJob, {}, specularWeightOf(settings), {settings.viewDir[0], settings.viewDir[1], settings.viewDir[2]}};
+    PhongRowJob phongJob{lambertJob,
+                         {},
+                         specularWeightOf(settings),
+                         {settings.viewDir[0], settings.viewDir[1], settings.viewDir[2]},
+                         settings.positivity == GlossyPositivity::Clamp};
     phongLobeFactors(settings.phongExponent, phongJob.phUniform);
 
     // ---- schedule: fixed row blocks, each with its own scratch ---------------

@@ -27,11 +27,22 @@ namespace terrain::gi {
 
 enum class Brdf { Lambert, Phong, LambertPlusPhong };
 
+// Non-negative glossy light. The order-4 SH lobe rings below zero wherever
+// the incident radiance varies sharply (a horizon, the sun): Off keeps the
+// paper's linear evaluation; Clamp (default) clamps the exit radiance a glossy
+// casting-set member sends (max(0, E . Y(-d)), gi/indirect_glossy) and every
+// Phong / mixture shade (max(0, .)). Against the exact glossy reference
+// (bench/results/gi_glossy.md) the clamp was the most accurate of the
+// variants measured, and it is the only one that guarantees no negative
+// radiance (the incident SH vectors themselves ring, so no lobe window can).
+enum class GlossyPositivity { Off, Clamp };
+
 struct ShadingSettings {
     Brdf brdf = Brdf::Lambert;
-    float phongExponent = 32.0f;            // S in Section 7
-    float specularWeight = 0.25f;           // weight of the Phong lobe in LambertPlusPhong
-    float viewDir[3] = {0.0f, 0.0f, 1.0f};  // unit vector towards the viewer (distant viewer)
+    float phongExponent = 32.0f;                            // S in Section 7
+    float specularWeight = 0.25f;                           // weight of the Phong lobe in LambertPlusPhong
+    float viewDir[3] = {0.0f, 0.0f, 1.0f};                  // unit vector towards the viewer (distant viewer)
+    GlossyPositivity positivity = GlossyPositivity::Clamp;  // paper: Off
     bool operator==(const ShadingSettings&) const = default;
 };
 

@@ -70,7 +70,15 @@ hm16="$tmp/g16/frame_000000.png"
 "$T" gi --heightmap "$hm24" --cell-size 10 --brdf phong:20 --bounces 1 --glossy vector --phong-exponent "$hm24" \
   --out-indirect "$tmp/gv.npy" >/dev/null 2>&1 && [ -s "$tmp/gv.npy" ] && ok || bad "gi --glossy vector with an exponent map"
 "$T" gi --heightmap "$hm24" --cell-size 10 --brdf mix:0.5,30 --bounces 1 --reference --reference-directions 128 \
+  --reference-lobe-rings 6 \
   --out-indirect "$tmp/gr.npy" >/dev/null 2>&1 && [ -s "$tmp/gr.npy" ] && ok || bad "gi --reference with a glossy BRDF"
+# the paper's linear glossy values stay reachable
+"$T" gi --heightmap "$hm24" --cell-size 10 --brdf phong:64 --bounces 1 --glossy vector --glossy-positivity off \
+  --out-indirect "$tmp/goff.npy" >/dev/null 2>&1 && [ -s "$tmp/goff.npy" ] && ok || bad "gi --glossy-positivity off"
+expect_error "lobe rings out of range" "reference-lobe-rings" "$T" gi --heightmap "$hm24" --cell-size 10 \
+  --brdf phong:20 --reference --reference-lobe-rings 0
+expect_error "bad glossy positivity" "glossy-positivity" "$T" gi --heightmap "$hm24" --cell-size 10 --brdf phong:20 \
+  --glossy-positivity maybe
 expect_error "exponent map of the wrong size" "16 x 16 pixels" "$T" gi --heightmap "$hm24" --cell-size 10 --brdf phong:20 \
   --bounces 1 --phong-exponent "$hm16"
 expect_error "unreadable exponent map" "missing.png" "$T" gi --heightmap "$hm24" --cell-size 10 --brdf phong:20 \

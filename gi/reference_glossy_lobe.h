@@ -1,0 +1,65 @@
+#pragma once
+// The exact Phong exit radiance of the glossy reference (gi/reference_gi.h,
+// renderReferenceGlossy): the sky's radiance through a point's exact
+// visibility, integrated against the point's Phong lobe by quadrature, with
+// no SH projection anywhere (so the reference can measure the fast path's
+// order-4 SH ringing and blur).
+//
+// The lobe (Section 7): the normalised Phong lobe of exponent S about the
+// reflection R of the outgoing direction,
+//   f(w) = (S + 1) / (2 pi) max(0, w . R)^S,  integral 1 over the sphere,
+// the lobe whose SH factors phongLobeFactors approximates by e^{-l^2/(2S)}.
+// The exit radiance's Phong part is int I(w) f(w) dw (no cosine: the fast
+// path's lobe is convolved with the incident radiance alone).
+//
+// The incident radiance I(w): the sky's SH radiance evaluated in direction w
+// (no projection of the visible part) where w is above the point's tangent
+// plane and above its horizon, 0 elsewhere. Horizons: the exact maximum
+// blocking slope of gi/reference (referenceMaxSlope) at every grid point for
+// M azimuths phi_a = 2 pi (a + 0.5) / M; between azimuths linear, at a first
+// hit between grid points bilinear.
+//
+// Quadrature. The substitution t = (w . R)^(S + 1) turns the lobe's measure
+// into a uniform one: int I f dw = int_0^1 dt int_0^{2 pi} I(w(t, psi)) dpsi / (2 pi),
+// psi the azimuth about R. A midpoint rule with n rings in t and 2n azimuths
+// in psi therefore integrates every exponent alike (the lobe's peak is
+// absorbed by the substitution); the error comes from the horizon edge and
+// the sky's variation only. The convergence in n is tested by doubling it.
+#include <vector>
+
+#include "core/grid.h"
+#include "gi/lights.h"
+
+namespace terrain::gi {
+
+/// Exact horizons of every grid point: the maximum blocking slope
+/// (referenceMaxSlope, kNoBlocker where nothing blocks) at M azimuths.
+struct SkyHorizons {
+    int nx = 0, ny = 0, azimuths = 0;
+    std::vector<float> slope;  // ((y * nx) + x) * azimuths + a
+    /// Blocking slope at (px, py) cells in direction phi: bilinear between
+    /// grid points, linear between azimuths.
+    double at(float px, float py, double phi) const;
+};
+
+void buildSkyHorizons(ConstGridView heights, float cellSize, int azimuths, SkyHorizons& out);
+
+/// Orthonormal frame (t, b) about the unit vector r.
+void lobeFrame(const double r[3], double t[3], double b[3]);
+
+/// Quadrature direction (ring i of n, azimuth j of 2n) of the Phong lobe of
+/// exponent S about r (frame t, b from lobeFrame); each carries the weight
+/// 1 / (2 n^2) of the lobe's unit mass.
+void lobeDirection(const double r[3], const double t[3], const double b[3], double S, int n, int i, int j, double w[3]);
+
+/// True when direction w is above the tangent plane of normal n and above the
+/// horizon at (px, py).
+bool skyVisible(const SkyHorizons& hz, float px, float py, const double n[3], const double w[3]);
+
+/// Phong part of the exit radiance (RGB) at (px, py) with unit normal n
+/// towards the direction whose reflection about n is r: int I f dw over the
+/// sky `lighting` through the exact visibility, n rings of quadrature.
+void exactLobeRadiance(const SkyHorizons& hz, const ShRgb& lighting, float px, float py, const double n[3],
+                       const double r[3], double S, int rings, double out[3]);
+
+}  // namespace terrain::gi
