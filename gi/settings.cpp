@@ -16,6 +16,7 @@ GiSettings paperGiSettings() {
     s.keyLightAzimuths = 3;
     s.keyLightExactCosine = false;
     s.ambient = AmbientMethod::ShProduct;
+    s.shading.positivity = GlossyPositivity::Off;
     s.indirect.radiance.levelsPerOctave = 4;
     s.indirect.radiance.levelOffset = 2;
     s.indirect.lambert = LambertIndirect::ShKernel;
