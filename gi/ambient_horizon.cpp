@@ -308,9 +308,13 @@ void ambientFromHorizons(const AmbientInputs& in, const AmbientOutputs& out, Amb
     });
 }
 
-void addConstantSky(const Grid& ambient, const float radiance[3], const AlbedoMap* albedo, std::array<Grid, 3>& shade,
-                    const std::vector<std::uint8_t>* rows) {
-    const int nx = ambient.nx, ny = ambient.ny;
+namespace {
+
+// shade[c] += albedo[c] x value(c, i) at every texel i of the flagged rows
+// (`rows` as for ambientFromHorizons; albedo 1 where the map has no channel).
+template <class Value>
+void addLambertSky(int nx, int ny, const AlbedoMap* albedo, std::array<Grid, 3>& shade,
+                   const std::vector<std::uint8_t>* rows, Value value) {
     parallelForRows(ny, nx, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
             if (rows && (*rows)[static_cast<std::size_t>(y)] == 0) continue;
@@ -320,32 +324,27 @@ void addConstantSky(const Grid& ambient, const float radiance[3], const AlbedoMa
                 float* out = shade[c].data() + row;
                 for (int x = 0; x < nx; ++x) {
                     const float a = mapped ? albedo->channel[c].v[row + x] : 1.0f;
-                    out[x] += a * radiance[c] * ambient.v[row + x];
+                    out[x] += a * value(c, row + x);
                 }
             }
         }
     });
 }
 
+}  // namespace
+
+void addConstantSky(const Grid& ambient, const float radiance[3], const AlbedoMap* albedo, std::array<Grid, 3>& shade,
+                    const std::vector<std::uint8_t>* rows) {
+    addLambertSky(ambient.nx, ambient.ny, albedo, shade, rows,
+                  [&](std::size_t c, std::size_t i) { return radiance[c] * ambient.v[i]; });
+}
+
 void addGradientSky(const AmbientOutputs& parts, const SkyGradient& sky, const AlbedoMap* albedo,
                     std::array<Grid, 3>& shade, const std::vector<std::uint8_t>* rows) {
-    const int nx = parts.ambient.nx, ny = parts.ambient.ny;
-    parallelForRows(ny, nx, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y) {
-            if (rows && (*rows)[static_cast<std::size_t>(y)] == 0) continue;
-            const std::size_t row = static_cast<std::size_t>(y) * nx;
-            for (std::size_t c = 0; c < 3; ++c) {
-                const bool mapped = albedo && !albedo->channel[c].empty();
-                const float above = sky.horizon[c], ground = sky.ground[c], rise = sky.zenith[c] - sky.horizon[c];
-                float* out = shade[c].data() + row;
-                for (int x = 0; x < nx; ++x) {
-                    const float a = mapped ? albedo->channel[c].v[row + x] : 1.0f;
-                    const float below = parts.below->v[row + x];
-                    out[x] += a * (above * (parts.ambient.v[row + x] - below) + ground * below +
-                                   rise * parts.rising->v[row + x]);
-                }
-            }
-        }
+    addLambertSky(parts.ambient.nx, parts.ambient.ny, albedo, shade, rows, [&](std::size_t c, std::size_t i) {
+        const float below = parts.below->v[i];
+        return sky.horizon[c] * (parts.ambient.v[i] - below) + sky.ground[c] * below +
+               (sky.zenith[c] - sky.horizon[c]) * parts.rising->v[i];
     });
 }
 
