@@ -168,7 +168,7 @@ void addLightTransportFlags(CLI::App* sub, GiOptions& o) {
                     "sin(max(0, H_j)), H_j the horizon elevation along azimuth j. normal (Oke; Dozier & Frew; SAGA's "
                     "Sky View Factor is this with H_j raised to 0): the cosine-weighted sky visible above max(H_j, "
                     "tangent plane) at the texel's own normal N, (1/pi) int (N . w) dw, 1 on an open plane of any "
-                    "tilt; the same map as --out-ambient. README: Sky-view factor")
+                    "tilt; the same map as --out-ambient (README: \"Sky-view factor and horizons\")")
         ->capture_default_str();
     sub->add_option("--out-horizons", o.outHorizons,
                     "Horizon elevation angle per azimuth of the scan (degrees above the horizontal, signed; -90 where "

@@ -44,6 +44,7 @@ int main(int argc, char** argv) {
     add(&addGiIncrementalSuite);
     add(&addGiBoundDiagnosisSuite);
     add(&addLongRunSuite);
+    add(&addSvfSagaSuite);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
