@@ -21,6 +21,20 @@ void receiverDegrees(const float* slopes, std::size_t count, std::vector<float>&
     for (std::size_t i = 0; i < count; ++i) out[i] = static_cast<float>(horizonDegrees(slopes[i]));
 }
 
+// The bilinear blend of the receivers' angles a..d (weights wa..wd) over
+// those that have terrain in the direction: a receiver with none (-90, a
+// border receiver looking out) says nothing about the texels between it and
+// a receiver that has, which do have terrain before them. -90 when none has.
+float blendWithTerrain(const float (&angle)[4], const float (&weight)[4]) {
+    float sum = 0.0f, total = 0.0f;
+    for (int k = 0; k < 4; ++k)
+        if (angle[k] > -90.0f) {
+            sum += weight[k] * angle[k];
+            total += weight[k];
+        }
+    return total > 0.0f ? sum / total : -90.0f;
+}
+
 // Bilinear from the receivers' angles to the texels of one plane.
 void interpolateToTexels(const std::vector<float>& receivers, int nxr, int nyr, int subsample, Grid& out) {
     const int nx = out.nx;
@@ -31,9 +45,10 @@ void interpolateToTexels(const std::vector<float>& receivers, int nxr, int nyr, 
             const float* r1 = receivers.data() + static_cast<std::size_t>(ry.i1) * nxr;
             for (int x = 0; x < nx; ++x) {
                 const ReceiverLerp rx = receiverLerp(x, subsample, nxr);
-                const float a = r0[rx.i0] + rx.f * (r0[rx.i1] - r0[rx.i0]);
-                const float b = r1[rx.i0] + rx.f * (r1[rx.i1] - r1[rx.i0]);
-                out(x, y) = a + ry.f * (b - a);
+                const float angle[4] = {r0[rx.i0], r0[rx.i1], r1[rx.i0], r1[rx.i1]};
+                const float weight[4] = {(1.0f - rx.f) * (1.0f - ry.f), rx.f * (1.0f - ry.f), (1.0f - rx.f) * ry.f,
+                                         rx.f * ry.f};
+                out(x, y) = blendWithTerrain(angle, weight);
             }
         }
     });

@@ -13,8 +13,9 @@
 // (VisibilityField::maxSlope) along its azimuths; at sub-sampling each
 // receiver's angle is interpolated bilinearly to the texels as the sky-view
 // factor's horizons are (Fig. 7 of Nowrouzezahrai & Snyder 2009), the angle
-// rather than its slope, so that a receiver with no blocker (-90) blends
-// with its neighbours' finite angles instead of swamping them. The exact
+// rather than its slope, and over the receivers that have terrain in the
+// direction only: a border receiver looking out (-90) says nothing about the
+// texels inside it, which have terrain before them. The exact
 // angles come from the march of the bilinear field (referenceMaxSlope,
 // gi/reference.h) along the same azimuths.
 #include <vector>

@@ -143,6 +143,14 @@ TEST_CASE("gi.horizon_angles: sub-sampled angles are the receivers' at their tex
         CHECK(h.degrees[j](10, 8) == receiver(5, 4));
         CHECK(h.degrees[j](11, 8) == doctest::Approx(0.5f * (receiver(5, 4) + receiver(6, 4))).epsilon(1e-5));
     }
+    // the east border's receivers see nothing eastwards (-90): the texel between the
+    // last two receivers takes the inner one's angle, not a blend with -90
+    const int last = nxr - 1;
+    REQUIRE(horizonDegrees(st.envVisibility.maxSlope[static_cast<std::size_t>(4) * nxr + last]) == -90.0);
+    REQUIRE(st.envVisibility.maxSlope[static_cast<std::size_t>(4) * nxr + last - 1] > kNoBlocker);
+    CHECK(h.degrees[0](2 * last - 1, 8) ==
+          static_cast<float>(horizonDegrees(st.envVisibility.maxSlope[static_cast<std::size_t>(4) * nxr + last - 1])));
+    CHECK(h.degrees[0](2 * last, 8) == -90.0f);
     CHECK_THROWS_AS(horizonAnglesFromScan(st.envVisibility, st.envOperator.phi, 1, 40, 34, h), InputError);
     CHECK_THROWS_AS(horizonAnglesFromScan(st.envVisibility, scanAzimuths(8), 2, 40, 34, h), InputError);
 }
