@@ -137,6 +137,14 @@ for ref in "" --reference; do
       "az000_000 az045_000 az090_000 az135_000 az180_000 az225_000 az270_000 az315_000 " ] \
     && ok || bad "--out-horizons .exr channel names ($ref)"
 done
+# bit-identical for any thread count (a field of several row chunks)
+"$T" sim --scene erosion --size 256 --ticks 1 --out "$tmp/hzfield" --format png --quiet >/dev/null 2>&1
+hz256=("$T" gi --heightmap "$tmp/hzfield/frame_000001.png" --cell-size 10 --subsample 2 --azimuths 8)
+"${hz256[@]}" --threads 1 --out-horizons "$tmp/hz1.npy" --out-svf "$tmp/sv1.npy" >/dev/null 2>&1 \
+  && "${hz256[@]}" --threads 3 --out-horizons "$tmp/hz3.npy" --out-svf "$tmp/sv3.npy" >/dev/null 2>&1 \
+  && head -c 128 "$tmp/hz1.npy" | grep -a -q "'shape': (8, 256, 256)" \
+  && cmp -s "$tmp/hz1.npy" "$tmp/hz3.npy" && cmp -s "$tmp/sv1.npy" "$tmp/sv3.npy" \
+  && ok || bad "--out-horizons / --out-svf differ between 1 and 3 threads"
 expect_error "horizons of another type" "--out-horizons must end in .npy, .exr or .tif (got '.*h.png')" "${gi24[@]}" \
   --cell-size 10 --out-horizons "$tmp/h.png"
 expect_error "bad sky-view kind" "--svf-kind must be plain or normal (got 'cosine')" "${gi24[@]}" --cell-size 10 \
