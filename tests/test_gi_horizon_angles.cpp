@@ -11,6 +11,7 @@
 #include "gi/frame.h"
 #include "gi/horizon_angles.h"
 #include "gi/sh.h"
+#include "gi/sky_view.h"
 #include "tests/gi_test_terrain.h"
 
 using namespace terrain;
@@ -67,6 +68,10 @@ TEST_CASE("gi.horizon_angles: a tilted plane's horizon is the plane, signed: ata
         CHECK(exact.degrees[j](24, 24) == doctest::Approx(expected).epsilon(1e-4));
         CHECK(exact.degrees[j](10, 30) == doctest::Approx(expected).epsilon(1e-4));
     }
+    // the plain sky-view factor of that plane: the lune below it hidden, 1 - S / pi
+    Grid svf;
+    referenceSkyViewFactor(plane.cview(), cell, 256, svf);
+    CHECK(svf(24, 24) == doctest::Approx(1.0 - std::atan(a) / kPi).epsilon(1e-3));
     // the east border looking east, the north border looking north: nothing there
     CHECK(exact.degrees[0](n - 1, 20) == -90.0f);
     CHECK(exact.degrees[12](20, 0) == -90.0f);
