@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -49,6 +50,38 @@ void writeFalseColour(const std::string& file, const std::array<Grid, 3>& rgb) {
         std::copy(c.begin(), c.end(), px.begin() + static_cast<std::ptrdiff_t>(3 * i));
     }
     writePngRgb(file, rgb[0].nx, rgb[0].ny, px, 3);
+}
+
+// The planes' compass bearings (degrees clockwise from north) and their
+// order by bearing.
+struct BearingOrder {
+    std::vector<double> bearing;      // per plane, in the engine's order
+    std::vector<std::size_t> sorted;  // plane indices by ascending bearing
+};
+BearingOrder bearingOrder(const gi::HorizonAngles& h, const GeoReference& geo) {
+    // a raster without georeferencing is taken as north-up: row 0 north, columns east
+    const double east = geo.georeferenced() ? geo.transform[1] : 1.0;
+    const double north = geo.georeferenced() ? geo.transform[5] : -1.0;
+    BearingOrder b;
+    for (double phi : h.azimuths) b.bearing.push_back(gi::compassAzimuthDegrees(phi, east, north));
+    b.sorted.resize(b.bearing.size());
+    for (std::size_t i = 0; i < b.sorted.size(); ++i) b.sorted[i] = i;
+    std::stable_sort(b.sorted.begin(), b.sorted.end(),
+                     [&](std::size_t a, std::size_t c) { return b.bearing[a] < b.bearing[c]; });
+    return b;
+}
+
+std::string exrBearingName(double bearing) {
+    const long thousandths = std::lround(bearing * 1000.0);
+    char name[32];
+    std::snprintf(name, sizeof name, "az%03ld_%03ld", thousandths / 1000, thousandths % 1000);
+    return name;
+}
+
+std::string tifBearingName(double bearing) {
+    char name[32];
+    std::snprintf(name, sizeof name, "%.10g", bearing);
+    return name;
 }
 
 }  // namespace
@@ -101,6 +134,38 @@ void writeIndirect(const std::string& file, const std::array<Grid, 3>& rgb, cons
         writeFalseColour(file, rgb);
     else
         throw InputError("--out-indirect must end in .npy, .exr, .png or .tif (got '" + file + "')");
+}
+
+void writeHorizons(const std::string& file, const gi::HorizonAngles& horizons, const GeoReference& geo) {
+    const std::string ext = extensionOf(file);
+    if (ext != ".npy" && ext != ".exr" && !isGeoTiffPath(file))
+        throw InputError("--out-horizons must end in .npy, .exr or .tif (got '" + file + "')");
+    if (horizons.degrees.empty()) throw InputError("--out-horizons: no horizon angles to write");
+    const BearingOrder order = bearingOrder(horizons, geo);
+    const Grid& first = horizons.degrees.front();
+    if (ext == ".npy") {
+        std::vector<float> planes;
+        planes.reserve(first.size() * order.sorted.size());
+        for (std::size_t j : order.sorted)
+            planes.insert(planes.end(), horizons.degrees[j].v.begin(), horizons.degrees[j].v.end());
+        writeNpyArray(file,
+                      {order.sorted.size(), static_cast<std::size_t>(first.ny), static_cast<std::size_t>(first.nx)},
+                      planes.data());
+        return;
+    }
+    std::vector<std::string> names;
+    std::vector<const Grid*> grids;
+    for (std::size_t j : order.sorted) {
+        names.push_back(ext == ".exr" ? exrBearingName(order.bearing[j]) : tifBearingName(order.bearing[j]));
+        grids.push_back(&horizons.degrees[j]);
+    }
+    if (ext == ".exr") {
+        writeExrChannels(file, names, grids);
+        return;
+    }
+    std::vector<Grid> bands;
+    for (const Grid* g : grids) bands.push_back(*g);
+    writeGeoTiff(file, bands, geo, names);
 }
 
 void writeGiExr(const std::string& file, const Grid& heights, float cellSize, const std::array<Grid, 3>& shade,

@@ -9,6 +9,7 @@
 
 #include "core/geotiff_io.h"
 #include "core/grid.h"
+#include "gi/horizon_angles.h"
 
 namespace terrain::app {
 
@@ -28,6 +29,15 @@ void writeAmbient(const std::string& file, const Grid& ambient, const GeoReferen
 /// (white), through blue, magenta, orange and yellow, so that small
 /// differences of a dim light show.
 void writeIndirect(const std::string& file, const std::array<Grid, 3>& rgb, const GeoReference& geo);
+
+/// The horizon angles (degrees), one plane per azimuth in ascending compass
+/// bearing (clockwise from north; north from `geo`'s axes when it is
+/// georeferenced, else row 0's side, as for a north-up raster): .npy float32
+/// (azimuths, rows, columns); .exr one float32 channel per azimuth named
+/// azDDD_FFF (the bearing's degrees and thousandths: no '.', which EXR
+/// readers take for a layer separator, and names that sort by bearing); .tif
+/// one band per azimuth described by its bearing in degrees.
+void writeHorizons(const std::string& file, const gi::HorizonAngles& horizons, const GeoReference& geo);
 
 /// Every map of a frame as float32 channels of one EXR (core/image_io.h):
 /// `height` (m), `ambient`, `shade.R`, `shade.G`, `shade.B` and, when

@@ -105,11 +105,14 @@ void checkOutputs(const GiOptions& o) {
         throw InputError("--out-indirect must end in .npy, .exr, .png or .tif (got '" + o.outIndirect + "')");
     if (!oneOf(o.outSvf, {".npy", ".exr"}))
         throw InputError("--out-svf must end in .npy, .exr or .tif (got '" + o.outSvf + "')");
+    if (!oneOf(o.outHorizons, {".npy", ".exr"}))
+        throw InputError("--out-horizons must end in .npy, .exr or .tif (got '" + o.outHorizons + "')");
+    svfKindOf(o);
     if (!o.outExr.empty() && extensionOf(o.outExr) != ".exr")
         throw InputError("--out-exr must end in .exr (got '" + o.outExr + "')");
     if (!o.outIndirect.empty() && o.settings.indirect.bounces == 0 && !o.reference)
         throw InputError("--out-indirect needs --bounces >= 1");
-    for (const std::string* out : {&o.outShade, &o.outAmbient, &o.outIndirect, &o.outExr, &o.outSvf})
+    for (const std::string* out : {&o.outShade, &o.outAmbient, &o.outIndirect, &o.outExr, &o.outSvf, &o.outHorizons})
         if (!out->empty()) checkWritableFile(*out);
 }
 
@@ -157,9 +160,23 @@ void addLightTransportFlags(CLI::App* sub, GiOptions& o) {
     sub->add_flag("--amortise", gs.indirect.amortise,
                   "With --frames on static geometry: alternate direct and indirect updates");
     sub->add_option("--out-svf", o.outSvf,
-                    "Sky-view factor as GIS tools define it: the open fraction of the upper hemisphere over the "
-                    "horizontal plane, 1 - mean sin(horizon elevation) (.npy float32, .exr or .tif; --out-ambient is "
-                    "the normal-weighted one)");
+                    "Sky-view factor (.npy float32, .exr or .tif), the one --svf-kind names, from the same horizons "
+                    "as the frame (with --reference: the exact horizons along 256 azimuths)");
+    sub->add_option("--svf-kind", o.svfKind,
+                    "Which sky-view factor --out-svf writes. plain (Zaksek et al. 2011; RVT, GRASS r.skyview): the "
+                    "open fraction of the upper hemisphere over the horizontal plane, SVF = 1 - (1/m) sum_j "
+                    "sin(max(0, H_j)), H_j the horizon elevation along azimuth j. normal (Oke; Dozier & Frew; SAGA's "
+                    "Sky View Factor is this with H_j raised to 0): the cosine-weighted sky visible above max(H_j, "
+                    "tangent plane) at the texel's own normal N, (1/pi) int (N . w) dw, 1 on an open plane of any "
+                    "tilt; the same map as --out-ambient (README: \"Sky-view factor and horizons\")")
+        ->capture_default_str();
+    sub->add_option("--out-horizons", o.outHorizons,
+                    "Horizon elevation angle per azimuth of the scan (degrees above the horizontal, signed; -90 where "
+                    "no terrain lies in that direction), full resolution: .npy float32 (azimuths, rows, columns), "
+                    ".exr (one float32 channel per azimuth, named azDDD_FFF: compass bearing in degrees) or .tif (one "
+                    "band per azimuth, described by its bearing); bearings clockwise from north, row 0 north unless "
+                    "a GeoTIFF input says otherwise; planes in ascending bearing. With --reference: the exact "
+                    "horizons along the same azimuths");
     sub->add_option("--out-exr", o.outExr,
                     "Every map as float32 channels of one .exr: height, ambient, shade.R/G/B and, with bounces, "
                     "indirect.R/G/B");
@@ -227,6 +244,10 @@ void checkGiOptions(const GiOptions& o) {
     checkGiFlags(o.settings);
     checkLightOptions(o.lights);
     checkOutputs(o);
+}
+
+SvfKind svfKindOf(const GiOptions& o) {
+    return namedChoice<SvfKind>("--svf-kind", o.svfKind, {{"plain", SvfKind::Plain}, {"normal", SvfKind::Normal}});
 }
 
 // The frame's settings from the options: the modes named by strings, then

@@ -35,8 +35,10 @@ struct GiOptions {
     std::string brdf = "lambert";
     std::string albedo;
     std::string outIndirect;
-    std::string outExr;  // every map as channels of one float32 EXR
-    std::string outSvf;  // the plain sky-view factor (gi/sky_view.h)
+    std::string outExr;             // every map as channels of one float32 EXR
+    std::string outSvf;             // a sky-view factor (gi/sky_view.h, gi/ambient_horizon.h)
+    std::string svfKind = "plain";  // which one --out-svf writes: plain | normal
+    std::string outHorizons;        // horizon elevation angles per azimuth (gi/horizon_angles.h)
     int referenceDirections = 2048;
     int referenceLobeRings = 12;   // glossy reference: lobe quadrature rings (ReferenceGiSettings::lobeRings)
     std::string glossy;            // vector | scalar (glossy indirect light)
@@ -44,6 +46,15 @@ struct GiOptions {
     std::string phongExponent;     // VALUE or a 16-bit PNG
     std::string phongExponentRange = "1,1000";
 };
+
+/// Which sky-view factor --out-svf writes.
+enum class SvfKind {
+    Plain,   // 1 - mean sin(max(0, horizon)): the open fraction of the hemisphere over the horizontal (gi/sky_view.h)
+    Normal,  // the cosine-weighted visible sky at the texel's normal / pi: the ambient map (gi/ambient_horizon.h)
+};
+
+/// The --svf-kind the options name. InputError when it is neither.
+SvfKind svfKindOf(const GiOptions& o);
 
 /// Registers every flag of `terrain gi` but those naming the input
 /// (--heightmap, --cell-size, --z-scale, --z-offset) on `sub`, bound to `o`.

@@ -12,6 +12,7 @@
 #include "core/finite.h"
 #include "core/parallel.h"
 #include "gi/frame.h"
+#include "gi/horizon_angles.h"
 #include "gi/reference.h"
 #include "gi/reference_gi.h"
 #include "gi/sky_view.h"
@@ -94,8 +95,31 @@ GiMaps runFastPath(const GiOptions& o, const gi::GiSettings& settings, const GiI
         maps.indirect = std::move(state.indirect.indirect);
         maps.hasIndirect = true;
     }
-    if (!o.outSvf.empty()) gi::skyViewFactor(state, in.heights.cview(), maps.svf);
+    if (!o.outSvf.empty()) {
+        if (svfKindOf(o) == SvfKind::Normal)
+            maps.svf = maps.ambient;
+        else
+            gi::skyViewFactor(state, in.heights.cview(), maps.svf);
+    }
+    if (!o.outHorizons.empty())
+        gi::horizonAnglesFromScan(state.envVisibility, state.envOperator.phi, settings.subsample, in.heights.nx,
+                                  in.heights.ny, maps.horizons);
     return maps;
+}
+
+// The ground truth's sky-view factor and horizons: the exact horizons, the
+// plain factor along 256 azimuths, the horizons along the scan's azimuths.
+void addReferenceHorizonMaps(const GiOptions& o, const gi::GiSettings& settings, const GiInputs& in, GiMaps& maps) {
+    const float cell = static_cast<float>(in.cell);
+    if (!o.outSvf.empty()) {
+        if (svfKindOf(o) == SvfKind::Normal)
+            maps.svf = maps.ambient;
+        else
+            gi::referenceSkyViewFactor(in.heights.cview(), cell, gi::ReferenceSettings{}.azimuths, maps.svf);
+    }
+    if (!o.outHorizons.empty())
+        gi::referenceHorizonAngles(in.heights.cview(), cell, gi::scanAzimuths(settings.visibility.azimuths),
+                                   maps.horizons);
 }
 
 }  // namespace
@@ -127,9 +151,7 @@ GiMaps runGiFrames(const GiOptions& o, const gi::GiSettings& settings, const GiI
     return withThreads(o.threads, [&] {
         if (!o.reference) return runFastPath(o, settings, in);
         GiMaps maps = runReference(o, settings, in);
-        if (!o.outSvf.empty())
-            gi::referenceSkyViewFactor(in.heights.cview(), static_cast<float>(in.cell),
-                                       gi::ReferenceSettings{}.azimuths, maps.svf);
+        addReferenceHorizonMaps(o, settings, in, maps);
         return maps;
     });
 }
@@ -142,6 +164,7 @@ void writeGiMaps(const GiOptions& o, const GiInputs& in, const GiMaps& maps) {
         for (const Grid& g : maps.shade) requireFinite(g, "the shade map");
         requireFinite(maps.ambient, "the ambient map");
         if (!o.outSvf.empty()) requireFinite(maps.svf, "the sky-view factor");
+        for (const Grid& g : maps.horizons.degrees) requireFinite(g, "the horizon angles");
         if (maps.hasIndirect)
             for (const Grid& g : maps.indirect) requireFinite(g, "the indirect light");
     } catch (const InputError& e) {
@@ -151,6 +174,7 @@ void writeGiMaps(const GiOptions& o, const GiInputs& in, const GiMaps& maps) {
     if (!o.outAmbient.empty()) writeAmbient(o.outAmbient, maps.ambient, geo);
     if (!o.outIndirect.empty()) writeIndirect(o.outIndirect, maps.indirect, geo);
     if (!o.outSvf.empty()) writeAmbient(o.outSvf, maps.svf, geo);
+    if (!o.outHorizons.empty()) writeHorizons(o.outHorizons, maps.horizons, geo);
     if (!o.outExr.empty())
         writeGiExr(o.outExr, in.heights, static_cast<float>(in.cell), maps.shade, maps.ambient,
                    maps.hasIndirect ? &maps.indirect : nullptr);

@@ -10,6 +10,7 @@
 #include "core/grid.h"
 #include "engine/light_rig.h"
 #include "gi/albedo_io.h"
+#include "gi/horizon_angles.h"
 #include "gi/lights.h"
 
 namespace terrain::app {
@@ -39,7 +40,8 @@ struct GiMaps {
     Grid ambient;
     std::array<Grid, 3> indirect;
     bool hasIndirect = false;
-    Grid svf;  // with --out-svf: the plain sky-view factor
+    Grid svf;                    // with --out-svf: the sky-view factor --svf-kind names
+    gi::HorizonAngles horizons;  // with --out-horizons
 };
 
 /// The fast path (o.frames times on the same field, the first a warm-up;

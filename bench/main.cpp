@@ -45,6 +45,7 @@ int main(int argc, char** argv) {
     add(&addGiSunSkySuite);
     add(&addGiBoundDiagnosisSuite);
     add(&addLongRunSuite);
+    add(&addSvfSagaSuite);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

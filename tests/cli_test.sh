@@ -129,6 +129,36 @@ expect_error "output that is a folder" "is a folder" "${gi24[@]}" --cell-size 10
 cmp -s "$tmp/o.npy" "$tmp/o.good" && ok || bad "a failing gi run changed o.npy"
 [ ! -e "$tmp/i.npy" ] && ok || bad "a failing gi run wrote i.npy"
 
+# sky-view factors and horizons: --svf-kind normal is the ambient map bit for bit; the horizons
+# as (azimuths, rows, columns) .npy, EXR channels named by compass bearing, in ascending bearing
+"${gi24[@]}" --cell-size 10 --svf-kind normal --out-svf "$tmp/svf_n.npy" --out-ambient "$tmp/amb.npy" >/dev/null 2>&1 \
+  && cmp -s "$tmp/svf_n.npy" "$tmp/amb.npy" && ok || bad "--svf-kind normal differs from --out-ambient"
+"${gi24[@]}" --cell-size 10 --reference --svf-kind normal --out-svf "$tmp/svf_rn.npy" --out-ambient "$tmp/amb_r.npy" \
+  >/dev/null 2>&1 && cmp -s "$tmp/svf_rn.npy" "$tmp/amb_r.npy" && ok || bad "--reference --svf-kind normal differs"
+"${gi24[@]}" --cell-size 10 --out-svf "$tmp/svf_p.npy" >/dev/null 2>&1 && ! cmp -s "$tmp/svf_p.npy" "$tmp/amb.npy" \
+  && ok || bad "--svf-kind plain (the default) equals the normal-weighted map"
+for ref in "" --reference; do
+  "${gi24[@]}" --cell-size 10 $ref --azimuths 8 --out-horizons "$tmp/hz.npy" >/dev/null 2>&1 \
+    && head -c 128 "$tmp/hz.npy" | grep -a -q "'shape': (8, 24, 24)" && ok || bad "--out-horizons .npy shape ($ref)"
+  "${gi24[@]}" --cell-size 10 $ref --azimuths 8 --out-horizons "$tmp/hz.exr" >/dev/null 2>&1 \
+    && [ "$(grep -a -o 'az[0-9]\{3\}_[0-9]\{3\}' "$tmp/hz.exr" | head -8 | tr '\n' ' ')" = \
+      "az000_000 az045_000 az090_000 az135_000 az180_000 az225_000 az270_000 az315_000 " ] \
+    && ok || bad "--out-horizons .exr channel names ($ref)"
+done
+# bit-identical for any thread count (a field of several row chunks)
+"$T" sim --scene erosion --size 256 --ticks 1 --out "$tmp/hzfield" --format png --quiet >/dev/null 2>&1
+hz256=("$T" gi --heightmap "$tmp/hzfield/frame_000001.png" --cell-size 10 --subsample 2 --azimuths 8)
+"${hz256[@]}" --threads 1 --out-horizons "$tmp/hz1.npy" --out-svf "$tmp/sv1.npy" >/dev/null 2>&1 \
+  && "${hz256[@]}" --threads 3 --out-horizons "$tmp/hz3.npy" --out-svf "$tmp/sv3.npy" >/dev/null 2>&1 \
+  && head -c 128 "$tmp/hz1.npy" | grep -a -q "'shape': (8, 256, 256)" \
+  && cmp -s "$tmp/hz1.npy" "$tmp/hz3.npy" && cmp -s "$tmp/sv1.npy" "$tmp/sv3.npy" \
+  && ok || bad "--out-horizons / --out-svf differ between 1 and 3 threads"
+expect_error "horizons of another type" "--out-horizons must end in .npy, .exr or .tif (got '.*h.png')" "${gi24[@]}" \
+  --cell-size 10 --out-horizons "$tmp/h.png"
+expect_error "bad sky-view kind" "--svf-kind must be plain or normal (got 'cosine')" "${gi24[@]}" --cell-size 10 \
+  --svf-kind cosine --out-svf "$tmp/s.npy"
+[ ! -e "$tmp/h.png" ] && [ ! -e "$tmp/s.npy" ] && ok || bad "a refused sky-view output was written"
+
 # command-line parse errors: one line and exit 1, like every error; --help still prints help and exits 0
 expect_error "unknown flag" "not expected: --bogus" "$T" sim --bogus
 expect_error "size that is not a number" "--size" "$T" sim --size abc
@@ -271,6 +301,13 @@ cp "$tmp/dem_ambient.tif" "$tmp/dem_ambient_before.tif"
 rc=$?
 [ $rc = 1 ] && [ "$(wc -l <"$tmp/e")" = 1 ] && grep -q "dem_ambient.tif: " "$tmp/e" && ok || bad "full disk (tif): rc=$rc $(cat "$tmp/e")"
 cmp -s "$tmp/dem_ambient.tif" "$tmp/dem_ambient_before.tif" && ok || bad "a failed GeoTIFF write changed the file"
+# horizons of a GeoTIFF: one band per azimuth, described by its bearing clockwise from north, with
+# the input's place (read back as a heightmap: band 1, bearing 0, north)
+"$T" gi --heightmap "$tmp/dem.tif" --azimuths 4 --out-horizons "$tmp/dem_hz.tif" >/dev/null 2>&1 \
+  && [ "$(grep -a -o 'role="description">[0-9.]*<' "$tmp/dem_hz.tif" | tr '\n' ' ')" = \
+    'role="description">0< role="description">90< role="description">180< role="description">270< ' ] \
+  && "$T" gi --heightmap "$tmp/dem_hz.tif" --out-ambient "$tmp/hz_again.npy" 2>&1 | grep -q "24 x 20 cells of 30 m" \
+  && ok || bad "--out-horizons .tif bands and georeferencing"
 ls "$tmp" | grep -q 'dem_ambient.tif.*tmp\|tmp.*dem_ambient' && bad "GeoTIFF temporary left behind" || ok
 
 # EXR frames: every layer a float32 channel; a frame is a heightmap again
