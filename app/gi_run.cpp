@@ -101,9 +101,12 @@ GiMaps runFastPath(const GiOptions& o, const gi::GiSettings& settings, const GiI
         else
             gi::skyViewFactor(state, in.heights.cview(), maps.svf);
     }
-    if (!o.outHorizons.empty())
+    if (!o.outHorizons.empty()) {
         gi::horizonAnglesFromScan(state.envVisibility, state.envOperator.phi, settings.subsample, in.heights.nx,
                                   in.heights.ny, maps.horizons);
+        gi::raiseHorizonAnglesToNearField(in.heights.cview(), static_cast<float>(in.cell), settings.subsample,
+                                          maps.horizons);
+    }
     return maps;
 }
 

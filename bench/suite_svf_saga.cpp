@@ -328,6 +328,7 @@ std::string horizonAccuracyText(const Dem& d, int border) {
         gi::runGiFrame(d.heights.cview(), d.cell, gi::GiLighting{}, settings, st);
         gi::HorizonAngles fast;
         gi::horizonAnglesFromScan(st.envVisibility, st.envOperator.phi, s, d.heights.nx, d.heights.ny, fast);
+        gi::raiseHorizonAnglesToNearField(d.heights.cview(), d.cell, s, fast);
         for (int band : {border, wide}) {
             double sum = 0.0, sum2 = 0.0, worst = 0.0;
             for (std::size_t j = 0; j < exact.degrees.size(); ++j) {

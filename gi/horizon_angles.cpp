@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "gi/near_field.h"
 #include "gi/reference.h"
 #include "gi/sh.h"
 #include "gi/shading.h"
@@ -84,6 +86,32 @@ void horizonAnglesFromScan(const VisibilityField& env, const std::vector<double>
             std::copy(receivers.begin(), receivers.end(), g.data());
         else
             interpolateToTexels(receivers, nxr, nyr, s, g);
+    }
+}
+
+void raiseHorizonAnglesToNearField(ConstGridView heights, float cellSize, int subsample, HorizonAngles& angles) {
+    if (subsample <= 1) return;
+    const int nx = heights.nx, ny = heights.ny;
+    std::vector<float> cosSin;
+    for (double phi : angles.azimuths) {
+        cosSin.push_back(static_cast<float>(std::cos(phi)));
+        cosSin.push_back(static_cast<float>(std::sin(phi)));
+    }
+    std::vector<NearFieldStep> steps;
+    buildNearFieldSteps(cosSin, subsample, cellSize, steps);
+    for (std::size_t j = 0; j < angles.azimuths.size(); ++j) {
+        Grid& g = angles.degrees[j];
+        if (g.nx != nx || g.ny != ny) throw InputError("horizon angles: not of this grid");
+        const std::span<const NearFieldStep> mine(steps.data() + j * subsample, static_cast<std::size_t>(subsample));
+        parallelForRows(ny, nx, [&](int y0, int y1) {
+            std::vector<float> near(static_cast<std::size_t>(nx));
+            for (int y = y0; y < y1; ++y) {
+                std::fill(near.begin(), near.end(), -std::numeric_limits<float>::infinity());
+                raiseToNearField(heights, y, mine, near.data());
+                for (int x = 0; x < nx; ++x)
+                    g(x, y) = std::max(g(x, y), static_cast<float>(horizonDegrees(near[static_cast<std::size_t>(x)])));
+            }
+        });
     }
 }
 

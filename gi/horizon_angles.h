@@ -44,6 +44,11 @@ double horizonDegrees(double slope);
 void horizonAnglesFromScan(const VisibilityField& env, const std::vector<double>& azimuths, int subsample, int nx,
                            int ny, HorizonAngles& out);
 
+/// At sub-sampling: raises each texel's angles to its own near field
+/// (gi/near_field.h), which the receivers' scans, starting one receiver
+/// spacing out, never sample. `heights` and `cellSize`: the field's.
+void raiseHorizonAnglesToNearField(ConstGridView heights, float cellSize, int subsample, HorizonAngles& angles);
+
 /// The exact angles of the bilinear field along `azimuths` (radians), at
 /// every texel.
 void referenceHorizonAngles(ConstGridView heights, float cellSize, const std::vector<double>& azimuths,

@@ -159,3 +159,25 @@ TEST_CASE("gi.horizon_angles: sub-sampled angles are the receivers' at their tex
     CHECK_THROWS_AS(horizonAnglesFromScan(st.envVisibility, st.envOperator.phi, 1, 40, 34, h), InputError);
     CHECK_THROWS_AS(horizonAnglesFromScan(st.envVisibility, scanAzimuths(8), 2, 40, 34, h), InputError);
 }
+
+TEST_CASE("gi.horizon_angles: at sub-sampling a texel between receivers takes its own near field") {
+    // ridges on the even columns (the receivers at 2x), one-cell valleys on the
+    // odd ones: across the ridges a valley texel sees a wall of slope 2
+    const Grid g = gridOf(40, 34, [](int x, int) { return x % 2 == 0 ? 2.0f : 0.0f; });
+    GiSettings settings;
+    settings.subsample = 2;
+    GiState st;
+    runGiFrame(g.cview(), 1.0f, GiLighting{}, settings, st);
+    HorizonAngles h;
+    horizonAnglesFromScan(st.envVisibility, st.envOperator.phi, 2, 40, 34, h);
+    const float interpolated = h.degrees[0](21, 16);  // azimuth 0: along +x, across the ridges
+    raiseHorizonAnglesToNearField(g.cview(), 1.0f, 2, h);
+    HorizonAngles exact;
+    referenceHorizonAngles(g.cview(), 1.0f, h.azimuths, exact);
+    MESSAGE("valley texel along +x: interpolated " << interpolated << ", with its near field " << h.degrees[0](21, 16)
+                                                   << ", exact " << exact.degrees[0](21, 16));
+    CHECK(interpolated < 1.0f);
+    CHECK(h.degrees[0](21, 16) == doctest::Approx(exact.degrees[0](21, 16)).epsilon(1e-4));
+    // a receiver on a ridge keeps its own angle
+    CHECK(h.degrees[0](20, 16) == doctest::Approx(exact.degrees[0](20, 16)).epsilon(0.05));
+}
