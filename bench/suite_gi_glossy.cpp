@@ -87,6 +87,75 @@ EngineError engineError(const Grid& h, float cell, const GiLighting& light, cons
     return e;
 }
 
+struct AccuracyRow {
+    Brdf brdf;
+    float S;
+};
+
+// The references of one row: exact, and the diagnostic whose first-bounce
+// receivers shade the SH-projected incident radiance (first hits exact).
+struct RowReferences {
+    ReferenceGiResult exact, receiverSh;
+    double mean = 0.0, seconds = 0.0;  // the exact one's mean indirect light and time
+};
+
+RowReferences rowReferences(const Grid& h, float cell, const GiLighting& light, const AlbedoMap& a,
+                            const GlossyOptions& o, const AccuracyRow& row) {
+    RowReferences r;
+    ReferenceGiSettings rs;
+    rs.directions = o.directions;
+    rs.lobeRings = o.lobeRings;
+    rs.bounces = 1;
+    rs.shading = settingsFor(row.brdf, row.S, 1, 1, GlossyIndirect::VectorPyramid).shading;
+    const auto t0 = Clock::now();
+    withThreads(2, [&] { renderReferenceGi(h.cview(), cell, light.environment, &a, rs, r.exact); });
+    r.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    ReferenceGiSettings rsh = rs;
+    rsh.receiverSh = true;
+    withThreads(2, [&] { renderReferenceGi(h.cview(), cell, light.environment, &a, rsh, r.receiverSh); });
+    for (const Grid& g : r.exact.indirect)
+        for (float v : g.v) r.mean += v;
+    r.mean /= 3.0 * h.nx * h.ny;
+    return r;
+}
+
+// The engine's errors of one row at sub-sampling s: e [vector, scalar][clamp,
+// off] against the exact reference; d, the vector mode [clamp, off] against
+// the diagnostic reference; az, the vector mode (clamp) with 16 and 32 scan
+// azimuths. Each also a CSV line.
+struct RowErrors {
+    EngineError e[2][2], d[2], az[2];
+};
+
+RowErrors rowErrors(const Grid& h, float cell, const GiLighting& light, const AlbedoMap& a, const AccuracyRow& row,
+                    int s, const RowReferences& ref, std::string& csv) {
+    RowErrors r;
+    auto csvLine = [&](const std::string& mode, const char* positivity, const EngineError& e) {
+        csv += strprintf("%s,%g,%d,%s,%s,%.5f,%+.5f,%.4f,%.5f,%.1f\n", brdfName(row.brdf), row.S, s, mode.c_str(),
+                         positivity, e.rmse, e.bias, e.negative, ref.mean, ref.seconds);
+    };
+    for (int k = 0; k < 2; ++k)
+        for (int p = 0; p < 2; ++p) {
+            const GlossyIndirect mode = k == 0 ? GlossyIndirect::VectorPyramid : GlossyIndirect::ScalarPyramid;
+            const GlossyPositivity pos = p == 0 ? GlossyPositivity::Clamp : GlossyPositivity::Off;
+            r.e[k][p] = engineError(h, cell, light, a, settingsFor(row.brdf, row.S, s, 1, mode), pos, ref.exact);
+            csvLine(k == 0 ? "vector" : "scalar", p == 0 ? "clamp" : "off", r.e[k][p]);
+        }
+    for (int p = 0; p < 2; ++p) {
+        const GlossyPositivity pos = p == 0 ? GlossyPositivity::Clamp : GlossyPositivity::Off;
+        r.d[p] = engineError(h, cell, light, a, settingsFor(row.brdf, row.S, s, 1, GlossyIndirect::VectorPyramid), pos,
+                             ref.receiverSh);
+        csvLine("vector vs receiver-SH reference", p == 0 ? "clamp" : "off", r.d[p]);
+    }
+    for (int k = 0; k < 2; ++k) {
+        GiSettings g = settingsFor(row.brdf, row.S, s, 1, GlossyIndirect::VectorPyramid);
+        g.indirect.azimuths = 16 << k;
+        r.az[k] = engineError(h, cell, light, a, g, GlossyPositivity::Clamp, ref.exact);
+        csvLine("vector " + std::to_string(16 << k) + " azimuths", "clamp", r.az[k]);
+    }
+    return r;
+}
+
 // Accuracy against the exact glossy reference on the central o.size^2 crop of
 // Mont Blanc: both glossy modes, with the positivity clamp (engine default)
 // and without it (paper), 1x and 2x.
@@ -110,77 +179,23 @@ std::string accuracySection(const GlossyOptions& o, const BenchContext& ctx, std
         "RMSE | bias | scalar off RMSE | bias | scalar off neg | reference mean indirect | reference time (s) |\n";
     md += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     csv += "brdf,S,subsample,mode,positivity,rel_rmse,bias,negative_share,reference_mean,reference_seconds\n";
-    struct Row {
-        Brdf brdf;
-        float S;
-    };
-    for (const Row& row : {Row{Brdf::Phong, 8.0f}, Row{Brdf::Phong, 16.0f}, Row{Brdf::Phong, 32.0f},
-                           Row{Brdf::Phong, 64.0f}, Row{Brdf::LambertPlusPhong, 64.0f}}) {
-        ReferenceGiSettings rs;
-        rs.directions = o.directions;
-        rs.lobeRings = o.lobeRings;
-        rs.bounces = 1;
-        rs.shading = settingsFor(row.brdf, row.S, 1, 1, GlossyIndirect::VectorPyramid).shading;
-        ReferenceGiResult ref;
-        const auto t0 = Clock::now();
-        withThreads(2, [&] { renderReferenceGi(h.cview(), cell, light.environment, &a, rs, ref); });
-        const double refSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
-        // the diagnostic reference: receivers shade the SH-projected incident radiance (exact first hits)
-        ReferenceGiSettings rsh = rs;
-        rsh.receiverSh = true;
-        ReferenceGiResult refSh;
-        withThreads(2, [&] { renderReferenceGi(h.cview(), cell, light.environment, &a, rsh, refSh); });
-        double refMean = 0.0;
-        for (const Grid& g : ref.indirect)
-            for (float v : g.v) refMean += v;
-        refMean /= 3.0 * o.size * o.size;
+    for (const AccuracyRow& row :
+         {AccuracyRow{Brdf::Phong, 8.0f}, AccuracyRow{Brdf::Phong, 16.0f}, AccuracyRow{Brdf::Phong, 32.0f},
+          AccuracyRow{Brdf::Phong, 64.0f}, AccuracyRow{Brdf::LambertPlusPhong, 64.0f}}) {
+        const RowReferences ref = rowReferences(h, cell, light, a, o, row);
         for (int s : {1, 2}) {
-            EngineError e[2][2], d[2], az[2];  // [vector, scalar][clamp, off]; vector [clamp, off] against refSh;
-                                               // vector clamp with 16 and 32 scan azimuths
-            for (int k = 0; k < 2; ++k)
-                for (int p = 0; p < 2; ++p) {
-                    const GlossyIndirect mode = k == 0 ? GlossyIndirect::VectorPyramid : GlossyIndirect::ScalarPyramid;
-                    const GlossyPositivity pos = p == 0 ? GlossyPositivity::Clamp : GlossyPositivity::Off;
-                    e[k][p] = engineError(h, cell, light, a, settingsFor(row.brdf, row.S, s, 1, mode), pos, ref);
-                    char c[256];
-                    std::snprintf(c, sizeof c, "%s,%g,%d,%s,%s,%.5f,%+.5f,%.4f,%.5f,%.1f\n", brdfName(row.brdf), row.S,
-                                  s, k == 0 ? "vector" : "scalar", p == 0 ? "clamp" : "off", e[k][p].rmse, e[k][p].bias,
-                                  e[k][p].negative, refMean, refSeconds);
-                    csv += c;
-                }
-            for (int p = 0; p < 2; ++p) {
-                const GlossyPositivity pos = p == 0 ? GlossyPositivity::Clamp : GlossyPositivity::Off;
-                d[p] = engineError(h, cell, light, a, settingsFor(row.brdf, row.S, s, 1, GlossyIndirect::VectorPyramid),
-                                   pos, refSh);
-                char c[256];
-                std::snprintf(c, sizeof c, "%s,%g,%d,vector vs receiver-SH reference,%s,%.5f,%+.5f,%.4f,%.5f,%.1f\n",
-                              brdfName(row.brdf), row.S, s, p == 0 ? "clamp" : "off", d[p].rmse, d[p].bias,
-                              d[p].negative, refMean, refSeconds);
-                csv += c;
-            }
-            for (int k = 0; k < 2; ++k) {
-                GiSettings g = settingsFor(row.brdf, row.S, s, 1, GlossyIndirect::VectorPyramid);
-                g.indirect.azimuths = 16 << k;
-                az[k] = engineError(h, cell, light, a, g, GlossyPositivity::Clamp, ref);
-                char c[256];
-                std::snprintf(c, sizeof c, "%s,%g,%d,vector %d azimuths,clamp,%.5f,%+.5f,%.4f,%.5f,%.1f\n",
-                              brdfName(row.brdf), row.S, s, 16 << k, az[k].rmse, az[k].bias, az[k].negative, refMean,
-                              refSeconds);
-                csv += c;
-            }
-            azim += strprintf("| %s | %g | %dx | %.4f | %.4f | %.4f |\n", brdfName(row.brdf), row.S, s, e[0][0].rmse,
-                              az[0].rmse, az[1].rmse);
+            const RowErrors r = rowErrors(h, cell, light, a, row, s, ref, csv);
+            azim += strprintf("| %s | %g | %dx | %.4f | %.4f | %.4f |\n", brdfName(row.brdf), row.S, s, r.e[0][0].rmse,
+                              r.az[0].rmse, r.az[1].rmse);
             diag += strprintf("| %s | %g | %dx | %.4f | %+.4f | %.4f | %+.4f |\n", brdfName(row.brdf), row.S, s,
-                              d[0].rmse, d[0].bias, d[1].rmse, d[1].bias);
-            char line[512];
-            std::snprintf(
-                line, sizeof line,
+                              r.d[0].rmse, r.d[0].bias, r.d[1].rmse, r.d[1].bias);
+            const std::string line = strprintf(
                 "| %s | %g | %dx | %.4f | %+.4f | %.4f | %+.4f | %.1f %% | %.4f | %+.4f | %.4f | %+.4f | %.1f "
                 "%% | %.4f | %.1f |\n",
-                brdfName(row.brdf), row.S, s, e[0][0].rmse, e[0][0].bias, e[0][1].rmse, e[0][1].bias,
-                100.0 * e[0][1].negative, e[1][0].rmse, e[1][0].bias, e[1][1].rmse, e[1][1].bias,
-                100.0 * e[1][1].negative, refMean, refSeconds);
-            std::fprintf(stderr, "%s", line);
+                brdfName(row.brdf), row.S, s, r.e[0][0].rmse, r.e[0][0].bias, r.e[0][1].rmse, r.e[0][1].bias,
+                100.0 * r.e[0][1].negative, r.e[1][0].rmse, r.e[1][0].bias, r.e[1][1].rmse, r.e[1][1].bias,
+                100.0 * r.e[1][1].negative, ref.mean, ref.seconds);
+            std::fprintf(stderr, "%s", line.c_str());
             md += line;
         }
     }
