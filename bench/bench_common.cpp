@@ -142,6 +142,22 @@ Grid alpsCentreCrop(const std::string& dataDir, int size, float& cell) {
     return centreCrop(full.heights, size);
 }
 
+bool readCachedGrids(const std::string& file, int nx, int ny, std::span<Grid> grids) {
+    std::ifstream in(file, std::ios::binary);
+    for (Grid& g : grids) {
+        g.resize(nx, ny);
+        if (!in.read(reinterpret_cast<char*>(g.data()), static_cast<std::streamsize>(g.size() * sizeof(float))))
+            return false;
+    }
+    return true;
+}
+
+void writeCachedGrids(const std::string& file, std::span<const Grid> grids) {
+    std::ofstream out(file, std::ios::binary);
+    for (const Grid& g : grids)
+        out.write(reinterpret_cast<const char*>(g.data()), static_cast<std::streamsize>(g.size() * sizeof(float)));
+}
+
 double relRmse(const std::array<Grid, 3>& a, const std::array<Grid, 3>& b, double& bias) {
     const int bx = a[0].nx / 10, by = a[0].ny / 10;
     double se = 0.0, sr = 0.0, sd = 0.0;

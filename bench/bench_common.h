@@ -3,6 +3,7 @@
 // results live, a scratch folder, the machine description every results file
 // starts with, medians, the real DEMs at true scale and relative errors.
 #include <array>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -77,6 +78,11 @@ Dem erodedScene(int size, int ticks);
 
 /// The central size^2 crop of alps-montblanc at true scale; sets cell.
 Grid alpsCentreCrop(const std::string& dataDir, int size, float& cell);
+
+/// Grids cached in a file across runs (a reference that takes minutes):
+/// read them when `file` holds that many nx x ny grids, else false.
+bool readCachedGrids(const std::string& file, int nx, int ny, std::span<Grid> grids);
+void writeCachedGrids(const std::string& file, std::span<const Grid> grids);
 
 /// Relative RMSE of a against b over the interior (10 % border left out), all
 /// three channels; bias = mean difference / RMS of b.

@@ -213,12 +213,8 @@ private:
 Grid GiSuite::referenceAmbient(const Dem& d, int stride, int border) const {
     const std::string cache =
         cacheDir_ + "/gi_reference_" + d.name + "_s" + std::to_string(stride) + "_b" + std::to_string(border) + ".bin";
-    Grid g(d.heights.nx, d.heights.ny);
-    {
-        std::ifstream in(cache, std::ios::binary);
-        if (in && in.read(reinterpret_cast<char*>(g.data()), static_cast<std::streamsize>(g.size() * sizeof(float))))
-            return g;
-    }
+    Grid g;
+    if (readCachedGrids(cache, d.heights.nx, d.heights.ny, {&g, 1})) return g;
     std::fprintf(stderr, "reference for %s (stride %d) ...\n", d.name.c_str(), stride);
     const auto t0 = Clock::now();
     ReferenceSettings rs;
@@ -229,9 +225,7 @@ Grid GiSuite::referenceAmbient(const Dem& d, int stride, int border) const {
     ReferenceResult rr;
     renderReference(d.heights.cview(), d.cell, nullptr, nullptr, rs, rr);
     std::fprintf(stderr, "reference: %.1f s\n", std::chrono::duration<double>(Clock::now() - t0).count());
-    std::ofstream out(cache, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(rr.ambient.data()),
-              static_cast<std::streamsize>(rr.ambient.size() * sizeof(float)));
+    writeCachedGrids(cache, {&rr.ambient, 1});
     return rr.ambient;
 }
 

@@ -6,7 +6,6 @@
 // (gi::renderReferenceSkyGradient + gi::addReferenceKeyLight). Writes
 // gi_sunsky.md and .csv.
 #include <cstdio>
-#include <fstream>
 #include <memory>
 #include <optional>
 #include <string>
@@ -55,41 +54,25 @@ struct SkyReference {
     std::array<Grid, 3> sky, sun, total;
 };
 
-bool readGrids(const std::string& file, int nx, int ny, std::array<Grid, 3>& g) {
-    std::ifstream in(file, std::ios::binary);
-    for (Grid& c : g) {
-        c.resize(nx, ny);
-        if (!in.read(reinterpret_cast<char*>(c.data()), static_cast<std::streamsize>(c.size() * sizeof(float))))
-            return false;
-    }
-    return true;
-}
-
-void writeGrids(const std::string& file, const std::array<Grid, 3>& g) {
-    std::ofstream out(file, std::ios::binary);
-    for (const Grid& c : g)
-        out.write(reinterpret_cast<const char*>(c.data()), static_cast<std::streamsize>(c.size() * sizeof(float)));
-}
-
 SkyReference reference(const Dem& d, const engine::SceneLights& l, const SunSkyOptions& o, const std::string& dir) {
     SkyReference r;
     const int nx = d.heights.nx, ny = d.heights.ny;
     const std::string base = dir + "/sunsky_reference_" + d.name + "_k" + std::to_string(o.keyAzimuths);
-    if (!readGrids(base + "_sky.bin", nx, ny, r.sky)) {
+    if (!readCachedGrids(base + "_sky.bin", nx, ny, r.sky)) {
         std::fprintf(stderr, "sky reference for %s ...\n", d.name.c_str());
         ReferenceSettings rs;
         rs.progress = true;
         ReferenceResult rr;
         renderReferenceSkyGradient(d.heights.cview(), d.cell, gradientOf(l), nullptr, rs, rr);
         r.sky = rr.rgb;
-        writeGrids(base + "_sky.bin", r.sky);
+        writeCachedGrids(base + "_sky.bin", r.sky);
     }
-    if (!readGrids(base + "_sun.bin", nx, ny, r.sun)) {
+    if (!readCachedGrids(base + "_sun.bin", nx, ny, r.sun)) {
         std::fprintf(stderr, "sun reference for %s ...\n", d.name.c_str());
         for (Grid& g : r.sun) g.resize(nx, ny, 0.0f);
         for (const KeyLight& k : l.keys)
             addReferenceKeyLight(d.heights.cview(), d.cell, k, nullptr, o.keyAzimuths, r.sun);
-        writeGrids(base + "_sun.bin", r.sun);
+        writeCachedGrids(base + "_sun.bin", r.sun);
     }
     for (std::size_t c = 0; c < 3; ++c) {
         r.total[c].resize(nx, ny);

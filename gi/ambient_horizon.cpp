@@ -26,10 +26,8 @@ struct AmbientJob {
     int nx, ny, nxr, nyr, m;
     int rowFloats;  // scratch floats per row buffer (nx rounded up, or nxr)
     float* scratch;
-    float* raised;    // azimuths x receivers (sub-sampling only)
-    const int* col0;  // per texel column: left receiver, right receiver, fraction towards it
-    const int* col1;
-    const float* colFrac;
+    float* raised;                   // azimuths x receivers (sub-sampling only)
+    const ReceiverLerp* columns;     // per texel column: the receivers it lies between
     const NearFieldStep* nearSteps;  // azimuths x subsample
     const std::vector<std::uint8_t>* rows;
     const AmbientOutputs& out;
@@ -139,8 +137,8 @@ void horizontalLerp(const AmbientJob& j, const float* vert, float* out) {
         for (int k = 0; k < S; ++k) out[S * X + k] = v0 + frac[k] * d;
     }
     for (int x = std::min(S * intervals, j.nx); x < j.nx; ++x) {
-        const float v0 = vert[j.col0[x]], v1 = vert[j.col1[x]];
-        out[x] = v0 + j.colFrac[x] * (v1 - v0);
+        const ReceiverLerp& r = j.columns[x];
+        out[x] = vert[r.i0] + r.f * (vert[r.i1] - vert[r.i0]);
     }
 }
 
@@ -158,8 +156,8 @@ void interpolatedHorizons(const AmbientJob& j, int y, int a, float* vert, float*
             return horizontalLerp<4>(j, vert, out);
         default:
             for (int x = 0; x < j.nx; ++x) {
-                const float v0 = vert[j.col0[x]], v1 = vert[j.col1[x]];
-                out[x] = v0 + j.colFrac[x] * (v1 - v0);
+                const ReceiverLerp& r = j.columns[x];
+                out[x] = vert[r.i0] + r.f * (vert[r.i1] - vert[r.i0]);
             }
     }
 }
@@ -241,19 +239,6 @@ void flagReceiverRows(int ny, int s, int nyr, const std::vector<std::uint8_t>* r
     }
 }
 
-// Per texel column: the receivers it lies between and the fraction towards the second.
-void buildColumnLerps(int nx, int s, int nxr, AmbientScratch& scratch) {
-    scratch.col0.resize(static_cast<std::size_t>(nx));
-    scratch.col1.resize(static_cast<std::size_t>(nx));
-    scratch.colFrac.resize(static_cast<std::size_t>(nx));
-    for (int x = 0; x < nx; ++x) {
-        const ReceiverLerp r = receiverLerp(x, s, nxr);
-        scratch.col0[static_cast<std::size_t>(x)] = r.i0;
-        scratch.col1[static_cast<std::size_t>(x)] = r.i1;
-        scratch.colFrac[static_cast<std::size_t>(x)] = r.f;
-    }
-}
-
 }  // namespace
 
 void ambientFromHorizons(const AmbientInputs& in, const AmbientOutputs& out, AmbientScratch& scratch,
@@ -273,7 +258,7 @@ void ambientFromHorizons(const AmbientInputs& in, const AmbientOutputs& out, Amb
     constexpr int kRowsPerBlock = 5;  // three integrals, horizon, the receivers' vertical blend
     scratch.rows.resize(static_cast<std::size_t>(nBlocks) * kRowsPerBlock * rowFloats);
     const int s = in.subsample, nxr = in.env->nxr, nyr = in.env->nyr;
-    buildColumnLerps(nx, s, nxr, scratch);
+    receiverLerps(nx, s, nxr, scratch.columns);
     if (s > 1) {
         scratch.raised.resize(in.env->maxSlope.size());
         buildNearFieldSteps(in.cosSin, s, in.cellSize, scratch.nearSteps);
@@ -287,9 +272,7 @@ void ambientFromHorizons(const AmbientInputs& in, const AmbientOutputs& out, Amb
                          rowFloats,
                          scratch.rows.data(),
                          scratch.raised.data(),
-                         scratch.col0.data(),
-                         scratch.col1.data(),
-                         scratch.colFrac.data(),
+                         scratch.columns.data(),
                          scratch.nearSteps.data(),
                          rows,
                          out};

@@ -60,8 +60,7 @@ struct AmbientScratch {
     std::vector<float> rows;                 // per row block
     std::vector<float> raised;               // azimuths x receivers: horizons raised to the lowest tangent slope
     std::vector<std::uint8_t> receiverRows;  // the receiver rows this call reads
-    std::vector<int> col0, col1;             // per texel column: the receivers it lies between
-    std::vector<float> colFrac;              // and the fraction towards the second
+    std::vector<ReceiverLerp> columns;       // per texel column: the receivers it lies between
     std::vector<NearFieldStep> nearSteps;    // azimuths x subsample
 };
 

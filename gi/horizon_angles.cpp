@@ -40,13 +40,15 @@ float blendWithTerrain(const float (&angle)[4], const float (&weight)[4]) {
 // Bilinear from the receivers' angles to the texels of one plane.
 void interpolateToTexels(const std::vector<float>& receivers, int nxr, int nyr, int subsample, Grid& out) {
     const int nx = out.nx;
+    std::vector<ReceiverLerp> columns;
+    receiverLerps(nx, subsample, nxr, columns);
     parallelForRows(out.ny, nx, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
             const ReceiverLerp ry = receiverLerp(y, subsample, nyr);
             const float* r0 = receivers.data() + static_cast<std::size_t>(ry.i0) * nxr;
             const float* r1 = receivers.data() + static_cast<std::size_t>(ry.i1) * nxr;
             for (int x = 0; x < nx; ++x) {
-                const ReceiverLerp rx = receiverLerp(x, subsample, nxr);
+                const ReceiverLerp& rx = columns[static_cast<std::size_t>(x)];
                 const float angle[4] = {r0[rx.i0], r0[rx.i1], r1[rx.i0], r1[rx.i1]};
                 const float weight[4] = {(1.0f - rx.f) * (1.0f - ry.f), rx.f * (1.0f - ry.f), (1.0f - rx.f) * ry.f,
                                          rx.f * ry.f};

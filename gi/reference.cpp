@@ -118,8 +118,9 @@ struct ReferenceTexels {
 void addGradientElevationIntegral(const SunSkySettings& sky, double lo, double nh, double nz, double rgb[3]) {
     auto cos2 = [](double w) { return 0.5 * w + 0.25 * std::sin(2.0 * w); };
     auto sinCos = [](double w) { return 0.5 * std::sin(w) * std::sin(w); };
-    auto sinCos2 = [](double w) { return -std::pow(std::cos(w), 3) / 3.0; };
-    auto sin2Cos = [](double w) { return std::pow(std::sin(w), 3) / 3.0; };
+    auto cube = [](double v) { return v * v * v; };
+    auto sinCos2 = [&](double w) { return -cube(std::cos(w)) / 3.0; };
+    auto sin2Cos = [&](double w) { return cube(std::sin(w)) / 3.0; };
     const double top = 0.5 * kPi, a = std::max(lo, 0.0), b = std::min(lo, 0.0);
     // above the horizontal: horizon + (zenith - horizon) sin w; below: ground
     const double flat = nh * (cos2(top) - cos2(a)) + nz * (sinCos(top) - sinCos(a));

@@ -122,6 +122,12 @@ inline ReceiverLerp receiverLerp(int x, int s, int n) {
     if (r.f > 1.0f) r.f = 1.0f;
     return r;
 }
+/// receiverLerp of every texel 0..count-1 (a row's columns or a grid's rows),
+/// into `out` (resized: no allocation once it is large enough).
+inline void receiverLerps(int count, int s, int n, std::vector<ReceiverLerp>& out) {
+    out.resize(static_cast<std::size_t>(count > 0 ? count : 0));
+    for (int x = 0; x < count; ++x) out[static_cast<std::size_t>(x)] = receiverLerp(x, s, n);
+}
 
 /// An albedo map of one value everywhere (every channel).
 AlbedoMap uniformAlbedo(int nx, int ny, float albedo);

@@ -30,6 +30,8 @@ void skyViewFactor(const GiState& st, ConstGridView heights, Grid& out) {
     std::vector<NearFieldStep> near;
     buildNearFieldSteps(st.envCosSin, s, st.pyramid.cellSize, near);
     out.resize(nx, ny);
+    std::vector<ReceiverLerp> columns;
+    receiverLerps(nx, s, nxr, columns);
     parallelForRows(ny, nx * m, [&](int y0, int y1) {
         std::vector<float> horizon(static_cast<std::size_t>(nx));
         std::vector<double> sum(static_cast<std::size_t>(nx));
@@ -41,7 +43,7 @@ void skyViewFactor(const GiState& st, ConstGridView heights, Grid& out) {
                 // raised to 0 before the blend: "nothing blocks" is a huge negative slope
                 auto at = [&](int X, int Y) { return std::max(0.0f, t[static_cast<std::size_t>(Y) * nxr + X]); };
                 for (int x = 0; x < nx; ++x) {
-                    const ReceiverLerp rx = receiverLerp(x, s, nxr);
+                    const ReceiverLerp& rx = columns[static_cast<std::size_t>(x)];
                     const float a = at(rx.i0, ry.i0) + rx.f * (at(rx.i1, ry.i0) - at(rx.i0, ry.i0));
                     const float b = at(rx.i0, ry.i1) + rx.f * (at(rx.i1, ry.i1) - at(rx.i0, ry.i1));
                     horizon[static_cast<std::size_t>(x)] = s == 1 ? at(x, y) : a + ry.f * (b - a);
