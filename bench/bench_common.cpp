@@ -1,15 +1,18 @@
 #include "bench/bench_common.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <stdexcept>
 #include <system_error>
 #include <thread>
 
 #include <sys/utsname.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "core/error.h"
@@ -70,7 +73,38 @@ std::string cpuAndThreads() {
 std::string machineDescription() {
     utsname u{};
     uname(&u);
-    return cpuAndThreads() + ", " + u.sysname + " " + u.release;
+    return cpuAndThreads() + ", " + u.sysname + " " + u.release + "; " + buildDescription();
+}
+
+std::string buildDescription() {
+#ifdef TERRAIN_BUILD_DESCRIPTION
+    return TERRAIN_BUILD_DESCRIPTION;
+#else
+    return "unknown build";
+#endif
+}
+
+void drawPlot(const BenchContext& ctx, const std::string& script) {
+#ifndef TERRAIN_PLOT_PYTHON
+#define TERRAIN_PLOT_PYTHON ""
+#endif
+    const std::string python = TERRAIN_PLOT_PYTHON;
+    const std::string path = std::string(TERRAIN_SOURCE_DIR) + "/bench/plots/" + script + ".py";
+    if (python.empty())
+        throw std::runtime_error("no Python 3 found when configuring; the CSV is written, the plot " + script +
+                                 " is not (install python3-matplotlib and re-run cmake)");
+    const pid_t pid = fork();
+    if (pid < 0) throw std::runtime_error("cannot start " + python + " to draw the plot " + script);
+    if (pid == 0) {
+        const char* argv[] = {python.c_str(), path.c_str(), ctx.outDir.c_str(), nullptr};
+        execv(argv[0], const_cast<char* const*>(argv));
+        _exit(127);
+    }
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {}
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+        throw std::runtime_error("the plot " + script + " was not drawn (" + python + " " + path +
+                                 " failed; it needs python3-matplotlib); the CSV and Markdown are written");
 }
 
 Dem loadAlps(const std::string& dataDir) {

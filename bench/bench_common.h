@@ -42,8 +42,17 @@ double median(std::vector<double> v);
 /// "<cpu>, <n> hardware threads".
 std::string cpuAndThreads();
 
-/// "<cpu>, <n> hardware threads, <kernel>": the machine line of a results file.
+/// "<cpu>, <n> hardware threads, <kernel>; <build>": the machine line of a results file.
 std::string machineDescription();
+
+/// "<compiler> <version>, <build type> (<flags>)".
+std::string buildDescription();
+
+/// Draws a plot from the CSV files in ctx.outDir: runs
+/// bench/plots/<script>.py <outDir> with the configured Python (matplotlib),
+/// which writes <name>.png and <name>.svg there. Throws with one line when
+/// the interpreter or matplotlib is missing or the script fails.
+void drawPlot(const BenchContext& ctx, const std::string& script);
 
 /// A height field at true scale: heights and cell size in metres.
 struct Dem {
