@@ -1,8 +1,7 @@
 // `terrain_bench gi-indirect`: accuracy of the indirect light against
-// gi/reference_gi, and the paper's Table 1 (frame time x size x sub-sampling x
-// bounces, with and without amortisation) on this machine. Writes
-// gi_indirect_accuracy.{md,csv} and gi_indirect_timing.{md,csv}; --diagnose
-// writes gi_indirect_diagnosis.md; --probe prints one frame time only.
+// gi/reference_gi (the paper's Table 1 frame times are `terrain_bench
+// table1`). Writes gi_indirect_accuracy.{md,csv}; --diagnose writes
+// gi_indirect_diagnosis.md; --probe prints one frame time only.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -11,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/indirect_frame.h"
 #include "bench/suites.h"
 #include "core/parallel.h"
 #include "core/simd.h"
@@ -25,14 +25,13 @@ using Clock = std::chrono::steady_clock;
 
 struct IndirectOptions {
     int runs = 5;
-    bool quick = false;         // 96^2 accuracy crops, Table 1 at 128^2 only
-    bool diagnose = false;      // the error breakdown instead of the tables
-    bool shKernel = false;      // the engine settings with the paper's SH Lambert kernel and receiver planes
-    int indirectAzimuths = 0;   // azimuths of the indirect scan (0: the settings' own)
-    int radianceK = 0;          // the engine's radiance pyramid k_u (0: the engine default)
-    int radianceO = -1;         // the engine's radiance pyramid o_u (-1: the engine default)
-    bool accuracyOnly = false;  // no Table 1
-    int probe = 0;              // only the frame time of a probe^2 erosion frame, 2x, one bounce (stderr)
+    bool quick = false;        // 96^2 accuracy crops, fewer erosion ticks
+    bool diagnose = false;     // the error breakdown instead of the tables
+    bool shKernel = false;     // the engine settings with the paper's SH Lambert kernel and receiver planes
+    int indirectAzimuths = 0;  // azimuths of the indirect scan (0: the settings' own)
+    int radianceK = 0;         // the engine's radiance pyramid k_u (0: the engine default)
+    int radianceO = -1;        // the engine's radiance pyramid o_u (-1: the engine default)
+    int probe = 0;             // only the frame time of a probe^2 erosion frame, 2x, one bounce (stderr)
 };
 
 // alps-montblanc at true scale, the central 256^2 crop (the 647^2 reference
@@ -43,122 +42,6 @@ Dem alpsCrop(const std::string& dataDir, int size) {
     d.note = "central " + std::to_string(size) + "^2 crop at true scale (cell 92.74 m)";
     d.heights = alpsCentreCrop(dataDir, size, d.cell);
     return d;
-}
-
-template <class T>
-std::size_t bytesOf(const std::vector<T>& v) {
-    return v.capacity() * sizeof(T);
-}
-std::size_t bytesOf(const Grid& g) { return g.v.capacity() * sizeof(float); }
-std::size_t bytesOf(const HeightPyramid& p) {
-    std::size_t b = bytesOf(p.rawPhase);
-    for (const Grid& g : p.meanOctaves) b += bytesOf(g);
-    for (const Grid& g : p.maxOctaves) b += bytesOf(g);
-    for (const PaddedField& f : p.synth) b += bytesOf(f.v);
-    for (const PaddedField& f : p.levels) b += bytesOf(f.v);
-    return b + bytesOf(p.rowTmp);
-}
-std::size_t bytesOf(const ShadeMaps& s) {
-    std::size_t b = bytesOf(s.ambient) + bytesOf(s.incident) + bytesOf(s.rowScratch) + bytesOf(s.basisScratch);
-    for (const Grid& g : s.rgb) b += bytesOf(g);
-    return b;
-}
-// Memory of every buffer of the frame (inputs and intermediates), MB.
-double frameMemoryMB(const Grid& heights, const GiState& st) {
-    std::size_t b = bytesOf(heights) + bytesOf(st.gradX) + bytesOf(st.gradY) + bytesOf(st.pyramid);
-    b += bytesOf(st.envVisibility.sh) + bytesOf(st.envVisibility.maxSlope);
-    for (const VisibilityField& v : st.keyVisibility) b += bytesOf(v.sh) + bytesOf(v.maxSlope);
-    b += bytesOf(st.shade);
-    const IndirectState& in = st.indirect;
-    for (const HeightPyramid& p : in.radiance.fields) b += bytesOf(p);
-    for (const VisibilityField& v : in.u) b += bytesOf(v.sh);
-    for (const ShadeMaps& s : in.bounceShade) b += bytesOf(s);
-    for (int c = 0; c < 3; ++c)
-        b += bytesOf(in.indirect[static_cast<std::size_t>(c)]) + bytesOf(in.total[static_cast<std::size_t>(c)]);
-    const BlockerRadianceState& br = in.blocker;
-    b += bytesOf(br.farSlope) + bytesOf(br.heights) + bytesOf(br.occlusion) + bytesOf(br.receiverOcclusion) +
-         bytesOf(br.scratch) + bytesOf(br.taps) + bytesOf(br.cols);
-    for (const std::vector<float>& e : br.receiverShade) b += bytesOf(e);
-    for (const IndirectScratch& s : in.blocks)
-        b += bytesOf(s.result) + bytesOf(s.irradiance) + bytesOf(s.state) + 4 * bytesOf(s.gx) + bytesOf(s.groupSteps) +
-             bytesOf(s.active);
-    return static_cast<double>(b) / (1024.0 * 1024.0);
-}
-
-KeyLight benchKey() {
-    KeyLight k;
-    k.azimuthDeg = 135.0f;
-    k.elevationDeg = 35.0f;
-    k.radiusDeg = 5.0f;
-    k.rgb[0] = 1.2f;
-    k.rgb[1] = 1.1f;
-    k.rgb[2] = 1.0f;
-    return k;
-}
-
-// The reference's lighting: environment plus the key light as an SH cap.
-ShRgb foldKeys(const GiLighting& l) {
-    ShRgb total = l.environment;
-    for (const KeyLight& k : l.keys) {
-        const ShRgb cap = keyLightSh(k);
-        for (int c = 0; c < 3; ++c)
-            for (int i = 0; i < kShCount; ++i)
-                total.c[static_cast<std::size_t>(c)][static_cast<std::size_t>(i)] +=
-                    cap.c[static_cast<std::size_t>(c)][static_cast<std::size_t>(i)];
-    }
-    return total;
-}
-
-// Reference: direct and the running sums of bounces 1..maxBounces.
-struct Reference {
-    std::array<Grid, 3> direct;
-    std::vector<std::array<Grid, 3>> indirectUpTo;  // [b - 1]: bounces 1..b
-    double seconds = 0.0;
-};
-
-Reference computeReference(const Dem& d, const GiLighting& light, const AlbedoMap& a, int maxBounces, int directions) {
-    const auto t0 = Clock::now();
-    Reference r;
-    ReferenceGiSettings s;
-    s.directions = directions;
-    s.bounces = 0;
-    ReferenceGiResult res;
-    s.keys = light.keys;  // exact caps (not folded into the SH lighting)
-    renderReferenceGi(d.heights.cview(), d.cell, light.environment, &a, s, res);
-    r.direct = res.direct;
-    std::array<Grid, 3> prev = res.direct, next, sum;
-    for (int c = 0; c < 3; ++c) sum[static_cast<std::size_t>(c)].resize(d.heights.nx, d.heights.ny, 0.0f);
-    for (int b = 1; b <= maxBounces; ++b) {
-        gatherReferenceBounce(d.heights.cview(), d.cell, prev, &a, s, next);
-        for (int c = 0; c < 3; ++c)
-            for (std::size_t i = 0; i < sum[static_cast<std::size_t>(c)].v.size(); ++i)
-                sum[static_cast<std::size_t>(c)].v[i] += next[static_cast<std::size_t>(c)].v[i];
-        r.indirectUpTo.push_back(sum);
-        std::swap(prev, next);
-    }
-    r.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-    return r;
-}
-
-struct Errors {
-    double total = 0.0, totalBias = 0.0, indirect = 0.0, indirectBias = 0.0;
-};
-
-Errors errorsOf(const GiState& st, const Reference& ref, int bounces) {
-    Errors e;
-    e.total = relRmse(
-        st.indirect.total,
-        [&] {
-            std::array<Grid, 3> t = ref.direct;
-            for (int c = 0; c < 3; ++c)
-                for (std::size_t i = 0; i < t[static_cast<std::size_t>(c)].v.size(); ++i)
-                    t[static_cast<std::size_t>(c)].v[i] +=
-                        ref.indirectUpTo[static_cast<std::size_t>(bounces - 1)][static_cast<std::size_t>(c)].v[i];
-            return t;
-        }(),
-        e.totalBias);
-    e.indirect = relRmse(st.indirect.indirect, ref.indirectUpTo[static_cast<std::size_t>(bounces - 1)], e.indirectBias);
-    return e;
 }
 
 // ---- error breakdown (--diagnose) ---------------------------------------------------
@@ -246,7 +129,7 @@ std::string diagnose(const Dem& d, const GiLighting& light, float albedo) {
 // Lower bound of any scheme that interpolates a smooth field from the
 // receivers: the reference's own indirect light, sampled at the s x s
 // receivers and re-interpolated bilinearly.
-std::string interpolationBound(const Reference& ref, int s) {
+std::string interpolationBound(const IndirectReference& ref, int s) {
     std::array<Grid, 3> ip = ref.indirectUpTo[0];
     const Grid& r0 = ref.indirectUpTo[0][0];
     for (int c = 0; c < 3; ++c)
@@ -270,18 +153,15 @@ std::string interpolationBound(const Reference& ref, int s) {
     return line;
 }
 
-// Table 1's figures of one row: ms per frame, amortised and indirect; memory in MB.
-struct FrameTime {
-    double ms = 0.0, msA = 0.0, msInd = 0.0, mem = 0.0;
-};
-
 // One run of the suite: the options, the lighting and the accuracy terrains
 // shared by its tables.
 class IndirectSuite {
 public:
     IndirectSuite(const IndirectOptions& o, const BenchContext& ctx) : o_(o), ctx_(ctx) {
-        light.environment = sunSkyLight();
-        light.keys.push_back(benchKey());
+        variant.indirectAzimuths = o_.indirectAzimuths;
+        variant.radianceK = o_.radianceK;
+        variant.radianceO = o_.radianceO;
+        variant.shKernel = o_.shKernel;
     }
 
     int run() {
@@ -298,7 +178,6 @@ public:
         }
         dems = {alpsCrop(ctx_.dataDir, accSize), erodedScene(accSize, o_.quick ? 200 : 2000)};
         accuracy();
-        if (!o_.accuracyOnly) frameTimes();
         return 0;
     }
 
@@ -307,52 +186,19 @@ private:
     const BenchContext& ctx_;
     const int accSize = o_.quick ? 96 : 256;
     const int refDirections = 2048;
-    const int refDirections512 =
-        1024;  // Table 1's 512^2 error: half the directions (the reference's time grows 8x with the size)
-    const float albedo = 0.6f;
-    GiLighting light;
-    std::vector<Dem> dems;        // the accuracy terrains: Mont Blanc and an eroded frame
-    std::vector<Reference> refs;  // their references
+    const float albedo = kIndirectFrameAlbedo;
+    const GiLighting light = indirectFrameLighting();
+    IndirectVariant variant;
+    std::vector<Dem> dems;  // the accuracy terrains: Mont Blanc and an eroded frame
 
     GiSettings settingsFor(int s, int bounces, bool paper) const {
-        GiSettings g = wholeFrames(paper ? paperGiSettings() : GiSettings{});
-        g.subsample = s;
-        g.indirect.bounces = bounces;
-        if (o_.indirectAzimuths > 0) g.indirect.azimuths = o_.indirectAzimuths;
-        if (!paper && o_.radianceK > 0) g.indirect.radiance.levelsPerOctave = o_.radianceK;
-        if (!paper && o_.radianceO >= 0) g.indirect.radiance.levelOffset = o_.radianceO;
-        if (!paper && o_.shKernel) {
-            g.indirect.lambert = LambertIndirect::ShKernel;
-            g.visibility.footprintTangent = false;
-        }
-        return g;
-    }
-
-    // The engine settings as the tables print them.
-    std::string engineSummary() const {
-        const GiSettings g = settingsFor(2, 1, false);
-        char b[512];
-        std::snprintf(b, sizeof b,
-                      "m %d, k_v %d, o_v %d, peak blend %.2f, k_u %d, o_u %d, %d indirect azimuths, %s, footprint "
-                      "tangent planes %s; "
-                      "%s kernels",
-                      g.visibility.azimuths, g.pyramid.levelsPerOctave, g.pyramid.levelOffset, g.pyramid.peakBlend,
-                      g.indirect.radiance.levelsPerOctave, g.indirect.radiance.levelOffset,
-                      g.indirect.azimuths > 0 ? g.indirect.azimuths : g.visibility.azimuths,
-                      g.indirect.lambert == LambertIndirect::BlockerRadiance
-                          ? "exact cosine at the receivers, blocker radiance x occlusion between them"
-                          : "SH kernel",
-                      g.visibility.footprintTangent ? "on" : "off",
-                      simd::wideEnabled() ? "8-wide AVX2" : "4-wide SSE2");
-        return b;
+        return indirectFrameSettings(s, bounces, paper, variant);
     }
 
     void probe() const;
     void accuracy();
-    std::string accuracyRows(const Dem& d, const AlbedoMap& a, const Reference& ref, std::string& summary,
+    std::string accuracyRows(const Dem& d, const AlbedoMap& a, const IndirectReference& ref, std::string& summary,
                              std::string& accCsv) const;
-    void frameTimes() const;
-    FrameTime timeFrames(const Dem& d, const AlbedoMap& a, int n, int s, int b) const;
 };
 
 void IndirectSuite::probe() const {
@@ -385,8 +231,8 @@ void IndirectSuite::probe() const {
 
 // The error table of one terrain: paper and engine settings at 1x/2x/4x, 1..3
 // bounces; adds the summary rows (one bounce) and the CSV rows.
-std::string IndirectSuite::accuracyRows(const Dem& d, const AlbedoMap& a, const Reference& ref, std::string& summary,
-                                        std::string& accCsv) const {
+std::string IndirectSuite::accuracyRows(const Dem& d, const AlbedoMap& a, const IndirectReference& ref,
+                                        std::string& summary, std::string& accCsv) const {
     std::string accMd;
     for (int paper = 0; paper < 2; ++paper)
         for (int s : {1, 2, 4})
@@ -394,7 +240,7 @@ std::string IndirectSuite::accuracyRows(const Dem& d, const AlbedoMap& a, const 
                 if (paper && b > 1) continue;
                 GiState st;
                 withThreads(2, [&] { runGiFrame(d.heights.cview(), d.cell, light, settingsFor(s, b, paper), st, &a); });
-                const Errors e = errorsOf(st, ref, b);
+                const IndirectErrors e = indirectErrors(st, ref, b);
                 const char* name =
                     paper ? "paper (m 32, k 4, o 2, SH kernel)" : "engine (m 16 / 8 indirect, o 3, blocker radiance)";
                 char line[512];
@@ -426,13 +272,13 @@ void IndirectSuite::accuracy() {
              " fixed gathering directions per texel, march step 0.5 cell. Relative RMSE over all three channels on the "
              "interior "
              "(10 % border excluded); bias = mean difference / RMS of the reference. Engine settings: " +
-             engineSummary() + ".\n\n";
+             indirectSettingsSummary(variant) + ".\n\n";
     std::string accCsv =
         "dem,settings,subsample,bounces,total_rel_rmse,total_bias,indirect_rel_rmse,indirect_bias,frame_ms\n";
     for (const Dem& d : dems) {
         const AlbedoMap a = uniformAlbedo(d.heights.nx, d.heights.ny, albedo);
         std::fprintf(stderr, "reference %s %dx%d ...\n", d.name.c_str(), d.heights.nx, d.heights.ny);
-        Reference ref = withThreads(0, [&] { return computeReference(d, light, a, 3, refDirections); });
+        const IndirectReference ref = computeIndirectReference(d, light, a, 3, refDirections);
         accMd += "## " + d.name + ": " + d.note + "\n\nReference: " + std::to_string(static_cast<int>(ref.seconds)) +
                  " s (3 bounces).\n\n";
         accMd +=
@@ -440,7 +286,6 @@ void IndirectSuite::accuracy() {
             "|\n|---|---|---|---|---|---|---|\n";
         accMd += accuracyRows(d, a, ref, summary, accCsv);
         for (int s : {2, 4}) accMd += interpolationBound(ref, s);
-        refs.push_back(std::move(ref));
     }
     const std::size_t head = accMd.find("\n\n") + 2;
     accMd.insert(
@@ -455,129 +300,18 @@ void IndirectSuite::accuracy() {
     writeResult(ctx_.outDir, "gi_indirect_accuracy.csv", accCsv);
 }
 
-// Median frame time (best of 3 repeats), amortised mean, indirect share and
-// memory of the engine settings at sub-sampling s with b bounces.
-FrameTime IndirectSuite::timeFrames(const Dem& d, const AlbedoMap& a, int n, int s, int b) const {
-    FrameTime ft;
-    // best of 3 repeats (this is a shared virtual machine): the smallest
-    // median (non-amortised) / mean (amortised) of the repeats
-    ft.ms = ft.msA = ft.msInd = 1e30;
-    for (int rep = 0; rep < 3; ++rep)
-        for (int amort = 0; amort < 2; ++amort) {
-            GiSettings g = settingsFor(s, b, false);
-            g.indirect.amortise = amort == 1;
-            GiState st;
-            std::vector<double> t, ti;
-            const int base = (n == 1024 && s == 1) ? std::min(o_.runs, 5) : o_.runs;
-            // amortised: an even number of frames (direct, indirect, direct, ...), mean of both kinds
-            const int runs = amort ? (base + 1) / 2 * 2 : base;
-            withThreads(2, [&] {
-                for (int f = 0; f <= runs; ++f) {
-                    st.geometryChanged = f == 0;
-                    const auto t0 = Clock::now();
-                    runGiFrame(d.heights.cview(), d.cell, light, g, st, &a);
-                    const double dt = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-                    if (f > 0) {
-                        t.push_back(dt);
-                        ti.push_back(st.timings.indirect);
-                    }
-                }
-            });
-            if (amort) {
-                double sum = 0.0;
-                for (double v : t) sum += v;
-                ft.msA = std::min(ft.msA, sum / static_cast<double>(t.size()));
-            } else if (median(t) < ft.ms) {
-                ft.ms = median(t);
-                ft.msInd = median(ti);
-                ft.mem = frameMemoryMB(d.heights, st);
-            }
-        }
-    return ft;
-}
-
-// The paper's Table 1 on this machine, with the error beside each figure.
-void IndirectSuite::frameTimes() const {
-    std::string tMd = "# GI with indirect light: frame time (the paper's Table 1 on this machine)\n\n";
-    tMd += "Machine: " + machineDescription() +
-           ", 2 threads. Scene: builtinScene(\"erosion\", N, 1) initial ground; engine "
-           "settings (" +
-           engineSummary() + "), sun-and-sky environment + one key light, albedo 0.6, Lambert. Median of " +
-           std::to_string(o_.runs) +
-           " frames after one warm-up, best of 3 repeats (shared virtual machine); amortised = static geometry, "
-           "frames alternate direct and indirect "
-           "updates; the amortised figure is the mean over an even number of frames (as many cheap as expensive). "
-           "Memory: every buffer of the frame (inputs and intermediates, float32). Error: indirect / "
-           "total relative RMSE against the reference of an eroded frame of the same size (builtinScene(\"erosion\", "
-           "N, 1) after 2000 "
-           "ticks; at 256^2 the accuracy table's erosion frame; at 512^2 a reference of " +
-           std::to_string(refDirections512) +
-           " directions, about 10 minutes; not measured at 1024^2, where the reference would take hours).\n\n";
-    tMd +=
-        "| size | sub-sampling | bounces | ms / frame | ms amortised | indirect ms | memory MB | indirect rel. RMSE | "
-        "total rel. RMSE |\n|---|---|---|---|---|---|---|---|---|\n";
-    std::string tCsv =
-        "size,subsample,bounces,ms,ms_amortised,indirect_ms,memory_mb,indirect_rel_rmse,total_rel_rmse\n";
-    const std::vector<int> sizes = o_.quick ? std::vector<int>{128} : std::vector<int>{256, 512, 1024};
-    // the error beside each figure: an eroded frame of the size and its reference
-    // (256^2: the accuracy table's; 512^2: computed here)
-    Dem eroded512;
-    Reference ref512;
-    if (!o_.quick) {
-        eroded512 = erodedScene(512, 2000);
-        const AlbedoMap a512 = uniformAlbedo(512, 512, albedo);
-        std::fprintf(stderr, "reference erosion 512x512 (Table 1 errors) ...\n");
-        ref512 = computeReference(eroded512, light, a512, 3, refDirections512);
-        std::fprintf(stderr, "  %.0f s\n", ref512.seconds);
-    }
-    for (int n : sizes) {
-        const Dem d = erodedScene(n, 0);
-        const AlbedoMap a = uniformAlbedo(n, n, albedo);
-        for (int s : {1, 2, 4})
-            for (int b : {1, 2, 3}) {
-                const FrameTime ft = timeFrames(d, a, n, s, b);
-                std::string err = "-", errT = "-";
-                char line[512];
-                if ((n == 256 || n == 512) && !o_.quick) {
-                    const Dem& de = n == 256 ? dems[1] : eroded512;
-                    const Reference& re = n == 256 ? refs[1] : ref512;
-                    GiState st;
-                    const AlbedoMap a2 = uniformAlbedo(de.heights.nx, de.heights.ny, albedo);
-                    withThreads(
-                        2, [&] { runGiFrame(de.heights.cview(), de.cell, light, settingsFor(s, b, false), st, &a2); });
-                    const Errors e = errorsOf(st, re, b);
-                    std::snprintf(line, sizeof line, "%.4f", e.indirect);
-                    err = line;
-                    std::snprintf(line, sizeof line, "%.4f", e.total);
-                    errT = line;
-                }
-                std::snprintf(line, sizeof line, "| %d^2 | %dx | %d | %.1f | %.1f | %.1f | %.1f | %s | %s |\n", n, s, b,
-                              ft.ms, ft.msA, ft.msInd, ft.mem, err.c_str(), errT.c_str());
-                tMd += line;
-                std::snprintf(line, sizeof line, "%d,%d,%d,%.2f,%.2f,%.2f,%.2f,%s,%s\n", n, s, b, ft.ms, ft.msA,
-                              ft.msInd, ft.mem, err.c_str(), errT.c_str());
-                tCsv += line;
-                std::fprintf(stderr, "%s", line);
-            }
-    }
-    writeResult(ctx_.outDir, "gi_indirect_timing.md", tMd);
-    writeResult(ctx_.outDir, "gi_indirect_timing.csv", tCsv);
-}
-
 }  // namespace
 
 Runner addGiIndirectSuite(CLI::App& app, const BenchContext& ctx) {
     auto o = std::make_shared<IndirectOptions>();
-    CLI::App* sub = app.add_subcommand(
-        "gi-indirect", "Indirect light: accuracy against gi/reference_gi and the paper's Table 1 (frame time)");
+    CLI::App* sub = app.add_subcommand("gi-indirect", "Indirect light: accuracy against gi/reference_gi");
     addRunsOption(*sub, o->runs, "Frames per timing (the median is reported)");
-    sub->add_flag("--quick", o->quick, "96^2 accuracy crops, fewer erosion ticks, Table 1 at 128^2 only");
+    sub->add_flag("--quick", o->quick, "96^2 accuracy crops, fewer erosion ticks");
     sub->add_flag("--diagnose", o->diagnose, "Error breakdown instead of the tables (gi_indirect_diagnosis.md)");
     sub->add_flag("--sh-kernel", o->shKernel, "Engine settings with the paper's SH Lambert kernel and receiver planes");
     sub->add_option("--indirect-azimuths", o->indirectAzimuths, "Azimuths of the indirect scan (0: the settings' own)");
     sub->add_option("--radiance-k", o->radianceK, "The engine's radiance pyramid k_u (0: the engine default)");
     sub->add_option("--radiance-o", o->radianceO, "The engine's radiance pyramid o_u (-1: the engine default)");
-    sub->add_flag("--accuracy-only", o->accuracyOnly, "The accuracy table only, no Table 1");
     sub->add_option("--probe", o->probe, "Only the frame time of an N^2 erosion frame, 2x, one bounce (on stderr)");
     return [o, &ctx] { return IndirectSuite(*o, ctx).run(); };
 }

@@ -12,6 +12,7 @@ import os
 import sys
 
 import matplotlib
+import matplotlib.ticker
 
 matplotlib.use("Agg")  # files only: no display needed
 import matplotlib.pyplot as plt  # noqa: E402 (after the backend is chosen)
@@ -34,8 +35,8 @@ def read_csv(folder, name):
         sys.exit(f"{os.path.basename(sys.argv[0])}: cannot read {path}: {e.strerror}")
 
 
-def figure(width=7.5, height=4.8):
-    """A new figure and axes in the house style."""
+def figure(width=7.5, height=4.8, panels=1):
+    """A new figure and its axes (a list of `panels` side by side when more than one) in the house style."""
     plt.rcParams.update({
         "font.size": 11,
         "axes.titlesize": 12,
@@ -44,10 +45,18 @@ def figure(width=7.5, height=4.8):
         "svg.fonttype": "none",  # text stays text in the SVG
         "svg.hashsalt": "terrain",  # the same SVG for the same data
     })
-    fig, ax = plt.subplots(figsize=(width, height), layout="constrained")
-    ax.grid(True, which="major", alpha=0.35)
-    ax.grid(True, which="minor", alpha=0.12)
-    return fig, ax
+    fig, axes = plt.subplots(1, panels, figsize=(width, height), layout="constrained", squeeze=False)
+    for ax in axes[0]:
+        ax.grid(True, which="major", alpha=0.35)
+        ax.grid(True, which="minor", alpha=0.12)
+    return fig, (axes[0][0] if panels == 1 else list(axes[0]))
+
+
+def plain_log_ticks(axis):
+    """Labels a log axis at 1, 2, 5 x 10^k as plain numbers (10, 20, 50), not powers."""
+    axis.set_major_locator(matplotlib.ticker.LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+    axis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+    axis.set_minor_formatter(matplotlib.ticker.NullFormatter())
 
 
 def save(fig, folder, stem):
