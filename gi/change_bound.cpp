@@ -128,7 +128,7 @@ double stepReach(const HeightPyramid& pyr, int i) {
     if (level < 0) return 1.0;
     // the octaves blendLevels reads for this level (gi/pyramid.cpp)
     const int kv = std::max(1, pyr.settings.levelsPerOctave);
-    const int nOctaves = static_cast<int>(pyr.synth.size());
+    const int nOctaves = pyr.octaves;
     int o = level / kv;
     bool blended = level % kv != 0;
     if (o >= nOctaves - 1) {
@@ -256,7 +256,7 @@ int stepOctave(const HeightPyramid& pyr, int i) {
     const int level = pyr.steps[static_cast<std::size_t>(i)].level;
     if (level < 0) return 0;
     const int kv = std::max(1, pyr.settings.levelsPerOctave);
-    return std::min(level / kv, static_cast<int>(pyr.synth.size()) - 1);
+    return std::min(level / kv, pyr.octaves - 1);
 }
 
 // Per axis, the largest weight of one cell in a texel of the mean octave o:
@@ -314,7 +314,7 @@ StepTable stepTable(const HeightPyramid& pyr) {
         t.tauMinFrom.push_back(tauMinFrom(pyr, i, firstLevel));
         t.octave.push_back(stepOctave(pyr, i));
     }
-    const int octaves = std::max(1, static_cast<int>(pyr.synth.size()));
+    const int octaves = std::max(1, pyr.octaves);
     t.wx = axisWeights(pyr.nx, octaves);
     t.wy = axisWeights(pyr.ny, octaves);
     const double b = pyr.settings.peakBlend;

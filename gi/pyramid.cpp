@@ -19,6 +19,23 @@ void PaddedField::padEdges() {
     std::copy(row(ny - 1), row(ny - 1) + stride, row(ny));
 }
 
+namespace {
+
+// Octaves o with o k_v < nLevels: those whose synthesis is a level.
+int octavesInLevels(int nLevels, int kv) { return nLevels <= 0 ? 0 : (nLevels - 1) / kv + 1; }
+
+// S_o: level o k_v, or a field of its own above the last level.
+template <class Pyramid>
+auto& octaveField(Pyramid& p, int o) {
+    const int kv = std::max(1, p.settings.levelsPerOctave);
+    const int inLevels = octavesInLevels(static_cast<int>(p.levels.size()), kv);
+    return o < inLevels ? p.levels[static_cast<std::size_t>(o * kv)] : p.synth[static_cast<std::size_t>(o - inLevels)];
+}
+
+}  // namespace
+
+const PaddedField& octaveSynthesis(const HeightPyramid& p, int o) { return octaveField(p, o); }
+
 int pyramidStepCount(int nx, int ny, int levelsPerOctave) {
     const double diag = std::sqrt(static_cast<double>(nx - 1) * (nx - 1) + static_cast<double>(ny - 1) * (ny - 1));
     if (diag <= 1.0) return 1;
@@ -193,14 +210,19 @@ void synthesisePass(ConstGridView src, int o, int pass, float blend, HeightPyram
 }
 
 // ---- B-spline synthesis of each octave at the receiver grid ---------------
-// S_o; mean and (optionally) max syntheses are blended here.
-void synthesiseOctaves(ConstGridView heights, int nOctaves, bool withMax, HeightPyramid& p) {
-    const int nxr = p.nxr, nyr = p.nyr;
-    p.synth.resize(static_cast<std::size_t>(nOctaves));
+// S_o; mean and (optionally) max syntheses are blended here. S_o is level
+// o k_v itself (q = 0), so it is synthesised straight into that level; only
+// the octaves above the last level, which the top levels blend towards, get
+// fields of their own (HeightPyramid::synth).
+void synthesiseOctaves(ConstGridView heights, int nLevels, int nOctaves, bool withMax, HeightPyramid& p) {
+    const int nxr = p.nxr, nyr = p.nyr, kv = std::max(1, p.settings.levelsPerOctave);
+    p.octaves = nOctaves;
+    p.levels.resize(static_cast<std::size_t>(nLevels));
+    p.synth.resize(static_cast<std::size_t>(std::max(0, nOctaves - octavesInLevels(nLevels, kv))));
     p.tapIndex.resize(static_cast<std::size_t>(4 * (nxr + nyr)));
     p.tapWeight.resize(static_cast<std::size_t>(4 * (nxr + nyr)));
     for (int o = 0; o < nOctaves; ++o) {
-        PaddedField& out = p.synth[static_cast<std::size_t>(o)];
+        PaddedField& out = octaveField(p, o);
         out.resize(nxr, nyr);
         if (o == 0) {
             receiverHeights(heights, p.subsample, out);
@@ -216,20 +238,21 @@ void synthesiseOctaves(ConstGridView heights, int nOctaves, bool withMax, Height
 }
 
 // ---- levels between octaves: f_l = (1 - q) S_o + q S_(o+1) -----------------
+// Levels past the last octave repeat it.
 void blendLevels(int nLevels, int nOctaves, int kv, HeightPyramid& p) {
     const int nxr = p.nxr, nyr = p.nyr;
-    p.levels.resize(static_cast<std::size_t>(nLevels));
     for (int l = 0; l < nLevels; ++l) {
         int o = l / kv;
         float q = static_cast<float>(l % kv) / static_cast<float>(kv);
+        if (q == 0.0f && o < nOctaves) continue;  // the octave itself, synthesised in place
         if (o >= nOctaves - 1) {
             o = nOctaves - 1;
             q = 0.0f;
         }
         PaddedField& lev = p.levels[static_cast<std::size_t>(l)];
         lev.resize(nxr, nyr);
-        const PaddedField& a = p.synth[static_cast<std::size_t>(o)];
-        const PaddedField& b = p.synth[static_cast<std::size_t>(std::min(o + 1, nOctaves - 1))];
+        const PaddedField& a = octaveSynthesis(p, o);
+        const PaddedField& b = octaveSynthesis(p, std::min(o + 1, nOctaves - 1));
         const float wa = 1.0f - q, wb = q;
         parallelForRows(nyr + 1, nxr, [&](int y0, int y1) {
             for (int Y = y0; Y < y1; ++Y) {
@@ -261,12 +284,14 @@ void buildHeightPyramid(ConstGridView heights, float cellSize, int subsample, co
     const int nLevels = maxLevel + 1;
     if (nLevels <= 0) {
         p.levels.resize(0);
+        p.synth.resize(0);
+        p.octaves = 0;
         return;
     }
     const int nOctaves = octaveCount(nx, ny, nLevels, kv);
     const bool withMax = settings.peakBlend > 0.0f;
     decimateOctaves(heights, nOctaves, withMax, p);
-    synthesiseOctaves(heights, nOctaves, withMax, p);
+    synthesiseOctaves(heights, nLevels, nOctaves, withMax, p);
     blendLevels(nLevels, nOctaves, kv, p);
 }
 

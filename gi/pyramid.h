@@ -18,7 +18,8 @@
 // paper's GPU version does, after Sigg & Hadwiger 2005), S_o; S_0 is the
 // height field itself at the receivers (level 0 is unfiltered, f_0 = f); a
 // level between octaves blends the two neighbouring ones:
-// f_l = (1 - q) S_o + q S_(o+1), o + q = l / k_v.
+// f_l = (1 - q) S_o + q S_(o+1), o + q = l / k_v. Level o k_v is S_o itself
+// (q = 0), synthesised in place: no copy of it is kept.
 // Like the paper we keep the stack "blown out" to the receiver resolution,
 // so for a fixed azimuth and step every receiver reads its level at the same
 // fractional offset: the scan streams rows with constant bilinear weights.
@@ -101,8 +102,9 @@ struct HeightPyramid {
     }
     std::vector<Grid> meanOctaves;    // B_1, B_2, ... (B_0 is the input)
     std::vector<Grid> maxOctaves;     // same, max-decimated (only when peakBlend > 0)
-    std::vector<PaddedField> synth;   // S_o at the receiver grid, o = 0..
-    std::vector<PaddedField> levels;  // f_l at the receiver grid, spacing s
+    int octaves = 0;                  // octaves synthesised, S_0 .. S_(octaves - 1)
+    std::vector<PaddedField> levels;  // f_l at the receiver grid, spacing s; level o k_v is S_o
+    std::vector<PaddedField> synth;   // S_o of the octaves above the last level (octaveSynthesis)
     std::vector<float> rowTmp;        // scratch of the separable synthesis
     std::vector<int> tapIndex;        // scratch: 4 taps per receiver column / row
     std::vector<float> tapWeight;
@@ -114,6 +116,11 @@ inline int receiverCount(int n, int s) { return n <= 0 ? 0 : (n - 1) / s + 1; }
 /// Number of exponential steps n_v for a grid (Eq. 14 and the domain size),
 /// before dropping the i_0 steps shorter than the receiver spacing.
 int pyramidStepCount(int nx, int ny, int levelsPerOctave);
+
+/// S_o at the receiver grid, o < pyramid.octaves: level o k_v, or for the
+/// octaves above the last level (which the top levels blend towards) a
+/// field of its own.
+const PaddedField& octaveSynthesis(const HeightPyramid& pyramid, int o);
 
 /// Builds (or rebuilds, reusing every buffer) the pyramid of `heights`.
 void buildHeightPyramid(ConstGridView heights, float cellSize, int subsample, const PyramidSettings& settings,

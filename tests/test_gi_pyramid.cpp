@@ -171,7 +171,7 @@ TEST_CASE("gi.pyramid: a linear ramp stays the ramp away from the borders; max o
         for (float blend : {0.0f, 0.5f, 1.0f}) {
             HeightPyramid p;
             buildHeightPyramid(g.cview(), 1.0f, s, pyramidSettings(kv, 0, blend), p);
-            const int nOct = static_cast<int>(p.synth.size());
+            const int nOct = p.octaves;
             auto drift = [&](int o) { return (std::fabs(a) + std::fabs(b)) * (std::exp2(o) - 1.0) / 2.0; };
             int checked = 0;
             for (int l = 0; l < static_cast<int>(p.levels.size()); ++l) {
@@ -205,7 +205,7 @@ TEST_CASE("gi.pyramid: a single spike: mean octaves divide it by 4^o, max octave
             HeightPyramid p;
             buildHeightPyramid(g.cview(), 1.0f, s, pyramidSettings(kv, 0, blend), p);
             INFO("s " << s << " peakBlend " << blend);
-            const int nOct = static_cast<int>(p.synth.size());
+            const int nOct = p.octaves;
             REQUIRE(nOct == 8);  // 128 .. 1
             for (int o = 1; o < nOct; ++o) {
                 const Grid& mean = p.meanOctaves[static_cast<std::size_t>(o - 1)];
