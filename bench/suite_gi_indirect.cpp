@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/gi_reference_cache.h"
 #include "bench/suites.h"
 #include "core/parallel.h"
 #include "core/simd.h"
@@ -34,16 +35,6 @@ struct IndirectOptions {
     bool accuracyOnly = false;  // no Table 1
     int probe = 0;              // only the frame time of a probe^2 erosion frame, 2x, one bounce (stderr)
 };
-
-// alps-montblanc at true scale, the central 256^2 crop (the 647^2 reference
-// with 2048 directions takes too long for this benchmark's budget)
-Dem alpsCrop(const std::string& dataDir, int size) {
-    Dem d;
-    d.name = "alps-montblanc";
-    d.note = "central " + std::to_string(size) + "^2 crop at true scale (cell 92.74 m)";
-    d.heights = alpsCentreCrop(dataDir, size, d.cell);
-    return d;
-}
 
 template <class T>
 std::size_t bytesOf(const std::vector<T>& v) {
@@ -85,17 +76,6 @@ double frameMemoryMB(const Grid& heights, const GiState& st) {
     return static_cast<double>(b) / (1024.0 * 1024.0);
 }
 
-KeyLight benchKey() {
-    KeyLight k;
-    k.azimuthDeg = 135.0f;
-    k.elevationDeg = 35.0f;
-    k.radiusDeg = 5.0f;
-    k.rgb[0] = 1.2f;
-    k.rgb[1] = 1.1f;
-    k.rgb[2] = 1.0f;
-    return k;
-}
-
 // The reference's lighting: environment plus the key light as an SH cap.
 ShRgb foldKeys(const GiLighting& l) {
     ShRgb total = l.environment;
@@ -109,42 +89,11 @@ ShRgb foldKeys(const GiLighting& l) {
     return total;
 }
 
-// Reference: direct and the running sums of bounces 1..maxBounces.
-struct Reference {
-    std::array<Grid, 3> direct;
-    std::vector<std::array<Grid, 3>> indirectUpTo;  // [b - 1]: bounces 1..b
-    double seconds = 0.0;
-};
-
-Reference computeReference(const Dem& d, const GiLighting& light, const AlbedoMap& a, int maxBounces, int directions) {
-    const auto t0 = Clock::now();
-    Reference r;
-    ReferenceGiSettings s;
-    s.directions = directions;
-    s.bounces = 0;
-    ReferenceGiResult res;
-    s.keys = light.keys;  // exact caps (not folded into the SH lighting)
-    renderReferenceGi(d.heights.cview(), d.cell, light.environment, &a, s, res);
-    r.direct = res.direct;
-    std::array<Grid, 3> prev = res.direct, next, sum;
-    for (int c = 0; c < 3; ++c) sum[static_cast<std::size_t>(c)].resize(d.heights.nx, d.heights.ny, 0.0f);
-    for (int b = 1; b <= maxBounces; ++b) {
-        gatherReferenceBounce(d.heights.cview(), d.cell, prev, &a, s, next);
-        for (int c = 0; c < 3; ++c)
-            for (std::size_t i = 0; i < sum[static_cast<std::size_t>(c)].v.size(); ++i)
-                sum[static_cast<std::size_t>(c)].v[i] += next[static_cast<std::size_t>(c)].v[i];
-        r.indirectUpTo.push_back(sum);
-        std::swap(prev, next);
-    }
-    r.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-    return r;
-}
-
 struct Errors {
     double total = 0.0, totalBias = 0.0, indirect = 0.0, indirectBias = 0.0;
 };
 
-Errors errorsOf(const GiState& st, const Reference& ref, int bounces) {
+Errors errorsOf(const GiState& st, const GiReference& ref, int bounces) {
     Errors e;
     e.total = relRmse(
         st.indirect.total,
@@ -246,7 +195,7 @@ std::string diagnose(const Dem& d, const GiLighting& light, float albedo) {
 // Lower bound of any scheme that interpolates a smooth field from the
 // receivers: the reference's own indirect light, sampled at the s x s
 // receivers and re-interpolated bilinearly.
-std::string interpolationBound(const Reference& ref, int s) {
+std::string interpolationBound(const GiReference& ref, int s) {
     std::array<Grid, 3> ip = ref.indirectUpTo[0];
     const Grid& r0 = ref.indirectUpTo[0][0];
     for (int c = 0; c < 3; ++c)
@@ -279,10 +228,7 @@ struct FrameTime {
 // shared by its tables.
 class IndirectSuite {
 public:
-    IndirectSuite(const IndirectOptions& o, const BenchContext& ctx) : o_(o), ctx_(ctx) {
-        light.environment = sunSkyLight();
-        light.keys.push_back(benchKey());
-    }
+    IndirectSuite(const IndirectOptions& o, const BenchContext& ctx) : o_(o), ctx_(ctx) { light = sunSkyAndBenchKey(); }
 
     int run() {
         if (o_.probe > 0) {
@@ -311,8 +257,8 @@ private:
         1024;  // Table 1's 512^2 error: half the directions (the reference's time grows 8x with the size)
     const float albedo = 0.6f;
     GiLighting light;
-    std::vector<Dem> dems;        // the accuracy terrains: Mont Blanc and an eroded frame
-    std::vector<Reference> refs;  // their references
+    std::vector<Dem> dems;          // the accuracy terrains: Mont Blanc and an eroded frame
+    std::vector<GiReference> refs;  // their references
 
     GiSettings settingsFor(int s, int bounces, bool paper) const {
         GiSettings g = wholeFrames(paper ? paperGiSettings() : GiSettings{});
@@ -349,7 +295,7 @@ private:
 
     void probe() const;
     void accuracy();
-    std::string accuracyRows(const Dem& d, const AlbedoMap& a, const Reference& ref, std::string& summary,
+    std::string accuracyRows(const Dem& d, const AlbedoMap& a, const GiReference& ref, std::string& summary,
                              std::string& accCsv) const;
     void frameTimes() const;
     FrameTime timeFrames(const Dem& d, const AlbedoMap& a, int n, int s, int b) const;
@@ -385,7 +331,7 @@ void IndirectSuite::probe() const {
 
 // The error table of one terrain: paper and engine settings at 1x/2x/4x, 1..3
 // bounces; adds the summary rows (one bounce) and the CSV rows.
-std::string IndirectSuite::accuracyRows(const Dem& d, const AlbedoMap& a, const Reference& ref, std::string& summary,
+std::string IndirectSuite::accuracyRows(const Dem& d, const AlbedoMap& a, const GiReference& ref, std::string& summary,
                                         std::string& accCsv) const {
     std::string accMd;
     for (int paper = 0; paper < 2; ++paper)
@@ -432,7 +378,7 @@ void IndirectSuite::accuracy() {
     for (const Dem& d : dems) {
         const AlbedoMap a = uniformAlbedo(d.heights.nx, d.heights.ny, albedo);
         std::fprintf(stderr, "reference %s %dx%d ...\n", d.name.c_str(), d.heights.nx, d.heights.ny);
-        Reference ref = withThreads(0, [&] { return computeReference(d, light, a, 3, refDirections); });
+        GiReference ref = withThreads(0, [&] { return computeReference(d, light, a, 3, refDirections); });
         accMd += "## " + d.name + ": " + d.note + "\n\nReference: " + std::to_string(static_cast<int>(ref.seconds)) +
                  " s (3 bounces).\n\n";
         accMd +=
@@ -522,7 +468,7 @@ void IndirectSuite::frameTimes() const {
     // the error beside each figure: an eroded frame of the size and its reference
     // (256^2: the accuracy table's; 512^2: computed here)
     Dem eroded512;
-    Reference ref512;
+    GiReference ref512;
     if (!o_.quick) {
         eroded512 = erodedScene(512, 2000);
         const AlbedoMap a512 = uniformAlbedo(512, 512, albedo);
@@ -540,7 +486,7 @@ void IndirectSuite::frameTimes() const {
                 char line[512];
                 if ((n == 256 || n == 512) && !o_.quick) {
                     const Dem& de = n == 256 ? dems[1] : eroded512;
-                    const Reference& re = n == 256 ? refs[1] : ref512;
+                    const GiReference& re = n == 256 ? refs[1] : ref512;
                     GiState st;
                     const AlbedoMap a2 = uniformAlbedo(de.heights.nx, de.heights.ny, albedo);
                     withThreads(

@@ -36,6 +36,12 @@ def read_csv(folder, name):
 
 def figure(width=7.5, height=4.8):
     """A new figure and axes in the house style."""
+    fig, axes = figure_grid(1, 1, width, height)
+    return fig, axes[0][0]
+
+
+def figure_grid(rows, cols, width=7.5, height=4.8, **subplots_args):
+    """A new figure of rows x cols panels in the house style; axes[row][col]."""
     plt.rcParams.update({
         "font.size": 11,
         "axes.titlesize": 12,
@@ -44,10 +50,12 @@ def figure(width=7.5, height=4.8):
         "svg.fonttype": "none",  # text stays text in the SVG
         "svg.hashsalt": "terrain",  # the same SVG for the same data
     })
-    fig, ax = plt.subplots(figsize=(width, height), layout="constrained")
-    ax.grid(True, which="major", alpha=0.35)
-    ax.grid(True, which="minor", alpha=0.12)
-    return fig, ax
+    fig, axes = plt.subplots(rows, cols, figsize=(width, height), layout="constrained", squeeze=False,
+                             **subplots_args)
+    for ax in axes.flat:
+        ax.grid(True, which="major", alpha=0.35)
+        ax.grid(True, which="minor", alpha=0.12)
+    return fig, axes
 
 
 def save(fig, folder, stem):
