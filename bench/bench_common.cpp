@@ -176,6 +176,34 @@ Grid alpsCentreCrop(const std::string& dataDir, int size, float& cell) {
     return centreCrop(full.heights, size);
 }
 
+Dem alpsCrop(const std::string& dataDir, int size) {
+    Dem d;
+    d.name = "alps-montblanc";
+    d.heights = alpsCentreCrop(dataDir, size, d.cell);
+    char note[128];
+    std::snprintf(note, sizeof note, "central %d^2 crop at true scale (cell %.2f m)", size, d.cell);
+    d.note = note;
+    return d;
+}
+
+gi::KeyLight benchKey() {
+    gi::KeyLight k;
+    k.azimuthDeg = 135.0f;
+    k.elevationDeg = 35.0f;
+    k.radiusDeg = 5.0f;
+    k.rgb[0] = 1.2f;
+    k.rgb[1] = 1.1f;
+    k.rgb[2] = 1.0f;
+    return k;
+}
+
+gi::GiLighting sunSkyAndBenchKey() {
+    gi::GiLighting light;
+    light.environment = gi::sunSkyLight();
+    light.keys.push_back(benchKey());
+    return light;
+}
+
 bool readCachedGrids(const std::string& file, int nx, int ny, std::span<Grid> grids) {
     std::ifstream in(file, std::ios::binary);
     for (Grid& g : grids) {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/grid.h"
+#include "gi/lights.h"
 #include "gi/settings.h"
 
 namespace terrain::bench {
@@ -87,6 +88,15 @@ Dem erodedScene(int size, int ticks);
 
 /// The central size^2 crop of alps-montblanc at true scale; sets cell.
 Grid alpsCentreCrop(const std::string& dataDir, int size, float& cell);
+
+/// alpsCentreCrop as a Dem named "alps-montblanc", its note saying so.
+Dem alpsCrop(const std::string& dataDir, int size);
+
+/// The key light of the indirect-light suites: a warm sun cap (az 135, el 35, r 5 deg).
+gi::KeyLight benchKey();
+
+/// The indirect-light suites' lighting: sun-and-sky environment (as SH) + benchKey().
+gi::GiLighting sunSkyAndBenchKey();
 
 /// Grids cached in a file across runs (a reference that takes minutes):
 /// read them when `file` holds that many nx x ny grids, else false.

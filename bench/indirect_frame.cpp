@@ -1,37 +1,12 @@
 #include "bench/indirect_frame.h"
 
-#include <chrono>
-#include <cstdint>
 #include <cstdio>
-#include <cstring>
-#include <filesystem>
-#include <span>
 
-#include "core/parallel.h"
 #include "core/simd.h"
-#include "gi/reference_gi.h"
 
 namespace terrain::bench {
 
 using namespace terrain::gi;
-
-KeyLight benchKey() {
-    KeyLight k;
-    k.azimuthDeg = 135.0f;
-    k.elevationDeg = 35.0f;
-    k.radiusDeg = 5.0f;
-    k.rgb[0] = 1.2f;
-    k.rgb[1] = 1.1f;
-    k.rgb[2] = 1.0f;
-    return k;
-}
-
-GiLighting indirectFrameLighting() {
-    GiLighting l;
-    l.environment = sunSkyLight();
-    l.keys.push_back(benchKey());
-    return l;
-}
 
 GiSettings indirectFrameSettings(int s, int bounces, bool paper, const IndirectVariant& v) {
     GiSettings g = wholeFrames(paper ? paperGiSettings() : GiSettings{});
@@ -73,93 +48,7 @@ ShRgb foldKeys(const GiLighting& l) {
     return total;
 }
 
-IndirectReference computeIndirectReference(const Dem& d, const GiLighting& light, const AlbedoMap& a, int maxBounces,
-                                           int directions) {
-    const auto t0 = std::chrono::steady_clock::now();
-    IndirectReference r;
-    ReferenceGiSettings s;
-    s.directions = directions;
-    s.bounces = 0;
-    s.keys = light.keys;  // exact caps (not folded into the SH lighting)
-    ReferenceGiResult res;
-    withThreads(0, [&] {
-        renderReferenceGi(d.heights.cview(), d.cell, light.environment, &a, s, res);
-        r.direct = res.direct;
-        std::array<Grid, 3> prev = res.direct, next, sum;
-        for (Grid& g : sum) g.resize(d.heights.nx, d.heights.ny, 0.0f);
-        for (int b = 1; b <= maxBounces; ++b) {
-            gatherReferenceBounce(d.heights.cview(), d.cell, prev, &a, s, next);
-            for (std::size_t c = 0; c < 3; ++c)
-                for (std::size_t i = 0; i < sum[c].v.size(); ++i) sum[c].v[i] += next[c].v[i];
-            r.indirectUpTo.push_back(sum);
-            std::swap(prev, next);
-        }
-    });
-    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return r;
-}
-
-namespace {
-
-// FNV-1a, 64 bits: names a cached reference by everything it depends on.
-struct Fnv1a {
-    std::uint64_t h = 14695981039346656037ull;
-    void add(const void* p, std::size_t n) {
-        const auto* b = static_cast<const unsigned char*>(p);
-        for (std::size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 1099511628211ull;
-    }
-    template <class T>
-    void add(const T& v) {
-        add(&v, sizeof v);
-    }
-};
-
-std::uint64_t referenceKey(const Dem& d, const GiLighting& light, const AlbedoMap& a, int maxBounces, int directions) {
-    Fnv1a f;
-    f.add(d.heights.nx);
-    f.add(d.heights.ny);
-    f.add(d.cell);
-    f.add(d.heights.v.data(), d.heights.v.size() * sizeof(float));
-    for (const auto& c : light.environment.c) f.add(c.data(), c.size() * sizeof(float));
-    for (const KeyLight& k : light.keys) f.add(k);
-    for (const Grid& g : a.channel) f.add(g.v.data(), g.v.size() * sizeof(float));
-    f.add(maxBounces);
-    f.add(directions);
-    return f.h;
-}
-
-}  // namespace
-
-IndirectReference cachedIndirectReference(const std::string& cacheDir, const Dem& d, const GiLighting& light,
-                                          const AlbedoMap& a, int maxBounces, int directions) {
-    if (cacheDir.empty()) return computeIndirectReference(d, light, a, maxBounces, directions);
-    char name[96];
-    std::snprintf(name, sizeof name, "indirect-ref-%016llx.f32",
-                  static_cast<unsigned long long>(referenceKey(d, light, a, maxBounces, directions)));
-    const std::string file = (std::filesystem::path(cacheDir) / name).string();
-    const std::size_t count = 3 * (1 + static_cast<std::size_t>(maxBounces));
-    std::vector<Grid> grids(count);
-    IndirectReference r;
-    if (!readCachedGrids(file, d.heights.nx, d.heights.ny, grids)) {
-        std::fprintf(stderr, "reference %s %dx%d, %d directions ...\n", d.name.c_str(), d.heights.nx, d.heights.ny,
-                     directions);
-        r = computeIndirectReference(d, light, a, maxBounces, directions);
-        std::fprintf(stderr, "  %.0f s\n", r.seconds);
-        for (std::size_t c = 0; c < 3; ++c) grids[c] = r.direct[c];
-        for (std::size_t b = 0; b < r.indirectUpTo.size(); ++b)
-            for (std::size_t c = 0; c < 3; ++c) grids[3 * (b + 1) + c] = r.indirectUpTo[b][c];
-        std::filesystem::create_directories(cacheDir);
-        writeCachedGrids(file, grids);
-        return r;
-    }
-    for (std::size_t c = 0; c < 3; ++c) r.direct[c] = grids[c];
-    r.indirectUpTo.resize(static_cast<std::size_t>(maxBounces));
-    for (std::size_t b = 0; b < r.indirectUpTo.size(); ++b)
-        for (std::size_t c = 0; c < 3; ++c) r.indirectUpTo[b][c] = grids[3 * (b + 1) + c];
-    return r;
-}
-
-IndirectErrors indirectErrors(const GiState& st, const IndirectReference& ref, int bounces) {
+IndirectErrors indirectErrors(const GiState& st, const GiReference& ref, int bounces) {
     const std::array<Grid, 3>& ind = ref.indirectUpTo[static_cast<std::size_t>(bounces - 1)];
     std::array<Grid, 3> total = ref.direct;
     for (std::size_t c = 0; c < 3; ++c)

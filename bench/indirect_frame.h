@@ -1,24 +1,19 @@
 #pragma once
 // The frame the indirect-light suites measure (gi-indirect's accuracy, the
-// paper's Table 1): sun-and-sky environment plus one key light, a uniform
-// albedo, Lambert, the engine's settings at a sub-sampling and a number of
-// bounces; and its exact reference (gi/reference_gi.h) with the errors
-// against it.
+// paper's Table 1): sun-and-sky environment plus one key light
+// (sunSkyAndBenchKey), a uniform albedo, Lambert, the engine's settings at a
+// sub-sampling and a number of bounces; and its errors against the exact
+// reference (bench/gi_reference_cache.h).
 #include <array>
 #include <string>
 #include <vector>
 
 #include "bench/bench_common.h"
+#include "bench/gi_reference_cache.h"
 #include "gi/frame.h"
 #include "gi/lights.h"
 
 namespace terrain::bench {
-
-/// The key light of the indirect-light frames: azimuth 135, elevation 35, radius 5 degrees.
-gi::KeyLight benchKey();
-
-/// Sun-and-sky environment (SH) plus benchKey().
-gi::GiLighting indirectFrameLighting();
 
 /// The albedo of the indirect-light frames, everywhere.
 inline constexpr float kIndirectFrameAlbedo = 0.6f;
@@ -41,27 +36,10 @@ std::string indirectSettingsSummary(const IndirectVariant& v = {});
 /// The reference's lighting: the environment plus each key light as an SH cap.
 gi::ShRgb foldKeys(const gi::GiLighting& l);
 
-/// Exact direct light and the running sums of bounces 1..maxBounces.
-struct IndirectReference {
-    std::array<Grid, 3> direct;
-    std::vector<std::array<Grid, 3>> indirectUpTo;  // [b - 1]: bounces 1..b
-    double seconds = 0.0;
-};
-
-/// The reference of d under `light` with `directions` gathering directions per texel (all threads).
-IndirectReference computeIndirectReference(const Dem& d, const gi::GiLighting& light, const gi::AlbedoMap& a,
-                                           int maxBounces, int directions);
-
-/// The same, read from cacheDir when a file of this DEM, lighting and
-/// reference settings is there (the name carries a hash of all of them),
-/// else computed and written there; an empty cacheDir caches nothing.
-IndirectReference cachedIndirectReference(const std::string& cacheDir, const Dem& d, const gi::GiLighting& light,
-                                          const gi::AlbedoMap& a, int maxBounces, int directions);
-
 /// Relative RMSE and bias (interior) of a frame's total and indirect light.
 struct IndirectErrors {
     double total = 0.0, totalBias = 0.0, indirect = 0.0, indirectBias = 0.0;
 };
-IndirectErrors indirectErrors(const gi::GiState& st, const IndirectReference& ref, int bounces);
+IndirectErrors indirectErrors(const gi::GiState& st, const GiReference& ref, int bounces);
 
 }  // namespace terrain::bench

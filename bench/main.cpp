@@ -47,6 +47,7 @@ int main(int argc, char** argv) {
     add(&addLongRunSuite);
     add(&addSvfSagaSuite);
     add(&addTable1Suite);
+    add(&addSpeedVsErrorSuite);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

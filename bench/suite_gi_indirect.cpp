@@ -34,16 +34,6 @@ struct IndirectOptions {
     int probe = 0;             // only the frame time of a probe^2 erosion frame, 2x, one bounce (stderr)
 };
 
-// alps-montblanc at true scale, the central 256^2 crop (the 647^2 reference
-// with 2048 directions takes too long for this benchmark's budget)
-Dem alpsCrop(const std::string& dataDir, int size) {
-    Dem d;
-    d.name = "alps-montblanc";
-    d.note = "central " + std::to_string(size) + "^2 crop at true scale (cell 92.74 m)";
-    d.heights = alpsCentreCrop(dataDir, size, d.cell);
-    return d;
-}
-
 // ---- error breakdown (--diagnose) ---------------------------------------------------
 std::string fmtErr(const char* what, double e, double b) {
     char line[256];
@@ -129,7 +119,7 @@ std::string diagnose(const Dem& d, const GiLighting& light, float albedo) {
 // Lower bound of any scheme that interpolates a smooth field from the
 // receivers: the reference's own indirect light, sampled at the s x s
 // receivers and re-interpolated bilinearly.
-std::string interpolationBound(const IndirectReference& ref, int s) {
+std::string interpolationBound(const GiReference& ref, int s) {
     std::array<Grid, 3> ip = ref.indirectUpTo[0];
     const Grid& r0 = ref.indirectUpTo[0][0];
     for (int c = 0; c < 3; ++c)
@@ -187,7 +177,7 @@ private:
     const int accSize = o_.quick ? 96 : 256;
     const int refDirections = 2048;
     const float albedo = kIndirectFrameAlbedo;
-    const GiLighting light = indirectFrameLighting();
+    const GiLighting light = sunSkyAndBenchKey();
     IndirectVariant variant;
     std::vector<Dem> dems;  // the accuracy terrains: Mont Blanc and an eroded frame
 
@@ -197,7 +187,7 @@ private:
 
     void probe() const;
     void accuracy();
-    std::string accuracyRows(const Dem& d, const AlbedoMap& a, const IndirectReference& ref, std::string& summary,
+    std::string accuracyRows(const Dem& d, const AlbedoMap& a, const GiReference& ref, std::string& summary,
                              std::string& accCsv) const;
 };
 
@@ -231,8 +221,8 @@ void IndirectSuite::probe() const {
 
 // The error table of one terrain: paper and engine settings at 1x/2x/4x, 1..3
 // bounces; adds the summary rows (one bounce) and the CSV rows.
-std::string IndirectSuite::accuracyRows(const Dem& d, const AlbedoMap& a, const IndirectReference& ref,
-                                        std::string& summary, std::string& accCsv) const {
+std::string IndirectSuite::accuracyRows(const Dem& d, const AlbedoMap& a, const GiReference& ref, std::string& summary,
+                                        std::string& accCsv) const {
     std::string accMd;
     for (int paper = 0; paper < 2; ++paper)
         for (int s : {1, 2, 4})
@@ -278,7 +268,7 @@ void IndirectSuite::accuracy() {
     for (const Dem& d : dems) {
         const AlbedoMap a = uniformAlbedo(d.heights.nx, d.heights.ny, albedo);
         std::fprintf(stderr, "reference %s %dx%d ...\n", d.name.c_str(), d.heights.nx, d.heights.ny);
-        const IndirectReference ref = computeIndirectReference(d, light, a, 3, refDirections);
+        const GiReference ref = withThreads(0, [&] { return computeReference(d, light, a, 3, refDirections); });
         accMd += "## " + d.name + ": " + d.note + "\n\nReference: " + std::to_string(static_cast<int>(ref.seconds)) +
                  " s (3 bounces).\n\n";
         accMd +=

@@ -69,7 +69,7 @@ struct RowTimes {
 // Frames of one configuration on one GiState: median (plain) or mean over an
 // even number of frames (amortised: as many cheap as expensive ones).
 double timeFrames(const Dem& d, const AlbedoMap& a, const GiSettings& g, int runs, GiState& st, double* indirectMs) {
-    const GiLighting light = indirectFrameLighting();
+    const GiLighting light = sunSkyAndBenchKey();
     std::vector<double> t, ti;
     const int frames = g.indirect.amortise ? (runs + 1) / 2 * 2 : runs;
     for (int f = 0; f <= frames; ++f) {
@@ -188,11 +188,10 @@ private:
         const Dem d = erodedScene(n, 0);
         const AlbedoMap a = uniformAlbedo(n, n, kIndirectFrameAlbedo);
         std::optional<Dem> eroded;
-        std::optional<IndirectReference> ref;
+        std::optional<GiReference> ref;
         if (hasErrors(n)) {
             eroded = erodedScene(n, 2000);
-            ref = cachedIndirectReference(o_.cache, *eroded, indirectFrameLighting(), a, o_.maxBounces,
-                                          n <= 256 ? 2048 : 1024);
+            ref = cachedReference(o_.cache, *eroded, sunSkyAndBenchKey(), a, o_.maxBounces, n <= 256 ? 2048 : 1024);
         }
         for (int s : o_.subsamples)
             for (int b = 1; b <= o_.maxBounces; ++b) {
@@ -203,7 +202,7 @@ private:
                 if (ref) {
                     GiState st;
                     withThreads(2, [&] {
-                        runGiFrame(eroded->heights.cview(), eroded->cell, indirectFrameLighting(),
+                        runGiFrame(eroded->heights.cview(), eroded->cell, sunSkyAndBenchKey(),
                                    indirectFrameSettings(s, b, false), st, &a);
                     });
                     const IndirectErrors e = indirectErrors(st, *ref, b);
@@ -303,7 +302,7 @@ std::string Table1Suite::memoryBreakdown() const {
         const double before = heapMB();
         auto st = std::make_unique<GiState>();
         withThreads(2, [&] {
-            runGiFrame(d.heights.cview(), d.cell, indirectFrameLighting(), indirectFrameSettings(s, 1, false), *st, &a);
+            runGiFrame(d.heights.cview(), d.cell, sunSkyAndBenchKey(), indirectFrameSettings(s, 1, false), *st, &a);
         });
         totals.push_back(heapMB() - before);
         parts.push_back(memoryParts(*st));

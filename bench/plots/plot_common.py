@@ -35,8 +35,14 @@ def read_csv(folder, name):
         sys.exit(f"{os.path.basename(sys.argv[0])}: cannot read {path}: {e.strerror}")
 
 
-def figure(width=7.5, height=4.8, panels=1):
-    """A new figure and its axes (a list of `panels` side by side when more than one) in the house style."""
+def figure(width=7.5, height=4.8):
+    """A new figure and axes in the house style."""
+    fig, axes = figure_grid(1, 1, width, height)
+    return fig, axes[0][0]
+
+
+def figure_grid(rows, cols, width=7.5, height=4.8, **subplots_args):
+    """A new figure of rows x cols panels in the house style; axes[row][col]."""
     plt.rcParams.update({
         "font.size": 11,
         "axes.titlesize": 12,
@@ -45,11 +51,12 @@ def figure(width=7.5, height=4.8, panels=1):
         "svg.fonttype": "none",  # text stays text in the SVG
         "svg.hashsalt": "terrain",  # the same SVG for the same data
     })
-    fig, axes = plt.subplots(1, panels, figsize=(width, height), layout="constrained", squeeze=False)
-    for ax in axes[0]:
+    fig, axes = plt.subplots(rows, cols, figsize=(width, height), layout="constrained", squeeze=False,
+                             **subplots_args)
+    for ax in axes.flat:
         ax.grid(True, which="major", alpha=0.35)
         ax.grid(True, which="minor", alpha=0.12)
-    return fig, (axes[0][0] if panels == 1 else list(axes[0]))
+    return fig, axes
 
 
 def plain_log_ticks(axis):

@@ -35,7 +35,8 @@ def panel(ax, rows, ours, paper, ylabel, title):
 def main():
     folder = pc.results_dir(__doc__)
     rows = pc.read_csv(folder, "table1.csv")
-    fig, axes = pc.figure(12.5, 5, panels=2)
+    fig, grid = pc.figure_grid(1, 2, 12.5, 5)
+    axes = grid[0]
     panel(axes[0], rows, "ms", "paper_ms", "ms per frame (one bounce)", "GI frame time")
     panel(axes[1], rows, "memory_mb", "paper_memory_mb", "MB", "GI memory")
     pc.save(fig, folder, "table1")
