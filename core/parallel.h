@@ -38,6 +38,14 @@ void parallelForRows(int ny, int nx, Fn&& fn) {
     parallelFor(0, ny, grain, std::forward<Fn>(fn));
 }
 
+/// How many threads may run a parallel loop's bodies at once here, and the
+/// calling thread's slot among them, in [0, workerSlots()): loop bodies that
+/// need scratch take it per slot instead of per chunk (a body never runs
+/// inside another body of the same thread unless it starts a parallel loop
+/// itself). Results must not depend on which slot's scratch a body gets.
+inline int workerSlots() { return std::max(1, tbb::this_task_arena::max_concurrency()); }
+inline int workerSlot() { return std::max(0, tbb::this_task_arena::current_thread_index()); }
+
 /// Deterministic reduction over [begin, end) with chunks of fixed size.
 /// map(b, e) -> T reduces one chunk serially; combine(T, T) -> T folds the
 /// partial results in chunk order.

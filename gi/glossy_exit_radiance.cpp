@@ -126,10 +126,11 @@ void glossyExitRadiance(ConstGridView gradX, ConstGridView gradY, int s, int nxr
     const float ws = specularWeightOf(shading);
     const float vx = shading.viewDir[0], vy = shading.viewDir[1], vz = shading.viewDir[2];
     const int nBlocks = std::max(1, std::min(ny, kMaxBlocks));
-    rowScratch.resize(static_cast<std::size_t>(nBlocks) * kGlossyFields * std::max(nxr, 1));
+    // a row keeps nothing in the scratch: one slot per thread serves every block it runs
+    rowScratch.resize(static_cast<std::size_t>(workerSlots()) * kGlossyFields * std::max(nxr, 1));
     parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
+        float* vert = rowScratch.data() + static_cast<std::size_t>(workerSlot()) * kGlossyFields * nxr;
         for (int block = b0; block < b1; ++block) {
-            float* vert = rowScratch.data() + static_cast<std::size_t>(block) * kGlossyFields * nxr;
             const int yBegin = static_cast<int>(static_cast<long long>(ny) * block / nBlocks);
             const int yEnd = static_cast<int>(static_cast<long long>(ny) * (block + 1) / nBlocks);
             for (int y = yBegin; y < yEnd; ++y) {

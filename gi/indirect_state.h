@@ -27,7 +27,7 @@ struct GlossyIndirectState {
     std::vector<const float*> fields;  // azimuths x steps x 48: field + offA of each plane
     std::vector<float> blockScratch;   // per row block: scan scratch (moments, basis, NLP)
     std::vector<int> blockList;        // per row block: steps with a new member
-    std::vector<float> rowScratch;     // per row block: interpolated incident SH of one row
+    std::vector<float> rowScratch;     // per worker slot: interpolated incident SH of one row
 };
 
 struct IndirectState {

@@ -447,8 +447,8 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
     const int nPlanes = 3 * nCoef + (ambient ? 9 : 0);  // incident radiance + V_env bands 0..2 (ambient)
     const int nBlocks = std::max(1, std::min(ny, 64));
     const int nxrS = nxr + 8;  // vertical scratch rows padded for 8-wide reads
-    sizeShadeMaps(nx, ny, planeR * 3 * nCoef, ambient, static_cast<std::size_t>(nBlocks) * nPlanes * (nxrS + nx),
-                  static_cast<std::size_t>(nBlocks) * 24 * nx, out);
+    const auto slots = static_cast<std::size_t>(workerSlots());
+    sizeShadeMaps(nx, ny, planeR * 3 * nCoef, ambient, slots * nPlanes * (nxrS + nx), slots * 24 * nx, out);
 
     if (rows && rows->size() != static_cast<std::size_t>(ny))
         throw InputError("shading: one row flag per texel row expected");
@@ -491,12 +491,14 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
                          settings.positivity == GlossyPositivity::Clamp};
     phongLobeFactors(settings.phongExponent, phongJob.phUniform);
 
-    // ---- schedule: fixed row blocks, each with its own scratch ---------------
+    // ---- schedule: fixed row blocks; a row keeps nothing in the scratch, so
+    // each thread's slot of it serves every block it runs ----------------------
     parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
+        const auto slot = static_cast<std::size_t>(workerSlot());
+        float* vert = out.rowScratch.data() + slot * nPlanes * (nxrS + nx);
+        float* up = vert + static_cast<std::size_t>(nPlanes) * nxrS;
+        float* basis = out.basisScratch.data() + slot * 24 * nx;
         for (int block = b0; block < b1; ++block) {
-            float* vert = out.rowScratch.data() + static_cast<std::size_t>(block) * nPlanes * (nxrS + nx);
-            float* up = vert + static_cast<std::size_t>(nPlanes) * nxrS;
-            float* basis = out.basisScratch.data() + static_cast<std::size_t>(block) * 24 * nx;
             const int yBegin = static_cast<int>(static_cast<long long>(ny) * block / nBlocks);
             const int yEnd = static_cast<int>(static_cast<long long>(ny) * (block + 1) / nBlocks);
             for (int y = yBegin; y < yEnd; ++y) {
