@@ -83,7 +83,7 @@ void BlockerRadianceIndirect::scanBlock(int block, bool horizons) {
     const std::size_t planeR = static_cast<std::size_t>(nxr) * nyr;
     void (*const accumulate)(const float*, float*, int, int, int, int) =
         simd::wideEnabled() ? accumulateIrradianceAvx2 : accumulateIrradianceSse;
-    IndirectScratch& sc = st_.blocks[static_cast<std::size_t>(block)];
+    IndirectScratch& sc = scan_.scratch();
     const RowBlock rb = scan_.rowBlock(block);
     if (!scan_.hasWork(rb)) return;  // no dirty tile in these rows: every receiver keeps its values
     // the rows' receiver heights and gradients; E sums zeroed

@@ -103,7 +103,7 @@ void ShKernelIndirect::scanBlock(int block) {
     const FoldedWedgeOperator& op = in_.op;
     const int P = op.patternSize();
     void (*const accumulate)(const URowSums&) = simd::wideEnabled() ? accumulateUAvx2 : accumulateUSse;
-    IndirectScratch& sc = st_.blocks[static_cast<std::size_t>(block)];
+    IndirectScratch& sc = scan_.scratch();
     const RowBlock rb = scan_.rowBlock(block);
     if (!scan_.hasWork(rb)) return;  // no dirty tile in these rows: every receiver keeps its U
     // the rows' receiver heights and gradients; U zeroed in the spans

@@ -36,7 +36,7 @@ struct IndirectState {
     std::vector<ScanStep> radianceSteps;  // Lambert strategies: channels x azimuths x steps
     std::vector<int> stepsPerColumn, stepsPerRow;
     DirtySpans spans;                      // Lambert strategies: the receiver columns to scan, per row
-    std::vector<IndirectScratch> blocks;   // Lambert strategies: per block of receiver rows
+    std::vector<IndirectScratch> blocks;   // Lambert strategies: per worker slot (LambertScan::scratch)
     std::array<VisibilityField, 3> u;      // U per channel (16 SH planes at the receivers; not with BlockerRadiance)
     int uZeroFrom = kShCount;              // U's planes from this one on are known to be 0
     std::array<ShadingLight, 3> lights;    // the shading lights of U

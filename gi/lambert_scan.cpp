@@ -35,7 +35,7 @@ LambertScan::LambertScan(const IndirectInputs& in, CastingMoments moments, Indir
 
 void LambertScan::beginFrame() {
     const int m = in_.op.azimuths, nyr = in_.heights.nyr;
-    st_.blocks.resize(static_cast<std::size_t>(nBlocks_));
+    st_.blocks.resize(static_cast<std::size_t>(workerSlots()));
     for (IndirectScratch& b : st_.blocks)
         sizeIndirectScratch(b, kRowsPerBlock, pad_, moments_ == CastingMoments::Irradiance);
     hMax_ = fieldTopHeight(in_.heights);

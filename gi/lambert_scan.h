@@ -19,6 +19,7 @@
 #include <span>
 
 #include "core/grid.h"
+#include "core/parallel.h"
 #include "gi/casting_set_scan.h"
 #include "gi/indirect_inputs.h"
 #include "gi/indirect_state.h"
@@ -39,9 +40,10 @@ public:
     /// A scan that sums `moments` over the casting sets, in st's buffers.
     LambertScan(const IndirectInputs& in, CastingMoments moments, IndirectState& st);
 
-    /// Sizes the step tables and the blocks' scratch (IndirectScratch::irradiance
-    /// with CastingMoments::Irradiance), finds the field's highest height and
-    /// the receiver spans to scan (InputError: tiles of another receiver grid).
+    /// Sizes the step tables and the scratch of each worker slot
+    /// (IndirectScratch::irradiance with CastingMoments::Irradiance), finds the
+    /// field's highest height and the receiver spans to scan (InputError:
+    /// tiles of another receiver grid).
     void beginFrame();
     /// The RGB radiance pyramid of the previous bounce's exit radiance (Section 5.3).
     void buildPyramid(const std::array<Grid, 3>& exit, const RadiancePyramidSettings& settings);
@@ -49,6 +51,9 @@ public:
     void buildStepTable();
 
     int blockCount() const { return nBlocks_; }
+    /// The calling thread's scratch: a block keeps nothing in it once done,
+    /// so each worker slot's serves every block that thread runs.
+    IndirectScratch& scratch() const { return st_.blocks[static_cast<std::size_t>(workerSlot())]; }
     RowBlock rowBlock(int block) const;
     /// The receiver columns of row Y to scan (the whole row without tiles).
     std::span<const ColumnSpan> spans(int Y) const { return st_.spans.ofRow(Y); }
