@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -263,9 +264,12 @@ void keyLightVisibility(const GiLighting& lighting, const GiSettings& settings, 
         ++st.keyVisibilitiesRecomputed;
         const KeyLight& light = lighting.keys[k];
         const KeyLightExtent ext = keyLightExtent(light);
-        if (st.keyOperators[k].azimuths != settings.keyLightAzimuths ||
+        // with the exact cosine the shading reads the visible fraction alone (V_00)
+        const int shRows = settings.keyLightExactCosine ? 1 : kShCount;
+        if (st.keyOperators[k].azimuths != settings.keyLightAzimuths || st.keyOperators[k].shRows != shRows ||
             !sameSkyRegion(st.keyOperatorLights[k], light)) {
             st.keyOperators[k] = foldPartialRange(ext.phiStart, ext.phiEnd, settings.keyLightAzimuths);
+            if (shRows == 1) st.keyOperators[k] = firstRowOnly(std::move(st.keyOperators[k]));
             st.keyOperatorLights[k] = light;
         }
         VisibilityTarget target;
@@ -276,8 +280,10 @@ void keyLightVisibility(const GiLighting& lighting, const GiSettings& settings, 
         target.footprint = footprint ? &st.footprint : nullptr;
         VisibilitySettings ks = settings.visibility;
         ks.azimuths = settings.keyLightAzimuths;
+        // tiles only over a last result of the same planes (the whole field after a switch)
+        const bool whole = change.keyRegion[k] || st.keyVisibility[k].planes != shRows;
         computeVisibility(st.pyramid, st.gradX.cview(), st.gradY.cview(), ks, target, st.visibilityState,
-                          st.keyVisibility[k], change.keyRegion[k] ? nullptr : only);
+                          st.keyVisibility[k], whole ? nullptr : only);
     }
 }
 

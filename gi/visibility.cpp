@@ -550,7 +550,7 @@ void visibilityOfRow(const VisibilityRows& r, int Y, std::span<const ColumnSpan>
     const int nxr = r.pyr.nxr, nyr = r.pyr.nyr, m = r.target.op->azimuths;
     VisibilityState& state = r.state;
     float* vRows[kShCount];
-    for (int i = 0; i < kShCount; ++i) {
+    for (int i = 0; i < r.out.planes; ++i) {
         vRows[i] = r.out.plane(i) + static_cast<std::size_t>(Y) * nxr;
         for (const ColumnSpan& span : spans) std::fill(vRows[i] + span.x0, vRows[i] + span.x1, 0.0f);
     }
@@ -686,7 +686,8 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
     const int m = op.azimuths;
     const int nSteps = static_cast<int>(pyr.steps.size());
     const std::size_t planeSize = static_cast<std::size_t>(nxr) * nyr;
-    if (only && (out.nxr != nxr || out.nyr != nyr || out.sh.size() != planeSize * kShCount ||
+    const int planes = op.shRows;
+    if (only && (out.nxr != nxr || out.nyr != nyr || out.planes != planes || out.sh.size() != planeSize * planes ||
                  out.maxSlope.size() != planeSize * m))
         throw InputError(
             "computeVisibility: receiver tiles need the previous result of this receiver grid and these "
@@ -694,7 +695,8 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
     dirtySpans(only, nxr, nyr, state.spans);
     out.nxr = nxr;
     out.nyr = nyr;
-    out.sh.resize(planeSize * kShCount);
+    out.planes = planes;
+    out.sh.resize(planeSize * planes);
     out.maxSlope.resize(planeSize * m);
     if (state.spans.empty()) return;  // no dirty tile (or no receiver): every receiver keeps its value
 

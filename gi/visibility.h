@@ -138,10 +138,12 @@ struct VisibilityTarget {
     float sinLow = -1.0f, sinHigh = 1.0f;
 };
 
-/// SH visibility of every receiver (16 planes) and its scan by-products.
+/// SH visibility of every receiver (16 planes, or V_00 alone for an
+/// operator of one row) and its scan by-products.
 struct VisibilityField {
     int nxr = 0, nyr = 0;
-    std::vector<float> sh;        // 16 planes of nxr * nyr: V (Eq. 21)
+    int planes = kShCount;        // SH planes held (FoldedWedgeOperator::shRows)
+    std::vector<float> sh;        // `planes` planes of nxr * nyr: V (Eq. 21)
     std::vector<float> maxSlope;  // azimuths planes of nxr * nyr: tan(omega_max) (Eq. 16)
     float* plane(int i) { return sh.data() + static_cast<std::size_t>(i) * nxr * nyr; }
     const float* plane(int i) const { return sh.data() + static_cast<std::size_t>(i) * nxr * nyr; }

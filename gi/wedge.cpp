@@ -44,7 +44,7 @@ bool couples(int r, int l) {
 void buildSparse(FoldedWedgeOperator& op) {
     op.patternRow.clear();
     op.patternNlp.clear();
-    for (int r = 0; r < kShCount; ++r)
+    for (int r = 0; r < op.shRows; ++r)
         for (int l = 0; l < kNlpCount; ++l)
             if (couples(r, l)) {
                 op.patternRow.push_back(static_cast<std::uint8_t>(r));
@@ -129,6 +129,12 @@ FoldedWedgeOperator foldFullCircle(int azimuths, AzimuthInterp interp) {
             const int sample = ((j + first + k) % azimuths + azimuths) % azimuths;
             addRotatedBlock(op, m, taps, k, op.phi[static_cast<std::size_t>(j)], sample);
         }
+    buildSparse(op);
+    return op;
+}
+
+FoldedWedgeOperator firstRowOnly(FoldedWedgeOperator op) {
+    op.shRows = 1;
     buildSparse(op);
     return op;
 }

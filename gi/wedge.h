@@ -48,6 +48,7 @@ struct FoldedWedgeOperator {
     std::vector<std::uint8_t> patternRow;  // SH row of each entry
     std::vector<std::uint8_t> patternNlp;  // NLP index of each entry
     std::vector<float> values;             // azimuths x pattern size
+    int shRows = kShCount;                 // SH rows of V it gives: all, or 1 (firstRowOnly)
     int patternSize() const { return static_cast<int>(patternRow.size()); }
 };
 
@@ -58,6 +59,11 @@ FoldedWedgeOperator foldFullCircle(int azimuths, AzimuthInterp interp);
 /// Partial domain [phiStart, phiEnd] (key lights, Section 6): m samples
 /// evenly spaced including both ends, m - 1 wedges, linear interpolation.
 FoldedWedgeOperator foldPartialRange(double phiStart, double phiEnd, int azimuths);
+
+/// The operator restricted to V's first SH row, V_00 (sqrt(4 pi) times the
+/// visible fraction of the domain): all that an exact-cosine key light reads,
+/// at a sixteenth of the output.
+FoldedWedgeOperator firstRowOnly(FoldedWedgeOperator op);
 
 /// Reference application of the dense operator: V = G [w_0; ...; w_{m-1}].
 void applyFoldedDense(const FoldedWedgeOperator& op, const double* nlp, double out[kShCount]);

@@ -237,6 +237,36 @@ TEST_CASE("gi.visibility: outputs are bit-identical for 1, 2, 3 and 8 threads") 
     }
 }
 
+TEST_CASE("gi.visibility: an exact-cosine key light keeps V_00 alone, the bits of the full operator's") {
+    // The exact cosine reads the visible fraction only: its key visibility
+    // holds one plane, bit for bit the first plane of the 16-row operator's.
+    const Grid g = hills(64, 48, 20.0f);
+    GiLighting light;
+    light.keys.push_back(KeyLight{});
+    for (int s : {1, 2}) {
+        GiSettings settings = GiSettings{};
+        settings.subsample = s;
+        settings.incremental = false;
+        GiState exact, full;
+        runGiFrame(g.cview(), 1.0f, light, settings, exact);
+        settings.keyLightExactCosine = false;
+        runGiFrame(g.cview(), 1.0f, light, settings, full);
+        const VisibilityField &ve = exact.keyVisibility[0], &vf = full.keyVisibility[0];
+        REQUIRE(ve.planes == 1);
+        REQUIRE(vf.planes == kShCount);
+        const std::size_t plane = static_cast<std::size_t>(ve.nxr) * ve.nyr;
+        REQUIRE(ve.sh.size() == plane);
+        CHECK(std::memcmp(ve.sh.data(), vf.sh.data(), plane * sizeof(float)) == 0);
+        REQUIRE(ve.maxSlope.size() == vf.maxSlope.size());
+        CHECK(std::memcmp(ve.maxSlope.data(), vf.maxSlope.data(), ve.maxSlope.size() * sizeof(float)) == 0);
+        // switching back on the same state recomputes the one plane
+        settings.keyLightExactCosine = true;
+        runGiFrame(g.cview(), 1.0f, light, settings, full);
+        REQUIRE(full.keyVisibility[0].sh.size() == plane);
+        CHECK(std::memcmp(ve.sh.data(), full.keyVisibility[0].sh.data(), plane * sizeof(float)) == 0);
+    }
+}
+
 TEST_CASE("gi.visibility: a second frame on a changed field reuses every buffer") {
     Grid g = hills(64, 48, 20.0f);
     GiLighting light;
