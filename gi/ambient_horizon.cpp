@@ -19,14 +19,14 @@ using simd::sqrtv;
 using simd::store;
 
 constexpr float kHalfPi = 1.57079632679489661923f;
+constexpr int kRowsPerSlot = 5;  // row buffers: three integrals, horizon, the receivers' vertical blend
 
 // What one row block needs, fixed for the frame.
 struct AmbientJob {
     const AmbientInputs& in;
     int nx, ny, nxr, nyr, m;
-    int rowFloats;  // scratch floats per row buffer (nx rounded up, or nxr)
-    float* scratch;
-    float* raised;                   // azimuths x receivers (sub-sampling only)
+    int rowFloats;                   // scratch floats per row buffer (nx rounded up, or nxr)
+    float* scratch;                  // per worker slot: kRowsPerSlot rows, then the raised window
     const ReceiverLerp* columns;     // per texel column: the receivers it lies between
     const NearFieldStep* nearSteps;  // azimuths x subsample
     const std::vector<std::uint8_t>* rows;
@@ -107,21 +107,28 @@ void receiverRowHorizons(const AmbientJob& j, int Y, int a, float c, float sn, f
     }
 }
 
-// The raised horizons of every receiver row flagged in `receiverRows`, each
-// azimuth's plane (the receivers' lowest tangent slopes applied once per
-// frame, not once per texel row that reads them).
-void raiseReceiverHorizons(const AmbientJob& j, const std::vector<std::uint8_t>& receiverRows) {
-    parallelForRows(j.nyr, j.nxr * j.m, [&](int y0, int y1) {
-        for (int Y = y0; Y < y1; ++Y) {
-            if (receiverRows[static_cast<std::size_t>(Y)] == 0) continue;
-            for (int a = 0; a < j.m; ++a) {
-                const float c = j.in.cosSin[2 * static_cast<std::size_t>(a)];
-                const float sn = j.in.cosSin[2 * static_cast<std::size_t>(a) + 1];
-                receiverRowHorizons(j, Y, a, c, sn, j.raised + (static_cast<std::size_t>(a) * j.nyr + Y) * j.nxr);
-            }
+// The two receiver rows a texel row interpolates between, every azimuth's
+// horizons raised (receiverRowHorizons), in a worker slot's scratch: azimuth
+// a's rows at rows + 2 a nxr (row i0) and rows + (2 a + 1) nxr (row i1). The
+// rows a block's texel rows read change every s texel rows, so they are
+// raised there, not once per texel row.
+struct RaisedWindow {
+    float* rows;
+    int i0 = -1, i1 = -1;
+
+    void cover(const AmbientJob& j, int y) {
+        const ReceiverLerp ry = receiverLerp(y, j.in.subsample, j.nyr);
+        if (ry.i0 == i0 && ry.i1 == i1) return;
+        i0 = ry.i0;
+        i1 = ry.i1;
+        for (int a = 0; a < j.m; ++a) {
+            const float c = j.in.cosSin[2 * static_cast<std::size_t>(a)];
+            const float sn = j.in.cosSin[2 * static_cast<std::size_t>(a) + 1];
+            receiverRowHorizons(j, i0, a, c, sn, rows + 2 * static_cast<std::size_t>(a) * j.nxr);
+            receiverRowHorizons(j, i1, a, c, sn, rows + (2 * static_cast<std::size_t>(a) + 1) * j.nxr);
         }
-    });
-}
+    }
+};
 
 // out[x] = v0 + f (v1 - v0) between the receivers around texel column x
 // (receiverLerp): S texels per receiver interval with the fractions k / S,
@@ -143,11 +150,12 @@ void horizontalLerp(const AmbientJob& j, const float* vert, float* out) {
 }
 
 // Horizon slopes of azimuth a at the texels of row y, bilinear from the
-// raised receivers (Fig. 7). vert: nxr floats of scratch.
-void interpolatedHorizons(const AmbientJob& j, int y, int a, float* vert, float* out) {
+// raised receivers (Fig. 7; `raised`: the window covering row y). vert: nxr
+// floats of scratch.
+void interpolatedHorizons(const AmbientJob& j, int y, int a, const float* raised, float* vert, float* out) {
     const ReceiverLerp ry = receiverLerp(y, j.in.subsample, j.nyr);
-    const float* t0 = j.raised + (static_cast<std::size_t>(a) * j.nyr + ry.i0) * j.nxr;
-    const float* t1 = j.raised + (static_cast<std::size_t>(a) * j.nyr + ry.i1) * j.nxr;
+    const float* t0 = raised + 2 * static_cast<std::size_t>(a) * j.nxr;
+    const float* t1 = t0 + j.nxr;
     for (int X = 0; X < j.nxr; ++X) vert[X] = t0[X] + ry.f * (t1[X] - t0[X]);
     switch (j.in.subsample) {
         case 2:
@@ -169,6 +177,7 @@ template <class V, bool Parts>
     float* const acc[3] = {buffers, buffers + j.rowFloats, buffers + 2 * static_cast<std::size_t>(j.rowFloats)};
     float* horizon = buffers + 3 * static_cast<std::size_t>(j.rowFloats);
     float* vert = buffers + 4 * static_cast<std::size_t>(j.rowFloats);
+    const float* raised = buffers + kRowsPerSlot * static_cast<std::size_t>(j.rowFloats);
     for (int r = 0; r < (Parts ? 3 : 1); ++r) std::fill(acc[r], acc[r] + j.nx, 0.0f);
     const float* gx = j.in.gradX.row(y);
     const float* gy = j.in.gradY.row(y);
@@ -179,7 +188,7 @@ template <class V, bool Parts>
         if (j.in.subsample == 1) {
             h = j.in.env->maxSlope.data() + (static_cast<std::size_t>(a) * j.ny + y) * j.nx;
         } else {
-            interpolatedHorizons(j, y, a, vert, horizon);
+            interpolatedHorizons(j, y, a, raised, vert, horizon);
             raiseToNearField(
                 j.in.heights, y,
                 {j.nearSteps + static_cast<std::size_t>(a) * j.in.subsample, static_cast<std::size_t>(j.in.subsample)},
@@ -229,16 +238,6 @@ void checkInputs(const AmbientInputs& in, int m, const std::vector<std::uint8_t>
         throw InputError("ambient: one row flag per texel row expected");
 }
 
-// The receiver rows the flagged texel rows interpolate between.
-void flagReceiverRows(int ny, int s, int nyr, const std::vector<std::uint8_t>* rows, std::vector<std::uint8_t>& out) {
-    out.assign(static_cast<std::size_t>(nyr), 0);
-    for (int y = 0; y < ny; ++y) {
-        if (rows && (*rows)[static_cast<std::size_t>(y)] == 0) continue;
-        const ReceiverLerp r = receiverLerp(y, s, nyr);
-        out[static_cast<std::size_t>(r.i0)] = out[static_cast<std::size_t>(r.i1)] = 1;
-    }
-}
-
 }  // namespace
 
 void ambientFromHorizons(const AmbientInputs& in, const AmbientOutputs& out, AmbientScratch& scratch,
@@ -255,38 +254,28 @@ void ambientFromHorizons(const AmbientInputs& in, const AmbientOutputs& out, Amb
     }
     const int nBlocks = std::max(1, std::min(ny, 64));
     const int rowFloats = std::max(nx, in.env->nxr);
-    constexpr int kRowsPerBlock = 5;  // three integrals, horizon, the receivers' vertical blend
-    scratch.rows.resize(static_cast<std::size_t>(nBlocks) * kRowsPerBlock * rowFloats);
     const int s = in.subsample, nxr = in.env->nxr, nyr = in.env->nyr;
+    // per worker slot: the row buffers, then (sub-sampling) the raised window
+    const std::size_t slotFloats =
+        kRowsPerSlot * static_cast<std::size_t>(rowFloats) + (s > 1 ? 2 * static_cast<std::size_t>(m) * nxr : 0);
+    scratch.rows.resize(static_cast<std::size_t>(workerSlots()) * slotFloats);
     receiverLerps(nx, s, nxr, scratch.columns);
-    if (s > 1) {
-        scratch.raised.resize(in.env->maxSlope.size());
-        buildNearFieldSteps(in.cosSin, s, in.cellSize, scratch.nearSteps);
-    }
-    const AmbientJob job{in,
-                         nx,
-                         ny,
-                         nxr,
-                         nyr,
-                         m,
-                         rowFloats,
-                         scratch.rows.data(),
-                         scratch.raised.data(),
-                         scratch.columns.data(),
-                         scratch.nearSteps.data(),
-                         rows,
-                         out};
-    if (s > 1) {
-        flagReceiverRows(ny, s, nyr, rows, scratch.receiverRows);
-        raiseReceiverHorizons(job, scratch.receiverRows);
-    }
+    if (s > 1) buildNearFieldSteps(in.cosSin, s, in.cellSize, scratch.nearSteps);
+    const AmbientJob job{
+        in,   nx, ny, nxr, nyr, m, rowFloats, scratch.rows.data(), scratch.columns.data(), scratch.nearSteps.data(),
+        rows, out};
+    // a row keeps nothing in the scratch but the window, which a block starts afresh
     parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
+        float* buffers = job.scratch + static_cast<std::size_t>(workerSlot()) * slotFloats;
         for (int block = b0; block < b1; ++block) {
-            float* buffers = job.scratch + static_cast<std::size_t>(block) * kRowsPerBlock * rowFloats;
+            RaisedWindow window{buffers + kRowsPerSlot * static_cast<std::size_t>(rowFloats)};
             const int yBegin = static_cast<int>(static_cast<long long>(ny) * block / nBlocks);
             const int yEnd = static_cast<int>(static_cast<long long>(ny) * (block + 1) / nBlocks);
-            for (int y = yBegin; y < yEnd; ++y)
-                if (!rows || (*rows)[static_cast<std::size_t>(y)] != 0) ambientRow(job, y, buffers);
+            for (int y = yBegin; y < yEnd; ++y) {
+                if (rows && (*rows)[static_cast<std::size_t>(y)] == 0) continue;
+                if (s > 1) window.cover(job, y);
+                ambientRow(job, y, buffers);
+            }
         }
     });
 }

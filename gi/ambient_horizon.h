@@ -57,11 +57,9 @@ struct AmbientInputs {
 
 /// Buffers of the computation, reused across frames.
 struct AmbientScratch {
-    std::vector<float> rows;                 // per row block
-    std::vector<float> raised;               // azimuths x receivers: horizons raised to the lowest tangent slope
-    std::vector<std::uint8_t> receiverRows;  // the receiver rows this call reads
-    std::vector<ReceiverLerp> columns;       // per texel column: the receivers it lies between
-    std::vector<NearFieldStep> nearSteps;    // azimuths x subsample
+    std::vector<float> rows;               // per worker slot: row buffers and the raised receiver rows
+    std::vector<ReceiverLerp> columns;     // per texel column: the receivers it lies between
+    std::vector<NearFieldStep> nearSteps;  // azimuths x subsample
 };
 
 /// Adds the light of a sky of constant radiance `radiance` (RGB) to a
