@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "bench/gi_reference_cache.h"
+#include "bench/indirect_frame.h"
 #include "bench/pareto.h"
 #include "bench/suites.h"
 #include "core/parallel.h"
@@ -101,16 +102,13 @@ double interiorRmse(const Grid& a, const Grid& b) {
 }
 
 Measurement errorsOf(const GiState& st, const GiReference& ref, int bounces) {
-    const std::array<Grid, 3>& indirect = ref.indirectUpTo[static_cast<std::size_t>(bounces - 1)];
-    std::array<Grid, 3> total = ref.direct;
-    for (std::size_t c = 0; c < 3; ++c)
-        for (std::size_t i = 0; i < total[c].v.size(); ++i) total[c].v[i] += indirect[c].v[i];
+    const IndirectErrors e = indirectErrors(st, ref, bounces);
     Measurement m;
     double bias = 0.0;
     m.ambient = interiorRmse(st.shade.ambient, ref.ambient);
     m.direct = relRmse(st.shade.rgb, ref.direct, bias);
-    m.indirect = relRmse(st.indirect.indirect, indirect, bias);
-    m.total = relRmse(st.indirect.total, total, bias);
+    m.indirect = e.indirect;
+    m.total = e.total;
     return m;
 }
 
