@@ -15,6 +15,7 @@ import matplotlib
 
 matplotlib.use("Agg")  # files only: no display needed
 import matplotlib.pyplot as plt  # noqa: E402 (after the backend is chosen)
+import matplotlib.ticker as ticker  # noqa: E402
 
 
 def results_dir(description):
@@ -59,3 +60,11 @@ def save(fig, folder, stem):
         fig.savefig(path, dpi=150, metadata=meta)
         print(f"wrote {path}", file=sys.stderr)
     plt.close(fig)
+
+
+def plain_log_ticks(axis):
+    """A log axis labelled in plain numbers (1, 2, 5, 10, ...) rather than powers of ten."""
+    plain = ticker.FuncFormatter(lambda v, _pos: f"{v:g}")
+    axis.set_major_formatter(plain)
+    axis.set_minor_locator(ticker.LogLocator(base=10, subs=(2.0, 5.0)))
+    axis.set_minor_formatter(plain)
