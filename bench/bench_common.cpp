@@ -76,6 +76,13 @@ std::string machineDescription() {
     return cpuAndThreads() + ", " + u.sysname + " " + u.release + "; " + buildDescription();
 }
 
+std::string loadAverage() {
+    std::ifstream in("/proc/loadavg");
+    std::string one, five;
+    in >> one >> five;
+    return one + " (1 min), " + five + " (5 min)";
+}
+
 std::string buildDescription() {
 #ifdef TERRAIN_BUILD_DESCRIPTION
     return TERRAIN_BUILD_DESCRIPTION;
@@ -207,6 +214,24 @@ double relRmse(const std::array<Grid, 3>& a, const std::array<Grid, 3>& b, doubl
             }
     bias = sd / n / std::sqrt(sr / n);
     return std::sqrt(se / n) / std::sqrt(sr / n);
+}
+
+gi::KeyLight benchKey() {
+    gi::KeyLight k;
+    k.azimuthDeg = 135.0f;
+    k.elevationDeg = 35.0f;
+    k.radiusDeg = 5.0f;
+    k.rgb[0] = 1.2f;
+    k.rgb[1] = 1.1f;
+    k.rgb[2] = 1.0f;
+    return k;
+}
+
+gi::GiLighting sunSkyAndBenchKey() {
+    gi::GiLighting l;
+    l.environment = gi::sunSkyLight();
+    l.keys.push_back(benchKey());
+    return l;
 }
 
 }  // namespace terrain::bench

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/grid.h"
+#include "gi/lights.h"
 #include "gi/settings.h"
 
 namespace terrain::bench {
@@ -44,6 +45,10 @@ std::string cpuAndThreads();
 
 /// "<cpu>, <n> hardware threads, <kernel>; <build>": the machine line of a results file.
 std::string machineDescription();
+
+/// "<1 min> (1 min), <5 min> (5 min)" from /proc/loadavg: how busy the
+/// machine was around a timing (other work shares the cores).
+std::string loadAverage();
 
 /// "<compiler> <version>, <build type> (<flags>)".
 std::string buildDescription();
@@ -96,6 +101,14 @@ void writeCachedGrids(const std::string& file, std::span<const Grid> grids);
 /// Relative RMSE of a against b over the interior (10 % border left out), all
 /// three channels; bias = mean difference / RMS of b.
 double relRmse(const std::array<Grid, 3>& a, const std::array<Grid, 3>& b, double& bias);
+
+/// The key light of the indirect-light timings (gi-indirect's Table 1,
+/// scaling): azimuth 135, elevation 35, radius 5 degrees, warm white.
+gi::KeyLight benchKey();
+
+/// Sun-and-sky environment (gi::sunSkyLight) plus benchKey(): the lighting
+/// of the indirect-light timings.
+gi::GiLighting sunSkyAndBenchKey();
 
 /// The settings with incremental frames off: the timing suites light the same
 /// field frame after frame and time whole frames (a static field would

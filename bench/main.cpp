@@ -46,6 +46,7 @@ int main(int argc, char** argv) {
     add(&addGiBoundDiagnosisSuite);
     add(&addLongRunSuite);
     add(&addSvfSagaSuite);
+    add(&addScalingSuite);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

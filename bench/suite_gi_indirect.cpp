@@ -85,17 +85,6 @@ double frameMemoryMB(const Grid& heights, const GiState& st) {
     return static_cast<double>(b) / (1024.0 * 1024.0);
 }
 
-KeyLight benchKey() {
-    KeyLight k;
-    k.azimuthDeg = 135.0f;
-    k.elevationDeg = 35.0f;
-    k.radiusDeg = 5.0f;
-    k.rgb[0] = 1.2f;
-    k.rgb[1] = 1.1f;
-    k.rgb[2] = 1.0f;
-    return k;
-}
-
 // The reference's lighting: environment plus the key light as an SH cap.
 ShRgb foldKeys(const GiLighting& l) {
     ShRgb total = l.environment;
@@ -279,10 +268,7 @@ struct FrameTime {
 // shared by its tables.
 class IndirectSuite {
 public:
-    IndirectSuite(const IndirectOptions& o, const BenchContext& ctx) : o_(o), ctx_(ctx) {
-        light.environment = sunSkyLight();
-        light.keys.push_back(benchKey());
-    }
+    IndirectSuite(const IndirectOptions& o, const BenchContext& ctx) : o_(o), ctx_(ctx), light(sunSkyAndBenchKey()) {}
 
     int run() {
         if (o_.probe > 0) {

@@ -35,8 +35,8 @@ def read_csv(folder, name):
         sys.exit(f"{os.path.basename(sys.argv[0])}: cannot read {path}: {e.strerror}")
 
 
-def figure(width=7.5, height=4.8):
-    """A new figure and axes in the house style."""
+def figure(width=7.5, height=4.8, cols=1):
+    """A new figure and its axes (one, or a tuple of `cols` side by side) in the house style."""
     plt.rcParams.update({
         "font.size": 11,
         "axes.titlesize": 12,
@@ -45,10 +45,11 @@ def figure(width=7.5, height=4.8):
         "svg.fonttype": "none",  # text stays text in the SVG
         "svg.hashsalt": "terrain",  # the same SVG for the same data
     })
-    fig, ax = plt.subplots(figsize=(width, height), layout="constrained")
-    ax.grid(True, which="major", alpha=0.35)
-    ax.grid(True, which="minor", alpha=0.12)
-    return fig, ax
+    fig, axes = plt.subplots(1, cols, figsize=(width, height), layout="constrained", squeeze=False)
+    for ax in axes[0]:
+        ax.grid(True, which="major", alpha=0.35)
+        ax.grid(True, which="minor", alpha=0.12)
+    return fig, (axes[0][0] if cols == 1 else tuple(axes[0]))
 
 
 def save(fig, folder, stem):
@@ -62,9 +63,10 @@ def save(fig, folder, stem):
     plt.close(fig)
 
 
-def plain_log_ticks(axis):
-    """A log axis labelled in plain numbers (1, 2, 5, 10, ...) rather than powers of ten."""
+def plain_log_ticks(axis, subs=(2.0, 5.0)):
+    """A log axis labelled in plain numbers (1, 2, 5, 10, ...: the decades and
+    subs times them) rather than powers of ten."""
     plain = ticker.FuncFormatter(lambda v, _pos: f"{v:g}")
     axis.set_major_formatter(plain)
-    axis.set_minor_locator(ticker.LogLocator(base=10, subs=(2.0, 5.0)))
+    axis.set_minor_locator(ticker.LogLocator(base=10, subs=subs))
     axis.set_minor_formatter(plain)
