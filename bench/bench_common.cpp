@@ -76,6 +76,13 @@ std::string machineDescription() {
     return cpuAndThreads() + ", " + u.sysname + " " + u.release + "; " + buildDescription();
 }
 
+std::string loadAverage() {
+    std::ifstream in("/proc/loadavg");
+    std::string one, five;
+    in >> one >> five;
+    return one + " (1 min), " + five + " (5 min)";
+}
+
 std::string buildDescription() {
 #ifdef TERRAIN_BUILD_DESCRIPTION
     return TERRAIN_BUILD_DESCRIPTION;

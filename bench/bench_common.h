@@ -46,6 +46,10 @@ std::string cpuAndThreads();
 /// "<cpu>, <n> hardware threads, <kernel>; <build>": the machine line of a results file.
 std::string machineDescription();
 
+/// "<1 min> (1 min), <5 min> (5 min)" from /proc/loadavg: how busy the
+/// machine was around a timing (other work shares the cores).
+std::string loadAverage();
+
 /// "<compiler> <version>, <build type> (<flags>)".
 std::string buildDescription();
 

@@ -48,6 +48,7 @@ int main(int argc, char** argv) {
     add(&addSvfSagaSuite);
     add(&addTable1Suite);
     add(&addSpeedVsErrorSuite);
+    add(&addScalingSuite);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

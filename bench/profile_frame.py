@@ -32,14 +32,14 @@ def callgrind(bench, size, runs, folder):
            str(runs)]
     print(f"profile: {' '.join(cmd)}", file=sys.stderr)
     subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    text = subprocess.run(["callgrind_annotate", "--threshold=100", out], check=True, capture_output=True,
-                          text=True).stdout
+    text = subprocess.run(["callgrind_annotate", "--threshold=100", "--auto=no", "--inclusive=no", out], check=True,
+                          capture_output=True, text=True).stdout
     costs = {}
     for line in text.splitlines():
+        # "cost (share)  file:function [binary]", self cost per function
         m = re.match(r"\s*([\d,]+)\s+\(\s*[\d.]+%\)\s+(.*)", line)
-        if not m or "=>" in line:
-            continue
-        costs[m.group(2).strip()] = costs.get(m.group(2).strip(), 0) + int(m.group(1).replace(",", ""))
+        if m:
+            costs[m.group(2).strip()] = costs.get(m.group(2).strip(), 0) + int(m.group(1).replace(",", ""))
     return costs
 
 
@@ -48,11 +48,13 @@ def function_of(entry):
     callgrind reports on its own (an inlined template), the file it is in."""
     if "memset" in entry or "memcpy" in entry or "memmove" in entry:
         return "libc memset / memcpy"
-    m = re.search(r"terrain::(?:gi::)?(?:\(anonymous namespace\)::)?([A-Za-z0-9_]+)", entry)
-    if m:
-        return m.group(1)
+    # the first engine function named that is not the parallel loop (a loop
+    # body is charged to the function it belongs to)
+    for name in re.findall(r"terrain::(?:gi::)?(?:\(anonymous namespace\)::)?([A-Za-z0-9_]+)", entry):
+        if name not in ("parallelFor", "parallelForRows", "gi", "Grid", "ConstGridView"):
+            return name
     m = re.search(r"/(?:gi|core)/([a-z_]+\.[ch](?:pp)?)", entry)
-    return f"inlined code in {m.group(1)}" if m else "other"
+    return f"inlined code in {m.group(1)}" if m else "other (TBB, libm, ...)"
 
 
 def main():

@@ -1,9 +1,9 @@
 // `terrain_bench gi`: accuracy of the GI fast path against the ground truth,
 // convergence in m / k_v / o_v, and time per frame, on the real DEMs. One
 // subcommand per mode; without one it runs accuracy, convergence and timing.
-// Writes gi_*.md and gi_*.csv (and gi_speed_error.png). Ground truths take
-// minutes: they are cached in a scratch folder for the run, or across runs in
-// the --cache folder.
+// Writes gi_*.md and gi_*.csv (and gi_speed_error.png / .svg, drawn by
+// bench/plots/gi_speed_error.py). Ground truths take minutes: they are cached
+// in a scratch folder for the run, or across runs in the --cache folder.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -20,7 +20,6 @@
 
 #include <unistd.h>
 
-#include "bench/speed_error_plot.h"
 #include "bench/suites.h"
 #include "core/error.h"
 #include "core/parallel.h"
@@ -539,7 +538,6 @@ void GiSuite::timing() const {
     md += "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     std::string csv =
         "dem,size,subsample,settings,threads,ms,pyramid_ms,visibility_ms,key_ms,shading_ms,rmse,bias,other_load\n";
-    std::vector<PlotPoint> pts;
     for (const Size& sz : sizes) {
         const int n = sz.dem.heights.nx;
         const int border = n / 10;
@@ -565,7 +563,6 @@ void GiSuite::timing() const {
                                   sz.dem.name.c_str(), n, s, which, threads, t.median, t.pyramid, t.visibility, t.key,
                                   t.shading, e.rmse, e.bias, otherLoad);
                     csv += buf;
-                    pts.push_back({n, s, threads, which, t.median, e.rmse});
                     std::fprintf(stderr, "%s %d %dx %s %dT: %.1f ms (rmse %.4f)\n", sz.dem.name.c_str(), n, s, which,
                                  threads, t.median, e.rmse);
                 }
@@ -573,26 +570,11 @@ void GiSuite::timing() const {
     md += "\n![speed vs error](gi_speed_error.png)\n";
     writeResult(ctx_.outDir, "gi_timing.md", md);
     writeResult(ctx_.outDir, "gi_timing.csv", csv);
-    speedErrorPlot(pts, ctx_.outDir + "/gi_speed_error.png");
+    drawPlot(ctx_, "gi_speed_error");
 }
 
-// plot only, from an existing gi_timing.csv
-void GiSuite::plotFromCsv() const {
-    std::ifstream in(ctx_.outDir + "/gi_timing.csv");
-    std::string line;
-    std::getline(in, line);
-    std::vector<PlotPoint> pts;
-    while (std::getline(in, line)) {
-        std::vector<std::string> f;
-        std::size_t a = 0;
-        for (std::size_t b; (b = line.find(',', a)) != std::string::npos; a = b + 1) f.push_back(line.substr(a, b - a));
-        f.push_back(line.substr(a));
-        if (f.size() < 12) continue;
-        pts.push_back({std::atoi(f[1].c_str()), std::atoi(f[2].c_str()), std::atoi(f[4].c_str()), f[3],
-                       std::atof(f[5].c_str()), std::atof(f[10].c_str())});
-    }
-    speedErrorPlot(pts, ctx_.outDir + "/gi_speed_error.png");
-}
+// plot only: redraws gi_speed_error.png / .svg from the gi_timing.csv in the results folder
+void GiSuite::plotFromCsv() const { drawPlot(ctx_, "gi_speed_error"); }
 
 // ---------------------------------------------------------------------------
 // stages: per-stage times of the target frames, 512^2 at 2x and 647^2 at 1x (a quick check while optimising)
@@ -771,7 +753,7 @@ const Mode kModes[] = {
      &GiSuite::accuracy},
     {"convergence", "Error vs m, k_v, o_v and sub-sampling on a 256^2 crop (gi_convergence.md, .csv)",
      &GiSuite::convergence},
-    {"timing", "Time per frame, 256^2..1024^2 x 1x/2x/4x x 1/2 threads (gi_timing.md, .csv, gi_speed_error.png)",
+    {"timing", "Time per frame, 256^2..1024^2 x 1x/2x/4x x 1/2 threads (gi_timing.md, .csv, gi_speed_error.png, .svg)",
      &GiSuite::timing},
     {"explore", "Many settings, to choose the defaults (gi_explore.csv)", &GiSuite::explore},
     {"stages", "Per-stage times of the target frames (stdout; a quick check while optimising)", &GiSuite::stages},
@@ -779,7 +761,8 @@ const Mode kModes[] = {
      &GiSuite::quickAccuracy},
     {"dems", "Ambient error and time on every real DEM, engine vs before vs paper (gi_ambient_dems.md, .csv)",
      &GiSuite::dems},
-    {"plot", "Only redraw gi_speed_error.png from an existing gi_timing.csv", &GiSuite::plotFromCsv},
+    {"plot", "Only redraw gi_speed_error.png and .svg from an existing gi_timing.csv (bench/plots/gi_speed_error.py)",
+     &GiSuite::plotFromCsv},
     {"cpu", "CPU time per stage, one thread, minimum over the runs (stdout)", &GiSuite::cpuStages},
     {"tiles", "computeVisibility with receiver tiles (1 %, 10 %, 50 %, all dirty) vs the whole grid (stdout)",
      &GiSuite::tileTiming},

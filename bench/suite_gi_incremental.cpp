@@ -4,20 +4,19 @@
 // recomputed, and the difference of the incremental result from the full
 // one: animated erosion and waves, the static Mont Blanc DEM, the DEM under a
 // sun moving 1 degree per frame, a crater dropped into it; a sweep of local
-// changes of growing area (gi_incremental_cost.png); and long animated runs
-// at several tolerances, from which the default tolerance is chosen.
-// Writes gi_incremental.md and .csv.
+// changes of growing area; and long animated runs at several tolerances,
+// from which the default tolerance is chosen. Writes gi_incremental.md and
+// .csv, and gi_incremental_cost.png / .svg (bench/plots/gi_incremental_cost.py:
+// the sweep's cost against its changed area).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <functional>
 #include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include "bench/incremental_plot.h"
 #include "bench/suites.h"
 #include "core/parallel.h"
 #include "gi/frame.h"
@@ -69,6 +68,7 @@ struct CaseResult {
     double visibility = 0.0, indirect = 0.0;   // mean share of receivers recomputed (frames after the first)
     Difference diff;
     StageMs stages;
+    double changedArea = -1.0;  // the sweep's share of the cells changed, (0, 1]; -1 for the other cases
 };
 
 // Frames of a crater or pit case: six events (the pit dropped or filled) after the first.
@@ -245,17 +245,15 @@ std::vector<CaseResult> runCases(const IncrementalOptions& o, const Grid& dem, f
 }
 
 // Local changes of growing area on the DEM: squares lowered by 30 m; the
-// plot's points.
-std::vector<CaseResult> runSweep(const IncrementalOptions& o, const Grid& dem, float cell,
-                                 std::vector<CostPoint>& pts) {
+// points of gi_incremental_cost.png, each with its changed area.
+std::vector<CaseResult> runSweep(const IncrementalOptions& o, const Grid& dem, float cell) {
     std::vector<CaseResult> rows;
     for (float tol : o.tolerances)
         for (int side : {5, 16, 51, 102, 229, 512}) {
             if (!o.wanted("dem, " + std::to_string(side) + "² pit")) continue;
             rows.push_back(
                 runCase("dem, " + std::to_string(side) + "² pit", 512, cell, tol, kEventFrames, demWithPit(dem, side)));
-            pts.push_back({static_cast<double>(side) * side / (512.0 * 512.0), tol,
-                           rows.back().incrementalMs / rows.back().fullMs});
+            rows.back().changedArea = static_cast<double>(side) * side / (512.0 * 512.0);
         }
     return rows;
 }
@@ -340,13 +338,20 @@ void writeReport(const std::vector<CaseResult>& rows, const std::vector<CaseResu
        << "incremental total (direct + indirect) from the full one, worst frame: RMS of the difference over RMS of "
        << "the full result, and largest |difference| over the mean, every texel and channel.\n\n"
        << kCaseHeader;
-    csv << "case,size,tolerance,full_ms,incremental_ms,v_recomputed,indirect_recomputed,rel_rms,max_rel\n";
+    csv << "case,size,tolerance,full_ms,incremental_ms,v_recomputed,indirect_recomputed,rel_rms,max_rel,"
+           "changed_area\n";
+    // The case names hold commas: quoted. changed_area is empty outside the sweep.
     const auto csvRow = [&](const CaseResult& r) {
-        char buf[320];
-        std::snprintf(buf, sizeof buf, "%s,%d,%g,%.3f,%.3f,%.4f,%.4f,%.3e,%.3e\n", r.name.c_str(), r.size,
+        char buf[360];
+        std::snprintf(buf, sizeof buf, "\"%s\",%d,%g,%.3f,%.3f,%.4f,%.4f,%.3e,%.3e,", r.name.c_str(), r.size,
                       static_cast<double>(r.tolerance), r.fullMs, r.incrementalMs, r.visibility, r.indirect, r.diff.rms,
                       r.diff.maxRel);
         csv << buf;
+        if (r.changedArea > 0.0) {
+            std::snprintf(buf, sizeof buf, "%.6g", r.changedArea);
+            csv << buf;
+        }
+        csv << '\n';
     };
     for (const CaseResult& r : rows) {
         md << caseRow(r);
@@ -403,17 +408,14 @@ Runner addGiIncrementalSuite(CLI::App& app, const BenchContext& ctx) {
         float cell = 0.0f;
         const Grid dem = alpsCentreCrop(ctx.dataDir, 512, cell);
         const std::vector<CaseResult> rows = runCases(*o, dem, cell);
-        std::vector<CostPoint> pts;
-        const std::vector<CaseResult> sweep = runSweep(*o, dem, cell, pts);
-        std::filesystem::create_directories(ctx.outDir);
-        if (o->only.empty())
-            incrementalCostPlot(pts, (std::filesystem::path(ctx.outDir) / "gi_incremental_cost.png").string());
+        const std::vector<CaseResult> sweep = runSweep(*o, dem, cell);
         std::vector<LongRun> longRuns;
         if (o->longFrames > 1)
             for (const char* scene : {"erosion", "waves"})
                 if (o->wanted(std::string(scene) + ", long run")) longRuns.push_back(runLong(scene, 256, *o));
         if (!o->only.empty()) return 0;  // a filtered run writes no report
         writeReport(rows, sweep, longRuns, *o, ctx);
+        drawPlot(ctx, "gi_incremental_cost");
         return 0;
     };
 }

@@ -195,13 +195,6 @@ struct SvfRun {
     ErrorStats error;
 };
 
-std::string loadAverage() {
-    std::ifstream in("/proc/loadavg");
-    std::string one, five;
-    in >> one >> five;
-    return one + " (1 min), " + five + " (5 min)";
-}
-
 std::vector<SvfRun> engineRuns(const SvfSagaOptions& o, const std::string& dem, const std::string& dir) {
     std::vector<SvfRun> runs;
     struct Variant {

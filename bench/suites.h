@@ -25,6 +25,7 @@ Runner addLongRunSuite(CLI::App& app, const BenchContext& ctx);
 Runner addSvfSagaSuite(CLI::App& app, const BenchContext& ctx);
 Runner addTable1Suite(CLI::App& app, const BenchContext& ctx);
 Runner addSpeedVsErrorSuite(CLI::App& app, const BenchContext& ctx);
+Runner addScalingSuite(CLI::App& app, const BenchContext& ctx);
 
 /// The --runs option every suite has: how many frames or runs a figure is taken over.
 inline CLI::Option* addRunsOption(CLI::App& sub, int& runs, const std::string& help) {

@@ -12,10 +12,10 @@ import os
 import sys
 
 import matplotlib
-import matplotlib.ticker
 
 matplotlib.use("Agg")  # files only: no display needed
 import matplotlib.pyplot as plt  # noqa: E402 (after the backend is chosen)
+import matplotlib.ticker as ticker  # noqa: E402
 
 
 def results_dir(description):
@@ -59,13 +59,6 @@ def figure_grid(rows, cols, width=7.5, height=4.8, **subplots_args):
     return fig, axes
 
 
-def plain_log_ticks(axis):
-    """Labels a log axis at 1, 2, 5 x 10^k as plain numbers (10, 20, 50), not powers."""
-    axis.set_major_locator(matplotlib.ticker.LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
-    axis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
-    axis.set_minor_formatter(matplotlib.ticker.NullFormatter())
-
-
 def save(fig, folder, stem):
     """Writes folder/stem.png and folder/stem.svg and says so on stderr."""
     for ext in ("png", "svg"):
@@ -75,3 +68,12 @@ def save(fig, folder, stem):
         fig.savefig(path, dpi=150, metadata=meta)
         print(f"wrote {path}", file=sys.stderr)
     plt.close(fig)
+
+
+def plain_log_ticks(axis, subs=(2.0, 5.0)):
+    """A log axis labelled in plain numbers (1, 2, 5, 10, ...: the decades and
+    subs times them) rather than powers of ten."""
+    plain = ticker.FuncFormatter(lambda v, _pos: f"{v:g}")
+    axis.set_major_formatter(plain)
+    axis.set_minor_locator(ticker.LogLocator(base=10, subs=subs))
+    axis.set_minor_formatter(plain)
