@@ -6,7 +6,9 @@ Runs `terrain_bench gi-indirect --probe N` (an N^2 erosion frame, 2x, one
 bounce, sun-and-sky + one key light: the Table 1 frame) under callgrind twice,
 with 2 and with 4 timed frames after the warm-up, collecting only inside
 runGiFrame; the difference of the two runs is the cost of two frames, free of
-the first frame's allocations and of everything outside the frame. Reports
+the first frame's allocations and of everything outside the frame. One
+thread: collection follows the calling thread's stack, so work handed to
+other threads would not be counted (and would be counted by chance). Reports
 instructions per frame by function (inlined kernels folded into the function
 they were inlined into where callgrind names the source line instead).
 
@@ -29,7 +31,7 @@ def callgrind(bench, size, runs, folder):
     out = os.path.join(folder, f"cg.{runs}")
     cmd = ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}",
            "--toggle-collect=terrain::gi::runGiFrame*", bench, "gi-indirect", "--probe", str(size), "--runs",
-           str(runs)]
+           str(runs), "--probe-threads", "1"]
     print(f"profile: {' '.join(cmd)}", file=sys.stderr)
     subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     text = subprocess.run(["callgrind_annotate", "--threshold=100", "--auto=no", "--inclusive=no", out], check=True,
@@ -76,7 +78,7 @@ def main():
     rows = sorted(by_function.items(), key=lambda kv: -kv[1])
     md = [f"# Instruction profile of one GI frame, {args.size}^2 2x, one bounce\n",
           f"Command: `bench/profile_frame.py BUILD --size {args.size}` (callgrind over `terrain_bench gi-indirect "
-          f"--probe {args.size}`, the Table 1 frame: erosion ground, sun-and-sky + one key light, engine "
+          f"--probe {args.size} --probe-threads 1`, the Table 1 frame: erosion ground, sun-and-sky + one key light, engine "
           "defaults; the difference of a 4-frame and a 2-frame run, so one frame after the first, inside "
           "runGiFrame only). Instructions are not time (cache misses and divisions cost more than one "
           "instruction), but they say where the work is and do not depend on the machine's load.\n",

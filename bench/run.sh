@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Refreshes bench/results/: runs every suite whose results are committed there
 # (with its default options; gi-bound-diagnosis with the --frames its committed
-# file has) and so redraws the plots. Slow: about 2 hours on the shared 2-core
+# file has) and so redraws the plots. Slow: about 2.5 hours on the shared 2-core
 # machine (bench/README.md lists each suite's time), most of it computing
 # ground truths and the long run.
 # Usage: bench/run.sh [build-dir] [suite ...]   (default: every suite below)
@@ -16,6 +16,8 @@ declare -A ARGS=(
   [sim]="sim"
   [render]="render"
   [scaling]="scaling"
+  [table1]="table1"
+  [speed-vs-error]="speed-vs-error"
   [gi]="gi accuracy convergence timing dems"
   [gi-sunsky]="gi-sunsky"
   [gi-indirect]="gi-indirect"
@@ -25,7 +27,7 @@ declare -A ARGS=(
   [long-run]="long-run"
   [svf-saga]="svf-saga --terrain $B/terrain"
 )
-ORDER=(sim render scaling gi gi-sunsky gi-indirect gi-glossy gi-incremental gi-bound-diagnosis long-run svf-saga)
+ORDER=(sim render scaling table1 speed-vs-error gi gi-sunsky gi-indirect gi-glossy gi-incremental gi-bound-diagnosis long-run svf-saga)
 [ $# -gt 0 ] && ORDER=("$@")
 
 for suite in "${ORDER[@]}"; do

@@ -32,6 +32,7 @@ struct IndirectOptions {
     int radianceK = 0;         // the engine's radiance pyramid k_u (0: the engine default)
     int radianceO = -1;        // the engine's radiance pyramid o_u (-1: the engine default)
     int probe = 0;             // only the frame time of a probe^2 erosion frame, 2x, one bounce (stderr)
+    int probeThreads = 2;      // threads of the probe (1: every instruction on the calling thread, for profiles)
 };
 
 // ---- error breakdown (--diagnose) ---------------------------------------------------
@@ -196,7 +197,7 @@ void IndirectSuite::probe() const {
     const AlbedoMap a = uniformAlbedo(o_.probe, o_.probe, albedo);
     GiState st;
     std::vector<double> t, ti, ts, parts[9];
-    withThreads(2, [&] {
+    withThreads(o_.probeThreads, [&] {
         for (int f = 0; f <= o_.runs; ++f) {
             const auto t0 = Clock::now();
             runGiFrame(d.heights.cview(), d.cell, light, settingsFor(2, 1, false), st, &a);
@@ -210,8 +211,9 @@ void IndirectSuite::probe() const {
             for (int k = 0; k < 9; ++k) parts[k].push_back(v[k]);
         }
     });
-    std::fprintf(stderr, "%d^2 2x 1 bounce: frame %.1f ms, indirect %.1f ms, scan %.1f ms (medians of %d, 2 threads)\n",
-                 o_.probe, median(t), median(ti), median(ts), o_.runs);
+    std::fprintf(stderr,
+                 "%d^2 2x 1 bounce: frame %.1f ms, indirect %.1f ms, scan %.1f ms (medians of %d, %d threads)\n",
+                 o_.probe, median(t), median(ti), median(ts), o_.runs, o_.probeThreads);
     std::fprintf(stderr,
                  "  gradient %.2f, height pyramid %.2f, env visibility %.2f, key visibility %.2f, direct shading %.2f; "
                  "indirect: radiance pyramid %.2f, scan %.2f, shading %.2f, total %.2f ms\n",
@@ -303,6 +305,9 @@ Runner addGiIndirectSuite(CLI::App& app, const BenchContext& ctx) {
     sub->add_option("--radiance-k", o->radianceK, "The engine's radiance pyramid k_u (0: the engine default)");
     sub->add_option("--radiance-o", o->radianceO, "The engine's radiance pyramid o_u (-1: the engine default)");
     sub->add_option("--probe", o->probe, "Only the frame time of an N^2 erosion frame, 2x, one bounce (on stderr)");
+    sub->add_option("--probe-threads", o->probeThreads, "Threads of --probe")
+        ->check(CLI::Range(1, 256))
+        ->capture_default_str();
     return [o, &ctx] { return IndirectSuite(*o, ctx).run(); };
 }
 
