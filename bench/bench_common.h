@@ -3,6 +3,7 @@
 // results live, a scratch folder, the machine description every results file
 // starts with, medians, the real DEMs at true scale and relative errors.
 #include <array>
+#include <cstdio>
 #include <span>
 #include <string>
 #include <vector>
@@ -36,6 +37,14 @@ private:
 
 /// Writes outDir/name atomically (creating outDir) and says so on stderr.
 void writeResult(const std::string& outDir, const std::string& name, const std::string& text);
+
+/// printf into a string of any length.
+template <class... Args>
+std::string fmt(const char* format, Args... args) {
+    std::string out(static_cast<std::size_t>(std::snprintf(nullptr, 0, format, args...)), '\0');
+    std::snprintf(out.data(), out.size() + 1, format, args...);
+    return out;
+}
 
 /// Median; the mean of the two middle values for an even count, 0 for none.
 double median(std::vector<double> v);

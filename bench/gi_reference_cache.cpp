@@ -112,6 +112,10 @@ GiReference computeReference(const Dem& d, const GiLighting& light, const Albedo
     return r;
 }
 
+std::string defaultReferenceCacheDir() {
+    return (std::filesystem::temp_directory_path() / "terrain_bench_references").string();
+}
+
 GiReference cachedReference(const std::string& cacheDir, const Dem& d, const GiLighting& light, const AlbedoMap& albedo,
                             int maxBounces, int directions) {
     const std::filesystem::path file =

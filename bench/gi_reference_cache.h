@@ -33,6 +33,10 @@ struct GiReference {
 GiReference computeReference(const Dem& d, const gi::GiLighting& light, const gi::AlbedoMap& albedo, int maxBounces,
                              int directions);
 
+/// Where the suites keep references across runs unless told otherwise: a
+/// folder in the system's temporary directory.
+std::string defaultReferenceCacheDir();
+
 /// The reference of computeReference, read from cacheDir when a file of the
 /// same inputs is there, else computed and written there (cacheDir created).
 GiReference cachedReference(const std::string& cacheDir, const Dem& d, const gi::GiLighting& light,

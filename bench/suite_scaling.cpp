@@ -180,13 +180,6 @@ std::vector<Fit> fitAll(const std::vector<Row>& rows, const ScalingOptions& o) {
     return fits;
 }
 
-// printf into a string of any length
-std::string fmt(const char* format, auto... args) {
-    std::string out(static_cast<std::size_t>(std::snprintf(nullptr, 0, format, args...)), '\0');
-    std::snprintf(out.data(), out.size() + 1, format, args...);
-    return out;
-}
-
 std::string csvText(const std::vector<Row>& rows, int subsample) {
     std::string csv =
         "sweep,size,subsample,cells,env_azimuths,indirect_azimuths,threads,ms,gradient_ms,pyramid_ms,visibility_ms,key_"

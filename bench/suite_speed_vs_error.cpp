@@ -32,7 +32,7 @@ using Clock = std::chrono::steady_clock;
 struct SpeedVsErrorOptions {
     int runs = 7;
     bool quick = false;  // 96^2 scenes, 200 erosion ticks, fewer values per sweep
-    std::string cacheDir = (std::filesystem::temp_directory_path() / "terrain_bench_references").string();
+    std::string cacheDir = defaultReferenceCacheDir();
     int directions = 2048;  // gathering directions of the references
     // the sweeps' values; with --quick, those not given on the command line are thinned
     std::vector<int> azimuths{8, 12, 16, 24, 32}, levelsPerOctave{2, 3, 4, 6}, levelOffsets{1, 2, 3, 4},

@@ -110,12 +110,6 @@ RowTimes timeRow(const Dem& d, const AlbedoMap& a, int s, int b, const Table1Opt
     return r;
 }
 
-std::string fmt(const char* f, double v) {
-    char b[64];
-    std::snprintf(b, sizeof b, f, v);
-    return b;
-}
-
 // The paper's figure in ms and our ratio to it ("-" without one).
 void paperColumns(const std::optional<PaperRow>& p, int b, const RowTimes& r, std::string& md, std::string& csv) {
     if (!p) {
@@ -374,7 +368,7 @@ std::string Table1Suite::animatedErosion() const {
 
 Runner addTable1Suite(CLI::App& app, const BenchContext& ctx) {
     auto o = std::make_shared<Table1Options>();
-    o->cache = (std::filesystem::temp_directory_path() / "terrain_bench_references").string();
+    o->cache = defaultReferenceCacheDir();
     CLI::App* sub = app.add_subcommand(
         "table1",
         "The paper's Table 1 on this machine: frame time, amortised time and memory by size, sub-sampling "

@@ -115,9 +115,11 @@ void receiverRowHorizons(const AmbientJob& j, int Y, int a, float c, float sn, f
 struct RaisedWindow {
     float* rows;
     int i0 = -1, i1 = -1;
+    float f = 0.0f;  // the covered texel row's fraction from row i0 towards row i1
 
     void cover(const AmbientJob& j, int y) {
         const ReceiverLerp ry = receiverLerp(y, j.in.subsample, j.nyr);
+        f = ry.f;
         if (ry.i0 == i0 && ry.i1 == i1) return;
         i0 = ry.i0;
         i1 = ry.i1;
@@ -149,14 +151,12 @@ void horizontalLerp(const AmbientJob& j, const float* vert, float* out) {
     }
 }
 
-// Horizon slopes of azimuth a at the texels of row y, bilinear from the
-// raised receivers (Fig. 7; `raised`: the window covering row y). vert: nxr
-// floats of scratch.
-void interpolatedHorizons(const AmbientJob& j, int y, int a, const float* raised, float* vert, float* out) {
-    const ReceiverLerp ry = receiverLerp(y, j.in.subsample, j.nyr);
-    const float* t0 = raised + 2 * static_cast<std::size_t>(a) * j.nxr;
+// Horizon slopes of azimuth a at the texels of the row the window covers,
+// bilinear from the raised receivers (Fig. 7). vert: nxr floats of scratch.
+void interpolatedHorizons(const AmbientJob& j, const RaisedWindow& window, int a, float* vert, float* out) {
+    const float* t0 = window.rows + 2 * static_cast<std::size_t>(a) * j.nxr;
     const float* t1 = t0 + j.nxr;
-    for (int X = 0; X < j.nxr; ++X) vert[X] = t0[X] + ry.f * (t1[X] - t0[X]);
+    for (int X = 0; X < j.nxr; ++X) vert[X] = t0[X] + window.f * (t1[X] - t0[X]);
     switch (j.in.subsample) {
         case 2:
             return horizontalLerp<2>(j, vert, out);
@@ -173,11 +173,11 @@ void interpolatedHorizons(const AmbientJob& j, int y, int a, const float* raised
 // One texel row: every azimuth's horizons (at sub-sampling interpolated and
 // raised to the near field) into the integrals, V the lane type.
 template <class V, bool Parts>
-[[gnu::always_inline]] inline void ambientRowWith(const AmbientJob& j, int y, float* buffers) {
+[[gnu::always_inline]] inline void ambientRowWith(const AmbientJob& j, int y, float* buffers,
+                                                  const RaisedWindow& window) {
     float* const acc[3] = {buffers, buffers + j.rowFloats, buffers + 2 * static_cast<std::size_t>(j.rowFloats)};
     float* horizon = buffers + 3 * static_cast<std::size_t>(j.rowFloats);
     float* vert = buffers + 4 * static_cast<std::size_t>(j.rowFloats);
-    const float* raised = buffers + kRowsPerSlot * static_cast<std::size_t>(j.rowFloats);
     for (int r = 0; r < (Parts ? 3 : 1); ++r) std::fill(acc[r], acc[r] + j.nx, 0.0f);
     const float* gx = j.in.gradX.row(y);
     const float* gy = j.in.gradY.row(y);
@@ -188,7 +188,7 @@ template <class V, bool Parts>
         if (j.in.subsample == 1) {
             h = j.in.env->maxSlope.data() + (static_cast<std::size_t>(a) * j.ny + y) * j.nx;
         } else {
-            interpolatedHorizons(j, y, a, raised, vert, horizon);
+            interpolatedHorizons(j, window, a, vert, horizon);
             raiseToNearField(
                 j.in.heights, y,
                 {j.nearSteps + static_cast<std::size_t>(a) * j.in.subsample, static_cast<std::size_t>(j.in.subsample)},
@@ -210,19 +210,22 @@ template <class V, bool Parts>
 // compiler's 32-byte vectors in the interpolation and the near field
 // (element-wise float arithmetic in the same order: the same bits as the
 // SSE2 build).
-[[gnu::target("avx2"), gnu::flatten]] void ambientRowAvx2(const AmbientJob& j, int y, float* buffers) {
-    ambientRowWith<simd::F8, false>(j, y, buffers);
+[[gnu::target("avx2"), gnu::flatten]] void ambientRowAvx2(const AmbientJob& j, int y, float* buffers,
+                                                          const RaisedWindow& window) {
+    ambientRowWith<simd::F8, false>(j, y, buffers, window);
 }
-[[gnu::target("avx2"), gnu::flatten]] void ambientPartsRowAvx2(const AmbientJob& j, int y, float* buffers) {
-    ambientRowWith<simd::F8, true>(j, y, buffers);
+[[gnu::target("avx2"), gnu::flatten]] void ambientPartsRowAvx2(const AmbientJob& j, int y, float* buffers,
+                                                               const RaisedWindow& window) {
+    ambientRowWith<simd::F8, true>(j, y, buffers, window);
 }
 
-void ambientRow(const AmbientJob& j, int y, float* buffers) {
+// One texel row; at sub-sampling `window` covers it (RaisedWindow::cover).
+void ambientRow(const AmbientJob& j, int y, float* buffers, const RaisedWindow& window) {
     const bool parts = j.out.below != nullptr;
     if (simd::wideEnabled())
-        (parts ? ambientPartsRowAvx2 : ambientRowAvx2)(j, y, buffers);
+        (parts ? ambientPartsRowAvx2 : ambientRowAvx2)(j, y, buffers, window);
     else
-        (parts ? ambientRowWith<simd::F4, true> : ambientRowWith<simd::F4, false>)(j, y, buffers);
+        (parts ? ambientRowWith<simd::F4, true> : ambientRowWith<simd::F4, false>)(j, y, buffers, window);
 }
 
 void checkInputs(const AmbientInputs& in, int m, const std::vector<std::uint8_t>* rows) {
@@ -274,7 +277,7 @@ void ambientFromHorizons(const AmbientInputs& in, const AmbientOutputs& out, Amb
             for (int y = yBegin; y < yEnd; ++y) {
                 if (rows && (*rows)[static_cast<std::size_t>(y)] == 0) continue;
                 if (s > 1) window.cover(job, y);
-                ambientRow(job, y, buffers);
+                ambientRow(job, y, buffers, window);
             }
         }
     });

@@ -280,10 +280,8 @@ void keyLightVisibility(const GiLighting& lighting, const GiSettings& settings, 
         target.footprint = footprint ? &st.footprint : nullptr;
         VisibilitySettings ks = settings.visibility;
         ks.azimuths = settings.keyLightAzimuths;
-        // tiles only over a last result of the same planes (the whole field after a switch)
-        const bool whole = change.keyRegion[k] || st.keyVisibility[k].planes != shRows;
         computeVisibility(st.pyramid, st.gradX.cview(), st.gradY.cview(), ks, target, st.visibilityState,
-                          st.keyVisibility[k], whole ? nullptr : only);
+                          st.keyVisibility[k], change.keyRegion[k] ? nullptr : only);
     }
 }
 
