@@ -240,8 +240,8 @@ double pyramidMB(const HeightPyramid& p) {
     return m;
 }
 double shadeMB(const ShadeMaps& s) {
-    double m = mbOf(s.ambient) + mbOf(s.skyBelow) + mbOf(s.skyRising) + mbOf(s.incident) + mbOf(s.rowScratch) +
-               mbOf(s.basisScratch);
+    double m = mbOf(s.ambient) + mbOf(s.skyBelow) + mbOf(s.skyRising) + mbOf(s.incident) + mbOf(s.incidentWindow) +
+               mbOf(s.rowScratch) + mbOf(s.basisScratch);
     for (const Grid& g : s.rgb) m += mbOf(g);
     return m;
 }

@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "gi/indirect.h"
 #include "gi/indirect_bounces.h"
 #include "gi/shading_rows.h"
 
@@ -330,6 +331,7 @@ void directShading(const GiLighting& lighting, const GiSettings& settings, const
                    const std::vector<std::uint8_t>* rows) {
     const std::size_t nKeys = lighting.keys.size();
     const bool exactKeys = settings.keyLightExactCosine;
+    st.shade.keepIncident = readsIncidentSh(settings.indirect, settings.shading);
     st.shadingLights.resize(1 + (exactKeys ? 0 : nKeys));
     // With the exact ambient a Lambert shade takes the sky's constant part
     // from it (addConstantSky) and the SH product only the rest.

@@ -10,7 +10,7 @@ namespace terrain::gi {
 void computeIndirect(const IndirectInputs& in, const IndirectSettings& settings, IndirectState& st) {
     validateIndirectSettings(settings);
     const bool lambertBrdf = in.shading.brdf == Brdf::Lambert;
-    if (settings.glossy == GlossyIndirect::VectorPyramid && !lambertBrdf && settings.bounces > 0) {
+    if (readsIncidentSh(settings, in.shading)) {
         VectorPyramidIndirect strategy(in, settings, st);
         runBounces(in, settings, strategy, st);
     } else if (lambertBrdf && settings.lambert == LambertIndirect::BlockerRadiance) {
@@ -20,6 +20,10 @@ void computeIndirect(const IndirectInputs& in, const IndirectSettings& settings,
         ShKernelIndirect strategy(in, settings, st);
         runBounces(in, settings, strategy, st);
     }
+}
+
+bool readsIncidentSh(const IndirectSettings& settings, const ShadingSettings& shading) {
+    return settings.glossy == GlossyIndirect::VectorPyramid && shading.brdf != Brdf::Lambert && settings.bounces > 0;
 }
 
 bool gathersByTiles(const IndirectSettings& settings, const ShadingSettings& shading) {

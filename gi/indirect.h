@@ -28,6 +28,10 @@ namespace terrain::gi {
 /// without a usable in.directShade.
 void computeIndirect(const IndirectInputs& in, const IndirectSettings& settings, IndirectState& state);
 
+/// The settings choose the glossy vector pyramid, which reads the direct
+/// shading's incident SH field (ShadeMaps::keepIncident must be set on it).
+bool readsIncidentSh(const IndirectSettings& settings, const ShadingSettings& shading);
+
 /// The settings choose a strategy whose one-bounce result can be re-gathered
 /// by receiver tiles over a cached one (IndirectInputs::only, with the bound
 /// of gi/indirect_cache.h): LambertIndirect::BlockerRadiance, one bounce.

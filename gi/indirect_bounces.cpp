@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <utility>
 
 namespace terrain::gi {
 
@@ -10,14 +11,23 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
-// Zeroes the sum of the bounces (full resolution) and sizes the bounce means.
+// Sizes the sum of the bounces (full resolution; zeroed when several bounces
+// add into it) and the bounce means.
 void clearIndirect(int nx, int ny, int bounces, IndirectState& st) {
     for (int c = 0; c < 3; ++c) {
         Grid& g = st.indirect[static_cast<std::size_t>(c)];
         g.ensureSize(nx, ny);
-        std::fill(g.v.begin(), g.v.end(), 0.0f);
+        if (bounces > 1) std::fill(g.v.begin(), g.v.end(), 0.0f);
     }
     st.bounceMean.resize(static_cast<std::size_t>(bounces));
+}
+
+// Mean over the texels and channels (RGB average).
+double meanOf(const std::array<Grid, 3>& rgb) {
+    double sum = 0.0;
+    for (const Grid& g : rgb)
+        for (float v : g.v) sum += v;
+    return sum / (3.0 * static_cast<double>(std::max<std::size_t>(1, rgb[0].v.size())));
 }
 
 }  // namespace
@@ -43,9 +53,17 @@ void runBounces(const IndirectInputs& in, const IndirectSettings& settings, Indi
         // ---- shading at full-resolution normals: L_b ---------------------------------
         t = Clock::now();
         ShadeMaps& out = st.bounceShade[static_cast<std::size_t>(b & 1)];
-        strategy.shade(b, out);
-        accumulateBounce(out.rgb, b, st);
-        source = {&out.rgb, &out};
+        if (settings.bounces == 1) {
+            // one bounce: the sum is L_1, shaded straight into it (no second field of it)
+            std::swap(out.rgb, st.indirect);
+            strategy.shade(b, out);
+            std::swap(out.rgb, st.indirect);
+            st.bounceMean[0] = meanOf(st.indirect);
+        } else {
+            strategy.shade(b, out);
+            accumulateBounce(out.rgb, b, st);
+            source = {&out.rgb, &out};
+        }
         st.timings.shading += msSince(t);
     }
     sumDirectAndIndirect(in.direct, st);
@@ -53,16 +71,12 @@ void runBounces(const IndirectInputs& in, const IndirectSettings& settings, Indi
 }
 
 void accumulateBounce(const std::array<Grid, 3>& exit, int b, IndirectState& st) {
-    double sum = 0.0;
     for (int c = 0; c < 3; ++c) {
         Grid& acc = st.indirect[static_cast<std::size_t>(c)];
         const Grid& add = exit[static_cast<std::size_t>(c)];
-        for (std::size_t i = 0; i < acc.v.size(); ++i) {
-            acc.v[i] += add.v[i];
-            sum += add.v[i];
-        }
+        for (std::size_t i = 0; i < acc.v.size(); ++i) acc.v[i] += add.v[i];
     }
-    st.bounceMean[static_cast<std::size_t>(b - 1)] = sum / (3.0 * std::max<std::size_t>(1, st.indirect[0].v.size()));
+    st.bounceMean[static_cast<std::size_t>(b - 1)] = meanOf(exit);
 }
 
 void sumDirectAndIndirect(const std::array<Grid, 3>& direct, IndirectState& st) {

@@ -46,7 +46,8 @@ public:
 };
 
 /// Runs settings.bounces bounces of `strategy`: fills state.indirect, total,
-/// bounceShade, bounceMean and timings.
+/// bounceShade (one bounce: its exit radiance is state.indirect itself),
+/// bounceMean and timings.
 void runBounces(const IndirectInputs& in, const IndirectSettings& settings, IndirectStrategy& strategy,
                 IndirectState& st);
 

@@ -315,6 +315,7 @@ void VectorPyramidIndirect::accumulateU(int j, float* (*uRows)[kShCount], const 
 
 // L_b; its incident SH feeds bounce b + 1
 void VectorPyramidIndirect::shade(int, ShadeMaps& out) {
+    out.keepIncident = true;
     shadeTexels(in_.gradX, in_.gradY, in_.heights.subsample, in_.envVisibility, st_.lights.data(), 3, in_.albedo,
                 in_.shading, out, false);
 }

@@ -40,7 +40,7 @@ struct IndirectState {
     std::array<VisibilityField, 3> u;      // U per channel (16 SH planes at the receivers; not with BlockerRadiance)
     int uZeroFrom = kShCount;              // U's planes from this one on are known to be 0
     std::array<ShadingLight, 3> lights;    // the shading lights of U
-    std::array<ShadeMaps, 2> bounceShade;  // exit radiance of the current / previous bounce
+    std::array<ShadeMaps, 2> bounceShade;  // exit radiance of the current / previous bounce (several bounces)
     std::array<Grid, 3> indirect;          // sum of bounces 1..B, full resolution
     std::array<Grid, 3> total;             // direct + indirect
     std::vector<double> bounceMean;        // mean exit radiance (RGB average) of each bounce

@@ -155,12 +155,21 @@ template <class V, int S>
     }
 }
 
+// Where the receivers' incident SH planes live: plane c of receiver row Y at
+// base + c planeStride + (Y - row0) nxr. The whole field (ShadeMaps::incident,
+// row0 = 0) or a worker's window of the rows one block of texel rows reads.
+struct IncidentRows {
+    float* base;
+    std::size_t planeStride;
+    int row0;
+};
+
 // One full-resolution Lambert row: the SH planes interpolated vertically at
 // the receivers (Fig. 7), then lambertRowS.
 struct LambertRowJob {
-    const float* incident;       // 3 nCoef planes at the receivers
+    IncidentRows incident;       // 3 nCoef planes at the receivers
     const VisibilityField* env;  // V_env (ambient); null: no ambient map
-    std::size_t planeR;
+    std::size_t planeR;          // of V_env
     int nxr, nyr, nxrS, s, nCoef, nx;
     const int* colIndex;
     const float* colFrac;
@@ -169,6 +178,21 @@ struct LambertRowJob {
     const AlbedoMap* albedo;
     ShadeMaps* out;
 };
+
+// Plane p's receiver rows ry.i0 and ry.i1: incident radiance for p < 3 nCoef, V_env after.
+struct PlaneRows {
+    const float *a, *b;
+};
+inline PlaneRows planeRows(const LambertRowJob& j, int p, const ReceiverLerp& ry) {
+    const int nIncident = 3 * j.nCoef;
+    if (p < nIncident) {
+        const float* plane = j.incident.base + static_cast<std::size_t>(p) * j.incident.planeStride;
+        return {plane + static_cast<std::size_t>(ry.i0 - j.incident.row0) * j.nxr,
+                plane + static_cast<std::size_t>(ry.i1 - j.incident.row0) * j.nxr};
+    }
+    const float* plane = j.env->plane(p - nIncident);
+    return {plane + static_cast<std::size_t>(ry.i0) * j.nxr, plane + static_cast<std::size_t>(ry.i1) * j.nxr};
+}
 
 template <class V>
 [[gnu::always_inline]] inline void lambertShadeRowImpl(const LambertRowJob& j, float* vert, const float* gxr,
@@ -179,10 +203,9 @@ template <class V>
     const int nv = j.nxr / L * L;
     const V fy = splat<V>(ry.f);
     for (int p = 0; p < nPlanes; ++p) {
-        const float* plane =
-            p < 3 * j.nCoef ? j.incident + static_cast<std::size_t>(p) * j.planeR : j.env->plane(p - 3 * j.nCoef);
-        const float* __restrict ra = plane + static_cast<std::size_t>(ry.i0) * j.nxr;
-        const float* __restrict rb = plane + static_cast<std::size_t>(ry.i1) * j.nxr;
+        const PlaneRows r = planeRows(j, p, ry);
+        const float* __restrict ra = r.a;
+        const float* __restrict rb = r.b;
         float* __restrict v = vert + static_cast<std::size_t>(p) * j.nxrS;
         for (int X = 0; X < nv; X += L) {
             const V a = load<V>(ra + X);
@@ -216,9 +239,10 @@ void lambertShadeRowSse(const LambertRowJob& j, float* vert, const float* gxr, c
 // coefficient sums its non-zero matrix entries in a fixed order (light, k).
 template <class V>
 [[gnu::always_inline]] inline void incidentRowImpl(const ShadingLight* lights, int nl, int nCoef, int nxr,
-                                                   std::size_t planeR, ShadeMaps& out, int Y) {
+                                                   const ShadeMaps& terms, IncidentRows to, int Y) {
     constexpr int L = LaneTraits<V>::n, NQ = 16 / L;
     const std::size_t r0 = static_cast<std::size_t>(Y) * nxr;
+    const std::size_t w0 = static_cast<std::size_t>(Y - to.row0) * nxr;
     for (int X = 0; X < nxr; X += 16) {
         const int n = std::min(16, nxr - X);
         for (int g0 = 0; g0 < nl; g0 += kMaxShadingLights) {
@@ -237,14 +261,14 @@ template <class V>
                     }
                 }
             for (int c = 0; c < 3 * nCoef; ++c) {
-                float* o = out.incident.data() + static_cast<std::size_t>(c) * planeR + r0 + X;
+                float* o = to.base + static_cast<std::size_t>(c) * to.planeStride + w0 + X;
                 V acc[NQ];
                 for (int q = 0; q < NQ; ++q) acc[q] = splat<V>(0.0f);
                 if (g0 > 0)
                     for (int e = 0; e < n; ++e) acc[e / L][e % L] = o[e];
-                for (int e = out.incidentTermStart[static_cast<std::size_t>(c)];
-                     e < out.incidentTermStart[static_cast<std::size_t>(c + 1)]; ++e) {
-                    const ShadeMaps::Term& term = out.incidentTerms[static_cast<std::size_t>(e)];
+                for (int e = terms.incidentTermStart[static_cast<std::size_t>(c)];
+                     e < terms.incidentTermStart[static_cast<std::size_t>(c + 1)]; ++e) {
+                    const ShadeMaps::Term& term = terms.incidentTerms[static_cast<std::size_t>(e)];
                     const int slot = term.index - g0 * kShCount;
                     if (slot < 0 || slot >= kMaxShadingLights * kShCount) continue;
                     const V t = splat<V>(term.value);
@@ -260,12 +284,13 @@ template <class V>
         }
     }
 }
-void incidentRowSse(const ShadingLight* lights, int nl, int nCoef, int nxr, std::size_t planeR, ShadeMaps& out, int Y) {
-    incidentRowImpl<F4>(lights, nl, nCoef, nxr, planeR, out, Y);
+void incidentRowSse(const ShadingLight* lights, int nl, int nCoef, int nxr, const ShadeMaps& terms, IncidentRows to,
+                    int Y) {
+    incidentRowImpl<F4>(lights, nl, nCoef, nxr, terms, to, Y);
 }
 [[gnu::target("avx2"), gnu::flatten]] void incidentRowAvx2(const ShadingLight* lights, int nl, int nCoef, int nxr,
-                                                           std::size_t planeR, ShadeMaps& out, int Y) {
-    incidentRowImpl<F8>(lights, nl, nCoef, nxr, planeR, out, Y);
+                                                           const ShadeMaps& terms, IncidentRows to, int Y) {
+    incidentRowImpl<F8>(lights, nl, nCoef, nxr, terms, to, Y);
 }
 
 // ---- setup ----------------------------------------------------------------------
@@ -331,13 +356,11 @@ void interpolatePlanesToRow(const LambertRowJob& j, int y, float* vert, float* u
     const int nxr = j.nxr, nxrS = j.nxrS, s = j.s, nCoef = j.nCoef, nx = j.nx;
     const int nPlanes = 3 * nCoef + (j.env ? 9 : 0);
     const ReceiverLerp ry = receiverLerp(y, s, j.nyr);
-    const int Y0 = ry.i0, Y1 = ry.i1;
     const float fy = ry.f;
     for (int p = 0; p < nPlanes; ++p) {
-        const float* plane =
-            p < 3 * nCoef ? j.incident + static_cast<std::size_t>(p) * j.planeR : j.env->plane(p - 3 * nCoef);
-        const float* __restrict ra = plane + static_cast<std::size_t>(Y0) * nxr;
-        const float* __restrict rb = plane + static_cast<std::size_t>(Y1) * nxr;
+        const PlaneRows r = planeRows(j, p, ry);
+        const float* __restrict ra = r.a;
+        const float* __restrict rb = r.b;
         float* __restrict v = vert + static_cast<std::size_t>(p) * nxrS;
         for (int X = 0; X < nxr; ++X) v[X] = ra[X] + fy * (rb[X] - ra[X]);
         for (int X = nxr; X < nxrS; ++X) v[X] = 0.0f;
@@ -436,6 +459,69 @@ AlbedoMap uniformAlbedo(int nx, int ny, float albedo) {
     return m;
 }
 
+namespace {
+
+// Texel rows [begin, end) of fixed block b of n (the shading's schedule).
+struct RowBlock {
+    int begin, end;
+};
+RowBlock rowBlock(int ny, int n, int b) {
+    return {static_cast<int>(static_cast<long long>(ny) * b / n),
+            static_cast<int>(static_cast<long long>(ny) * (b + 1) / n)};
+}
+
+// The receiver rows [first, last] texel rows [y0, y1) read (Fig. 7; receiverLerp is monotone in y).
+struct ReceiverSpan {
+    int first, last;
+};
+ReceiverSpan receiverSpanOf(int y0, int y1, int s, int nyr) {
+    return {receiverLerp(y0, s, nyr).i0, receiverLerp(y1 - 1, s, nyr).i1};
+}
+
+// The flagged rows' span inside a block (all of it without flags); empty: begin == end.
+RowBlock flaggedSpan(RowBlock b, const std::vector<std::uint8_t>* rows) {
+    if (!rows) return b;
+    while (b.begin < b.end && (*rows)[static_cast<std::size_t>(b.begin)] == 0) ++b.begin;
+    while (b.end > b.begin && (*rows)[static_cast<std::size_t>(b.end - 1)] == 0) --b.end;
+    return b;
+}
+
+// Every receiver row of the incident field some shaded texel row reads (all
+// of them without `rows`), into ShadeMaps::incident.
+void incidentField(const ShadingLight* lights, int nl, int nCoef, int s, int ny, int nxr, int nyr,
+                   const std::vector<std::uint8_t>* rows, ShadeMaps& out) {
+    const std::size_t planeR = static_cast<std::size_t>(nxr) * nyr;
+    std::vector<std::uint8_t>& receiverRows = out.receiverRows;
+    if (rows) {
+        receiverRows.assign(static_cast<std::size_t>(nyr), 0);
+        for (int y = 0; y < ny; ++y)
+            if ((*rows)[static_cast<std::size_t>(y)] != 0) {
+                const ReceiverLerp r = receiverLerp(y, s, nyr);
+                receiverRows[static_cast<std::size_t>(r.i0)] = receiverRows[static_cast<std::size_t>(r.i1)] = 1;
+            }
+    }
+    const auto row = simd::wideEnabled() ? incidentRowAvx2 : incidentRowSse;
+    const IncidentRows to{out.incident.data(), planeR, 0};
+    parallelForRows(nyr, nxr * 16, [&](int y0, int y1) {
+        for (int Y = y0; Y < y1; ++Y)
+            if (!rows || receiverRows[static_cast<std::size_t>(Y)] != 0) row(lights, nl, nCoef, nxr, out, to, Y);
+    });
+}
+
+// The most receiver rows one block's texel rows read: a worker's window.
+int windowRows(int ny, int nBlocks, int s, int nyr) {
+    int most = 0;
+    for (int b = 0; b < nBlocks; ++b) {
+        const RowBlock rb = rowBlock(ny, nBlocks, b);
+        if (rb.begin == rb.end) continue;
+        const ReceiverSpan r = receiverSpanOf(rb.begin, rb.end, s, nyr);
+        most = std::max(most, r.last - r.first + 1);
+    }
+    return most;
+}
+
+}  // namespace
+
 void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const VisibilityField& env,
                  const ShadingLight* lights, int lightCount, const AlbedoMap* albedo, const ShadingSettings& settings,
                  ShadeMaps& out, bool ambient, const std::vector<std::uint8_t>* rows) {
@@ -448,28 +534,22 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
     const int nBlocks = std::max(1, std::min(ny, 64));
     const int nxrS = nxr + 8;  // vertical scratch rows padded for 8-wide reads
     const auto slots = static_cast<std::size_t>(workerSlots());
-    sizeShadeMaps(nx, ny, planeR * 3 * nCoef, ambient, slots * nPlanes * (nxrS + nx), slots * 24 * nx, out);
+    const bool keep = out.keepIncident;
+    // restricted rows keep the others' incident rows only where the last call kept the field
+    const bool fieldKept = out.incident.size() == planeR * 3 * nCoef;
+    const std::size_t windowSize =
+        keep ? 0 : static_cast<std::size_t>(3 * nCoef) * windowRows(ny, nBlocks, s, nyr) * nxr;
+    sizeShadeMaps(nx, ny, keep ? planeR * 3 * nCoef : 0, ambient, slots * nPlanes * (nxrS + nx), slots * 24 * nx, out);
+    if (!keep) std::vector<float>().swap(out.incident);
+    out.incidentWindow.resize(slots * windowSize);
+    if (keep) std::vector<float>().swap(out.incidentWindow);
 
     if (rows && rows->size() != static_cast<std::size_t>(ny))
         throw InputError("shading: one row flag per texel row expected");
     // ---- algorithm, receivers: incident radiance I_c = sum_L T_{L,c} V_L ------
-    // (with `rows`: at the receiver rows the shaded texel rows read)
-    std::vector<std::uint8_t>& receiverRows = out.receiverRows;
-    if (rows) {
-        receiverRows.assign(static_cast<std::size_t>(nyr), 0);
-        for (int y = 0; y < ny; ++y)
-            if ((*rows)[static_cast<std::size_t>(y)] != 0) {
-                const ReceiverLerp r = receiverLerp(y, s, nyr);
-                receiverRows[static_cast<std::size_t>(r.i0)] = receiverRows[static_cast<std::size_t>(r.i1)] = 1;
-            }
-    }
+    // (the whole field when a later pass reads it, else per block of texel rows)
     buildIncidentTerms(lights, lightCount, nCoef, out);
-    const bool wide = simd::wideEnabled();
-    parallelForRows(nyr, nxr * 16, [&](int y0, int y1) {
-        for (int Y = y0; Y < y1; ++Y)
-            if (!rows || receiverRows[static_cast<std::size_t>(Y)] != 0)
-                (wide ? incidentRowAvx2 : incidentRowSse)(lights, lightCount, nCoef, nxr, planeR, out, Y);
-    });
+    if (keep) incidentField(lights, lightCount, nCoef, s, ny, nxr, nyr, fieldKept ? rows : nullptr, out);
 
     // ---- interpolation tables (receiver X sits at column s X) -----------------
     for (int x = 0; x < nx; ++x) {
@@ -478,12 +558,26 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
         out.colFrac[static_cast<std::size_t>(x)] = r.f;
     }
 
+    const bool wide = simd::wideEnabled();
     const LambertFactors lf = lambertFactors();
     const float diffuseWeight = settings.brdf == Brdf::Phong ? 0.0f : 1.0f;
-    const LambertRowJob lambertJob{
-        out.incident.data(), ambient ? &env : nullptr, planeR, nxr,           nyr,    nxrS, s, nCoef, nx,
-        out.colIndex.data(), out.colFrac.data(),       lf,     diffuseWeight, albedo, &out};
+    const LambertRowJob lambertJob{{out.incident.data(), planeR, 0},
+                                   ambient ? &env : nullptr,
+                                   planeR,
+                                   nxr,
+                                   nyr,
+                                   nxrS,
+                                   s,
+                                   nCoef,
+                                   nx,
+                                   out.colIndex.data(),
+                                   out.colFrac.data(),
+                                   lf,
+                                   diffuseWeight,
+                                   albedo,
+                                   &out};
     const auto lambertShadeRow = wide ? lambertShadeRowAvx2 : lambertShadeRowSse;
+    const auto incidentRow = wide ? incidentRowAvx2 : incidentRowSse;
     PhongRowJob phongJob{lambertJob,
                          {},
                          specularWeightOf(settings),
@@ -498,18 +592,26 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
         float* vert = out.rowScratch.data() + slot * nPlanes * (nxrS + nx);
         float* up = vert + static_cast<std::size_t>(nPlanes) * nxrS;
         float* basis = out.basisScratch.data() + slot * 24 * nx;
+        PhongRowJob job = phongJob;
         for (int block = b0; block < b1; ++block) {
-            const int yBegin = static_cast<int>(static_cast<long long>(ny) * block / nBlocks);
-            const int yEnd = static_cast<int>(static_cast<long long>(ny) * (block + 1) / nBlocks);
-            for (int y = yBegin; y < yEnd; ++y) {
+            const RowBlock shaded = flaggedSpan(rowBlock(ny, nBlocks, block), rows);
+            if (shaded.begin == shaded.end) continue;
+            if (!keep) {  // this block's receiver rows into the slot's window
+                const ReceiverSpan r = receiverSpanOf(shaded.begin, shaded.end, s, nyr);
+                job.base.incident = {out.incidentWindow.data() + slot * windowSize,
+                                     static_cast<std::size_t>(r.last - r.first + 1) * nxr, r.first};
+                for (int Y = r.first; Y <= r.last; ++Y)
+                    incidentRow(lights, lightCount, nCoef, nxr, out, job.base.incident, Y);
+            }
+            for (int y = shaded.begin; y < shaded.end; ++y) {
                 if (rows && (*rows)[static_cast<std::size_t>(y)] == 0) continue;  // keeps its last values
                 if (!phong) {
-                    lambertShadeRow(lambertJob, vert, gradX.row(y), gradY.row(y), y);
+                    lambertShadeRow(job.base, vert, gradX.row(y), gradY.row(y), y);
                     continue;
                 }
-                interpolatePlanesToRow(phongJob.base, y, vert, up);
+                interpolatePlanesToRow(job.base, y, vert, up);
                 lambertBasisRow(lf, gradX.row(y), gradY.row(y), nx, basis);
-                phongShadeRow(phongJob, gradX.row(y), gradY.row(y), basis, up, y);
+                phongShadeRow(job, gradX.row(y), gradY.row(y), basis, up, y);
             }
         }
     });

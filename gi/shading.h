@@ -147,11 +147,17 @@ struct ShadeMaps {
     // this geometry's values.
     Grid skyBelow, skyRising;
     bool skyParts = false;
+    // Set by the owner when a later pass reads the receivers' incident SH
+    // (the glossy vector bounces): shading then keeps the whole field in
+    // `incident`. Otherwise each block of texel rows computes the receiver
+    // rows it reads into its worker's window (a few rows, not the field).
+    bool keepIncident = false;
     // receiver-resolution buffers
-    std::vector<float> incident;       // 3 x coefficients planes: sum over lights of T_L V
-    std::vector<int> colIndex;         // per full-res column: left receiver
-    std::vector<float> colFrac;        // and the fraction towards the right one
-    std::vector<float> lightMatrices;  // lights x 3 x 16 x 16, float copies of the product matrices
+    std::vector<float> incident;        // with keepIncident: 3 x coefficients planes, sum over lights of T_L V
+    std::vector<float> incidentWindow;  // without: per worker slot, those planes at one block's receiver rows
+    std::vector<int> colIndex;          // per full-res column: left receiver
+    std::vector<float> colFrac;         // and the fraction towards the right one
+    std::vector<float> lightMatrices;   // lights x 3 x 16 x 16, float copies of the product matrices
     struct Term {
         float value;  // the matrix entry
         int index;    // light * 16 + k

@@ -279,7 +279,7 @@ TEST_CASE("gi.visibility: a second frame on a changed field reuses every buffer"
     const float* p1 = st.shade.ambient.data();
     const float* p2 = st.pyramid.levels.back().v.data();
     const float* p3 = st.visibilityState.blocks[0].maxRow.data();
-    const float* p4 = st.shade.incident.data();
+    const float* p4 = st.shade.incidentWindow.data();
     const float* p5 = st.keyVisibility[0].sh.data();
     const std::uint64_t before = hashState(st);
     for (float& v : g.v) v *= 1.5f;  // the terrain changed
@@ -288,7 +288,7 @@ TEST_CASE("gi.visibility: a second frame on a changed field reuses every buffer"
     CHECK(st.shade.ambient.data() == p1);
     CHECK(st.pyramid.levels.back().v.data() == p2);
     CHECK(st.visibilityState.blocks[0].maxRow.data() == p3);
-    CHECK(st.shade.incident.data() == p4);
+    CHECK(st.shade.incidentWindow.data() == p4);
     CHECK(st.keyVisibility[0].sh.data() == p5);
     CHECK(hashState(st) != before);
 }
