@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/spread.h"
 #include "core/grid.h"
 #include "gi/lights.h"
 #include "gi/settings.h"

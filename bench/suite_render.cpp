@@ -44,7 +44,8 @@ struct RenderOptions {
 // Medians over the measured frames of one scene and size.
 struct SceneTimes {
     double sim = 0, pyramids = 0, scan = 0, integrate = 0, shade = 0, upload = 0;
-    std::vector<double> draw;  // per LOD setting
+    std::vector<double> draw;      // per LOD setting
+    std::vector<double> totalIqr;  // per LOD setting: interquartile range of the frames' whole time
     std::vector<DrawStats> stats;
     // per LOD setting, against the full grid's image (-1: no full grid drawn):
     std::vector<double> meanDifference;  // mean over pixels of the largest |difference| over R, G, B (levels)
@@ -63,7 +64,7 @@ SceneTimes measureScene(Renderer& renderer, const char* scene, int size, const R
     const auto fullGrid = std::find(o.lod.begin(), o.lod.end(), 0.0f);
     const std::size_t reference = static_cast<std::size_t>(fullGrid - o.lod.begin());  // == modes: none
     std::vector<std::vector<std::uint8_t>> images(modes);
-    std::vector<std::vector<double>> stage(6), draw(modes), meanDifference(modes), above8(modes);
+    std::vector<std::vector<double>> stage(6), draw(modes), total(modes), meanDifference(modes), above8(modes);
     SceneTimes st;
     st.stats.resize(modes);
     for (int f = 0; f <= o.runs; ++f) {
@@ -89,11 +90,14 @@ SceneTimes measureScene(Renderer& renderer, const char* scene, int size, const R
         const StageTimings& s = pipeline.timings();
         const double v[6] = {s.sim, s.pyramids, s.scan, s.integrate, s.shade, upload};
         for (std::size_t i = 0; i < 6; ++i) stage[i].push_back(v[i]);
+        const double shared = v[0] + v[1] + v[2] + v[3] + v[4] + v[5];
+        for (std::size_t m = 0; m < modes; ++m) total[m].push_back(shared + draw[m].back());
     }
     double* fields[6] = {&st.sim, &st.pyramids, &st.scan, &st.integrate, &st.shade, &st.upload};
     for (std::size_t i = 0; i < 6; ++i) *fields[i] = median(stage[i]);
     for (std::size_t m = 0; m < modes; ++m) {
         st.draw.push_back(median(draw[m]));
+        st.totalIqr.push_back(spreadOf(total[m]).iqr());
         st.meanDifference.push_back(reference < modes ? median(meanDifference[m]) : -1.0);
         st.above8.push_back(reference < modes ? median(above8[m]) : -1.0);
     }
@@ -118,12 +122,13 @@ int runRender(const RenderOptions& o, const BenchContext& ctx) {
     std::ostringstream csv, md;
     csv << "scene,size,lod_px,subsample,width,height,threads,ticks_per_frame,runs,sim_ms,pyramids_ms,scan_ms,"
            "integrate_ms,shade_ms,upload_ms,draw_ms,render_ms,total_ms,triangles,terrain_triangles,terrain_chunks,"
-           "mean_abs_difference,fraction_above_8\n";
+           "mean_abs_difference,fraction_above_8,total_iqr_ms\n";
     md << "# Renderer benchmark: per-stage time per frame, terrain level of detail off and on\n\n"
        << "Animated scenes, GI sub-sampling 2x, global lighting with one indirect bounce (sky + key light with soft "
           "visibility, no amortisation), headless OSMesa at "
        << width << " x " << height << ", median of " << o.runs
-       << " frames after one warm-up frame. Each frame is simulated, lit and uploaded once and drawn once per LOD "
+       << " frames after one warm-up frame (IQR: the interquartile range of the frames' whole time). Each frame is "
+          "simulated, lit and uploaded once and drawn once per LOD "
           "setting: \"off\" is the full grid (`RenderSettings::lodPixelError` 0, one vertex per grid point), \"1 "
           "px\" the default (render/terrain_lod.h). The simulation, GI and upload columns are the same frames for "
           "every setting. \"Δ mean\" and \"Δ > 8\" compare each setting's image with the full grid's of the same "
@@ -134,8 +139,8 @@ int runRender(const RenderOptions& o, const BenchContext& ctx) {
        << " hardware threads; llvmpipe rasterises on its own threads, as many, on the same cores.\n\n"
        << "Command: `" << ctx.command << "`.\n\n"
        << "| scene | size | LOD | ticks/frame | sim | pyramids | scan | shade | upload | draw | render | total ms | "
-          "fps | terrain triangles | chunks | all triangles | Δ mean | Δ > 8 |\n"
-       << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+          "IQR | fps | terrain triangles | chunks | all triangles | Δ mean | Δ > 8 |\n"
+       << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const char* scene : {"erosion", "waves"})
         for (int size : o.sizes) {
             const SceneTimes st = measureScene(renderer, scene, size, o, width, height);
@@ -147,13 +152,13 @@ int runRender(const RenderOptions& o, const BenchContext& ctx) {
                     << ',' << st.ticksPerFrame << ',' << o.runs << ',' << st.sim << ',' << st.pyramids << ',' << st.scan
                     << ',' << st.integrate << ',' << st.shade << ',' << st.upload << ',' << st.draw[m] << ',' << render
                     << ',' << total << ',' << ds.triangles << ',' << ds.terrainTriangles << ',' << ds.terrainChunks
-                    << ',' << st.meanDifference[m] << ',' << st.above8[m] << '\n';
+                    << ',' << st.meanDifference[m] << ',' << st.above8[m] << ',' << st.totalIqr[m] << '\n';
                 char line[512];
                 std::snprintf(line, sizeof line,
-                              "| %s | %d² | %s | %d | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.2f | "
-                              "%lld | %d | %lld | %.2f | %.2f %% |\n",
+                              "| %s | %d² | %s | %d | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | "
+                              "%.2f | %lld | %d | %lld | %.2f | %.2f %% |\n",
                               scene, size, lodName(o.lod[m]).c_str(), st.ticksPerFrame, st.sim, st.pyramids, st.scan,
-                              st.shade, st.upload, st.draw[m], render, total, 1000.0 / total,
+                              st.shade, st.upload, st.draw[m], render, total, st.totalIqr[m], 1000.0 / total,
                               static_cast<long long>(ds.terrainTriangles), ds.terrainChunks,
                               static_cast<long long>(ds.triangles), st.meanDifference[m], 100.0 * st.above8[m]);
                 md << line;

@@ -2,7 +2,7 @@
 // number of cells and with the number of azimuths, at 1 and 2 threads.
 // Frames: the initial ground of builtinScene("erosion", N, 1), the engine's
 // default GI settings with one bounce and 2x sub-sampling, sun-and-sky plus
-// one key light, uniform albedo (the frames of gi-indirect's Table 1), whole
+// one key light, uniform albedo (the frames of the table1 suite), whole
 // frames (no incremental caching). The exponents of time against cells and
 // against azimuths are fitted by least squares on log-log axes. Writes
 // scaling.md, scaling.csv, scaling_fit.csv and scaling.png / .svg
@@ -55,6 +55,7 @@ const char* sweepName(Sweep s) {
 // the measured frames (below the thread count: other work took the cores).
 struct FrameMs {
     double total = 0.0, gradient = 0.0, pyramid = 0.0, visibility = 0.0, key = 0.0, shading = 0.0, indirect = 0.0;
+    double totalQ1 = 0.0, totalQ3 = 0.0;  // quartiles of the whole frame's time
     double cores = 0.0;
 };
 
@@ -103,6 +104,9 @@ FrameMs timeFrames(const Dem& d, const gi::GiSettings& s, int threads, int runs)
         wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     });
     FrameMs ms{median(t[0]), median(t[1]), median(t[2]), median(t[3]), median(t[4]), median(t[5]), median(t[6])};
+    const Spread total = spreadOf(t[0]);
+    ms.totalQ1 = total.q1;
+    ms.totalQ3 = total.q3;
     ms.cores = cpu / wall;
     return ms;
 }
@@ -184,11 +188,12 @@ std::string csvText(const std::vector<Row>& rows, int subsample) {
     std::string csv =
         "sweep,size,subsample,cells,env_azimuths,indirect_azimuths,threads,ms,gradient_ms,pyramid_ms,visibility_ms,key_"
         "ms,"
-        "shading_ms,indirect_ms,cores\n";
+        "shading_ms,indirect_ms,cores,ms_q1,ms_q3\n";
     for (const Row& r : rows)
-        csv += fmt("%s,%d,%d,%.0f,%d,%d,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.2f\n", sweepName(r.sweep), r.size,
-                   subsample, r.cells(), r.envAzimuths, r.indirectAzimuths, r.threads, r.ms.total, r.ms.gradient,
-                   r.ms.pyramid, r.ms.visibility, r.ms.key, r.ms.shading, r.ms.indirect, r.ms.cores);
+        csv += fmt("%s,%d,%d,%.0f,%d,%d,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.2f,%.3f,%.3f\n", sweepName(r.sweep),
+                   r.size, subsample, r.cells(), r.envAzimuths, r.indirectAzimuths, r.threads, r.ms.total,
+                   r.ms.gradient, r.ms.pyramid, r.ms.visibility, r.ms.key, r.ms.shading, r.ms.indirect, r.ms.cores,
+                   r.ms.totalQ1, r.ms.totalQ3);
     return csv;
 }
 
@@ -204,17 +209,17 @@ std::string rowsTable(const std::vector<Row>& rows, Sweep sweep) {
     std::string md =
         sweep == Sweep::Cells ? "| size | cells | threads |" : "| size | m | indirect azimuths | threads |";
     md +=
-        " ms / frame | gradient | pyramid | visibility | key | shading | indirect | ns / cell | cores |\n"
-        "|---|---|---|---|---|---|---|---|---|---|---|---|";
+        " ms / frame | IQR | gradient | pyramid | visibility | key | shading | indirect | ns / cell | cores |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|";
     md += sweep == Sweep::Cells ? "\n" : "---|\n";
     for (const Row& r : rows) {
         if (r.sweep != sweep) continue;
         md += sweep == Sweep::Cells
                   ? fmt("| %d² | %.0f | %d |", r.size, r.cells(), r.threads)
                   : fmt("| %d² | %d | %d | %d |", r.size, r.envAzimuths, r.indirectAzimuths, r.threads);
-        md += fmt(" %.1f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.1f | %.2f |\n", r.ms.total, r.ms.gradient,
-                  r.ms.pyramid, r.ms.visibility, r.ms.key, r.ms.shading, r.ms.indirect, 1e6 * r.ms.total / r.cells(),
-                  r.ms.cores);
+        md += fmt(" %.1f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.1f | %.2f |\n", r.ms.total,
+                  r.ms.totalQ3 - r.ms.totalQ1, r.ms.gradient, r.ms.pyramid, r.ms.visibility, r.ms.key, r.ms.shading,
+                  r.ms.indirect, 1e6 * r.ms.total / r.cells(), r.ms.cores);
     }
     return md;
 }
@@ -251,7 +256,8 @@ std::string markdown(const std::vector<Row>& rows, const std::vector<Fit>& fits,
             "(gi/settings.h: m %d, k_v %d, o_v %d, %d indirect azimuths, blocker radiance) with one bounce and %dx "
             "sub-sampling, whole frames (incremental caching off); sun-and-sky environment plus one key light "
             "(azimuth 135, elevation 35, radius 5 degrees; 3 azimuths over its extent); uniform albedo 0.6 (the frames "
-            "of gi-indirect's Table 1). Median of %d frames after one warm-up frame; the stage columns are medians "
+            "of the table1 suite). Median of %d frames after one warm-up frame (IQR: the interquartile range of those "
+            "frames); the stage columns are medians "
             "of GiState::timings (ms; gradient and pyramid of the heights, environment visibility, key-light "
             "visibility, direct shading, indirect light with its radiance pyramid, scan and shading). cores: the "
             "process's CPU time over the wall time of the measured frames; below the thread count, other work had the "

@@ -27,11 +27,12 @@ struct Row {
     std::string scene;
     int size, threads;
     double kernelMs, tickMs;
+    double tickIqrMs = 0.0;  // the spread of tickMs over the runs
 };
 
 Row measure(const char* scene, int size, int threads, const SimOptions& o) {
     const int runs = o.runs, ticks = o.ticks;
-    Row r{scene, size, threads, 0, 0};
+    Row r{scene, size, threads, 0, 0, 0};
     withThreads(threads, [&] {
         SceneSettings s = builtinScene(scene, size, 1);
         Simulation sim(s);
@@ -55,7 +56,9 @@ Row measure(const char* scene, int size, int threads, const SimOptions& o) {
             tick.push_back((now() - t0) / ticks);
         }
         r.kernelMs = 1e3 * median(kernel);
-        r.tickMs = 1e3 * median(tick);
+        const Spread t = spreadOf(tick);
+        r.tickMs = 1e3 * t.median;
+        r.tickIqrMs = 1e3 * t.iqr();
     });
     return r;
 }
@@ -64,24 +67,24 @@ void writeReport(const std::vector<Row>& rows, const SimOptions& o, const BenchC
     const int runs = o.runs, ticks = o.ticks;
     std::ostringstream md, csv;
     md << "# Simulation benchmark\n\n"
-       << "Machine: " << machineDescription() << ". Release build (-O3, baseline x86-64, no fast-math).\n\n"
-       << "Command: `build/terrain_bench sim --runs " << runs << " --ticks " << ticks
-       << "`. Each figure is the median of " << runs << " runs of " << ticks
-       << " ticks, after 10 warm-up ticks. *kernels*: the scene's simulation steps "
+       << "Machine: " << machineDescription() << ".\n\n"
+       << "Command: `" << ctx.command << "`. Each figure is the median of " << runs << " runs of " << ticks
+       << " ticks, after 10 warm-up ticks; IQR: the interquartile range of the runs' tick time. *kernels*: the scene's "
+          "simulation steps "
        << "alone (erosion: hydraulic + thermal; waves: shallow water); *tick*: `Simulation::tick` "
        << "(kernels + stability check + change tracking).\n\n"
-       << "| scene | size | threads | kernels ms/tick | tick ms/tick | ticks/s | Mcell-updates/s |\n"
-       << "|---|---|---|---|---|---|---|\n";
-    csv << "scene,size,threads,kernel_ms,tick_ms,ticks_per_s,mcell_updates_per_s\n";
+       << "| scene | size | threads | kernels ms/tick | tick ms/tick | IQR | ticks/s | Mcell-updates/s |\n"
+       << "|---|---|---|---|---|---|---|---|\n";
+    csv << "scene,size,threads,kernel_ms,tick_ms,ticks_per_s,mcell_updates_per_s,tick_iqr_ms\n";
     char buf[256];
     for (const Row& r : rows) {
         const double tps = 1e3 / r.tickMs;
         const double mcells = tps * r.size * r.size * 1e-6;
-        std::snprintf(buf, sizeof buf, "| %s | %d² | %d | %.2f | %.2f | %.1f | %.1f |\n", r.scene.c_str(), r.size,
-                      r.threads, r.kernelMs, r.tickMs, tps, mcells);
+        std::snprintf(buf, sizeof buf, "| %s | %d² | %d | %.2f | %.2f | %.2f | %.1f | %.1f |\n", r.scene.c_str(),
+                      r.size, r.threads, r.kernelMs, r.tickMs, r.tickIqrMs, tps, mcells);
         md << buf;
-        std::snprintf(buf, sizeof buf, "%s,%d,%d,%.3f,%.3f,%.2f,%.2f\n", r.scene.c_str(), r.size, r.threads, r.kernelMs,
-                      r.tickMs, tps, mcells);
+        std::snprintf(buf, sizeof buf, "%s,%d,%d,%.3f,%.3f,%.2f,%.2f,%.3f\n", r.scene.c_str(), r.size, r.threads,
+                      r.kernelMs, r.tickMs, tps, mcells, r.tickIqrMs);
         csv << buf;
     }
     auto find = [&](const char* scene) {

@@ -66,6 +66,7 @@ std::vector<Sweep> sweepsOf(const SpeedVsErrorOptions& o) {
 // What a set of settings costs and how far off it is.
 struct Measurement {
     double ms = 0.0;        // median whole-frame time, 2 threads
+    double msIqr = 0.0;     // its spread: the interquartile range of the frames
     double ambient = 0.0;   // RMSE of the ambient map (a sky-view factor in [0, 1])
     double direct = 0.0;    // relative RMSE of the direct shade
     double indirect = 0.0;  // relative RMSE of the indirect light
@@ -189,7 +190,9 @@ std::vector<Measurement> SpeedVsErrorSuite::measureAll(const Scene& sc, const st
     std::vector<Measurement> out;
     for (std::size_t i = 0; i < settings.size(); ++i) {
         out.push_back(errorsOf(states[i], sc.ref, settings[i].indirect.bounces));
-        out.back().ms = median(ms[i]);
+        const Spread t = spreadOf(ms[i]);
+        out.back().ms = t.median;
+        out.back().msIqr = t.iqr();
     }
     return out;
 }
@@ -234,7 +237,8 @@ std::string SpeedVsErrorSuite::header(const std::vector<Scene>& scenes) const {
           "sub-sampling and bounces: " +
           settingsText(paperPoint()) + ".\n\n";
     md += "Time: median of " + std::to_string(o_.runs) +
-          " whole frames (incremental frames off) after a warm-up, 2 threads; the settings of a scene take turns, "
+          " whole frames (incremental frames off) after a warm-up, 2 threads, with the interquartile range of those "
+          "frames (IQR); the settings of a scene take turns, "
           "one frame each per round, so that the machine's load falls on all of them alike. Lighting: sun-and-sky "
           "environment "
           "(SH) + one key light (az 135, el 35, r 5 deg), albedo 0.6 everywhere, Lambert. Errors against the exact "
@@ -255,15 +259,15 @@ std::string SpeedVsErrorSuite::header(const std::vector<Scene>& scenes) const {
 
 std::string SpeedVsErrorSuite::sceneTable(const Scene& sc, const std::vector<Point>& points) {
     std::string md = "## " + sc.dem.name +
-                     "\n\n| sweep | value | ms / frame | ambient RMSE | direct rel. RMSE | "
-                     "indirect rel. RMSE | total rel. RMSE | |\n|---|---|---|---|---|---|---|---|\n";
+                     "\n\n| sweep | value | ms / frame | IQR | ambient RMSE | direct rel. RMSE | "
+                     "indirect rel. RMSE | total rel. RMSE | |\n|---|---|---|---|---|---|---|---|---|\n";
     char line[256];
     for (const Point& p : points) {
         const std::string mark = std::string(p.isDefault ? "default" : "") + (p.isDefault && p.onFront ? ", " : "") +
                                  (p.onFront ? "Pareto" : "");
-        std::snprintf(line, sizeof line, "| %s | %s | %.1f | %.4f | %.2f %% | %.2f %% | %.2f %% | %s |\n",
-                      p.sweep.c_str(), p.value.c_str(), p.m.ms, p.m.ambient, 100 * p.m.direct, 100 * p.m.indirect,
-                      100 * p.m.total, mark.c_str());
+        std::snprintf(line, sizeof line, "| %s | %s | %.1f | %.1f | %.4f | %.2f %% | %.2f %% | %.2f %% | %s |\n",
+                      p.sweep.c_str(), p.value.c_str(), p.m.ms, p.m.msIqr, p.m.ambient, 100 * p.m.direct,
+                      100 * p.m.indirect, 100 * p.m.total, mark.c_str());
         md += line;
     }
     // the front from fast to accurate, each settings once (the defaults recur in every sweep)
@@ -298,16 +302,16 @@ int SpeedVsErrorSuite::run() {
     std::string md = header(scenes);
     std::string csv =
         "scene,sweep,value,is_default,pareto,ms,ambient_rmse,direct_rel_rmse,indirect_rel_rmse,"
-        "total_rel_rmse\n";
+        "total_rel_rmse,ms_iqr\n";
     for (const Scene& sc : scenes) {
         std::fprintf(stderr, "timing %s, %d rounds ...\n", sc.dem.name.c_str(), o_.runs);
         const std::vector<Point> points = pointsOf(sc);
         md += sceneTable(sc, points);
         for (const Point& p : points) {
             char line[256];
-            std::snprintf(line, sizeof line, "%s,%s,%s,%d,%d,%.3f,%.5f,%.5f,%.5f,%.5f\n", sc.dem.name.c_str(),
+            std::snprintf(line, sizeof line, "%s,%s,%s,%d,%d,%.3f,%.5f,%.5f,%.5f,%.5f,%.3f\n", sc.dem.name.c_str(),
                           p.sweep.c_str(), p.value.c_str(), p.isDefault, p.onFront, p.m.ms, p.m.ambient, p.m.direct,
-                          p.m.indirect, p.m.total);
+                          p.m.indirect, p.m.total, p.m.msIqr);
             csv += line;
         }
     }

@@ -63,12 +63,14 @@ double heapMB() {
 }
 
 struct RowTimes {
-    double ms = 1e30, msAmortised = 1e30, msIndirect = 0.0, memoryMB = 0.0;
+    Spread ms{1e30}, msAmortised{1e30};
+    double msIndirect = 0.0, memoryMB = 0.0;
 };
 
-// Frames of one configuration on one GiState: median (plain) or mean over an
-// even number of frames (amortised: as many cheap as expensive ones).
-double timeFrames(const Dem& d, const AlbedoMap& a, const GiSettings& g, int runs, GiState& st, double* indirectMs) {
+// Frames of one configuration on one GiState after one warm-up: plain, each
+// frame's time; amortised (cheap and expensive frames alternate), the mean of
+// each pair of frames. Their median and quartiles.
+Spread timeFrames(const Dem& d, const AlbedoMap& a, const GiSettings& g, int runs, GiState& st, double* indirectMs) {
     const GiLighting light = sunSkyAndBenchKey();
     std::vector<double> t, ti;
     const int frames = g.indirect.amortise ? (runs + 1) / 2 * 2 : runs;
@@ -81,10 +83,10 @@ double timeFrames(const Dem& d, const AlbedoMap& a, const GiSettings& g, int run
         ti.push_back(st.timings.indirect);
     }
     if (indirectMs) *indirectMs = median(ti);
-    if (!g.indirect.amortise) return median(t);
-    double sum = 0.0;
-    for (double v : t) sum += v;
-    return sum / static_cast<double>(t.size());
+    if (!g.indirect.amortise) return spreadOf(t);
+    std::vector<double> pairs;
+    for (std::size_t i = 0; i + 1 < t.size(); i += 2) pairs.push_back(0.5 * (t[i] + t[i + 1]));
+    return spreadOf(pairs);
 }
 
 RowTimes timeRow(const Dem& d, const AlbedoMap& a, int s, int b, const Table1Options& o) {
@@ -95,8 +97,8 @@ RowTimes timeRow(const Dem& d, const AlbedoMap& a, int s, int b, const Table1Opt
             const double before = heapMB();
             auto st = std::make_unique<GiState>();
             double indirect = 0.0;
-            const double ms = timeFrames(d, a, g, o.runs, *st, &indirect);
-            if (ms < r.ms) {
+            const Spread ms = timeFrames(d, a, g, o.runs, *st, &indirect);
+            if (ms.median < r.ms.median) {
                 r.ms = ms;
                 r.msIndirect = indirect;
             }
@@ -104,7 +106,8 @@ RowTimes timeRow(const Dem& d, const AlbedoMap& a, int s, int b, const Table1Opt
             st.reset();
             g.indirect.amortise = true;
             GiState sa;
-            r.msAmortised = std::min(r.msAmortised, timeFrames(d, a, g, o.runs, sa, nullptr));
+            const Spread amortised = timeFrames(d, a, g, o.runs, sa, nullptr);
+            if (amortised.median < r.msAmortised.median) r.msAmortised = amortised;
         }
     });
     return r;
@@ -118,8 +121,9 @@ void paperColumns(const std::optional<PaperRow>& p, int b, const RowTimes& r, st
         return;
     }
     const double ms = 1000.0 / p->fps[b - 1], msA = 1000.0 / p->fpsAmortised[b - 1];
-    md += fmt(" %.1f |", ms) + fmt(" %.2f |", r.ms / ms) + fmt(" %.1f |", msA) + fmt(" %.2f |", r.msAmortised / msA);
-    csv += fmt(",%.2f", ms) + fmt(",%.3f", r.ms / ms) + fmt(",%.2f", msA) + fmt(",%.3f", r.msAmortised / msA);
+    const double ours = r.ms.median, oursA = r.msAmortised.median;
+    md += fmt(" %.1f |", ms) + fmt(" %.2f |", ours / ms) + fmt(" %.1f |", msA) + fmt(" %.2f |", oursA / msA);
+    csv += fmt(",%.2f", ms) + fmt(",%.3f", ours / ms) + fmt(",%.2f", msA) + fmt(",%.3f", oursA / msA);
 }
 
 class Table1Suite {
@@ -130,11 +134,11 @@ public:
         std::string md = header(), csv =
                                        "size,subsample,bounces,ms,ms_amortised,indirect_ms,memory_mb,paper_memory_mb,"
                                        "indirect_rel_rmse,total_rel_rmse,paper_ms,ratio,paper_ms_amortised,ratio_"
-                                       "amortised\n";
+                                       "amortised,ms_q1,ms_q3,ms_amortised_q1,ms_amortised_q3\n";
         md +=
-            "| size | sub | bounces | ms / frame | ms amortised | indirect ms | memory MB | paper MB | indirect "
-            "error | total error | paper ms | ratio | paper ms amortised | ratio amortised |\n"
-            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+            "| size | sub | bounces | ms / frame | IQR | ms amortised | IQR | indirect ms | memory MB | paper MB | "
+            "indirect error | total error | paper ms | ratio | paper ms amortised | ratio amortised |\n"
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
         for (int n : o_.sizes) sizeRows(n, md, csv);
         md += memoryBreakdown();
         md += animatedErosion();
@@ -155,8 +159,10 @@ private:
                "), sun-and-sky environment + one key light, albedo 0.6, Lambert; whole frames (no incremental "
                "caching). ms / frame: median of " +
                std::to_string(o_.runs) + " frames after one warm-up, the lowest of " + std::to_string(o_.repeats) +
-               " such medians (the machine is a shared virtual machine). Amortised: static geometry, frames alternate "
-               "direct and indirect updates (Section 7); the mean over an even number of frames. Memory: what the "
+               " such medians (the machine is a shared virtual machine); IQR: the interquartile range of the frames "
+               "of that median (CSV: ms_q1, ms_q3). Amortised: static geometry, frames alternate direct and indirect "
+               "updates (Section 7); the median of the means of consecutive pairs (one frame of each kind), with "
+               "their IQR. Memory (our MB: 2^20 bytes): what the "
                "allocator holds for the GI state after the frames (every buffer the frame keeps, measured by "
                "mallinfo2, not estimated). Errors: indirect and total relative RMSE (interior) against the exact "
                "reference of an eroded frame of the same size (after 2000 ticks), where one is computed "
@@ -205,15 +211,18 @@ private:
                 }
                 const std::string paperMem = p ? fmt("%.1f", p->memoryMB) : "-";
                 md += "| " + std::to_string(n) + "^2 | " + std::to_string(s) + "x | " + std::to_string(b) + " |" +
-                      fmt(" %.1f |", r.ms) + fmt(" %.1f |", r.msAmortised) + fmt(" %.1f |", r.msIndirect) +
-                      fmt(" %.1f |", r.memoryMB) + " " + paperMem + " | " + errI + " | " + errT + " |";
-                csv += std::to_string(n) + "," + std::to_string(s) + "," + std::to_string(b) + fmt(",%.2f", r.ms) +
-                       fmt(",%.2f", r.msAmortised) + fmt(",%.2f", r.msIndirect) + fmt(",%.1f", r.memoryMB) + "," +
-                       (p ? paperMem : "") + "," + (ref ? errI : "") + "," + (ref ? errT : "");
+                      fmt(" %.1f |", r.ms.median) + fmt(" %.1f |", r.ms.iqr()) + fmt(" %.1f |", r.msAmortised.median) +
+                      fmt(" %.1f |", r.msAmortised.iqr()) + fmt(" %.1f |", r.msIndirect) + fmt(" %.1f |", r.memoryMB) +
+                      " " + paperMem + " | " + errI + " | " + errT + " |";
+                csv += std::to_string(n) + "," + std::to_string(s) + "," + std::to_string(b) +
+                       fmt(",%.2f", r.ms.median) + fmt(",%.2f", r.msAmortised.median) + fmt(",%.2f", r.msIndirect) +
+                       fmt(",%.1f", r.memoryMB) + "," + (p ? paperMem : "") + "," + (ref ? errI : "") + "," +
+                       (ref ? errT : "");
                 paperColumns(p, b, r, md, csv);
                 md += "\n";
-                csv += "\n";
-                std::fprintf(stderr, "  %.1f ms, amortised %.1f ms, %.1f MB\n", r.ms, r.msAmortised, r.memoryMB);
+                csv += fmt(",%.2f,%.2f,%.2f,%.2f\n", r.ms.q1, r.ms.q3, r.msAmortised.q1, r.msAmortised.q3);
+                std::fprintf(stderr, "  %.1f ms (IQR %.1f), amortised %.1f ms, %.1f MB\n", r.ms.median, r.ms.iqr(),
+                             r.msAmortised.median, r.memoryMB);
             }
     }
 
@@ -330,8 +339,9 @@ std::string Table1Suite::animatedErosion() const {
         "engine's frame pipeline (engine/pipeline.h) at the scene's pacing: the ticks of a frame, then the GI "
         "(global lighting, 2x, one bounce) and the per-texel frame data, no rendering; 2 threads; " +
         std::to_string(o_.animatedFrames) +
-        " frames after the spin-up and one frame; median.\n\n| GI frames | ticks / frame | sim ms | GI + frame data ms "
-        "| ms / frame | frames / s |\n|---|---|---|---|---|---|\n";
+        " frames after the spin-up and one frame; medians, and the interquartile range of the whole frame.\n\n| GI "
+        "frames | ticks / frame | sim ms | GI + frame data ms | ms / frame | IQR | frames / s |\n"
+        "|---|---|---|---|---|---|---|\n";
     for (bool incremental : {false, true}) {
         engine::PipelineSettings ps;
         ps.lighting = engine::LightingMode::Global;
@@ -354,12 +364,13 @@ std::string Table1Suite::animatedErosion() const {
                 total.push_back(std::chrono::duration<double, std::milli>(t2 - t0).count());
             }
         });
-        const double ms = median(total), msSim = median(sim);
+        const Spread whole = spreadOf(total);
+        const double ms = whole.median, msSim = median(sim);
         std::fprintf(stderr, "table1: animated erosion 512^2, %s GI: %.1f ms / frame\n",
                      incremental ? "incremental" : "full", ms);
         md += std::string("| ") + (incremental ? "incremental (engine default, tolerance 0.02)" : "full recompute") +
               " | " + std::to_string(ticks) + " |" + fmt(" %.1f |", msSim) + fmt(" %.1f |", ms - msSim) +
-              fmt(" %.1f |", ms) + fmt(" %.1f |", 1000.0 / ms) + "\n";
+              fmt(" %.1f |", ms) + fmt(" %.1f |", whole.iqr()) + fmt(" %.1f |", 1000.0 / ms) + "\n";
     }
     return md;
 }

@@ -35,7 +35,11 @@ def cells_panel(ax, rows, fits):
         line = sorted((r for r in rows if int(r["threads"]) == t), key=lambda r: float(r["cells"]))
         xs = [float(r["cells"]) for r in line]
         ys = [float(r["ms"]) for r in line]
-        ax.plot(xs, ys, marker="o", lw=0, ms=7, color=colour(t), label=f"{t} thread{'s' if t > 1 else ''}")
+        bars = None
+        if line and "ms_q1" in line[0]:  # the quartiles of the frames around each median
+            bars = [[y - float(r["ms_q1"]) for r, y in zip(line, ys)], [float(r["ms_q3"]) - y for r, y in zip(line, ys)]]
+        ax.errorbar(xs, ys, yerr=bars, marker="o", lw=0, elinewidth=1.2, capsize=3, ms=7, color=colour(t),
+                    label=f"{t} thread{'s' if t > 1 else ''}")
         for r, x, y in zip(line, xs, ys) if t == threads[0] else []:  # the sizes, once
             ax.annotate(f"{r['size']}²", (x, y), xytext=(-6, 6), textcoords="offset points", fontsize=8,
                         color="0.3", ha="right")
