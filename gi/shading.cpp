@@ -531,7 +531,9 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
     const bool phong = settings.brdf != Brdf::Lambert;
     const int nCoef = phong ? kShCount : 9;
     const int nPlanes = 3 * nCoef + (ambient ? 9 : 0);  // incident radiance + V_env bands 0..2 (ambient)
-    const int nBlocks = std::max(1, std::min(ny, 64));
+    // Fixed blocks of at least 16 receiver rows: a block computes the one
+    // receiver row it shares with the next again (windowed incident SH).
+    const int nBlocks = std::clamp(ny / (16 * s), 1, 64);
     const int nxrS = nxr + 8;  // vertical scratch rows padded for 8-wide reads
     const auto slots = static_cast<std::size_t>(workerSlots());
     const bool keep = out.keepIncident;
