@@ -206,8 +206,15 @@ void Renderer::upload(const engine::FrameData& f) {
     sky_.upload(f.lights);
 
     // The chunks' errors and bounds follow the heights as drawn (render/terrain_lod.h).
-    if (newHeights || lodTree_.levels.empty() || f.exaggeration != meta_.exaggeration || f.hasWater != meta_.hasWater)
-        buildChunkTree(f.heights, f.nx, f.ny, f.cellSize, f.exaggeration, f.hasWater, kChunkQuads, lodTree_);
+    if (newHeights || groundTree_.levels.empty() || f.exaggeration != meta_.exaggeration ||
+        f.hasWater != meta_.hasWater) {
+        buildChunkTree(f.heights, f.nx, f.ny, f.cellSize, f.exaggeration, LodSurface::Ground, kChunkQuads, groundTree_);
+        if (f.hasWater)
+            buildChunkTree(f.heights, f.nx, f.ny, f.cellSize, f.exaggeration, LodSurface::Water, kChunkQuads,
+                           waterTree_);
+        else
+            waterTree_ = ChunkTree{};
+    }
     meta_.nx = f.nx;
     meta_.ny = f.ny;
     meta_.nxr = f.nxr;
@@ -292,7 +299,7 @@ Renderer::MeshCount Renderer::drawMesh(GLuint program, const float* cullViewProj
     } else {
         gl_.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, chunkIndexBuffer_);
         gl_.Uniform1i(row, kChunkQuads + 1);
-        for (const LodChunk& c : lodSelection_.chunks) {
+        for (const LodChunk& c : groundChunks_.chunks) {
             if (!boxInClipVolume(cullViewProj, c.boxMin, c.boxMax)) continue;
             gl_.Uniform2i(origin, c.x0, c.y0);
             gl_.Uniform1i(step, 1 << c.level);
@@ -334,7 +341,7 @@ Renderer::MeshCount Renderer::drawWaterMesh(GLuint program, const float* cullVie
     };
     std::vector<Piece> pieces;
     waterChunkIndices_.clear();
-    for (const LodChunk& c : lodSelection_.chunks) {
+    for (const LodChunk& c : waterChunks_.chunks) {
         if (!c.wet || !boxInClipVolume(cullViewProj, c.boxMin, c.boxMax)) continue;
         const MeshPlacement p{c.x0, c.y0, 1 << c.level, kChunkQuads + 1, meta_.nx, meta_.ny};
         const std::size_t first = waterChunkIndices_.size();
@@ -378,13 +385,15 @@ struct Renderer::FrameViews {
 // distance, so the camera never dips under the terrain nor cuts it open.
 float Renderer::lowestEye(float x, float y, float nearPlane) const {
     float lowest = -std::numeric_limits<float>::infinity();
-    if (lodTree_.levels.empty()) return lowest;
-    const ChunkTree::Level& fine = lodTree_.levels[0];
-    const float span = static_cast<float>(lodTree_.quads) * lodTree_.cellSize;
-    const int cx = static_cast<int>(std::floor(x / span)), cy = static_cast<int>(std::floor(y / span));
-    for (int j = std::max(cy - 1, 0); j <= std::min(cy + 1, fine.nodesY - 1); ++j)
-        for (int i = std::max(cx - 1, 0); i <= std::min(cx + 1, fine.nodesX - 1); ++i)
-            lowest = std::max(lowest, fine.zMax[static_cast<std::size_t>(j) * fine.nodesX + i] + 2.0f * nearPlane);
+    for (const ChunkTree* tree : {&groundTree_, &waterTree_}) {
+        if (tree->levels.empty()) continue;
+        const ChunkTree::Level& fine = tree->levels[0];
+        const float span = static_cast<float>(tree->quads) * tree->cellSize;
+        const int cx = static_cast<int>(std::floor(x / span)), cy = static_cast<int>(std::floor(y / span));
+        for (int j = std::max(cy - 1, 0); j <= std::min(cy + 1, fine.nodesY - 1); ++j)
+            for (int i = std::max(cx - 1, 0); i <= std::min(cx + 1, fine.nodesX - 1); ++i)
+                lowest = std::max(lowest, fine.zMax[static_cast<std::size_t>(j) * fine.nodesX + i] + 2.0f * nearPlane);
+    }
     return lowest;
 }
 
@@ -465,7 +474,8 @@ void Renderer::drawFrame(const RenderSettings& s, int width, int height) {
         std::copy_n(glm::value_ptr(v.eye), 3, view.eye);
         view.pixelsPerUnit = static_cast<float>(height) / (2.0f * std::tan(0.5f * s.camera.fovYDeg * kDeg));
         view.pixelError = s.lodPixelError;
-        selectChunks(lodTree_, view, lodSelection_);
+        selectChunks(groundTree_, view, groundChunks_);
+        if (meta_.hasWater) selectChunks(waterTree_, view, waterChunks_);
     }
     const bool debug = s.debug != DebugView::None;
     const bool water = s.water && meta_.hasWater && !debug;

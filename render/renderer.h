@@ -156,8 +156,10 @@ private:
     GLuint waterIndexBuffer_ = 0;
     std::vector<std::uint16_t> waterChunkIndices_;
     std::vector<std::uint32_t> waterGridIndices_;
-    ChunkTree lodTree_;
-    ChunkSelection lodSelection_;
+    // Level of detail per mesh pass: the ground's chunks (terrain, shadow map)
+    // and the water surface's (only with water), each following its own surface.
+    ChunkTree groundTree_, waterTree_;
+    ChunkSelection groundChunks_, waterChunks_;
     DrawStats stats_;
     GLuint heightTex_ = 0, shadeTex_ = 0, keyTex_ = 0, receiverTex_ = 0, albedoTex_ = 0, hydrologyTex_ = 0;
     int heightW_ = 0, heightH_ = 0, shadeW_ = 0, shadeH_ = 0, keyW_ = 0, keyH_ = 0, recvW_ = 0, recvH_ = 0,

@@ -89,17 +89,16 @@ struct Plane {
     const float* row(int y) const { return v + static_cast<std::size_t>(y) * nx; }
 };
 
-// The surfaces as kMeshVertex places them: the ground and (water) the water
-// surface, heights times the exaggeration, in the same float operations.
-void fillSurfaces(const std::vector<float>& heights, float exag, bool water, ChunkTree& t) {
+// The surface as kMeshVertex places it, heights times the exaggeration, in
+// the same float operations.
+void fillSurface(const std::vector<float>& heights, float exag, LodSurface surface, ChunkTree& t) {
     const std::size_t n = static_cast<std::size_t>(t.nx) * t.ny;
-    t.ground.resize(n);
-    t.water.resize(water ? n : 0);
+    t.surface.resize(n);
+    const bool water = surface == LodSurface::Water;
     parallelForRows(t.ny, t.nx, [&](int y0, int y1) {
         for (std::size_t i = static_cast<std::size_t>(y0) * t.nx; i < static_cast<std::size_t>(y1) * t.nx; ++i) {
             const float g = heights[2 * i], d = heights[2 * i + 1];
-            t.ground[i] = g * exag;
-            if (water) t.water[i] = (d > kWetDepth ? g + d : g - 0.2f) * exag;
+            t.surface[i] = water ? (d > kWetDepth ? g + d : g - 0.2f) * exag : g * exag;
         }
     });
 }
@@ -269,20 +268,18 @@ void layOut(ChunkTree& t) {
     }
 }
 
-// Level 0: each chunk's height range over its grid points (both surfaces),
-// and whether one of them is under water.
+// Level 0: each chunk's height range over its grid points, and whether one
+// of them is under water.
 void rangesLevel0(const std::vector<float>& heights, ChunkTree& t) {
     ChunkTree::Level& L = t.levels[0];
     parallelFor(0, L.nodesX * L.nodesY, 1, [&](int b, int e) {
         for (int n = b; n < e; ++n) {
             const int x0 = (n % L.nodesX) * t.quads, y0 = (n / L.nodesX) * t.quads;
             const int x1 = std::min(x0 + t.quads, t.nx - 1), y1 = std::min(y0 + t.quads, t.ny - 1);
-            float lo = t.ground[static_cast<std::size_t>(y0) * t.nx + x0], hi = lo;
+            float lo = t.surface[static_cast<std::size_t>(y0) * t.nx + x0], hi = lo;
             bool wet = false;
             for (int y = y0; y <= y1; ++y) {
-                rowRange(Plane{t.ground.data(), t.nx}.row(y) + x0, x1 - x0 + 1, lo, hi);
-                if (t.water.empty()) continue;
-                rowRange(Plane{t.water.data(), t.nx}.row(y) + x0, x1 - x0 + 1, lo, hi);
+                rowRange(Plane{t.surface.data(), t.nx}.row(y) + x0, x1 - x0 + 1, lo, hi);
                 for (int x = x0; x <= x1 && !wet; ++x)
                     wet = heights[2 * (static_cast<std::size_t>(y) * t.nx + x) + 1] > kWetDepth;
             }
@@ -621,8 +618,8 @@ std::vector<ChunkTriangle> chunkTriangles(int quads, int stitched) {
     return out;
 }
 
-void buildChunkTree(const std::vector<float>& heights, int nx, int ny, float cellSize, float exaggeration, bool water,
-                    int quads, ChunkTree& tree) {
+void buildChunkTree(const std::vector<float>& heights, int nx, int ny, float cellSize, float exaggeration,
+                    LodSurface surface, int quads, ChunkTree& tree) {
     if (quads < 4 || quads > 254 || quads % 2 != 0) throw InputError("LOD chunks need an even 4..254 quads a side");
     if (heights.size() != 2 * static_cast<std::size_t>(std::max(nx, 0)) * static_cast<std::size_t>(std::max(ny, 0)))
         throw InputError("LOD: the heights are not 2 per texel of the grid");
@@ -632,9 +629,8 @@ void buildChunkTree(const std::vector<float>& heights, int nx, int ny, float cel
     tree.cellSize = cellSize;
     layOut(tree);
     if (tree.levels.empty()) return;
-    fillSurfaces(heights, exaggeration, water, tree);
-    std::vector<Plane> surfaces{{tree.ground.data(), nx}};
-    if (water) surfaces.push_back({tree.water.data(), nx});
+    fillSurface(heights, exaggeration, surface, tree);
+    const std::vector<Plane> surfaces{{tree.surface.data(), nx}};
     rangesLevel0(heights, tree);
     std::vector<float> rowMax;
     for (int k = 1; k < static_cast<int>(tree.levels.size()); ++k) {

@@ -15,8 +15,7 @@
 //
 // Level choice. Each chunk of each level carries a geometric error: the
 // largest vertical distance, over every grid point it covers, between the
-// full-resolution surface and the chunk's triangles (the ground, and the
-// water surface as the vertex shader places it), made monotonic (a chunk's
+// full-resolution surface and the chunk's triangles, made monotonic (a chunk's
 // error is at least its children's) so that a refined selection never has a
 // larger error; and per side the same for the triangles that side adds when
 // it is stitched. Both are computed exactly on the CPU when the heights are
@@ -29,6 +28,11 @@
 // surface point (normals come from the height texture at full resolution).
 // Where a stitched side's error would exceed it, the coarser neighbour is
 // split instead, so that the side needs no stitch.
+//
+// One tree per drawn surface (LodSurface): the ground, and the water surface
+// as the vertex shader places it. Each mesh pass selects its own chunks, so
+// a choppy sea does not refine the flat bed under it, nor a rough bed a calm
+// sea.
 //
 // Cracks: neighbouring chunks differ by at most one level (a restricted
 // quadtree: the selection is refined until it is), and a chunk beside a
@@ -69,6 +73,11 @@ using ChunkTriangle = std::array<std::uint16_t, 3>;
 /// full mesh's split.
 std::vector<ChunkTriangle> chunkTriangles(int quads, int stitched);
 
+/// The surface a chunk tree follows: the ground, or the water surface as the
+/// vertex shader places it (the ground plus the depth where wet, just under
+/// the ground where dry).
+enum class LodSurface { Ground, Water };
+
 /// Bounds of every chunk of every level, computed from the heights on upload.
 struct ChunkTree {
     struct Level {
@@ -76,24 +85,24 @@ struct ChunkTree {
         // per chunk (row-major), world units (heights x exaggeration):
         std::vector<float> error;       // geometric error, monotonic towards the root
         std::vector<float> sideError;   // 4 per chunk (left, right, bottom, top): of the triangles a stitched side adds
-        std::vector<float> zMin, zMax;  // range of the ground and the water surface
+        std::vector<float> zMin, zMax;  // range of the surface
         std::vector<std::uint8_t> wet;  // 1: some grid point is under water (the water surface shows)
     };
     int nx = 0, ny = 0;
     int quads = kChunkQuads;
     float cellSize = 1.0f;
     std::vector<Level> levels;  // [0] full resolution ... back(): the root, one chunk
-    // scratch of buildChunkTree: the drawn surfaces in world units, row-major
-    std::vector<float> ground, water;
+    // scratch of buildChunkTree: the drawn surface in world units, row-major
+    std::vector<float> surface;
 };
 
 /// Fills `tree` for an nx x ny grid of `heights` (2 per texel: ground, water
 /// depth, m) with chunks of `quads` quads (even, 4..254: with 2, a chunk
-/// stitched on every side folds onto a fin). `water`: the water
-/// surface is drawn too and counts in the errors and bounds. Parallel;
-/// bit-identical for any thread count.
-void buildChunkTree(const std::vector<float>& heights, int nx, int ny, float cellSize, float exaggeration, bool water,
-                    int quads, ChunkTree& tree);
+/// stitched on every side folds onto a fin), its errors and bounds those of
+/// `surface` (the wet flags are the same for both). Parallel; bit-identical
+/// for any thread count.
+void buildChunkTree(const std::vector<float>& heights, int nx, int ny, float cellSize, float exaggeration,
+                    LodSurface surface, int quads, ChunkTree& tree);
 
 /// The camera as the level choice sees it.
 struct LodView {

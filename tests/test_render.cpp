@@ -340,7 +340,7 @@ int borderSides(int nx, int ny, int quads, int k, int ci, int cj) {
 /// triangles of chunk (k, ci, cj) drawn with the `stitched` sides, at every
 /// grid point inside a triangle (barycentric weights in double).
 double bruteForceChunkError(const std::vector<float>& h, int nx, int ny, float exag, int quads, int k, int ci, int cj,
-                            int stitched) {
+                            int stitched, int surface) {
     const int step = 1 << k, span = quads << k, x0 = ci * span, y0 = cj * span;
     double worst = 0.0;
     for (const ChunkTriangle& t : chunkTriangles(quads, stitched)) {
@@ -357,12 +357,10 @@ double bruteForceChunkError(const std::vector<float>& h, int nx, int ny, float e
                 const double w1 = (double(px[0] - px[2]) * (y - py[2]) - double(py[0] - py[2]) * (x - px[2])) / area;
                 const double w2 = 1.0 - w0 - w1;
                 if (w0 < -1e-12 || w1 < -1e-12 || w2 < -1e-12) continue;
-                for (int s = 0; s < 2; ++s) {
-                    const double plane = w0 * drawnHeight(h, nx, px[0], py[0], s, exag) +
-                                         w1 * drawnHeight(h, nx, px[1], py[1], s, exag) +
-                                         w2 * drawnHeight(h, nx, px[2], py[2], s, exag);
-                    worst = std::max(worst, std::abs(drawnHeight(h, nx, x, y, s, exag) - plane));
-                }
+                const double plane = w0 * drawnHeight(h, nx, px[0], py[0], surface, exag) +
+                                     w1 * drawnHeight(h, nx, px[1], py[1], surface, exag) +
+                                     w2 * drawnHeight(h, nx, px[2], py[2], surface, exag);
+                worst = std::max(worst, std::abs(drawnHeight(h, nx, x, y, surface, exag) - plane));
             }
     }
     return worst;
@@ -426,68 +424,72 @@ TEST_CASE("render.lod: every stitch variant of a chunk tiles it, its borders mat
 
 TEST_CASE("render.lod: chunk errors match a brute-force computation, for any thread count") {
     for (const auto& size : {std::pair{33, 33}, std::pair{40, 45}, std::pair{66, 66}, std::pair{97, 90}})
-        for (int quads : {4, 8}) {
-            const int nx = size.first, ny = size.second;  // plain locals: CAPTURE and the lambdas take them
-            CAPTURE(nx);
-            CAPTURE(ny);
-            CAPTURE(quads);
-            const std::vector<float> h = roughField(nx, ny);
-            const float exag = 1.3f;
-            ChunkTree tree, twin;
-            withThreads(2, [&] { buildChunkTree(h, nx, ny, 2.0f, exag, true, quads, tree); });
-            withThreads(1, [&] { buildChunkTree(h, nx, ny, 2.0f, exag, true, quads, twin); });
-            int wrong = 0, unsound = 0, loose = 0, differ = 0;
-            const int levels = static_cast<int>(tree.levels.size());
-            const auto above = [](double a, double b) { return a > b + 1e-4 * (1.0 + b); };
-            for (int k = 0; k < levels; ++k) {
-                const ChunkTree::Level& L = tree.levels[static_cast<std::size_t>(k)];
-                const ChunkTree::Level& T = twin.levels[static_cast<std::size_t>(k)];
-                for (int j = 0; j < L.nodesY; ++j)
-                    for (int i = 0; i < L.nodesX; ++i) {
-                        const std::size_t n = static_cast<std::size_t>(j) * static_cast<std::size_t>(L.nodesX) +
-                                              static_cast<std::size_t>(i);
-                        // the plain error is kept monotonic: the largest of the chunk's and its descendants'
-                        double expected = 0.0;
-                        for (int d = 0; d <= k; ++d) {
-                            const int f = 1 << (k - d);
-                            const ChunkTree::Level& D = tree.levels[static_cast<std::size_t>(d)];
-                            for (int dj = j * f; dj < std::min((j + 1) * f, D.nodesY); ++dj)
-                                for (int di = i * f; di < std::min((i + 1) * f, D.nodesX); ++di)
-                                    expected =
-                                        std::max(expected, bruteForceChunkError(h, nx, ny, exag, quads, d, di, dj, 0));
-                        }
-                        if (above(L.error[n], expected) || above(expected, L.error[n])) ++wrong;
-                        // Each stitch variant a chunk may be drawn with stays within the plain error and its
-                        // stitched sides' errors, and each side's error is reached by some variant.
-                        const int border = borderSides(nx, ny, quads, k, i, j);
-                        double reached[4] = {0.0, 0.0, 0.0, 0.0};
-                        for (int stitched = 1; stitched < kStitchVariants && k + 1 < levels; ++stitched) {
-                            if (stitched & border) continue;
-                            const double e = bruteForceChunkError(h, nx, ny, exag, quads, k, i, j, stitched);
-                            double bound = L.error[n];
+        for (int quads : {4, 8})
+            for (int surface : {0, 1}) {
+                const int nx = size.first, ny = size.second;  // plain locals: CAPTURE and the lambdas take them
+                CAPTURE(nx);
+                CAPTURE(ny);
+                CAPTURE(quads);
+                CAPTURE(surface);
+                const std::vector<float> h = roughField(nx, ny);
+                const float exag = 1.3f;
+                const LodSurface which = surface == 0 ? LodSurface::Ground : LodSurface::Water;
+                ChunkTree tree, twin;
+                withThreads(2, [&] { buildChunkTree(h, nx, ny, 2.0f, exag, which, quads, tree); });
+                withThreads(1, [&] { buildChunkTree(h, nx, ny, 2.0f, exag, which, quads, twin); });
+                int wrong = 0, unsound = 0, loose = 0, differ = 0;
+                const int levels = static_cast<int>(tree.levels.size());
+                const auto above = [](double a, double b) { return a > b + 1e-4 * (1.0 + b); };
+                for (int k = 0; k < levels; ++k) {
+                    const ChunkTree::Level& L = tree.levels[static_cast<std::size_t>(k)];
+                    const ChunkTree::Level& T = twin.levels[static_cast<std::size_t>(k)];
+                    for (int j = 0; j < L.nodesY; ++j)
+                        for (int i = 0; i < L.nodesX; ++i) {
+                            const std::size_t n = static_cast<std::size_t>(j) * static_cast<std::size_t>(L.nodesX) +
+                                                  static_cast<std::size_t>(i);
+                            // the plain error is kept monotonic: the largest of the chunk's and its descendants'
+                            double expected = 0.0;
+                            for (int d = 0; d <= k; ++d) {
+                                const int f = 1 << (k - d);
+                                const ChunkTree::Level& D = tree.levels[static_cast<std::size_t>(d)];
+                                for (int dj = j * f; dj < std::min((j + 1) * f, D.nodesY); ++dj)
+                                    for (int di = i * f; di < std::min((i + 1) * f, D.nodesX); ++di)
+                                        expected = std::max(expected, bruteForceChunkError(h, nx, ny, exag, quads, d,
+                                                                                           di, dj, 0, surface));
+                            }
+                            if (above(L.error[n], expected) || above(expected, L.error[n])) ++wrong;
+                            // Each stitch variant a chunk may be drawn with stays within the plain error and its
+                            // stitched sides' errors, and each side's error is reached by some variant.
+                            const int border = borderSides(nx, ny, quads, k, i, j);
+                            double reached[4] = {0.0, 0.0, 0.0, 0.0};
+                            for (int stitched = 1; stitched < kStitchVariants && k + 1 < levels; ++stitched) {
+                                if (stitched & border) continue;
+                                const double e =
+                                    bruteForceChunkError(h, nx, ny, exag, quads, k, i, j, stitched, surface);
+                                double bound = L.error[n];
+                                for (int side = 0; side < 4; ++side)
+                                    if (stitched & (1 << side)) {
+                                        bound = std::max(bound,
+                                                         double(L.sideError[4 * n + static_cast<std::size_t>(side)]));
+                                        reached[side] = std::max(reached[side], e);
+                                    }
+                                if (above(e, bound)) ++unsound;
+                            }
                             for (int side = 0; side < 4; ++side)
-                                if (stitched & (1 << side)) {
-                                    bound =
-                                        std::max(bound, double(L.sideError[4 * n + static_cast<std::size_t>(side)]));
-                                    reached[side] = std::max(reached[side], e);
-                                }
-                            if (above(e, bound)) ++unsound;
+                                if (above(L.sideError[4 * n + static_cast<std::size_t>(side)], reached[side])) ++loose;
+                            if (L.error[n] != T.error[n] || L.zMin[n] != T.zMin[n] || L.zMax[n] != T.zMax[n] ||
+                                L.wet[n] != T.wet[n] ||
+                                !std::equal(L.sideError.begin() + static_cast<std::ptrdiff_t>(4 * n),
+                                            L.sideError.begin() + static_cast<std::ptrdiff_t>(4 * n + 4),
+                                            T.sideError.begin() + static_cast<std::ptrdiff_t>(4 * n)))
+                                ++differ;
                         }
-                        for (int side = 0; side < 4; ++side)
-                            if (above(L.sideError[4 * n + static_cast<std::size_t>(side)], reached[side])) ++loose;
-                        if (L.error[n] != T.error[n] || L.zMin[n] != T.zMin[n] || L.zMax[n] != T.zMax[n] ||
-                            L.wet[n] != T.wet[n] ||
-                            !std::equal(L.sideError.begin() + static_cast<std::ptrdiff_t>(4 * n),
-                                        L.sideError.begin() + static_cast<std::ptrdiff_t>(4 * n + 4),
-                                        T.sideError.begin() + static_cast<std::ptrdiff_t>(4 * n)))
-                            ++differ;
-                    }
+                }
+                CHECK(wrong == 0);
+                CHECK(unsound == 0);
+                CHECK(loose == 0);
+                CHECK(differ == 0);
             }
-            CHECK(wrong == 0);
-            CHECK(unsound == 0);
-            CHECK(loose == 0);
-            CHECK(differ == 0);
-        }
 }
 
 TEST_CASE(
@@ -495,7 +497,7 @@ TEST_CASE(
     const int nx = 300, ny = 260, quads = 8;
     const std::vector<float> h = roughField(nx, ny, 0.02f);
     ChunkTree tree;
-    buildChunkTree(h, nx, ny, 20.0f, 1.0f, false, quads, tree);
+    buildChunkTree(h, nx, ny, 20.0f, 1.0f, LodSurface::Ground, quads, tree);
     // An eye level with the highest point: the bound is then rho = delta K / D.
     LodView view;
     view.eye[0] = -100.0f;  // near a corner: chunks from 100 m to 8 km away
