@@ -520,6 +520,65 @@ int windowRows(int ny, int nBlocks, int s, int nyr) {
     return most;
 }
 
+// Sizes the maps and each worker slot's scratch. The receivers' incident SH
+// is a whole field when out.keepIncident, else a window per slot of the most
+// receiver rows a block reads; returns that window's floats (0 for a field).
+std::size_t sizeBuffers(int nx, int ny, int nxr, int nyr, int s, int nCoef, int nPlanes, int nxrS, int nBlocks,
+                        bool ambient, ShadeMaps& out) {
+    const auto slots = static_cast<std::size_t>(workerSlots());
+    const bool keep = out.keepIncident;
+    const std::size_t field = static_cast<std::size_t>(nxr) * nyr * 3 * nCoef;
+    const std::size_t window = keep ? 0 : static_cast<std::size_t>(3 * nCoef) * windowRows(ny, nBlocks, s, nyr) * nxr;
+    sizeShadeMaps(nx, ny, keep ? field : 0, ambient, slots * nPlanes * (nxrS + nx), slots * 24 * nx, out);
+    if (!keep) std::vector<float>().swap(out.incident);
+    out.incidentWindow.resize(slots * window);
+    if (keep) std::vector<float>().swap(out.incidentWindow);
+    return window;
+}
+
+// What every block of one shading call shares.
+struct BlockSchedule {
+    ConstGridView gradX, gradY;
+    const ShadingLight* lights;
+    int lightCount;
+    const std::vector<std::uint8_t>* rows;  // null: every row
+    int nBlocks, nPlanes;
+    std::size_t window;  // floats of a slot's incident window (0: the field is kept)
+    bool phong;
+};
+
+// One block of texel rows on a worker's slot of the scratch: the receiver
+// rows it reads into the slot's incident window (unless the field is kept),
+// then each of its (flagged) rows.
+void shadeBlock(const BlockSchedule& b, PhongRowJob job, int block, std::size_t slot) {
+    LambertRowJob& base = job.base;
+    ShadeMaps& out = *base.out;
+    const int nx = base.nx, nxr = base.nxr, nxrS = base.nxrS;
+    const RowBlock shaded = flaggedSpan(rowBlock(b.gradX.ny, b.nBlocks, block), b.rows);
+    if (shaded.begin == shaded.end) return;
+    const bool wide = simd::wideEnabled();
+    if (b.window > 0) {
+        const ReceiverSpan r = receiverSpanOf(shaded.begin, shaded.end, base.s, base.nyr);
+        base.incident = {out.incidentWindow.data() + slot * b.window,
+                         static_cast<std::size_t>(r.last - r.first + 1) * nxr, r.first};
+        for (int Y = r.first; Y <= r.last; ++Y)
+            (wide ? incidentRowAvx2 : incidentRowSse)(b.lights, b.lightCount, base.nCoef, nxr, out, base.incident, Y);
+    }
+    float* vert = out.rowScratch.data() + slot * b.nPlanes * (nxrS + nx);
+    float* up = vert + static_cast<std::size_t>(b.nPlanes) * nxrS;
+    float* basis = out.basisScratch.data() + slot * 24 * nx;
+    for (int y = shaded.begin; y < shaded.end; ++y) {
+        if (b.rows && (*b.rows)[static_cast<std::size_t>(y)] == 0) continue;  // keeps its last values
+        if (!b.phong) {
+            (wide ? lambertShadeRowAvx2 : lambertShadeRowSse)(base, vert, b.gradX.row(y), b.gradY.row(y), y);
+            continue;
+        }
+        interpolatePlanesToRow(base, y, vert, up);
+        lambertBasisRow(base.lf, b.gradX.row(y), b.gradY.row(y), nx, basis);
+        phongShadeRow(job, b.gradX.row(y), b.gradY.row(y), basis, up, y);
+    }
+}
+
 }  // namespace
 
 void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const VisibilityField& env,
@@ -535,23 +594,16 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
     // receiver row it shares with the next again (windowed incident SH).
     const int nBlocks = std::clamp(ny / (16 * s), 1, 64);
     const int nxrS = nxr + 8;  // vertical scratch rows padded for 8-wide reads
-    const auto slots = static_cast<std::size_t>(workerSlots());
-    const bool keep = out.keepIncident;
-    // restricted rows keep the others' incident rows only where the last call kept the field
-    const bool fieldKept = out.incident.size() == planeR * 3 * nCoef;
-    const std::size_t windowSize =
-        keep ? 0 : static_cast<std::size_t>(3 * nCoef) * windowRows(ny, nBlocks, s, nyr) * nxr;
-    sizeShadeMaps(nx, ny, keep ? planeR * 3 * nCoef : 0, ambient, slots * nPlanes * (nxrS + nx), slots * 24 * nx, out);
-    if (!keep) std::vector<float>().swap(out.incident);
-    out.incidentWindow.resize(slots * windowSize);
-    if (keep) std::vector<float>().swap(out.incidentWindow);
-
     if (rows && rows->size() != static_cast<std::size_t>(ny))
         throw InputError("shading: one row flag per texel row expected");
+    // restricted rows keep the others' incident rows only where the last call kept the field
+    const bool fieldKept = out.incident.size() == planeR * 3 * nCoef;
+    const std::size_t window = sizeBuffers(nx, ny, nxr, nyr, s, nCoef, nPlanes, nxrS, nBlocks, ambient, out);
+
     // ---- algorithm, receivers: incident radiance I_c = sum_L T_{L,c} V_L ------
     // (the whole field when a later pass reads it, else per block of texel rows)
     buildIncidentTerms(lights, lightCount, nCoef, out);
-    if (keep) incidentField(lights, lightCount, nCoef, s, ny, nxr, nyr, fieldKept ? rows : nullptr, out);
+    if (out.keepIncident) incidentField(lights, lightCount, nCoef, s, ny, nxr, nyr, fieldKept ? rows : nullptr, out);
 
     // ---- interpolation tables (receiver X sits at column s X) -----------------
     for (int x = 0; x < nx; ++x) {
@@ -560,8 +612,6 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
         out.colFrac[static_cast<std::size_t>(x)] = r.f;
     }
 
-    const bool wide = simd::wideEnabled();
-    const LambertFactors lf = lambertFactors();
     const float diffuseWeight = settings.brdf == Brdf::Phong ? 0.0f : 1.0f;
     const LambertRowJob lambertJob{{out.incident.data(), planeR, 0},
                                    ambient ? &env : nullptr,
@@ -574,12 +624,10 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
                                    nx,
                                    out.colIndex.data(),
                                    out.colFrac.data(),
-                                   lf,
+                                   lambertFactors(),
                                    diffuseWeight,
                                    albedo,
                                    &out};
-    const auto lambertShadeRow = wide ? lambertShadeRowAvx2 : lambertShadeRowSse;
-    const auto incidentRow = wide ? incidentRowAvx2 : incidentRowSse;
     PhongRowJob phongJob{lambertJob,
                          {},
                          specularWeightOf(settings),
@@ -589,33 +637,10 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
 
     // ---- schedule: fixed row blocks; a row keeps nothing in the scratch, so
     // each thread's slot of it serves every block it runs ----------------------
+    const BlockSchedule schedule{gradX, gradY, lights, lightCount, rows, nBlocks, nPlanes, window, phong};
     parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
         const auto slot = static_cast<std::size_t>(workerSlot());
-        float* vert = out.rowScratch.data() + slot * nPlanes * (nxrS + nx);
-        float* up = vert + static_cast<std::size_t>(nPlanes) * nxrS;
-        float* basis = out.basisScratch.data() + slot * 24 * nx;
-        PhongRowJob job = phongJob;
-        for (int block = b0; block < b1; ++block) {
-            const RowBlock shaded = flaggedSpan(rowBlock(ny, nBlocks, block), rows);
-            if (shaded.begin == shaded.end) continue;
-            if (!keep) {  // this block's receiver rows into the slot's window
-                const ReceiverSpan r = receiverSpanOf(shaded.begin, shaded.end, s, nyr);
-                job.base.incident = {out.incidentWindow.data() + slot * windowSize,
-                                     static_cast<std::size_t>(r.last - r.first + 1) * nxr, r.first};
-                for (int Y = r.first; Y <= r.last; ++Y)
-                    incidentRow(lights, lightCount, nCoef, nxr, out, job.base.incident, Y);
-            }
-            for (int y = shaded.begin; y < shaded.end; ++y) {
-                if (rows && (*rows)[static_cast<std::size_t>(y)] == 0) continue;  // keeps its last values
-                if (!phong) {
-                    lambertShadeRow(job.base, vert, gradX.row(y), gradY.row(y), y);
-                    continue;
-                }
-                interpolatePlanesToRow(job.base, y, vert, up);
-                lambertBasisRow(lf, gradX.row(y), gradY.row(y), nx, basis);
-                phongShadeRow(job, gradX.row(y), gradY.row(y), basis, up, y);
-            }
-        }
+        for (int block = b0; block < b1; ++block) shadeBlock(schedule, phongJob, block, slot);
     });
 }
 
