@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <system_error>
 #include <thread>
+#include <utility>
 
 #include <sys/utsname.h>
 #include <sys/wait.h>
@@ -49,12 +50,7 @@ void writeResult(const std::string& outDir, const std::string& name, const std::
     std::fprintf(stderr, "wrote %s\n", path.c_str());
 }
 
-double median(std::vector<double> v) {
-    if (v.empty()) return 0.0;
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+double median(std::vector<double> v) { return spreadOf(std::move(v)).median; }
 
 namespace {
 std::string cpuName() {

@@ -47,7 +47,7 @@ std::string fmt(const char* format, Args... args) {
     return out;
 }
 
-/// Median; the mean of the two middle values for an even count, 0 for none.
+/// Median (spreadOf's): the mean of the two middle values for an even count, 0 for none.
 double median(std::vector<double> v);
 
 /// "<cpu>, <n> hardware threads".

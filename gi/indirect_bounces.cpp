@@ -13,7 +13,7 @@ double msSince(Clock::time_point t0) { return std::chrono::duration<double, std:
 
 // Sizes the sum of the bounces (full resolution; zeroed when several bounces
 // add into it) and the bounce means.
-void clearIndirect(int nx, int ny, int bounces, IndirectState& st) {
+void prepareIndirectSum(int nx, int ny, int bounces, IndirectState& st) {
     for (int c = 0; c < 3; ++c) {
         Grid& g = st.indirect[static_cast<std::size_t>(c)];
         g.ensureSize(nx, ny);
@@ -37,7 +37,7 @@ void runBounces(const IndirectInputs& in, const IndirectSettings& settings, Indi
     const auto t0 = Clock::now();
     st.timings = IndirectTimings{};
     strategy.beginFrame();
-    clearIndirect(in.heights.nx, in.heights.ny, settings.bounces, st);
+    prepareIndirectSum(in.heights.nx, in.heights.ny, settings.bounces, st);
     BounceSource source{&in.direct, in.directShade};
     for (int b = 1; b <= settings.bounces; ++b) {
         // ---- pyramid of bounce b - 1 (Section 5.3) ------------------------------------

@@ -268,9 +268,10 @@ void layOut(ChunkTree& t) {
     }
 }
 
-// Level 0: each chunk's height range over its grid points, and whether one
-// of them is under water.
-void rangesLevel0(const std::vector<float>& heights, ChunkTree& t) {
+// Level 0: each chunk's height range over its grid points and, for the water
+// surface's tree, whether one of them is under water.
+void rangesLevel0(const std::vector<float>& heights, LodSurface surface, ChunkTree& t) {
+    const bool water = surface == LodSurface::Water;
     ChunkTree::Level& L = t.levels[0];
     parallelFor(0, L.nodesX * L.nodesY, 1, [&](int b, int e) {
         for (int n = b; n < e; ++n) {
@@ -280,7 +281,7 @@ void rangesLevel0(const std::vector<float>& heights, ChunkTree& t) {
             bool wet = false;
             for (int y = y0; y <= y1; ++y) {
                 rowRange(Plane{t.surface.data(), t.nx}.row(y) + x0, x1 - x0 + 1, lo, hi);
-                for (int x = x0; x <= x1 && !wet; ++x)
+                for (int x = x0; x <= x1 && water && !wet; ++x)
                     wet = heights[2 * (static_cast<std::size_t>(y) * t.nx + x) + 1] > kWetDepth;
             }
             L.zMin[static_cast<std::size_t>(n)] = lo;
@@ -631,7 +632,7 @@ void buildChunkTree(const std::vector<float>& heights, int nx, int ny, float cel
     if (tree.levels.empty()) return;
     fillSurface(heights, exaggeration, surface, tree);
     const std::vector<Plane> surfaces{{tree.surface.data(), nx}};
-    rangesLevel0(heights, tree);
+    rangesLevel0(heights, surface, tree);
     std::vector<float> rowMax;
     for (int k = 1; k < static_cast<int>(tree.levels.size()); ++k) {
         if (k == 1)

@@ -86,7 +86,7 @@ struct ChunkTree {
         std::vector<float> error;       // geometric error, monotonic towards the root
         std::vector<float> sideError;   // 4 per chunk (left, right, bottom, top): of the triangles a stitched side adds
         std::vector<float> zMin, zMax;  // range of the surface
-        std::vector<std::uint8_t> wet;  // 1: some grid point is under water (the water surface shows)
+        std::vector<std::uint8_t> wet;  // 1: some grid point is under water (water tree only; ground: 0)
     };
     int nx = 0, ny = 0;
     int quads = kChunkQuads;
@@ -99,8 +99,8 @@ struct ChunkTree {
 /// Fills `tree` for an nx x ny grid of `heights` (2 per texel: ground, water
 /// depth, m) with chunks of `quads` quads (even, 4..254: with 2, a chunk
 /// stitched on every side folds onto a fin), its errors and bounds those of
-/// `surface` (the wet flags are the same for both). Parallel; bit-identical
-/// for any thread count.
+/// `surface`; the wet flags are set in the water surface's tree only (the
+/// water pass skips dry chunks). Parallel; bit-identical for any thread count.
 void buildChunkTree(const std::vector<float>& heights, int nx, int ny, float cellSize, float exaggeration,
                     LodSurface surface, int quads, ChunkTree& tree);
 
