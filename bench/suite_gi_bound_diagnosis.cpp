@@ -226,6 +226,7 @@ gi::GiSettings diagnosisSettings() {
     settings.subsample = 2;
     settings.indirect.bounces = 1;
     settings.incremental = false;
+    settings.minEnvironmentShRows = gi::kShCount;  // the ambient with the cached V shades with it
     return settings;
 }
 

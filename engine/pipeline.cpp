@@ -285,6 +285,7 @@ void FramePipeline::light() {
     // lit surface moved, which drives the shading amortisation
     // (Nowrouzezahrai & Snyder 2009, Section 7) when it is on.
     gi::GiSettings gs = settings_.gi;
+    gs.minEnvironmentShRows = 1;  // the receivers' sky fraction dims the water's mirrored sky (packReceivers)
     if (settings_.lighting != LightingMode::Global) gs.indirect.bounces = 0;
     // Incremental GI frames see for themselves what changed since the cached
     // results (gi/frame_change.h); without them the simulator's report of the

@@ -86,6 +86,26 @@ template <class V, bool Parts>
     for (int r = 0; r < rows; ++r) std::copy(tailAcc[r], tailAcc[r] + n, acc[r] + vecEnd);
 }
 
+// out[r][x] = acc[r][x] / (m n) over a row, n = sqrt(1 + gx^2 + gy^2): the
+// midpoint rule's weight and the normal's length (gi/ambient_horizon.h);
+// whole vectors, then the rest one by one (the same IEEE operations).
+template <class V, int Maps>
+[[gnu::always_inline]] inline void normaliseRow(const float* const acc[3], const float* gx, const float* gy,
+                                                float perAzimuth, float* const out[3], int nx) {
+    constexpr int L = simd::kLaneCount<V>;
+    const V one = splat<V>(1.0f), w = splat<V>(perAzimuth);
+    int x = 0;
+    for (; x + L <= nx; x += L) {
+        const V gxv = load<V>(gx + x), gyv = load<V>(gy + x);
+        const V n = sqrtv(one + gxv * gxv + gyv * gyv);
+        for (int r = 0; r < Maps; ++r) store(out[r] + x, load<V>(acc[r] + x) * w / n);
+    }
+    for (; x < nx; ++x) {
+        const float n = std::sqrt(1.0f + gx[x] * gx[x] + gy[x] * gy[x]);
+        for (int r = 0; r < Maps; ++r) out[r][x] = acc[r][x] * perAzimuth / n;
+    }
+}
+
 // The horizon slopes of receiver row Y along azimuth a (c, sn), each raised
 // to the receiver's lowest tangent slope: the footprint box's when there is
 // one, else its own.
@@ -109,25 +129,34 @@ void receiverRowHorizons(const AmbientJob& j, int Y, int a, float c, float sn, f
 
 // The two receiver rows a texel row interpolates between, every azimuth's
 // horizons raised (receiverRowHorizons), in a worker slot's scratch: azimuth
-// a's rows at rows + 2 a nxr (row i0) and rows + (2 a + 1) nxr (row i1). The
-// rows a block's texel rows read change every s texel rows, so they are
-// raised there, not once per texel row.
+// a's two rows at rows + 2 a nxr and rows + (2 a + 1) nxr, `first` saying
+// which of them holds row i0. The rows a block's texel rows read change
+// every s texel rows, and then the last i1 is the new i0: it is kept, and
+// only the new i1 is raised.
 struct RaisedWindow {
     float* rows;
+    int nxr = 0;
     int i0 = -1, i1 = -1;
+    int first = 0;
     float f = 0.0f;  // the covered texel row's fraction from row i0 towards row i1
+
+    float* slot(int a, int k) const { return rows + (2 * static_cast<std::size_t>(a) + k) * nxr; }
+    const float* row0(int a) const { return slot(a, first); }
+    const float* row1(int a) const { return slot(a, 1 - first); }
 
     void cover(const AmbientJob& j, int y) {
         const ReceiverLerp ry = receiverLerp(y, j.in.subsample, j.nyr);
         f = ry.f;
         if (ry.i0 == i0 && ry.i1 == i1) return;
+        const bool shift = ry.i0 == i1;  // the old i1's rows are the new i0's
+        if (shift) first = 1 - first;
         i0 = ry.i0;
         i1 = ry.i1;
         for (int a = 0; a < j.m; ++a) {
             const float c = j.in.cosSin[2 * static_cast<std::size_t>(a)];
             const float sn = j.in.cosSin[2 * static_cast<std::size_t>(a) + 1];
-            receiverRowHorizons(j, i0, a, c, sn, rows + 2 * static_cast<std::size_t>(a) * j.nxr);
-            receiverRowHorizons(j, i1, a, c, sn, rows + (2 * static_cast<std::size_t>(a) + 1) * j.nxr);
+            if (!shift) receiverRowHorizons(j, i0, a, c, sn, slot(a, first));
+            receiverRowHorizons(j, i1, a, c, sn, slot(a, 1 - first));
         }
     }
 };
@@ -154,8 +183,8 @@ void horizontalLerp(const AmbientJob& j, const float* vert, float* out) {
 // Horizon slopes of azimuth a at the texels of the row the window covers,
 // bilinear from the raised receivers (Fig. 7). vert: nxr floats of scratch.
 void interpolatedHorizons(const AmbientJob& j, const RaisedWindow& window, int a, float* vert, float* out) {
-    const float* t0 = window.rows + 2 * static_cast<std::size_t>(a) * j.nxr;
-    const float* t1 = t0 + j.nxr;
+    const float* t0 = window.row0(a);
+    const float* t1 = window.row1(a);
     for (int X = 0; X < j.nxr; ++X) vert[X] = t0[X] + window.f * (t1[X] - t0[X]);
     switch (j.in.subsample) {
         case 2:
@@ -197,13 +226,11 @@ template <class V, bool Parts>
         }
         addAzimuthRow<V, Parts>(gx, gy, h, c, sn, acc, j.nx);
     }
-    const float perAzimuth = 1.0f / static_cast<float>(j.m);
     Grid* const maps[3] = {&j.out.ambient, j.out.below, j.out.rising};
-    for (int r = 0; r < (Parts ? 3 : 1); ++r) {
-        float* out = maps[r]->data() + static_cast<std::size_t>(y) * j.nx;
-        for (int x = 0; x < j.nx; ++x)
-            out[x] = acc[r][x] * perAzimuth / std::sqrt(1.0f + gx[x] * gx[x] + gy[x] * gy[x]);
-    }
+    float* const out[3] = {maps[0]->data() + static_cast<std::size_t>(y) * j.nx,
+                           Parts ? maps[1]->data() + static_cast<std::size_t>(y) * j.nx : nullptr,
+                           Parts ? maps[2]->data() + static_cast<std::size_t>(y) * j.nx : nullptr};
+    normaliseRow<V, Parts ? 3 : 1>(acc, gx, gy, 1.0f / static_cast<float>(j.m), out, j.nx);
 }
 
 // The AVX2 builds of the row: 8-wide lanes in the integrals and the
@@ -271,7 +298,7 @@ void ambientFromHorizons(const AmbientInputs& in, const AmbientOutputs& out, Amb
     parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
         float* buffers = job.scratch + static_cast<std::size_t>(workerSlot()) * slotFloats;
         for (int block = b0; block < b1; ++block) {
-            RaisedWindow window{buffers + kRowsPerSlot * static_cast<std::size_t>(rowFloats)};
+            RaisedWindow window{buffers + kRowsPerSlot * static_cast<std::size_t>(rowFloats), nxr};
             const int yBegin = static_cast<int>(static_cast<long long>(ny) * block / nBlocks);
             const int yEnd = static_cast<int>(static_cast<long long>(ny) * (block + 1) / nBlocks);
             for (int y = yBegin; y < yEnd; ++y) {

@@ -19,11 +19,11 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
-// The folded wedge operator of the indirect scan: the environment's, or
-// one of its own azimuths (IndirectSettings::azimuths), cached.
+// The folded wedge operator of the indirect scan: the environment's (when it
+// gives V), or one of its own azimuths (IndirectSettings::azimuths), cached.
 const FoldedWedgeOperator& indirectScanOperator(const GiSettings& settings, GiState& st) {
-    const int m = settings.indirect.azimuths;
-    if (m == 0 || m == settings.visibility.azimuths) return st.envOperator;
+    const int m = settings.indirect.azimuths == 0 ? settings.visibility.azimuths : settings.indirect.azimuths;
+    if (m == settings.visibility.azimuths && st.envOperator.shRows == kShCount) return st.envOperator;
     if (st.indirectOperatorAzimuths != m || st.indirectOperatorInterp != settings.visibility.interp) {
         st.indirectOperator = foldFullCircle(m, settings.visibility.interp);
         st.indirectOperatorAzimuths = m;
@@ -228,9 +228,12 @@ void planAmortisation(ConstGridView heights, const GiSettings& settings, GiState
 
 // The environment's visibility V at the receivers; with sub-sampling and
 // footprint tangent planes, omega_min from each receiver's footprint box.
-void environmentVisibility(const GiSettings& settings, const ReceiverTiles* only, GiState& st) {
-    if (st.envOperatorAzimuths != settings.visibility.azimuths || st.envOperatorInterp != settings.visibility.interp) {
+void environmentVisibility(const GiSettings& settings, int shRows, const ReceiverTiles* only, GiState& st) {
+    if (st.envOperatorAzimuths != settings.visibility.azimuths || st.envOperatorInterp != settings.visibility.interp ||
+        st.envOperator.shRows != shRows) {
         st.envOperator = foldFullCircle(settings.visibility.azimuths, settings.visibility.interp);
+        if (shRows == 1) st.envOperator = firstRowOnly(std::move(st.envOperator));
+        if (shRows == 0) st.envOperator = horizonsOnly(std::move(st.envOperator));
         st.envOperatorAzimuths = settings.visibility.azimuths;
         st.envOperatorInterp = settings.visibility.interp;
         const std::vector<double>& phi = st.envOperator.phi;
@@ -286,20 +289,50 @@ void keyLightVisibility(const GiLighting& lighting, const GiSettings& settings, 
     }
 }
 
-// The environment as the SH shading stage sees it: its SH radiance, or with
-// splitSky all but its constant part, which goes to `constant` (RGB
-// radiance) instead.
-ShadingLight environmentShadingLight(const ShRgb& environment, const VisibilityField& v, bool splitSky,
-                                     float constant[3]) {
+// The environment as the direct shading lights it. With the exact ambient a
+// Lambert shade takes the sky's constant part (its band-0 SH coefficient)
+// from the ambient map (addConstantSky), or, when the ambient's parts are
+// there, the analytic sky's whole function (addGradientSky); only the rest
+// goes through the SH product.
+struct EnvironmentSplit {
+    bool splitSky = false;                     // the constant part is lit from the ambient map
+    bool exactSky = false;                     // the analytic sky is lit from the ambient's parts
+    ShRgb sh;                                  // what goes through the SH product
+    float constant[3] = {0.0f, 0.0f, 0.0f};  // RGB radiance lit from the ambient map (splitSky)
+};
+
+EnvironmentSplit splitEnvironment(const GiLighting& lighting, const GiSettings& settings, bool skyParts) {
+    EnvironmentSplit e;
+    e.splitSky = settings.ambient == AmbientMethod::Horizons && settings.shading.brdf == Brdf::Lambert;
+    e.exactSky = e.splitSky && lighting.gradient && skyParts;
+    if (e.exactSky) return e;
+    e.sh = lighting.environment;
+    if (!e.splitSky) return e;
+    for (std::size_t ch = 0; ch < 3; ++ch) {
+        e.constant[ch] = static_cast<float>(e.sh.c[ch][0] * kShY00);
+        e.sh.c[ch][0] = 0.0;
+    }
+    return e;
+}
+
+ShadingLight environmentShadingLight(const ShRgb& radiance, const VisibilityField& v) {
     ShadingLight out;
     out.visibility = &v;
-    for (std::size_t ch = 0; ch < 3; ++ch) {
-        ShVector radiance = environment.c[ch];
-        constant[ch] = splitSky ? static_cast<float>(radiance[0] * kShY00) : 0.0f;
-        if (splitSky) radiance[0] = 0.0;
-        out.product[ch] = shProductMatrix(radiance);
-    }
+    for (std::size_t ch = 0; ch < 3; ++ch) out.product[ch] = shProductMatrix(radiance.c[ch]);
     return out;
+}
+
+// Whether the frame reads the environment's SH visibility V: the paper's SH
+// ambient does, and so does an environment with a part that goes through the
+// SH product. The exact ambient and sky read the horizons alone, so a
+// uniform or analytic sky (the sun and key lights have their own
+// visibility) needs no V. The sky's parts come with the ambient whenever
+// there is a sky gradient (runDirectStages).
+bool readsEnvironmentSh(const GiLighting& lighting, const GiSettings& settings) {
+    if (settings.ambient == AmbientMethod::ShProduct) return true;
+    const EnvironmentSplit e = splitEnvironment(lighting, settings, lighting.gradient.has_value());
+    VisibilityField none;
+    return lightContributes(environmentShadingLight(e.sh, none));
 }
 
 // The ambient map from the environment scan's horizons (gi/ambient_horizon.h),
@@ -332,26 +365,23 @@ void directShading(const GiLighting& lighting, const GiSettings& settings, const
     const std::size_t nKeys = lighting.keys.size();
     const bool exactKeys = settings.keyLightExactCosine;
     st.shade.keepIncident = readsIncidentSh(settings.indirect, settings.shading);
-    st.shadingLights.resize(1 + (exactKeys ? 0 : nKeys));
-    // With the exact ambient a Lambert shade takes the sky's constant part
-    // from it (addConstantSky) and the SH product only the rest.
     const bool shAmbient = settings.ambient == AmbientMethod::ShProduct;
-    const bool splitSky = !shAmbient && settings.shading.brdf == Brdf::Lambert;
-    // The analytic sky's own function, integrated above the horizons, when
-    // the ambient's parts for it are there; then nothing of it goes through SH.
-    const bool exactSky = splitSky && lighting.gradient && st.shade.skyParts;
-    float skyConstant[3] = {0.0f, 0.0f, 0.0f};
-    st.shadingLights[0] =
-        environmentShadingLight(exactSky ? ShRgb{} : lighting.environment, st.envVisibility, splitSky, skyConstant);
+    const EnvironmentSplit sky = splitEnvironment(lighting, settings, st.shade.skyParts);
+    // An environment lit wholly from the ambient map adds nothing through SH
+    // (and its V may not have been computed): it is left out, which leaves
+    // every other light's sums as they were (its terms are none).
+    st.shadingLights.clear();
+    const ShadingLight environment = environmentShadingLight(sky.sh, st.envVisibility);
+    if (lightContributes(environment)) st.shadingLights.push_back(environment);
     for (std::size_t k = 0; k < (exactKeys ? 0 : nKeys); ++k)
-        st.shadingLights[k + 1] = keyShadingLight(lighting.keys[k], st.keyVisibility[k]);
+        st.shadingLights.push_back(keyShadingLight(lighting.keys[k], st.keyVisibility[k]));
     shadeTexels(st.gradX.cview(), st.gradY.cview(), settings.subsample, st.envVisibility, st.shadingLights.data(),
                 static_cast<int>(st.shadingLights.size()), albedo, settings.shading, st.shade, shAmbient, rows);
-    if (exactSky)
+    if (sky.exactSky)
         addGradientSky({st.shade.ambient, &st.shade.skyBelow, &st.shade.skyRising}, *lighting.gradient, albedo,
                        st.shade.rgb, rows);
-    else if (splitSky)
-        addConstantSky(st.shade.ambient, skyConstant, albedo, st.shade.rgb, rows);
+    else if (sky.splitSky)
+        addConstantSky(st.shade.ambient, sky.constant, albedo, st.shade.rgb, rows);
     if (exactKeys)
         for (std::size_t k = 0; k < nKeys; ++k)
             addKeyLightExactCosine(lighting.keys[k], st.keyVisibility[k], settings.subsample, albedo, st, st.shade.rgb,
@@ -419,6 +449,12 @@ void runDirectStages(ConstGridView heights, float cellSize, const GiLighting& li
     auto t = Clock::now();
     const ReceiverTiles* only = nullptr;     // the environment's tiles to recompute (null: all)
     const ReceiverTiles* keyOnly = nullptr;  // the key lights'
+    const int shRows = readsEnvironmentSh(lighting, settings) ? kShCount : settings.minEnvironmentShRows;
+    // Tiles keep the last V: only when it has the planes this frame reads.
+    const bool samePlanes = st.envVisibility.planes == shRows;
+    // V newly read on unchanged geometry (the lighting now has a part that
+    // goes through SH): the environment's scan reruns for every receiver.
+    const bool shMissing = !change.geometry && st.envVisibility.planes < shRows;
     if (change.geometry) {
         computeGradient(heights, cellSize, st.gradX, st.gradY);
         st.timings.gradient = msSince(t);
@@ -426,12 +462,18 @@ void runDirectStages(ConstGridView heights, float cellSize, const GiLighting& li
         buildHeightPyramid(heights, cellSize, settings.subsample, settings.pyramid, st.pyramid);
         st.timings.pyramid = msSince(t);
         t = Clock::now();
-        if (!plan.tiled) resetVisibilityCache(st.pyramid, st.visibilityCache);
-        only = plan.tiled ? &st.visibilityCache.tiles : nullptr;
+    }
+    if (change.geometry || shMissing) {
+        const bool tiled = plan.tiled && samePlanes;
+        if (change.geometry && !plan.tiled)
+            resetVisibilityCache(st.pyramid, st.visibilityCache);
+        else if (!tiled)
+            forgetEnvironmentDrift(st.visibilityCache);
+        only = tiled ? &st.visibilityCache.tiles : nullptr;
         keyOnly = plan.tiled ? &st.visibilityCache.keyTiles : nullptr;
-        environmentVisibility(settings, only, st);
+        environmentVisibility(settings, shRows, only, st);
         st.timings.visibility += msSince(t);
-        st.receiversRecomputed = plan.tiled ? st.visibilityCache.tiles.dirtyFraction() : 1.0;
+        st.receiversRecomputed = tiled ? st.visibilityCache.tiles.dirtyFraction() : 1.0;
     }
     t = Clock::now();
     keyLightVisibility(lighting, settings, change, keyOnly, st);
@@ -443,8 +485,8 @@ void runDirectStages(ConstGridView heights, float cellSize, const GiLighting& li
         // geometry needs them over the whole field
         const bool withSkyParts = lighting.gradient.has_value();
         const bool partsMissing = withSkyParts && !st.shade.skyParts;
-        if (change.geometry || partsMissing)
-            exactAmbient(heights, cellSize, settings, withSkyParts, st, partsMissing ? nullptr : rows);
+        if (change.geometry || partsMissing || shMissing)
+            exactAmbient(heights, cellSize, settings, withSkyParts, st, partsMissing || shMissing ? nullptr : rows);
     }
     directShading(lighting, settings, albedo, st, rows);
     st.timings.shading = msSince(t);
@@ -517,7 +559,7 @@ void shadeKeyLight(const GiState& st, const GiSettings& settings, const GiLighti
     }
     const ShadingLight sl = keyShadingLight(light, v);
     shadeTexels(st.gradX.cview(), st.gradY.cview(), settings.subsample, st.envVisibility, &sl, 1, nullptr,
-                settings.shading, scratch);
+                settings.shading, scratch, false);
     out = scratch.rgb;
 }
 

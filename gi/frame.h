@@ -89,6 +89,8 @@ void checkHeightsFinite(ConstGridView heights);
 /// Redoes the direct light of every texel (and the ambient map) from the
 /// visibility `st` holds, as the last frame's shading stage would with every
 /// row: what a frame's shading gives, apart from the rows it kept.
+/// InputError when `lighting` has a part that goes through the SH product
+/// and the last frame, whose lighting had none, computed no SH visibility.
 void shadeDirect(const GiLighting& lighting, const GiSettings& settings, const AlbedoMap* albedo, GiState& st);
 
 /// The shade key light k alone gives every texel (white albedo) in the last

@@ -1,5 +1,7 @@
 #include "gi/settings.h"
 
+#include <string>
+
 #include "core/error.h"
 
 namespace terrain::gi {
@@ -28,6 +30,9 @@ GiSettings paperGiSettings() {
 void validateGiSettings(const GiSettings& s) {
     checkRange(ranges::kSubsample, s.subsample);
     if (s.subsample == 3) throw InputError("subsample must be 1, 2 or 4 (got 3)");
+    if (s.minEnvironmentShRows != 0 && s.minEnvironmentShRows != 1 && s.minEnvironmentShRows != kShCount)
+        throw InputError("minEnvironmentShRows must be 0, 1 or 16 (got " + std::to_string(s.minEnvironmentShRows) +
+                         ")");
     checkRange(ranges::kAzimuths, s.visibility.azimuths);
     checkRange(ranges::kLevelsPerOctave, s.pyramid.levelsPerOctave);
     checkRange(ranges::kLevelOffset, s.pyramid.levelOffset);

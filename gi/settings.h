@@ -29,6 +29,13 @@ struct GiSettings {
     // (gi/ambient_horizon.h) instead of lam(N) . V_env / pi, whose order-4
     // SH truncation is a floor on its error (bench/results/gi_accuracy.md).
     AmbientMethod ambient = AmbientMethod::Horizons;  // paper: ShProduct
+    // At least this many SH rows of the environment's V are computed: 0, 1
+    // (V_00, the visible fraction of the sky at each receiver: the renderer's
+    // water dims its mirrored sky by it) or 16 (diagnostics that shade with
+    // V). The frame computes all 16 when a light or the SH ambient reads V;
+    // a uniform or analytic sky with the exact ambient reads the horizons
+    // alone.
+    int minEnvironmentShRows = 0;
     ShadingSettings shading;
     IndirectSettings indirect;  // bounces, radiance pyramid, amortisation
     // Incremental frames (gi/frame_change.h): a stage reruns only when its

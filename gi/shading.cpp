@@ -579,12 +579,50 @@ void shadeBlock(const BlockSchedule& b, PhongRowJob job, int block, std::size_t 
     }
 }
 
+// Every light that adds something reads all the SH planes of its visibility
+// (a horizons-only field has none); the ambient map reads V_env's bands 0..2.
+void requireVisibilityPlanes(const VisibilityField& env, const ShadingLight* lights, int lightCount, bool ambient) {
+    if (ambient && env.planes < 9)
+        throw InputError("shading: the ambient map needs the environment's SH visibility (bands 0..2)");
+    for (int L = 0; L < lightCount; ++L)
+        if (lightContributes(lights[L]) && (!lights[L].visibility || lights[L].visibility->planes < kShCount))
+            throw InputError("shading: a light needs the SH visibility of its receivers (all 16 planes)");
+}
+
+// No light adds anything and nothing else is asked for: the shade is 0 at
+// the flagged rows (what the SH shading would give, without its work).
+void shadeNothing(int nx, int ny, const std::vector<std::uint8_t>* rows, ShadeMaps& out) {
+    out.nx = nx;
+    out.ny = ny;
+    for (Grid& g : out.rgb) {
+        g.ensureSize(nx, ny);
+        for (int y = 0; y < ny; ++y)
+            if (!rows || (*rows)[static_cast<std::size_t>(y)] != 0)
+                std::fill(g.data() + static_cast<std::size_t>(y) * nx, g.data() + static_cast<std::size_t>(y + 1) * nx,
+                          0.0f);
+    }
+}
+
 }  // namespace
+
+// The incident SH reads exactly the entries that are not 0 in float (buildIncidentTerms).
+bool lightContributes(const ShadingLight& light) {
+    for (const ShMatrix& m : light.product)
+        for (double e : m)
+            if (static_cast<float>(e) != 0.0f) return true;
+    return false;
+}
 
 void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const VisibilityField& env,
                  const ShadingLight* lights, int lightCount, const AlbedoMap* albedo, const ShadingSettings& settings,
                  ShadeMaps& out, bool ambient, const std::vector<std::uint8_t>* rows) {
     const int nx = gradX.nx, ny = gradX.ny;
+    requireVisibilityPlanes(env, lights, lightCount, ambient);
+    if (rows && rows->size() != static_cast<std::size_t>(ny))
+        throw InputError("shading: one row flag per texel row expected");
+    if (!ambient && !out.keepIncident &&
+        std::none_of(lights, lights + lightCount, [](const ShadingLight& l) { return lightContributes(l); }))
+        return shadeNothing(nx, ny, rows, out);
     const int nxr = env.nxr, nyr = env.nyr;
     const std::size_t planeR = static_cast<std::size_t>(nxr) * nyr;
     const bool phong = settings.brdf != Brdf::Lambert;
@@ -594,8 +632,6 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
     // receiver row it shares with the next again (windowed incident SH).
     const int nBlocks = std::clamp(ny / (16 * s), 1, 64);
     const int nxrS = nxr + 8;  // vertical scratch rows padded for 8-wide reads
-    if (rows && rows->size() != static_cast<std::size_t>(ny))
-        throw InputError("shading: one row flag per texel row expected");
     // restricted rows keep the others' incident rows only where the last call kept the field
     const bool fieldKept = out.incident.size() == planeR * 3 * nCoef;
     const std::size_t window = sizeBuffers(nx, ny, nxr, nyr, s, nCoef, nPlanes, nxrS, nBlocks, ambient, out);

@@ -169,6 +169,11 @@ struct ShadeMaps {
     std::vector<std::uint8_t> receiverRows;  // per receiver row: its incident radiance is updated (restricted rows)
 };
 
+/// Whether a light adds anything to a shade: some entry of its product
+/// matrices is not 0 in float. A light that does reads all 16 SH planes of
+/// its visibility.
+bool lightContributes(const ShadingLight& light);
+
 /// Shades every texel. envVisibility supplies the ambient map (with ambient
 /// false none is made and out.ambient is left as it is: the indirect bounces,
 /// the exact ambient of gi/ambient_horizon.h);
@@ -177,6 +182,9 @@ struct ShadeMaps {
 /// flagged rows are shaded, the others keep what `out` holds, which must be
 /// a result of the same size and settings (which rows may keep theirs is the
 /// caller's: gi/shading_rows.h). Each row's values do not depend on the rows.
+/// When no light adds anything and neither the ambient nor the incident SH
+/// is asked for, the flagged rows are 0 without the SH work. InputError when
+/// the ambient or a light that adds something lacks the SH planes it reads.
 void shadeTexels(ConstGridView gradX, ConstGridView gradY, int subsample, const VisibilityField& envVisibility,
                  const ShadingLight* lights, int lightCount, const AlbedoMap* albedo, const ShadingSettings& settings,
                  ShadeMaps& out, bool ambient = true, const std::vector<std::uint8_t>* rows = nullptr);

@@ -420,6 +420,7 @@ template <class V>
             scanRow<V, 8, BsplineMaxVisitor>(table, colSteps, rowSteps, r.Y, r.h0, r.spans, r.maxRow, r.rowPtr);
         float* maxOut = r.maxSlope + planeSize * j + static_cast<std::size_t>(r.Y) * r.nxr;
         for (const ColumnSpan& span : r.spans) std::copy(r.maxRow + span.x0, r.maxRow + span.x1, maxOut + span.x0);
+        if (P == 0) continue;  // horizons only (horizonsOnly): no V
         float* nlp = r.nlp + static_cast<std::size_t>(a) * 4 * r.nxrPad;
         const float cj = r.cosSin[2 * static_cast<std::size_t>(j)], sj = r.cosSin[2 * static_cast<std::size_t>(j) + 1];
         const float* tgx = r.foot ? r.gradX + (cj >= 0.0f ? 1 : 2) * r.nxrPad : r.gradX;
@@ -428,7 +429,8 @@ template <class V>
         nlps[a] = nlp;
         ops[a] = r.op->values.data() + static_cast<std::size_t>(j) * P;
     }
-    accumulateRows<V>(nlps, ops, r.batch, r.op->patternRow.data(), r.op->patternNlp.data(), P, r.vRows, r.nxr, r.spans,
+    if (P > 0)
+        accumulateRows<V>(nlps, ops, r.batch, r.op->patternRow.data(), r.op->patternNlp.data(), P, r.vRows, r.nxr, r.spans,
                       r.nxrPad);
 }
 

@@ -138,8 +138,8 @@ struct VisibilityTarget {
     float sinLow = -1.0f, sinHigh = 1.0f;
 };
 
-/// SH visibility of every receiver (16 planes, or V_00 alone for an
-/// operator of one row) and its scan by-products.
+/// SH visibility of every receiver (16 planes, V_00 alone for an operator
+/// of one row, none for horizonsOnly) and its scan by-products.
 struct VisibilityField {
     int nxr = 0, nyr = 0;
     int planes = kShCount;        // SH planes held (FoldedWedgeOperator::shRows)

@@ -25,6 +25,8 @@ void resetVisibilityCache(const HeightPyramid& pyr, VisibilityCache& cache) {
     cache.geometryDrift.assign(cache.tiles.dirty.size(), 0.0f);
 }
 
+void forgetEnvironmentDrift(VisibilityCache& cache) { std::fill(cache.drift.begin(), cache.drift.end(), 0.0f); }
+
 bool shouldPlanTiles(VisibilityCache& cache) {
     if (cache.framesWithoutPlan == 0) return true;
     --cache.framesWithoutPlan;

@@ -68,6 +68,10 @@ bool shouldPlanTiles(VisibilityCache& cache);
 /// Forgets the drift: every tile's V is about to be computed from scratch.
 void resetVisibilityCache(const HeightPyramid& pyr, VisibilityCache& cache);
 
+/// Every receiver's environment V has just been computed: its drifts are 0
+/// (the key lights' and the geometry's are kept, their results were not).
+void forgetEnvironmentDrift(VisibilityCache& cache);
+
 /// Adds the change from `before` to the pyramid's heights `after` to every
 /// tile's drifts and marks the tiles whose drift exceeds `tolerance` (their
 /// drift reset to 0): cache.tiles for the environment's V (`vis`: its

@@ -139,6 +139,12 @@ FoldedWedgeOperator firstRowOnly(FoldedWedgeOperator op) {
     return op;
 }
 
+FoldedWedgeOperator horizonsOnly(FoldedWedgeOperator op) {
+    op.shRows = 0;
+    buildSparse(op);
+    return op;
+}
+
 FoldedWedgeOperator foldPartialRange(double phiStart, double phiEnd, int azimuths) {
     FoldedWedgeOperator op;
     op.azimuths = azimuths;

@@ -48,7 +48,7 @@ struct FoldedWedgeOperator {
     std::vector<std::uint8_t> patternRow;  // SH row of each entry
     std::vector<std::uint8_t> patternNlp;  // NLP index of each entry
     std::vector<float> values;             // azimuths x pattern size
-    int shRows = kShCount;                 // SH rows of V it gives: all, or 1 (firstRowOnly)
+    int shRows = kShCount;                 // SH rows of V it gives: all, 1 (firstRowOnly) or 0 (horizonsOnly)
     int patternSize() const { return static_cast<int>(patternRow.size()); }
 };
 
@@ -64,6 +64,13 @@ FoldedWedgeOperator foldPartialRange(double phiStart, double phiEnd, int azimuth
 /// visible fraction of the domain): all that an exact-cosine key light reads,
 /// at a sixteenth of the output.
 FoldedWedgeOperator firstRowOnly(FoldedWedgeOperator op);
+
+/// The operator with no SH row: the scan gives its horizons (the maximum
+/// blocking slope per azimuth) and no V, for a frame whose every reader of
+/// the environment's visibility takes the horizons (the exact ambient and
+/// sky, gi/ambient_horizon.h): the NLP vectors and V = sum_j G_j w_j
+/// (Eq. 21) are then work nothing reads.
+FoldedWedgeOperator horizonsOnly(FoldedWedgeOperator op);
 
 /// Reference application of the dense operator: V = G [w_0; ...; w_{m-1}].
 void applyFoldedDense(const FoldedWedgeOperator& op, const double* nlp, double out[kShCount]);
