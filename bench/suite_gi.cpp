@@ -20,6 +20,7 @@
 
 #include <unistd.h>
 
+#include "bench/spread.h"
 #include "bench/suites.h"
 #include "core/error.h"
 #include "core/parallel.h"
@@ -187,6 +188,7 @@ public:
     void stages() const;
     void quickAccuracy() const;
     void dems() const;
+    void frameTime() const;
     void plotFromCsv() const;
     void cpuStages() const;
     void tileTiming() const;
@@ -314,6 +316,69 @@ void GiSuite::dems() const {
     }
     writeResult(ctx_.outDir, "gi_ambient_dems.md", md);
     writeResult(ctx_.outDir, "gi_ambient_dems.csv", csv);
+}
+
+// frame-time: the whole frame on every real DEM at 1x and 2x, 2 threads, the
+// engine against itself before the exact ambient (SH ambient, peak blend
+// 0.5), each under a uniform sky (the ambient's own frame: the engine reads
+// the horizons alone and computes no SH visibility) and under the sun and
+// sky projected on SH (a lighting that reads V in both). Rounds interleave
+// the four so that the machine's drift falls on all alike.
+void GiSuite::frameTime() const {
+    struct Case {
+        const char* label;
+        GiSettings s;
+        GiLighting light;
+        std::vector<double> ms;
+        GiState st;
+    };
+    constexpr int kRounds = 3;
+    GiLighting shSky;
+    shSky.environment = sunSkyLight();
+    std::string md = "# Frame time of the exact ambient\n\n";
+    md += "Whole GI frame (gradient, pyramid, visibility, ambient, shading), 2 threads, median and interquartile range of " +
+          std::to_string(kRounds * o_.runs) + " frames (" + std::to_string(kRounds) +
+          " interleaved rounds of " + std::to_string(o_.runs) +
+          " after a warm-up). \"engine\": GiSettings{}; \"before\": the same with the order-4 SH ambient and "
+          "peak blend 0.5 (the engine before the exact ambient). Uniform sky: the ambient's own frame (the engine "
+          "reads the scan's horizons alone and computes no SH visibility V); SH sky: sunSkyLight() projected on SH, "
+          "whose variation goes through the SH product in both, so both compute V. Ratio: engine over before under "
+          "the same sky.\n\n" +
+          provenance();
+    md += "| DEM | cells | s | sky | engine ms | IQR | before ms | IQR | ratio |\n|---|---|---|---|---|---|---|---|---|\n";
+    std::string csv = "dem,subsample,sky,engine_ms,engine_iqr,before_ms,before_iqr,ratio\n";
+    for (const Dem& d : realDems(ctx_.dataDir))
+        for (int s : {1, 2}) {
+            std::vector<Case> cases;
+            cases.push_back({"uniform", withSubsample(engineDefaults(), s), GiLighting{}, {}, {}});
+            cases.push_back({"uniform", withSubsample(engineBeforeExactAmbient(), s), GiLighting{}, {}, {}});
+            cases.push_back({"SH", withSubsample(engineDefaults(), s), shSky, {}, {}});
+            cases.push_back({"SH", withSubsample(engineBeforeExactAmbient(), s), shSky, {}, {}});
+            withThreads(2, [&] {
+                for (Case& c : cases) runGiFrame(d.heights.cview(), d.cell, c.light, c.s, c.st);
+                for (int round = 0; round < kRounds; ++round)
+                    for (Case& c : cases)
+                        for (int r = 0; r < o_.runs; ++r) {
+                            runGiFrame(d.heights.cview(), d.cell, c.light, c.s, c.st);
+                            c.ms.push_back(c.st.timings.total);
+                        }
+                return 0;
+            });
+            for (std::size_t k = 0; k < cases.size(); k += 2) {
+                const Spread e = spreadOf(cases[k].ms), b = spreadOf(cases[k + 1].ms);
+                char row[256];
+                std::snprintf(row, sizeof row, "| %s | %d x %d | %dx | %s | %.1f | %.1f | %.1f | %.1f | %.2fx |\n",
+                              d.name.c_str(), d.heights.nx, d.heights.ny, s, cases[k].label, e.median, e.iqr(),
+                              b.median, b.iqr(), e.median / b.median);
+                md += row;
+                std::snprintf(row, sizeof row, "%s,%d,%s,%.2f,%.2f,%.2f,%.2f,%.3f\n", d.name.c_str(), s,
+                              cases[k].label, e.median, e.iqr(), b.median, b.iqr(), e.median / b.median);
+                csv += row;
+                std::fprintf(stderr, "%s", row);
+            }
+        }
+    writeResult(ctx_.outDir, "gi_frame_time.md", md);
+    writeResult(ctx_.outDir, "gi_frame_time.csv", csv);
 }
 
 void GiSuite::runSettingsRows(const Dem& d, const Grid& ref, int border, std::vector<Row>& rows, int threads) const {
@@ -761,6 +826,10 @@ const Mode kModes[] = {
      &GiSuite::quickAccuracy},
     {"dems", "Ambient error and time on every real DEM, engine vs before vs paper (gi_ambient_dems.md, .csv)",
      &GiSuite::dems},
+    {"frame-time",
+     "Whole-frame time on every real DEM at 1x/2x: engine vs before the exact ambient, uniform and SH sky "
+     "(gi_frame_time.md, .csv)",
+     &GiSuite::frameTime},
     {"plot", "Only redraw gi_speed_error.png and .svg from an existing gi_timing.csv (bench/plots/gi_speed_error.py)",
      &GiSuite::plotFromCsv},
     {"cpu", "CPU time per stage, one thread, minimum over the runs (stdout)", &GiSuite::cpuStages},
