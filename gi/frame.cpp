@@ -10,6 +10,7 @@
 #include "core/parallel.h"
 #include "gi/indirect.h"
 #include "gi/indirect_bounces.h"
+#include "gi/key_light_exact.h"
 #include "gi/shading_rows.h"
 
 namespace terrain::gi {
@@ -72,50 +73,6 @@ void runIndirectStage(const GiSettings& settings, const FrameChange& change, GiS
     if (cached) recordIndirectSource(st.shade.rgb, st.pyramid, only == nullptr, st.indirectCache);
     st.indirectRecomputed = only ? only->dirtyFraction() : 1.0;
     st.timings.indirect = msSince(t);
-}
-
-// Key light with the exact cosine (GiSettings::keyLightExactCosine): adds
-// albedo RGB f max(0, N . l) to the shade, f = visible fraction of the light's
-// region, bilinear from the receiver grid like the SH vectors (Fig. 7).
-void addKeyLightExactCosine(const KeyLight& light, const VisibilityField& v, int s, const AlbedoMap* albedo,
-                            const GiState& st, std::array<Grid, 3>& out,
-                            const std::vector<std::uint8_t>* rows = nullptr) {
-    const KeyLightExtent ext = keyLightExtent(light);
-    const double solidAngle = (ext.phiEnd - ext.phiStart) * (static_cast<double>(ext.sinHigh) - ext.sinLow);
-    if (!(solidAngle > 0.0)) return;
-    const float toFrac = static_cast<float>(std::sqrt(4.0 * kPi) / solidAngle);
-    const double az = light.azimuthDeg * kPi / 180.0, el = light.elevationDeg * kPi / 180.0;
-    const float lx = static_cast<float>(std::cos(el) * std::cos(az)),
-                ly = static_cast<float>(std::cos(el) * std::sin(az));
-    const float lz = static_cast<float>(std::sin(el));
-    const int nx = st.gradX.nx, ny = st.gradX.ny, nxr = v.nxr, nyr = v.nyr;
-    const float* v0 = v.plane(0);
-    const float invS = 1.0f / static_cast<float>(s);
-    parallelForRows(ny, nx, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y) {
-            if (rows && (*rows)[static_cast<std::size_t>(y)] == 0) continue;  // shaded with the rest of its row
-            const int Y0 = std::min(y / s, nyr - 1), Y1 = std::min(Y0 + 1, nyr - 1);
-            const float fy = Y1 == Y0 ? 0.0f : static_cast<float>(y - s * Y0) * invS;
-            const float* r0 = v0 + static_cast<std::size_t>(Y0) * nxr;
-            const float* r1 = v0 + static_cast<std::size_t>(Y1) * nxr;
-            for (int x = 0; x < nx; ++x) {
-                const int X0 = std::min(x / s, nxr - 1), X1 = std::min(X0 + 1, nxr - 1);
-                const float fx = X1 == X0 ? 0.0f : static_cast<float>(x - s * X0) * invS;
-                const float a = r0[X0] + fx * (r0[X1] - r0[X0]);
-                const float b = r1[X0] + fx * (r1[X1] - r1[X0]);
-                const float f = std::clamp((a + fy * (b - a)) * toFrac, 0.0f, 1.0f);
-                const float gx = st.gradX(x, y), gy = st.gradY(x, y);
-                const float cosine = (lz - gx * lx - gy * ly) / std::sqrt(1.0f + gx * gx + gy * gy);
-                if (!(cosine > 0.0f) || !(f > 0.0f)) continue;
-                for (int c = 0; c < 3; ++c) {
-                    const float alb = albedo && !albedo->channel[static_cast<std::size_t>(c)].empty()
-                                          ? albedo->channel[static_cast<std::size_t>(c)](x, y)
-                                          : 1.0f;
-                    out[static_cast<std::size_t>(c)](x, y) += alb * light.rgb[c] * f * cosine;
-                }
-            }
-        }
-    });
 }
 
 // The key light as the SH shading stage sees it (Section 6): its visibility
@@ -384,7 +341,8 @@ void directShading(const GiLighting& lighting, const GiSettings& settings, const
         addConstantSky(st.shade.ambient, sky.constant, albedo, st.shade.rgb, rows);
     if (exactKeys)
         for (std::size_t k = 0; k < nKeys; ++k)
-            addKeyLightExactCosine(lighting.keys[k], st.keyVisibility[k], settings.subsample, albedo, st, st.shade.rgb,
+            addKeyLightExactCosine(lighting.keys[k], st.keyVisibility[k], settings.subsample, st.gradX.cview(),
+                                   st.gradY.cview(), albedo, st.shade.rgb,
                                    rows);
 }
 
@@ -554,7 +512,7 @@ void shadeKeyLight(const GiState& st, const GiSettings& settings, const GiLighti
     const VisibilityField& v = st.keyVisibility[static_cast<std::size_t>(k)];
     if (settings.keyLightExactCosine) {
         for (Grid& g : out) g.resize(st.gradX.nx, st.gradX.ny, 0.0f);
-        addKeyLightExactCosine(light, v, settings.subsample, nullptr, st, out);
+        addKeyLightExactCosine(light, v, settings.subsample, st.gradX.cview(), st.gradY.cview(), nullptr, out);
         return;
     }
     const ShadingLight sl = keyShadingLight(light, v);
