@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "core/parallel.h"
 #include "core/simd.h"
@@ -43,6 +44,16 @@ void addKeyLightExactCosine(const KeyLight& light, const VisibilityField& v, int
     const int nx = gradX.nx, ny = gradX.ny, nxr = v.nxr, nyr = v.nyr;
     const float* v0 = v.plane(0);
     const float invS = 1.0f / static_cast<float>(s);
+    // each texel column's receivers and fraction, once per call
+    struct Column {
+        int X0, X1;
+        float fx;
+    };
+    std::vector<Column> columns(static_cast<std::size_t>(nx));
+    for (int x = 0; x < nx; ++x) {
+        const int X0 = std::min(x / s, nxr - 1), X1 = std::min(X0 + 1, nxr - 1);
+        columns[static_cast<std::size_t>(x)] = {X0, X1, X1 == X0 ? 0.0f : static_cast<float>(x - s * X0) * invS};
+    }
     parallelForRows(ny, nx, [&](int y0, int y1) {
         float cosine[kChunk];
         for (int y = y0; y < y1; ++y) {
@@ -57,10 +68,9 @@ void addKeyLightExactCosine(const KeyLight& light, const VisibilityField& v, int
                 for (int k = 0; k < n; ++k) {
                     const int x = c0 + k;
                     if (!(cosine[k] > 0.0f)) continue;
-                    const int X0 = std::min(x / s, nxr - 1), X1 = std::min(X0 + 1, nxr - 1);
-                    const float fx = X1 == X0 ? 0.0f : static_cast<float>(x - s * X0) * invS;
-                    const float a = r0[X0] + fx * (r0[X1] - r0[X0]);
-                    const float b = r1[X0] + fx * (r1[X1] - r1[X0]);
+                    const Column& col = columns[static_cast<std::size_t>(x)];
+                    const float a = r0[col.X0] + col.fx * (r0[col.X1] - r0[col.X0]);
+                    const float b = r1[col.X0] + col.fx * (r1[col.X1] - r1[col.X0]);
                     const float f = std::clamp((a + fy * (b - a)) * toFrac, 0.0f, 1.0f);
                     if (!(f > 0.0f)) continue;
                     for (std::size_t c = 0; c < 3; ++c) {
