@@ -38,6 +38,8 @@ struct GiState {
     AzimuthInterp indirectOperatorInterp = AzimuthInterp::Linear;
     VisibilityState visibilityState;
     FootprintBox footprint;  // this frame's receiver footprint boxes (sub-sampling)
+    // The environment's scan: its horizons always; its SH planes V all 16 when
+    // a light or the SH ambient reads them, else GiSettings::minEnvironmentShRows.
     VisibilityField envVisibility;
     std::vector<FoldedWedgeOperator> keyOperators;
     std::vector<KeyLight> keyOperatorLights;  // the lights the key operators were built for
