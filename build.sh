@@ -29,6 +29,9 @@ PACKAGES=(
   clang libclang-rt-14-dev
 )
 
+# the benchmarks draw their plots with matplotlib (bench/plots/)
+if [ "${1:-}" = bench ]; then PACKAGES+=(python3-matplotlib); fi
+
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

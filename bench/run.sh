@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 B=build
 if [ $# -gt 0 ] && [ -f "$1/CMakeCache.txt" ]; then B=$1; shift; fi  # a build folder, not a suite
 
-# suite -> its terrain_bench arguments (gi runs its four modes in one process,
+# suite -> its terrain_bench arguments (gi runs its five modes in one process,
 # so they share the ground truths it computes)
 declare -A ARGS=(
   [sim]="sim"
@@ -18,7 +18,7 @@ declare -A ARGS=(
   [scaling]="scaling"
   [table1]="table1"
   [speed-vs-error]="speed-vs-error"
-  [gi]="gi accuracy convergence timing dems"
+  [gi]="gi accuracy convergence timing dems frame-time"
   [gi-sunsky]="gi-sunsky"
   [gi-indirect]="gi-indirect"
   [gi-glossy]="gi-glossy"
