@@ -343,7 +343,9 @@ void GiSuite::frameTime() const {
           "peak blend 0.5 (the engine before the exact ambient). Uniform sky: the ambient's own frame (the engine "
           "reads the scan's horizons alone and computes no SH visibility V); SH sky: sunSkyLight() projected on SH, "
           "whose variation goes through the SH product in both, so both compute V. Ratio: engine over before under "
-          "the same sky.\n\n" +
+          "the same sky. The ambient maps are those of `gi dems` bit for bit (its errors against the exact reference "
+          "hold: gi_ambient_dems.md); a frame that computes no V gives the same outputs as one that does "
+          "(tests/test_gi_environment_sh.cpp).\n\n" +
           provenance();
     md += "| DEM | cells | s | sky | engine ms | IQR | before ms | IQR | ratio |\n|---|---|---|---|---|---|---|---|---|\n";
     std::string csv = "dem,subsample,sky,engine_ms,engine_iqr,before_ms,before_iqr,ratio\n";
