@@ -336,18 +336,22 @@ void GiSuite::frameTime() const {
     GiLighting shSky;
     shSky.environment = sunSkyLight();
     std::string md = "# Frame time of the exact ambient\n\n";
-    md += "Whole GI frame (gradient, pyramid, visibility, ambient, shading), 2 threads, median and interquartile range of " +
-          std::to_string(kRounds * o_.runs) + " frames (" + std::to_string(kRounds) +
-          " interleaved rounds of " + std::to_string(o_.runs) +
-          " after a warm-up). \"engine\": GiSettings{}; \"before\": the same with the order-4 SH ambient and "
-          "peak blend 0.5 (the engine before the exact ambient). Uniform sky: the ambient's own frame (the engine "
-          "reads the scan's horizons alone and computes no SH visibility V); SH sky: sunSkyLight() projected on SH, "
-          "whose variation goes through the SH product in both, so both compute V. Ratio: engine over before under "
-          "the same sky. The ambient maps are those of `gi dems` bit for bit (its errors against the exact reference "
-          "hold: gi_ambient_dems.md); a frame that computes no V gives the same outputs as one that does "
-          "(tests/test_gi_environment_sh.cpp).\n\n" +
-          provenance();
-    md += "| DEM | cells | s | sky | engine ms | IQR | before ms | IQR | ratio |\n|---|---|---|---|---|---|---|---|---|\n";
+    md +=
+        "Whole GI frame (gradient, pyramid, visibility, ambient, shading), 2 threads, median and interquartile range "
+        "of " +
+        std::to_string(kRounds * o_.runs) + " frames (" + std::to_string(kRounds) + " interleaved rounds of " +
+        std::to_string(o_.runs) +
+        " after a warm-up). \"engine\": GiSettings{}; \"before\": the same with the order-4 SH ambient and "
+        "peak blend 0.5 (the engine before the exact ambient). Uniform sky: the ambient's own frame (the engine "
+        "reads the scan's horizons alone and computes no SH visibility V); SH sky: sunSkyLight() projected on SH, "
+        "whose variation goes through the SH product in both, so both compute V. Ratio: engine over before under "
+        "the same sky. The ambient maps are those of `gi dems` bit for bit (its errors against the exact reference "
+        "hold: gi_ambient_dems.md); a frame that computes no V gives the same outputs as one that does "
+        "(tests/test_gi_environment_sh.cpp).\n\n" +
+        provenance();
+    md +=
+        "| DEM | cells | s | sky | engine ms | IQR | before ms | IQR | ratio "
+        "|\n|---|---|---|---|---|---|---|---|---|\n";
     std::string csv = "dem,subsample,sky,engine_ms,engine_iqr,before_ms,before_iqr,ratio\n";
     for (const Dem& d : realDems(ctx_.dataDir))
         for (int s : {1, 2}) {
@@ -368,15 +372,13 @@ void GiSuite::frameTime() const {
             });
             for (std::size_t k = 0; k < cases.size(); k += 2) {
                 const Spread e = spreadOf(cases[k].ms), b = spreadOf(cases[k + 1].ms);
-                char row[256];
-                std::snprintf(row, sizeof row, "| %s | %d x %d | %dx | %s | %.1f | %.1f | %.1f | %.1f | %.2fx |\n",
-                              d.name.c_str(), d.heights.nx, d.heights.ny, s, cases[k].label, e.median, e.iqr(),
-                              b.median, b.iqr(), e.median / b.median);
-                md += row;
-                std::snprintf(row, sizeof row, "%s,%d,%s,%.2f,%.2f,%.2f,%.2f,%.3f\n", d.name.c_str(), s,
-                              cases[k].label, e.median, e.iqr(), b.median, b.iqr(), e.median / b.median);
+                md += fmt("| %s | %d x %d | %dx | %s | %.1f | %.1f | %.1f | %.1f | %.2fx |\n", d.name.c_str(),
+                          d.heights.nx, d.heights.ny, s, cases[k].label, e.median, e.iqr(), b.median, b.iqr(),
+                          e.median / b.median);
+                const std::string row = fmt("%s,%d,%s,%.2f,%.2f,%.2f,%.2f,%.3f\n", d.name.c_str(), s, cases[k].label,
+                                            e.median, e.iqr(), b.median, b.iqr(), e.median / b.median);
                 csv += row;
-                std::fprintf(stderr, "%s", row);
+                std::fprintf(stderr, "%s", row.c_str());
             }
         }
     writeResult(ctx_.outDir, "gi_frame_time.md", md);

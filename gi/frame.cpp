@@ -252,9 +252,9 @@ void keyLightVisibility(const GiLighting& lighting, const GiSettings& settings, 
 // there, the analytic sky's whole function (addGradientSky); only the rest
 // goes through the SH product.
 struct EnvironmentSplit {
-    bool splitSky = false;                     // the constant part is lit from the ambient map
-    bool exactSky = false;                     // the analytic sky is lit from the ambient's parts
-    ShRgb sh;                                  // what goes through the SH product
+    bool splitSky = false;                   // the constant part is lit from the ambient map
+    bool exactSky = false;                   // the analytic sky is lit from the ambient's parts
+    ShRgb sh;                                // what goes through the SH product
     float constant[3] = {0.0f, 0.0f, 0.0f};  // RGB radiance lit from the ambient map (splitSky)
 };
 
@@ -324,14 +324,11 @@ void directShading(const GiLighting& lighting, const GiSettings& settings, const
     st.shade.keepIncident = readsIncidentSh(settings.indirect, settings.shading);
     const bool shAmbient = settings.ambient == AmbientMethod::ShProduct;
     const EnvironmentSplit sky = splitEnvironment(lighting, settings, st.shade.skyParts);
-    // An environment lit wholly from the ambient map adds nothing through SH
-    // (and its V may not have been computed): it is left out, which leaves
-    // every other light's sums as they were (its terms are none).
-    st.shadingLights.clear();
-    const ShadingLight environment = environmentShadingLight(sky.sh, st.envVisibility);
-    if (lightContributes(environment)) st.shadingLights.push_back(environment);
+    st.shadingLights.resize(1 + (exactKeys ? 0 : nKeys));
+    // the shading leaves the environment out when nothing of it goes through SH
+    st.shadingLights[0] = environmentShadingLight(sky.sh, st.envVisibility);
     for (std::size_t k = 0; k < (exactKeys ? 0 : nKeys); ++k)
-        st.shadingLights.push_back(keyShadingLight(lighting.keys[k], st.keyVisibility[k]));
+        st.shadingLights[k + 1] = keyShadingLight(lighting.keys[k], st.keyVisibility[k]);
     shadeTexels(st.gradX.cview(), st.gradY.cview(), settings.subsample, st.envVisibility, st.shadingLights.data(),
                 static_cast<int>(st.shadingLights.size()), albedo, settings.shading, st.shade, shAmbient, rows);
     if (sky.exactSky)
@@ -342,8 +339,7 @@ void directShading(const GiLighting& lighting, const GiSettings& settings, const
     if (exactKeys)
         for (std::size_t k = 0; k < nKeys; ++k)
             addKeyLightExactCosine(lighting.keys[k], st.keyVisibility[k], settings.subsample, st.gradX.cview(),
-                                   st.gradY.cview(), albedo, st.shade.rgb,
-                                   rows);
+                                   st.gradY.cview(), albedo, st.shade.rgb, rows);
 }
 
 // Which receivers' visibility the frame recomputes, planned before any stage

@@ -579,14 +579,23 @@ void shadeBlock(const BlockSchedule& b, PhongRowJob job, int block, std::size_t 
     }
 }
 
-// Every light that adds something reads all the SH planes of its visibility
-// (a horizons-only field has none); the ambient map reads V_env's bands 0..2.
-void requireVisibilityPlanes(const VisibilityField& env, const ShadingLight* lights, int lightCount, bool ambient) {
+// The lights that add something, in their order, into out.activeLights: a
+// light that adds nothing (an environment lit wholly from the ambient map,
+// whose V may not have been computed) has no incident terms, so leaving it
+// out leaves every other light's sums as they were. Each light kept reads all
+// the SH planes of its visibility (a horizons-only field has none); the
+// ambient map reads V_env's bands 0..2.
+void keepActiveLights(const VisibilityField& env, const ShadingLight* lights, int lightCount, bool ambient,
+                      ShadeMaps& out) {
     if (ambient && env.planes < 9)
         throw InputError("shading: the ambient map needs the environment's SH visibility (bands 0..2)");
-    for (int L = 0; L < lightCount; ++L)
-        if (lightContributes(lights[L]) && (!lights[L].visibility || lights[L].visibility->planes < kShCount))
+    out.activeLights.clear();
+    for (int L = 0; L < lightCount; ++L) {
+        if (!lightContributes(lights[L])) continue;
+        if (!lights[L].visibility || lights[L].visibility->planes < kShCount)
             throw InputError("shading: a light needs the SH visibility of its receivers (all 16 planes)");
+        out.activeLights.push_back(lights[L]);
+    }
 }
 
 // No light adds anything and nothing else is asked for: the shade is 0 at
@@ -617,12 +626,12 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
                  const ShadingLight* lights, int lightCount, const AlbedoMap* albedo, const ShadingSettings& settings,
                  ShadeMaps& out, bool ambient, const std::vector<std::uint8_t>* rows) {
     const int nx = gradX.nx, ny = gradX.ny;
-    requireVisibilityPlanes(env, lights, lightCount, ambient);
     if (rows && rows->size() != static_cast<std::size_t>(ny))
         throw InputError("shading: one row flag per texel row expected");
-    if (!ambient && !out.keepIncident &&
-        std::none_of(lights, lights + lightCount, [](const ShadingLight& l) { return lightContributes(l); }))
-        return shadeNothing(nx, ny, rows, out);
+    keepActiveLights(env, lights, lightCount, ambient, out);
+    lights = out.activeLights.data();
+    lightCount = static_cast<int>(out.activeLights.size());
+    if (!ambient && !out.keepIncident && lightCount == 0) return shadeNothing(nx, ny, rows, out);
     const int nxr = env.nxr, nyr = env.nyr;
     const std::size_t planeR = static_cast<std::size_t>(nxr) * nyr;
     const bool phong = settings.brdf != Brdf::Lambert;

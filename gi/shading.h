@@ -153,11 +153,12 @@ struct ShadeMaps {
     // rows it reads into its worker's window (a few rows, not the field).
     bool keepIncident = false;
     // receiver-resolution buffers
-    std::vector<float> incident;        // with keepIncident: 3 x coefficients planes, sum over lights of T_L V
-    std::vector<float> incidentWindow;  // without: per worker slot, those planes at one block's receiver rows
-    std::vector<int> colIndex;          // per full-res column: left receiver
-    std::vector<float> colFrac;         // and the fraction towards the right one
-    std::vector<float> lightMatrices;   // lights x 3 x 16 x 16, float copies of the product matrices
+    std::vector<float> incident;             // with keepIncident: 3 x coefficients planes, sum over lights of T_L V
+    std::vector<float> incidentWindow;       // without: per worker slot, those planes at one block's receiver rows
+    std::vector<int> colIndex;               // per full-res column: left receiver
+    std::vector<float> colFrac;              // and the fraction towards the right one
+    std::vector<ShadingLight> activeLights;  // the call's lights that add something (lightContributes)
+    std::vector<float> lightMatrices;        // lights x 3 x 16 x 16, float copies of the product matrices
     struct Term {
         float value;  // the matrix entry
         int index;    // light * 16 + k
@@ -182,9 +183,10 @@ bool lightContributes(const ShadingLight& light);
 /// flagged rows are shaded, the others keep what `out` holds, which must be
 /// a result of the same size and settings (which rows may keep theirs is the
 /// caller's: gi/shading_rows.h). Each row's values do not depend on the rows.
-/// When no light adds anything and neither the ambient nor the incident SH
-/// is asked for, the flagged rows are 0 without the SH work. InputError when
-/// the ambient or a light that adds something lacks the SH planes it reads.
+/// Lights that add nothing are left out (their visibility is not read); when
+/// none is left and neither the ambient nor the incident SH is asked for, the
+/// flagged rows are 0 without the SH work. InputError when the ambient or a
+/// light that adds something lacks the SH planes it reads.
 void shadeTexels(ConstGridView gradX, ConstGridView gradY, int subsample, const VisibilityField& envVisibility,
                  const ShadingLight* lights, int lightCount, const AlbedoMap* albedo, const ShadingSettings& settings,
                  ShadeMaps& out, bool ambient = true, const std::vector<std::uint8_t>* rows = nullptr);

@@ -429,9 +429,8 @@ template <class V>
         nlps[a] = nlp;
         ops[a] = r.op->values.data() + static_cast<std::size_t>(j) * P;
     }
-    if (P > 0)
-        accumulateRows<V>(nlps, ops, r.batch, r.op->patternRow.data(), r.op->patternNlp.data(), P, r.vRows, r.nxr, r.spans,
-                      r.nxrPad);
+    accumulateRows<V>(nlps, ops, r.batch, r.op->patternRow.data(), r.op->patternNlp.data(), P, r.vRows, r.nxr, r.spans,
+                      r.nxrPad);  // nothing for P = 0
 }
 
 void rowBatchSse(const RowBatch& r) { rowBatchImpl<simd::F4>(r); }
