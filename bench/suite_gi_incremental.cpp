@@ -219,27 +219,26 @@ std::vector<CaseResult> runCases(const IncrementalOptions& o, const Grid& dem, f
             const int frames = size == 1024 ? std::max(3, o.frames / 3) : o.frames;
             rows.push_back(runCase("erosion", size, sim->state().cellSize, tol, frames, next));
         }
-        if (!o.only.empty()) {
-            // a filtered run: the DEM cases whose name matches
-            if (o.wanted("dem, 16x16 crater"))
-                rows.push_back(runCase("dem, 16x16 crater", 512, cell, tol, kEventFrames, demWithPit(dem, 16)));
-            continue;
+        if (o.wanted("waves 512")) {
+            std::shared_ptr<Simulation> sim;
+            const NextFrame waves = animated("waves", 512, sim);
+            rows.push_back(runCase("waves", 512, sim->state().cellSize, tol, o.frames, waves));
         }
-        std::shared_ptr<Simulation> sim;
-        const NextFrame waves = animated("waves", 512, sim);
-        rows.push_back(runCase("waves", 512, sim->state().cellSize, tol, o.frames, waves));
-        rows.push_back(runCase("dem, static", 512, cell, tol, o.frames, [&](int, Grid& s, gi::GiLighting& l) {
-            s = dem;
-            l = sunAndSky(135.0f);
-            return true;
-        }));
-        rows.push_back(
-            runCase("dem, sun 1 deg per frame", 512, cell, tol, o.frames, [&](int f, Grid& s, gi::GiLighting& l) {
+        if (o.wanted("dem, static"))
+            rows.push_back(runCase("dem, static", 512, cell, tol, o.frames, [&](int, Grid& s, gi::GiLighting& l) {
                 s = dem;
-                l = sunAndSky(135.0f + static_cast<float>(f));
+                l = sunAndSky(135.0f);
                 return true;
             }));
-        rows.push_back(runCase("dem, 16x16 crater", 512, cell, tol, kEventFrames, demWithPit(dem, 16)));
+        if (o.wanted("dem, sun 1 deg per frame"))
+            rows.push_back(
+                runCase("dem, sun 1 deg per frame", 512, cell, tol, o.frames, [&](int f, Grid& s, gi::GiLighting& l) {
+                    s = dem;
+                    l = sunAndSky(135.0f + static_cast<float>(f));
+                    return true;
+                }));
+        if (o.wanted("dem, 16x16 crater"))
+            rows.push_back(runCase("dem, 16x16 crater", 512, cell, tol, kEventFrames, demWithPit(dem, 16)));
     }
     return rows;
 }

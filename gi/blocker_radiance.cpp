@@ -5,6 +5,7 @@
 
 #include "core/parallel.h"
 #include "core/simd.h"
+#include "gi/receiver_tiles.h"
 #include "gi/visibility.h"
 
 namespace terrain::gi {
@@ -86,26 +87,49 @@ struct PointRow {
     int nTaps;
 };
 
-// O / pi of one row of points: per azimuth fillFar(j, far) sets the horizons
-// of the n points, then the kernel adds the azimuth's integral.
+// A run of points [x0, x1) widened to whole lane groups within the padded row.
+struct LaneRun {
+    int a, b;
+};
+LaneRun laneRun(const ColumnSpan& run, int pad) {
+    return {run.x0 / kLanePad * kLanePad, std::min(pad, padLanes(run.x1))};
+}
+
+// O / pi of the runs of one row of points: per azimuth fillFar(j, far, a, b)
+// sets the horizons of the points [a, min(b, n)), then the kernel adds the
+// azimuth's integral. Each point's value is its own lanes' arithmetic, the
+// same whatever the runs.
 template <class FillFar>
-void occlusionOfRow(ConstGridView gradX, ConstGridView gradY, const PointRow& p, const RowScratch& r,
-                    const NearTap* taps, const float* cosPhi, const float* sinPhi, int m, float scale,
-                    AzimuthFn azimuth, FillFar&& fillFar, float* out) {
-    for (int i = 0; i < p.pad; ++i) {
-        const int x = std::min(p.step * i, gradX.nx - 1);
-        r.gx[i] = i < p.n ? gradX(x, p.y) : 0.0f;
-        r.gy[i] = i < p.n ? gradY(x, p.y) : 0.0f;
-        r.sum[i] = 0.0f;
+void occlusionOfRow(ConstGridView gradX, ConstGridView gradY, const PointRow& p, std::span<const ColumnSpan> runs,
+                    const RowScratch& r, const NearTap* taps, const float* cosPhi, const float* sinPhi, int m,
+                    float scale, AzimuthFn azimuth, FillFar&& fillFar, float* out) {
+    for (const ColumnSpan& run : runs) {
+        if (run.x0 >= run.x1) continue;
+        const LaneRun lr = laneRun(run, p.pad);
+        for (int i = lr.a; i < lr.b; ++i) {
+            const int x = std::min(p.step * i, gradX.nx - 1);
+            r.gx[i] = i < p.n ? gradX(x, p.y) : 0.0f;
+            r.gy[i] = i < p.n ? gradY(x, p.y) : 0.0f;
+            r.sum[i] = 0.0f;
+        }
     }
     // without near samples the heights are not read
-    const OcclusionRow row{p.heights ? p.heights : r.far, p.stride, r.gx, r.gy, r.far, r.sum, p.pad};
+    const float* heights = p.heights ? p.heights : r.far;
     for (int j = 0; j < m; ++j) {
-        fillFar(j, r.far);
-        std::fill(r.far + p.n, r.far + p.pad, kNoBlocker);
-        azimuth(row, taps ? taps + static_cast<std::size_t>(j) * p.nTaps : nullptr, p.nTaps, cosPhi[j], sinPhi[j]);
+        const NearTap* jTaps = taps ? taps + static_cast<std::size_t>(j) * p.nTaps : nullptr;
+        for (const ColumnSpan& run : runs) {
+            if (run.x0 >= run.x1) continue;
+            const LaneRun lr = laneRun(run, p.pad);
+            fillFar(j, r.far, lr.a, std::min(lr.b, p.n));
+            if (lr.b > p.n) std::fill(r.far + std::max(lr.a, p.n), r.far + lr.b, kNoBlocker);
+            const OcclusionRow row{heights + lr.a, p.stride,     r.gx + lr.a, r.gy + lr.a,
+                                   r.far + lr.a,   r.sum + lr.a, lr.b - lr.a};
+            azimuth(row, jTaps, p.nTaps, cosPhi[j], sinPhi[j]);
+        }
     }
-    for (int i = 0; i < p.n; ++i) out[i] = scale * r.sum[i] / std::sqrt(1.0f + r.gx[i] * r.gx[i] + r.gy[i] * r.gy[i]);
+    for (const ColumnSpan& run : runs)
+        for (int i = run.x0; i < run.x1; ++i)
+            out[i] = scale * r.sum[i] / std::sqrt(1.0f + r.gx[i] * r.gx[i] + r.gy[i] * r.gy[i]);
 }
 
 // Full-resolution heights with a border of B cells (kOutside there), rows of
@@ -160,8 +184,9 @@ struct OcclusionPass {
     AzimuthFn azimuth;
 };
 
-// O / pi at every texel: the receivers' horizons interpolated between rows,
-// then along the row, and the near samples from the bordered heights.
+// O / pi at the texels of st.texelRuns: the receivers' horizons
+// interpolated between rows, then along the row, and the near samples from
+// the bordered heights.
 void occlusionAtTexels(const HeightPyramid& pyr, ConstGridView gradX, ConstGridView gradY, int B, std::ptrdiff_t stride,
                        int nTaps, const OcclusionPass& pass, BlockerRadianceState& st) {
     const int nx = pyr.nx, ny = pyr.ny, s = pyr.subsample, nxr = pyr.nxr, nyr = pyr.nyr;
@@ -175,18 +200,23 @@ void occlusionAtTexels(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
             float* recv = r.sum + pad;
             for (int y = block * kRowsPerBlock; y < std::min(ny, (block + 1) * kRowsPerBlock); ++y) {
                 const ReceiverLerp ry = receiverLerp(y, s, nyr);
+                const std::span<const ColumnSpan> runs = st.texelRuns.ofRow(ry.i0);
+                if (runs.empty()) continue;
                 const PointRow pts{y, 1, nx, pad, st.heights.data() + (y + B) * stride + B, stride, nTaps};
-                const auto fillFar = [&](int j, float* far) {
+                // the texels [a, e) read the receivers [cols[a].i0, cols[e - 1].i1]
+                const auto fillFar = [&](int j, float* far, int a, int e) {
                     const float* fs = st.farSlope.data() + static_cast<std::size_t>(j) * nxr * nyr;
                     const float* f0 = fs + static_cast<std::size_t>(ry.i0) * nxr;
                     const float* f1 = fs + static_cast<std::size_t>(ry.i1) * nxr;
-                    for (int X = 0; X < nxr; ++X) recv[X] = f0[X] + ry.f * (f1[X] - f0[X]);
-                    for (int x = 0; x < nx; ++x) {
+                    const int X0 = st.cols[static_cast<std::size_t>(a)].i0;
+                    const int X1 = st.cols[static_cast<std::size_t>(e - 1)].i1;
+                    for (int X = X0; X <= X1; ++X) recv[X] = f0[X] + ry.f * (f1[X] - f0[X]);
+                    for (int x = a; x < e; ++x) {
                         const ReceiverLerp& rx = st.cols[static_cast<std::size_t>(x)];
                         far[x] = recv[rx.i0] + rx.f * (recv[rx.i1] - recv[rx.i0]);
                     }
                 };
-                occlusionOfRow(gradX, gradY, pts, r, st.taps.data(), st.cosPhi.data(), st.sinPhi.data(), pass.m,
+                occlusionOfRow(gradX, gradY, pts, runs, r, st.taps.data(), st.cosPhi.data(), st.sinPhi.data(), pass.m,
                                pass.scale, pass.azimuth, fillFar,
                                st.occlusion.data() + static_cast<std::size_t>(y) * nx);
             }
@@ -194,10 +224,10 @@ void occlusionAtTexels(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
     });
 }
 
-// O_k at the receivers below the scan's horizons alone, the blockers E_k
-// saw (no near samples: the scan starts s cells away), so that E_k / O_k
-// is their mean radiance; at a receiver's own texel the near field then
-// adds O(x) / O_k at that radiance
+// O_k at the receivers of st.receiverRuns below the scan's horizons alone,
+// the blockers E_k saw (no near samples: the scan starts s cells away), so
+// that E_k / O_k is their mean radiance; at a receiver's own texel the near
+// field then adds O(x) / O_k at that radiance
 void occlusionAtReceivers(const HeightPyramid& pyr, ConstGridView gradX, ConstGridView gradY, const OcclusionPass& pass,
                           BlockerRadianceState& st) {
     const int ny = pyr.ny, s = pyr.subsample, nxr = pyr.nxr, nyr = pyr.nyr;
@@ -209,17 +239,37 @@ void occlusionAtReceivers(const HeightPyramid& pyr, ConstGridView gradX, ConstGr
         for (int block = b0; block < b1; ++block) {
             const RowScratch r = RowScratch::at(st.scratch.data() + perBlockR * block, padR);
             for (int Y = block * kRowsPerBlock; Y < std::min(nyr, (block + 1) * kRowsPerBlock); ++Y) {
+                const std::span<const ColumnSpan> runs = st.receiverRuns.ofRow(Y);
+                if (runs.empty()) continue;
                 const PointRow pts{std::min(s * Y, ny - 1), s, nxr, padR, nullptr, 0, 0};
-                const auto fillFar = [&](int j, float* far) {
+                const auto fillFar = [&](int j, float* far, int a, int e) {
                     const float* fs = st.farSlope.data() + static_cast<std::size_t>(j) * nxr * nyr +
                                       static_cast<std::size_t>(Y) * nxr;
-                    std::copy(fs, fs + nxr, far);
+                    std::copy(fs + a, fs + std::max(a, e), far + a);
                 };
-                occlusionOfRow(gradX, gradY, pts, r, nullptr, st.cosPhi.data(), st.sinPhi.data(), pass.m, pass.scale,
-                               pass.azimuth, fillFar, st.receiverOcclusion.data() + static_cast<std::size_t>(Y) * nxr);
+                occlusionOfRow(gradX, gradY, pts, runs, r, nullptr, st.cosPhi.data(), st.sinPhi.data(), pass.m,
+                               pass.scale, pass.azimuth, fillFar,
+                               st.receiverOcclusion.data() + static_cast<std::size_t>(Y) * nxr);
             }
         }
     });
+}
+
+// The runs of the texel passes: the receivers of the dirty tiles (every
+// receiver without tiles), and the texels whose lower receiver (receiverLerp's
+// i0, along both axes) is one of them, as texel column runs per receiver row.
+void planRuns(const ReceiverTiles* tiles, int nx, int nxr, int nyr, BlockerRadianceState& st) {
+    dirtySpans(tiles, nxr, nyr, st.receiverRuns);
+    // firstTexel[X]: the first column whose lower receiver is X or after it (i0 grows with x)
+    std::vector<int>& first = st.firstTexel;
+    first.assign(static_cast<std::size_t>(nxr) + 1, nx);
+    for (int x = nx - 1; x >= 0; --x) first[static_cast<std::size_t>(st.cols[static_cast<std::size_t>(x)].i0)] = x;
+    for (int X = nxr - 1; X >= 0; --X)
+        first[static_cast<std::size_t>(X)] =
+            std::min(first[static_cast<std::size_t>(X)], first[static_cast<std::size_t>(X) + 1]);
+    st.texelRuns = st.receiverRuns;
+    for (ColumnSpan& run : st.texelRuns.spans)
+        run = {first[static_cast<std::size_t>(run.x0)], first[static_cast<std::size_t>(run.x1)]};
 }
 
 }  // namespace
@@ -242,7 +292,7 @@ void prepareBlockerRadiance(const HeightPyramid& pyr, int azimuths, BlockerRadia
 }
 
 void computeTexelOcclusion(const HeightPyramid& pyr, ConstGridView gradX, ConstGridView gradY,
-                           const std::vector<double>& phi, BlockerRadianceState& st) {
+                           const std::vector<double>& phi, const ReceiverTiles* tiles, BlockerRadianceState& st) {
     const int nx = pyr.nx, s = pyr.subsample, nxr = pyr.nxr;
     const int m = static_cast<int>(phi.size());
     const int B = s;  // border: the near samples reach s - 0.5 cells, their taps s cells
@@ -254,6 +304,7 @@ void computeTexelOcclusion(const HeightPyramid& pyr, ConstGridView gradX, ConstG
     // per full-resolution column: the receivers it interpolates
     st.cols.resize(static_cast<std::size_t>(nx));
     for (int x = 0; x < nx; ++x) st.cols[static_cast<std::size_t>(x)] = receiverLerp(x, s, nxr);
+    planRuns(st.occlusionValid ? tiles : nullptr, nx, nxr, pyr.nyr, st);
     const OcclusionPass pass{m, 2.0f / static_cast<float>(m),
                              simd::wideEnabled() ? occlusionAzimuthAvx2 : occlusionAzimuthSse};
     occlusionAtTexels(pyr, gradX, gradY, B, stride, nTaps, pass, st);
@@ -261,7 +312,42 @@ void computeTexelOcclusion(const HeightPyramid& pyr, ConstGridView gradX, ConstG
     st.occlusionValid = true;
 }
 
-void shadeBlockerRadiance(BlockerRadianceState& st, const AlbedoMap* albedo, std::array<Grid, 3>& rgb) {
+namespace {
+
+// The bounce's exit radiance at the texels [x0, x1) of row y (s > 1), the
+// receivers' rows interpolated over the receivers those texels read.
+void shadeTexelRun(const BlockerRadianceState& st, const float* const alb[3], int y, int x0, int x1, float* oRow,
+                   float* const eRow[3], std::array<Grid, 3>& rgb) {
+    const int nx = st.nx, nxr = st.nxr;
+    const ReceiverLerp ry = receiverLerp(y, st.subsample, st.nyr);
+    const std::size_t r0 = static_cast<std::size_t>(ry.i0) * nxr, r1 = static_cast<std::size_t>(ry.i1) * nxr;
+    const int X0 = st.cols[static_cast<std::size_t>(x0)].i0, X1 = st.cols[static_cast<std::size_t>(x1 - 1)].i1;
+    const float* o = st.receiverOcclusion.data();
+    for (int X = X0; X <= X1; ++X) oRow[X] = o[r0 + X] + ry.f * (o[r1 + X] - o[r0 + X]);
+    for (int c = 0; c < 3; ++c) {
+        const float* e = st.receiverShade[static_cast<std::size_t>(c)].data();
+        for (int X = X0; X <= X1; ++X) eRow[c][X] = e[r0 + X] + ry.f * (e[r1 + X] - e[r0 + X]);
+    }
+    const std::size_t at = static_cast<std::size_t>(y) * nx;
+    const float* occ = st.occlusion.data() + at;
+    for (int x = x0; x < x1; ++x) {
+        const ReceiverLerp& rx = st.cols[static_cast<std::size_t>(x)];
+        const float den = oRow[rx.i0] + rx.f * (oRow[rx.i1] - oRow[rx.i0]);
+        // the blockers' mean radiance (E / O, interpolated) times this texel's occlusion
+        const float k = den > 0.0f ? occ[x] / den : 0.0f;
+        for (int c = 0; c < 3; ++c) {
+            const float* e = eRow[c];
+            const float num = e[rx.i0] + rx.f * (e[rx.i1] - e[rx.i0]);
+            rgb[static_cast<std::size_t>(c)].v[at + static_cast<std::size_t>(x)] =
+                (alb[c] ? alb[c][at + x] : 1.0f) * (k * num);
+        }
+    }
+}
+
+}  // namespace
+
+void shadeBlockerRadiance(BlockerRadianceState& st, const AlbedoMap* albedo, const ReceiverTiles* tiles,
+                          std::array<Grid, 3>& rgb) {
     const int nx = st.nx, ny = st.ny, s = st.subsample, nxr = st.nxr, nyr = st.nyr;
     for (Grid& g : rgb) g.ensureSize(nx, ny);
     const float* alb[3];
@@ -270,48 +356,31 @@ void shadeBlockerRadiance(BlockerRadianceState& st, const AlbedoMap* albedo, std
                      ? albedo->channel[static_cast<std::size_t>(c)].data()
                      : nullptr;
     if (s == 1) {  // every texel a receiver
+        dirtySpans(tiles, nxr, nyr, st.receiverRuns);
         parallelForRows(ny, nx, [&](int y0, int y1) {
-            for (int c = 0; c < 3; ++c) {
-                const std::size_t a = static_cast<std::size_t>(y0) * nx, e = static_cast<std::size_t>(y1) * nx;
-                const float* in = st.receiverShade[static_cast<std::size_t>(c)].data();
-                float* out = rgb[static_cast<std::size_t>(c)].data();
-                for (std::size_t i = a; i < e; ++i) out[i] = (alb[c] ? alb[c][i] : 1.0f) * in[i];
-            }
+            for (int y = y0; y < y1; ++y)
+                for (const ColumnSpan& run : st.receiverRuns.ofRow(y))
+                    for (int c = 0; c < 3; ++c) {
+                        const std::size_t a = static_cast<std::size_t>(y) * nx + run.x0;
+                        const std::size_t e = static_cast<std::size_t>(y) * nx + run.x1;
+                        const float* in = st.receiverShade[static_cast<std::size_t>(c)].data();
+                        float* out = rgb[static_cast<std::size_t>(c)].data();
+                        for (std::size_t i = a; i < e; ++i) out[i] = (alb[c] ? alb[c][i] : 1.0f) * in[i];
+                    }
         });
         return;
     }
+    planRuns(tiles, nx, nxr, nyr, st);
     const int nBlocks = (ny + kRowsPerBlock - 1) / kRowsPerBlock;
     const std::size_t perBlock = static_cast<std::size_t>(4) * nxr;  // O, E x 3 of a row, between receiver rows
     if (st.scratch.size() < perBlock * nBlocks) st.scratch.resize(perBlock * nBlocks);
     parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
         for (int block = b0; block < b1; ++block) {
             float* oRow = st.scratch.data() + perBlock * block;
-            float* eRow[3] = {oRow + nxr, oRow + 2 * nxr, oRow + 3 * nxr};
-            for (int y = block * kRowsPerBlock; y < std::min(ny, (block + 1) * kRowsPerBlock); ++y) {
-                const ReceiverLerp ry = receiverLerp(y, s, nyr);
-                const std::size_t r0 = static_cast<std::size_t>(ry.i0) * nxr,
-                                  r1 = static_cast<std::size_t>(ry.i1) * nxr;
-                const float* o = st.receiverOcclusion.data();
-                for (int X = 0; X < nxr; ++X) oRow[X] = o[r0 + X] + ry.f * (o[r1 + X] - o[r0 + X]);
-                for (int c = 0; c < 3; ++c) {
-                    const float* e = st.receiverShade[static_cast<std::size_t>(c)].data();
-                    for (int X = 0; X < nxr; ++X) eRow[c][X] = e[r0 + X] + ry.f * (e[r1 + X] - e[r0 + X]);
-                }
-                const std::size_t at = static_cast<std::size_t>(y) * nx;
-                const float* occ = st.occlusion.data() + at;
-                for (int x = 0; x < nx; ++x) {
-                    const ReceiverLerp& rx = st.cols[static_cast<std::size_t>(x)];
-                    const float den = oRow[rx.i0] + rx.f * (oRow[rx.i1] - oRow[rx.i0]);
-                    // the blockers' mean radiance (E / O, interpolated) times this texel's occlusion
-                    const float k = den > 0.0f ? occ[x] / den : 0.0f;
-                    for (int c = 0; c < 3; ++c) {
-                        const float* e = eRow[c];
-                        const float num = e[rx.i0] + rx.f * (e[rx.i1] - e[rx.i0]);
-                        rgb[static_cast<std::size_t>(c)].v[at + static_cast<std::size_t>(x)] =
-                            (alb[c] ? alb[c][at + x] : 1.0f) * (k * num);
-                    }
-                }
-            }
+            float* const eRow[3] = {oRow + nxr, oRow + 2 * nxr, oRow + 3 * nxr};
+            for (int y = block * kRowsPerBlock; y < std::min(ny, (block + 1) * kRowsPerBlock); ++y)
+                for (const ColumnSpan& run : st.texelRuns.ofRow(receiverLerp(y, s, nyr).i0))
+                    if (run.x0 < run.x1) shadeTexelRun(st, alb, y, run.x0, run.x1, oRow, eRow, rgb);
         }
     });
 }

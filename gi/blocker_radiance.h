@@ -41,6 +41,7 @@
 
 #include "core/grid.h"
 #include "gi/pyramid.h"
+#include "gi/receiver_tiles.h"
 #include "gi/shading.h"
 
 namespace terrain::gi {
@@ -64,18 +65,31 @@ struct BlockerRadianceState {
     std::vector<NearTap> taps;                        // azimuths x near samples
     std::vector<float> cosPhi, sinPhi;
     std::vector<ReceiverLerp> cols;  // per full-resolution column: the receivers it reads
+    // The texel passes' extent (receiver tiles): the receivers to redo and,
+    // per receiver row, the texel column runs whose lower receiver is one of
+    // them; firstTexel[X] is the first column whose lower receiver is X or later.
+    DirtySpans receiverRuns, texelRuns;
+    std::vector<int> firstTexel;
 };
 
 /// Sizes the buffers for a frame (farSlope is then filled by the scan).
 void prepareBlockerRadiance(const HeightPyramid& pyr, int azimuths, BlockerRadianceState& st);
 
 /// O / pi at every texel from the receivers' horizons (farSlope, filled) and
-/// the full-resolution heights; phi: the indirect azimuths (radians).
+/// the full-resolution heights; phi: the indirect azimuths (radians). With
+/// receiver tiles (null: every texel) and a valid occlusion of this grid in
+/// the state, only the receivers of the dirty tiles and the texels whose
+/// lower receiver (receiverLerp's i0, along both axes) is one of them; the
+/// others keep their values. Each value is the same whichever are computed.
 void computeTexelOcclusion(const HeightPyramid& pyr, ConstGridView gradX, ConstGridView gradY,
-                           const std::vector<double>& phi, BlockerRadianceState& st);
+                           const std::vector<double>& phi, const ReceiverTiles* tiles, BlockerRadianceState& st);
 
 /// The bounce's exit radiance albedo E(x) / pi at every texel from the
 /// receivers' E / pi (receiverShade). With s = 1 every texel is a receiver.
-void shadeBlockerRadiance(BlockerRadianceState& st, const AlbedoMap* albedo, std::array<Grid, 3>& rgb);
+/// With receiver tiles (null: every texel), only the texels whose lower
+/// receiver lies in a dirty tile; rgb keeps the others (it must hold a
+/// result of this grid).
+void shadeBlockerRadiance(BlockerRadianceState& st, const AlbedoMap* albedo, const ReceiverTiles* tiles,
+                          std::array<Grid, 3>& rgb);
 
 }  // namespace terrain::gi

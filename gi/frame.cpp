@@ -51,6 +51,25 @@ const ReceiverTiles* planIndirect(const GiSettings& settings, const FrameChange&
     return planIndirectTiles(in, st.indirectCache);
 }
 
+// The texel tiles the indirect light's texel passes redo (gi/indirect_cache.h).
+// The height change since the last pass is this frame's visibility plan's
+// when the pass before it was on the geometry this frame replaced: this
+// frame recomputed the geometry (a direct frame), once since that pass, and
+// planned tiles (receiver tiles with changed geometry imply a tiled plan).
+const ReceiverTiles* planTexels(const FrameChange& change, const ReceiverTiles* only, const AlbedoMap* albedo,
+                                GiState& st) {
+    const IndirectCache& cache = st.indirectCache;
+    const bool same = st.geometryVersion == cache.geometryVersion;
+    const bool replacedLast =
+        st.directUpdated && change.geometry && only != nullptr && st.geometryVersion == cache.geometryVersion + 1;
+    const IndirectTexelInputs in{.gathered = only,
+                                 .sameGeometry = same,
+                                 .heightChange = replacedLast ? &st.visibilityCache.change : nullptr,
+                                 .albedo = albedo,
+                                 .heights = st.pyramid};
+    return planIndirectTexels(in, st.indirectCache);
+}
+
 // Indirect bounces over the last computed direct shade, re-gathered where
 // its sources or the geometry within reach changed (incremental frames).
 void runIndirectStage(const GiSettings& settings, const FrameChange& change, GiState& st, const AlbedoMap* albedo) {
@@ -58,6 +77,7 @@ void runIndirectStage(const GiSettings& settings, const FrameChange& change, GiS
     const FoldedWedgeOperator& op = indirectScanOperator(settings, st);
     const bool cached = settings.incremental && gathersByTiles(settings.indirect, settings.shading);
     const ReceiverTiles* only = planIndirect(settings, change, cached, op.azimuths, st);
+    const ReceiverTiles* texels = cached ? planTexels(change, only, albedo, st) : nullptr;
     const IndirectInputs in{.heights = st.pyramid,
                             .gradX = st.gradX.cview(),
                             .gradY = st.gradY.cview(),
@@ -68,9 +88,11 @@ void runIndirectStage(const GiSettings& settings, const FrameChange& change, GiS
                             .albedo = albedo,
                             .shading = settings.shading,
                             .only = only,
+                            .texels = texels,
                             .sameGeometry = !change.geometry};
     computeIndirect(in, settings.indirect, st.indirect);
     if (cached) recordIndirectSource(st.shade.rgb, st.pyramid, only == nullptr, st.indirectCache);
+    st.indirectCache.geometryVersion = st.geometryVersion;
     st.indirectRecomputed = only ? only->dirtyFraction() : 1.0;
     st.timings.indirect = msSince(t);
 }
@@ -410,6 +432,7 @@ void runDirectStages(ConstGridView heights, float cellSize, const GiLighting& li
     // goes through SH): the environment's scan reruns for every receiver.
     const bool shMissing = !change.geometry && st.envVisibility.planes < shRows;
     if (change.geometry) {
+        ++st.geometryVersion;
         computeGradient(heights, cellSize, st.gradX, st.gradY);
         st.timings.gradient = msSince(t);
         t = Clock::now();

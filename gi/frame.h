@@ -74,6 +74,7 @@ struct GiState {
     bool amortiseReady = false;        // a full frame with the current key ran before
     std::array<int, 7> amortiseKey{};  // nx, ny, subsample, bounces, azimuths, brdf, indirect azimuths of that frame
     bool directUpdated = false, indirectUpdated = false;  // what the last frame recomputed
+    std::uint64_t geometryVersion = 0;                    // counts the frames that recomputed the gradient and pyramid
 };
 
 /// Runs one frame. Throws InputError when heights contain NaN/Inf, the cell

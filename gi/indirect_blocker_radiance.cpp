@@ -128,14 +128,15 @@ void BlockerRadianceIndirect::receiverIrradiance(const RowBlock& rb, const Indir
     }
 }
 
-// The texel passes stay whole with receiver tiles, reading the clean
-// receivers' cached horizons and E; the occlusion, a function of the
-// geometry alone, is kept when the geometry is the last call's.
+// The texel passes redo the texels of the caller's texel tiles (every texel
+// without them), reading the clean receivers' cached horizons and E; the
+// occlusion, a function of the geometry alone, is kept whole when the
+// geometry is the last call's.
 void BlockerRadianceIndirect::shade(int b, ShadeMaps& out) {
     const bool keepOcclusion = in_.sameGeometry && st_.blocker.occlusionValid;
     if (b == 1 && in_.heights.subsample > 1 && !keepOcclusion)
-        computeTexelOcclusion(in_.heights, in_.gradX, in_.gradY, in_.op.phi, st_.blocker);
-    shadeBlockerRadiance(st_.blocker, in_.albedo, out.rgb);
+        computeTexelOcclusion(in_.heights, in_.gradX, in_.gradY, in_.op.phi, in_.texels, st_.blocker);
+    shadeBlockerRadiance(st_.blocker, in_.albedo, in_.texels, out.rgb);
 }
 
 }  // namespace terrain::gi

@@ -1,6 +1,8 @@
 #include "gi/indirect_cache.h"
 
 #include <algorithm>
+#include <cstring>
+#include <utility>
 
 #include "gi/visibility_cache.h"
 
@@ -64,6 +66,62 @@ void recordIndirectSource(const std::array<Grid, 3>& source, const HeightPyramid
     cache.tiles.reset(heights.nxr, heights.nyr, kVisibilityTile, false);
     cache.drift.assign(cache.tiles.dirty.size(), 0.0f);
     cache.valid = true;
+}
+
+namespace {
+
+// The albedo channels equal the recorded ones (recorded when not).
+bool sameAlbedoAsLastPass(const AlbedoMap* albedo, IndirectCache& cache) {
+    bool same = cache.hadAlbedo == (albedo != nullptr);
+    for (std::size_t c = 0; c < 3 && same && albedo; ++c) {
+        const Grid& now = albedo->channel[c];
+        const Grid& last = cache.lastAlbedo[c];
+        same = now.nx == last.nx && now.ny == last.ny &&
+               std::memcmp(now.v.data(), last.v.data(), sizeof(float) * now.v.size()) == 0;  // bits: -0 is not 0 here
+    }
+    if (same) return true;
+    cache.hadAlbedo = albedo != nullptr;
+    for (std::size_t c = 0; c < 3; ++c) cache.lastAlbedo[c] = albedo ? albedo->channel[c] : Grid{};
+    return false;
+}
+
+// The texels of receivers [X0, X1) along an axis of n receivers and
+// `cells` texels, as a cell range dilated by `reach`: their lower receivers
+// lie in it (receiverLerp clamps the lower receiver to n - 2, so the tile
+// holding it takes the texels up to the grid's end).
+std::pair<int, int> texelCells(int X0, int X1, int n, int s, int cells, int reach) {
+    const int hi = X1 > n - 2 ? cells - 1 : s * X1 - 1;
+    return {s * X0 - reach, hi + reach};
+}
+
+// A dirty receiver tile at (tx, ty) or after it by one along x, y or both.
+bool readsGathered(const ReceiverTiles& g, int tx, int ty) {
+    for (int dy = 0; dy <= 1; ++dy)
+        for (int dx = 0; dx <= 1; ++dx)
+            if (tx + dx < g.tilesX && ty + dy < g.tilesY && g.isDirty(tx + dx, ty + dy)) return true;
+    return false;
+}
+
+}  // namespace
+
+const ReceiverTiles* planIndirectTexels(const IndirectTexelInputs& in, IndirectCache& cache) {
+    const bool albedo = sameAlbedoAsLastPass(in.albedo, cache);
+    if (!in.gathered || !albedo || (!in.sameGeometry && !in.heightChange)) return nullptr;
+    const HeightPyramid& h = in.heights;
+    const ReceiverTiles& g = *in.gathered;
+    const int s = h.subsample, reach = s + 1, T = g.tileSize;
+    cache.texels.reset(h.nxr, h.nyr, T, false);
+    for (int ty = 0; ty < g.tilesY; ++ty)
+        for (int tx = 0; tx < g.tilesX; ++tx) {
+            bool dirty = readsGathered(g, tx, ty);
+            if (!dirty && !in.sameGeometry) {
+                const auto [x0, x1] = texelCells(tx * T, std::min(h.nxr, (tx + 1) * T), h.nxr, s, h.nx, reach);
+                const auto [y0, y1] = texelCells(ty * T, std::min(h.nyr, (ty + 1) * T), h.nyr, s, h.ny, reach);
+                dirty = maxChangeInBox(*in.heightChange, x0, y0, x1, y1) > 0.0f;
+            }
+            cache.texels.setDirty(tx, ty, dirty);
+        }
+    return &cache.texels;
 }
 
 }  // namespace terrain::gi

@@ -19,7 +19,21 @@
 // Tolerance 0 re-gathers every tile where either bound is not 0, which gives
 // the full recompute bit for bit. More than one bounce, or another strategy:
 // every receiver (no per-bounce cache).
+//
+// The texel passes after the scan (gi/blocker_radiance.h: each texel's
+// occlusion below its receivers' horizons and near field, and its light
+// from its receivers' E and O) redo only the texel tiles whose inputs can
+// differ from the last pass's, bit for bit (planIndirectTexels). A texel
+// belongs to the tile of its lower receiver and reads that receiver and the
+// next one along each axis, so its tile is redone when
+//  - one of those receivers was re-gathered (its tile, or the tile after it
+//    along x, y or both), or
+//  - a height changed within s + 1 cells of the tile's texels (the near
+//    samples reach s cells, the gradients one more, and the receivers' own
+//    gradients lie among them), or
+//  - the albedo changed (every texel).
 #include <array>
+#include <cstdint>
 #include <vector>
 
 #include "core/grid.h"
@@ -27,16 +41,21 @@
 #include "gi/pyramid.h"
 #include "gi/radiance_pyramid.h"
 #include "gi/receiver_tiles.h"
+#include "gi/shading.h"
 
 namespace terrain::gi {
 
 struct IndirectCache {
-    bool valid = false;               // the fields below describe the cached indirect result
-    std::array<Grid, 3> lastSource;   // L_0 the last indirect pass read
-    MaxChangePyramid change;          // this frame: max over the channels of |L_0 - lastSource|
-    std::vector<float> azimuthBound;  // per tile and indirect azimuth (tile-major)
-    std::vector<float> drift;         // per tile: bound of the radiance change since its result was gathered
-    ReceiverTiles tiles;              // this frame's tiles to re-gather
+    bool valid = false;                 // the fields below describe the cached indirect result
+    std::array<Grid, 3> lastSource;     // L_0 the last indirect pass read
+    MaxChangePyramid change;            // this frame: max over the channels of |L_0 - lastSource|
+    std::vector<float> azimuthBound;    // per tile and indirect azimuth (tile-major)
+    std::vector<float> drift;           // per tile: bound of the radiance change since its result was gathered
+    ReceiverTiles tiles;                // this frame's tiles to re-gather
+    ReceiverTiles texels;               // this frame's texel tiles to redo
+    std::uint64_t geometryVersion = 0;  // GiState::geometryVersion of the last pass
+    bool hadAlbedo = false;             // the last pass's albedo channels (empty: 1)
+    std::array<Grid, 3> lastAlbedo;
 };
 
 /// What the frame knows when it plans the indirect tiles.
@@ -58,6 +77,20 @@ const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCac
 /// every receiver (the tiles and drifts start again at 0).
 void recordIndirectSource(const std::array<Grid, 3>& source, const HeightPyramid& heights, bool all,
                           IndirectCache& cache);
+
+/// What the frame knows of the texels' inputs since the last pass.
+struct IndirectTexelInputs {
+    const ReceiverTiles* gathered;         // this pass's receiver tiles (null: every receiver)
+    bool sameGeometry;                     // heights and gradients are the last pass's
+    const MaxChangePyramid* heightChange;  // else |dh| since the last pass's heights; null: not known
+    const AlbedoMap* albedo;               // this pass's (null: 1)
+    const HeightPyramid& heights;          // this pass's grid
+};
+
+/// The texel tiles to redo (cache.texels, on the layout of cache.tiles), or
+/// null for every texel: every receiver gathered, the height change not
+/// known, or a new albedo (recorded for the next pass).
+const ReceiverTiles* planIndirectTexels(const IndirectTexelInputs& in, IndirectCache& cache);
 
 /// Forgets the cache: the next pass gathers every receiver.
 inline void invalidateIndirectCache(IndirectCache& cache) { cache.valid = false; }

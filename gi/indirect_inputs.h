@@ -34,10 +34,14 @@ struct IndirectInputs {
     // clean receiver keeps the previous call's last bounce at bounce 1 and
     // this call's bounce b - 1 at bounce b, so the tiles give a consistent
     // result with one bounce; more bounces need a cache per bounce, which the
-    // state does not keep (gathersByTiles, gi/indirect.h). The texel passes
-    // after the scan stay whole: they cost little beside the scan.
+    // state does not keep (gathersByTiles, gi/indirect.h).
     // GlossyIndirect::VectorPyramid ignores the tiles (every receiver).
     const ReceiverTiles* only = nullptr;
+    // BlockerRadiance, one bounce: the texel tiles whose occlusion and light
+    // the texel passes redo (a texel belongs to the tile of its lower
+    // receiver; gi/blocker_radiance.h); null: every texel. The others keep
+    // the state's values: the caller's cache (gi/indirect_cache.h).
+    const ReceiverTiles* texels = nullptr;
     // The heights, gradients and settings are those of the state's last
     // call: BlockerRadiance keeps the texel occlusion it computed then
     // (a pure function of them), where it holds one of this grid.

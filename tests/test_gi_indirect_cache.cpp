@@ -3,6 +3,7 @@
 // recompute at tolerance 0, and the radiance bound it adds up holds.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <random>
 #include <string>
@@ -11,6 +12,7 @@
 #include <doctest/doctest.h>
 
 #include "core/parallel.h"
+#include "gi/blocker_radiance.h"
 #include "gi/change_bound.h"
 #include "gi/frame.h"
 #include "gi/visibility_cache.h"
@@ -200,4 +202,115 @@ TEST_CASE("gi.indirect_cache: with a local height change the indirect light stay
     CHECK(inc.receiversRecomputed < 1.0);
     CHECK(direct <= settings.tolerance);
     CHECK(indirect <= settings.tolerance);
+}
+
+namespace {
+
+// The texel passes redone over every texel from the state an incremental
+// frame left: the occlusion and the indirect light it would then hold.
+struct WholeTexelPasses {
+    Grid occlusion;
+    std::array<Grid, 3> light;
+};
+WholeTexelPasses redoTexelPasses(const GiState& st, const AlbedoMap* albedo) {
+    BlockerRadianceState copy = st.indirect.blocker;
+    computeTexelOcclusion(st.pyramid, st.gradX.cview(), st.gradY.cview(), st.indirectOperator.phi, nullptr, copy);
+    WholeTexelPasses out;
+    shadeBlockerRadiance(copy, albedo, nullptr, out.light);
+    out.occlusion = copy.occlusion;
+    return out;
+}
+
+bool sameBits(const Grid& a, const Grid& b) {
+    return a.nx == b.nx && a.ny == b.ny && std::memcmp(a.v.data(), b.v.data(), sizeof(float) * a.v.size()) == 0;
+}
+
+}  // namespace
+
+TEST_CASE("gi.indirect_cache: the texel passes redo only the texel tiles whose inputs changed") {
+    // 256^2 at 2x: 4 x 4 tiles; a pit moving along x across a tile's edge, a
+    // texel of new albedo on frame 2, a key light from frame 4, the pit filled
+    // on frame 5, a bump on frame 6 beside the edge of a tile column. At
+    // tolerance 0.1 some receiver tiles re-gather (their texels and those
+    // reading them redo); at 1 none does, and only the heights' reach decides.
+    const Grid h = bumpy(256, 256);
+    for (float tolerance : {0.1f, 1.0f}) {
+        GiLighting light;
+        GiSettings settings = withBounces(GiSettings{}, 2, 1);
+        settings.tolerance = tolerance;
+        AlbedoMap albedo;
+        for (Grid& c : albedo.channel) c.resize(256, 256, 0.6f);
+        GiState inc;
+        runGiFrame(h.cview(), 10.0f, light, settings, inc, &albedo);
+        int partial = 0;
+        for (int f = 1; f <= 6; ++f) {
+            Grid g = h;
+            if (f == 6) g(62, 200) += 1.0f;  // the texels of the next tile column read it
+            if (f < 5)
+                for (int y = 120; y < 128; ++y)
+                    for (int x = 184 + 2 * f; x < 192 + 2 * f; ++x) g(x, y) -= 3.0f;
+            if (f == 2) albedo.channel[1](100, 100) = 0.3f;
+            if (f == 4) light.keys.push_back(KeyLight{});
+            runGiFrame(g.cview(), 10.0f, light, settings, inc, &albedo);
+            const ReceiverTiles& texels = inc.indirectCache.texels;
+            const bool tiled =
+                f != 2 && inc.indirectRecomputed < 1.0 && texels.dirtyCount() < static_cast<int>(texels.dirty.size());
+            partial += tiled ? 1 : 0;
+            INFO("tolerance " << tolerance << ", frame " << f << ": indirect re-gathered at "
+                              << 100.0 * inc.indirectRecomputed << " %, texel tiles " << texels.dirtyCount() << " of "
+                              << texels.dirty.size());
+            // the tiles kept hold what redoing them would give, bit for bit
+            const WholeTexelPasses whole = redoTexelPasses(inc, &albedo);
+            CHECK(sameBits(whole.occlusion, inc.indirect.blocker.occlusion));
+            for (std::size_t c = 0; c < 3; ++c) CHECK(sameBits(whole.light[c], inc.indirect.indirect[c]));
+        }
+        MESSAGE("tolerance " << tolerance << ": frames whose texel passes redid only some tiles: " << partial
+                             << " of 5");
+        CHECK(partial > 0);
+    }
+}
+
+TEST_CASE(
+    "gi.indirect_cache: texel tiles: a height change reaches the tiles within s + 1 cells, a re-gather the tiles "
+    "before it") {
+    // 200^2 at 2x: 100^2 receivers, tiles of 32 (the last one 4 wide); a
+    // texel's tile is that of its lower receiver, clamped to 98
+    HeightPyramid pyr;
+    buildHeightPyramid(bumpy(200, 200).cview(), 1.0f, 2, PyramidSettings{}, pyr);
+    ReceiverTiles gathered;
+    gathered.reset(pyr.nxr, pyr.nyr, kVisibilityTile, false);
+    IndirectCache cache;
+    const auto dirtyTiles = [&](int cx, int cy) {
+        Grid dh(200, 200, 0.0f);
+        if (cx >= 0) dh(cx, cy) = 1.0f;
+        MaxChangePyramid change;
+        buildMaxChangePyramid(dh.cview(), change);
+        const IndirectTexelInputs in{
+            .gathered = &gathered, .sameGeometry = cx < 0, .heightChange = &change, .albedo = nullptr, .heights = pyr};
+        const ReceiverTiles* t = planIndirectTexels(in, cache);
+        REQUIRE(t != nullptr);
+        std::vector<int> out;
+        for (int i = 0; i < static_cast<int>(t->dirty.size()); ++i)
+            if (t->dirty[static_cast<std::size_t>(i)] != 0) out.push_back(i);
+        return out;
+    };
+    // texels 0..63 are tile column 0, 64..127 column 1, and so on; s + 1 = 3
+    CHECK(dirtyTiles(10, 10) == std::vector<int>{0});
+    CHECK(dirtyTiles(66, 10) == std::vector<int>{0, 1});  // 3 cells from texel 63
+    CHECK(dirtyTiles(67, 10) == std::vector<int>{1});
+    CHECK(dirtyTiles(61, 10) == std::vector<int>{0, 1});  // 3 cells before texel 64
+    CHECK(dirtyTiles(60, 10) == std::vector<int>{0});
+    CHECK(dirtyTiles(10, 66) == std::vector<int>{0, 4});
+    CHECK(dirtyTiles(199, 10) == std::vector<int>{3});  // the last column (receivers 96..99) to the grid's end
+    CHECK(dirtyTiles(193, 10) == std::vector<int>{2, 3});
+    CHECK(dirtyTiles(-1, 0).empty());  // same geometry, nothing gathered
+    gathered.setDirty(1, 1);
+    CHECK(dirtyTiles(-1, 0) == std::vector<int>{0, 1, 4, 5});  // the tiles whose texels read tile (1, 1)'s receivers
+    // a new albedo: every texel
+    AlbedoMap albedo;
+    albedo.channel[0] = Grid(200, 200, 0.5f);
+    const IndirectTexelInputs in{
+        .gathered = &gathered, .sameGeometry = true, .heightChange = nullptr, .albedo = &albedo, .heights = pyr};
+    CHECK(planIndirectTexels(in, cache) == nullptr);
+    CHECK(planIndirectTexels(in, cache) != nullptr);  // recorded: the next pass with it is tiled again
 }
