@@ -29,7 +29,7 @@ struct AmbientJob {
     float* scratch;                  // per worker slot: kRowsPerSlot rows, then the raised window
     const ReceiverLerp* columns;     // per texel column: the receivers it lies between
     const NearFieldStep* nearSteps;  // azimuths x subsample
-    const std::vector<std::uint8_t>* rows;
+    const TexelRuns* runs;           // null: every texel
     const AmbientOutputs& out;
 };
 
@@ -65,15 +65,15 @@ template <class V, bool Parts>
     }
 }
 
-// The texel range [0, nx) of a row: whole vectors, then the rest through one
-// zero-padded vector (the same lane arithmetic, so a texel's value does not
-// depend on where it falls).
+// The texel range [x0, x1) of a row: whole vectors, then the rest through
+// one zero-padded vector (the same lane arithmetic, so a texel's value does
+// not depend on where it falls).
 template <class V, bool Parts>
-[[gnu::always_inline]] inline void addAzimuthRow(const float* gx, const float* gy, const float* horizon, float c,
-                                                 float sn, float* const acc[3], int nx) {
+[[gnu::always_inline]] inline void addAzimuthRun(const float* gx, const float* gy, const float* horizon, float c,
+                                                 float sn, float* const acc[3], int x0, int x1) {
     constexpr int L = simd::kLaneCount<V>;
-    const int vecEnd = nx / L * L;
-    addAzimuth<V, Parts>(gx, gy, horizon, c, sn, acc, 0, vecEnd);
+    const int vecEnd = x0 + (x1 - x0) / L * L, nx = x1;
+    addAzimuth<V, Parts>(gx, gy, horizon, c, sn, acc, x0, vecEnd);
     if (vecEnd == nx) return;
     alignas(32) float tail[6][L] = {};
     const int n = nx - vecEnd, rows = Parts ? 3 : 1;
@@ -106,22 +106,22 @@ template <class V, int Maps>
     }
 }
 
-// The horizon slopes of receiver row Y along azimuth a (c, sn), each raised
-// to the receiver's lowest tangent slope: the footprint box's when there is
-// one, else its own.
-void receiverRowHorizons(const AmbientJob& j, int Y, int a, float c, float sn, float* out) {
+// The horizon slopes of receiver row Y along azimuth a (c, sn) at the
+// receivers `cols`, each raised to the receiver's lowest tangent slope: the
+// footprint box's when there is one, else its own.
+void receiverRowHorizons(const AmbientJob& j, int Y, int a, float c, float sn, ColumnSpan cols, float* out) {
     const std::size_t row = static_cast<std::size_t>(Y) * j.nxr;
     const float* h = j.in.env->maxSlope.data() + static_cast<std::size_t>(a) * j.nxr * j.nyr + row;
     if (const FootprintBox* f = j.in.footprint) {
         const float* tx = (c >= 0.0f ? f->loX.data() : f->hiX.data()) + row;
         const float* ty = (sn >= 0.0f ? f->loY.data() : f->hiY.data()) + row;
-        for (int X = 0; X < j.nxr; ++X) out[X] = std::max(h[X], tx[X] * c + ty[X] * sn);
+        for (int X = cols.x0; X < cols.x1; ++X) out[X] = std::max(h[X], tx[X] * c + ty[X] * sn);
         return;
     }
     const int s = j.in.subsample, y = std::min(s * Y, j.ny - 1);
     const float* gx = j.in.gradX.row(y);
     const float* gy = j.in.gradY.row(y);
-    for (int X = 0; X < j.nxr; ++X) {
+    for (int X = cols.x0; X < cols.x1; ++X) {
         const int x = std::min(s * X, j.nx - 1);
         out[X] = std::max(h[X], gx[x] * c + gy[x] * sn);
     }
@@ -132,10 +132,12 @@ void receiverRowHorizons(const AmbientJob& j, int Y, int a, float c, float sn, f
 // a's two rows at rows + 2 a nxr and rows + (2 a + 1) nxr, `first` saying
 // which of them holds row i0. The rows a block's texel rows read change
 // every s texel rows, and then the last i1 is the new i0: it is kept, and
-// only the new i1 is raised.
+// only the new i1 is raised. Only the receivers `cols` (the block's texels
+// read no others) are raised.
 struct RaisedWindow {
     float* rows;
     int nxr = 0;
+    ColumnSpan cols;
     int i0 = -1, i1 = -1;
     int first = 0;
     float f = 0.0f;  // the covered texel row's fraction from row i0 towards row i1
@@ -155,8 +157,8 @@ struct RaisedWindow {
         for (int a = 0; a < j.m; ++a) {
             const float c = j.in.cosSin[2 * static_cast<std::size_t>(a)];
             const float sn = j.in.cosSin[2 * static_cast<std::size_t>(a) + 1];
-            if (!shift) receiverRowHorizons(j, i0, a, c, sn, slot(a, first));
-            receiverRowHorizons(j, i1, a, c, sn, slot(a, 1 - first));
+            if (!shift) receiverRowHorizons(j, i0, a, c, sn, cols, slot(a, first));
+            receiverRowHorizons(j, i1, a, c, sn, cols, slot(a, 1 - first));
         }
     }
 };
@@ -199,15 +201,33 @@ void interpolatedHorizons(const AmbientJob& j, const RaisedWindow& window, int a
     }
 }
 
-// One texel row: every azimuth's horizons (at sub-sampling interpolated and
-// raised to the near field) into the integrals, V the lane type.
+// The same over the texels of a run only, each texel's value as above (the
+// vertical mix, then the columns' receivers and fraction, the same operations
+// as horizontalLerp's).
+void interpolatedHorizonsOfRun(const AmbientJob& j, const RaisedWindow& window, int a, ColumnSpan run, float* vert,
+                               float* out) {
+    if (run.x0 == 0 && run.x1 == j.nx) return interpolatedHorizons(j, window, a, vert, out);
+    const float* t0 = window.row0(a);
+    const float* t1 = window.row1(a);
+    const int X0 = j.columns[run.x0].i0, X1 = j.columns[run.x1 - 1].i1;
+    for (int X = X0; X <= X1; ++X) vert[X] = t0[X] + window.f * (t1[X] - t0[X]);
+    for (int x = run.x0; x < run.x1; ++x) {
+        const ReceiverLerp& r = j.columns[x];
+        out[x] = vert[r.i0] + r.f * (vert[r.i1] - vert[r.i0]);
+    }
+}
+
+// One texel row's runs: every azimuth's horizons (at sub-sampling
+// interpolated and raised to the near field) into the integrals of the runs'
+// texels, V the lane type.
 template <class V, bool Parts>
-[[gnu::always_inline]] inline void ambientRowWith(const AmbientJob& j, int y, float* buffers,
-                                                  const RaisedWindow& window) {
+[[gnu::always_inline]] inline void ambientRowWith(const AmbientJob& j, int y, std::span<const ColumnSpan> runs,
+                                                  float* buffers, const RaisedWindow& window) {
     float* const acc[3] = {buffers, buffers + j.rowFloats, buffers + 2 * static_cast<std::size_t>(j.rowFloats)};
     float* horizon = buffers + 3 * static_cast<std::size_t>(j.rowFloats);
     float* vert = buffers + 4 * static_cast<std::size_t>(j.rowFloats);
-    for (int r = 0; r < (Parts ? 3 : 1); ++r) std::fill(acc[r], acc[r] + j.nx, 0.0f);
+    for (int r = 0; r < (Parts ? 3 : 1); ++r)
+        for (const ColumnSpan& run : runs) std::fill(acc[r] + run.x0, acc[r] + run.x1, 0.0f);
     const float* gx = j.in.gradX.row(y);
     const float* gy = j.in.gradY.row(y);
     for (int a = 0; a < j.m; ++a) {
@@ -217,45 +237,51 @@ template <class V, bool Parts>
         if (j.in.subsample == 1) {
             h = j.in.env->maxSlope.data() + (static_cast<std::size_t>(a) * j.ny + y) * j.nx;
         } else {
-            interpolatedHorizons(j, window, a, vert, horizon);
-            raiseToNearField(
-                j.in.heights, y,
-                {j.nearSteps + static_cast<std::size_t>(a) * j.in.subsample, static_cast<std::size_t>(j.in.subsample)},
-                horizon);
+            const std::span<const NearFieldStep> near{j.nearSteps + static_cast<std::size_t>(a) * j.in.subsample,
+                                                      static_cast<std::size_t>(j.in.subsample)};
+            for (const ColumnSpan& run : runs) {
+                interpolatedHorizonsOfRun(j, window, a, run, vert, horizon);
+                raiseToNearField(j.in.heights, y, near, horizon, run.x0, run.x1);
+            }
             h = horizon;
         }
-        addAzimuthRow<V, Parts>(gx, gy, h, c, sn, acc, j.nx);
+        for (const ColumnSpan& run : runs) addAzimuthRun<V, Parts>(gx, gy, h, c, sn, acc, run.x0, run.x1);
     }
     Grid* const maps[3] = {&j.out.ambient, j.out.below, j.out.rising};
-    float* const out[3] = {maps[0]->data() + static_cast<std::size_t>(y) * j.nx,
-                           Parts ? maps[1]->data() + static_cast<std::size_t>(y) * j.nx : nullptr,
-                           Parts ? maps[2]->data() + static_cast<std::size_t>(y) * j.nx : nullptr};
-    normaliseRow<V, Parts ? 3 : 1>(acc, gx, gy, 1.0f / static_cast<float>(j.m), out, j.nx);
+    for (const ColumnSpan& run : runs) {
+        const std::size_t at = static_cast<std::size_t>(y) * j.nx + run.x0;
+        float* const out[3] = {maps[0]->data() + at, Parts ? maps[1]->data() + at : nullptr,
+                               Parts ? maps[2]->data() + at : nullptr};
+        const float* const runAcc[3] = {acc[0] + run.x0, acc[1] + run.x0, acc[2] + run.x0};
+        normaliseRow<V, Parts ? 3 : 1>(runAcc, gx + run.x0, gy + run.x0, 1.0f / static_cast<float>(j.m), out,
+                                       run.x1 - run.x0);
+    }
 }
 
 // The AVX2 builds of the row: 8-wide lanes in the integrals and the
 // compiler's 32-byte vectors in the interpolation and the near field
 // (element-wise float arithmetic in the same order: the same bits as the
 // SSE2 build).
-[[gnu::target("avx2"), gnu::flatten]] void ambientRowAvx2(const AmbientJob& j, int y, float* buffers,
+using Runs = std::span<const ColumnSpan>;
+[[gnu::target("avx2"), gnu::flatten]] void ambientRowAvx2(const AmbientJob& j, int y, Runs runs, float* buffers,
                                                           const RaisedWindow& window) {
-    ambientRowWith<simd::F8, false>(j, y, buffers, window);
+    ambientRowWith<simd::F8, false>(j, y, runs, buffers, window);
 }
-[[gnu::target("avx2"), gnu::flatten]] void ambientPartsRowAvx2(const AmbientJob& j, int y, float* buffers,
+[[gnu::target("avx2"), gnu::flatten]] void ambientPartsRowAvx2(const AmbientJob& j, int y, Runs runs, float* buffers,
                                                                const RaisedWindow& window) {
-    ambientRowWith<simd::F8, true>(j, y, buffers, window);
+    ambientRowWith<simd::F8, true>(j, y, runs, buffers, window);
 }
 
-// One texel row; at sub-sampling `window` covers it (RaisedWindow::cover).
-void ambientRow(const AmbientJob& j, int y, float* buffers, const RaisedWindow& window) {
+// The runs of one texel row; at sub-sampling `window` covers it (RaisedWindow::cover).
+void ambientRow(const AmbientJob& j, int y, Runs runs, float* buffers, const RaisedWindow& window) {
     const bool parts = j.out.below != nullptr;
     if (simd::wideEnabled())
-        (parts ? ambientPartsRowAvx2 : ambientRowAvx2)(j, y, buffers, window);
+        (parts ? ambientPartsRowAvx2 : ambientRowAvx2)(j, y, runs, buffers, window);
     else
-        (parts ? ambientRowWith<simd::F4, true> : ambientRowWith<simd::F4, false>)(j, y, buffers, window);
+        (parts ? ambientRowWith<simd::F4, true> : ambientRowWith<simd::F4, false>)(j, y, runs, buffers, window);
 }
 
-void checkInputs(const AmbientInputs& in, int m, const std::vector<std::uint8_t>* rows) {
+void checkInputs(const AmbientInputs& in, int m, const TexelRuns* runs) {
     const VisibilityField& env = *in.env;
     const int s = in.subsample;
     if (in.gradY.nx != in.gradX.nx || in.gradY.ny != in.gradX.ny || s < 1 || env.nxr != (in.gradX.nx + s - 1) / s ||
@@ -264,16 +290,28 @@ void checkInputs(const AmbientInputs& in, int m, const std::vector<std::uint8_t>
         throw InputError("ambient: the horizons are not of this grid, sub-sampling and azimuth count");
     if (s > 1 && (in.heights.nx != in.gradX.nx || in.heights.ny != in.gradX.ny || !(in.cellSize > 0.0f)))
         throw InputError("ambient: sub-sampling needs the field's heights and cell size");
-    if (rows && rows->size() != static_cast<std::size_t>(in.gradX.ny))
-        throw InputError("ambient: one row flag per texel row expected");
+    if (runs && runs->ny != in.gradX.ny) throw InputError("ambient: texel runs of another grid");
+}
+
+// The receiver columns the texels of rows [y0, y1) to compute read.
+ColumnSpan receiversRead(const AmbientJob& j, int y0, int y1) {
+    if (!j.runs) return {0, j.nxr};
+    int x0 = j.nxr, x1 = 0;
+    for (int y = y0; y < y1; ++y) {
+        const Runs r = j.runs->ofRow(y);
+        if (r.empty()) continue;
+        x0 = std::min(x0, j.columns[r.front().x0].i0);
+        x1 = std::max(x1, j.columns[r.back().x1 - 1].i1 + 1);
+    }
+    return {x0, std::max(x0, x1)};
 }
 
 }  // namespace
 
 void ambientFromHorizons(const AmbientInputs& in, const AmbientOutputs& out, AmbientScratch& scratch,
-                         const std::vector<std::uint8_t>* rows) {
+                         const TexelRuns* runs) {
     const int m = static_cast<int>(in.cosSin.size() / 2);
-    checkInputs(in, m, rows);
+    checkInputs(in, m, runs);
     if ((out.below == nullptr) != (out.rising == nullptr))
         throw InputError("ambient: the sky gradient's parts come together (below and rising)");
     const int nx = in.gradX.nx, ny = in.gradX.ny;
@@ -293,18 +331,21 @@ void ambientFromHorizons(const AmbientInputs& in, const AmbientOutputs& out, Amb
     if (s > 1) buildNearFieldSteps(in.cosSin, s, in.cellSize, scratch.nearSteps);
     const AmbientJob job{
         in,   nx, ny, nxr, nyr, m, rowFloats, scratch.rows.data(), scratch.columns.data(), scratch.nearSteps.data(),
-        rows, out};
+        runs, out};
     // a row keeps nothing in the scratch but the window, which a block starts afresh
     parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
         float* buffers = job.scratch + static_cast<std::size_t>(workerSlot()) * slotFloats;
         for (int block = b0; block < b1; ++block) {
-            RaisedWindow window{buffers + kRowsPerSlot * static_cast<std::size_t>(rowFloats), nxr};
             const int yBegin = static_cast<int>(static_cast<long long>(ny) * block / nBlocks);
             const int yEnd = static_cast<int>(static_cast<long long>(ny) * (block + 1) / nBlocks);
+            RaisedWindow window{buffers + kRowsPerSlot * static_cast<std::size_t>(rowFloats), nxr,
+                                receiversRead(job, yBegin, yEnd)};
+            const ColumnSpan wholeRow{0, nx};
             for (int y = yBegin; y < yEnd; ++y) {
-                if (rows && (*rows)[static_cast<std::size_t>(y)] == 0) continue;
+                const Runs rowRuns = runs ? runs->ofRow(y) : Runs(&wholeRow, 1);
+                if (rowRuns.empty()) continue;
                 if (s > 1) window.cover(job, y);
-                ambientRow(job, y, buffers, window);
+                ambientRow(job, y, rowRuns, buffers, window);
             }
         }
     });
@@ -312,23 +353,24 @@ void ambientFromHorizons(const AmbientInputs& in, const AmbientOutputs& out, Amb
 
 namespace {
 
-// shade[c] += albedo[c] x value(c, i) at every texel i of the flagged rows
-// (`rows` as for ambientFromHorizons; albedo 1 where the map has no channel).
+// shade[c] += albedo[c] x value(c, i) at every texel i of the runs (`runs`
+// as for ambientFromHorizons; albedo 1 where the map has no channel).
 template <class Value>
-void addLambertSky(int nx, int ny, const AlbedoMap* albedo, std::array<Grid, 3>& shade,
-                   const std::vector<std::uint8_t>* rows, Value value) {
+void addLambertSky(int nx, int ny, const AlbedoMap* albedo, std::array<Grid, 3>& shade, const TexelRuns* runs,
+                   Value value) {
+    const ColumnSpan wholeRow{0, nx};
     parallelForRows(ny, nx, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
-            if (rows && (*rows)[static_cast<std::size_t>(y)] == 0) continue;
             const std::size_t row = static_cast<std::size_t>(y) * nx;
-            for (std::size_t c = 0; c < 3; ++c) {
-                const bool mapped = albedo && !albedo->channel[c].empty();
-                float* out = shade[c].data() + row;
-                for (int x = 0; x < nx; ++x) {
-                    const float a = mapped ? albedo->channel[c].v[row + x] : 1.0f;
-                    out[x] += a * value(c, row + x);
+            for (const ColumnSpan& run : runs ? runs->ofRow(y) : std::span<const ColumnSpan>(&wholeRow, 1))
+                for (std::size_t c = 0; c < 3; ++c) {
+                    const bool mapped = albedo && !albedo->channel[c].empty();
+                    float* out = shade[c].data() + row;
+                    for (int x = run.x0; x < run.x1; ++x) {
+                        const float a = mapped ? albedo->channel[c].v[row + x] : 1.0f;
+                        out[x] += a * value(c, row + x);
+                    }
                 }
-            }
         }
     });
 }
@@ -336,14 +378,14 @@ void addLambertSky(int nx, int ny, const AlbedoMap* albedo, std::array<Grid, 3>&
 }  // namespace
 
 void addConstantSky(const Grid& ambient, const float radiance[3], const AlbedoMap* albedo, std::array<Grid, 3>& shade,
-                    const std::vector<std::uint8_t>* rows) {
-    addLambertSky(ambient.nx, ambient.ny, albedo, shade, rows,
+                    const TexelRuns* runs) {
+    addLambertSky(ambient.nx, ambient.ny, albedo, shade, runs,
                   [&](std::size_t c, std::size_t i) { return radiance[c] * ambient.v[i]; });
 }
 
 void addGradientSky(const AmbientOutputs& parts, const SkyGradient& sky, const AlbedoMap* albedo,
-                    std::array<Grid, 3>& shade, const std::vector<std::uint8_t>* rows) {
-    addLambertSky(parts.ambient.nx, parts.ambient.ny, albedo, shade, rows, [&](std::size_t c, std::size_t i) {
+                    std::array<Grid, 3>& shade, const TexelRuns* runs) {
+    addLambertSky(parts.ambient.nx, parts.ambient.ny, albedo, shade, runs, [&](std::size_t c, std::size_t i) {
         const float below = parts.below->v[i];
         return sky.horizon[c] * (parts.ambient.v[i] - below) + sky.ground[c] * below +
                (sky.zenith[c] - sky.horizon[c]) * parts.rising->v[i];

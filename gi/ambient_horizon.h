@@ -32,6 +32,7 @@
 #include "gi/lights.h"
 #include "gi/near_field.h"
 #include "gi/shading.h"
+#include "gi/texel_runs.h"
 #include "gi/visibility.h"
 
 namespace terrain::gi {
@@ -68,9 +69,9 @@ struct AmbientScratch {
 /// the environment's constant part (its band-0 SH coefficient) is lit
 /// exactly this way and only the rest goes through the SH product, whose
 /// truncation error then scales with the sky's variation, not its level.
-/// `rows` as for ambientFromHorizons.
+/// `runs` as for ambientFromHorizons.
 void addConstantSky(const Grid& ambient, const float radiance[3], const AlbedoMap* albedo, std::array<Grid, 3>& shade,
-                    const std::vector<std::uint8_t>* rows = nullptr);
+                    const TexelRuns* runs = nullptr);
 
 /// What ambientFromHorizons writes: the ambient map and, when `below` and
 /// `rising` are given, the two parts of it that light the analytic sky
@@ -87,16 +88,16 @@ struct AmbientOutputs {
 };
 
 /// Writes the ambient map and the parts asked for (resized to the gradients'
-/// size). `rows` (one flag per texel row; null: every row): only the flagged
-/// rows are computed, the others keep what the maps hold. Each row's values
-/// do not depend on the rows, the thread count, or whether the parts are
+/// size). `runs` (gi/texel_runs.h; null: every texel): only those texels
+/// are computed, the others keep what the maps hold. Each texel's values do
+/// not depend on the runs, the thread count, or whether the parts are
 /// computed.
 void ambientFromHorizons(const AmbientInputs& in, const AmbientOutputs& out, AmbientScratch& scratch,
-                         const std::vector<std::uint8_t>* rows = nullptr);
+                         const TexelRuns* runs = nullptr);
 
 /// Adds the Lambert shade of the analytic sky from the ambient's parts
-/// (AmbientOutputs with below and rising). `rows` as for ambientFromHorizons.
+/// (AmbientOutputs with below and rising). `runs` as for ambientFromHorizons.
 void addGradientSky(const AmbientOutputs& parts, const SkyGradient& sky, const AlbedoMap* albedo,
-                    std::array<Grid, 3>& shade, const std::vector<std::uint8_t>* rows = nullptr);
+                    std::array<Grid, 3>& shade, const TexelRuns* runs = nullptr);
 
 }  // namespace terrain::gi

@@ -200,7 +200,7 @@ void occlusionAtTexels(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
             float* recv = r.sum + pad;
             for (int y = block * kRowsPerBlock; y < std::min(ny, (block + 1) * kRowsPerBlock); ++y) {
                 const ReceiverLerp ry = receiverLerp(y, s, nyr);
-                const std::span<const ColumnSpan> runs = st.texelRuns.ofRow(ry.i0);
+                const std::span<const ColumnSpan> runs = st.texelRuns.ofRow(y);
                 if (runs.empty()) continue;
                 const PointRow pts{y, 1, nx, pad, st.heights.data() + (y + B) * stride + B, stride, nTaps};
                 // the texels [a, e) read the receivers [cols[a].i0, cols[e - 1].i1]
@@ -255,21 +255,11 @@ void occlusionAtReceivers(const HeightPyramid& pyr, ConstGridView gradX, ConstGr
     });
 }
 
-// The runs of the texel passes: the receivers of the dirty tiles (every
-// receiver without tiles), and the texels whose lower receiver (receiverLerp's
-// i0, along both axes) is one of them, as texel column runs per receiver row.
-void planRuns(const ReceiverTiles* tiles, int nx, int nxr, int nyr, BlockerRadianceState& st) {
-    dirtySpans(tiles, nxr, nyr, st.receiverRuns);
-    // firstTexel[X]: the first column whose lower receiver is X or after it (i0 grows with x)
-    std::vector<int>& first = st.firstTexel;
-    first.assign(static_cast<std::size_t>(nxr) + 1, nx);
-    for (int x = nx - 1; x >= 0; --x) first[static_cast<std::size_t>(st.cols[static_cast<std::size_t>(x)].i0)] = x;
-    for (int X = nxr - 1; X >= 0; --X)
-        first[static_cast<std::size_t>(X)] =
-            std::min(first[static_cast<std::size_t>(X)], first[static_cast<std::size_t>(X) + 1]);
-    st.texelRuns = st.receiverRuns;
-    for (ColumnSpan& run : st.texelRuns.spans)
-        run = {first[static_cast<std::size_t>(run.x0)], first[static_cast<std::size_t>(run.x1)]};
+// The runs of the texel passes: the receivers of the dirty tiles and their
+// texels (every one without tiles).
+void planRuns(const ReceiverTiles* tiles, BlockerRadianceState& st) {
+    dirtySpans(tiles, st.nxr, st.nyr, st.receiverRuns);
+    texelRunsOfTiles(tiles, st.nx, st.ny, st.subsample, st.texelRuns);
 }
 
 }  // namespace
@@ -304,7 +294,7 @@ void computeTexelOcclusion(const HeightPyramid& pyr, ConstGridView gradX, ConstG
     // per full-resolution column: the receivers it interpolates
     st.cols.resize(static_cast<std::size_t>(nx));
     for (int x = 0; x < nx; ++x) st.cols[static_cast<std::size_t>(x)] = receiverLerp(x, s, nxr);
-    planRuns(st.occlusionValid ? tiles : nullptr, nx, nxr, pyr.nyr, st);
+    planRuns(st.occlusionValid ? tiles : nullptr, st);
     const OcclusionPass pass{m, 2.0f / static_cast<float>(m),
                              simd::wideEnabled() ? occlusionAzimuthAvx2 : occlusionAzimuthSse};
     occlusionAtTexels(pyr, gradX, gradY, B, stride, nTaps, pass, st);
@@ -370,7 +360,7 @@ void shadeBlockerRadiance(BlockerRadianceState& st, const AlbedoMap* albedo, con
         });
         return;
     }
-    planRuns(tiles, nx, nxr, nyr, st);
+    planRuns(tiles, st);
     const int nBlocks = (ny + kRowsPerBlock - 1) / kRowsPerBlock;
     const std::size_t perBlock = static_cast<std::size_t>(4) * nxr;  // O, E x 3 of a row, between receiver rows
     if (st.scratch.size() < perBlock * nBlocks) st.scratch.resize(perBlock * nBlocks);
@@ -379,8 +369,8 @@ void shadeBlockerRadiance(BlockerRadianceState& st, const AlbedoMap* albedo, con
             float* oRow = st.scratch.data() + perBlock * block;
             float* const eRow[3] = {oRow + nxr, oRow + 2 * nxr, oRow + 3 * nxr};
             for (int y = block * kRowsPerBlock; y < std::min(ny, (block + 1) * kRowsPerBlock); ++y)
-                for (const ColumnSpan& run : st.texelRuns.ofRow(receiverLerp(y, s, nyr).i0))
-                    if (run.x0 < run.x1) shadeTexelRun(st, alb, y, run.x0, run.x1, oRow, eRow, rgb);
+                for (const ColumnSpan& run : st.texelRuns.ofRow(y))
+                    shadeTexelRun(st, alb, y, run.x0, run.x1, oRow, eRow, rgb);
         }
     });
 }

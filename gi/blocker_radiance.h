@@ -43,6 +43,7 @@
 #include "gi/pyramid.h"
 #include "gi/receiver_tiles.h"
 #include "gi/shading.h"
+#include "gi/texel_runs.h"
 
 namespace terrain::gi {
 
@@ -65,11 +66,10 @@ struct BlockerRadianceState {
     std::vector<NearTap> taps;                        // azimuths x near samples
     std::vector<float> cosPhi, sinPhi;
     std::vector<ReceiverLerp> cols;  // per full-resolution column: the receivers it reads
-    // The texel passes' extent (receiver tiles): the receivers to redo and,
-    // per receiver row, the texel column runs whose lower receiver is one of
-    // them; firstTexel[X] is the first column whose lower receiver is X or later.
-    DirtySpans receiverRuns, texelRuns;
-    std::vector<int> firstTexel;
+    // The texel passes' extent (receiver tiles): the receivers to redo and
+    // the texels whose lower receiver is one of them (gi/texel_runs.h).
+    DirtySpans receiverRuns;
+    TexelRuns texelRuns;
 };
 
 /// Sizes the buffers for a frame (farSlope is then filled by the scan).
@@ -80,7 +80,8 @@ void prepareBlockerRadiance(const HeightPyramid& pyr, int azimuths, BlockerRadia
 /// receiver tiles (null: every texel) and a valid occlusion of this grid in
 /// the state, only the receivers of the dirty tiles and the texels whose
 /// lower receiver (receiverLerp's i0, along both axes) is one of them; the
-/// others keep their values. Each value is the same whichever are computed.
+/// others keep their values (gi/texel_runs.h). Each value is the same
+/// whichever are computed.
 void computeTexelOcclusion(const HeightPyramid& pyr, ConstGridView gradX, ConstGridView gradY,
                            const std::vector<double>& phi, const ReceiverTiles* tiles, BlockerRadianceState& st);
 

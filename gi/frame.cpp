@@ -11,7 +11,7 @@
 #include "gi/indirect.h"
 #include "gi/indirect_bounces.h"
 #include "gi/key_light_exact.h"
-#include "gi/shading_rows.h"
+#include "gi/shading_tiles.h"
 
 namespace terrain::gi {
 
@@ -52,32 +52,34 @@ const ReceiverTiles* planIndirect(const GiSettings& settings, const FrameChange&
 }
 
 // The texel tiles the indirect light's texel passes redo (gi/indirect_cache.h).
-// The height change since the last pass is this frame's visibility plan's
-// when the pass before it was on the geometry this frame replaced: this
-// frame recomputed the geometry (a direct frame), once since that pass, and
-// planned tiles (receiver tiles with changed geometry imply a tiled plan).
-const ReceiverTiles* planTexels(const FrameChange& change, const ReceiverTiles* only, const AlbedoMap* albedo,
-                                GiState& st) {
+// The last pass's heights are the recorded ones when the pass before this one
+// was on the geometry this frame replaced: this frame recomputed the
+// geometry (a direct frame) and nothing else did since that pass (every
+// frame that changes the heights recomputes the geometry and records them).
+const ReceiverTiles* planTexels(ConstGridView heights, const FrameChange& change, const ReceiverTiles* only,
+                                const AlbedoMap* albedo, GiState& st) {
     const IndirectCache& cache = st.indirectCache;
     const bool same = st.geometryVersion == cache.geometryVersion;
     const bool replacedLast =
         st.directUpdated && change.geometry && only != nullptr && st.geometryVersion == cache.geometryVersion + 1;
     const IndirectTexelInputs in{.gathered = only,
                                  .sameGeometry = same,
-                                 .heightChange = replacedLast ? &st.visibilityCache.change : nullptr,
+                                 .lastHeights = replacedLast ? &st.lastInputs.heights : nullptr,
+                                 .heights = heights,
                                  .albedo = albedo,
-                                 .heights = st.pyramid};
+                                 .pyramid = st.pyramid};
     return planIndirectTexels(in, st.indirectCache);
 }
 
 // Indirect bounces over the last computed direct shade, re-gathered where
 // its sources or the geometry within reach changed (incremental frames).
-void runIndirectStage(const GiSettings& settings, const FrameChange& change, GiState& st, const AlbedoMap* albedo) {
+void runIndirectStage(ConstGridView heights, const GiSettings& settings, const FrameChange& change, GiState& st,
+                      const AlbedoMap* albedo) {
     const auto t = Clock::now();
     const FoldedWedgeOperator& op = indirectScanOperator(settings, st);
     const bool cached = settings.incremental && gathersByTiles(settings.indirect, settings.shading);
     const ReceiverTiles* only = planIndirect(settings, change, cached, op.azimuths, st);
-    const ReceiverTiles* texels = cached ? planTexels(change, only, albedo, st) : nullptr;
+    const ReceiverTiles* texels = cached ? planTexels(heights, change, only, albedo, st) : nullptr;
     const IndirectInputs in{.heights = st.pyramid,
                             .gradX = st.gradX.cview(),
                             .gradY = st.gradY.cview(),
@@ -319,7 +321,7 @@ bool readsEnvironmentSh(const GiLighting& lighting, const GiSettings& settings) 
 // light's by now). It depends on the geometry alone: the frames recompute it
 // where the environment's V was recomputed, not when only the lights change.
 void exactAmbient(ConstGridView heights, float cellSize, const GiSettings& settings, bool withSkyParts, GiState& st,
-                  const std::vector<std::uint8_t>* rows) {
+                  const TexelRuns* runs) {
     const bool footprint = settings.subsample > 1 && settings.visibility.footprintTangent;
     const AmbientInputs in{.gradX = st.gradX.cview(),
                            .gradY = st.gradY.cview(),
@@ -331,16 +333,16 @@ void exactAmbient(ConstGridView heights, float cellSize, const GiSettings& setti
                            .footprint = footprint ? &st.footprint : nullptr};
     ShadeMaps& sh = st.shade;
     const AmbientOutputs out{sh.ambient, withSkyParts ? &sh.skyBelow : nullptr, withSkyParts ? &sh.skyRising : nullptr};
-    ambientFromHorizons(in, out, st.ambientScratch, rows);
+    ambientFromHorizons(in, out, st.ambientScratch, runs);
     sh.skyParts = withSkyParts;
 }
 
 // Direct light at every texel: the lighting's SH product matrices once per
 // frame, then the shading (Section 7); key lights through the SH clamped
 // cosine, or with the exact cosine (GiSettings::keyLightExactCosine). With
-// `rows` only those texel rows, the others keep the last frame's light.
+// `runs` only those texels, the others keep the last frame's light.
 void directShading(const GiLighting& lighting, const GiSettings& settings, const AlbedoMap* albedo, GiState& st,
-                   const std::vector<std::uint8_t>* rows) {
+                   const TexelRuns* runs) {
     const std::size_t nKeys = lighting.keys.size();
     const bool exactKeys = settings.keyLightExactCosine;
     st.shade.keepIncident = readsIncidentSh(settings.indirect, settings.shading);
@@ -352,16 +354,16 @@ void directShading(const GiLighting& lighting, const GiSettings& settings, const
     for (std::size_t k = 0; k < (exactKeys ? 0 : nKeys); ++k)
         st.shadingLights[k + 1] = keyShadingLight(lighting.keys[k], st.keyVisibility[k]);
     shadeTexels(st.gradX.cview(), st.gradY.cview(), settings.subsample, st.envVisibility, st.shadingLights.data(),
-                static_cast<int>(st.shadingLights.size()), albedo, settings.shading, st.shade, shAmbient, rows);
+                static_cast<int>(st.shadingLights.size()), albedo, settings.shading, st.shade, shAmbient, runs);
     if (sky.exactSky)
         addGradientSky({st.shade.ambient, &st.shade.skyBelow, &st.shade.skyRising}, *lighting.gradient, albedo,
-                       st.shade.rgb, rows);
+                       st.shade.rgb, runs);
     else if (sky.splitSky)
-        addConstantSky(st.shade.ambient, sky.constant, albedo, st.shade.rgb, rows);
+        addConstantSky(st.shade.ambient, sky.constant, albedo, st.shade.rgb, runs);
     if (exactKeys)
         for (std::size_t k = 0; k < nKeys; ++k)
             addKeyLightExactCosine(lighting.keys[k], st.keyVisibility[k], settings.subsample, st.gradX.cview(),
-                                   st.gradY.cview(), albedo, st.shade.rgb, rows);
+                                   st.gradY.cview(), albedo, st.shade.rgb, runs);
 }
 
 // Which receivers' visibility the frame recomputes, planned before any stage
@@ -401,20 +403,20 @@ GeometryPlan planGeometry(ConstGridView heights, const GiLighting& lighting, con
     return plan;
 }
 
-// The texel rows whose direct light can differ from the last frame's
-// (gi/shading_rows.h), or null for every row: only when the heights alone
+// The texels whose direct light can differ from the last frame's
+// (gi/shading_tiles.h), or null for every texel: only when the heights alone
 // changed, the visibility was recomputed by tiles and the last direct
 // shading is of the recorded inputs.
-const std::vector<std::uint8_t>* shadingRows(ConstGridView heights, const FrameChange& change, const GeometryPlan& plan,
-                                             GiState& st) {
+const TexelRuns* shadingRuns(ConstGridView heights, const FrameChange& change, const GeometryPlan& plan, GiState& st) {
     const bool keyRegions = std::find(change.keyRegion.begin(), change.keyRegion.end(), true) != change.keyRegion.end();
     if (!plan.tiled || change.radiance || keyRegions || st.directStale || !st.lastInputs.valid ||
         st.shade.nx != heights.nx || st.shade.ny != heights.ny || st.lastInputs.heights.nx != heights.nx ||
         st.lastInputs.heights.ny != heights.ny)
         return nullptr;
-    changedShadingRows(st.lastInputs.heights.cview(), heights, st.visibilityCache.tiles, st.visibilityCache.keyTiles,
-                       st.pyramid.subsample, st.shadingRows);
-    return &st.shadingRows;
+    changedShadingTiles(st.lastInputs.heights.cview(), heights, st.visibilityCache.tiles, st.visibilityCache.keyTiles,
+                        st.pyramid.subsample, st.shadingTiles);
+    texelRunsOfTiles(&st.shadingTiles, heights.nx, heights.ny, st.pyramid.subsample, st.shadingRuns);
+    return &st.shadingRuns;
 }
 
 // The direct light's stages: geometry (gradient, pyramid, environment V)
@@ -456,16 +458,16 @@ void runDirectStages(ConstGridView heights, float cellSize, const GiLighting& li
     keyLightVisibility(lighting, settings, change, keyOnly, st);
     st.timings.keyVisibility = msSince(t);
     t = Clock::now();
-    const std::vector<std::uint8_t>* rows = shadingRows(heights, change, plan, st);
+    const TexelRuns* runs = shadingRuns(heights, change, plan, st);
     if (settings.ambient == AmbientMethod::Horizons) {
         // the sky's parts ride with the ambient; a sky gradient new to this
         // geometry needs them over the whole field
         const bool withSkyParts = lighting.gradient.has_value();
         const bool partsMissing = withSkyParts && !st.shade.skyParts;
         if (change.geometry || partsMissing || shMissing)
-            exactAmbient(heights, cellSize, settings, withSkyParts, st, partsMissing || shMissing ? nullptr : rows);
+            exactAmbient(heights, cellSize, settings, withSkyParts, st, partsMissing || shMissing ? nullptr : runs);
     }
-    directShading(lighting, settings, albedo, st, rows);
+    directShading(lighting, settings, albedo, st, runs);
     st.timings.shading = msSince(t);
 }
 
@@ -496,14 +498,14 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
     if (!st.directUpdated) {
         // indirect only: geometry, pyramid, visibility and direct shade are the
         // last direct frame's, and so are the recorded inputs (below)
-        runIndirectStage(settings, change, st, albedo);
+        runIndirectStage(heights, settings, change, st, albedo);
         st.directStale = change.any();
         st.indirectStale = false;
     } else {
         runDirectStages(heights, cellSize, lighting, settings, change, plan, albedo, st);
         st.directStale = false;
         if (st.indirectUpdated) {
-            runIndirectStage(settings, change, st, albedo);
+            runIndirectStage(heights, settings, change, st, albedo);
             st.indirectStale = false;
         } else if (settings.indirect.bounces > 0) {
             sumDirectAndIndirect(st.shade.rgb, st.indirect);  // the last indirect light on the new direct shade

@@ -59,11 +59,12 @@ struct GiState {
     VisibilityCache visibilityCache;  // per tile, how far the cached V may have drifted
     IndirectCache indirectCache;      // per tile, how far the cached indirect light may have drifted
     bool directStale = false, indirectStale = false;
-    std::vector<std::uint8_t> shadingRows;  // this frame's texel rows whose direct light was redone (gi/shading_rows.h)
-    double receiversRecomputed = 0.0;       // fraction of the receivers whose environment V the last frame recomputed
-    int keyVisibilitiesRecomputed = 0;      // key lights whose V the last frame recomputed
-    int framesSinceRefresh = 0;             // incremental frames since the last full one (GiSettings::refreshEvery)
-    double indirectRecomputed = 0.0;        // fraction of the receivers whose indirect light the last frame re-gathered
+    ReceiverTiles shadingTiles;         // this frame's texel tiles whose direct light was redone (gi/shading_tiles.h)
+    TexelRuns shadingRuns;              // and their texels
+    double receiversRecomputed = 0.0;   // fraction of the receivers whose environment V the last frame recomputed
+    int keyVisibilitiesRecomputed = 0;  // key lights whose V the last frame recomputed
+    int framesSinceRefresh = 0;         // incremental frames since the last full one (GiSettings::refreshEvery)
+    double indirectRecomputed = 0.0;    // fraction of the receivers whose indirect light the last frame re-gathered
     // Shading amortisation (Section 7): with settings.indirect.amortise, frames
     // on unchanged geometry update the direct and the indirect light
     // alternately. Incremental frames set geometryChanged themselves; without

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cstring>
-#include <utility>
 
+#include "gi/texel_runs.h"
 #include "gi/visibility_cache.h"
 
 namespace terrain::gi {
@@ -85,39 +85,21 @@ bool sameAlbedoAsLastPass(const AlbedoMap* albedo, IndirectCache& cache) {
     return false;
 }
 
-// The texels of receivers [X0, X1) along an axis of n receivers and
-// `cells` texels, as a cell range dilated by `reach`: their lower receivers
-// lie in it (receiverLerp clamps the lower receiver to n - 2, so the tile
-// holding it takes the texels up to the grid's end).
-std::pair<int, int> texelCells(int X0, int X1, int n, int s, int cells, int reach) {
-    const int hi = X1 > n - 2 ? cells - 1 : s * X1 - 1;
-    return {s * X0 - reach, hi + reach};
-}
-
-// A dirty receiver tile at (tx, ty) or after it by one along x, y or both.
-bool readsGathered(const ReceiverTiles& g, int tx, int ty) {
-    for (int dy = 0; dy <= 1; ++dy)
-        for (int dx = 0; dx <= 1; ++dx)
-            if (tx + dx < g.tilesX && ty + dy < g.tilesY && g.isDirty(tx + dx, ty + dy)) return true;
-    return false;
-}
-
 }  // namespace
 
 const ReceiverTiles* planIndirectTexels(const IndirectTexelInputs& in, IndirectCache& cache) {
     const bool albedo = sameAlbedoAsLastPass(in.albedo, cache);
-    if (!in.gathered || !albedo || (!in.sameGeometry && !in.heightChange)) return nullptr;
-    const HeightPyramid& h = in.heights;
+    if (!in.gathered || !albedo || (!in.sameGeometry && !in.lastHeights)) return nullptr;
+    const HeightPyramid& h = in.pyramid;
     const ReceiverTiles& g = *in.gathered;
-    const int s = h.subsample, reach = s + 1, T = g.tileSize;
-    cache.texels.reset(h.nxr, h.nyr, T, false);
+    const int reach = h.subsample + 1;
+    cache.texels.reset(h.nxr, h.nyr, g.tileSize, false);
     for (int ty = 0; ty < g.tilesY; ++ty)
         for (int tx = 0; tx < g.tilesX; ++tx) {
-            bool dirty = readsGathered(g, tx, ty);
+            bool dirty = readsDirtyReceivers(g, tx, ty);
             if (!dirty && !in.sameGeometry) {
-                const auto [x0, x1] = texelCells(tx * T, std::min(h.nxr, (tx + 1) * T), h.nxr, s, h.nx, reach);
-                const auto [y0, y1] = texelCells(ty * T, std::min(h.nyr, (ty + 1) * T), h.nyr, s, h.ny, reach);
-                dirty = maxChangeInBox(*in.heightChange, x0, y0, x1, y1) > 0.0f;
+                dirty = cellsDiffer(in.lastHeights->cview(), in.heights,
+                                    texelCellsOfTile(g, tx, ty, h.nx, h.ny, h.subsample, reach));
             }
             cache.texels.setDirty(tx, ty, dirty);
         }

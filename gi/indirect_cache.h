@@ -80,11 +80,12 @@ void recordIndirectSource(const std::array<Grid, 3>& source, const HeightPyramid
 
 /// What the frame knows of the texels' inputs since the last pass.
 struct IndirectTexelInputs {
-    const ReceiverTiles* gathered;         // this pass's receiver tiles (null: every receiver)
-    bool sameGeometry;                     // heights and gradients are the last pass's
-    const MaxChangePyramid* heightChange;  // else |dh| since the last pass's heights; null: not known
-    const AlbedoMap* albedo;               // this pass's (null: 1)
-    const HeightPyramid& heights;          // this pass's grid
+    const ReceiverTiles* gathered;  // this pass's receiver tiles (null: every receiver)
+    bool sameGeometry;              // heights and gradients are the last pass's
+    const Grid* lastHeights;        // else the last pass's heights (null: not known)
+    ConstGridView heights;          // and this pass's
+    const AlbedoMap* albedo;        // this pass's (null: 1)
+    const HeightPyramid& pyramid;   // this pass's grid
 };
 
 /// The texel tiles to redo (cache.texels, on the layout of cache.tiles), or

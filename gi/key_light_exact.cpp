@@ -32,7 +32,7 @@ void cosinesOfChunk(const float* gx, const float* gy, float lx, float ly, float 
 
 void addKeyLightExactCosine(const KeyLight& light, const VisibilityField& v, int s, ConstGridView gradX,
                             ConstGridView gradY, const AlbedoMap* albedo, std::array<Grid, 3>& out,
-                            const std::vector<std::uint8_t>* rows) {
+                            const TexelRuns* runs) {
     const KeyLightExtent ext = keyLightExtent(light);
     const double solidAngle = (ext.phiEnd - ext.phiStart) * (static_cast<double>(ext.sinHigh) - ext.sinLow);
     if (!(solidAngle > 0.0)) return;
@@ -54,31 +54,34 @@ void addKeyLightExactCosine(const KeyLight& light, const VisibilityField& v, int
         const int X0 = std::min(x / s, nxr - 1), X1 = std::min(X0 + 1, nxr - 1);
         columns[static_cast<std::size_t>(x)] = {X0, X1, X1 == X0 ? 0.0f : static_cast<float>(x - s * X0) * invS};
     }
+    const ColumnSpan wholeRow{0, nx};
     parallelForRows(ny, nx, [&](int y0, int y1) {
         float cosine[kChunk];
         for (int y = y0; y < y1; ++y) {
-            if (rows && (*rows)[static_cast<std::size_t>(y)] == 0) continue;  // shaded with the rest of its row
+            const std::span<const ColumnSpan> rowRuns =
+                runs ? runs->ofRow(y) : std::span<const ColumnSpan>(&wholeRow, 1);
             const int Y0 = std::min(y / s, nyr - 1), Y1 = std::min(Y0 + 1, nyr - 1);
             const float fy = Y1 == Y0 ? 0.0f : static_cast<float>(y - s * Y0) * invS;
             const float* r0 = v0 + static_cast<std::size_t>(Y0) * nxr;
             const float* r1 = v0 + static_cast<std::size_t>(Y1) * nxr;
-            for (int c0 = 0; c0 < nx; c0 += kChunk) {
-                const int n = std::min(kChunk, nx - c0);
-                cosinesOfChunk(gradX.row(y) + c0, gradY.row(y) + c0, lx, ly, lz, n, cosine);
-                for (int k = 0; k < n; ++k) {
-                    const int x = c0 + k;
-                    if (!(cosine[k] > 0.0f)) continue;
-                    const Column& col = columns[static_cast<std::size_t>(x)];
-                    const float a = r0[col.X0] + col.fx * (r0[col.X1] - r0[col.X0]);
-                    const float b = r1[col.X0] + col.fx * (r1[col.X1] - r1[col.X0]);
-                    const float f = std::clamp((a + fy * (b - a)) * toFrac, 0.0f, 1.0f);
-                    if (!(f > 0.0f)) continue;
-                    for (std::size_t c = 0; c < 3; ++c) {
-                        const float alb = albedo && !albedo->channel[c].empty() ? albedo->channel[c](x, y) : 1.0f;
-                        out[c](x, y) += alb * light.rgb[c] * f * cosine[k];
+            for (const ColumnSpan& run : rowRuns)
+                for (int c0 = run.x0; c0 < run.x1; c0 += kChunk) {
+                    const int n = std::min(kChunk, run.x1 - c0);
+                    cosinesOfChunk(gradX.row(y) + c0, gradY.row(y) + c0, lx, ly, lz, n, cosine);
+                    for (int k = 0; k < n; ++k) {
+                        const int x = c0 + k;
+                        if (!(cosine[k] > 0.0f)) continue;
+                        const Column& col = columns[static_cast<std::size_t>(x)];
+                        const float a = r0[col.X0] + col.fx * (r0[col.X1] - r0[col.X0]);
+                        const float b = r1[col.X0] + col.fx * (r1[col.X1] - r1[col.X0]);
+                        const float f = std::clamp((a + fy * (b - a)) * toFrac, 0.0f, 1.0f);
+                        if (!(f > 0.0f)) continue;
+                        for (std::size_t c = 0; c < 3; ++c) {
+                            const float alb = albedo && !albedo->channel[c].empty() ? albedo->channel[c](x, y) : 1.0f;
+                            out[c](x, y) += alb * light.rgb[c] * f * cosine[k];
+                        }
                     }
                 }
-            }
         }
     });
 }

@@ -12,16 +12,17 @@
 #include "core/grid.h"
 #include "gi/lights.h"
 #include "gi/shading.h"
+#include "gi/texel_runs.h"
 #include "gi/visibility.h"
 
 namespace terrain::gi {
 
 /// Adds the key light's shade to `out` (the gradients' size) at every texel
-/// of the flagged rows (`rows`: one flag per texel row; null: every row).
+/// of the runs (gi/texel_runs.h; null: every texel).
 /// `v`: the light's visibility (its V_00 plane) on the receiver grid of
 /// sub-sampling s. Each texel's value depends on its own inputs alone.
 void addKeyLightExactCosine(const KeyLight& light, const VisibilityField& v, int s, ConstGridView gradX,
                             ConstGridView gradY, const AlbedoMap* albedo, std::array<Grid, 3>& out,
-                            const std::vector<std::uint8_t>* rows = nullptr);
+                            const TexelRuns* runs = nullptr);
 
 }  // namespace terrain::gi

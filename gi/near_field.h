@@ -28,16 +28,17 @@ void buildNearFieldSteps(std::span<const float> cosSin, int subsample, float cel
 
 /// Raises horizon[x] (blocking slopes of texel row y along one azimuth, nx
 /// floats) to the texels' own slopes at that azimuth's `steps` (those whose
-/// sample lies inside the field). Element-wise float arithmetic: the same
-/// bits whatever vector width the compiler gives it.
+/// sample lies inside the field), over the texels [xBegin, xEnd) (default:
+/// the row). Element-wise float arithmetic: the same bits whatever vector
+/// width the compiler gives it.
 [[gnu::always_inline]] inline void raiseToNearField(ConstGridView heights, int y, std::span<const NearFieldStep> steps,
-                                                    float* horizon) {
+                                                    float* horizon, int xBegin = 0, int xEnd = -1) {
     const int nx = heights.nx, ny = heights.ny;
     const float* h0 = heights.row(y);
     for (const NearFieldStep& st : steps) {
         if (std::min(y + st.ay, y + st.by) < 0 || std::max(y + st.ay, y + st.by) >= ny) continue;
-        const int x0 = std::max({0, -st.ax, -st.bx});
-        const int x1 = std::min({nx, nx - st.ax, nx - st.bx});
+        const int x0 = std::max({xBegin, -st.ax, -st.bx});
+        const int x1 = std::min({xEnd < 0 ? nx : xEnd, nx - st.ax, nx - st.bx});
         const float* hA = heights.row(y + st.ay) + st.ax;
         const float* hB = heights.row(y + st.by) + st.bx;
         const float wA = st.wA, wB = st.wB, inv = st.invTau;

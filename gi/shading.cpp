@@ -88,7 +88,7 @@ template <class V, int S>
 [[gnu::always_inline]] inline void lambertRowS(const float* vert, int nxrS, int nxr, int nCoef, const float* gxr,
                                                const float* gyr, const int* colIndex, const float* colFrac,
                                                const LambertFactors& lf, float diffuseWeight, const AlbedoMap* albedo,
-                                               bool ambient, int y, int nx, ShadeMaps& out) {
+                                               bool ambient, int y, int nx, ColumnSpan run, ShadeMaps& out) {
     // out.ambient may hold another method's map (gi/ambient_horizon.h) of another size: written only when asked
     float* amb = ambient ? out.ambient.data() + static_cast<std::size_t>(y) * nx : nullptr;
     float* rgb[3];
@@ -100,13 +100,16 @@ template <class V, int S>
                             : nullptr;
         alb[ch] = a ? a->data() + static_cast<std::size_t>(y) * nx : nullptr;
     }
-    // texels [0, xVec) take the vector path: all of x .. x+L-1 below s (nxr - 1)
+    // texels [0, xVec) take the vector path: all of x .. x+L-1 below s (nxr
+    // - 1); of the run, the whole lane groups there, from a multiple of L
     using I = typename LaneTraits<V>::I;
     constexpr int L = LaneTraits<V>::n;
     const int interior = S * std::max(nxr - 1, 0);
     const int xVec = nxr >= 3 ? std::max(0, interior - (S == 2 ? 2 : 0)) / L * L : 0;
+    const int vecBegin = std::min((run.x0 + L - 1) / L * L, xVec);
+    const int vecEnd = std::max(vecBegin, std::min(run.x1 / L * L, xVec));
     const V fmax = splat<V>(3.40282347e38f);
-    for (int x = 0; x < xVec; x += L) {
+    for (int x = vecBegin; x < vecEnd; x += L) {
         const V gx = load<V>(gxr + x), gy = load<V>(gyr + x);
         const V inv = splat<V>(1.0f) / sqrtv(splat<V>(1.0f) + gx * gx + gy * gy);
         const V X = -gx * inv, Yn = -gy * inv, Z = inv;
@@ -127,8 +130,8 @@ template <class V, int S>
             store(rgb[ch] + x, finite ? o : splat<V>(0.0f));
         }
     }
-    // remaining texels, scalar (same operations)
-    for (int x = xVec; x < nx; ++x) {
+    // the run's other texels, scalar (the same operations)
+    const auto scalarTexel = [&](int x) {
         const int X0 = colIndex[x];
         const int X1 = std::min(X0 + 1, nxr - 1);
         const float f = colFrac[x];
@@ -152,7 +155,9 @@ template <class V, int S>
             o *= diffuseWeight * (alb[ch] ? alb[ch][x] : 1.0f);
             rgb[ch][x] = std::isfinite(o) ? o : 0.0f;
         }
-    }
+    };
+    for (int x = run.x0; x < std::min(vecBegin, run.x1); ++x) scalarTexel(x);
+    for (int x = std::max(vecEnd, run.x0); x < run.x1; ++x) scalarTexel(x);
 }
 
 // Where the receivers' incident SH planes live: plane c of receiver row Y at
@@ -194,30 +199,36 @@ inline PlaneRows planeRows(const LambertRowJob& j, int p, const ReceiverLerp& ry
     return {plane + static_cast<std::size_t>(ry.i0) * j.nxr, plane + static_cast<std::size_t>(ry.i1) * j.nxr};
 }
 
+using Runs = std::span<const ColumnSpan>;
+
 template <class V>
 [[gnu::always_inline]] inline void lambertShadeRowImpl(const LambertRowJob& j, float* vert, const float* gxr,
-                                                       const float* gyr, int y) {
+                                                       const float* gyr, int y, Runs runs) {
     constexpr int L = LaneTraits<V>::n;
     const ReceiverLerp ry = receiverLerp(y, j.s, j.nyr);
     const int nPlanes = 3 * j.nCoef + (j.env ? 9 : 0);
-    const int nv = j.nxr / L * L;
+    // the receivers the runs' texels read: [X0, X1)
+    const int X0 = j.colIndex[runs.front().x0];
+    const int X1 = std::min(j.nxr, j.colIndex[runs.back().x1 - 1] + 2);
+    const int nv = X0 + (X1 - X0) / L * L;
     const V fy = splat<V>(ry.f);
     for (int p = 0; p < nPlanes; ++p) {
         const PlaneRows r = planeRows(j, p, ry);
         const float* __restrict ra = r.a;
         const float* __restrict rb = r.b;
         float* __restrict v = vert + static_cast<std::size_t>(p) * j.nxrS;
-        for (int X = 0; X < nv; X += L) {
+        for (int X = X0; X < nv; X += L) {
             const V a = load<V>(ra + X);
             store(v + X, a + fy * (load<V>(rb + X) - a));
         }
-        for (int X = nv; X < j.nxr; ++X) v[X] = ra[X] + ry.f * (rb[X] - ra[X]);
+        for (int X = nv; X < X1; ++X) v[X] = ra[X] + ry.f * (rb[X] - ra[X]);
         for (int X = j.nxr; X < j.nxrS; ++X) v[X] = 0.0f;
     }
     auto row = [&](auto sTag) {
         constexpr int S = decltype(sTag)::value;
-        lambertRowS<V, S>(vert, j.nxrS, j.nxr, j.nCoef, gxr, gyr, j.colIndex, j.colFrac, j.lf, j.diffuseWeight,
-                          j.albedo, j.env != nullptr, y, j.nx, *j.out);
+        for (const ColumnSpan& run : runs)
+            lambertRowS<V, S>(vert, j.nxrS, j.nxr, j.nCoef, gxr, gyr, j.colIndex, j.colFrac, j.lf, j.diffuseWeight,
+                              j.albedo, j.env != nullptr, y, j.nx, run, *j.out);
     };
     if (j.s == 1)
         row(std::integral_constant<int, 1>{});
@@ -226,24 +237,25 @@ template <class V>
     else
         row(std::integral_constant<int, 4>{});
 }
-void lambertShadeRowSse(const LambertRowJob& j, float* vert, const float* gxr, const float* gyr, int y) {
-    lambertShadeRowImpl<F4>(j, vert, gxr, gyr, y);
+void lambertShadeRowSse(const LambertRowJob& j, float* vert, const float* gxr, const float* gyr, int y, Runs runs) {
+    lambertShadeRowImpl<F4>(j, vert, gxr, gyr, y, runs);
 }
 [[gnu::target("avx2"), gnu::flatten]] void lambertShadeRowAvx2(const LambertRowJob& j, float* vert, const float* gxr,
-                                                               const float* gyr, int y) {
-    lambertShadeRowImpl<F8>(j, vert, gxr, gyr, y);
+                                                               const float* gyr, int y, Runs runs) {
+    lambertShadeRowImpl<F8>(j, vert, gxr, gyr, y, runs);
 }
 
 // ---- algorithm, receivers: incident radiance I_c = sum_L T_{L,c} V_L, row Y ----
-// 16 receivers at a time: the lights' V vectors are read once, each output
-// coefficient sums its non-zero matrix entries in a fixed order (light, k).
+// 16 receivers at a time from `cols.x0` (a multiple of 16) to `cols.x1`: the
+// lights' V vectors are read once, each output coefficient sums its non-zero
+// matrix entries in a fixed order (light, k), lane by lane.
 template <class V>
 [[gnu::always_inline]] inline void incidentRowImpl(const ShadingLight* lights, int nl, int nCoef, int nxr,
-                                                   const ShadeMaps& terms, IncidentRows to, int Y) {
+                                                   ColumnSpan cols, const ShadeMaps& terms, IncidentRows to, int Y) {
     constexpr int L = LaneTraits<V>::n, NQ = 16 / L;
     const std::size_t r0 = static_cast<std::size_t>(Y) * nxr;
     const std::size_t w0 = static_cast<std::size_t>(Y - to.row0) * nxr;
-    for (int X = 0; X < nxr; X += 16) {
+    for (int X = cols.x0; X < cols.x1; X += 16) {
         const int n = std::min(16, nxr - X);
         for (int g0 = 0; g0 < nl; g0 += kMaxShadingLights) {
             const int g1 = std::min(nl, g0 + kMaxShadingLights);
@@ -284,13 +296,14 @@ template <class V>
         }
     }
 }
-void incidentRowSse(const ShadingLight* lights, int nl, int nCoef, int nxr, const ShadeMaps& terms, IncidentRows to,
-                    int Y) {
-    incidentRowImpl<F4>(lights, nl, nCoef, nxr, terms, to, Y);
+void incidentRowSse(const ShadingLight* lights, int nl, int nCoef, int nxr, ColumnSpan cols, const ShadeMaps& terms,
+                    IncidentRows to, int Y) {
+    incidentRowImpl<F4>(lights, nl, nCoef, nxr, cols, terms, to, Y);
 }
 [[gnu::target("avx2"), gnu::flatten]] void incidentRowAvx2(const ShadingLight* lights, int nl, int nCoef, int nxr,
-                                                           const ShadeMaps& terms, IncidentRows to, int Y) {
-    incidentRowImpl<F8>(lights, nl, nCoef, nxr, terms, to, Y);
+                                                           ColumnSpan cols, const ShadeMaps& terms, IncidentRows to,
+                                                           int Y) {
+    incidentRowImpl<F8>(lights, nl, nCoef, nxr, cols, terms, to, Y);
 }
 
 // ---- setup ----------------------------------------------------------------------
@@ -399,10 +412,10 @@ void lambertBasisRow(const LambertFactors& lf, const float* __restrict gxr, cons
 
 // o[x] += specWeight * (Phong lobe about texel x's reflection vector) . I_ch (Section 7).
 void addPhongLobe(const PhongRowJob& j, const float* __restrict gxr, const float* __restrict gyr,
-                  const float* __restrict up, int ch, int y, float* __restrict o) {
+                  const float* __restrict up, int ch, int y, ColumnSpan run, float* __restrict o) {
     const int nx = j.base.nx, nCoef = j.base.nCoef;
     const float vx = j.view[0], vy = j.view[1], vz = j.view[2];
-    for (int x = 0; x < nx; ++x) {
+    for (int x = run.x0; x < run.x1; ++x) {
         const float gx = gxr[x], gy = gyr[x];
         const float inv = 1.0f / std::sqrt(1.0f + gx * gx + gy * gy);
         const float nxv = -gx * inv, nyv = -gy * inv, nzv = inv;
@@ -418,36 +431,36 @@ void addPhongLobe(const PhongRowJob& j, const float* __restrict gxr, const float
     }
 }
 
-// Ambient and RGB of row y from the row's SH planes `up` and its Lambert basis
-// `lamRow` (lambertBasisRow).
+// Ambient and RGB of the run of row y from the row's SH planes `up` and its
+// Lambert basis `lamRow` (lambertBasisRow).
 void phongShadeRow(const PhongRowJob& j, const float* __restrict gxr, const float* __restrict gyr,
-                   const float* __restrict lamRow, const float* __restrict up, int y) {
-    const int nx = j.base.nx, nCoef = j.base.nCoef;
+                   const float* __restrict lamRow, const float* __restrict up, int y, ColumnSpan run) {
+    const int nx = j.base.nx, nCoef = j.base.nCoef, x0 = run.x0, x1 = run.x1;
     ShadeMaps& out = *j.base.out;
     const AlbedoMap* albedo = j.base.albedo;
     float* __restrict amb = j.base.env ? out.ambient.data() + static_cast<std::size_t>(y) * nx : nullptr;
     if (amb)
-        for (int x = 0; x < nx; ++x) amb[x] = 0.0f;
+        for (int x = x0; x < x1; ++x) amb[x] = 0.0f;
     for (int i = 0; i < (amb ? 9 : 0); ++i) {
         const float* __restrict l = lamRow + static_cast<std::size_t>(i) * nx;
         const float* __restrict u = up + static_cast<std::size_t>(3 * nCoef + i) * nx;
-        for (int x = 0; x < nx; ++x) amb[x] += l[x] * u[x];
+        for (int x = x0; x < x1; ++x) amb[x] += l[x] * u[x];
     }
     for (int ch = 0; ch < 3; ++ch) {
         float* __restrict o = out.rgb[static_cast<std::size_t>(ch)].data() + static_cast<std::size_t>(y) * nx;
-        for (int x = 0; x < nx; ++x) o[x] = 0.0f;
+        for (int x = x0; x < x1; ++x) o[x] = 0.0f;
         for (int i = 0; i < 9; ++i) {
             const float* __restrict l = lamRow + static_cast<std::size_t>(i) * nx;
             const float* __restrict u = up + static_cast<std::size_t>(ch * nCoef + i) * nx;
-            for (int x = 0; x < nx; ++x) o[x] += l[x] * u[x];
+            for (int x = x0; x < x1; ++x) o[x] += l[x] * u[x];
         }
         const Grid* a = albedo && !albedo->channel[static_cast<std::size_t>(ch)].empty()
                             ? &albedo->channel[static_cast<std::size_t>(ch)]
                             : nullptr;
-        for (int x = 0; x < nx; ++x) o[x] *= j.base.diffuseWeight * (a ? (*a)(x, y) : 1.0f);
-        addPhongLobe(j, gxr, gyr, up, ch, y, o);
+        for (int x = x0; x < x1; ++x) o[x] *= j.base.diffuseWeight * (a ? (*a)(x, y) : 1.0f);
+        addPhongLobe(j, gxr, gyr, up, ch, y, run, o);
         const float floor = j.clamp ? 0.0f : -std::numeric_limits<float>::infinity();
-        for (int x = 0; x < nx; ++x) o[x] = std::isfinite(o[x]) ? std::max(o[x], floor) : 0.0f;
+        for (int x = x0; x < x1; ++x) o[x] = std::isfinite(o[x]) ? std::max(o[x], floor) : 0.0f;
     }
 }
 
@@ -478,24 +491,24 @@ ReceiverSpan receiverSpanOf(int y0, int y1, int s, int nyr) {
     return {receiverLerp(y0, s, nyr).i0, receiverLerp(y1 - 1, s, nyr).i1};
 }
 
-// The flagged rows' span inside a block (all of it without flags); empty: begin == end.
-RowBlock flaggedSpan(RowBlock b, const std::vector<std::uint8_t>* rows) {
-    if (!rows) return b;
-    while (b.begin < b.end && (*rows)[static_cast<std::size_t>(b.begin)] == 0) ++b.begin;
-    while (b.end > b.begin && (*rows)[static_cast<std::size_t>(b.end - 1)] == 0) --b.end;
+// The span of the rows with runs inside a block (all of it without runs); empty: begin == end.
+RowBlock rowsWithRuns(RowBlock b, const TexelRuns* runs) {
+    if (!runs) return b;
+    while (b.begin < b.end && !runs->hasRow(b.begin)) ++b.begin;
+    while (b.end > b.begin && !runs->hasRow(b.end - 1)) --b.end;
     return b;
 }
 
 // Every receiver row of the incident field some shaded texel row reads (all
-// of them without `rows`), into ShadeMaps::incident.
+// of them without `runs`), into ShadeMaps::incident.
 void incidentField(const ShadingLight* lights, int nl, int nCoef, int s, int ny, int nxr, int nyr,
-                   const std::vector<std::uint8_t>* rows, ShadeMaps& out) {
+                   const TexelRuns* runs, ShadeMaps& out) {
     const std::size_t planeR = static_cast<std::size_t>(nxr) * nyr;
     std::vector<std::uint8_t>& receiverRows = out.receiverRows;
-    if (rows) {
+    if (runs) {
         receiverRows.assign(static_cast<std::size_t>(nyr), 0);
         for (int y = 0; y < ny; ++y)
-            if ((*rows)[static_cast<std::size_t>(y)] != 0) {
+            if (runs->hasRow(y)) {
                 const ReceiverLerp r = receiverLerp(y, s, nyr);
                 receiverRows[static_cast<std::size_t>(r.i0)] = receiverRows[static_cast<std::size_t>(r.i1)] = 1;
             }
@@ -504,7 +517,8 @@ void incidentField(const ShadingLight* lights, int nl, int nCoef, int s, int ny,
     const IncidentRows to{out.incident.data(), planeR, 0};
     parallelForRows(nyr, nxr * 16, [&](int y0, int y1) {
         for (int Y = y0; Y < y1; ++Y)
-            if (!rows || receiverRows[static_cast<std::size_t>(Y)] != 0) row(lights, nl, nCoef, nxr, out, to, Y);
+            if (!runs || receiverRows[static_cast<std::size_t>(Y)] != 0)
+                row(lights, nl, nCoef, nxr, ColumnSpan{0, nxr}, out, to, Y);
     });
 }
 
@@ -541,41 +555,59 @@ struct BlockSchedule {
     ConstGridView gradX, gradY;
     const ShadingLight* lights;
     int lightCount;
-    const std::vector<std::uint8_t>* rows;  // null: every row
+    const TexelRuns* runs;  // null: every texel
     int nBlocks, nPlanes;
     std::size_t window;  // floats of a slot's incident window (0: the field is kept)
     bool phong;
 };
 
+// The receiver columns the runs of rows [rows.begin, rows.end) read, from a
+// multiple of 16 (incidentRowImpl's groups); every column without runs.
+ColumnSpan receiverColumnsOf(const LambertRowJob& j, const TexelRuns* runs, RowBlock rows) {
+    if (!runs) return {0, j.nxr};
+    int x0 = j.nxr, x1 = 0;
+    for (int y = rows.begin; y < rows.end; ++y) {
+        const Runs r = runs->ofRow(y);
+        if (r.empty()) continue;
+        x0 = std::min(x0, j.colIndex[r.front().x0]);
+        x1 = std::max(x1, std::min(j.nxr, j.colIndex[r.back().x1 - 1] + 2));
+    }
+    return {x0 / 16 * 16, std::max(x0 / 16 * 16, x1)};
+}
+
 // One block of texel rows on a worker's slot of the scratch: the receiver
 // rows it reads into the slot's incident window (unless the field is kept),
-// then each of its (flagged) rows.
+// then the runs of each of its rows.
 void shadeBlock(const BlockSchedule& b, PhongRowJob job, int block, std::size_t slot) {
     LambertRowJob& base = job.base;
     ShadeMaps& out = *base.out;
     const int nx = base.nx, nxr = base.nxr, nxrS = base.nxrS;
-    const RowBlock shaded = flaggedSpan(rowBlock(b.gradX.ny, b.nBlocks, block), b.rows);
+    const RowBlock shaded = rowsWithRuns(rowBlock(b.gradX.ny, b.nBlocks, block), b.runs);
     if (shaded.begin == shaded.end) return;
     const bool wide = simd::wideEnabled();
     if (b.window > 0) {
         const ReceiverSpan r = receiverSpanOf(shaded.begin, shaded.end, base.s, base.nyr);
         base.incident = {out.incidentWindow.data() + slot * b.window,
                          static_cast<std::size_t>(r.last - r.first + 1) * nxr, r.first};
+        const ColumnSpan cols = receiverColumnsOf(base, b.runs, shaded);
         for (int Y = r.first; Y <= r.last; ++Y)
-            (wide ? incidentRowAvx2 : incidentRowSse)(b.lights, b.lightCount, base.nCoef, nxr, out, base.incident, Y);
+            (wide ? incidentRowAvx2 : incidentRowSse)(b.lights, b.lightCount, base.nCoef, nxr, cols, out, base.incident,
+                                                      Y);
     }
     float* vert = out.rowScratch.data() + slot * b.nPlanes * (nxrS + nx);
     float* up = vert + static_cast<std::size_t>(b.nPlanes) * nxrS;
     float* basis = out.basisScratch.data() + slot * 24 * nx;
+    const ColumnSpan wholeRow{0, nx};
     for (int y = shaded.begin; y < shaded.end; ++y) {
-        if (b.rows && (*b.rows)[static_cast<std::size_t>(y)] == 0) continue;  // keeps its last values
+        const Runs runs = b.runs ? b.runs->ofRow(y) : Runs(&wholeRow, 1);
+        if (runs.empty()) continue;  // keeps its last values
         if (!b.phong) {
-            (wide ? lambertShadeRowAvx2 : lambertShadeRowSse)(base, vert, b.gradX.row(y), b.gradY.row(y), y);
+            (wide ? lambertShadeRowAvx2 : lambertShadeRowSse)(base, vert, b.gradX.row(y), b.gradY.row(y), y, runs);
             continue;
         }
         interpolatePlanesToRow(base, y, vert, up);
         lambertBasisRow(base.lf, b.gradX.row(y), b.gradY.row(y), nx, basis);
-        phongShadeRow(job, b.gradX.row(y), b.gradY.row(y), basis, up, y);
+        for (const ColumnSpan& run : runs) phongShadeRow(job, b.gradX.row(y), b.gradY.row(y), basis, up, y, run);
     }
 }
 
@@ -599,16 +631,17 @@ void keepActiveLights(const VisibilityField& env, const ShadingLight* lights, in
 }
 
 // No light adds anything and nothing else is asked for: the shade is 0 at
-// the flagged rows (what the SH shading would give, without its work).
-void shadeNothing(int nx, int ny, const std::vector<std::uint8_t>* rows, ShadeMaps& out) {
+// the texels of the runs (what the SH shading would give, without its work).
+void shadeNothing(int nx, int ny, const TexelRuns* runs, ShadeMaps& out) {
     out.nx = nx;
     out.ny = ny;
+    const ColumnSpan wholeRow{0, nx};
     for (Grid& g : out.rgb) {
         g.ensureSize(nx, ny);
         for (int y = 0; y < ny; ++y)
-            if (!rows || (*rows)[static_cast<std::size_t>(y)] != 0)
-                std::fill(g.data() + static_cast<std::size_t>(y) * nx, g.data() + static_cast<std::size_t>(y + 1) * nx,
-                          0.0f);
+            for (const ColumnSpan& run : runs ? runs->ofRow(y) : Runs(&wholeRow, 1))
+                std::fill(g.data() + static_cast<std::size_t>(y) * nx + run.x0,
+                          g.data() + static_cast<std::size_t>(y) * nx + run.x1, 0.0f);
     }
 }
 
@@ -624,14 +657,13 @@ bool lightContributes(const ShadingLight& light) {
 
 void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const VisibilityField& env,
                  const ShadingLight* lights, int lightCount, const AlbedoMap* albedo, const ShadingSettings& settings,
-                 ShadeMaps& out, bool ambient, const std::vector<std::uint8_t>* rows) {
+                 ShadeMaps& out, bool ambient, const TexelRuns* runs) {
     const int nx = gradX.nx, ny = gradX.ny;
-    if (rows && rows->size() != static_cast<std::size_t>(ny))
-        throw InputError("shading: one row flag per texel row expected");
+    if (runs && runs->ny != ny) throw InputError("shading: texel runs of another grid");
     keepActiveLights(env, lights, lightCount, ambient, out);
     lights = out.activeLights.data();
     lightCount = static_cast<int>(out.activeLights.size());
-    if (!ambient && !out.keepIncident && lightCount == 0) return shadeNothing(nx, ny, rows, out);
+    if (!ambient && !out.keepIncident && lightCount == 0) return shadeNothing(nx, ny, runs, out);
     const int nxr = env.nxr, nyr = env.nyr;
     const std::size_t planeR = static_cast<std::size_t>(nxr) * nyr;
     const bool phong = settings.brdf != Brdf::Lambert;
@@ -648,7 +680,7 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
     // ---- algorithm, receivers: incident radiance I_c = sum_L T_{L,c} V_L ------
     // (the whole field when a later pass reads it, else per block of texel rows)
     buildIncidentTerms(lights, lightCount, nCoef, out);
-    if (out.keepIncident) incidentField(lights, lightCount, nCoef, s, ny, nxr, nyr, fieldKept ? rows : nullptr, out);
+    if (out.keepIncident) incidentField(lights, lightCount, nCoef, s, ny, nxr, nyr, fieldKept ? runs : nullptr, out);
 
     // ---- interpolation tables (receiver X sits at column s X) -----------------
     for (int x = 0; x < nx; ++x) {
@@ -682,7 +714,7 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
 
     // ---- schedule: fixed row blocks; a row keeps nothing in the scratch, so
     // each thread's slot of it serves every block it runs ----------------------
-    const BlockSchedule schedule{gradX, gradY, lights, lightCount, rows, nBlocks, nPlanes, window, phong};
+    const BlockSchedule schedule{gradX, gradY, lights, lightCount, runs, nBlocks, nPlanes, window, phong};
     parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
         const auto slot = static_cast<std::size_t>(workerSlot());
         for (int block = b0; block < b1; ++block) shadeBlock(schedule, phongJob, block, slot);

@@ -21,6 +21,7 @@
 
 #include "core/grid.h"
 #include "gi/sh.h"
+#include "gi/texel_runs.h"
 #include "gi/visibility.h"
 
 namespace terrain::gi {
@@ -179,16 +180,16 @@ bool lightContributes(const ShadingLight& light);
 /// false none is made and out.ambient is left as it is: the indirect bounces,
 /// the exact ambient of gi/ambient_horizon.h);
 /// lights the incident radiance. gradX/gradY are the full resolution height
-/// derivatives. `rows` (one flag per texel row; null: every row): only the
-/// flagged rows are shaded, the others keep what `out` holds, which must be
-/// a result of the same size and settings (which rows may keep theirs is the
-/// caller's: gi/shading_rows.h). Each row's values do not depend on the rows.
+/// derivatives. `runs` (gi/texel_runs.h; null: every texel): only those
+/// texels are shaded, the others keep what `out` holds, which must be a
+/// result of the same size and settings (which texels may keep theirs is the
+/// caller's: gi/shading_tiles.h). Each texel's values do not depend on the runs.
 /// Lights that add nothing are left out (their visibility is not read); when
 /// none is left and neither the ambient nor the incident SH is asked for, the
-/// flagged rows are 0 without the SH work. InputError when the ambient or a
+/// texels of the runs are 0 without the SH work. InputError when the ambient or a
 /// light that adds something lacks the SH planes it reads.
 void shadeTexels(ConstGridView gradX, ConstGridView gradY, int subsample, const VisibilityField& envVisibility,
                  const ShadingLight* lights, int lightCount, const AlbedoMap* albedo, const ShadingSettings& settings,
-                 ShadeMaps& out, bool ambient = true, const std::vector<std::uint8_t>* rows = nullptr);
+                 ShadeMaps& out, bool ambient = true, const TexelRuns* runs = nullptr);
 
 }  // namespace terrain::gi

@@ -275,18 +275,21 @@ TEST_CASE(
     "before it") {
     // 200^2 at 2x: 100^2 receivers, tiles of 32 (the last one 4 wide); a
     // texel's tile is that of its lower receiver, clamped to 98
+    const Grid before = bumpy(200, 200);
     HeightPyramid pyr;
-    buildHeightPyramid(bumpy(200, 200).cview(), 1.0f, 2, PyramidSettings{}, pyr);
+    buildHeightPyramid(before.cview(), 1.0f, 2, PyramidSettings{}, pyr);
     ReceiverTiles gathered;
     gathered.reset(pyr.nxr, pyr.nyr, kVisibilityTile, false);
     IndirectCache cache;
     const auto dirtyTiles = [&](int cx, int cy) {
-        Grid dh(200, 200, 0.0f);
-        if (cx >= 0) dh(cx, cy) = 1.0f;
-        MaxChangePyramid change;
-        buildMaxChangePyramid(dh.cview(), change);
-        const IndirectTexelInputs in{
-            .gathered = &gathered, .sameGeometry = cx < 0, .heightChange = &change, .albedo = nullptr, .heights = pyr};
+        Grid after = before;
+        if (cx >= 0) after(cx, cy) += 1.0f;
+        const IndirectTexelInputs in{.gathered = &gathered,
+                                     .sameGeometry = cx < 0,
+                                     .lastHeights = &before,
+                                     .heights = after.cview(),
+                                     .albedo = nullptr,
+                                     .pyramid = pyr};
         const ReceiverTiles* t = planIndirectTexels(in, cache);
         REQUIRE(t != nullptr);
         std::vector<int> out;
@@ -309,8 +312,12 @@ TEST_CASE(
     // a new albedo: every texel
     AlbedoMap albedo;
     albedo.channel[0] = Grid(200, 200, 0.5f);
-    const IndirectTexelInputs in{
-        .gathered = &gathered, .sameGeometry = true, .heightChange = nullptr, .albedo = &albedo, .heights = pyr};
+    const IndirectTexelInputs in{.gathered = &gathered,
+                                 .sameGeometry = true,
+                                 .lastHeights = nullptr,
+                                 .heights = before.cview(),
+                                 .albedo = &albedo,
+                                 .pyramid = pyr};
     CHECK(planIndirectTexels(in, cache) == nullptr);
     CHECK(planIndirectTexels(in, cache) != nullptr);  // recorded: the next pass with it is tiled again
 }

@@ -1,0 +1,39 @@
+#pragma once
+// Which texels an incremental frame's direct shading must redo (the frame's
+// one place for it; the shading kernels only take the runs, gi/texel_runs.h).
+//
+// A texel's direct light (the SH shading, the exact ambient and sky, the key
+// lights' exact cosine) is a pure function of
+//  - its own height gradient (the heights within one cell of it),
+//  - at sub-sampling s > 1, its near field (the exact ambient's samples at
+//    the first s crossings of each azimuth's ray with the grid, read between
+//    two texels across it: within s + 1 cells),
+//  - the visibility of the up to four receivers it interpolates, and their
+//    horizons raised to their lowest tangent slope (the footprint box's
+//    gradients, within s / 2 + 1 cells of a receiver, itself within s cells
+//    of the texel),
+//  - the lights and the albedo.
+// When only the heights changed and the visibility was recomputed by tiles
+// (gi/visibility_cache.h), the texels of a tile (gi/texel_runs.h) have the
+// last frame's inputs bit for bit unless a height within s + s / 2 + 1 cells
+// of them changed or they read a receiver of a tile whose environment or
+// key-light visibility was recomputed; the others keep their light,
+// identical to recomputing it.
+#include "core/grid.h"
+#include "gi/receiver_tiles.h"
+#include "gi/texel_runs.h"
+
+namespace terrain::gi {
+
+/// The cells within this many of a texel that its direct light reads.
+inline int shadingReach(int subsample) { return subsample + subsample / 2 + 1; }
+
+/// The texel tiles (out, on the layout of env) whose direct light must be
+/// redone after the heights went from `before` to `after` (same size) and
+/// the visibility of the dirty tiles of `env` and `keys` (on the receiver
+/// grid of `subsample`) was recomputed. Throws InputError when the sizes
+/// differ.
+void changedShadingTiles(ConstGridView before, ConstGridView after, const ReceiverTiles& env, const ReceiverTiles& keys,
+                         int subsample, ReceiverTiles& out);
+
+}  // namespace terrain::gi

@@ -1,0 +1,93 @@
+#include "gi/texel_runs.h"
+
+#include <algorithm>
+#include <cstring>
+#include <string>
+
+#include "core/error.h"
+#include "gi/shading.h"
+
+namespace terrain::gi {
+
+namespace {
+
+// first[X]: the first texel (column or row) whose lower receiver is X or a
+// later one (nothing: `count`), X = 0..n; the lower receiver grows with the texel.
+void firstTexels(int count, int s, int n, std::vector<int>& first) {
+    first.assign(static_cast<std::size_t>(n) + 1, count);
+    for (int x = count - 1; x >= 0; --x) first[static_cast<std::size_t>(receiverLerp(x, s, n).i0)] = x;
+    for (int X = n - 1; X >= 0; --X)
+        first[static_cast<std::size_t>(X)] =
+            std::min(first[static_cast<std::size_t>(X)], first[static_cast<std::size_t>(X) + 1]);
+}
+
+}  // namespace
+
+void texelRunsOfTiles(const ReceiverTiles* tiles, int nx, int ny, int subsample, TexelRuns& out) {
+    const int s = subsample, nxr = (nx + s - 1) / s, nyr = (ny + s - 1) / s;
+    out.ny = ny;
+    out.first.assign(static_cast<std::size_t>(ny) + 1, 0);
+    out.runs.clear();
+    if (!tiles) {
+        for (int y = 0; y < ny; ++y) {
+            if (nx > 0) out.runs.push_back({0, nx});
+            out.first[static_cast<std::size_t>(y) + 1] = static_cast<int>(out.runs.size());
+        }
+        return;
+    }
+    if (tiles->nxr != nxr || tiles->nyr != nyr)
+        throw InputError("texel runs: tiles of a " + std::to_string(tiles->nxr) + " x " + std::to_string(tiles->nyr) +
+                         " receiver grid, not " + std::to_string(nxr) + " x " + std::to_string(nyr));
+    std::vector<int> col;
+    firstTexels(nx, s, nxr, col);
+    const int T = tiles->tileSize;
+    for (int y = 0; y < ny; ++y) {
+        const int ty = receiverLerp(y, s, nyr).i0 / T;
+        for (int tx = 0; tx < tiles->tilesX; ++tx) {
+            if (!tiles->isDirty(tx, ty)) continue;
+            const int x0 = col[static_cast<std::size_t>(tx * T)];
+            const int x1 = col[static_cast<std::size_t>(std::min(nxr, (tx + 1) * T))];
+            if (x0 >= x1) continue;
+            const bool joins =
+                static_cast<int>(out.runs.size()) > out.first[static_cast<std::size_t>(y)] && out.runs.back().x1 == x0;
+            if (joins)
+                out.runs.back().x1 = x1;
+            else
+                out.runs.push_back({x0, x1});
+        }
+        out.first[static_cast<std::size_t>(y) + 1] = static_cast<int>(out.runs.size());
+    }
+}
+
+CellBox texelCellsOfTile(const ReceiverTiles& tiles, int tx, int ty, int nx, int ny, int subsample, int reach) {
+    const int s = subsample, T = tiles.tileSize;
+    // receivers [X0, X1) take the texels [s X0, s X1), and the tile holding
+    // receiver n - 2 (the largest lower receiver) the texels up to the end
+    const auto span = [&](int t, int n, int cells) {
+        const int X0 = t * T, X1 = std::min(n, (t + 1) * T);
+        const int hi = X1 > n - 2 ? cells - 1 : s * X1 - 1;
+        return std::pair<int, int>{s * X0 - reach, hi + reach};
+    };
+    const auto [x0, x1] = span(tx, tiles.nxr, nx);
+    const auto [y0, y1] = span(ty, tiles.nyr, ny);
+    return {x0, y0, x1, y1};
+}
+
+bool cellsDiffer(ConstGridView before, ConstGridView after, CellBox box) {
+    const int x0 = std::max(0, box.x0), x1 = std::min(after.nx - 1, box.x1);
+    const int y0 = std::max(0, box.y0), y1 = std::min(after.ny - 1, box.y1);
+    if (x0 > x1) return false;
+    const std::size_t bytes = sizeof(float) * static_cast<std::size_t>(x1 - x0 + 1);
+    for (int y = y0; y <= y1; ++y)
+        if (std::memcmp(before.row(y) + x0, after.row(y) + x0, bytes) != 0) return true;
+    return false;
+}
+
+bool readsDirtyReceivers(const ReceiverTiles& tiles, int tx, int ty) {
+    for (int dy = 0; dy <= 1; ++dy)
+        for (int dx = 0; dx <= 1; ++dx)
+            if (tx + dx < tiles.tilesX && ty + dy < tiles.tilesY && tiles.isDirty(tx + dx, ty + dy)) return true;
+    return false;
+}
+
+}  // namespace terrain::gi
