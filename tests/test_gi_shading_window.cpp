@@ -70,7 +70,7 @@ TEST_CASE("gi.shading: incident SH in per-block windows shades like the whole fi
             });
             for (int threads : {1, 3}) {
                 CAPTURE(threads);
-                std::array<ShadeMaps, 2> whole, windowed;  // [0]: every row; [1]: the flagged rows over the old light
+                std::array<ShadeMaps, 2> whole, windowed;  // [0]: every texel; [1]: the runs over the old light
                 for (ShadeMaps* m : {&whole[0], &whole[1]}) m->keepIncident = true;
                 withThreads(threads, [&] {
                     const auto shade = [&](const std::vector<ShadingLight>& l, ShadeMaps& out, const TexelRuns* only) {
