@@ -98,7 +98,9 @@ LaneRun laneRun(const ColumnSpan& run, int pad) {
 // O / pi of the runs of one row of points: per azimuth fillFar(j, far, a, b)
 // sets the horizons of the points [a, min(b, n)), then the kernel adds the
 // azimuth's integral. Each point's value is its own lanes' arithmetic, the
-// same whatever the runs.
+// same whatever the runs. The runs start on multiples of kLanePad (a tile's
+// texels and receivers do: tiles are multiples of 16 receivers), so their
+// lane groups never overlap and no point is summed twice.
 template <class FillFar>
 void occlusionOfRow(ConstGridView gradX, ConstGridView gradY, const PointRow& p, std::span<const ColumnSpan> runs,
                     const RowScratch& r, const NearTap* taps, const float* cosPhi, const float* sinPhi, int m,

@@ -130,34 +130,36 @@ template <class V, int S>
             store(rgb[ch] + x, finite ? o : splat<V>(0.0f));
         }
     }
-    // the run's other texels, scalar (the same operations)
-    const auto scalarTexel = [&](int x) {
-        const int X0 = colIndex[x];
-        const int X1 = std::min(X0 + 1, nxr - 1);
-        const float f = colFrac[x];
-        const float gx = gxr[x], gy = gyr[x];
-        const float inv = 1.0f / std::sqrt(1.0f + gx * gx + gy * gy);
-        const float X = -gx * inv, Yn = -gy * inv, Z = inv;
-        float lam[9];
-        lambertAtNormal(lf, X, Yn, Z, lam);
-        auto u = [&](int plane) {
-            const float* v = vert + static_cast<std::size_t>(plane) * nxrS;
-            return S == 1 ? v[x] : v[X0] + f * (v[X1] - v[X0]);
-        };
-        if (amb) {
-            float acc = 0.0f;
-            for (int i = 0; i < 9; ++i) acc += lam[i] * u(3 * nCoef + i);
-            amb[x] = acc;
+    // the run's other texels, scalar (the same operations): those before the
+    // vector groups, then those after them
+    const int scalarFrom[2] = {run.x0, std::max(vecEnd, run.x0)};
+    const int scalarTo[2] = {std::min(vecBegin, run.x1), run.x1};
+    for (int part = 0; part < 2; ++part)
+        for (int x = scalarFrom[part]; x < scalarTo[part]; ++x) {
+            const int X0 = colIndex[x];
+            const int X1 = std::min(X0 + 1, nxr - 1);
+            const float f = colFrac[x];
+            const float gx = gxr[x], gy = gyr[x];
+            const float inv = 1.0f / std::sqrt(1.0f + gx * gx + gy * gy);
+            const float X = -gx * inv, Yn = -gy * inv, Z = inv;
+            float lam[9];
+            lambertAtNormal(lf, X, Yn, Z, lam);
+            auto u = [&](int plane) {
+                const float* v = vert + static_cast<std::size_t>(plane) * nxrS;
+                return S == 1 ? v[x] : v[X0] + f * (v[X1] - v[X0]);
+            };
+            if (amb) {
+                float acc = 0.0f;
+                for (int i = 0; i < 9; ++i) acc += lam[i] * u(3 * nCoef + i);
+                amb[x] = acc;
+            }
+            for (int ch = 0; ch < 3; ++ch) {
+                float o = 0.0f;
+                for (int i = 0; i < 9; ++i) o += lam[i] * u(ch * nCoef + i);
+                o *= diffuseWeight * (alb[ch] ? alb[ch][x] : 1.0f);
+                rgb[ch][x] = std::isfinite(o) ? o : 0.0f;
+            }
         }
-        for (int ch = 0; ch < 3; ++ch) {
-            float o = 0.0f;
-            for (int i = 0; i < 9; ++i) o += lam[i] * u(ch * nCoef + i);
-            o *= diffuseWeight * (alb[ch] ? alb[ch][x] : 1.0f);
-            rgb[ch][x] = std::isfinite(o) ? o : 0.0f;
-        }
-    };
-    for (int x = run.x0; x < std::min(vecBegin, run.x1); ++x) scalarTexel(x);
-    for (int x = std::max(vecEnd, run.x0); x < run.x1; ++x) scalarTexel(x);
 }
 
 // Where the receivers' incident SH planes live: plane c of receiver row Y at
