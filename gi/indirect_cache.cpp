@@ -76,8 +76,9 @@ bool sameAlbedoAsLastPass(const AlbedoMap* albedo, IndirectCache& cache) {
     for (std::size_t c = 0; c < 3 && same && albedo; ++c) {
         const Grid& now = albedo->channel[c];
         const Grid& last = cache.lastAlbedo[c];
-        same = now.nx == last.nx && now.ny == last.ny &&
-               std::memcmp(now.v.data(), last.v.data(), sizeof(float) * now.v.size()) == 0;  // bits: -0 is not 0 here
+        // bits (-0 is not 0 here); an empty channel (albedo 1) has no data to compare
+        same = now.nx == last.nx && now.ny == last.ny && now.v.size() == last.v.size() &&
+               (now.v.empty() || std::memcmp(now.v.data(), last.v.data(), sizeof(float) * now.v.size()) == 0);
     }
     if (same) return true;
     cache.hadAlbedo = albedo != nullptr;
