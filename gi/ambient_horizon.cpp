@@ -182,35 +182,21 @@ void horizontalLerp(const AmbientJob& j, const float* vert, float* out) {
     }
 }
 
-// Horizon slopes of azimuth a at the texels of the row the window covers,
-// bilinear from the raised receivers (Fig. 7). vert: nxr floats of scratch.
-void interpolatedHorizons(const AmbientJob& j, const RaisedWindow& window, int a, float* vert, float* out) {
+// Horizon slopes of azimuth a at the texels of a run of the row the window
+// covers, bilinear from the raised receivers (Fig. 7): the vertical mix of
+// the receivers the run reads, then along the row, by horizontalLerp over a
+// whole row and by the columns' receivers and fraction over a part of one
+// (the same operations). vert: nxr floats of scratch.
+void interpolatedHorizons(const AmbientJob& j, const RaisedWindow& window, int a, ColumnSpan run, float* vert,
+                          float* out) {
+    const bool wholeRow = run.x0 == 0 && run.x1 == j.nx;
+    const ColumnSpan read =
+        wholeRow ? ColumnSpan{0, j.nxr} : receiversReadBy(j.columns[run.x0].i0, j.columns[run.x1 - 1].i0, j.nxr);
     const float* t0 = window.row0(a);
     const float* t1 = window.row1(a);
-    for (int X = 0; X < j.nxr; ++X) vert[X] = t0[X] + window.f * (t1[X] - t0[X]);
-    switch (j.in.subsample) {
-        case 2:
-            return horizontalLerp<2>(j, vert, out);
-        case 4:
-            return horizontalLerp<4>(j, vert, out);
-        default:
-            for (int x = 0; x < j.nx; ++x) {
-                const ReceiverLerp& r = j.columns[x];
-                out[x] = vert[r.i0] + r.f * (vert[r.i1] - vert[r.i0]);
-            }
-    }
-}
-
-// The same over the texels of a run only, each texel's value as above (the
-// vertical mix, then the columns' receivers and fraction, the same operations
-// as horizontalLerp's).
-void interpolatedHorizonsOfRun(const AmbientJob& j, const RaisedWindow& window, int a, ColumnSpan run, float* vert,
-                               float* out) {
-    if (run.x0 == 0 && run.x1 == j.nx) return interpolatedHorizons(j, window, a, vert, out);
-    const float* t0 = window.row0(a);
-    const float* t1 = window.row1(a);
-    const int X0 = j.columns[run.x0].i0, X1 = j.columns[run.x1 - 1].i1;
-    for (int X = X0; X <= X1; ++X) vert[X] = t0[X] + window.f * (t1[X] - t0[X]);
+    for (int X = read.x0; X < read.x1; ++X) vert[X] = t0[X] + window.f * (t1[X] - t0[X]);
+    if (wholeRow && j.in.subsample == 2) return horizontalLerp<2>(j, vert, out);
+    if (wholeRow && j.in.subsample == 4) return horizontalLerp<4>(j, vert, out);
     for (int x = run.x0; x < run.x1; ++x) {
         const ReceiverLerp& r = j.columns[x];
         out[x] = vert[r.i0] + r.f * (vert[r.i1] - vert[r.i0]);
@@ -240,7 +226,7 @@ template <class V, bool Parts>
             const std::span<const NearFieldStep> near{j.nearSteps + static_cast<std::size_t>(a) * j.in.subsample,
                                                       static_cast<std::size_t>(j.in.subsample)};
             for (const ColumnSpan& run : runs) {
-                interpolatedHorizonsOfRun(j, window, a, run, vert, horizon);
+                interpolatedHorizons(j, window, a, run, vert, horizon);
                 raiseToNearField(j.in.heights, y, near, horizon, run.x0, run.x1);
             }
             h = horizon;
@@ -293,19 +279,6 @@ void checkInputs(const AmbientInputs& in, int m, const TexelRuns* runs) {
     if (runs && runs->ny != in.gradX.ny) throw InputError("ambient: texel runs of another grid");
 }
 
-// The receiver columns the texels of rows [y0, y1) to compute read.
-ColumnSpan receiversRead(const AmbientJob& j, int y0, int y1) {
-    if (!j.runs) return {0, j.nxr};
-    int x0 = j.nxr, x1 = 0;
-    for (int y = y0; y < y1; ++y) {
-        const Runs r = j.runs->ofRow(y);
-        if (r.empty()) continue;
-        x0 = std::min(x0, j.columns[r.front().x0].i0);
-        x1 = std::max(x1, j.columns[r.back().x1 - 1].i1 + 1);
-    }
-    return {x0, std::max(x0, x1)};
-}
-
 }  // namespace
 
 void ambientFromHorizons(const AmbientInputs& in, const AmbientOutputs& out, AmbientScratch& scratch,
@@ -338,11 +311,12 @@ void ambientFromHorizons(const AmbientInputs& in, const AmbientOutputs& out, Amb
         for (int block = b0; block < b1; ++block) {
             const int yBegin = static_cast<int>(static_cast<long long>(ny) * block / nBlocks);
             const int yEnd = static_cast<int>(static_cast<long long>(ny) * (block + 1) / nBlocks);
-            RaisedWindow window{buffers + kRowsPerSlot * static_cast<std::size_t>(rowFloats), nxr,
-                                receiversRead(job, yBegin, yEnd)};
+            const ColumnSpan read =
+                receiverColumnsRead(runs, yBegin, yEnd, nxr, [&](int x) { return job.columns[x].i0; });
+            RaisedWindow window{buffers + kRowsPerSlot * static_cast<std::size_t>(rowFloats), nxr, read};
             const ColumnSpan wholeRow{0, nx};
             for (int y = yBegin; y < yEnd; ++y) {
-                const Runs rowRuns = runs ? runs->ofRow(y) : Runs(&wholeRow, 1);
+                const Runs rowRuns = runsOfRow(runs, y, wholeRow);
                 if (rowRuns.empty()) continue;
                 if (s > 1) window.cover(job, y);
                 ambientRow(job, y, rowRuns, buffers, window);
@@ -362,7 +336,7 @@ void addLambertSky(int nx, int ny, const AlbedoMap* albedo, std::array<Grid, 3>&
     parallelForRows(ny, nx, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
             const std::size_t row = static_cast<std::size_t>(y) * nx;
-            for (const ColumnSpan& run : runs ? runs->ofRow(y) : std::span<const ColumnSpan>(&wholeRow, 1))
+            for (const ColumnSpan& run : runsOfRow(runs, y, wholeRow))
                 for (std::size_t c = 0; c < 3; ++c) {
                     const bool mapped = albedo && !albedo->channel[c].empty();
                     float* out = shade[c].data() + row;

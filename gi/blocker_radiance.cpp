@@ -106,7 +106,6 @@ void occlusionOfRow(ConstGridView gradX, ConstGridView gradY, const PointRow& p,
                     const RowScratch& r, const NearTap* taps, const float* cosPhi, const float* sinPhi, int m,
                     float scale, AzimuthFn azimuth, FillFar&& fillFar, float* out) {
     for (const ColumnSpan& run : runs) {
-        if (run.x0 >= run.x1) continue;
         const LaneRun lr = laneRun(run, p.pad);
         for (int i = lr.a; i < lr.b; ++i) {
             const int x = std::min(p.step * i, gradX.nx - 1);
@@ -120,7 +119,6 @@ void occlusionOfRow(ConstGridView gradX, ConstGridView gradY, const PointRow& p,
     for (int j = 0; j < m; ++j) {
         const NearTap* jTaps = taps ? taps + static_cast<std::size_t>(j) * p.nTaps : nullptr;
         for (const ColumnSpan& run : runs) {
-            if (run.x0 >= run.x1) continue;
             const LaneRun lr = laneRun(run, p.pad);
             fillFar(j, r.far, lr.a, std::min(lr.b, p.n));
             if (lr.b > p.n) std::fill(r.far + std::max(lr.a, p.n), r.far + lr.b, kNoBlocker);
@@ -205,14 +203,13 @@ void occlusionAtTexels(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
                 const std::span<const ColumnSpan> runs = st.texelRuns.ofRow(y);
                 if (runs.empty()) continue;
                 const PointRow pts{y, 1, nx, pad, st.heights.data() + (y + B) * stride + B, stride, nTaps};
-                // the texels [a, e) read the receivers [cols[a].i0, cols[e - 1].i1]
                 const auto fillFar = [&](int j, float* far, int a, int e) {
                     const float* fs = st.farSlope.data() + static_cast<std::size_t>(j) * nxr * nyr;
                     const float* f0 = fs + static_cast<std::size_t>(ry.i0) * nxr;
                     const float* f1 = fs + static_cast<std::size_t>(ry.i1) * nxr;
-                    const int X0 = st.cols[static_cast<std::size_t>(a)].i0;
-                    const int X1 = st.cols[static_cast<std::size_t>(e - 1)].i1;
-                    for (int X = X0; X <= X1; ++X) recv[X] = f0[X] + ry.f * (f1[X] - f0[X]);
+                    const ColumnSpan read = receiversReadBy(st.cols[static_cast<std::size_t>(a)].i0,
+                                                            st.cols[static_cast<std::size_t>(e - 1)].i0, nxr);
+                    for (int X = read.x0; X < read.x1; ++X) recv[X] = f0[X] + ry.f * (f1[X] - f0[X]);
                     for (int x = a; x < e; ++x) {
                         const ReceiverLerp& rx = st.cols[static_cast<std::size_t>(x)];
                         far[x] = recv[rx.i0] + rx.f * (recv[rx.i1] - recv[rx.i0]);
@@ -313,12 +310,13 @@ void shadeTexelRun(const BlockerRadianceState& st, const float* const alb[3], in
     const int nx = st.nx, nxr = st.nxr;
     const ReceiverLerp ry = receiverLerp(y, st.subsample, st.nyr);
     const std::size_t r0 = static_cast<std::size_t>(ry.i0) * nxr, r1 = static_cast<std::size_t>(ry.i1) * nxr;
-    const int X0 = st.cols[static_cast<std::size_t>(x0)].i0, X1 = st.cols[static_cast<std::size_t>(x1 - 1)].i1;
+    const ColumnSpan read =
+        receiversReadBy(st.cols[static_cast<std::size_t>(x0)].i0, st.cols[static_cast<std::size_t>(x1 - 1)].i0, nxr);
     const float* o = st.receiverOcclusion.data();
-    for (int X = X0; X <= X1; ++X) oRow[X] = o[r0 + X] + ry.f * (o[r1 + X] - o[r0 + X]);
+    for (int X = read.x0; X < read.x1; ++X) oRow[X] = o[r0 + X] + ry.f * (o[r1 + X] - o[r0 + X]);
     for (int c = 0; c < 3; ++c) {
         const float* e = st.receiverShade[static_cast<std::size_t>(c)].data();
-        for (int X = X0; X <= X1; ++X) eRow[c][X] = e[r0 + X] + ry.f * (e[r1 + X] - e[r0 + X]);
+        for (int X = read.x0; X < read.x1; ++X) eRow[c][X] = e[r0 + X] + ry.f * (e[r1 + X] - e[r0 + X]);
     }
     const std::size_t at = static_cast<std::size_t>(y) * nx;
     const float* occ = st.occlusion.data() + at;

@@ -91,19 +91,11 @@ bool sameAlbedoAsLastPass(const AlbedoMap* albedo, IndirectCache& cache) {
 const ReceiverTiles* planIndirectTexels(const IndirectTexelInputs& in, IndirectCache& cache) {
     const bool albedo = sameAlbedoAsLastPass(in.albedo, cache);
     if (!in.gathered || !albedo || (!in.sameGeometry && !in.lastHeights)) return nullptr;
-    const HeightPyramid& h = in.pyramid;
-    const ReceiverTiles& g = *in.gathered;
-    const int reach = h.subsample + 1;
-    cache.texels.reset(h.nxr, h.nyr, g.tileSize, false);
-    for (int ty = 0; ty < g.tilesY; ++ty)
-        for (int tx = 0; tx < g.tilesX; ++tx) {
-            bool dirty = readsDirtyReceivers(g, tx, ty);
-            if (!dirty && !in.sameGeometry) {
-                dirty = cellsDiffer(in.lastHeights->cview(), in.heights,
-                                    texelCellsOfTile(g, tx, ty, h.nx, h.ny, h.subsample, reach));
-            }
-            cache.texels.setDirty(tx, ty, dirty);
-        }
+    // the near samples reach s cells, the gradients one more
+    const ConstGridView last = in.lastHeights ? in.lastHeights->cview() : ConstGridView{};
+    const ReceiverTiles* recomputed[] = {in.gathered};
+    texelTilesToRedo(recomputed, in.sameGeometry ? nullptr : &last, in.heights, in.pyramid.subsample,
+                     in.pyramid.subsample + 1, cache.texels);
     return &cache.texels;
 }
 

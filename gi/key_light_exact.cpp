@@ -58,13 +58,11 @@ void addKeyLightExactCosine(const KeyLight& light, const VisibilityField& v, int
     parallelForRows(ny, nx, [&](int y0, int y1) {
         float cosine[kChunk];
         for (int y = y0; y < y1; ++y) {
-            const std::span<const ColumnSpan> rowRuns =
-                runs ? runs->ofRow(y) : std::span<const ColumnSpan>(&wholeRow, 1);
             const int Y0 = std::min(y / s, nyr - 1), Y1 = std::min(Y0 + 1, nyr - 1);
             const float fy = Y1 == Y0 ? 0.0f : static_cast<float>(y - s * Y0) * invS;
             const float* r0 = v0 + static_cast<std::size_t>(Y0) * nxr;
             const float* r1 = v0 + static_cast<std::size_t>(Y1) * nxr;
-            for (const ColumnSpan& run : rowRuns)
+            for (const ColumnSpan& run : runsOfRow(runs, y, wholeRow))
                 for (int c0 = run.x0; c0 < run.x1; c0 += kChunk) {
                     const int n = std::min(kChunk, run.x1 - c0);
                     cosinesOfChunk(gradX.row(y) + c0, gradY.row(y) + c0, lx, ly, lz, n, cosine);

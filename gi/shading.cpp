@@ -210,8 +210,8 @@ template <class V>
     const ReceiverLerp ry = receiverLerp(y, j.s, j.nyr);
     const int nPlanes = 3 * j.nCoef + (j.env ? 9 : 0);
     // the receivers the runs' texels read: [X0, X1)
-    const int X0 = j.colIndex[runs.front().x0];
-    const int X1 = std::min(j.nxr, j.colIndex[runs.back().x1 - 1] + 2);
+    const ColumnSpan read = receiversReadBy(j.colIndex[runs.front().x0], j.colIndex[runs.back().x1 - 1], j.nxr);
+    const int X0 = read.x0, X1 = read.x1;
     const int nv = X0 + (X1 - X0) / L * L;
     const V fy = splat<V>(ry.f);
     for (int p = 0; p < nPlanes; ++p) {
@@ -566,15 +566,8 @@ struct BlockSchedule {
 // The receiver columns the runs of rows [rows.begin, rows.end) read, from a
 // multiple of 16 (incidentRowImpl's groups); every column without runs.
 ColumnSpan receiverColumnsOf(const LambertRowJob& j, const TexelRuns* runs, RowBlock rows) {
-    if (!runs) return {0, j.nxr};
-    int x0 = j.nxr, x1 = 0;
-    for (int y = rows.begin; y < rows.end; ++y) {
-        const Runs r = runs->ofRow(y);
-        if (r.empty()) continue;
-        x0 = std::min(x0, j.colIndex[r.front().x0]);
-        x1 = std::max(x1, std::min(j.nxr, j.colIndex[r.back().x1 - 1] + 2));
-    }
-    return {x0 / 16 * 16, std::max(x0 / 16 * 16, x1)};
+    const ColumnSpan c = receiverColumnsRead(runs, rows.begin, rows.end, j.nxr, [&](int x) { return j.colIndex[x]; });
+    return {c.x0 / 16 * 16, std::max(c.x0 / 16 * 16, c.x1)};
 }
 
 // One block of texel rows on a worker's slot of the scratch: the receiver
@@ -601,7 +594,7 @@ void shadeBlock(const BlockSchedule& b, PhongRowJob job, int block, std::size_t 
     float* basis = out.basisScratch.data() + slot * 24 * nx;
     const ColumnSpan wholeRow{0, nx};
     for (int y = shaded.begin; y < shaded.end; ++y) {
-        const Runs runs = b.runs ? b.runs->ofRow(y) : Runs(&wholeRow, 1);
+        const Runs runs = runsOfRow(b.runs, y, wholeRow);
         if (runs.empty()) continue;  // keeps its last values
         if (!b.phong) {
             (wide ? lambertShadeRowAvx2 : lambertShadeRowSse)(base, vert, b.gradX.row(y), b.gradY.row(y), y, runs);
@@ -641,7 +634,7 @@ void shadeNothing(int nx, int ny, const TexelRuns* runs, ShadeMaps& out) {
     for (Grid& g : out.rgb) {
         g.ensureSize(nx, ny);
         for (int y = 0; y < ny; ++y)
-            for (const ColumnSpan& run : runs ? runs->ofRow(y) : Runs(&wholeRow, 1))
+            for (const ColumnSpan& run : runsOfRow(runs, y, wholeRow))
                 std::fill(g.data() + static_cast<std::size_t>(y) * nx + run.x0,
                           g.data() + static_cast<std::size_t>(y) * nx + run.x1, 0.0f);
     }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstring>
 #include <string>
+#include <utility>
 
 #include "core/error.h"
 #include "gi/shading.h"
@@ -59,6 +60,15 @@ void texelRunsOfTiles(const ReceiverTiles* tiles, int nx, int ny, int subsample,
     }
 }
 
+namespace {
+
+// A cell box, inclusive (it may reach outside the grid).
+struct CellBox {
+    int x0, y0, x1, y1;
+};
+
+// The cells of tile (tx, ty)'s texels (on `tiles`' receiver grid, an nx x
+// ny field at sub-sampling s), dilated by `reach` cells.
 CellBox texelCellsOfTile(const ReceiverTiles& tiles, int tx, int ty, int nx, int ny, int subsample, int reach) {
     const int s = subsample, T = tiles.tileSize;
     // receivers [X0, X1) take the texels [s X0, s X1), and the tile holding
@@ -73,6 +83,7 @@ CellBox texelCellsOfTile(const ReceiverTiles& tiles, int tx, int ty, int nx, int
     return {x0, y0, x1, y1};
 }
 
+// Whether any cell of the box (clamped to the grids) differs bit for bit.
 bool cellsDiffer(ConstGridView before, ConstGridView after, CellBox box) {
     const int x0 = std::max(0, box.x0), x1 = std::min(after.nx - 1, box.x1);
     const int y0 = std::max(0, box.y0), y1 = std::min(after.ny - 1, box.y1);
@@ -83,11 +94,30 @@ bool cellsDiffer(ConstGridView before, ConstGridView after, CellBox box) {
     return false;
 }
 
+// Whether a texel of tile (tx, ty) reads a receiver of a dirty tile: its
+// own, or the next one along x, y or both.
 bool readsDirtyReceivers(const ReceiverTiles& tiles, int tx, int ty) {
     for (int dy = 0; dy <= 1; ++dy)
         for (int dx = 0; dx <= 1; ++dx)
             if (tx + dx < tiles.tilesX && ty + dy < tiles.tilesY && tiles.isDirty(tx + dx, ty + dy)) return true;
     return false;
+}
+
+}  // namespace
+
+void texelTilesToRedo(std::span<const ReceiverTiles* const> recomputed, const ConstGridView* before,
+                      ConstGridView after, int subsample, int reach, ReceiverTiles& out) {
+    const ReceiverTiles& layout = *recomputed.front();
+    out.reset(layout.nxr, layout.nyr, layout.tileSize, false);
+    for (int ty = 0; ty < out.tilesY; ++ty)
+        for (int tx = 0; tx < out.tilesX; ++tx) {
+            bool dirty = false;
+            for (const ReceiverTiles* t : recomputed) dirty = dirty || readsDirtyReceivers(*t, tx, ty);
+            if (!dirty && before)
+                dirty =
+                    cellsDiffer(*before, after, texelCellsOfTile(out, tx, ty, after.nx, after.ny, subsample, reach));
+            out.setDirty(tx, ty, dirty);
+        }
 }
 
 }  // namespace terrain::gi

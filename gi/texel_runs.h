@@ -41,21 +41,43 @@ struct TexelRuns {
 /// Throws InputError when the tiles are not of that receiver grid.
 void texelRunsOfTiles(const ReceiverTiles* tiles, int nx, int ny, int subsample, TexelRuns& out);
 
-/// A cell box, inclusive (it may reach outside the grid).
-struct CellBox {
-    int x0, y0, x1, y1;
-};
+/// Row y's runs, or `whole` (a caller's run [0, nx)) when there are no runs
+/// (null: every texel).
+inline std::span<const ColumnSpan> runsOfRow(const TexelRuns* runs, int y, const ColumnSpan& whole) {
+    return runs ? runs->ofRow(y) : std::span<const ColumnSpan>(&whole, 1);
+}
 
-/// The cells of tile (tx, ty)'s texels (on `tiles`' receiver grid, an nx x
-/// ny field at sub-sampling s), dilated by `reach` cells.
-CellBox texelCellsOfTile(const ReceiverTiles& tiles, int tx, int ty, int nx, int ny, int subsample, int reach);
+/// The receivers [a, b) a stretch of texels reads along one axis of n
+/// receivers, from the lower receivers (receiverLerp's i0) of its first and
+/// last texel: each texel reads its lower receiver and the next one, clamped.
+inline ColumnSpan receiversReadBy(int firstLower, int lastLower, int n) {
+    return {firstLower, lastLower + 2 < n ? lastLower + 2 : n};
+}
 
-/// Whether a texel of tile (tx, ty) reads a receiver of a dirty tile of
-/// `tiles`: its own, or the next one along x, y or both.
-bool readsDirtyReceivers(const ReceiverTiles& tiles, int tx, int ty);
+/// The receiver columns the runs of texel rows [y0, y1) read, of n;
+/// lowerOf(x) is texel column x's lower receiver. Every column without runs;
+/// an empty span when none of the rows has a run.
+template <class LowerOf>
+ColumnSpan receiverColumnsRead(const TexelRuns* runs, int y0, int y1, int n, LowerOf lowerOf) {
+    if (!runs) return {0, n};
+    ColumnSpan cols{n, 0};
+    for (int y = y0; y < y1; ++y) {
+        const std::span<const ColumnSpan> r = runs->ofRow(y);
+        if (r.empty()) continue;
+        const ColumnSpan read = receiversReadBy(lowerOf(r.front().x0), lowerOf(r.back().x1 - 1), n);
+        cols = {cols.x0 < read.x0 ? cols.x0 : read.x0, cols.x1 > read.x1 ? cols.x1 : read.x1};
+    }
+    return {cols.x0, cols.x1 > cols.x0 ? cols.x1 : cols.x0};
+}
 
-/// Whether any cell of the box (clamped to the grids, of one size) differs
-/// between the two grids, bit for bit (-0 is not 0: it can change a result's sign).
-bool cellsDiffer(ConstGridView before, ConstGridView after, CellBox box);
+/// The texel tiles to redo (out, on the layout of the tiles in `recomputed`,
+/// which share one): those whose texels read a receiver of a dirty tile of
+/// any of them (their own tile's, or the next one's along x, y or both), or
+/// lie within `reach` cells of a height that differs between `before` and
+/// `after` bit for bit (-0 is not 0: it can change a result's sign); null
+/// `before`: the heights are the same. The heights are a field at
+/// sub-sampling s of the tiles' receiver grid.
+void texelTilesToRedo(std::span<const ReceiverTiles* const> recomputed, const ConstGridView* before,
+                      ConstGridView after, int subsample, int reach, ReceiverTiles& out);
 
 }  // namespace terrain::gi
