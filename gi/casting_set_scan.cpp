@@ -5,6 +5,7 @@
 
 #include "core/simd.h"
 #include "gi/indirect_scan_tables.h"
+#include "gi/sh.h"
 
 namespace terrain::gi {
 
@@ -14,10 +15,13 @@ namespace {
 // F8 (AVX2, chosen at run time where the processor has it): core/simd.h.
 using namespace simd;
 
-constexpr int kMaxMoments = 4;  // moments per segment and channel (Nlp)
+constexpr int kMaxMoments = 4;           // moments per segment and channel (Nlp)
+constexpr int kShFields = 3 * kShCount;  // GlossyNlp: RGB x 16 SH planes of the exit radiance
 
 // Step i's taps: the two height samples of the receivers' row and each
-// channel's two radiance samples, with their weights.
+// channel's two radiance samples, with their weights; with GlossyNlp the
+// exit-radiance planes' samples instead (each plane's origin + o + X, its
+// second sample dB further) and the direction back to the receiver.
 template <class V>
 struct StepTaps {
     const float *a, *b;
@@ -25,9 +29,13 @@ struct StepTaps {
     const float* ra[3];
     const float* rb[3];
     V rwa[3], rwb[3];
+    const float* const* planes;  // GlossyNlp: kShFields origins
+    std::ptrdiff_t o, dB;
+    V back[2];   // -(cos phi, sin phi)
+    bool clamp;  // members send max(0, u)
 };
 
-template <class V>
+template <class V, CastingMoments K>
 [[gnu::always_inline]] inline StepTaps<V> stepTaps(const AzimuthSteps& az, int i, int Y) {
     StepTaps<V> tp;
     const ScanStep& st = az.heights[i];
@@ -37,6 +45,18 @@ template <class V>
     tp.wa = splat<V>(st.w[0][0]);
     tp.wb = splat<V>(st.w[1][0]);
     tp.inv = splat<V>(st.w[2][0]);
+    if constexpr (K == CastingMoments::GlossyNlp) {
+        const ScanStep& rs = az.glossy[i];
+        tp.planes = az.glossyFields + static_cast<std::size_t>(i) * kShFields;
+        tp.o = Y * rs.rowStep;
+        tp.dB = rs.offB - rs.offA;
+        tp.rwa[0] = splat<V>(rs.w[0][0]);
+        tp.rwb[0] = splat<V>(rs.w[1][0]);
+        tp.back[0] = splat<V>(-az.cosPhi);
+        tp.back[1] = splat<V>(-az.sinPhi);
+        tp.clamp = az.clampNegative;
+        return tp;
+    }
     for (int c = 0; c < 3; ++c) {
         const ScanStep& rs = az.radiance[c][i];
         const std::ptrdiff_t ro = Y * rs.rowStep;
@@ -67,6 +87,7 @@ struct CastingRow {
     using I = typename LaneTraits<V>::I;
     static constexpr int L = LaneTraits<V>::n;
     static constexpr bool Exact = K == CastingMoments::Irradiance;
+    static constexpr bool Glossy = K == CastingMoments::GlossyNlp;
     static constexpr int nMo = Exact ? 1 : kMaxMoments;  // moments per segment
 
     const ReceiverRow& in;
@@ -120,6 +141,26 @@ struct CastingRow {
         return nAny;
     }
 
+    // GlossyNlp: what each new member sends back to its receiver per
+    // channel, u = Ebar . Y(-d) at its own (unclamped) elevation; 0 in the
+    // lanes without a new member (their basis is 0, their samples finite).
+    [[gnu::always_inline]] void glossyRadiance(const StepTaps<V>& tp, I nw, V t, int X0, V u[3]) const {
+        V tm = t < nlim ? nlim : (t > lim ? lim : t);
+        tm = nw ? tm : zero;
+        const V ic = one / sqrtv(one + tm * tm);
+        V y[kShCount];
+        shBasisLanes<V>(tp.back[0] * ic, tp.back[1] * ic, -(tm * ic), y);
+        for (int f = 0; f < kShCount; ++f) y[f] = nw ? y[f] : zero;
+        for (int c = 0; c < 3; ++c) {
+            V sum = zero;
+            for (int f = 0; f < kShCount; ++f) {
+                const float* pa = tp.planes[c * kShCount + f] + (tp.o + X0);
+                sum += (tp.rwa[0] * load<V>(pa) + tp.rwb[0] * load<V>(pa + tp.dB)) * y[f];
+            }
+            u[c] = tp.clamp ? vmax(sum, zero) : sum;
+        }
+    }
+
     // The new members' segments [c_(i-1), c_i] clamped to [omega_min, pi/2]:
     // their moments times the radiance samples, into the sums A.
     [[gnu::always_inline]] void addSegments(const StepTaps<V>& tp, I nw, V t, int X0) {
@@ -146,11 +187,15 @@ struct CastingRow {
         }
         // moments x radiance (lanes without a new member have zero moments;
         // the radiance read there is finite: inside the field's padding and guard)
+        V u[3];
+        if constexpr (Glossy)
+            glossyRadiance(tp, nw, t, X0, u);
+        else
+            for (int c = 0; c < 3; ++c) u[c] = tp.rwa[c] * load<V>(tp.ra[c] + X0) + tp.rwb[c] * load<V>(tp.rb[c] + X0);
         for (int c = 0; c < 3; ++c) {
-            const V u = tp.rwa[c] * load<V>(tp.ra[c] + X0) + tp.rwb[c] * load<V>(tp.rb[c] + X0);
             for (int p = 0; p < nMo; ++p) {
                 float* acc = A + static_cast<std::size_t>(c * nMo + p) * pad + X0;
-                store(acc, load<V>(acc) + u * mo[p]);
+                store(acc, load<V>(acc) + u[c] * mo[p]);
             }
         }
     }
@@ -191,7 +236,7 @@ struct CastingRow {
             }
         const V hMax = splat<V>(in.hMax);
         for (int i = 0; i < nMax && nActive > 0; ++i) {
-            const StepTaps<V> tp = stepTaps<V>(az, i, in.Y);
+            const StepTaps<V> tp = stepTaps<V, K>(az, i, in.Y);
             const I iv = I{} + i;
             int kept = 0;
             for (int q = 0; q < nActive; ++q) {
@@ -260,9 +305,15 @@ void sizeIndirectScratch(IndirectScratch& sc, int rows, int pad, bool irradiance
 
 CastRowFn castRowFor(CastingMoments moments) {
     const bool wide = simd::wideEnabled();
-    if (moments == CastingMoments::Nlp)
-        return wide ? castRowAvx2<CastingMoments::Nlp> : castRowSse<CastingMoments::Nlp>;
-    return wide ? castRowAvx2<CastingMoments::Irradiance> : castRowSse<CastingMoments::Irradiance>;
+    switch (moments) {
+        case CastingMoments::Nlp:
+            return wide ? castRowAvx2<CastingMoments::Nlp> : castRowSse<CastingMoments::Nlp>;
+        case CastingMoments::Irradiance:
+            return wide ? castRowAvx2<CastingMoments::Irradiance> : castRowSse<CastingMoments::Irradiance>;
+        case CastingMoments::GlossyNlp:
+            break;
+    }
+    return wide ? castRowAvx2<CastingMoments::GlossyNlp> : castRowSse<CastingMoments::GlossyNlp>;
 }
 
 }  // namespace terrain::gi

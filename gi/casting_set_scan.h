@@ -21,6 +21,15 @@
 // coefficients once per receiver and azimuth:
 //   u_0 = k0 A1, u_1 = k1 A2, u_2 = k2 (A3 - A1), u_3 = k3 (5 A4 - 6 A2).
 //
+// GlossyNlp: Nlp with a radiance that depends on the direction (Section
+// 5.3, "non-diffuse surfaces", Fig. 5 middle): the member at slope t_i in
+// azimuth phi sends u(t_i) = Ebar(t_i) . Y(-d_i) back to the receiver, Ebar
+// the exit-radiance SH vector (RGB x 16 planes, gi/glossy_exit_radiance.h)
+// read from its pyramid at the step, d_i = (cos phi c, sin phi c, s) with
+// c = 1 / sqrt(1 + t_i^2), s = t_i c (16 bilinear reads per channel instead
+// of 1); with GlossyPositivity::Clamp no member sends negative radiance,
+// u = max(0, .).
+//
 // Irradiance: the exact clamped-cosine irradiance at the receiver's own
 // normal up to dphi / |n|: u(t_i) Delta F with F = f2 - g f1 at the clamped
 // segment ends (f1 = (w + sin w cos w) / 2, f2 = sin^2 w / 2, g the tangent
@@ -44,6 +53,7 @@ namespace terrain::gi {
 enum class CastingMoments {
     Nlp,         // 3 channels x 4 NLP coefficients (LambertIndirect::ShKernel)
     Irradiance,  // 3 channels x the exact clamped-cosine irradiance (LambertIndirect::BlockerRadiance)
+    GlossyNlp,   // Nlp from the exit-radiance SH pyramid (GlossyIndirect::VectorPyramid)
 };
 
 /// Per-block scratch of the Lambert scan (one per fixed block of receiver rows).
@@ -65,9 +75,15 @@ void sizeIndirectScratch(IndirectScratch& sc, int rows, int pad, bool irradiance
 /// One azimuth's step tables as the kernel reads them.
 struct AzimuthSteps {
     const ScanStep* heights;      // the height steps
-    const ScanStep* radiance[3];  // each channel's radiance steps
+    const ScanStep* radiance[3];  // each channel's radiance steps (not with GlossyNlp)
     const int* stepsPerColumn;    // valid prefix per receiver column (padded row)
     float cosPhi, sinPhi;
+    // GlossyNlp: the exit-radiance pyramid's steps (offsets and weights, the
+    // same in its 48 planes), each step's 48 plane origins (field + offA,
+    // plane c * 16 + k), and whether members send max(0, u)
+    const ScanStep* glossy = nullptr;
+    const float* const* glossyFields = nullptr;
+    bool clampNegative = false;
 };
 
 /// One receiver row: padded inputs (loadReceiverRow), the row's valid

@@ -1,7 +1,7 @@
 #pragma once
 // Exit radiance of glossy surfaces as SH vectors (Section 5.3, "non-diffuse
 // surfaces", Fig. 5 middle; Section 7's Phong lobe): what the vector pyramid
-// of GlossyIndirect::VectorPyramid filters (gi/indirect_glossy.h).
+// of GlossyIndirect::VectorPyramid filters (gi/indirect_sh_kernel.h).
 //
 // What each texel stores (the choice of this engine). Bounce b - 1 leaves at
 // every texel q an incident-radiance SH vector I_q (RGB x order-4 SH: T_L V

@@ -2,7 +2,6 @@
 
 #include "gi/indirect_blocker_radiance.h"
 #include "gi/indirect_bounces.h"
-#include "gi/indirect_glossy.h"
 #include "gi/indirect_sh_kernel.h"
 
 namespace terrain::gi {
@@ -10,10 +9,7 @@ namespace terrain::gi {
 void computeIndirect(const IndirectInputs& in, const IndirectSettings& settings, IndirectState& st) {
     validateIndirectSettings(settings);
     const bool lambertBrdf = in.shading.brdf == Brdf::Lambert;
-    if (readsIncidentSh(settings, in.shading)) {
-        VectorPyramidIndirect strategy(in, settings, st);
-        runBounces(in, settings, strategy, st);
-    } else if (lambertBrdf && settings.lambert == LambertIndirect::BlockerRadiance) {
+    if (lambertBrdf && settings.lambert == LambertIndirect::BlockerRadiance) {
         BlockerRadianceIndirect strategy(in, settings, st);
         runBounces(in, settings, strategy, st);
     } else {

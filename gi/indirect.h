@@ -9,13 +9,11 @@
 //     exact clamped-cosine irradiance at the receivers, the blockers' mean
 //     radiance times each texel's occlusion between them
 //     (gi/indirect_blocker_radiance.h);
-//   GlossyIndirect::VectorPyramid, non-Lambert BRDF: a pyramid of SH
-//     exit-radiance vectors evaluated towards each receiver
-//     (gi/indirect_glossy.h);
-//   otherwise (LambertIndirect::ShKernel; GlossyIndirect::ScalarPyramid):
-//     Eq. 12, U through the folded wedge operator, shaded in SH
-//     (gi/indirect_sh_kernel.h).
-// The casting-set kernel of the Lambert strategies is gi/casting_set_scan.h.
+//   otherwise (LambertIndirect::ShKernel; GlossyIndirect::ScalarPyramid and
+//     VectorPyramid): Eq. 12, U through the folded wedge operator, shaded in
+//     SH (gi/indirect_sh_kernel.h); with VectorPyramid and a non-Lambert BRDF
+//     the members send their SH exit-radiance vectors towards each receiver.
+// The casting-set kernel of every strategy is gi/casting_set_scan.h.
 #include "gi/indirect_inputs.h"
 #include "gi/indirect_settings.h"
 #include "gi/indirect_state.h"

@@ -11,7 +11,7 @@
 // occlusion O (gi/blocker_radiance.h). No U is formed and nothing is shaded
 // from SH. With s = 1 every texel is a receiver: E alone.
 #include "gi/indirect_bounces.h"
-#include "gi/lambert_scan.h"
+#include "gi/indirect_scan.h"
 
 namespace terrain::gi {
 
@@ -30,7 +30,7 @@ private:
     const IndirectInputs& in_;
     const IndirectSettings& settings_;
     IndirectState& st_;
-    LambertScan scan_;
+    IndirectScan scan_;
 };
 
 }  // namespace terrain::gi

@@ -26,7 +26,7 @@ struct BounceSource {
 };
 
 /// One way of turning casting sets into light (gi/indirect_sh_kernel.h,
-/// gi/indirect_blocker_radiance.h, gi/indirect_glossy.h), over the inputs,
+/// gi/indirect_blocker_radiance.h), over the inputs,
 /// settings and state it was made with.
 class IndirectStrategy {
 public:

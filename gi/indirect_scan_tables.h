@@ -1,7 +1,6 @@
 #pragma once
-// What every indirect scan reads besides the pyramids (the Lambert scan,
-// gi/lambert_scan.h, and the glossy one, gi/indirect_glossy.h): the
-// per-bounce step tables and each receiver row's inputs.
+// What the indirect scan (gi/indirect_scan.h) reads besides the pyramids:
+// the per-bounce step tables and each receiver row's inputs.
 //
 // The scans walk the height pyramid's exponential steps (Eq. 14) and read the
 // radiance pyramid (gi/radiance_pyramid.h) at the same step positions. Like

@@ -12,7 +12,7 @@ enum class GlossyIndirect {
     // (gi/indirect_sh_kernel.h).
     ScalarPyramid,
     // A pyramid of SH exit-radiance vectors, evaluated towards each receiver
-    // (Fig. 5 middle; gi/indirect_glossy.h).
+    // (Fig. 5 middle; gi/indirect_sh_kernel.h).
     VectorPyramid,
 };
 

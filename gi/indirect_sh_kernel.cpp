@@ -6,6 +6,8 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/simd.h"
+#include "gi/glossy_exit_radiance.h"
+#include "gi/indirect.h"
 #include "gi/sh.h"
 
 namespace terrain::gi {
@@ -55,12 +57,14 @@ ShKernelIndirect::ShKernelIndirect(const IndirectInputs& in, const IndirectSetti
     : in_(in),
       settings_(settings),
       st_(st),
-      scan_(in, CastingMoments::Nlp, st),
+      exitVectors_(readsIncidentSh(settings, in.shading)),
+      scan_(in, exitVectors_ ? CastingMoments::GlossyNlp : CastingMoments::Nlp, st),
       nRows_(in.shading.brdf == Brdf::Lambert ? 9 : kShCount) {}  // Lambert reads bands 0..2 only
 
 void ShKernelIndirect::beginFrame() {
     const int nxr = in_.heights.nxr, nyr = in_.heights.nyr;
     const std::size_t planeR = static_cast<std::size_t>(nxr) * nyr;
+    if (exitVectors_) checkExitVectorInputs();
     // receiver tiles: the clean receivers keep the U of a previous scan
     if (in_.only)
         for (const VisibilityField& u : st_.u)
@@ -84,8 +88,27 @@ void ShKernelIndirect::beginFrame() {
     setUShadingLights(st_);
 }
 
+// The exit-radiance vectors need the previous bounce's incident SH vectors
+// (bounce 1: the direct shading's).
+void ShKernelIndirect::checkExitVectorInputs() {
+    const HeightPyramid& pyr = in_.heights;
+    if (!in_.directShade) throw InputError("glossy vector pyramid: the direct shading (incident SH) is required");
+    const ShadeMaps& direct = *in_.directShade;
+    const std::size_t planeR = static_cast<std::size_t>(pyr.nxr) * pyr.nyr;
+    if (direct.incident.size() != planeR * kGlossyFields || direct.nx != pyr.nx || direct.ny != pyr.ny)
+        throw InputError("glossy vector pyramid: the direct shading is not a Phong shading of this field");
+    st_.glossy.exitSh.resize(static_cast<std::size_t>(pyr.nx) * pyr.ny * kGlossyFields);
+}
+
+// The RGB pyramid of L_(b-1), or E of bounce b - 1 at full resolution and
+// its 48 planes' pyramid (Section 5.3)
 void ShKernelIndirect::buildPyramid(const BounceSource& previous) {
-    scan_.buildPyramid(*previous.rgb, settings_.radiance);
+    if (!exitVectors_) return scan_.buildPyramid(*previous.rgb, settings_.radiance);
+    const HeightPyramid& pyr = in_.heights;
+    GlossyIndirectState& gs = st_.glossy;
+    glossyExitRadiance(in_.gradX, in_.gradY, pyr.subsample, pyr.nxr, pyr.nyr, previous.shade->incident.data(),
+                       previous.shade->rgb, in_.albedo, in_.shading, gs.rowScratch, gs.exitSh.data());
+    buildScalarPyramids(gs.exitSh.data(), kGlossyFields, pyr, settings_.radiance, gs.pyramid);
 }
 
 void ShKernelIndirect::scan(int) {
@@ -117,7 +140,7 @@ void ShKernelIndirect::scanBlock(int block) {
                     std::fill(u + span.x0, u + span.x1, 0.0f);
                 }
     for (int j = 0; j < op.azimuths; ++j) {
-        const AzimuthSteps az = scan_.azimuth(j);
+        const AzimuthSteps az = scan_.azimuth(j, in_.shading.positivity == GlossyPositivity::Clamp);
         const float* vals = op.values.data() + static_cast<std::size_t>(j) * P;
         for (int r = 0; r < rb.rows; ++r) {
             const int Y = rb.yBegin + r;
@@ -143,8 +166,10 @@ void ShKernelIndirect::scanBlock(int block) {
 }
 
 // The texel pass stays whole with receiver tiles: it costs little beside the
-// scan, and interpolates the clean receivers' cached U.
+// scan, and interpolates the clean receivers' cached U. With the exit-radiance
+// vectors its incident SH feeds bounce b + 1.
 void ShKernelIndirect::shade(int, ShadeMaps& out) {
+    if (exitVectors_) out.keepIncident = true;
     shadeTexels(in_.gradX, in_.gradY, in_.heights.subsample, in_.envVisibility, st_.lights.data(), 3, in_.albedo,
                 in_.shading, out, false);
 }

@@ -19,24 +19,22 @@ struct IndirectTimings {
     double pyramid = 0.0, scan = 0.0, shading = 0.0, total = 0.0;
 };
 
-/// Buffers of the vector-pyramid bounce (GlossyIndirect::VectorPyramid, gi/indirect_glossy.h).
+/// Buffers of the vector-pyramid bounce (GlossyIndirect::VectorPyramid, gi/indirect_sh_kernel.h).
 struct GlossyIndirectState {
     std::vector<float> exitSh;         // 3 x 16 planes of nx * ny: E at full resolution (plane c * 16 + k)
     RadiancePyramid pyramid;           // one field per plane of exitSh
     std::vector<ScanStep> steps;       // azimuths x steps: geometry and weights (field 0)
     std::vector<const float*> fields;  // azimuths x steps x 48: field + offA of each plane
-    std::vector<float> blockScratch;   // per row block: scan scratch (moments, basis, NLP)
-    std::vector<int> blockList;        // per row block: steps with a new member
     std::vector<float> rowScratch;     // per worker slot: interpolated incident SH of one row
 };
 
 struct IndirectState {
-    RadiancePyramid radiance;             // Lambert strategies: the previous bounce's RGB radiance pyramid
+    RadiancePyramid radiance;             // RGB pyramids: the previous bounce's RGB radiance pyramid
     std::vector<ScanStep> heightSteps;    // azimuths x steps
-    std::vector<ScanStep> radianceSteps;  // Lambert strategies: channels x azimuths x steps
+    std::vector<ScanStep> radianceSteps;  // RGB pyramids: channels x azimuths x steps
     std::vector<int> stepsPerColumn, stepsPerRow;
-    DirtySpans spans;                      // Lambert strategies: the receiver columns to scan, per row
-    std::vector<IndirectScratch> blocks;   // Lambert strategies: per worker slot (LambertScan::scratch)
+    DirtySpans spans;                      // the receiver columns to scan, per row
+    std::vector<IndirectScratch> blocks;   // per worker slot (IndirectScan::scratch)
     std::array<VisibilityField, 3> u;      // U per channel (16 SH planes at the receivers; not with BlockerRadiance)
     int uZeroFrom = kShCount;              // U's planes from this one on are known to be 0
     std::array<ShadingLight, 3> lights;    // the shading lights of U

@@ -31,7 +31,7 @@ enum class Brdf { Lambert, Phong, LambertPlusPhong };
 // Non-negative glossy light. The order-4 SH lobe rings below zero wherever
 // the incident radiance varies sharply (a horizon, the sun): Off keeps the
 // paper's linear evaluation; Clamp (default) clamps the exit radiance a glossy
-// casting-set member sends (max(0, E . Y(-d)), gi/indirect_glossy) and every
+// casting-set member sends (max(0, E . Y(-d)), gi/casting_set_scan) and every
 // Phong / mixture shade (max(0, .)). Against the exact glossy reference
 // (bench/results/gi_glossy.md) the clamp was the most accurate of the
 // variants measured, and it is the only one that guarantees no negative

@@ -1,5 +1,5 @@
 // Glossy indirect light: the SH radiance-vector pyramid
-// (gi/indirect_glossy), the per-texel Phong exponent map and the glossy
+// (gi/indirect_sh_kernel, gi/glossy_exit_radiance), the per-texel Phong exponent map and the glossy
 // reference (gi/reference_glossy).
 #include <algorithm>
 #include <cmath>
@@ -456,11 +456,11 @@ TEST_CASE("gi.glossy: a second frame allocates nothing new") {
     const float* p1 = st.indirect.glossy.pyramid.fields[17].levels.empty()
                           ? nullptr
                           : st.indirect.glossy.pyramid.fields[17].levels[0].data();
-    const float* p2 = st.indirect.glossy.blockScratch.data();
+    const float* p2 = st.indirect.blocks.at(0).state.data();
     Grid h2 = h;
     for (float& v : h2.v) v *= 1.3f;
     runGiFrame(h2.view(), 1.0f, GiLighting{}, s, st, &a);
     CHECK(st.indirect.glossy.exitSh.data() == p0);
     if (p1) CHECK(st.indirect.glossy.pyramid.fields[17].levels[0].data() == p1);
-    CHECK(st.indirect.glossy.blockScratch.data() == p2);
+    CHECK(st.indirect.blocks.at(0).state.data() == p2);
 }

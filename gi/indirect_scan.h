@@ -1,8 +1,10 @@
 #pragma once
-// The scan of the Lambert strategies (gi/indirect_sh_kernel.h,
-// gi/indirect_blocker_radiance.h): per bounce the previous bounce's RGB
-// radiance pyramid, the step table of heights and the 3 channels' radiance,
-// and the casting-set kernel (gi/casting_set_scan.h) row by row.
+// The casting-set scan of the indirect strategies (gi/indirect_sh_kernel.h,
+// gi/indirect_blocker_radiance.h): per bounce the previous bounce's radiance
+// pyramid (RGB; with CastingMoments::GlossyNlp the 48 planes of the
+// exit-radiance SH vectors, IndirectState::glossy, which the strategy
+// builds), the step table of heights and radiance, and the casting-set
+// kernel (gi/casting_set_scan.h) row by row.
 //
 // Schedule: like gi/visibility: a per-bounce step table, fixed blocks of
 // kRowsPerBlock receiver rows in parallel; within a block azimuth by azimuth,
@@ -33,21 +35,23 @@ struct RowBlock {
     int yBegin, rows;
 };
 
-class LambertScan {
+class IndirectScan {
 public:
     static constexpr int kRowsPerBlock = 8;
 
     /// A scan that sums `moments` over the casting sets, in st's buffers.
-    LambertScan(const IndirectInputs& in, CastingMoments moments, IndirectState& st);
+    IndirectScan(const IndirectInputs& in, CastingMoments moments, IndirectState& st);
 
     /// Sizes the step tables and the scratch of each worker slot
     /// (IndirectScratch::irradiance with CastingMoments::Irradiance), finds the
     /// field's highest height and the receiver spans to scan (InputError:
     /// tiles of another receiver grid).
     void beginFrame();
-    /// The RGB radiance pyramid of the previous bounce's exit radiance (Section 5.3).
+    /// The RGB radiance pyramid of the previous bounce's exit radiance (Section 5.3;
+    /// not with GlossyNlp).
     void buildPyramid(const std::array<Grid, 3>& exit, const RadiancePyramidSettings& settings);
-    /// The bounce's step table: height and radiance steps, valid prefixes.
+    /// The bounce's step table: height and radiance steps, valid prefixes
+    /// (GlossyNlp: of IndirectState::glossy's pyramid).
     void buildStepTable();
 
     int blockCount() const { return nBlocks_; }
@@ -61,8 +65,8 @@ public:
     bool hasWork(const RowBlock& rb) const;
     /// The block's receiver rows (loadReceiverRow) into its scratch.
     void loadRows(const RowBlock& rb, IndirectScratch& sc) const;
-    /// Azimuth j's step tables.
-    AzimuthSteps azimuth(int j) const;
+    /// Azimuth j's step tables; clampNegative: GlossyNlp's members send max(0, u).
+    AzimuthSteps azimuth(int j, bool clampNegative = false) const;
     /// Scans receiver row Y, row r of its block, along azimuth j: sc.result
     /// at the receivers of spans(Y).
     void castRow(const AzimuthSteps& az, int j, int Y, int r, IndirectScratch& sc) const;
@@ -70,6 +74,8 @@ public:
     int pad() const { return pad_; }
 
 private:
+    void buildGlossyStepTable();
+
     const IndirectInputs& in_;
     IndirectState& st_;
     CastingMoments moments_;

@@ -1,9 +1,10 @@
-#include "gi/lambert_scan.h"
+#include "gi/indirect_scan.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include "gi/glossy_exit_radiance.h"
 #include "gi/indirect_scan_tables.h"
 
 namespace terrain::gi {
@@ -23,7 +24,7 @@ float fieldTopHeight(const HeightPyramid& pyr) {
 
 }  // namespace
 
-LambertScan::LambertScan(const IndirectInputs& in, CastingMoments moments, IndirectState& st)
+IndirectScan::IndirectScan(const IndirectInputs& in, CastingMoments moments, IndirectState& st)
     : in_(in),
       st_(st),
       moments_(moments),
@@ -33,24 +34,30 @@ LambertScan::LambertScan(const IndirectInputs& in, CastingMoments moments, Indir
       nBlocks_(std::max(1, (in.heights.nyr + kRowsPerBlock - 1) / kRowsPerBlock)),
       tableSize_(static_cast<std::size_t>(in.op.azimuths) * nSteps_) {}
 
-void LambertScan::beginFrame() {
+void IndirectScan::beginFrame() {
     const int m = in_.op.azimuths, nyr = in_.heights.nyr;
     st_.blocks.resize(static_cast<std::size_t>(workerSlots()));
     for (IndirectScratch& b : st_.blocks)
         sizeIndirectScratch(b, kRowsPerBlock, pad_, moments_ == CastingMoments::Irradiance);
     hMax_ = fieldTopHeight(in_.heights);
     st_.heightSteps.resize(tableSize_);
-    st_.radianceSteps.resize(3 * tableSize_);
+    if (moments_ == CastingMoments::GlossyNlp) {
+        st_.glossy.steps.resize(tableSize_);
+        st_.glossy.fields.resize(tableSize_ * kGlossyFields);
+    } else {
+        st_.radianceSteps.resize(3 * tableSize_);
+    }
     st_.stepsPerColumn.resize(static_cast<std::size_t>(m) * pad_);
     st_.stepsPerRow.resize(static_cast<std::size_t>(m) * nyr);
     dirtySpans(in_.only, in_.heights.nxr, nyr, st_.spans);
 }
 
-void LambertScan::buildPyramid(const std::array<Grid, 3>& exit, const RadiancePyramidSettings& settings) {
+void IndirectScan::buildPyramid(const std::array<Grid, 3>& exit, const RadiancePyramidSettings& settings) {
     buildRadiancePyramid(exit, in_.heights, settings, st_.radiance);
 }
 
-void LambertScan::buildStepTable() {
+void IndirectScan::buildStepTable() {
+    if (moments_ == CastingMoments::GlossyNlp) return buildGlossyStepTable();
     const auto channelSteps = [&](int i, double c, double sn, std::size_t at, ValidPrefix& prefix) {
         for (int ch = 0; ch < 3; ++ch) {
             const ScanStepInfo r = scanStepInfo(st_.radiance.fields[static_cast<std::size_t>(ch)], i, c, sn);
@@ -62,18 +69,37 @@ void LambertScan::buildStepTable() {
                            channelSteps);
 }
 
-RowBlock LambertScan::rowBlock(int block) const {
+// The exit-radiance planes' steps: one geometry (the 48 pyramids share
+// their layout) and each plane's origin.
+void IndirectScan::buildGlossyStepTable() {
+    GlossyIndirectState& gs = st_.glossy;
+    const auto planeSteps = [&](int i, double c, double sn, std::size_t at, ValidPrefix& prefix) {
+        const ScanStepInfo r = scanStepInfo(gs.pyramid.fields[0], i, c, sn);
+        gs.steps[at] = r.step;
+        const float** origins = gs.fields.data() + at * kGlossyFields;
+        for (int f = 0; f < kGlossyFields; ++f) {
+            const ScanStep plane =
+                f == 0 ? r.step : scanStepInfo(gs.pyramid.fields[static_cast<std::size_t>(f)], i, c, sn).step;
+            origins[f] = plane.field + plane.offA;
+        }
+        prefix.narrow(r);
+    };
+    buildIndirectStepTable(in_.heights, in_.op.phi, pad_, st_.heightSteps, st_.stepsPerColumn, st_.stepsPerRow,
+                           planeSteps);
+}
+
+RowBlock IndirectScan::rowBlock(int block) const {
     const int yBegin = block * kRowsPerBlock;
     return {yBegin, std::min(kRowsPerBlock, in_.heights.nyr - yBegin)};
 }
 
-bool LambertScan::hasWork(const RowBlock& rb) const {
+bool IndirectScan::hasWork(const RowBlock& rb) const {
     for (int r = 0; r < rb.rows; ++r)
         if (!spans(rb.yBegin + r).empty()) return true;
     return false;
 }
 
-void LambertScan::loadRows(const RowBlock& rb, IndirectScratch& sc) const {
+void IndirectScan::loadRows(const RowBlock& rb, IndirectScratch& sc) const {
     for (int r = 0; r < rb.rows; ++r) {
         const std::size_t ro = static_cast<std::size_t>(r) * pad_;
         loadReceiverRow(in_.heights, in_.gradX, in_.gradY, rb.yBegin + r, pad_, sc.gx.data() + ro, sc.gy.data() + ro,
@@ -81,18 +107,25 @@ void LambertScan::loadRows(const RowBlock& rb, IndirectScratch& sc) const {
     }
 }
 
-AzimuthSteps LambertScan::azimuth(int j) const {
+AzimuthSteps IndirectScan::azimuth(int j, bool clampNegative) const {
     const std::size_t base = static_cast<std::size_t>(j) * nSteps_;
     const double phi = in_.op.phi[static_cast<std::size_t>(j)];
-    return {st_.heightSteps.data() + base,
-            {st_.radianceSteps.data() + base, st_.radianceSteps.data() + tableSize_ + base,
-             st_.radianceSteps.data() + 2 * tableSize_ + base},
-            st_.stepsPerColumn.data() + static_cast<std::size_t>(j) * pad_,
-            static_cast<float>(std::cos(phi)),
-            static_cast<float>(std::sin(phi))};
+    AzimuthSteps az{st_.heightSteps.data() + base,
+                    {},
+                    st_.stepsPerColumn.data() + static_cast<std::size_t>(j) * pad_,
+                    static_cast<float>(std::cos(phi)),
+                    static_cast<float>(std::sin(phi))};
+    if (moments_ == CastingMoments::GlossyNlp) {
+        az.glossy = st_.glossy.steps.data() + base;
+        az.glossyFields = st_.glossy.fields.data() + base * kGlossyFields;
+        az.clampNegative = clampNegative;
+        return az;
+    }
+    for (std::size_t c = 0; c < 3; ++c) az.radiance[c] = st_.radianceSteps.data() + c * tableSize_ + base;
+    return az;
 }
 
-void LambertScan::castRow(const AzimuthSteps& az, int j, int Y, int r, IndirectScratch& sc) const {
+void IndirectScan::castRow(const AzimuthSteps& az, int j, int Y, int r, IndirectScratch& sc) const {
     const std::size_t ro = static_cast<std::size_t>(r) * pad_;
     const int rowSteps = st_.stepsPerRow[static_cast<std::size_t>(j) * in_.heights.nyr + static_cast<std::size_t>(Y)];
     const ReceiverRow row{
