@@ -163,28 +163,9 @@ struct RaisedWindow {
     }
 };
 
-// out[x] = v0 + f (v1 - v0) between the receivers around texel column x
-// (receiverLerp): S texels per receiver interval with the fractions k / S,
-// unrolled so that the compiler vectorises the runs; the columns past the
-// last whole interval from the tables.
-template <int S>
-void horizontalLerp(const AmbientJob& j, const float* vert, float* out) {
-    float frac[S];
-    for (int k = 0; k < S; ++k) frac[k] = static_cast<float>(k) / static_cast<float>(S);
-    const int intervals = std::max(0, j.nxr - 1);
-    for (int X = 0; X < intervals; ++X) {
-        const float v0 = vert[X], d = vert[X + 1] - vert[X];
-        for (int k = 0; k < S; ++k) out[S * X + k] = v0 + frac[k] * d;
-    }
-    for (int x = std::min(S * intervals, j.nx); x < j.nx; ++x) {
-        const ReceiverLerp& r = j.columns[x];
-        out[x] = vert[r.i0] + r.f * (vert[r.i1] - vert[r.i0]);
-    }
-}
-
 // Horizon slopes of azimuth a at the texels of a run of the row the window
 // covers, bilinear from the raised receivers (Fig. 7): the vertical mix of
-// the receivers the run reads, then along the row, by horizontalLerp over a
+// the receivers the run reads, then along the row, by lerpReceiverRow over a
 // whole row and by the columns' receivers and fraction over a part of one
 // (the same operations). vert: nxr floats of scratch.
 void interpolatedHorizons(const AmbientJob& j, const RaisedWindow& window, int a, ColumnSpan run, float* vert,
@@ -195,8 +176,7 @@ void interpolatedHorizons(const AmbientJob& j, const RaisedWindow& window, int a
     const float* t0 = window.row0(a);
     const float* t1 = window.row1(a);
     for (int X = read.x0; X < read.x1; ++X) vert[X] = t0[X] + window.f * (t1[X] - t0[X]);
-    if (wholeRow && j.in.subsample == 2) return horizontalLerp<2>(j, vert, out);
-    if (wholeRow && j.in.subsample == 4) return horizontalLerp<4>(j, vert, out);
+    if (wholeRow) return lerpReceiverRow(vert, j.nxr, j.in.subsample, j.columns, j.nx, out);
     for (int x = run.x0; x < run.x1; ++x) {
         const ReceiverLerp& r = j.columns[x];
         out[x] = vert[r.i0] + r.f * (vert[r.i1] - vert[r.i0]);

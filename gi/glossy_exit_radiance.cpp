@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/parallel.h"
+#include "core/simd.h"
 
 namespace terrain::gi {
 
@@ -72,14 +73,16 @@ const MirrorTables& mirrorTables() {
     return t;
 }
 
-// E for the three channels of one texel; I: 3 x 16 interpolated incident SH.
-void exitVectors(const MirrorTables& mt, const float (*I)[kShCount], float nx, float ny, float nz,
-                 const float ph[kShOrder], float ws, const float diffuse[3], float (*E)[kShCount]) {
-    float yr[7][kShCount];
+// E for the three channels of one texel per lane (V: float, F4 or F8, the
+// same operations in every lane); I: 3 x 16 interpolated incident SH.
+template <class V>
+[[gnu::always_inline]] inline void exitVectors(const MirrorTables& mt, const V (*I)[kShCount], V nx, V ny, V nz,
+                                               const V ph[kShOrder], float ws, const V diffuse[3], V (*E)[kShCount]) {
+    V yr[7][kShCount];
     for (int j = 0; j < 7; ++j) {
         const float* d = mt.dir[j];
-        const float dn = 2.0f * (nx * d[0] + ny * d[1] + nz * d[2]);
-        shBasisLanes<float>(dn * nx - d[0], dn * ny - d[1], dn * nz - d[2], yr[j]);
+        const V dn = 2.0f * (nx * d[0] + ny * d[1] + nz * d[2]);
+        shBasisLanes<V>(dn * nx - d[0], dn * ny - d[1], dn * nz - d[2], yr[j]);
     }
     const float sqrt4pi = 3.5449077018110318f;
     for (int c = 0; c < 3; ++c) {
@@ -87,21 +90,84 @@ void exitVectors(const MirrorTables& mt, const float (*I)[kShCount], float nx, f
         E[c][0] = ws * ph[0] * I[c][0] + sqrt4pi * diffuse[c];
         for (int l = 1; l < kShOrder; ++l) {
             const int n = 2 * l + 1, b = l * l;
-            float cl[7], h[7];
+            V cl[7], h[7];
             for (int m = 0; m < n; ++m) cl[m] = ws * ph[l] * I[c][b + m];
             for (int j = 0; j < n; ++j) {
-                float s = 0.0f;
-                for (int m = 0; m < n; ++m) s += cl[m] * yr[j][b + m];
-                h[j] = s;
+                V sum = simd::splat<V>(0.0f);
+                for (int m = 0; m < n; ++m) sum += cl[m] * yr[j][b + m];
+                h[j] = sum;
             }
             const float* inv = mt.inv + MirrorTables::offset(l);
             for (int m = 0; m < n; ++m) {
-                float s = 0.0f;
-                for (int j = 0; j < n; ++j) s += inv[m * n + j] * h[j];
-                E[c][b + m] = s;
+                V sum = simd::splat<V>(0.0f);
+                for (int j = 0; j < n; ++j) sum += inv[m * n + j] * h[j];
+                E[c][b + m] = sum;
             }
         }
     }
+}
+
+// What one row's texels read: the incident SH interpolated to every texel
+// column (48 rows of the worker's scratch) and the row's inputs.
+struct ExitRow {
+    const float* incident;  // 48 planes of nxPad: I at the texels
+    std::size_t nxPad;
+    const float *gx, *gy;
+    const float* shade[3];
+    const float* lobe[kShOrder - 1];  // per-texel lobe factors of bands 1..3 (null: uniform)
+    const float* uniformLobe;         // phongLobeFactors of the settings
+    float ws, view[3];
+    float* out;  // E plane 0 at the row's first texel
+    std::size_t plane;
+};
+
+// E of the texels [x, x + lanes of V) of a row: the normal, the lobe, the
+// diffuse part (the shade less the lobe towards the viewer), then E; a
+// value that is not finite is written as 0.
+template <class V>
+[[gnu::always_inline]] inline void exitTexels(const MirrorTables& mt, const ExitRow& r, int x) {
+    using simd::load;
+    using simd::splat;
+    V I[3][kShCount];
+    for (int c = 0; c < 3; ++c)
+        for (int i = 0; i < kShCount; ++i) I[c][i] = load<V>(r.incident + (c * kShCount + i) * r.nxPad + x);
+    const V gx = load<V>(r.gx + x), gy = load<V>(r.gy + x), one = splat<V>(1.0f), zero = splat<V>(0.0f);
+    const V inv = one / simd::sqrtv(one + gx * gx + gy * gy);
+    const V nx = -gx * inv, ny = -gy * inv, nz = inv;
+    V ph[kShOrder];
+    ph[0] = splat<V>(r.uniformLobe[0]);
+    for (int l = 1; l < kShOrder; ++l) ph[l] = r.lobe[l - 1] ? load<V>(r.lobe[l - 1] + x) : splat<V>(r.uniformLobe[l]);
+    // what the shade holds beside the lobe towards the viewer: the diffuse part
+    const V nv = nx * r.view[0] + ny * r.view[1] + nz * r.view[2];
+    V yv[kShCount];
+    shBasisLanes<V>(2.0f * nv * nx - r.view[0], 2.0f * nv * ny - r.view[1], 2.0f * nv * nz - r.view[2], yv);
+    V diffuse[3];
+    for (int c = 0; c < 3; ++c) {
+        V sp = zero;
+        for (int i = 0; i < kShCount; ++i) sp += ph[shBand(i)] * yv[i] * I[c][i];
+        diffuse[c] = load<V>(r.shade[c] + x) - r.ws * sp;
+    }
+    V E[3][kShCount];
+    exitVectors<V>(mt, I, nx, ny, nz, ph, r.ws, diffuse, E);
+    for (int c = 0; c < 3; ++c)
+        for (int i = 0; i < kShCount; ++i) {
+            const V e = E[c][i];
+            simd::store(r.out + static_cast<std::size_t>(c * kShCount + i) * r.plane + x, (e - e) == zero ? e : zero);
+        }
+}
+
+// A row's texels: whole lane groups, then the rest one by one (the same
+// operations per texel).
+template <class V>
+[[gnu::always_inline]] inline void exitRowWith(const MirrorTables& mt, const ExitRow& r, int nx) {
+    constexpr int L = simd::kLaneCount<V>;
+    int x = 0;
+    for (; x + L <= nx; x += L) exitTexels<V>(mt, r, x);
+    for (; x < nx; ++x) exitTexels<float>(mt, r, x);
+}
+void exitRowSse(const MirrorTables& mt, const ExitRow& r, int nx) { exitRowWith<simd::F4>(mt, r, nx); }
+[[gnu::target("avx2"), gnu::flatten]] void exitRowAvx2(const MirrorTables& mt, const ExitRow& r, int nx) {
+    exitRowWith<simd::F8>(mt, r, nx);
 }
 
 }  // namespace
@@ -111,7 +177,7 @@ void glossyExitVector(const float incident[kShCount], float nx, float ny, float 
     float I[3][kShCount] = {}, E[3][kShCount];
     const float d[3] = {diffuse, 0.0f, 0.0f};
     for (int i = 0; i < kShCount; ++i) I[0][i] = incident[i];
-    exitVectors(mirrorTables(), I, nx, ny, nz, ph, ws, d, E);
+    exitVectors<float>(mirrorTables(), I, nx, ny, nz, ph, ws, d, E);
     for (int i = 0; i < kShCount; ++i) out[i] = E[0][i];
 }
 
@@ -123,61 +189,48 @@ void glossyExitRadiance(ConstGridView gradX, ConstGridView gradY, int s, int nxr
     const MirrorTables& mt = mirrorTables();
     float phUniform[kShOrder];
     phongLobeFactors(shading.phongExponent, phUniform);
-    const float ws = specularWeightOf(shading);
-    const float vx = shading.viewDir[0], vy = shading.viewDir[1], vz = shading.viewDir[2];
+    const bool lobeMap = surface && !surface->phongLobe[0].empty();
+    std::vector<ReceiverLerp> columns;
+    receiverLerps(nx, s, nxr, columns);
     const int nBlocks = std::max(1, std::min(ny, kMaxBlocks));
-    // a row keeps nothing in the scratch: one slot per thread serves every block it runs
-    rowScratch.resize(static_cast<std::size_t>(workerSlots()) * kGlossyFields * std::max(nxr, 1));
+    // per worker slot: the receivers' rows mixed vertically (48 x nxr), then
+    // along the row (48 x nx); a row keeps nothing in it
+    const std::size_t nxPad = static_cast<std::size_t>(nx), slot = kGlossyFields * (std::max(nxr, 1) + nxPad);
+    rowScratch.resize(static_cast<std::size_t>(workerSlots()) * slot);
+    void (*const exitRow)(const MirrorTables&, const ExitRow&, int) = simd::wideEnabled() ? exitRowAvx2 : exitRowSse;
     parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
-        float* vert = rowScratch.data() + static_cast<std::size_t>(workerSlot()) * kGlossyFields * nxr;
+        float* vert = rowScratch.data() + static_cast<std::size_t>(workerSlot()) * slot;
+        float* texels = vert + kGlossyFields * static_cast<std::size_t>(nxr);
         for (int block = b0; block < b1; ++block) {
             const int yBegin = static_cast<int>(static_cast<long long>(ny) * block / nBlocks);
             const int yEnd = static_cast<int>(static_cast<long long>(ny) * (block + 1) / nBlocks);
             for (int y = yBegin; y < yEnd; ++y) {
-                // ---- the incident SH vectors of this row, interpolated as gi/shading does (Fig. 7)
+                // the incident SH vectors of this row, interpolated as gi/shading does (Fig. 7)
                 const ReceiverLerp ry = receiverLerp(y, s, nyr);
-                const int Y0 = ry.i0, Y1 = ry.i1;
-                const float fy = ry.f;
                 for (int p = 0; p < kGlossyFields; ++p) {
-                    const float* ra = incident + p * planeR + static_cast<std::size_t>(Y0) * nxr;
-                    const float* rb = incident + p * planeR + static_cast<std::size_t>(Y1) * nxr;
+                    const float* ra = incident + p * planeR + static_cast<std::size_t>(ry.i0) * nxr;
+                    const float* rb = incident + p * planeR + static_cast<std::size_t>(ry.i1) * nxr;
                     float* v = vert + static_cast<std::size_t>(p) * nxr;
-                    for (int X = 0; X < nxr; ++X) v[X] = ra[X] + fy * (rb[X] - ra[X]);
+                    for (int X = 0; X < nxr; ++X) v[X] = ra[X] + ry.f * (rb[X] - ra[X]);
+                    lerpReceiverRow(v, nxr, s, columns.data(), nx, texels + p * nxPad);
                 }
-                for (int x = 0; x < nx; ++x) {
-                    const ReceiverLerp rx = receiverLerp(x, s, nxr);
-                    const int X0 = rx.i0, X1 = rx.i1;
-                    const float fx = rx.f;
-                    float I[3][kShCount];
-                    for (int c = 0; c < 3; ++c)
-                        for (int i = 0; i < kShCount; ++i) {
-                            const float* v = vert + static_cast<std::size_t>(c * kShCount + i) * nxr;
-                            I[c][i] = v[X0] + fx * (v[X1] - v[X0]);
-                        }
-                    const float gxv = gradX(x, y), gyv = gradY(x, y);
-                    const float inv = 1.0f / std::sqrt(1.0f + gxv * gxv + gyv * gyv);
-                    const float nxv = -gxv * inv, nyv = -gyv * inv, nzv = inv;
-                    const std::size_t idx = static_cast<std::size_t>(y) * nx + x;
-                    float ph[kShOrder];
-                    texelPhongLobe(surface, idx, phUniform, ph);
-                    // what the shade holds beside the lobe towards the viewer: the diffuse part
-                    const float nv = nxv * vx + nyv * vy + nzv * vz;
-                    float yv[kShCount];
-                    shBasisLanes<float>(2.0f * nv * nxv - vx, 2.0f * nv * nyv - vy, 2.0f * nv * nzv - vz, yv);
-                    float diffuse[3];
-                    for (int c = 0; c < 3; ++c) {
-                        float sp = 0.0f;
-                        for (int i = 0; i < kShCount; ++i) sp += ph[shBand(i)] * yv[i] * I[c][i];
-                        diffuse[c] = shade[static_cast<std::size_t>(c)].v[idx] - ws * sp;
-                    }
-                    float E[3][kShCount];
-                    exitVectors(mt, I, nxv, nyv, nzv, ph, ws, diffuse, E);
-                    for (int c = 0; c < 3; ++c)
-                        for (int i = 0; i < kShCount; ++i) {
-                            const float e = E[c][i];
-                            out[static_cast<std::size_t>(c * kShCount + i) * plane + idx] = std::isfinite(e) ? e : 0.0f;
-                        }
-                }
+                const std::size_t row = static_cast<std::size_t>(y) * nx;
+                ExitRow r{texels,
+                          nxPad,
+                          gradX.row(y),
+                          gradY.row(y),
+                          {},
+                          {},
+                          phUniform,
+                          specularWeightOf(shading),
+                          {shading.viewDir[0], shading.viewDir[1], shading.viewDir[2]},
+                          out + row,
+                          plane};
+                for (std::size_t c = 0; c < 3; ++c) r.shade[c] = shade[c].v.data() + row;
+                for (int l = 1; l < kShOrder; ++l)
+                    r.lobe[l - 1] =
+                        lobeMap ? surface->phongLobe[static_cast<std::size_t>(l - 1)].v.data() + row : nullptr;
+                exitRow(mt, r, nx);
             }
         }
     });

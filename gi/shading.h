@@ -130,6 +130,33 @@ inline void receiverLerps(int count, int s, int n, std::vector<ReceiverLerp>& ou
     for (int x = 0; x < count; ++x) out[static_cast<std::size_t>(x)] = receiverLerp(x, s, n);
 }
 
+/// A row of receiver values v (nxr of them) interpolated to the texel
+/// columns 0..nx-1 (Fig. 7): out[x] = v[i0] + f (v[i1] - v[i0]), `columns`
+/// the row's receiverLerps. At s = 2 and 4 the whole receiver intervals are
+/// unrolled with the fractions k / s (the same operations) so that the
+/// compiler vectorises them; the columns past the last whole interval, and
+/// every column at other s, from the table.
+template <int S>
+inline int lerpReceiverIntervals(const float* v, int nxr, int nx, float* out) {
+    float frac[S];
+    for (int k = 0; k < S; ++k) frac[k] = static_cast<float>(k) / static_cast<float>(S);
+    const int intervals = nxr > 1 ? nxr - 1 : 0;
+    for (int X = 0; X < intervals; ++X) {
+        const float v0 = v[X], d = v[X + 1] - v[X];
+        for (int k = 0; k < S; ++k) out[S * X + k] = v0 + frac[k] * d;
+    }
+    return S * intervals < nx ? S * intervals : nx;
+}
+inline void lerpReceiverRow(const float* v, int nxr, int s, const ReceiverLerp* columns, int nx, float* out) {
+    int x = 0;
+    if (s == 2) x = lerpReceiverIntervals<2>(v, nxr, nx, out);
+    if (s == 4) x = lerpReceiverIntervals<4>(v, nxr, nx, out);
+    for (; x < nx; ++x) {
+        const ReceiverLerp& r = columns[x];
+        out[x] = v[r.i0] + r.f * (v[r.i1] - v[r.i0]);
+    }
+}
+
 /// An albedo map of one value everywhere (every channel).
 AlbedoMap uniformAlbedo(int nx, int ny, float albedo);
 
