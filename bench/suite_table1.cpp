@@ -250,7 +250,7 @@ double pyramidMB(const HeightPyramid& p) {
 }
 double shadeMB(const ShadeMaps& s) {
     double m = mbOf(s.ambient) + mbOf(s.skyBelow) + mbOf(s.skyRising) + mbOf(s.incident) + mbOf(s.incidentWindow) +
-               mbOf(s.rowScratch) + mbOf(s.basisScratch);
+               mbOf(s.rowScratch);
     for (const Grid& g : s.rgb) m += mbOf(g);
     return m;
 }

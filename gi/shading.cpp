@@ -309,15 +309,13 @@ void incidentRowSse(const ShadingLight* lights, int nl, int nCoef, int nxr, Colu
 }
 
 // ---- setup ----------------------------------------------------------------------
-void sizeShadeMaps(int nx, int ny, std::size_t incidentSize, bool ambient, std::size_t rowScratchSize,
-                   std::size_t basisScratchSize, ShadeMaps& out) {
+void sizeShadeMaps(int nx, int ny, std::size_t incidentSize, bool ambient, std::size_t rowScratchSize, ShadeMaps& out) {
     out.nx = nx;
     out.ny = ny;
     for (Grid& g : out.rgb) g.ensureSize(nx, ny);
     if (ambient) out.ambient.ensureSize(nx, ny);
     out.incident.resize(incidentSize);
     out.rowScratch.resize(rowScratchSize);
-    out.basisScratch.resize(basisScratchSize);
     out.colIndex.resize(static_cast<std::size_t>(nx));
     out.colFrac.resize(static_cast<std::size_t>(nx));
 }
@@ -355,7 +353,7 @@ void buildIncidentTerms(const ShadingLight* lights, int nl, int nCoef, ShadeMaps
 // ---- Phong rows (Brdf::Phong, LambertPlusPhong) --------------------------------
 // One full-resolution row: the SH planes interpolated to the row
 // (interpolatePlanesToRow), the Lambert part at each texel's normal and the
-// Phong lobe about its reflection vector (phongShadeRow).
+// Phong lobe about its reflection vector (phongTexels).
 struct PhongRowJob {
     LambertRowJob base;         // planes, sizes, tables, Lambert factors, diffuse weight, albedo, out
     float phUniform[kShOrder];  // the uniform lobe factors (phongLobeFactors of the settings)
@@ -398,72 +396,74 @@ void interpolatePlanesToRow(const LambertRowJob& j, int y, float* vert, float* u
     }
 }
 
-// ---- algorithm: rotated BRDF at each full-resolution normal -----
-// lamRow: the clamped-cosine zonal vector turned to each texel's normal (9 x nx).
-void lambertBasisRow(const LambertFactors& lf, const float* __restrict gxr, const float* __restrict gyr, int nx,
-                     float* __restrict lamRow) {
-    for (int x = 0; x < nx; ++x) {
-        const float gx = gxr[x], gy = gyr[x];
-        const float inv = 1.0f / std::sqrt(1.0f + gx * gx + gy * gy);
-        const float X = -gx * inv, Yn = -gy * inv, Z = inv;
-        float lam[9];
-        lambertAtNormal(lf, X, Yn, Z, lam);
-        for (int i = 0; i < 9; ++i) lamRow[static_cast<std::size_t>(i) * nx + x] = lam[i];
+// ---- algorithm: Lambert and Phong at each texel of a run ----------------------
+// Texels [x, x + lanes of V) of row y: the clamped-cosine zonal vector turned
+// to the texel's normal (ambient and the diffuse part), then per channel the
+// Phong lobe about its reflection vector (Section 7), dotted with the row's
+// SH planes `up`; a shade that is not finite is written as 0, and below 0 as
+// 0 with the clamp. V: float, F4 or F8, the same operations in every lane.
+template <class V>
+[[gnu::always_inline]] inline void phongTexels(const PhongRowJob& j, const float* gxr, const float* gyr,
+                                               const float* up, int y, int x) {
+    using simd::load;
+    using simd::splat;
+    const LambertRowJob& b = j.base;
+    const int nx = b.nx, nCoef = b.nCoef;
+    const std::size_t row = static_cast<std::size_t>(y) * nx;
+    const V zero = splat<V>(0.0f), one = splat<V>(1.0f);
+    const V gx = load<V>(gxr + x), gy = load<V>(gyr + x);
+    const V inv = one / simd::sqrtv(one + gx * gx + gy * gy);
+    const V nxv = -gx * inv, nyv = -gy * inv, nzv = inv;
+    V lam[9];
+    lambertAtNormal(b.lf, nxv, nyv, nzv, lam);
+    if (b.env) {
+        V amb = zero;
+        for (int i = 0; i < 9; ++i) amb += lam[i] * load<V>(up + static_cast<std::size_t>(3 * nCoef + i) * nx + x);
+        simd::store(b.out->ambient.data() + row + x, amb);
     }
-}
-
-// o[x] += specWeight * (Phong lobe about texel x's reflection vector) . I_ch (Section 7).
-void addPhongLobe(const PhongRowJob& j, const float* __restrict gxr, const float* __restrict gyr,
-                  const float* __restrict up, int ch, int y, ColumnSpan run, float* __restrict o) {
-    const int nx = j.base.nx, nCoef = j.base.nCoef;
     const float vx = j.view[0], vy = j.view[1], vz = j.view[2];
-    for (int x = run.x0; x < run.x1; ++x) {
-        const float gx = gxr[x], gy = gyr[x];
-        const float inv = 1.0f / std::sqrt(1.0f + gx * gx + gy * gy);
-        const float nxv = -gx * inv, nyv = -gy * inv, nzv = inv;
-        const float nv = nxv * vx + nyv * vy + nzv * vz;
-        float ph[kShOrder];  // the texel's exponent (AlbedoMap::phongExponent) or the uniform one
-        texelPhongLobe(j.base.albedo, static_cast<std::size_t>(y) * nx + x, j.phUniform, ph);
-        float yb[kShCount];
-        shBasisLanes(2.0f * nv * nxv - vx, 2.0f * nv * nyv - vy, 2.0f * nv * nzv - vz, yb, kShCount);
-        float sp = 0.0f;
+    const V nv = nxv * vx + nyv * vy + nzv * vz;
+    V ph[kShOrder];  // the texel's exponent (AlbedoMap::phongExponent) or the uniform one
+    const bool lobeMap = b.albedo && !b.albedo->phongLobe[0].empty();
+    ph[0] = splat<V>(j.phUniform[0]);
+    for (int l = 1; l < kShOrder; ++l)
+        ph[l] = lobeMap ? load<V>(b.albedo->phongLobe[static_cast<std::size_t>(l - 1)].v.data() + row + x)
+                        : splat<V>(j.phUniform[l]);
+    V yb[kShCount];
+    shBasisLanes<V>(2.0f * nv * nxv - vx, 2.0f * nv * nyv - vy, 2.0f * nv * nzv - vz, yb);
+    const V floor = splat<V>(j.clamp ? 0.0f : -std::numeric_limits<float>::infinity());
+    for (int ch = 0; ch < 3; ++ch) {
+        V o = zero;
+        for (int i = 0; i < 9; ++i) o += lam[i] * load<V>(up + static_cast<std::size_t>(ch * nCoef + i) * nx + x);
+        const Grid* a = b.albedo && !b.albedo->channel[static_cast<std::size_t>(ch)].empty()
+                            ? &b.albedo->channel[static_cast<std::size_t>(ch)]
+                            : nullptr;
+        o *= b.diffuseWeight * (a ? load<V>(a->v.data() + row + x) : one);
+        V sp = zero;
         for (int i = 0; i < kShCount; ++i)
-            sp += ph[shBand(i)] * yb[i] * up[static_cast<std::size_t>(ch * nCoef + i) * nx + x];
-        o[x] += j.specWeight * sp;
+            sp += ph[shBand(i)] * yb[i] * load<V>(up + static_cast<std::size_t>(ch * nCoef + i) * nx + x);
+        o += j.specWeight * sp;
+        o = (o - o) == zero ? (o < floor ? floor : o) : zero;
+        simd::store(b.out->rgb[static_cast<std::size_t>(ch)].data() + row + x, o);
     }
 }
 
-// Ambient and RGB of the run of row y from the row's SH planes `up` and its
-// Lambert basis `lamRow` (lambertBasisRow).
-void phongShadeRow(const PhongRowJob& j, const float* __restrict gxr, const float* __restrict gyr,
-                   const float* __restrict lamRow, const float* __restrict up, int y, ColumnSpan run) {
-    const int nx = j.base.nx, nCoef = j.base.nCoef, x0 = run.x0, x1 = run.x1;
-    ShadeMaps& out = *j.base.out;
-    const AlbedoMap* albedo = j.base.albedo;
-    float* __restrict amb = j.base.env ? out.ambient.data() + static_cast<std::size_t>(y) * nx : nullptr;
-    if (amb)
-        for (int x = x0; x < x1; ++x) amb[x] = 0.0f;
-    for (int i = 0; i < (amb ? 9 : 0); ++i) {
-        const float* __restrict l = lamRow + static_cast<std::size_t>(i) * nx;
-        const float* __restrict u = up + static_cast<std::size_t>(3 * nCoef + i) * nx;
-        for (int x = x0; x < x1; ++x) amb[x] += l[x] * u[x];
-    }
-    for (int ch = 0; ch < 3; ++ch) {
-        float* __restrict o = out.rgb[static_cast<std::size_t>(ch)].data() + static_cast<std::size_t>(y) * nx;
-        for (int x = x0; x < x1; ++x) o[x] = 0.0f;
-        for (int i = 0; i < 9; ++i) {
-            const float* __restrict l = lamRow + static_cast<std::size_t>(i) * nx;
-            const float* __restrict u = up + static_cast<std::size_t>(ch * nCoef + i) * nx;
-            for (int x = x0; x < x1; ++x) o[x] += l[x] * u[x];
-        }
-        const Grid* a = albedo && !albedo->channel[static_cast<std::size_t>(ch)].empty()
-                            ? &albedo->channel[static_cast<std::size_t>(ch)]
-                            : nullptr;
-        for (int x = x0; x < x1; ++x) o[x] *= j.base.diffuseWeight * (a ? (*a)(x, y) : 1.0f);
-        addPhongLobe(j, gxr, gyr, up, ch, y, run, o);
-        const float floor = j.clamp ? 0.0f : -std::numeric_limits<float>::infinity();
-        for (int x = x0; x < x1; ++x) o[x] = std::isfinite(o[x]) ? std::max(o[x], floor) : 0.0f;
-    }
+// The texels of a run: whole lane groups, then the rest one by one.
+template <class V>
+[[gnu::always_inline]] inline void phongShadeRunWith(const PhongRowJob& j, const float* gxr, const float* gyr,
+                                                     const float* up, int y, ColumnSpan run) {
+    constexpr int L = simd::kLaneCount<V>;
+    int x = run.x0;
+    for (; x + L <= run.x1; x += L) phongTexels<V>(j, gxr, gyr, up, y, x);
+    for (; x < run.x1; ++x) phongTexels<float>(j, gxr, gyr, up, y, x);
+}
+void phongShadeRunSse(const PhongRowJob& j, const float* gxr, const float* gyr, const float* up, int y,
+                      ColumnSpan run) {
+    phongShadeRunWith<simd::F4>(j, gxr, gyr, up, y, run);
+}
+[[gnu::target("avx2"), gnu::flatten]] void phongShadeRunAvx2(const PhongRowJob& j, const float* gxr, const float* gyr,
+                                                             const float* up, int y, ColumnSpan run) {
+    phongShadeRunWith<simd::F8>(j, gxr, gyr, up, y, run);
 }
 
 }  // namespace
@@ -545,7 +545,7 @@ std::size_t sizeBuffers(int nx, int ny, int nxr, int nyr, int s, int nCoef, int 
     const bool keep = out.keepIncident;
     const std::size_t field = static_cast<std::size_t>(nxr) * nyr * 3 * nCoef;
     const std::size_t window = keep ? 0 : static_cast<std::size_t>(3 * nCoef) * windowRows(ny, nBlocks, s, nyr) * nxr;
-    sizeShadeMaps(nx, ny, keep ? field : 0, ambient, slots * nPlanes * (nxrS + nx), slots * 24 * nx, out);
+    sizeShadeMaps(nx, ny, keep ? field : 0, ambient, slots * nPlanes * (nxrS + nx), out);
     if (!keep) std::vector<float>().swap(out.incident);
     out.incidentWindow.resize(slots * window);
     if (keep) std::vector<float>().swap(out.incidentWindow);
@@ -591,7 +591,6 @@ void shadeBlock(const BlockSchedule& b, PhongRowJob job, int block, std::size_t 
     }
     float* vert = out.rowScratch.data() + slot * b.nPlanes * (nxrS + nx);
     float* up = vert + static_cast<std::size_t>(b.nPlanes) * nxrS;
-    float* basis = out.basisScratch.data() + slot * 24 * nx;
     const ColumnSpan wholeRow{0, nx};
     for (int y = shaded.begin; y < shaded.end; ++y) {
         const Runs runs = runsOfRow(b.runs, y, wholeRow);
@@ -601,8 +600,8 @@ void shadeBlock(const BlockSchedule& b, PhongRowJob job, int block, std::size_t 
             continue;
         }
         interpolatePlanesToRow(base, y, vert, up);
-        lambertBasisRow(base.lf, b.gradX.row(y), b.gradY.row(y), nx, basis);
-        for (const ColumnSpan& run : runs) phongShadeRow(job, b.gradX.row(y), b.gradY.row(y), basis, up, y, run);
+        for (const ColumnSpan& run : runs)
+            (wide ? phongShadeRunAvx2 : phongShadeRunSse)(job, b.gradX.row(y), b.gradY.row(y), up, y, run);
     }
 }
 

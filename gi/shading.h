@@ -194,7 +194,6 @@ struct ShadeMaps {
     std::vector<Term> incidentTerms;         // non-zero matrix entries per output coefficient
     std::vector<int> incidentTermStart;      // 3 x coefficients + 1
     std::vector<float> rowScratch;           // per worker slot: interpolated SH planes of one row
-    std::vector<float> basisScratch;         // per worker slot: rotated BRDF coefficients of one row
     std::vector<std::uint8_t> receiverRows;  // per receiver row: its incident radiance is updated (restricted rows)
 };
 
