@@ -46,6 +46,16 @@ void parallelForRows(int ny, int nx, Fn&& fn) {
 inline int workerSlots() { return std::max(1, tbb::this_task_arena::max_concurrency()); }
 inline int workerSlot() { return std::max(0, tbb::this_task_arena::current_thread_index()); }
 
+/// Runs fn() so that, while it waits for the parallel loops it starts, the
+/// calling thread runs only their bodies (tbb::this_task_arena::isolate). A
+/// loop body that takes per-slot scratch (workerSlot) and starts nested
+/// loops runs them in here: otherwise another body of the outer loop could
+/// start on its thread meanwhile and take the same scratch.
+template <class Fn>
+void isolated(Fn&& fn) {
+    tbb::this_task_arena::isolate(std::forward<Fn>(fn));
+}
+
 /// Deterministic reduction over [begin, end) with chunks of fixed size.
 /// map(b, e) -> T reduces one chunk serially; combine(T, T) -> T folds the
 /// partial results in chunk order.

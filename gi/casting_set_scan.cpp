@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstring>
 
+#include "core/bfloat16.h"
 #include "core/simd.h"
 #include "gi/indirect_scan_tables.h"
 #include "gi/sh.h"
@@ -15,7 +16,6 @@ namespace {
 // F8 (AVX2, chosen at run time where the processor has it): core/simd.h.
 using namespace simd;
 
-constexpr int kMaxMoments = 4;           // moments per segment and channel (Nlp)
 constexpr int kShFields = 3 * kShCount;  // GlossyNlp: RGB x 16 SH planes of the exit radiance
 
 // Step i's taps: the two height samples of the receivers' row and each
@@ -29,7 +29,7 @@ struct StepTaps {
     const float* ra[3];
     const float* rb[3];
     V rwa[3], rwb[3];
-    const float* const* planes;  // GlossyNlp: kShFields origins
+    const std::uint16_t* const* planes;  // GlossyNlp: kShFields origins (bfloat16)
     std::ptrdiff_t o, dB;
     V back[2];   // -(cos phi, sin phi)
     bool clamp;  // members send max(0, u)
@@ -88,29 +88,32 @@ struct CastingRow {
     static constexpr int L = LaneTraits<V>::n;
     static constexpr bool Exact = K == CastingMoments::Irradiance;
     static constexpr bool Glossy = K == CastingMoments::GlossyNlp;
-    static constexpr int nMo = Exact ? 1 : kMaxMoments;  // moments per segment
+    static constexpr int nMo = Exact ? 1 : kCastingMoments;  // moments per segment
 
-    const ReceiverRow& in;
-    int pad;
+    const ReceiverRow* in = nullptr;
+    int pad = 0;
     // state planes (pad floats each): M the running maximum, g the tangent
     // slope, q1 (Nlp) the sin of the last segment end, F (Irradiance) F at the
     // last segment end, then 3 x nMo sums A
-    float *M, *g, *q1, *F, *A;
-    int* steps;   // per lane: the valid prefix (row limit applied)
-    int* active;  // groups still walking
+    float *M = nullptr, *g = nullptr, *q1 = nullptr, *F = nullptr, *A = nullptr;
+    int* steps = nullptr;   // per lane: the valid prefix (row limit applied)
+    int* active = nullptr;  // groups still walking
+    int nActive = 0;
     const V one = splat<V>(1.0f), half = splat<V>(0.5f), zero = splat<V>(0.0f);
     const V lim = splat<V>(1e6f), nlim = splat<V>(-1e6f);
 
-    CastingRow(const ReceiverRow& r, IndirectScratch& sc, int p)
-        : in(r),
-          pad(p),
-          M(sc.state.data()),
-          g(M + p),
-          q1(M + 2 * p),
-          F(M + 3 * p),
-          A(M + 4 * p),
-          steps(sc.groupSteps.data()),
-          active(sc.active.data()) {}
+    // Row r of the block: its running values in the scratch (IndirectScratch::stateOf).
+    void init(const ReceiverRow& row, IndirectScratch& sc, int r) {
+        in = &row;
+        pad = sc.pad;
+        M = sc.stateOf(r);
+        g = M + pad;
+        q1 = M + 2 * pad;
+        F = M + 3 * pad;
+        A = M + 4 * pad;
+        steps = sc.groupSteps.data() + static_cast<std::size_t>(r) * pad;
+        active = sc.active.data() + static_cast<std::size_t>(r) * pad;
+    }
 
     // Group G's running values before the first step; returns its longest valid prefix.
     [[gnu::always_inline]] int startGroup(int G, const AzimuthSteps& az, I rowLimit) {
@@ -123,7 +126,7 @@ struct CastingRow {
         for (int l = 0; l < L; ++l) nAny = std::max(nAny, static_cast<int>(c[l]));
         store(M + X0, splat<V>(kNoBlocker));
         // omega_min: the tangent plane's slope along the azimuth (Section 3)
-        const V gv = load<V>(in.gx + X0) * splat<V>(az.cosPhi) + load<V>(in.gy + X0) * splat<V>(az.sinPhi);
+        const V gv = load<V>(in->gx + X0) * splat<V>(az.cosPhi) + load<V>(in->gy + X0) * splat<V>(az.sinPhi);
         store(g + X0, gv);
         if constexpr (!Exact) {
             const V t = gv < nlim ? nlim : (gv > lim ? lim : gv);
@@ -154,8 +157,8 @@ struct CastingRow {
         for (int c = 0; c < 3; ++c) {
             V sum = zero;
             for (int f = 0; f < kShCount; ++f) {
-                const float* pa = tp.planes[c * kShCount + f] + (tp.o + X0);
-                sum += (tp.rwa[0] * load<V>(pa) + tp.rwb[0] * load<V>(pa + tp.dB)) * y[f];
+                const std::uint16_t* pa = tp.planes[c * kShCount + f] + (tp.o + X0);
+                sum += (tp.rwa[0] * loadBfloat16<V>(pa) + tp.rwb[0] * loadBfloat16<V>(pa + tp.dB)) * y[f];
             }
             u[c] = tp.clamp ? vmax(sum, zero) : sum;
         }
@@ -206,9 +209,9 @@ struct CastingRow {
     [[gnu::always_inline]] bool stepGroup(const StepTaps<V>& tp, I iv, V hMax, int X0) {
         I stp;
         std::memcpy(&stp, steps + X0, sizeof stp);
-        const V h0 = load<V>(in.h0 + X0);
+        const V h0 = load<V>(in->h0 + X0);
         const V t =
-            (((tp.wa * load<V>(tp.a + X0) + tp.wb * load<V>(tp.b + X0)) - h0) - load<V>(in.margin + X0)) * tp.inv;
+            (((tp.wa * load<V>(tp.a + X0) + tp.wb * load<V>(tp.b + X0)) - h0) - load<V>(in->margin + X0)) * tp.inv;
         V m = load<V>(M + X0);
         const I nw = (iv < stp) & (t > m);  // Eq. 17: above every earlier sample
         if (laneBits(nw) == 0) {
@@ -224,27 +227,34 @@ struct CastingRow {
         return laneBits(iv + 1 < stp) != 0;
     }
 
-    // The walk: steps in order, the groups still walking at each.
-    [[gnu::always_inline]] void walk(const AzimuthSteps& az) {
-        const I rowLimit = I{} + in.steps;
-        int nActive = 0, nMax = 0;
-        for (const ColumnSpan& span : in.spans)
+    // Before the first step: the groups of the row's spans with a step to
+    // walk; returns the row's longest valid prefix.
+    [[gnu::always_inline]] int start(const AzimuthSteps& az) {
+        const I rowLimit = I{} + in->steps;
+        int nMax = 0;
+        nActive = 0;
+        for (const ColumnSpan& span : in->spans)
             for (int G = span.x0 / L; G < indirectRowPad(span.x1) / L; ++G) {
                 const int nAny = startGroup(G, az, rowLimit);
                 nMax = std::max(nMax, nAny);
                 if (nAny > 0) active[nActive++] = G;
             }
-        const V hMax = splat<V>(in.hMax);
-        for (int i = 0; i < nMax && nActive > 0; ++i) {
-            const StepTaps<V> tp = stepTaps<V, K>(az, i, in.Y);
-            const I iv = I{} + i;
-            int kept = 0;
-            for (int q = 0; q < nActive; ++q) {
-                const int G = active[q];
-                if (stepGroup(tp, iv, hMax, G * L)) active[kept++] = G;
-            }
-            nActive = kept;
+        return nMax;
+    }
+
+    // Step i of the groups still walking; false once none is (past the row's
+    // longest prefix none is).
+    [[gnu::always_inline]] bool step(const AzimuthSteps& az, int i) {
+        const StepTaps<V> tp = stepTaps<V, K>(az, i, in->Y);
+        const I iv = I{} + i;
+        const V hMax = splat<V>(in->hMax);
+        int kept = 0;
+        for (int q = 0; q < nActive; ++q) {
+            const int G = active[q];
+            if (stepGroup(tp, iv, hMax, G * L)) active[kept++] = G;
         }
+        nActive = kept;
+        return nActive > 0;
     }
 
     // The sums per channel into out: the exact moment (Irradiance), or the
@@ -253,7 +263,7 @@ struct CastingRow {
         const V k0 = splat<V>(0.70710678118654752440f), k1 = splat<V>(0.61237243569579452455f);
         const V k2 = splat<V>(0.79056941504209483300f), k3 = splat<V>(0.23385358667337133659f);
         for (int c = 0; c < 3; ++c)
-            for (const ColumnSpan& span : in.spans)
+            for (const ColumnSpan& span : in->spans)
                 for (int X0 = span.x0; X0 < indirectRowPad(span.x1); X0 += L) {
                     V Ac[nMo];
                     for (int p = 0; p < nMo; ++p) Ac[p] = load<V>(A + static_cast<std::size_t>(c * nMo + p) * pad + X0);
@@ -270,50 +280,66 @@ struct CastingRow {
     }
 };
 
+// The block's rows walk the steps together: at step i every row's groups
+// still walking, row after row. Consecutive rows read neighbouring rows of
+// the step's level, so each sample line serves the block's rows while it is
+// in cache (the 48-plane glossy pyramid is far larger than the cache).
 template <class V, CastingMoments K>
-[[gnu::always_inline]] inline void castRowImpl(const AzimuthSteps& az, const ReceiverRow& in, IndirectScratch& sc,
-                                               int pad) {
-    CastingRow<V, K> row(in, sc, pad);
-    row.walk(az);
-    row.finish(sc.result.data());
+[[gnu::always_inline]] inline void castRowsImpl(const AzimuthSteps& az, std::span<const ReceiverRow> rows,
+                                                IndirectScratch& sc) {
+    CastingRow<V, K> walk[kMaxScanRows];
+    const int n = static_cast<int>(rows.size());
+    int nMax = 0;
+    for (int r = 0; r < n; ++r) {
+        walk[r].init(rows[static_cast<std::size_t>(r)], sc, r);
+        nMax = std::max(nMax, walk[r].start(az));
+    }
+    for (int i = 0; i < nMax; ++i) {
+        bool walking = false;
+        for (int r = 0; r < n; ++r)
+            if (walk[r].nActive > 0) walking |= walk[r].step(az, i);
+        if (!walking) break;
+    }
+    for (int r = 0; r < n; ++r) walk[r].finish(sc.resultOf(r));
 }
 
 template <CastingMoments K>
-void castRowSse(const AzimuthSteps& az, const ReceiverRow& in, IndirectScratch& sc, int pad) {
-    castRowImpl<F4, K>(az, in, sc, pad);
+void castRowsSse(const AzimuthSteps& az, std::span<const ReceiverRow> rows, IndirectScratch& sc) {
+    castRowsImpl<F4, K>(az, rows, sc);
 }
 template <CastingMoments K>
-[[gnu::target("avx2"), gnu::flatten]] void castRowAvx2(const AzimuthSteps& az, const ReceiverRow& in,
-                                                       IndirectScratch& sc, int pad) {
-    castRowImpl<F8, K>(az, in, sc, pad);
+[[gnu::target("avx2"), gnu::flatten]] void castRowsAvx2(const AzimuthSteps& az, std::span<const ReceiverRow> rows,
+                                                        IndirectScratch& sc) {
+    castRowsImpl<F8, K>(az, rows, sc);
 }
 
 }  // namespace
 
 void sizeIndirectScratch(IndirectScratch& sc, int rows, int pad, bool irradiance) {
     const std::size_t rowFloats = static_cast<std::size_t>(rows) * pad;
+    sc.pad = pad;
     sc.gx.resize(rowFloats);
     sc.gy.resize(rowFloats);
     sc.h0.resize(rowFloats);
     sc.margin.resize(rowFloats);
     if (irradiance) sc.irradiance.resize(rowFloats * 3);
-    sc.result.resize(static_cast<std::size_t>(3 * kMaxMoments) * pad);
-    sc.state.resize(static_cast<std::size_t>(4 + 3 * kMaxMoments) * pad);
-    sc.groupSteps.resize(static_cast<std::size_t>(pad));
-    sc.active.resize(static_cast<std::size_t>(pad));
+    sc.result.resize(static_cast<std::size_t>(IndirectScratch::kResultPlanes) * rowFloats);
+    sc.state.resize(static_cast<std::size_t>(IndirectScratch::kStatePlanes) * rowFloats);
+    sc.groupSteps.resize(rowFloats);
+    sc.active.resize(rowFloats);
 }
 
-CastRowFn castRowFor(CastingMoments moments) {
+CastRowsFn castRowsFor(CastingMoments moments) {
     const bool wide = simd::wideEnabled();
     switch (moments) {
         case CastingMoments::Nlp:
-            return wide ? castRowAvx2<CastingMoments::Nlp> : castRowSse<CastingMoments::Nlp>;
+            return wide ? castRowsAvx2<CastingMoments::Nlp> : castRowsSse<CastingMoments::Nlp>;
         case CastingMoments::Irradiance:
-            return wide ? castRowAvx2<CastingMoments::Irradiance> : castRowSse<CastingMoments::Irradiance>;
+            return wide ? castRowsAvx2<CastingMoments::Irradiance> : castRowsSse<CastingMoments::Irradiance>;
         case CastingMoments::GlossyNlp:
             break;
     }
-    return wide ? castRowAvx2<CastingMoments::GlossyNlp> : castRowSse<CastingMoments::GlossyNlp>;
+    return wide ? castRowsAvx2<CastingMoments::GlossyNlp> : castRowsSse<CastingMoments::GlossyNlp>;
 }
 
 }  // namespace terrain::gi

@@ -36,11 +36,14 @@
 // slope along the azimuth; n = (-gx, -gy, 1), so d . n_h = -g).
 //
 // Speed: the kernel runs over 8 (AVX2) or 4 (SSE2) lanes, bit-identically
-// (core/simd.h), one receiver row at a time, step by step (each step's reads
-// sweep one stretch of its field). A group of lanes stops walking once the
+// (core/simd.h), over a block of up to kMaxScanRows receiver rows, step by
+// step: at each step every row's groups in turn (each step's reads sweep
+// neighbouring stretches of its field, which serve the block's rows while
+// they are in cache). A group of lanes stops walking once the
 // field's highest height, seen from each lane's receiver at the current
 // distance, can no longer beat that lane's running maximum (no member can
 // follow; results unchanged).
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -56,17 +59,27 @@ enum class CastingMoments {
     GlossyNlp,   // Nlp from the exit-radiance SH pyramid (GlossyIndirect::VectorPyramid)
 };
 
-/// Per-block scratch of the Lambert scan (one per fixed block of receiver rows).
+/// Receiver rows the kernel walks together, at most.
+inline constexpr int kMaxScanRows = 8;
+/// Moments per segment and channel (Nlp, GlossyNlp).
+inline constexpr int kCastingMoments = 4;
+
+/// Per-block scratch of the scan (one per fixed block of receiver rows).
 struct IndirectScratch {
+    static constexpr int kResultPlanes = 3 * kCastingMoments;     // per row
+    static constexpr int kStatePlanes = 4 + 3 * kCastingMoments;  // per row
+    int pad = 0;                                                  // floats per padded row
     std::vector<float> gx, gy, h0, margin;  // the block's receiver rows (loadReceiverRow): rows x padded row
     std::vector<float> irradiance;  // BlockerRadiance: rows x 3 channels x padded row, E summed over the azimuths
-    // The kernel's output for one row and azimuth, channel c's value k at
-    // result[(c * n + k) * pad + X]: n = 4 NLP coefficients (Nlp) or 1 (Irradiance).
+    // The kernel's output for one azimuth, row r's channel c value k at
+    // resultOf(r)[(c * n + k) * pad + X]: n = 4 NLP coefficients (Nlp) or 1 (Irradiance).
     std::vector<float> result;
-    // The row's running values: 4 + 3 x 4 planes of pad floats; plane 0 is
+    // Each row's running values: kStatePlanes planes of pad floats; plane 0 is
     // each receiver's running maximum slope (after the walk: its horizon).
     std::vector<float> state;
-    std::vector<int> groupSteps, active;  // per lane the valid prefix; the groups still walking
+    std::vector<int> groupSteps, active;  // per row: per lane the valid prefix; the groups still walking
+    float* resultOf(int r) { return result.data() + static_cast<std::size_t>(r) * kResultPlanes * pad; }
+    float* stateOf(int r) { return state.data() + static_cast<std::size_t>(r) * kStatePlanes * pad; }
 };
 
 /// Sizes a block's scratch for rows receiver rows of pad floats.
@@ -82,7 +95,7 @@ struct AzimuthSteps {
     // same in its 48 planes), each step's 48 plane origins (field + offA,
     // plane c * 16 + k), and whether members send max(0, u)
     const ScanStep* glossy = nullptr;
-    const float* const* glossyFields = nullptr;
+    const std::uint16_t* const* glossyFields = nullptr;  // bfloat16 (gi/radiance_pyramid.h)
     bool clampNegative = false;
 };
 
@@ -98,11 +111,13 @@ struct ReceiverRow {
     float hMax;  // the field's highest height: no sample rises above it
 };
 
-/// Scans one receiver row's spans along one azimuth; out, at the spans'
-/// receivers: IndirectScratch::result (and the running values in ::state).
-/// The AVX2 and SSE2 variants give identical bits. pad: the padded row
-/// length, a multiple of 8 (indirectRowPad).
-using CastRowFn = void (*)(const AzimuthSteps&, const ReceiverRow&, IndirectScratch&, int pad);
-CastRowFn castRowFor(CastingMoments moments);
+/// Scans the spans of up to kMaxScanRows receiver rows along one azimuth;
+/// out, at the spans' receivers of row r (the r-th of `rows`):
+/// IndirectScratch::resultOf(r) (and the running values in stateOf(r)). The
+/// scratch is sized for them with the rows' padded length (a multiple of 8,
+/// indirectRowPad). The AVX2 and SSE2 variants give identical bits, and each
+/// row's the same as scanning it alone.
+using CastRowsFn = void (*)(const AzimuthSteps&, std::span<const ReceiverRow> rows, IndirectScratch&);
+CastRowsFn castRowsFor(CastingMoments moments);
 
 }  // namespace terrain::gi

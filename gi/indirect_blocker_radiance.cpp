@@ -91,16 +91,17 @@ void BlockerRadianceIndirect::scanBlock(int block, bool horizons) {
     std::fill(sc.irradiance.data(), sc.irradiance.data() + 3 * static_cast<std::size_t>(rb.rows) * pad, 0.0f);
     for (int j = 0; j < in_.op.azimuths; ++j) {
         const AzimuthSteps az = scan_.azimuth(j);
+        scan_.castRows(az, j, rb, sc);
         for (int r = 0; r < rb.rows; ++r) {
             const int Y = rb.yBegin + r;
             float* far = horizons ? st_.blocker.farSlope.data() + static_cast<std::size_t>(j) * planeR +
                                         static_cast<std::size_t>(Y) * nxr
                                   : nullptr;
-            scan_.castRow(az, j, Y, r, sc);
+            const float* horizon = sc.stateOf(r);
             for (const ColumnSpan& span : scan_.spans(Y)) {
                 // the receivers' horizon along this azimuth (the walk's running maximum)
-                if (horizons) std::copy(sc.state.data() + span.x0, sc.state.data() + span.x1, far + span.x0);
-                accumulate(sc.result.data(), sc.irradiance.data() + 3 * static_cast<std::size_t>(r) * pad, pad, span.x0,
+                if (horizons) std::copy(horizon + span.x0, horizon + span.x1, far + span.x0);
+                accumulate(sc.resultOf(r), sc.irradiance.data() + 3 * static_cast<std::size_t>(r) * pad, pad, span.x0,
                            span.x1, nxr);
             }
         }

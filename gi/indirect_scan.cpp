@@ -28,7 +28,7 @@ IndirectScan::IndirectScan(const IndirectInputs& in, CastingMoments moments, Ind
     : in_(in),
       st_(st),
       moments_(moments),
-      castRow_(castRowFor(moments)),
+      castRows_(castRowsFor(moments)),
       pad_(indirectRowPad(in.heights.nxr)),
       nSteps_(static_cast<int>(in.heights.steps.size())),
       nBlocks_(std::max(1, (in.heights.nyr + kRowsPerBlock - 1) / kRowsPerBlock)),
@@ -73,15 +73,13 @@ void IndirectScan::buildStepTable() {
 // their layout) and each plane's origin.
 void IndirectScan::buildGlossyStepTable() {
     GlossyIndirectState& gs = st_.glossy;
+    const HeightPyramid& geometry = gs.pyramid.geometry;
     const auto planeSteps = [&](int i, double c, double sn, std::size_t at, ValidPrefix& prefix) {
-        const ScanStepInfo r = scanStepInfo(gs.pyramid.fields[0], i, c, sn);
+        const ScanStepInfo r = scanStepInfo(geometry, i, c, sn);
         gs.steps[at] = r.step;
-        const float** origins = gs.fields.data() + at * kGlossyFields;
-        for (int f = 0; f < kGlossyFields; ++f) {
-            const ScanStep plane =
-                f == 0 ? r.step : scanStepInfo(gs.pyramid.fields[static_cast<std::size_t>(f)], i, c, sn).step;
-            origins[f] = plane.field + plane.offA;
-        }
+        const std::uint16_t** origins = gs.fields.data() + at * kGlossyFields;
+        const int level = geometry.steps[static_cast<std::size_t>(i)].level;
+        for (int f = 0; f < kGlossyFields; ++f) origins[f] = gs.pyramid.address(f, level, r.step.field + r.step.offA);
         prefix.narrow(r);
     };
     buildIndirectStepTable(in_.heights, in_.op.phi, pad_, st_.heightSteps, st_.stepsPerColumn, st_.stepsPerRow,
@@ -125,12 +123,18 @@ AzimuthSteps IndirectScan::azimuth(int j, bool clampNegative) const {
     return az;
 }
 
-void IndirectScan::castRow(const AzimuthSteps& az, int j, int Y, int r, IndirectScratch& sc) const {
-    const std::size_t ro = static_cast<std::size_t>(r) * pad_;
-    const int rowSteps = st_.stepsPerRow[static_cast<std::size_t>(j) * in_.heights.nyr + static_cast<std::size_t>(Y)];
-    const ReceiverRow row{
-        Y, rowSteps, spans(Y), sc.h0.data() + ro, sc.margin.data() + ro, sc.gx.data() + ro, sc.gy.data() + ro, hMax_};
-    castRow_(az, row, sc, pad_);
+void IndirectScan::castRows(const AzimuthSteps& az, int j, const RowBlock& rb, IndirectScratch& sc) const {
+    std::array<ReceiverRow, kRowsPerBlock> rows;
+    for (int r = 0; r < rb.rows; ++r) {
+        const int Y = rb.yBegin + r;
+        const std::size_t ro = static_cast<std::size_t>(r) * pad_;
+        const int rowSteps =
+            st_.stepsPerRow[static_cast<std::size_t>(j) * in_.heights.nyr + static_cast<std::size_t>(Y)];
+        rows[static_cast<std::size_t>(r)] = {
+            Y,    rowSteps, spans(Y), sc.h0.data() + ro, sc.margin.data() + ro, sc.gx.data() + ro, sc.gy.data() + ro,
+            hMax_};
+    }
+    castRows_(az, std::span<const ReceiverRow>(rows.data(), static_cast<std::size_t>(rb.rows)), sc);
 }
 
 }  // namespace terrain::gi

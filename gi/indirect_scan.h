@@ -8,9 +8,8 @@
 //
 // Schedule: like gi/visibility: a per-bounce step table, fixed blocks of
 // kRowsPerBlock receiver rows in parallel; within a block azimuth by azimuth,
-// the block's rows one after the other (consecutive rows read neighbouring
-// rows of every level, which stay in cache), every receiver written by one
-// block: bit-identical for any thread count; no allocation after the first
+// the block's rows walking the steps together (gi/casting_set_scan.h),
+// every receiver written by one block: bit-identical for any thread count; no allocation after the first
 // frame of a given size and settings.
 //
 // Receiver tiles (IndirectInputs::only): rows are scanned over their dirty
@@ -37,7 +36,7 @@ struct RowBlock {
 
 class IndirectScan {
 public:
-    static constexpr int kRowsPerBlock = 8;
+    static constexpr int kRowsPerBlock = kMaxScanRows;
 
     /// A scan that sums `moments` over the casting sets, in st's buffers.
     IndirectScan(const IndirectInputs& in, CastingMoments moments, IndirectState& st);
@@ -67,9 +66,9 @@ public:
     void loadRows(const RowBlock& rb, IndirectScratch& sc) const;
     /// Azimuth j's step tables; clampNegative: GlossyNlp's members send max(0, u).
     AzimuthSteps azimuth(int j, bool clampNegative = false) const;
-    /// Scans receiver row Y, row r of its block, along azimuth j: sc.result
-    /// at the receivers of spans(Y).
-    void castRow(const AzimuthSteps& az, int j, int Y, int r, IndirectScratch& sc) const;
+    /// Scans the block's rows along azimuth j (loaded by loadRows): row r's
+    /// results in sc.resultOf(r), at the receivers of spans(yBegin + r).
+    void castRows(const AzimuthSteps& az, int j, const RowBlock& rb, IndirectScratch& sc) const;
 
     int pad() const { return pad_; }
 
@@ -79,7 +78,7 @@ private:
     const IndirectInputs& in_;
     IndirectState& st_;
     CastingMoments moments_;
-    CastRowFn castRow_;
+    CastRowsFn castRows_;
     int pad_, nSteps_, nBlocks_;
     std::size_t tableSize_;  // azimuths x steps
     float hMax_ = 0.0f;

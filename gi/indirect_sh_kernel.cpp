@@ -108,7 +108,7 @@ void ShKernelIndirect::buildPyramid(const BounceSource& previous) {
     GlossyIndirectState& gs = st_.glossy;
     glossyExitRadiance(in_.gradX, in_.gradY, pyr.subsample, pyr.nxr, pyr.nyr, previous.shade->incident.data(),
                        previous.shade->rgb, in_.albedo, in_.shading, gs.rowScratch, gs.exitSh.data());
-    buildScalarPyramids(gs.exitSh.data(), kGlossyFields, pyr, settings_.radiance, gs.pyramid);
+    buildPackedPyramids(gs.exitSh.data(), kGlossyFields, pyr, settings_.radiance, gs.pyramid);
 }
 
 void ShKernelIndirect::scan(int) {
@@ -142,14 +142,14 @@ void ShKernelIndirect::scanBlock(int block) {
     for (int j = 0; j < op.azimuths; ++j) {
         const AzimuthSteps az = scan_.azimuth(j, in_.shading.positivity == GlossyPositivity::Clamp);
         const float* vals = op.values.data() + static_cast<std::size_t>(j) * P;
+        scan_.castRows(az, j, rb, sc);
         for (int r = 0; r < rb.rows; ++r) {
             const int Y = rb.yBegin + r;
             float* uRow[3];
             for (int c = 0; c < 3; ++c)
                 uRow[c] = st_.u[static_cast<std::size_t>(c)].plane(0) + static_cast<std::size_t>(Y) * nxr;
-            scan_.castRow(az, j, Y, r, sc);
             for (const ColumnSpan& span : scan_.spans(Y))
-                accumulate({sc.result.data(),
+                accumulate({sc.resultOf(r),
                             pad,
                             nxr,
                             span.x0,

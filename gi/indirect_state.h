@@ -21,11 +21,11 @@ struct IndirectTimings {
 
 /// Buffers of the vector-pyramid bounce (GlossyIndirect::VectorPyramid, gi/indirect_sh_kernel.h).
 struct GlossyIndirectState {
-    std::vector<float> exitSh;         // 3 x 16 planes of nx * ny: E at full resolution (plane c * 16 + k)
-    RadiancePyramid pyramid;           // one field per plane of exitSh
-    std::vector<ScanStep> steps;       // azimuths x steps: geometry and weights (field 0)
-    std::vector<const float*> fields;  // azimuths x steps x 48: field + offA of each plane
-    std::vector<float> rowScratch;     // per worker slot: interpolated incident SH of one row
+    std::vector<float> exitSh;                 // 3 x 16 planes of nx * ny: E at full resolution (plane c * 16 + k)
+    PackedPyramids pyramid;                    // one field per plane of exitSh, bfloat16
+    std::vector<ScanStep> steps;               // azimuths x steps: geometry and weights (field 0)
+    std::vector<const std::uint16_t*> fields;  // azimuths x steps x 48: field + offA of each plane
+    std::vector<float> rowScratch;             // per worker slot: interpolated incident SH of one row
 };
 
 struct IndirectState {
