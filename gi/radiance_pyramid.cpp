@@ -69,27 +69,20 @@ void packField(const HeightPyramid& p, int f, PackedPyramids& out) {
     }
 }
 
-// The block's layout. A field's regions follow one another, each starting
-// on a cache line; field f starts at f (P + 1) lines, P the field's size
-// rounded up to whole pages: the samples of one position in the 48 fields
-// then fall in 48 different sets of the first-level cache (f lines apart
-// modulo a page), where fields on page boundaries, as separate allocations
-// are, would all share one set and evict one another at every read of the
-// scan (measured at 512² 2x: the scan 20 % faster with this layout).
+// The block's layout: the regions one after the other, field by field,
+// each starting on a cache line.
 void layOut(const HeightPyramid& g, int count, PackedPyramids& out) {
-    constexpr std::size_t kLine = 32, kPage = 2048;  // bfloat16 values per 64-byte line, per 4 KiB page
+    constexpr std::size_t kLine = 32;  // bfloat16 values per 64-byte line
     const std::size_t regions = g.levels.size() + 1;
     out.regionAt.resize(static_cast<std::size_t>(count) * regions);
-    std::size_t fieldSize = 0;
-    for (std::size_t l = 0; l < regions; ++l) {
-        out.regionAt[l] = fieldSize;
-        fieldSize += (l < g.levels.size() ? g.levels[l].v.size() : g.rawPhase.size()) + kLine - 1;
-        fieldSize -= fieldSize % kLine;
+    std::size_t at = 0;
+    for (std::size_t r = 0; r < out.regionAt.size(); ++r) {
+        const std::size_t l = r % regions;
+        out.regionAt[r] = at;
+        at += (l < g.levels.size() ? g.levels[l].v.size() : g.rawPhase.size()) + kLine - 1;
+        at -= at % kLine;
     }
-    const std::size_t fieldStride = (fieldSize + kPage - 1) / kPage * kPage + kLine;
-    for (std::size_t f = 1; f < static_cast<std::size_t>(count); ++f)
-        for (std::size_t l = 0; l < regions; ++l) out.regionAt[f * regions + l] = f * fieldStride + out.regionAt[l];
-    out.block.resize(static_cast<std::size_t>(count) * fieldStride);
+    out.block.resize(at);
 }
 
 }  // namespace
