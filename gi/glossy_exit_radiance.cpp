@@ -183,23 +183,23 @@ void glossyExitVector(const float incident[kShCount], float nx, float ny, float 
 
 void glossyExitRadiance(ConstGridView gradX, ConstGridView gradY, int s, int nxr, int nyr, const float* incident,
                         const std::array<Grid, 3>& shade, const AlbedoMap* surface, const ShadingSettings& shading,
-                        std::vector<float>& rowScratch, float* out) {
+                        GlossyExitScratch& scratch, float* out) {
     const int nx = gradX.nx, ny = gradX.ny;
     const std::size_t planeR = static_cast<std::size_t>(nxr) * nyr, plane = static_cast<std::size_t>(nx) * ny;
     const MirrorTables& mt = mirrorTables();
     float phUniform[kShOrder];
     phongLobeFactors(shading.phongExponent, phUniform);
     const bool lobeMap = surface && !surface->phongLobe[0].empty();
-    std::vector<ReceiverLerp> columns;
+    std::vector<ReceiverLerp>& columns = scratch.columns;
     receiverLerps(nx, s, nxr, columns);
     const int nBlocks = std::max(1, std::min(ny, kMaxBlocks));
     // per worker slot: the receivers' rows mixed vertically (48 x nxr), then
     // along the row (48 x nx); a row keeps nothing in it
     const std::size_t nxPad = static_cast<std::size_t>(nx), slot = kGlossyFields * (std::max(nxr, 1) + nxPad);
-    rowScratch.resize(static_cast<std::size_t>(workerSlots()) * slot);
+    scratch.rows.resize(static_cast<std::size_t>(workerSlots()) * slot);
     void (*const exitRow)(const MirrorTables&, const ExitRow&, int) = simd::wideEnabled() ? exitRowAvx2 : exitRowSse;
     parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
-        float* vert = rowScratch.data() + static_cast<std::size_t>(workerSlot()) * slot;
+        float* vert = scratch.rows.data() + static_cast<std::size_t>(workerSlot()) * slot;
         float* texels = vert + kGlossyFields * static_cast<std::size_t>(nxr);
         for (int block = b0; block < b1; ++block) {
             const int yBegin = static_cast<int>(static_cast<long long>(ny) * block / nBlocks);

@@ -24,7 +24,7 @@
 // directions d_j and solved with the precomputed inverse of [Y_lm(d_j)].
 //
 // Filtering. E is linear in the exit-radiance field, so the pyramid over its
-// 48 planes (buildScalarPyramids, the same B-spline filtering as the scalar
+// 48 planes (buildPackedPyramids, the same B-spline filtering as the scalar
 // radiance pyramid) is the filtered exit-radiance function itself: a coarse
 // level's E . Y(w) is the area average of L_q(w). (Filtering I, N and S
 // separately, the paper's "augment with the BRDF parameters", would mix
@@ -48,10 +48,14 @@ inline constexpr int kGlossyFields = 3 * kShCount;  // RGB x 16 SH planes of E
 /// from the previous bounce's incident radiance at the receivers
 /// (`incident`: 3 x 16 planes of nxr * nyr, as ShadeMaps::incident with a
 /// Phong BRDF) and its shade towards the viewer (full resolution).
-/// rowScratch: reusable buffer (no allocation after the first call of a size).
+/// scratch: reused (no allocation after the first call of a size).
+struct GlossyExitScratch {
+    std::vector<float> rows;            // per worker slot: the incident SH of one row, at receivers and texels
+    std::vector<ReceiverLerp> columns;  // per texel column: the receivers it lies between
+};
 void glossyExitRadiance(ConstGridView gradX, ConstGridView gradY, int subsample, int nxr, int nyr,
                         const float* incident, const std::array<Grid, 3>& shade, const AlbedoMap* surface,
-                        const ShadingSettings& shading, std::vector<float>& rowScratch, float* out);
+                        const ShadingSettings& shading, GlossyExitScratch& scratch, float* out);
 
 /// Exit-radiance SH vector of one texel (the scalar twin for tests and the
 /// reference): E = Rot_N(pi)(w_s g (.) I) + sqrt(4 pi) D e_00 for unit normal

@@ -107,7 +107,7 @@ void ShKernelIndirect::buildPyramid(const BounceSource& previous) {
     const HeightPyramid& pyr = in_.heights;
     GlossyIndirectState& gs = st_.glossy;
     glossyExitRadiance(in_.gradX, in_.gradY, pyr.subsample, pyr.nxr, pyr.nyr, previous.shade->incident.data(),
-                       previous.shade->rgb, in_.albedo, in_.shading, gs.rowScratch, gs.exitSh.data());
+                       previous.shade->rgb, in_.albedo, in_.shading, gs.exitScratch, gs.exitSh.data());
     buildPackedPyramids(gs.exitSh.data(), kGlossyFields, pyr, settings_.radiance, gs.pyramid);
 }
 

@@ -8,6 +8,7 @@
 #include "core/grid.h"
 #include "gi/blocker_radiance.h"
 #include "gi/casting_set_scan.h"
+#include "gi/glossy_exit_radiance.h"
 #include "gi/radiance_pyramid.h"
 #include "gi/receiver_tiles.h"
 #include "gi/shading.h"
@@ -25,7 +26,7 @@ struct GlossyIndirectState {
     PackedPyramids pyramid;                    // one field per plane of exitSh, bfloat16
     std::vector<ScanStep> steps;               // azimuths x steps: geometry and weights (field 0)
     std::vector<const std::uint16_t*> fields;  // azimuths x steps x 48: field + offA of each plane
-    std::vector<float> rowScratch;             // per worker slot: interpolated incident SH of one row
+    GlossyExitScratch exitScratch;             // E's rows and columns
 };
 
 struct IndirectState {

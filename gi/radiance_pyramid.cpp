@@ -46,18 +46,6 @@ void buildRadiancePyramid(const std::array<Grid, 3>& radiance, const HeightPyram
     });
 }
 
-void buildScalarPyramids(const float* fields, int count, const HeightPyramid& heights,
-                         const RadiancePyramidSettings& settings, RadiancePyramid& out) {
-    out.fields.resize(static_cast<std::size_t>(count));
-    const std::size_t n = static_cast<std::size_t>(heights.nx) * heights.ny;
-    parallelFor(0, count, 1, [&](int c0, int c1) {
-        for (int c = c0; c < c1; ++c) {
-            const ConstGridView v(fields + n * static_cast<std::size_t>(c), heights.nx, heights.ny, heights.nx);
-            buildOne(v, heights, settings, out.fields[static_cast<std::size_t>(c)]);
-        }
-    });
-}
-
 namespace {
 
 // Field p's pyramid rounded into out's bfloat16 copy of field f.

@@ -15,7 +15,7 @@
 // the step index minus k_u o_u, as in the paper).
 //
 // Glossy surfaces (vector pyramid): the same pyramid over each coefficient of
-// an SH radiance vector field (RGB x SH planes), see buildScalarPyramids,
+// an SH radiance vector field (RGB x SH planes),
 // kept as bfloat16 in one block (buildPackedPyramids): the 48 planes'
 // pyramids are far larger than any cache, and bfloat16 halves their memory.
 #include <array>
@@ -48,11 +48,6 @@ struct RadiancePyramid {
 void buildRadiancePyramid(const std::array<Grid, 3>& radiance, const HeightPyramid& heights,
                           const RadiancePyramidSettings& settings, RadiancePyramid& out);
 
-/// Builds the pyramid of `count` scalar fields (row-major nx x ny each,
-/// consecutive in `fields`), e.g. RGB x SH coefficients of incident radiance.
-void buildScalarPyramids(const float* fields, int count, const HeightPyramid& heights,
-                         const RadiancePyramidSettings& settings, RadiancePyramid& out);
-
 /// The pyramids of many scalar fields stored as bfloat16 (core/bfloat16.h:
 /// 2^-9 relative precision, float's range): every field's pyramid has the
 /// layout of `geometry`, the float pyramid of field 0, whose steps and
@@ -71,8 +66,9 @@ struct PackedPyramids {
     const std::uint16_t* address(int f, int level, const float* p) const;
 };
 
-/// Builds the pyramids of `count` fields (as buildScalarPyramids) and keeps
-/// them rounded to bfloat16; field 0's float pyramid stays as the geometry.
+/// Builds the pyramids of `count` scalar fields (row-major nx x ny each,
+/// consecutive in `fields`), each as one channel of buildRadiancePyramid, and
+/// keeps them rounded to bfloat16; field 0's float pyramid stays as the geometry.
 void buildPackedPyramids(const float* fields, int count, const HeightPyramid& heights,
                          const RadiancePyramidSettings& settings, PackedPyramids& out);
 
