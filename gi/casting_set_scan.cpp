@@ -31,12 +31,16 @@ struct StepTaps {
     V rwa[3], rwb[3];
     const std::uint16_t* const* planes;  // GlossyNlp: kShFields origins (bfloat16)
     std::ptrdiff_t o, dB;
+    // GlossyNlp: the samples the block reads next (the next row's at this
+    // step, or the first row's at the next step), asked for early
+    const std::uint16_t* const* nextPlanes;
+    std::ptrdiff_t nextO, nextDB;
     V back[2];   // -(cos phi, sin phi)
     bool clamp;  // members send max(0, u)
 };
 
 template <class V, CastingMoments K>
-[[gnu::always_inline]] inline StepTaps<V> stepTaps(const AzimuthSteps& az, int i, int Y) {
+[[gnu::always_inline]] inline StepTaps<V> stepTaps(const AzimuthSteps& az, int i, int Y, int nextI, int nextY) {
     StepTaps<V> tp;
     const ScanStep& st = az.heights[i];
     const std::ptrdiff_t o = Y * st.rowStep;
@@ -50,6 +54,10 @@ template <class V, CastingMoments K>
         tp.planes = az.glossyFields + static_cast<std::size_t>(i) * kShFields;
         tp.o = Y * rs.rowStep;
         tp.dB = rs.offB - rs.offA;
+        const ScanStep& ns = az.glossy[nextI];
+        tp.nextPlanes = az.glossyFields + static_cast<std::size_t>(nextI) * kShFields;
+        tp.nextO = nextY * ns.rowStep;
+        tp.nextDB = ns.offB - ns.offA;
         tp.rwa[0] = splat<V>(rs.w[0][0]);
         tp.rwb[0] = splat<V>(rs.w[1][0]);
         tp.back[0] = splat<V>(-az.cosPhi);
@@ -155,15 +163,21 @@ struct CastingRow {
         shBasisLanes<V>(tp.back[0] * ic, tp.back[1] * ic, -(tm * ic), y);
         for (int f = 0; f < kShCount; ++f) y[f] = nw ? y[f] : zero;
         // The groups of a row walk each step left to right: once per 64-byte
-        // line (32 values, 4 groups), the line 3 ahead in each of the 48
-        // planes is asked for early (the hardware's prefetchers do not follow
-        // 96 streams at once; README, "Glossy indirect light", has the gain).
+        // line (32 values, 4 groups), each of the 48 planes' line 3 ahead and
+        // the line the block reads next at this column (the next row's, or
+        // after the last row the first row's at the next step) are asked for
+        // early: the hardware's prefetchers do not follow 96 streams at once,
+        // and a row's first lines would otherwise come late (README, "Glossy
+        // indirect light", has the gains).
         const bool prefetch = (X0 & 31) == 0;
         for (int c = 0; c < 3; ++c) {
             V sum = zero;
             for (int f = 0; f < kShCount; ++f) {
                 const std::uint16_t* pa = tp.planes[c * kShCount + f] + (tp.o + X0);
                 if (prefetch) {
+                    const std::uint16_t* pn = tp.nextPlanes[c * kShCount + f] + (tp.nextO + X0);
+                    __builtin_prefetch(pn);
+                    __builtin_prefetch(pn + tp.nextDB);
                     __builtin_prefetch(pa + 96);
                     __builtin_prefetch(pa + tp.dB + 96);
                 }
@@ -253,8 +267,8 @@ struct CastingRow {
 
     // Step i of the groups still walking; false once none is (past the row's
     // longest prefix none is).
-    [[gnu::always_inline]] bool step(const AzimuthSteps& az, int i) {
-        const StepTaps<V> tp = stepTaps<V, K>(az, i, in->Y);
+    [[gnu::always_inline]] bool step(const AzimuthSteps& az, int i, int nextI, int nextY) {
+        const StepTaps<V> tp = stepTaps<V, K>(az, i, in->Y, nextI, nextY);
         const I iv = I{} + i;
         const V hMax = splat<V>(in->hMax);
         int kept = 0;
@@ -305,8 +319,13 @@ template <class V, CastingMoments K>
     }
     for (int i = 0; i < nMax; ++i) {
         bool walking = false;
-        for (int r = 0; r < n; ++r)
-            if (walk[r].nActive > 0) walking |= walk[r].step(az, i);
+        for (int r = 0; r < n; ++r) {
+            // the rows the block reads after this one (prefetch)
+            const bool last = r + 1 == n;
+            const int nextI = last ? std::min(i + 1, nMax - 1) : i;
+            const int nextY = rows[last ? 0 : static_cast<std::size_t>(r) + 1].Y;
+            if (walk[r].nActive > 0) walking |= walk[r].step(az, i, nextI, nextY);
+        }
         if (!walking) break;
     }
     for (int r = 0; r < n; ++r) walk[r].finish(sc.resultOf(r));
