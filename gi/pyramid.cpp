@@ -54,16 +54,36 @@ inline void bsplineWeights(float a, float w[4]) {
 }
 
 // ---- algorithm: one octave decimation row (2x2 box or 2x2 max) ----------
-void decimateRows(ConstGridView src, Grid& dst, bool useMax, int y0, int y1) {
+// The 2x2 cells' value: their maximum, or their mean.
+template <bool UseMax>
+[[gnu::always_inline]] inline float decimated(float a, float b, float c, float d) {
+    return UseMax ? std::max(std::max(a, b), std::max(c, d)) : 0.25f * ((a + b) + (c + d));
+}
+
+template <bool UseMax>
+void decimateRowsOf(ConstGridView src, Grid& dst, int y0, int y1) {
+    // columns whose 2x2 cells are all inside src (a loop the compiler
+    // vectorises), then the last column of an odd width (its cells replicate
+    // the last source column)
+    const int inside = src.nx / 2;
     for (int y = y0; y < y1; ++y) {
-        const int ya = std::min(2 * y, src.ny - 1), yb = std::min(2 * y + 1, src.ny - 1);
+        const float* ra = src.row(std::min(2 * y, src.ny - 1));
+        const float* rb = src.row(std::min(2 * y + 1, src.ny - 1));
         float* out = dst.data() + static_cast<std::size_t>(y) * dst.nx;
-        for (int x = 0; x < dst.nx; ++x) {
+        for (int x = 0; x < inside; ++x)
+            out[x] = decimated<UseMax>(ra[2 * x], ra[2 * x + 1], rb[2 * x], rb[2 * x + 1]);
+        for (int x = inside; x < dst.nx; ++x) {
             const int xa = std::min(2 * x, src.nx - 1), xb = std::min(2 * x + 1, src.nx - 1);
-            const float a = src(xa, ya), b = src(xb, ya), c = src(xa, yb), d = src(xb, yb);
-            out[x] = useMax ? std::max(std::max(a, b), std::max(c, d)) : 0.25f * ((a + b) + (c + d));
+            out[x] = decimated<UseMax>(ra[xa], ra[xb], rb[xa], rb[xb]);
         }
     }
+}
+
+void decimateRows(ConstGridView src, Grid& dst, bool useMax, int y0, int y1) {
+    if (useMax)
+        decimateRowsOf<true>(src, dst, y0, y1);
+    else
+        decimateRowsOf<false>(src, dst, y0, y1);
 }
 
 // Taps of the B-spline synthesis of octave o (spacing 2^o) at receiver
@@ -115,7 +135,14 @@ void splitRawPhases(ConstGridView heights, HeightPyramid& p) {
             const float* src = heights.row(std::min(y, ny - 1));
             for (int q = 0; q < s; ++q) {
                 float* d = p.rawPhase.data() + kFieldGuard + q * p.rawPhasePlane + static_cast<std::ptrdiff_t>(y) * wp;
-                for (int x = 0; x < wp; ++x) d[x] = src[std::min(s * x + q, nx - 1)];
+                // columns inside the row (a strided copy the compiler
+                // vectorises for s = 2), then the replicated last column
+                const int inside = q > nx - 1 ? 0 : std::min(wp, (nx - 1 - q) / s + 1);
+                if (s == 2)
+                    for (int x = 0; x < inside; ++x) d[x] = src[2 * x + q];
+                else
+                    for (int x = 0; x < inside; ++x) d[x] = src[s * x + q];
+                for (int x = inside; x < wp; ++x) d[x] = src[nx - 1];
             }
         }
     });
