@@ -101,10 +101,13 @@ LaneRun laneRun(const ColumnSpan& run, int pad) {
 // same whatever the runs. The runs start on multiples of kLanePad (a tile's
 // texels and receivers do: tiles are multiples of 16 receivers), so their
 // lane groups never overlap and no point is summed twice.
+// `running` (null: not kept): after azimuth j, the running sum at the runs'
+// points, at running + j * plane.
 template <class FillFar>
 void occlusionOfRow(ConstGridView gradX, ConstGridView gradY, const PointRow& p, std::span<const ColumnSpan> runs,
                     const RowScratch& r, const NearTap* taps, const float* cosPhi, const float* sinPhi, int m,
-                    float scale, AzimuthFn azimuth, FillFar&& fillFar, float* out) {
+                    float scale, AzimuthFn azimuth, FillFar&& fillFar, float* out, float* running = nullptr,
+                    std::size_t plane = 0) {
     for (const ColumnSpan& run : runs) {
         const LaneRun lr = laneRun(run, p.pad);
         for (int i = lr.a; i < lr.b; ++i) {
@@ -126,6 +129,9 @@ void occlusionOfRow(ConstGridView gradX, ConstGridView gradY, const PointRow& p,
                                    r.far + lr.a,   r.sum + lr.a, lr.b - lr.a};
             azimuth(row, jTaps, p.nTaps, cosPhi[j], sinPhi[j]);
         }
+        if (running)
+            for (const ColumnSpan& run : runs)
+                std::copy(r.sum + run.x0, r.sum + run.x1, running + static_cast<std::size_t>(j) * plane + run.x0);
     }
     for (const ColumnSpan& run : runs)
         for (int i = run.x0; i < run.x1; ++i)
@@ -248,7 +254,9 @@ void occlusionAtReceivers(const HeightPyramid& pyr, ConstGridView gradX, ConstGr
                 };
                 occlusionOfRow(gradX, gradY, pts, runs, r, nullptr, st.cosPhi.data(), st.sinPhi.data(), pass.m,
                                pass.scale, pass.azimuth, fillFar,
-                               st.receiverOcclusion.data() + static_cast<std::size_t>(Y) * nxr);
+                               st.receiverOcclusion.data() + static_cast<std::size_t>(Y) * nxr,
+                               st.receiverOcclusionRunning.data() + static_cast<std::size_t>(Y) * nxr,
+                               static_cast<std::size_t>(nxr) * nyr);
             }
         }
     });
@@ -277,6 +285,7 @@ void prepareBlockerRadiance(const HeightPyramid& pyr, int azimuths, BlockerRadia
     if (pyr.subsample == 1) return;  // every texel a receiver: E alone
     st.farSlope.resize(planeR * static_cast<std::size_t>(azimuths));
     st.receiverOcclusion.resize(planeR);
+    st.receiverOcclusionRunning.resize(planeR * static_cast<std::size_t>(azimuths));
     st.occlusion.ensureSize(pyr.nx, pyr.ny);
 }
 

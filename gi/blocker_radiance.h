@@ -61,6 +61,10 @@ struct BlockerRadianceState {
     Grid occlusion;                        // O / pi at every texel
     bool occlusionValid = false;           // occlusion and receiverOcclusion hold a result of this grid
     std::vector<float> receiverOcclusion;  // O / pi at the receivers
+    // per azimuth j (planes of nxr * nyr): the receivers' occlusion sum over
+    // the azimuths 0..j, unnormalised (azimuth j's share of O_k is
+    // (running_j - running_(j-1)) / running_(m-1); gi/indirect_cache.h)
+    std::vector<float> receiverOcclusionRunning;
     std::array<std::vector<float>, 3> receiverShade;  // E / pi at the receivers, per channel
     std::vector<float> scratch;                       // per block of rows: padded row buffers
     std::vector<NearTap> taps;                        // azimuths x near samples

@@ -47,7 +47,8 @@ const ReceiverTiles* planIndirect(const GiSettings& settings, const FrameChange&
                                 .lastPyramid = st.indirect.radiance,
                                 .geometryTiles = change.geometry ? &st.visibilityCache.geometryTiles : nullptr,
                                 .azimuths = azimuths,
-                                .tolerance = settings.tolerance};
+                                .tolerance = settings.tolerance,
+                                .blocker = &st.indirect.blocker};
     return planIndirectTiles(in, st.indirectCache);
 }
 

@@ -23,24 +23,111 @@ bool cacheFits(const IndirectPlanInputs& in, const IndirectCache& cache) {
            (!in.geometryTiles || in.geometryTiles->dirty.size() == cache.tiles.dirty.size());
 }
 
-// Adds this frame's radiance bounds (per tile: the largest over the
-// azimuths) to the drifts; none when L_0 did not change at all.
-void addRadianceDrift(const IndirectPlanInputs& in, IndirectCache& cache) {
+// The last pass kept the occlusions of this grid (sub-sampling).
+bool hasOcclusions(const IndirectPlanInputs& in) {
+    const BlockerRadianceState* b = in.blocker;
+    const HeightPyramid& h = in.heights;
+    return b && b->occlusionValid && h.subsample > 1 && b->nx == h.nx && b->ny == h.ny && b->nxr == h.nxr &&
+           b->nyr == h.nyr && b->azimuths == in.azimuths && b->occlusion.nx == h.nx && b->occlusion.ny == h.ny &&
+           b->receiverOcclusionRunning.size() == static_cast<std::size_t>(in.azimuths) * h.nxr * h.nyr;
+}
+
+// Per tile: the largest over its receivers of sum_j share_kj D_tj, the
+// azimuth bounds D_tj weighed by each receiver's shares of its occlusion
+// (the bound on the move of its mean blocker radiance: gi/indirect_cache.h);
+// max_j D_tj without the occlusions, or for a receiver with none.
+void sharedBounds(const IndirectPlanInputs& in, IndirectCache& cache) {
+    const HeightPyramid& h = in.heights;
+    const int tilesX = tileCount(h.nxr, kVisibilityTile), tilesY = tileCount(h.nyr, kVisibilityTile);
+    const std::size_t m = static_cast<std::size_t>(in.azimuths), plane = static_cast<std::size_t>(h.nxr) * h.nyr;
+    cache.sharedBound.resize(static_cast<std::size_t>(tilesX) * tilesY);
+    const bool shares = hasOcclusions(in);
+    for (int ty = 0; ty < tilesY; ++ty)
+        for (int tx = 0; tx < tilesX; ++tx) {
+            const std::size_t t = static_cast<std::size_t>(ty) * tilesX + tx;
+            const float* D = cache.azimuthBound.data() + t * m;
+            const float largest = *std::max_element(D, D + m);
+            float bound = shares ? 0.0f : largest;
+            for (int Y = ty * kVisibilityTile; shares && Y < std::min(h.nyr, (ty + 1) * kVisibilityTile); ++Y)
+                for (int X = tx * kVisibilityTile; X < std::min(h.nxr, (tx + 1) * kVisibilityTile); ++X) {
+                    const float* running = in.blocker->receiverOcclusionRunning.data() +
+                                           static_cast<std::size_t>(Y) * h.nxr + static_cast<std::size_t>(X);
+                    const float total = running[(m - 1) * plane];
+                    if (!(total > 0.0f)) {
+                        bound = largest;
+                        continue;
+                    }
+                    float weighed = 0.0f, before = 0.0f;
+                    for (std::size_t j = 0; j < m; ++j) {
+                        const float now = running[j * plane];
+                        weighed += std::max(0.0f, now - before) * D[j];
+                        before = now;
+                    }
+                    // the shares' rounding: up by a few ulp of the total
+                    bound = std::max(bound, std::min(largest, weighed / total * (1.0f + 1e-5f)));
+                }
+            cache.sharedBound[t] = bound;
+        }
+}
+
+// The texels that read receivers of each tile along one axis: per tile,
+// the first and last texel whose receivers (receiverLerp: i0 and i1) meet
+// the tile's [T t, T t + T).
+void texelRangesOfTiles(int texels, int s, int receivers, int tiles, std::vector<int>& first, std::vector<int>& last) {
+    first.assign(static_cast<std::size_t>(tiles), texels);
+    last.assign(static_cast<std::size_t>(tiles), -1);
+    for (int x = 0; x < texels; ++x) {
+        const ReceiverLerp r = receiverLerp(x, s, receivers);
+        for (const int t : {r.i0 / kVisibilityTile, r.i1 / kVisibilityTile}) {
+            first[static_cast<std::size_t>(t)] = std::min(first[static_cast<std::size_t>(t)], x);
+            last[static_cast<std::size_t>(t)] = std::max(last[static_cast<std::size_t>(t)], x);
+        }
+    }
+}
+
+// Per tile: min(1, the largest O / pi of the texels that read its
+// receivers + the tolerance), or 1 without a texel occlusion (the
+// occlusion factor of gi/indirect_cache.h).
+void occlusionFactors(const IndirectPlanInputs& in, IndirectCache& cache) {
+    const HeightPyramid& h = in.heights;
+    const int tilesX = tileCount(h.nxr, kVisibilityTile), tilesY = tileCount(h.nyr, kVisibilityTile);
+    cache.occlusionFactor.assign(static_cast<std::size_t>(tilesX) * tilesY, 1.0f);
+    if (!hasOcclusions(in)) return;
+    const Grid* occ = &in.blocker->occlusion;
+    std::vector<int> x0, x1, y0, y1;
+    texelRangesOfTiles(h.nx, h.subsample, h.nxr, tilesX, x0, x1);
+    texelRangesOfTiles(h.ny, h.subsample, h.nyr, tilesY, y0, y1);
+    for (int ty = 0; ty < tilesY; ++ty)
+        for (int tx = 0; tx < tilesX; ++tx) {
+            float largest = 0.0f;
+            for (int y = y0[static_cast<std::size_t>(ty)]; y <= y1[static_cast<std::size_t>(ty)]; ++y) {
+                const float* row = occ->data() + static_cast<std::size_t>(y) * h.nx;
+                for (int x = x0[static_cast<std::size_t>(tx)]; x <= x1[static_cast<std::size_t>(tx)]; ++x)
+                    largest = std::max(largest, row[x]);
+            }
+            cache.occlusionFactor[static_cast<std::size_t>(ty) * tilesX + tx] =
+                std::min(1.0f, largest + in.tolerance);
+        }
+}
+
+}  // namespace
+
+void boundRadianceChange(const IndirectPlanInputs& in, IndirectCache& cache) {
+    const HeightPyramid& h = in.heights;
+    const std::size_t tiles =
+        static_cast<std::size_t>(tileCount(h.nxr, kVisibilityTile)) * tileCount(h.nyr, kVisibilityTile);
     const std::array<ConstGridView, 3> before{cache.lastSource[0].cview(), cache.lastSource[1].cview(),
                                               cache.lastSource[2].cview()};
     const std::array<ConstGridView, 3> after{in.source[0].cview(), in.source[1].cview(), in.source[2].cview()};
     buildMaxChangePyramid(before, after, cache.change);
+    cache.radianceBound.assign(tiles, 0.0f);
     if (maxChangeAll(cache.change) == 0.0f) return;
     boundSampleChangePerAzimuth(cache.change, in.lastPyramid.fields[0], kVisibilityTile, in.azimuths,
                                 cache.azimuthBound);
-    const std::size_t m = static_cast<std::size_t>(in.azimuths);
-    for (std::size_t t = 0; t < cache.drift.size(); ++t) {
-        const float* az = cache.azimuthBound.data() + t * m;
-        cache.drift[t] += *std::max_element(az, az + m);
-    }
+    occlusionFactors(in, cache);
+    sharedBounds(in, cache);
+    for (std::size_t t = 0; t < tiles; ++t) cache.radianceBound[t] = cache.occlusionFactor[t] * cache.sharedBound[t];
 }
-
-}  // namespace
 
 const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCache& cache) {
     const bool allGeometry =
@@ -49,7 +136,8 @@ const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCac
         cache.valid = false;
         return nullptr;
     }
-    addRadianceDrift(in, cache);
+    boundRadianceChange(in, cache);
+    for (std::size_t t = 0; t < cache.drift.size(); ++t) cache.drift[t] += cache.radianceBound[t];
     for (std::size_t t = 0; t < cache.drift.size(); ++t) {
         const bool geometry = in.geometryTiles && in.geometryTiles->dirty[t] != 0;
         const bool dirty = geometry || cache.drift[t] > in.tolerance;

@@ -8,10 +8,26 @@
 //  - the blockers' radiance: each frame adds, per tile, the bound of
 //    gi/change_bound.h on how far the frame's change of L_0 moves the
 //    samples the tile's scan reads (boundSampleChangePerAzimuth, the largest
-//    over the indirect azimuths: the gathered irradiance and the mean blocker
-//    radiance move by at most that much, in shade units). The sum of these
+//    per indirect azimuth), weighed and scaled as below. The sum of these
 //    bounds since the tile's cached result was computed bounds its drift
 //    (triangle inequality); beyond the tolerance, the tile re-gathers.
+//
+//    Weights and scale (sub-sampling): a texel's light is O(x) times its
+//    receivers' interpolated mean blocker radiance sum w_k E_k / sum w_k O_k
+//    (gi/blocker_radiance.h), and a receiver's E_k sums the samples' radiance
+//    over its casting sets, whose clamped-cosine measures along azimuth j
+//    add up to O_kj, its occlusion along j (O_k = sum_j O_kj). So E_k moves
+//    by at most sum_j O_kj D_j (D_j: the largest sample move along j), the
+//    mean blocker radiance by at most rho_k = sum_j (O_kj / O_k) D_j <= max_j
+//    D_j, and the texel's light by at most O(x) max_k rho_k, O(x) = O / pi
+//    <= 1. Per tile the bound is the largest rho_k of its receivers times the
+//    largest O(x) of the texels that read them. A far change (a pit, a
+//    crater) that moves coarse samples of every tile then counts by the
+//    share of the sky its azimuths' blockers cover. The occlusions are the
+//    last pass's; the geometry may have moved since by no more than the
+//    tolerance (else the tile re-gathers), so the factor is that largest
+//    O(x) plus the tolerance, at most 1. Without sub-sampling (every texel a
+//    receiver, no texel occlusion kept) the bound is max_j D_j.
 //  - the geometry within reach: the tiles whose geometry drifted beyond the
 //    tolerance this frame (VisibilityCache::geometryTiles, the bound over
 //    every azimuth, so it covers the indirect azimuths): their casting sets
@@ -37,6 +53,7 @@
 #include <vector>
 
 #include "core/grid.h"
+#include "gi/blocker_radiance.h"
 #include "gi/change_bound.h"
 #include "gi/pyramid.h"
 #include "gi/radiance_pyramid.h"
@@ -51,6 +68,9 @@ struct IndirectCache {
     MaxChangePyramid change;            // this frame: max over the channels of |L_0 - lastSource|
     std::vector<float> azimuthBound;    // per tile and indirect azimuth (tile-major)
     std::vector<float> drift;           // per tile: bound of the radiance change since its result was gathered
+    std::vector<float> occlusionFactor;  // per tile: this frame's factor of the radiance bound
+    std::vector<float> sharedBound;      // per tile: the azimuth bounds weighed by the receivers' shares
+    std::vector<float> radianceBound;    // per tile: this frame's bound (boundRadianceChange)
     ReceiverTiles tiles;                // this frame's tiles to re-gather
     ReceiverTiles texels;               // this frame's texel tiles to redo
     std::uint64_t geometryVersion = 0;  // GiState::geometryVersion of the last pass
@@ -66,7 +86,18 @@ struct IndirectPlanInputs {
     const ReceiverTiles* geometryTiles;  // tiles whose geometry drifted beyond the tolerance; null: none
     int azimuths;                        // of the indirect scan
     float tolerance;
+    // the last pass's occlusions (sub-sampling, blocker radiance: the
+    // occlusion factor and the azimuths' shares); null: neither
+    const BlockerRadianceState* blocker = nullptr;
 };
+
+/// This frame's bound per tile (cache.radianceBound, shade units; 0 where L_0
+/// did not change) on how far the change of L_0 from cache.lastSource to
+/// in.source moves the indirect light of every texel that reads one of the
+/// tile's receivers, the geometry being the last pass's: the largest sample
+/// move over the tile's azimuths weighed by each receiver's shares of its
+/// occlusion, times the occlusion factor (above).
+void boundRadianceChange(const IndirectPlanInputs& in, IndirectCache& cache);
 
 /// The tiles to re-gather (cache.tiles), or null when every receiver must be
 /// (no valid cache of this grid: the drifts start again at 0).
