@@ -32,10 +32,16 @@ bool hasOcclusions(const IndirectPlanInputs& in) {
            b->receiverOcclusionRunning.size() == static_cast<std::size_t>(in.azimuths) * h.nxr * h.nyr;
 }
 
+// A receiver's occlusion sum (unnormalised, over the azimuths) at or below
+// this is rounding: its E_k and O_k come from two computations of the same
+// clamped-cosine measures, whose ratio only bounds the shares when the
+// measures are well above their rounding.
+constexpr float kNoShareBelow = 1e-6f;
+
 // Per tile: the largest over its receivers of sum_j share_kj D_tj, the
 // azimuth bounds D_tj weighed by each receiver's shares of its occlusion
 // (the bound on the move of its mean blocker radiance: gi/indirect_cache.h);
-// max_j D_tj without the occlusions, or for a receiver with none.
+// max_j D_tj without the occlusions, or for a receiver with (next to) none.
 void sharedBounds(const IndirectPlanInputs& in, IndirectCache& cache) {
     const HeightPyramid& h = in.heights;
     const int tilesX = tileCount(h.nxr, kVisibilityTile), tilesY = tileCount(h.nyr, kVisibilityTile);
@@ -53,7 +59,7 @@ void sharedBounds(const IndirectPlanInputs& in, IndirectCache& cache) {
                     const float* running = in.blocker->receiverOcclusionRunning.data() +
                                            static_cast<std::size_t>(Y) * h.nxr + static_cast<std::size_t>(X);
                     const float total = running[(m - 1) * plane];
-                    if (!(total > 0.0f)) {
+                    if (!(total > kNoShareBelow)) {  // no occlusion to share, up to rounding
                         bound = largest;
                         continue;
                     }
