@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstring>
 
+#include "core/parallel.h"
 #include "gi/texel_runs.h"
 #include "gi/visibility_cache.h"
 
@@ -38,42 +39,49 @@ bool hasOcclusions(const IndirectPlanInputs& in) {
 // measures are well above their rounding.
 constexpr float kNoShareBelow = 1e-6f;
 
-// Per tile: the largest over its receivers of sum_j share_kj D_tj, the
-// azimuth bounds D_tj weighed by each receiver's shares of its occlusion
-// (the bound on the move of its mean blocker radiance: gi/indirect_cache.h);
-// max_j D_tj without the occlusions, or for a receiver with (next to) none.
+// rho_k of receiver k (row-major index): the azimuth bounds D_j weighed by
+// its shares of its occlusion, sum_j (O_kj / O_k) D_j (gi/indirect_cache.h);
+// `largest` (max_j D_j) for a receiver with (next to) no occlusion.
+float receiverShareBound(const BlockerRadianceState& b, std::size_t k, const float* D, float largest) {
+    const std::size_t m = static_cast<std::size_t>(b.azimuths), plane = static_cast<std::size_t>(b.nxr) * b.nyr;
+    const float* running = b.receiverOcclusionRunning.data() + k;
+    const float total = running[(m - 1) * plane];
+    if (!(total > kNoShareBelow)) return largest;  // no occlusion to share, up to rounding
+    float weighed = 0.0f, before = 0.0f;
+    for (std::size_t j = 0; j < m; ++j) {
+        const float now = running[j * plane];
+        weighed += std::max(0.0f, now - before) * D[j];
+        before = now;
+    }
+    // the shares' rounding: up by a few ulp of the total
+    return std::min(largest, weighed / total * (1.0f + 1e-5f));
+}
+
+// Per tile: the largest rho_k over its receivers; max_j D_tj without the
+// last pass's occlusions. Tile rows in parallel (each tile's value alone).
 void sharedBounds(const IndirectPlanInputs& in, IndirectCache& cache) {
     const HeightPyramid& h = in.heights;
     const int tilesX = tileCount(h.nxr, kVisibilityTile), tilesY = tileCount(h.nyr, kVisibilityTile);
-    const std::size_t m = static_cast<std::size_t>(in.azimuths), plane = static_cast<std::size_t>(h.nxr) * h.nyr;
+    const std::size_t m = static_cast<std::size_t>(in.azimuths);
     cache.sharedBound.resize(static_cast<std::size_t>(tilesX) * tilesY);
     const bool shares = hasOcclusions(in);
-    for (int ty = 0; ty < tilesY; ++ty)
-        for (int tx = 0; tx < tilesX; ++tx) {
-            const std::size_t t = static_cast<std::size_t>(ty) * tilesX + tx;
-            const float* D = cache.azimuthBound.data() + t * m;
-            const float largest = *std::max_element(D, D + m);
-            float bound = shares ? 0.0f : largest;
-            for (int Y = ty * kVisibilityTile; shares && Y < std::min(h.nyr, (ty + 1) * kVisibilityTile); ++Y)
-                for (int X = tx * kVisibilityTile; X < std::min(h.nxr, (tx + 1) * kVisibilityTile); ++X) {
-                    const float* running = in.blocker->receiverOcclusionRunning.data() +
-                                           static_cast<std::size_t>(Y) * h.nxr + static_cast<std::size_t>(X);
-                    const float total = running[(m - 1) * plane];
-                    if (!(total > kNoShareBelow)) {  // no occlusion to share, up to rounding
-                        bound = largest;
-                        continue;
-                    }
-                    float weighed = 0.0f, before = 0.0f;
-                    for (std::size_t j = 0; j < m; ++j) {
-                        const float now = running[j * plane];
-                        weighed += std::max(0.0f, now - before) * D[j];
-                        before = now;
-                    }
-                    // the shares' rounding: up by a few ulp of the total
-                    bound = std::max(bound, std::min(largest, weighed / total * (1.0f + 1e-5f)));
-                }
-            cache.sharedBound[t] = bound;
-        }
+    const auto tileBound = [&](int tx, int ty, const float* D) {
+        const float largest = *std::max_element(D, D + m);
+        if (!shares) return largest;
+        float bound = 0.0f;
+        for (int Y = ty * kVisibilityTile; Y < std::min(h.nyr, (ty + 1) * kVisibilityTile); ++Y)
+            for (int X = tx * kVisibilityTile; X < std::min(h.nxr, (tx + 1) * kVisibilityTile); ++X)
+                bound = std::max(bound,
+                                 receiverShareBound(*in.blocker, static_cast<std::size_t>(Y) * h.nxr + X, D, largest));
+        return bound;
+    };
+    parallelFor(0, tilesY, 1, [&](int ty0, int ty1) {
+        for (int ty = ty0; ty < ty1; ++ty)
+            for (int tx = 0; tx < tilesX; ++tx) {
+                const std::size_t t = static_cast<std::size_t>(ty) * tilesX + tx;
+                cache.sharedBound[t] = tileBound(tx, ty, cache.azimuthBound.data() + t * m);
+            }
+    });
 }
 
 // The texels that read receivers of each tile along one axis: per tile,
@@ -91,6 +99,18 @@ void texelRangesOfTiles(int texels, int s, int receivers, int tiles, std::vector
     }
 }
 
+// The largest of n >= 0 values (0 for none; the occlusions are >= 0), in
+// eight independent maxima that the compiler keeps in vector lanes (a
+// maximum is exact in any order).
+float largestOf(const float* v, int n) {
+    float lanes[8] = {};
+    int i = 0;
+    for (; i + 8 <= n; i += 8)
+        for (int k = 0; k < 8; ++k) lanes[k] = std::max(lanes[k], v[i + k]);
+    for (; i < n; ++i) lanes[0] = std::max(lanes[0], v[i]);
+    return *std::max_element(lanes, lanes + 8);
+}
+
 // Per tile: min(1, the largest O / pi of the texels that read its
 // receivers + the tolerance), or 1 without a texel occlusion (the
 // occlusion factor of gi/indirect_cache.h).
@@ -103,17 +123,19 @@ void occlusionFactors(const IndirectPlanInputs& in, IndirectCache& cache) {
     std::vector<int> x0, x1, y0, y1;
     texelRangesOfTiles(h.nx, h.subsample, h.nxr, tilesX, x0, x1);
     texelRangesOfTiles(h.ny, h.subsample, h.nyr, tilesY, y0, y1);
-    for (int ty = 0; ty < tilesY; ++ty)
-        for (int tx = 0; tx < tilesX; ++tx) {
-            float largest = 0.0f;
-            for (int y = y0[static_cast<std::size_t>(ty)]; y <= y1[static_cast<std::size_t>(ty)]; ++y) {
-                const float* row = occ->data() + static_cast<std::size_t>(y) * h.nx;
-                for (int x = x0[static_cast<std::size_t>(tx)]; x <= x1[static_cast<std::size_t>(tx)]; ++x)
-                    largest = std::max(largest, row[x]);
+    parallelFor(0, tilesY, 1, [&](int ty0, int ty1) {
+        for (int ty = ty0; ty < ty1; ++ty)
+            for (int tx = 0; tx < tilesX; ++tx) {
+                float largest = 0.0f;
+                for (int y = y0[static_cast<std::size_t>(ty)]; y <= y1[static_cast<std::size_t>(ty)]; ++y) {
+                    const int a = x0[static_cast<std::size_t>(tx)], b = x1[static_cast<std::size_t>(tx)];
+                    largest =
+                        std::max(largest, largestOf(occ->data() + static_cast<std::size_t>(y) * h.nx + a, b - a + 1));
+                }
+                cache.occlusionFactor[static_cast<std::size_t>(ty) * tilesX + tx] =
+                    std::min(1.0f, largest + in.tolerance);
             }
-            cache.occlusionFactor[static_cast<std::size_t>(ty) * tilesX + tx] =
-                std::min(1.0f, largest + in.tolerance);
-        }
+    });
 }
 
 }  // namespace
