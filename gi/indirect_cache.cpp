@@ -57,13 +57,13 @@ float receiverShareBound(const BlockerRadianceState& b, std::size_t k, const flo
     return std::min(largest, weighed / total * (1.0f + 1e-5f));
 }
 
-// Per tile: the largest rho_k over its receivers; max_j D_tj without the
-// last pass's occlusions. Tile rows in parallel (each tile's value alone).
+// Per tile: the radiance bound, the largest rho_k over its receivers (max_j
+// D_tj without the last pass's occlusions) times its occlusion factor.
+// Tile rows in parallel (each tile's value alone).
 void sharedBounds(const IndirectPlanInputs& in, IndirectCache& cache) {
     const HeightPyramid& h = in.heights;
     const int tilesX = tileCount(h.nxr, kVisibilityTile), tilesY = tileCount(h.nyr, kVisibilityTile);
     const std::size_t m = static_cast<std::size_t>(in.azimuths);
-    cache.sharedBound.resize(static_cast<std::size_t>(tilesX) * tilesY);
     const bool shares = hasOcclusions(in);
     const auto tileBound = [&](int tx, int ty, const float* D) {
         const float largest = *std::max_element(D, D + m);
@@ -79,24 +79,10 @@ void sharedBounds(const IndirectPlanInputs& in, IndirectCache& cache) {
         for (int ty = ty0; ty < ty1; ++ty)
             for (int tx = 0; tx < tilesX; ++tx) {
                 const std::size_t t = static_cast<std::size_t>(ty) * tilesX + tx;
-                cache.sharedBound[t] = tileBound(tx, ty, cache.azimuthBound.data() + t * m);
+                cache.radianceBound[t] =
+                    cache.occlusionFactor[t] * tileBound(tx, ty, cache.azimuthBound.data() + t * m);
             }
     });
-}
-
-// The texels that read receivers of each tile along one axis: per tile,
-// the first and last texel whose receivers (receiverLerp: i0 and i1) meet
-// the tile's [T t, T t + T).
-void texelRangesOfTiles(int texels, int s, int receivers, int tiles, std::vector<int>& first, std::vector<int>& last) {
-    first.assign(static_cast<std::size_t>(tiles), texels);
-    last.assign(static_cast<std::size_t>(tiles), -1);
-    for (int x = 0; x < texels; ++x) {
-        const ReceiverLerp r = receiverLerp(x, s, receivers);
-        for (const int t : {r.i0 / kVisibilityTile, r.i1 / kVisibilityTile}) {
-            first[static_cast<std::size_t>(t)] = std::min(first[static_cast<std::size_t>(t)], x);
-            last[static_cast<std::size_t>(t)] = std::max(last[static_cast<std::size_t>(t)], x);
-        }
-    }
 }
 
 // The largest of n >= 0 values (0 for none; the occlusions are >= 0), in
@@ -121,8 +107,8 @@ void occlusionFactors(const IndirectPlanInputs& in, IndirectCache& cache) {
     if (!hasOcclusions(in)) return;
     const Grid* occ = &in.blocker->occlusion;
     std::vector<int> x0, x1, y0, y1;
-    texelRangesOfTiles(h.nx, h.subsample, h.nxr, tilesX, x0, x1);
-    texelRangesOfTiles(h.ny, h.subsample, h.nyr, tilesY, y0, y1);
+    texelsReadingTiles(h.nx, h.subsample, h.nxr, kVisibilityTile, x0, x1);
+    texelsReadingTiles(h.ny, h.subsample, h.nyr, kVisibilityTile, y0, y1);
     parallelFor(0, tilesY, 1, [&](int ty0, int ty1) {
         for (int ty = ty0; ty < ty1; ++ty)
             for (int tx = 0; tx < tilesX; ++tx) {
@@ -154,7 +140,6 @@ void boundRadianceChange(const IndirectPlanInputs& in, IndirectCache& cache) {
                                 cache.azimuthBound);
     occlusionFactors(in, cache);
     sharedBounds(in, cache);
-    for (std::size_t t = 0; t < tiles; ++t) cache.radianceBound[t] = cache.occlusionFactor[t] * cache.sharedBound[t];
 }
 
 const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCache& cache) {

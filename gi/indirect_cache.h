@@ -69,7 +69,6 @@ struct IndirectCache {
     std::vector<float> azimuthBound;    // per tile and indirect azimuth (tile-major)
     std::vector<float> drift;           // per tile: bound of the radiance change since its result was gathered
     std::vector<float> occlusionFactor;  // per tile: this frame's factor of the radiance bound
-    std::vector<float> sharedBound;      // per tile: the azimuth bounds weighed by the receivers' shares
     std::vector<float> radianceBound;    // per tile: this frame's bound (boundRadianceChange)
     ReceiverTiles tiles;                // this frame's tiles to re-gather
     ReceiverTiles texels;               // this frame's texel tiles to redo

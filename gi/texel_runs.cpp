@@ -24,6 +24,19 @@ void firstTexels(int count, int s, int n, std::vector<int>& first) {
 
 }  // namespace
 
+void texelsReadingTiles(int count, int s, int n, int T, std::vector<int>& first, std::vector<int>& last) {
+    std::vector<int> lowerFrom;
+    firstTexels(count, s, n, lowerFrom);
+    const int tiles = (n + T - 1) / T;
+    first.resize(static_cast<std::size_t>(tiles));
+    last.resize(static_cast<std::size_t>(tiles));
+    for (int t = 0; t < tiles; ++t) {
+        // lower receivers from the one before the tile (whose next is the tile's first) to its last
+        first[static_cast<std::size_t>(t)] = lowerFrom[static_cast<std::size_t>(std::max(0, t * T - 1))];
+        last[static_cast<std::size_t>(t)] = lowerFrom[static_cast<std::size_t>(std::min(n, (t + 1) * T))] - 1;
+    }
+}
+
 void texelRunsOfTiles(const ReceiverTiles* tiles, int nx, int ny, int subsample, TexelRuns& out) {
     const int s = subsample, nxr = (nx + s - 1) / s, nyr = (ny + s - 1) / s;
     out.ny = ny;

@@ -47,6 +47,11 @@ inline std::span<const ColumnSpan> runsOfRow(const TexelRuns* runs, int y, const
     return runs ? runs->ofRow(y) : std::span<const ColumnSpan>(&whole, 1);
 }
 
+/// Along one axis of `count` texels at sub-sampling s (n receivers, tiles
+/// of T): per tile t, the first and last texel that reads one of its
+/// receivers [T t, T t + T) (a texel reads its lower receiver and the next).
+void texelsReadingTiles(int count, int s, int n, int T, std::vector<int>& first, std::vector<int>& last);
+
 /// The receivers [a, b) a stretch of texels reads along one axis of n
 /// receivers, from the lower receivers (receiverLerp's i0) of its first and
 /// last texel: each texel reads its lower receiver and the next one, clamped.
