@@ -37,32 +37,53 @@ struct AmbientJob {
 // slopes before the tangent plane is applied (sin sigma cos sigma =
 // t / (1 + t^2), cos^2 sigma = 1 / (1 + t^2)):
 //   acc[0] += -g (pi/2 - sigma - sin sigma cos sigma) + cos^2 sigma,
-// and with the sky gradient's parts (gi/ambient_horizon.h), a = max(sigma, 0):
+// evaluated as (cos^2 sigma + g (t cos^2 sigma - pi/2)) + g sigma, so that the
+// atan's long chain ends in one multiply-add; and with the sky gradient's
+// parts (gi/ambient_horizon.h), a = max(sigma, 0):
 //   acc[1] += that minus its value at sigma = 0 (1 - g pi/2) when sigma < 0,
 //   acc[2] += 2/3 (1 - sin^3 a - g cos^3 a).
+// K vectors at a time, each step over all K before the next: their chains
+// are independent, and interleaved the out-of-order core overlaps them (one
+// vector's chain alone keeps its scheduler waiting on the divisions).
+template <class V, bool Parts, int K>
+[[gnu::always_inline]] inline void addAzimuthVectors(const float* gx, const float* gy, const float* horizon, V vc,
+                                                     V vs, float* const acc[3], int x) {
+    constexpr int L = simd::kLaneCount<V>;
+    const V one = splat<V>(1.0f), halfPi = splat<V>(kHalfPi);
+    V g[K], t[K], r2[K], sigma[K];
+    for (int k = 0; k < K; ++k) {
+        g[k] = load<V>(gx + x + k * L) * vc + load<V>(gy + x + k * L) * vs;
+        const V h = load<V>(horizon + x + k * L);
+        t[k] = h > g[k] ? h : g[k];
+    }
+    for (int k = 0; k < K; ++k) r2[k] = one / (one + t[k] * t[k]);
+    for (int k = 0; k < K; ++k) sigma[k] = atanv(t[k]);
+    for (int k = 0; k < K; ++k) {
+        float* const out = acc[0] + x + k * L;
+        const V term = (r2[k] + g[k] * (t[k] * r2[k] - halfPi)) + g[k] * sigma[k];
+        store(out, load<V>(out) + term);
+        if constexpr (Parts) {
+            const V zero = splat<V>(0.0f), twoThirds = splat<V>(2.0f / 3.0f);
+            const V below = t[k] < zero ? term - (one - g[k] * halfPi) : zero;
+            const V ta = t[k] > zero ? t[k] : zero;
+            const V cos2a = t[k] > zero ? r2[k] : one;
+            const V cos3a = cos2a * sqrtv(cos2a);
+            const V rising = twoThirds * (one - ta * ta * ta * cos3a - g[k] * cos3a);
+            store(acc[1] + x + k * L, load<V>(acc[1] + x + k * L) + below);
+            store(acc[2] + x + k * L, load<V>(acc[2] + x + k * L) + rising);
+        }
+    }
+}
+
+// The whole vectors of [x0, x1).
 template <class V, bool Parts>
 [[gnu::always_inline]] inline void addAzimuth(const float* gx, const float* gy, const float* horizon, float c, float sn,
                                               float* const acc[3], int x0, int x1) {
-    constexpr int L = simd::kLaneCount<V>;
-    const V vc = splat<V>(c), vs = splat<V>(sn), one = splat<V>(1.0f), halfPi = splat<V>(kHalfPi);
-    const V zero = splat<V>(0.0f), twoThirds = splat<V>(2.0f / 3.0f);
-    for (int x = x0; x + L <= x1; x += L) {
-        const V g = load<V>(gx + x) * vc + load<V>(gy + x) * vs;
-        const V h = load<V>(horizon + x);
-        const V t = h > g ? h : g;
-        const V r2 = one / (one + t * t);
-        const V term = (-g) * (halfPi - atanv(t) - t * r2) + r2;
-        store(acc[0] + x, load<V>(acc[0] + x) + term);
-        if constexpr (Parts) {
-            const V below = t < zero ? term - (one - g * halfPi) : zero;
-            const V ta = t > zero ? t : zero;
-            const V cos2a = t > zero ? r2 : one;
-            const V cos3a = cos2a * sqrtv(cos2a);
-            const V rising = twoThirds * (one - ta * ta * ta * cos3a - g * cos3a);
-            store(acc[1] + x, load<V>(acc[1] + x) + below);
-            store(acc[2] + x, load<V>(acc[2] + x) + rising);
-        }
-    }
+    constexpr int L = simd::kLaneCount<V>, K = 4;
+    const V vc = splat<V>(c), vs = splat<V>(sn);
+    int x = x0;
+    for (; x + K * L <= x1; x += K * L) addAzimuthVectors<V, Parts, K>(gx, gy, horizon, vc, vs, acc, x);
+    for (; x + L <= x1; x += L) addAzimuthVectors<V, Parts, 1>(gx, gy, horizon, vc, vs, acc, x);
 }
 
 // The texel range [x0, x1) of a row: whole vectors, then the rest through
