@@ -28,6 +28,7 @@ struct GlossyOptions {
     int lobeRings = 12;     // lobe quadrature of the reference (rings x 2 rings directions per lobe)
     bool timing = true;     // the frame-time section
     bool accuracy = true;   // the accuracy section
+    bool floors = false;    // the floors of the vector mode (gi_glossy_floors.md)
 };
 
 constexpr float albedo = 0.6f;
@@ -261,6 +262,82 @@ std::string frameTimeSection(const GlossyOptions& o, const BenchContext& ctx) {
     return md;
 }
 
+// What gi_glossy_floors.md measures, before its table.
+std::string floorsIntro(const GlossyOptions& o) {
+    std::string md = "# Floors of the vector glossy mode\n\n";
+    md += "Machine: " + machineDescription() + ".\n\n";
+    md += "Alps-montblanc, central " + std::to_string(o.size) +
+          "^2 crop at true scale, sun-and-sky SH environment, Phong, one bounce, 1x. Relative RMSE (10 % border "
+          "left out) of `renderReferenceGlossy` with one of the fast path's approximations against the exact "
+          "reference (" +
+          std::to_string(o.lobeRings) + " x " + std::to_string(2 * o.lobeRings) +
+          " lobe directions at the receivers and at every first hit): members SH: the first hits send the Phong part "
+          "of their incident radiance projected to order-4 SH (`ReferenceGiSettings::membersSh`, what the vector "
+          "pyramid's E sends, without its pyramid and scan); receivers SH: the receivers shade their incident "
+          "radiance projected to order-4 SH (`receiverSh`); N rays: the receivers' lobe sampled by the same "
+          "quadrature with N directions (2 or 3 rings).\n\n";
+    return md;
+}
+
+// The floors of the vector mode: the exact reference against its own
+// diagnostics, each keeping one of the fast path's approximations and nothing
+// else: the first hits sending their order-4 SH exit radiance (membersSh), the
+// receivers shading order-4 SH incident radiance (receiverSh), both, and the
+// receivers' lobe sampled by a few rays (2 or 3 rings of the lobe quadrature:
+// 8 or 18 rays) with exact or order-4 members. Phong, 1x, on the accuracy crop.
+void floorsSection(const GlossyOptions& o, const BenchContext& ctx) {
+    float cell = 1.0f;
+    const Grid h = alpsCentreCrop(ctx.dataDir, o.size, cell);
+    const AlbedoMap a = uniformAlbedo(o.size, o.size, albedo);
+    const GiLighting light = sunSkyLighting();
+    struct Variant {
+        const char* name;
+        bool membersSh, receiverSh;
+        int rings;  // 0: the reference's
+    };
+    const Variant variants[] = {{"members SH", true, false, 0},
+                                {"receivers SH", false, true, 0},
+                                {"both SH", true, true, 0},
+                                {"receivers 8 rays", false, false, 2},
+                                {"receivers 18 rays", false, false, 3},
+                                {"8 rays, members SH", true, false, 2},
+                                {"18 rays, members SH", true, false, 3}};
+    std::string md = floorsIntro(o);
+    std::string head = "| S |", rule = "|---|";
+    for (const Variant& v : variants) {
+        head += std::string(" ") + v.name + " |";
+        rule += "---|";
+    }
+    md += head + "\n" + rule + "\n";
+    std::string csv = "S,variant,rel_rmse,bias\n";
+    for (float S : {8.0f, 16.0f, 32.0f, 64.0f}) {
+        ReferenceGiSettings rs;
+        rs.directions = o.directions;
+        rs.lobeRings = o.lobeRings;
+        rs.bounces = 1;
+        rs.shading = settingsFor(Brdf::Phong, S, 1, 1, GlossyIndirect::VectorPyramid).shading;
+        ReferenceGiResult exact;
+        withThreads(2, [&] { renderReferenceGi(h.cview(), cell, light.environment, &a, rs, exact); });
+        std::string line = strprintf("| %g |", S);
+        for (const Variant& v : variants) {
+            ReferenceGiSettings d = rs;
+            d.membersSh = v.membersSh;
+            d.receiverSh = v.receiverSh;
+            if (v.rings > 0) d.lobeRings = v.rings;
+            ReferenceGiResult r;
+            withThreads(2, [&] { renderReferenceGi(h.cview(), cell, light.environment, &a, d, r); });
+            double bias = 0.0;
+            const double e = relRmse(r.indirect, exact.indirect, bias);
+            line += strprintf(" %.1f %% |", 100.0 * e);
+            csv += strprintf("%g,%s,%.5f,%+.5f\n", S, v.name, e, bias);
+            std::fprintf(stderr, "S %g, %s: %.4f (bias %+.4f)\n", S, v.name, e, bias);
+        }
+        md += line + "\n";
+    }
+    writeResult(ctx.outDir, "gi_glossy_floors.md", md);
+    writeResult(ctx.outDir, "gi_glossy_floors.csv", csv);
+}
+
 int runGlossy(const GlossyOptions& o, const BenchContext& ctx) {
     std::string md = "# Glossy indirect light: vector vs scalar pyramid\n\n";
     md += "Machine: " + machineDescription() +
@@ -271,8 +348,9 @@ int runGlossy(const GlossyOptions& o, const BenchContext& ctx) {
     std::string csv;
     if (o.accuracy) md += accuracySection(o, ctx, csv);
     if (o.timing) md += frameTimeSection(o, ctx);
-    writeResult(ctx.outDir, "gi_glossy.md", md);
+    if (o.accuracy || o.timing) writeResult(ctx.outDir, "gi_glossy.md", md);
     if (o.accuracy) writeResult(ctx.outDir, "gi_glossy.csv", csv);
+    if (o.floors) floorsSection(o, ctx);
     return 0;
 }
 
@@ -293,6 +371,9 @@ Runner addGiGlossySuite(CLI::App& app, const BenchContext& ctx) {
         ->capture_default_str();
     sub->add_flag("!--no-timing", o->timing, "Skip the frame-time section");
     sub->add_flag("!--no-accuracy", o->accuracy, "Skip the accuracy section");
+    sub->add_flag("--floors", o->floors,
+                  "Also the floors of the vector mode: the reference with one approximation at a time "
+                  "(gi_glossy_floors.md, .csv; about 12 minutes)");
     return [o, &ctx] { return runGlossy(*o, ctx); };
 }
 

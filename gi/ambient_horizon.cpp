@@ -46,8 +46,8 @@ struct AmbientJob {
 // are independent, and interleaved the out-of-order core overlaps them (one
 // vector's chain alone keeps its scheduler waiting on the divisions).
 template <class V, bool Parts, int K>
-[[gnu::always_inline]] inline void addAzimuthVectors(const float* gx, const float* gy, const float* horizon, V vc,
-                                                     V vs, float* const acc[3], int x) {
+[[gnu::always_inline]] inline void addAzimuthVectors(const float* gx, const float* gy, const float* horizon, V vc, V vs,
+                                                     float* const acc[3], int x) {
     constexpr int L = simd::kLaneCount<V>;
     const V one = splat<V>(1.0f), halfPi = splat<V>(kHalfPi);
     V g[K], t[K], r2[K], sigma[K];

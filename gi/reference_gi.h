@@ -52,6 +52,12 @@ struct ReferenceGiSettings {
     // exactly; the first hits stay exact. Separates the error of what the
     // fast path's casting-set members send from its receivers' order-4 lobe.
     bool receiverSh = false;
+    // Glossy reference diagnostic: the first bounce's hits send the exit
+    // radiance of their incident radiance projected to order-4 SH, Phong part
+    // sum_lm g_l I_0,lm Y_lm (as the fast path's exit-radiance vectors E do),
+    // instead of integrating their lobe exactly; the receivers stay exact
+    // unless receiverSh is set too. The floor of what order-4 members send.
+    bool membersSh = false;
     // BRDF of every texel. Lambert (default): the scalar gathering above.
     // Phong / LambertPlusPhong: the glossy reference (renderReferenceGlossy).
     ShadingSettings shading;
@@ -89,7 +95,8 @@ void renderReferenceGi(ConstGridView heights, float cellSize, const ShRgb& light
 /// lobeRings quadrature rays, the Lambert part D_1 = w_d albedo(p) / pi
 /// 4 pi / K sum_k L_0(q_k, -w_k) (N . w_k) the fixed direction set.
 /// With receiverSh (a diagnostic) the first bounce's receivers shade as in
-/// the bounces after it, from I_1 projected to SH.
+/// the bounces after it, from I_1 projected to SH; with membersSh (another)
+/// its first hits send the Phong part of I_0 projected to SH.
 /// Bounces b >= 2 (an approximation): the previous bounce's incident
 /// radiance projected to order-4 SH at every texel,
 ///   I_b(p) = 4 pi / K sum_k L_(b-1)(q_k, -w_k) Y(w_k),

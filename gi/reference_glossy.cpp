@@ -304,10 +304,11 @@ void gatherTexel(const GlossyGather& g, const std::array<Grid, 3>& prevD, const 
 // The first bounce's Phong part towards the viewer at texel (x, y), exact:
 // the texel's lobe about the viewer's reflection sampled by the lobe
 // quadrature (gi/reference_glossy_lobe.h), each ray's first hit sending its
-// exact exit radiance; rays below the tangent plane carry nothing, rays that
-// escape see the sky (direct light, bounce 0).
-void firstBouncePhong(const GlossyGather& g, const std::array<Grid, 3>& prevD, const double view[3], int x, int y,
-                      double out[3]) {
+// exact exit radiance (prevI null; else from I_0 in SH, the membersSh
+// diagnostic); rays below the tangent plane carry nothing, rays that escape
+// see the sky (direct light, bounce 0).
+void firstBouncePhong(const GlossyGather& g, const std::array<Grid, 3>& prevD, const std::vector<float>* prevI,
+                      const double view[3], int x, int y, double out[3]) {
     const int nx = g.heights.nx, ny = g.heights.ny, n = g.s.lobeRings;
     const std::size_t i = static_cast<std::size_t>(y) * nx + x;
     double nrm[3], r[3], t[3], b[3], acc[3] = {0.0, 0.0, 0.0};
@@ -326,7 +327,7 @@ void firstBouncePhong(const GlossyGather& g, const std::array<Grid, 3>& prevD, c
             if (!referenceFirstHit(g.heights.data(), nx, ny, g.hMax, g.cellSize, x, y, dir, g.s.marchStep, qx, qy))
                 continue;
             double L[3];
-            radianceFromHit(g, qx, qy, w, prevD, nullptr, L);
+            radianceFromHit(g, qx, qy, w, prevD, prevI, L);
             for (int c = 0; c < 3; ++c) acc[c] += L[c];
         }
     for (int c = 0; c < 3; ++c) out[c] = g.ws * acc[c] / (2.0 * n * n);
@@ -414,10 +415,11 @@ void renderReferenceGlossy(ConstGridView heights, float cellSize, const ShRgb& l
     buildSkyHorizons(heights, cellSize, s.azimuths, horizons);
 
     // ---- bounce 0: exact Lambert part + exact-cap keys (D_0), exact Phong part
-    // towards the viewer; I_0 (SH) only for the bounces after the first
+    // towards the viewer; I_0 (SH) only for the bounces after the first and
+    // the membersSh diagnostic
     std::vector<float> prevI, nextI;
     std::array<Grid, 3> prevD, nextD;
-    directBounce(heights, cellSize, lighting, surface, s, wd, s.bounces >= 2, out, prevD, prevI);
+    directBounce(heights, cellSize, lighting, surface, s, wd, s.bounces >= 2 || s.membersSh, out, prevD, prevI);
     for (int c = 0; c < 3; ++c) nextD[c].resize(nx, ny, 0.0f);
     directTowardsViewer(surf, horizons, lighting, view, ws, s.lobeRings, prevD, out.direct);
 
@@ -439,14 +441,16 @@ void renderReferenceGlossy(ConstGridView heights, float cellSize, const ShRgb& l
             // SH incident radiance: for the next bounce, and for towardsViewer after the first
             const bool exact = b == 1, needI = b < s.bounces || !exact || s.receiverSh;
             if (needI) nextI.assign(plane * 3 * kShCount, 0.0f);
+            // the first hits' exit radiance: exact, or from I_0 in SH (membersSh)
+            const std::vector<float>* hitsI = exact && !s.membersSh ? nullptr : &prevI;
             parallelFor(0, ny, 1, [&](int y0, int y1) {
                 for (int y = y0; y < y1; ++y)
                     for (int x = 0; x < nx; ++x) {
                         if (wd != 0.0 || needI)
-                            gatherTexel(gather, prevD, exact ? nullptr : &prevI, x, y, nextD, needI ? &nextI : nullptr);
+                            gatherTexel(gather, prevD, hitsI, x, y, nextD, needI ? &nextI : nullptr);
                         if (!exact || s.receiverSh) continue;
                         double phong[3] = {0.0, 0.0, 0.0};
-                        if (ws != 0.0) firstBouncePhong(gather, prevD, view, x, y, phong);
+                        if (ws != 0.0) firstBouncePhong(gather, prevD, hitsI, view, x, y, phong);
                         const std::size_t i = static_cast<std::size_t>(y) * nx + x;
                         for (int c = 0; c < 3; ++c)
                             out.indirect[c].v[i] += static_cast<float>(nextD[c].v[i] + phong[c]);

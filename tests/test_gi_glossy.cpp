@@ -463,3 +463,41 @@ TEST_CASE("gi.glossy: a second frame allocates nothing new") {
     CHECK(packed.block.data() == p1);
     CHECK(st.indirect.blocks.at(0).state.data() == p2);
 }
+
+TEST_CASE("gi.glossy reference: the order-4 diagnostics change what they name and nothing else") {
+    // The V valley of the test above, S = 64 (the walls reflect each other
+    // through sharp lobes). membersSh: the first hits send the Phong part of
+    // their order-4 SH incident radiance; receiverSh: the receivers shade
+    // theirs. Each moves the wall's indirect light away from the exact value
+    // (the truncation it isolates: 12-14 % here), and neither touches the
+    // direct light.
+    const int n = 41, c = n / 2;
+    const Grid h = valley(n, n, 1.0f);
+    const AlbedoMap a = uniformAlbedo(n, n, 1.0f);
+    const GiLighting light;
+    auto reference = [&](bool membersSh, bool receiverSh) {
+        ReferenceGiSettings rs;
+        rs.directions = 512;
+        rs.azimuths = 64;
+        rs.lobeRings = 6;
+        rs.bounces = 1;
+        rs.shading = glossySettings(Brdf::Phong, 64.0f, 1, GlossyIndirect::VectorPyramid).shading;
+        rs.membersSh = membersSh;
+        rs.receiverSh = receiverSh;
+        ReferenceGiResult r;
+        renderReferenceGi(h.view(), 1.0f, light.environment, &a, rs, r);
+        return r;
+    };
+    auto wall = [&](const ReferenceGiResult& r) { return meanOver(r.indirect[0], c + 3, c + 10, 10, n - 10); };
+    const ReferenceGiResult exact = reference(false, false);
+    const ReferenceGiResult members = reference(true, false);
+    const ReferenceGiResult receivers = reference(false, true);
+    MESSAGE("wall: exact " << wall(exact) << ", members SH " << wall(members) << ", receivers SH " << wall(receivers));
+    CHECK(wall(exact) > 0.01);
+    CHECK(std::fabs(wall(members) - wall(exact)) > 0.02 * wall(exact));
+    CHECK(std::fabs(wall(receivers) - wall(exact)) > 0.02 * wall(exact));
+    for (int ch = 0; ch < 3; ++ch) {
+        CHECK(members.direct[ch].v == exact.direct[ch].v);
+        CHECK(receivers.direct[ch].v == exact.direct[ch].v);
+    }
+}
