@@ -63,17 +63,18 @@
 namespace terrain::gi {
 
 struct IndirectCache {
-    bool valid = false;                 // the fields below describe the cached indirect result
-    std::array<Grid, 3> lastSource;     // L_0 the last indirect pass read
-    MaxChangePyramid change;            // this frame: max over the channels of |L_0 - lastSource|
-    std::vector<float> azimuthBound;    // per tile and indirect azimuth (tile-major)
-    std::vector<float> drift;           // per tile: bound of the radiance change since its result was gathered
+    bool valid = false;                  // the fields below describe the cached indirect result
+    std::array<Grid, 3> lastSource;      // L_0 the last indirect pass read
+    MaxChangePyramid change;             // this frame: max over the channels of |L_0 - lastSource|
+    std::vector<float> azimuthBound;     // per tile and indirect azimuth (tile-major)
+    std::vector<float> drift;            // per tile: bound of the radiance change since its result was gathered
     std::vector<float> occlusionFactor;  // per tile: this frame's factor of the radiance bound
     std::vector<float> radianceBound;    // per tile: this frame's bound (boundRadianceChange)
-    ReceiverTiles tiles;                // this frame's tiles to re-gather
-    ReceiverTiles texels;               // this frame's texel tiles to redo
-    std::uint64_t geometryVersion = 0;  // GiState::geometryVersion of the last pass
-    bool hadAlbedo = false;             // the last pass's albedo channels (empty: 1)
+    ReceiverTiles tiles;                 // this frame's tiles to re-gather
+    ReceiverTiles texels;                // this frame's texel tiles to redo
+    std::uint64_t geometryVersion = 0;   // GiState::geometryVersion of the last pass
+    int framesWithoutPlan = 0;           // frames left that re-gather everything unplanned
+    bool hadAlbedo = false;              // the last pass's albedo channels (empty: 1)
     std::array<Grid, 3> lastAlbedo;
 };
 
@@ -99,7 +100,10 @@ struct IndirectPlanInputs {
 void boundRadianceChange(const IndirectPlanInputs& in, IndirectCache& cache);
 
 /// The tiles to re-gather (cache.tiles), or null when every receiver must be
-/// (no valid cache of this grid: the drifts start again at 0).
+/// (no valid cache of this grid: the drifts start again at 0). As for the
+/// visibility (kFramesWithoutPlan, gi/visibility_cache.h): after a plan that
+/// found every tile dirty, that many frames re-gather everything without
+/// computing the bound, whose cost would only be added to a full pass.
 const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCache& cache);
 
 /// After an indirect pass over `source` (on the receiver grid of `heights`):

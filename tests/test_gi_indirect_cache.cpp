@@ -206,6 +206,42 @@ TEST_CASE("gi.indirect_cache: small source changes accumulate until they pass th
     CHECK(regathered > 0);
 }
 
+TEST_CASE("gi.indirect_cache: after a plan that finds every tile dirty, frames re-gather without planning") {
+    // A key light three times as bright dirties every tile; the bound would
+    // only add its cost to the next frames' full passes, so kFramesWithoutPlan
+    // frames re-gather everything unplanned (a full frame's indirect light,
+    // bit for bit); then planning resumes, and a change below the tolerance
+    // re-gathers nothing.
+    const Grid h = bumpy(96, 96);
+    GiLighting light;
+    KeyLight key;
+    key.azimuthDeg = 60.0f;
+    key.elevationDeg = 35.0f;
+    light.keys.push_back(key);
+    GiSettings settings = withBounces(GiSettings{}, 2, 1);
+    settings.tolerance = 0.01f;
+    GiSettings off = settings;
+    off.incremental = false;
+    GiState inc;
+    runGiFrame(h.cview(), kCell, light, settings, inc);
+    light.keys[0].rgb[0] *= 3.0f;
+    runGiFrame(h.cview(), kCell, light, settings, inc);
+    CHECK(inc.indirectRecomputed == 1.0);
+    CHECK(inc.indirectCache.framesWithoutPlan == kFramesWithoutPlan);
+    for (int k = 1; k <= kFramesWithoutPlan; ++k) {
+        light.keys[0].rgb[0] *= 1.0001f;
+        runGiFrame(h.cview(), kCell, light, settings, inc);
+        GiState full;
+        runGiFrame(h.cview(), kCell, light, off, full);
+        CHECK(inc.indirectRecomputed == 1.0);
+        CHECK(inc.indirectCache.framesWithoutPlan == kFramesWithoutPlan - k);
+        CHECK(largestDifference(inc.indirect.indirect, full.indirect.indirect) == 0.0);
+    }
+    light.keys[0].rgb[0] *= 1.0001f;
+    runGiFrame(h.cview(), kCell, light, settings, inc);
+    CHECK(inc.indirectRecomputed == 0.0);
+}
+
 TEST_CASE("gi.indirect_cache: with a local height change the indirect light stays within the tolerance") {
     const Grid h = bumpy(256, 256);
     GiLighting light;  // uniform unit sky: shade units are the ambient map's
