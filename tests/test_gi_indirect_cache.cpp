@@ -176,15 +176,27 @@ TEST_CASE("gi.indirect_cache: the radiance bound holds for local, global and edg
     }
 }
 
+// A uniform unit sky plus one key light, whose brightness the tests change,
+// over a bumpy 96² field at 2x with one bounce and tolerance 0.01.
+struct KeyLitField {
+    Grid h = bumpy(96, 96);
+    GiLighting light;
+    GiSettings settings;
+    KeyLitField() {
+        KeyLight key;
+        key.azimuthDeg = 60.0f;
+        key.elevationDeg = 35.0f;
+        light.keys.push_back(key);
+        settings = withBounces(GiSettings{}, 2, 1);
+        settings.tolerance = 0.01f;
+    }
+};
+
 TEST_CASE("gi.indirect_cache: small source changes accumulate until they pass the tolerance") {
-    const Grid h = bumpy(96, 96);
-    GiLighting light;  // uniform unit sky plus a key light that brightens a little each frame
-    KeyLight key;
-    key.azimuthDeg = 60.0f;
-    key.elevationDeg = 35.0f;
-    light.keys.push_back(key);
-    GiSettings settings = withBounces(GiSettings{}, 2, 1);
-    settings.tolerance = 0.01f;
+    KeyLitField field;  // the key light brightens a little each frame
+    const Grid& h = field.h;
+    GiLighting& light = field.light;
+    const GiSettings& settings = field.settings;
     GiState inc;
     runGiFrame(h.cview(), kCell, light, settings, inc);
     int regathered = 0, kept = 0;
@@ -212,14 +224,10 @@ TEST_CASE("gi.indirect_cache: after a plan that finds every tile dirty, frames r
     // frames re-gather everything unplanned (a full frame's indirect light,
     // bit for bit); then planning resumes, and a change below the tolerance
     // re-gathers nothing.
-    const Grid h = bumpy(96, 96);
-    GiLighting light;
-    KeyLight key;
-    key.azimuthDeg = 60.0f;
-    key.elevationDeg = 35.0f;
-    light.keys.push_back(key);
-    GiSettings settings = withBounces(GiSettings{}, 2, 1);
-    settings.tolerance = 0.01f;
+    KeyLitField field;
+    const Grid& h = field.h;
+    GiLighting& light = field.light;
+    const GiSettings& settings = field.settings;
     GiSettings off = settings;
     off.incremental = false;
     GiState inc;
