@@ -275,7 +275,10 @@ std::string floorsIntro(const GlossyOptions& o) {
           "of their incident radiance projected to order-4 SH (`ReferenceGiSettings::membersSh`, what the vector "
           "pyramid's E sends, without its pyramid and scan); receivers SH: the receivers shade their incident "
           "radiance projected to order-4 SH (`receiverSh`); N rays: the receivers' lobe sampled by the same "
-          "quadrature with N directions (2 or 3 rings).\n\n";
+          "quadrature with N directions (2 or 3 rings); M azimuths: each of the receivers' lobe rays takes the "
+          "first hits at its elevation along the two nearest of M evenly spaced azimuths (the fast path's scan "
+          "azimuths, 8 by default), linearly weighted (`receiverAzimuths`): what a receiver that integrates its "
+          "own lobe over the scan's incident radiance could reach.\n\n";
     return md;
 }
 
@@ -284,7 +287,9 @@ std::string floorsIntro(const GlossyOptions& o) {
 // else: the first hits sending their order-4 SH exit radiance (membersSh), the
 // receivers shading order-4 SH incident radiance (receiverSh), both, and the
 // receivers' lobe sampled by a few rays (2 or 3 rings of the lobe quadrature:
-// 8 or 18 rays) with exact or order-4 members. Phong, 1x, on the accuracy crop.
+// 8 or 18 rays) with exact or order-4 members, and the receivers' lobe seeing
+// its incident radiance along the scan's azimuths only (receiverAzimuths: 8,
+// the engine's, 16 or 32). Phong, 1x, on the accuracy crop.
 void floorsSection(const GlossyOptions& o, const BenchContext& ctx) {
     float cell = 1.0f;
     const Grid h = alpsCentreCrop(ctx.dataDir, o.size, cell);
@@ -293,15 +298,20 @@ void floorsSection(const GlossyOptions& o, const BenchContext& ctx) {
     struct Variant {
         const char* name;
         bool membersSh, receiverSh;
-        int rings;  // 0: the reference's
+        int rings;     // 0: the reference's
+        int azimuths;  // ReferenceGiSettings::receiverAzimuths (0: every ray its own)
     };
-    const Variant variants[] = {{"members SH", true, false, 0},
-                                {"receivers SH", false, true, 0},
-                                {"both SH", true, true, 0},
-                                {"receivers 8 rays", false, false, 2},
-                                {"receivers 18 rays", false, false, 3},
-                                {"8 rays, members SH", true, false, 2},
-                                {"18 rays, members SH", true, false, 3}};
+    const Variant variants[] = {{"members SH", true, false, 0, 0},
+                                {"receivers SH", false, true, 0, 0},
+                                {"both SH", true, true, 0, 0},
+                                {"receivers 8 rays", false, false, 2, 0},
+                                {"receivers 18 rays", false, false, 3, 0},
+                                {"8 rays, members SH", true, false, 2, 0},
+                                {"18 rays, members SH", true, false, 3, 0},
+                                {"members SH, 8 azimuths", true, false, 0, 8},
+                                {"18 rays, members SH, 8 azimuths", true, false, 3, 8},
+                                {"18 rays, members SH, 16 azimuths", true, false, 3, 16},
+                                {"18 rays, members SH, 32 azimuths", true, false, 3, 32}};
     std::string md = floorsIntro(o);
     std::string head = "| S |", rule = "|---|";
     for (const Variant& v : variants) {
@@ -324,6 +334,7 @@ void floorsSection(const GlossyOptions& o, const BenchContext& ctx) {
             d.membersSh = v.membersSh;
             d.receiverSh = v.receiverSh;
             if (v.rings > 0) d.lobeRings = v.rings;
+            d.receiverAzimuths = v.azimuths;
             ReferenceGiResult r;
             withThreads(2, [&] { renderReferenceGi(h.cview(), cell, light.environment, &a, d, r); });
             double bias = 0.0;
@@ -373,7 +384,7 @@ Runner addGiGlossySuite(CLI::App& app, const BenchContext& ctx) {
     sub->add_flag("!--no-accuracy", o->accuracy, "Skip the accuracy section");
     sub->add_flag("--floors", o->floors,
                   "Also the floors of the vector mode: the reference with one approximation at a time "
-                  "(gi_glossy_floors.md, .csv; about 12 minutes)");
+                  "(gi_glossy_floors.md, .csv; about 20 minutes)");
     return [o, &ctx] { return runGlossy(*o, ctx); };
 }
 

@@ -58,6 +58,16 @@ struct ReferenceGiSettings {
     // instead of integrating their lobe exactly; the receivers stay exact
     // unless receiverSh is set too. The floor of what order-4 members send.
     bool membersSh = false;
+    // Glossy reference diagnostic: the first bounce's receivers see their
+    // incident radiance only along m = receiverAzimuths evenly spaced
+    // azimuths phi_j = 2 pi j / m (the fast path's scan azimuths), exactly
+    // in elevation: each lobe ray takes the first hits of the rays at its
+    // own elevation along the two azimuths on either side of it, linearly
+    // weighted by its azimuth between them (a ray below the receiver's
+    // tangent plane carries nothing). 0: every ray's own first hit. The
+    // floor that the scan's azimuths set for a receiver that integrates its
+    // own lobe.
+    int receiverAzimuths = 0;
     // BRDF of every texel. Lambert (default): the scalar gathering above.
     // Phong / LambertPlusPhong: the glossy reference (renderReferenceGlossy).
     ShadingSettings shading;

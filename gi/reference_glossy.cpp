@@ -307,9 +307,45 @@ void gatherTexel(const GlossyGather& g, const std::array<Grid, 3>& prevD, const 
 // exact exit radiance (prevI null; else from I_0 in SH, the membersSh
 // diagnostic); rays below the tangent plane carry nothing, rays that escape
 // see the sky (direct light, bounce 0).
+// The radiance arriving at texel (x, y) from direction w (the first hit's,
+// 0 for a ray below the tangent plane or one that escapes to the sky), added
+// to acc times `weight`.
+void addRayRadiance(const GlossyGather& g, const std::array<Grid, 3>& prevD, const std::vector<float>* prevI,
+                    const double nrm[3], const double w[3], int x, int y, double weight, double acc[3]) {
+    if (nrm[0] * w[0] + nrm[1] * w[1] + nrm[2] * w[2] <= 0.0) return;
+    const std::array<float, 3> dir = {static_cast<float>(w[0]), static_cast<float>(w[1]), static_cast<float>(w[2])};
+    float qx, qy;
+    if (!referenceFirstHit(g.heights.data(), g.heights.nx, g.heights.ny, g.hMax, g.cellSize, x, y, dir, g.s.marchStep,
+                           qx, qy))
+        return;
+    double L[3];
+    radianceFromHit(g, qx, qy, w, prevD, prevI, L);
+    for (int c = 0; c < 3; ++c) acc[c] += weight * L[c];
+}
+
+// The lobe ray w seen along m azimuths only (ReferenceGiSettings::
+// receiverAzimuths): the rays at w's elevation along the two azimuths
+// phi_j = 2 pi j / m on either side of w's, weighted linearly.
+void addAzimuthSnappedRadiance(const GlossyGather& g, const std::array<Grid, 3>& prevD, const std::vector<float>* prevI,
+                               const double nrm[3], const double w[3], int x, int y, double acc[3]) {
+    const int m = g.s.receiverAzimuths;
+    const double dphi = 2.0 * kPi / m;
+    double phi = std::atan2(w[1], w[0]);
+    if (phi < 0.0) phi += 2.0 * kPi;
+    const double u = phi / dphi;
+    const int j0 = std::min(static_cast<int>(u), m - 1);
+    const double f = u - j0;
+    const double horizontal = std::sqrt(w[0] * w[0] + w[1] * w[1]);
+    for (int k = 0; k < 2; ++k) {
+        const double phiJ = dphi * ((j0 + k) % m);
+        const double wj[3] = {horizontal * std::cos(phiJ), horizontal * std::sin(phiJ), w[2]};
+        addRayRadiance(g, prevD, prevI, nrm, wj, x, y, k == 0 ? 1.0 - f : f, acc);
+    }
+}
+
 void firstBouncePhong(const GlossyGather& g, const std::array<Grid, 3>& prevD, const std::vector<float>* prevI,
                       const double view[3], int x, int y, double out[3]) {
-    const int nx = g.heights.nx, ny = g.heights.ny, n = g.s.lobeRings;
+    const int nx = g.heights.nx, n = g.s.lobeRings;
     const std::size_t i = static_cast<std::size_t>(y) * nx + x;
     double nrm[3], r[3], t[3], b[3], acc[3] = {0.0, 0.0, 0.0};
     g.surf.normalAt(i, nrm);
@@ -320,15 +356,10 @@ void firstBouncePhong(const GlossyGather& g, const std::array<Grid, 3>& prevD, c
         for (int j = 0; j < 2 * n; ++j) {
             double w[3];
             lobeDirection(r, t, b, S, n, a, j, w);
-            if (nrm[0] * w[0] + nrm[1] * w[1] + nrm[2] * w[2] <= 0.0) continue;
-            const std::array<float, 3> dir = {static_cast<float>(w[0]), static_cast<float>(w[1]),
-                                              static_cast<float>(w[2])};
-            float qx, qy;
-            if (!referenceFirstHit(g.heights.data(), nx, ny, g.hMax, g.cellSize, x, y, dir, g.s.marchStep, qx, qy))
-                continue;
-            double L[3];
-            radianceFromHit(g, qx, qy, w, prevD, prevI, L);
-            for (int c = 0; c < 3; ++c) acc[c] += L[c];
+            if (g.s.receiverAzimuths > 0)
+                addAzimuthSnappedRadiance(g, prevD, prevI, nrm, w, x, y, acc);
+            else
+                addRayRadiance(g, prevD, prevI, nrm, w, x, y, 1.0, acc);
         }
     for (int c = 0; c < 3; ++c) out[c] = g.ws * acc[c] / (2.0 * n * n);
 }
@@ -408,6 +439,7 @@ void renderReferenceGlossy(ConstGridView heights, float cellSize, const ShRgb& l
     const double wd = sh.brdf == Brdf::Phong ? 0.0 : 1.0;
     const double view[3] = {sh.viewDir[0], sh.viewDir[1], sh.viewDir[2]};
     if (s.lobeRings < 1) throw InputError("glossy reference: lobeRings must be at least 1");
+    if (s.receiverAzimuths < 0) throw InputError("glossy reference: receiverAzimuths must not be negative");
     Grid gx, gy;
     computeGradient(heights, cellSize, gx, gy);
     const GlossySurface surf(gx, gy, surface, sh);

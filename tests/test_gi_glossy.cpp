@@ -38,6 +38,32 @@ GiSettings glossySettings(Brdf brdf, float exponent, int bounces, GlossyIndirect
     return s;
 }
 
+// One-bounce glossy reference settings (Phong of exponent S) with the given
+// quadrature: fixed directions, horizon azimuths and lobe rings.
+ReferenceGiSettings glossyReference(float S, int directions, int azimuths, int lobeRings) {
+    ReferenceGiSettings rs;
+    rs.directions = directions;
+    rs.azimuths = azimuths;
+    rs.lobeRings = lobeRings;
+    rs.bounces = 1;
+    rs.shading = glossySettings(Brdf::Phong, S, 1, GlossyIndirect::VectorPyramid).shading;
+    return rs;
+}
+
+// Relative RMS difference of a's green indirect light from b's over the
+// interior of an n x 9 valley (two cells of border left out).
+double valleyInteriorChange(const ReferenceGiResult& a, const ReferenceGiResult& b, int n) {
+    double d2 = 0.0, r2 = 0.0;
+    for (int y = 2; y < 7; ++y)
+        for (int x = 2; x < n - 2; ++x) {
+            const double v = a.indirect[1](x, y), w = b.indirect[1](x, y);
+            d2 += (v - w) * (v - w);
+            r2 += w * w;
+        }
+    REQUIRE(r2 > 0.0);
+    return std::sqrt(d2 / r2);
+}
+
 std::vector<float> allChannels(const std::array<Grid, 3>& g) {
     std::vector<float> v;
     for (const Grid& c : g) v.insert(v.end(), c.v.begin(), c.v.end());
@@ -234,26 +260,13 @@ TEST_CASE("gi.glossy reference: converged in the lobe quadrature, and symmetric 
     const Grid h = valley(n, 9, 1.0f);
     const AlbedoMap a = uniformAlbedo(n, 9, 1.0f);
     for (float S : {8.0f, 64.0f}) {
-        ReferenceGiSettings rs;
-        rs.directions = 256;
-        rs.azimuths = 128;
-        rs.bounces = 1;
-        rs.shading = glossySettings(Brdf::Phong, S, 1, GlossyIndirect::VectorPyramid).shading;
+        ReferenceGiSettings rs = glossyReference(S, 256, 128, 8);
         ReferenceGiResult r12, r24;  // 8 and 16 rings
-        rs.lobeRings = 8;
         renderReferenceGi(h.view(), 1.0f, sunSkyLight(), &a, rs, r12);
         rs.lobeRings = 16;
         renderReferenceGi(h.view(), 1.0f, sunSkyLight(), &a, rs, r24);
-        double d2 = 0.0, r2 = 0.0;
-        for (int y = 2; y < 7; ++y)
-            for (int x = 2; x < n - 2; ++x) {
-                const double v12 = r12.indirect[1](x, y), v24 = r24.indirect[1](x, y);
-                d2 += (v12 - v24) * (v12 - v24);
-                r2 += v24 * v24;
-            }
-        const double change = std::sqrt(d2 / r2);
+        const double change = valleyInteriorChange(r12, r24, n);
         MESSAGE("S = " << S << ": 8 -> 16 rings, relative RMS change " << change);
-        CHECK(r2 > 0.0);
         CHECK(change < 0.03);
         // under a uniform sky the walls mirror each other
         ReferenceGiResult u;
@@ -476,12 +489,7 @@ TEST_CASE("gi.glossy reference: the order-4 diagnostics change what they name an
     const AlbedoMap a = uniformAlbedo(n, n, 1.0f);
     const GiLighting light;
     auto reference = [&](bool membersSh, bool receiverSh) {
-        ReferenceGiSettings rs;
-        rs.directions = 512;
-        rs.azimuths = 64;
-        rs.lobeRings = 6;
-        rs.bounces = 1;
-        rs.shading = glossySettings(Brdf::Phong, 64.0f, 1, GlossyIndirect::VectorPyramid).shading;
+        ReferenceGiSettings rs = glossyReference(64.0f, 512, 64, 6);
         rs.membersSh = membersSh;
         rs.receiverSh = receiverSh;
         ReferenceGiResult r;
@@ -500,4 +508,31 @@ TEST_CASE("gi.glossy reference: the order-4 diagnostics change what they name an
         CHECK(members.direct[ch].v == exact.direct[ch].v);
         CHECK(receivers.direct[ch].v == exact.direct[ch].v);
     }
+}
+
+TEST_CASE("gi.glossy reference: the scan-azimuth diagnostic converges to every ray's own hit") {
+    // receiverAzimuths: each receiver lobe ray reads the first hits at its
+    // elevation along the two nearest of m azimuths. With m large the two
+    // rays are the lobe ray's neighbours, so the indirect light comes close
+    // to the exact one; with 3 azimuths (none along the valley's cross
+    // section) the walls lose what faces them; the direct light is the same.
+    const int n = 21;
+    const Grid h = valley(n, 9, 1.0f);
+    const AlbedoMap a = uniformAlbedo(n, 9, 1.0f);
+    ReferenceGiSettings rs = glossyReference(32.0f, 256, 128, 6);
+    ReferenceGiResult exact, fine, coarse;
+    renderReferenceGi(h.view(), 1.0f, sunSkyLight(), &a, rs, exact);
+    rs.receiverAzimuths = 2048;
+    renderReferenceGi(h.view(), 1.0f, sunSkyLight(), &a, rs, fine);
+    rs.receiverAzimuths = 3;
+    renderReferenceGi(h.view(), 1.0f, sunSkyLight(), &a, rs, coarse);
+    const double fineChange = valleyInteriorChange(fine, exact, n),
+                 coarseChange = valleyInteriorChange(coarse, exact, n);
+    MESSAGE("relative RMS change from every ray's own hit: 2048 azimuths " << fineChange << ", 3 azimuths "
+                                                                           << coarseChange);
+    CHECK(fineChange < 0.01);
+    CHECK(coarseChange > 0.1);
+    for (int ch = 0; ch < 3; ++ch) CHECK(fine.direct[ch].v == exact.direct[ch].v);
+    rs.receiverAzimuths = -1;
+    CHECK_THROWS_AS(renderReferenceGi(h.view(), 1.0f, sunSkyLight(), &a, rs, coarse), InputError);
 }
