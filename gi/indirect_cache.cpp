@@ -149,10 +149,7 @@ const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCac
         cache.valid = false;
         return nullptr;
     }
-    if (cache.framesWithoutPlan > 0) {
-        --cache.framesWithoutPlan;
-        return nullptr;
-    }
+    if (skipsPlan(cache.framesWithoutPlan)) return nullptr;
     boundRadianceChange(in, cache);
     for (std::size_t t = 0; t < cache.drift.size(); ++t) cache.drift[t] += cache.radianceBound[t];
     for (std::size_t t = 0; t < cache.drift.size(); ++t) {
@@ -161,8 +158,7 @@ const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCac
         if (dirty) cache.drift[t] = 0.0f;
         cache.tiles.dirty[t] = dirty ? 1 : 0;
     }
-    if (cache.tiles.dirtyCount() == static_cast<int>(cache.tiles.dirty.size()))
-        cache.framesWithoutPlan = kFramesWithoutPlan;
+    countAfterPlan(cache.tiles.dirtyCount() == static_cast<int>(cache.tiles.dirty.size()), cache.framesWithoutPlan);
     return &cache.tiles;
 }
 

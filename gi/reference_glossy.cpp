@@ -301,12 +301,6 @@ void gatherTexel(const GlossyGather& g, const std::array<Grid, 3>& prevD, const 
     }
 }
 
-// The first bounce's Phong part towards the viewer at texel (x, y), exact:
-// the texel's lobe about the viewer's reflection sampled by the lobe
-// quadrature (gi/reference_glossy_lobe.h), each ray's first hit sending its
-// exact exit radiance (prevI null; else from I_0 in SH, the membersSh
-// diagnostic); rays below the tangent plane carry nothing, rays that escape
-// see the sky (direct light, bounce 0).
 // The radiance arriving at texel (x, y) from direction w (the first hit's,
 // 0 for a ray below the tangent plane or one that escapes to the sky), added
 // to acc times `weight`.
@@ -343,6 +337,13 @@ void addAzimuthSnappedRadiance(const GlossyGather& g, const std::array<Grid, 3>&
     }
 }
 
+// The first bounce's Phong part towards the viewer at texel (x, y), exact:
+// the texel's lobe about the viewer's reflection sampled by the lobe
+// quadrature (gi/reference_glossy_lobe.h), each ray's first hit sending its
+// exact exit radiance (prevI null; else from I_0 in SH, the membersSh
+// diagnostic); rays below the tangent plane carry nothing, rays that escape
+// see the sky (direct light, bounce 0). With receiverAzimuths, each ray as the
+// scan's azimuths see it (addAzimuthSnappedRadiance).
 void firstBouncePhong(const GlossyGather& g, const std::array<Grid, 3>& prevD, const std::vector<float>* prevI,
                       const double view[3], int x, int y, double out[3]) {
     const int nx = g.heights.nx, n = g.s.lobeRings;

@@ -27,11 +27,7 @@ void resetVisibilityCache(const HeightPyramid& pyr, VisibilityCache& cache) {
 
 void forgetEnvironmentDrift(VisibilityCache& cache) { std::fill(cache.drift.begin(), cache.drift.end(), 0.0f); }
 
-bool shouldPlanTiles(VisibilityCache& cache) {
-    if (cache.framesWithoutPlan == 0) return true;
-    --cache.framesWithoutPlan;
-    return false;
-}
+bool shouldPlanTiles(VisibilityCache& cache) { return !skipsPlan(cache.framesWithoutPlan); }
 
 namespace {
 
@@ -76,8 +72,7 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
         cache.geometryTiles.dirty[t] = addDrift(any, tolerance, cache.geometryDrift[t]) ? 1 : 0;
     }
     const int all = static_cast<int>(cache.drift.size());
-    if (cache.tiles.dirtyCount() == all && cache.geometryTiles.dirtyCount() == all)
-        cache.framesWithoutPlan = kFramesWithoutPlan;
+    countAfterPlan(cache.tiles.dirtyCount() == all && cache.geometryTiles.dirtyCount() == all, cache.framesWithoutPlan);
 }
 
 }  // namespace terrain::gi

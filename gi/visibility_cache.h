@@ -41,6 +41,18 @@ inline constexpr int kVisibilityTile = 32;
 /// tolerance, and the choice depends on the frames alone (deterministic).
 inline constexpr int kFramesWithoutPlan = 7;
 
+/// The count-down of kFramesWithoutPlan, for every cache that plans tiles
+/// (this one, gi/indirect_cache.h): whether this frame skips its plan (and
+/// counts it), and the count set again after a plan that found every tile dirty.
+inline bool skipsPlan(int& framesWithoutPlan) {
+    if (framesWithoutPlan == 0) return false;
+    --framesWithoutPlan;
+    return true;
+}
+inline void countAfterPlan(bool everyTileDirty, int& framesWithoutPlan) {
+    if (everyTileDirty) framesWithoutPlan = kFramesWithoutPlan;
+}
+
 /// The azimuths [phi0, phi1] (radians) a key light's visibility reads.
 struct AzimuthRange {
     double phi0 = 0.0, phi1 = 0.0;
