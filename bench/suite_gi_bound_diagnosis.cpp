@@ -21,6 +21,7 @@
 #include "bench/suites.h"
 #include "core/parallel.h"
 #include "gi/frame.h"
+#include "gi/indirect_cache.h"
 #include "sim/scene.h"
 
 namespace terrain::bench {
@@ -71,7 +72,7 @@ struct Track {
     std::string name;
     GiState now, last;
     Grid heights, lastHeights;
-    std::vector<double> bound, vChange, indirectBound, indirectChange, dh;
+    std::vector<double> bound, vChange, indirectSampleBound, indirectBound, indirectChange, dh;
     // An oracle that knows the true results: per tile it keeps its cached V
     // and indirect light until they are more than the tolerance from the
     // truth. The share of tiles it recomputes per frame is what any
@@ -131,10 +132,10 @@ void oracleFrame(Track& t, const gi::GiSettings& settings, float tolerance) {
     t.oracleIndirectShare.push_back(refreshTiles(ind, tolerance, t.now, s, nullptr, &t.oracleIndirect));
 }
 
-// Per tile, the radiance bound of gi/indirect_cache.h for the change of the
-// direct light from the last frame to this one (the largest over the
-// indirect azimuths of boundSampleChangePerAzimuth).
-std::vector<double> indirectRadianceBound(const GiState& now, const GiState& last, int azimuths) {
+// Per tile, the largest move of the indirect scan's radiance samples for the
+// change of the direct light from the last frame to this one (the largest
+// over the indirect azimuths of boundSampleChangePerAzimuth).
+std::vector<double> indirectSampleBound(const GiState& now, const GiState& last, int azimuths) {
     const std::array<ConstGridView, 3> before{last.shade.rgb[0].cview(), last.shade.rgb[1].cview(),
                                               last.shade.rgb[2].cview()};
     const std::array<ConstGridView, 3> after{now.shade.rgb[0].cview(), now.shade.rgb[1].cview(),
@@ -149,6 +150,22 @@ std::vector<double> indirectRadianceBound(const GiState& now, const GiState& las
         t = std::max(t, static_cast<double>(perAzimuth[i]));
     }
     return out;
+}
+
+// Per tile, the radiance bound gi/indirect_cache.h adds for that change: the
+// sample moves weighed by the last frame's receivers' occlusion shares.
+std::vector<double> indirectRadianceBound(const GiState& now, const GiState& last, int azimuths) {
+    gi::IndirectCache cache;
+    cache.lastSource = last.shade.rgb;
+    const gi::IndirectPlanInputs plan{.source = now.shade.rgb,
+                                      .heights = now.pyramid,
+                                      .lastPyramid = last.indirect.radiance,
+                                      .geometryTiles = nullptr,
+                                      .azimuths = azimuths,
+                                      .tolerance = 0.0f,
+                                      .blocker = &last.indirect.blocker};
+    gi::boundRadianceChange(plan, cache);
+    return std::vector<double>(cache.radianceBound.begin(), cache.radianceBound.end());
 }
 
 // The ambient map at the new normals with the last frame's environment V.
@@ -176,6 +193,8 @@ void measureFrame(Track& t, const gi::GiSettings& settings, float cell, float to
     const std::vector<double> ind =
         perTile({&t.last.indirect.indirect[0], &t.last.indirect.indirect[1], &t.last.indirect.indirect[2]},
                 {&t.now.indirect.indirect[0], &t.now.indirect.indirect[1], &t.now.indirect.indirect[2]}, t.now, s);
+    const std::vector<double> indSample = indirectSampleBound(t.now, t.last, settings.indirect.azimuths);
+    t.indirectSampleBound.insert(t.indirectSampleBound.end(), indSample.begin(), indSample.end());
     const std::vector<double> indBound = indirectRadianceBound(t.now, t.last, settings.indirect.azimuths);
     t.indirectBound.insert(t.indirectBound.end(), indBound.begin(), indBound.end());
     t.bound.insert(t.bound.end(), cache.drift.begin(), cache.drift.end());
@@ -188,9 +207,11 @@ const char* kIntro =
     "frames compared per visibility tile (32 x 32 receivers). One-frame V bound: the drift "
     "gi/visibility_cache.h adds for the frame (environment, per azimuth, V alone). True change of the cached V: "
     "the ambient map at the new normals shaded with the last frame's V against the new V, largest over the tile's "
-    "texels. Radiance bound of the indirect light: what gi/indirect_cache.h adds for the frame's change of the "
-    "direct light (the largest over the indirect azimuths of boundSampleChangePerAzimuth); the true change of the "
-    "indirect light is that of the whole frame (sources and geometry), largest over the tile's texels and "
+    "texels. Largest radiance sample move: the largest over the indirect azimuths of boundSampleChangePerAzimuth "
+    "for the frame's change of the direct light; radiance bound of the indirect light: what gi/indirect_cache.h "
+    "adds for it (the sample moves weighed by each receiver's occlusion shares per azimuth and per distance "
+    "group, times the occlusion factor); the true change of the indirect light is that of the whole frame (sources and "
+    "geometry), largest over the tile's texels and "
     "channels. Quantiles over every tile of every frame after the first. The oracle knows the true results: per "
     "tile it keeps its cached V (or indirect light) until the tile's texels are more than the tolerance from the "
     "truth, then takes the truth; the share of tiles it recomputes per frame is about the least any conservative "
@@ -214,6 +235,7 @@ std::string report(const Track& t, float tolerance) {
            row("per tile: one-frame bound on the cached V's ambient change", t.bound, tolerance) +
            row("per tile: true change of the cached V's ambient", t.vChange, tolerance) +
            row("per tile: V bound / true change (share above 1)", ratio, 1.0) +
+           row("per tile: largest radiance sample move of the indirect scan", t.indirectSampleBound, tolerance) +
            row("per tile: one-frame radiance bound of the indirect light", t.indirectBound, tolerance) +
            row("per tile: true change of the indirect light", t.indirectChange, tolerance) +
            row("oracle: share of the tiles whose V it recomputes, per frame (share above 0)", t.oracleVShare, 0.0) +

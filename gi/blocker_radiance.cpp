@@ -286,6 +286,7 @@ void prepareBlockerRadiance(const HeightPyramid& pyr, int azimuths, BlockerRadia
     st.farSlope.resize(planeR * static_cast<std::size_t>(azimuths));
     st.receiverOcclusion.resize(planeR);
     st.receiverOcclusionRunning.resize(planeR * static_cast<std::size_t>(azimuths));
+    st.receiverGroupOcclusion.resize(planeR * static_cast<std::size_t>(kDistanceGroups));
     st.occlusion.ensureSize(pyr.nx, pyr.ny);
 }
 

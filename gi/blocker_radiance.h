@@ -65,6 +65,11 @@ struct BlockerRadianceState {
     // the azimuths 0..j, unnormalised (azimuth j's share of O_k is
     // (running_j - running_(j-1)) / running_(m-1); gi/indirect_cache.h)
     std::vector<float> receiverOcclusionRunning;
+    // per distance group g (kDistanceGroups planes of nxr * nyr, gi/pyramid.h):
+    // the part of the receivers' occlusion that group's members cover,
+    // unnormalised as the running sums, from the scan (summed |Delta F| over
+    // the azimuths; the groups add up to the last running sum, up to rounding)
+    std::vector<float> receiverGroupOcclusion;
     std::array<std::vector<float>, 3> receiverShade;  // E / pi at the receivers, per channel
     std::vector<float> scratch;                       // per block of rows: padded row buffers
     std::vector<NearTap> taps;                        // azimuths x near samples

@@ -37,6 +37,7 @@ struct StepTaps {
     std::ptrdiff_t nextO, nextDB;
     V back[2];   // -(cos phi, sin phi)
     bool clamp;  // members send max(0, u)
+    int group;   // Irradiance: the step's distance group (-1: none summed)
 };
 
 template <class V, CastingMoments K>
@@ -65,6 +66,7 @@ template <class V, CastingMoments K>
         tp.clamp = az.clampNegative;
         return tp;
     }
+    tp.group = az.distanceGroups ? az.distanceGroups[i] : -1;
     for (int c = 0; c < 3; ++c) {
         const ScanStep& rs = az.radiance[c][i];
         const std::ptrdiff_t ro = Y * rs.rowStep;
@@ -210,6 +212,11 @@ struct CastingRow {
             const V fv = (nw & (tc >= gl)) ? fNew : f;  // below the receiver's plane: nothing
             mo[0] = fv - f;
             store(F + X0, fv);
+            if (tp.group >= 0) {
+                // |Delta F|: float rounding may make a difference of increasing F negative
+                float* occ = A + static_cast<std::size_t>(3 + tp.group) * pad + X0;
+                store(occ, load<V>(occ) + (mo[0] < zero ? zero - mo[0] : mo[0]));
+            }
         }
         // moments x radiance (lanes without a new member have zero moments;
         // the radiance read there is finite: inside the field's padding and guard)

@@ -35,6 +35,12 @@
 // segment ends (f1 = (w + sin w cos w) / 2, f2 = sin^2 w / 2, g the tangent
 // slope along the azimuth; n = (-gx, -gy, 1), so d . n_h = -g).
 //
+// Occlusion by distance (Irradiance, AzimuthSteps::distanceGroups): each
+// segment's measure |Delta F| is also summed per distance group of its step
+// (gi/pyramid.h, distanceGroup), over the azimuths the caller walks: the part
+// of the receiver's occlusion each group's members cover, by which the
+// indirect cache weighs a change of that group's samples (gi/indirect_cache.h).
+//
 // Speed: the kernel runs over 8 (AVX2) or 4 (SSE2) lanes, bit-identically
 // (core/simd.h), over a block of up to kMaxScanRows receiver rows, step by
 // step: at each step every row's groups in turn (each step's reads sweep
@@ -47,6 +53,7 @@
 #include <span>
 #include <vector>
 
+#include "gi/pyramid.h"
 #include "gi/receiver_tiles.h"
 #include "gi/visibility.h"
 
@@ -76,7 +83,12 @@ struct IndirectScratch {
     std::vector<float> result;
     // Each row's running values: kStatePlanes planes of pad floats; plane 0 is
     // each receiver's running maximum slope (after the walk: its horizon).
+    // Irradiance with distance groups: planes kGroupPlane.. hold each group's
+    // summed |Delta F|, added to over every azimuth walked (the caller zeroes them).
     std::vector<float> state;
+    static constexpr int kGroupPlane = 4 + 3;
+    static_assert(kGroupPlane + kDistanceGroups <= kStatePlanes, "the Irradiance state has room for the groups");
+    float* groupOccludersOf(int r) { return stateOf(r) + static_cast<std::size_t>(kGroupPlane) * pad; }
     std::vector<int> groupSteps, active;  // per row: per lane the valid prefix; the groups still walking
     float* resultOf(int r) { return result.data() + static_cast<std::size_t>(r) * kResultPlanes * pad; }
     float* stateOf(int r) { return state.data() + static_cast<std::size_t>(r) * kStatePlanes * pad; }
@@ -97,6 +109,9 @@ struct AzimuthSteps {
     const ScanStep* glossy = nullptr;
     const std::uint16_t* const* glossyFields = nullptr;  // bfloat16 (gi/radiance_pyramid.h)
     bool clampNegative = false;
+    // Irradiance: each step's distance group, whose |Delta F| the kernel sums
+    // (IndirectScratch::groupOccludersOf); null: none summed
+    const std::uint8_t* distanceGroups = nullptr;
 };
 
 /// One receiver row: padded inputs (loadReceiverRow), the row's valid

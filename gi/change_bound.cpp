@@ -303,6 +303,7 @@ struct StepTable {
     std::vector<StepExtent> extent;
     std::vector<double> tauMinFrom;
     std::vector<int> octave;
+    std::vector<int> group;  // distance group (gi/pyramid.h)
     AxisWeights wx, wy;
     double meanPart = 1.0, maxPart = 0.0;  // |1 - b|, |b|
 };
@@ -313,6 +314,7 @@ StepTable stepTable(const HeightPyramid& pyr) {
         t.extent.push_back(stepExtent(pyr, i));
         t.tauMinFrom.push_back(tauMinFrom(pyr, i, firstLevel));
         t.octave.push_back(stepOctave(pyr, i));
+        t.group.push_back(distanceGroup(pyr.steps[static_cast<std::size_t>(i)].tauCells));
     }
     const int octaves = std::max(1, pyr.octaves);
     t.wx = axisWeights(pyr.nx, octaves);
@@ -364,22 +366,29 @@ void forEachTile(const HeightPyramid& pyr, int T, std::vector<float>& out, PerTi
     });
 }
 
-// Largest D_ij over the steps of one azimuth; steps before `first` see no
-// change from any azimuth, and no step's D exceeds the largest change anywhere.
+// Largest D_ij over the steps of one azimuth, and with groupBest (null: not
+// wanted) over each distance group's steps (kDistanceGroups values, raised to
+// it); steps before `first` see no change from any azimuth, and no step's D
+// exceeds the largest change anywhere.
 double sampleBoundFrom(const MaxChangePyramid& dv, const StepTable& steps, const CellBox& c, int first, double cs,
-                       double sn) {
+                       double sn, double* groupBest = nullptr) {
     const double mAll = maxChangeAll(dv);
     double best = 0.0;
-    for (std::size_t i = static_cast<std::size_t>(first); i < steps.extent.size() && best < mAll; ++i) {
+    for (std::size_t i = static_cast<std::size_t>(first); i < steps.extent.size(); ++i) {
+        double* group = groupBest ? groupBest + steps.group[i] : nullptr;
+        if (group ? *group >= mAll : best >= mAll) continue;
         const CellBox box = stepBoxOver(steps.extent[i], c, oneDirection(cs, sn));
-        best = std::max(best, filteredChange(dv, steps, static_cast<int>(i), box));
+        const double d = filteredChange(dv, steps, static_cast<int>(i), box);
+        best = std::max(best, d);
+        if (group) *group = std::max(*group, d);
     }
     return best;
 }
 
 // Fills `azimuths` values per tile (tile-major) at the m samples phi_j = 2 pi
 // j / m of the full circle, tile rows in parallel: perTile(the tile's cells,
-// cos phi_j and sin phi_j of every j, out) writes one tile's m values.
+// cos phi_j and sin phi_j of every j, out, the tile's index) writes one
+// tile's m values.
 template <class PerTile>
 void forEachTileAndAzimuth(const MaxChangePyramid& dv, const HeightPyramid& pyr, int T, int azimuths,
                            std::vector<float>& out, PerTile&& perTile) {
@@ -398,7 +407,7 @@ void forEachTileAndAzimuth(const MaxChangePyramid& dv, const HeightPyramid& pyr,
         for (int ty = ty0; ty < ty1; ++ty)
             for (int tx = 0; tx < tilesX; ++tx) {
                 float* values = out.data() + (static_cast<std::size_t>(ty) * tilesX + tx) * m;
-                perTile(tileCells(pyr, T, tx, ty), cs, sn, values);
+                perTile(tileCells(pyr, T, tx, ty), cs, sn, values, static_cast<std::size_t>(ty) * tilesX + tx);
             }
     });
 }
@@ -557,7 +566,7 @@ void boundSlopeChangePerAzimuth(const MaxChangePyramid& dh, const HeightPyramid&
     const double lipschitz = heightFilterLipschitz(pyr);
     forEachTileAndAzimuth(
         dh, pyr, tileReceivers, azimuths, tileBound,
-        [&](const CellBox& c, const std::vector<double>& cs, const std::vector<double>& sn, float* out) {
+        [&](const CellBox& c, const std::vector<double>& cs, const std::vector<double>& sn, float* out, std::size_t) {
             const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
             const int first = firstBusyStep(dh, pyr, c, m0);
             for (std::size_t j = 0; j < cs.size(); ++j)
@@ -570,10 +579,27 @@ void boundSampleChangePerAzimuth(const MaxChangePyramid& dv, const HeightPyramid
     const StepTable steps = stepTable(field);
     forEachTileAndAzimuth(
         dv, field, tileReceivers, azimuths, tileBound,
-        [&](const CellBox& c, const std::vector<double>& cs, const std::vector<double>& sn, float* out) {
+        [&](const CellBox& c, const std::vector<double>& cs, const std::vector<double>& sn, float* out, std::size_t) {
             const int first = lastQuietStep(dv, field, c) + 1;
             for (std::size_t j = 0; j < cs.size(); ++j)
                 out[j] = roundUp(sampleBoundFrom(dv, steps, c, first, cs[j], sn[j]));
+        });
+}
+
+void boundSampleChangePerAzimuthAndGroup(const MaxChangePyramid& dv, const HeightPyramid& field, int tileReceivers,
+                                         int azimuths, std::vector<float>& tileBound, std::vector<float>& groupBound) {
+    const StepTable steps = stepTable(field);
+    const std::size_t tiles =
+        static_cast<std::size_t>(tileCount(field.nxr, tileReceivers)) * tileCount(field.nyr, tileReceivers);
+    groupBound.assign(tiles * kDistanceGroups, 0.0f);
+    forEachTileAndAzimuth(
+        dv, field, tileReceivers, azimuths, tileBound,
+        [&](const CellBox& c, const std::vector<double>& cs, const std::vector<double>& sn, float* out, std::size_t t) {
+            const int first = lastQuietStep(dv, field, c) + 1;
+            double groups[kDistanceGroups] = {};
+            for (std::size_t j = 0; j < cs.size(); ++j)
+                out[j] = roundUp(sampleBoundFrom(dv, steps, c, first, cs[j], sn[j], groups));
+            for (int g = 0; g < kDistanceGroups; ++g) groupBound[t * kDistanceGroups + g] = roundUp(groups[g]);
         });
 }
 

@@ -211,6 +211,13 @@ float blockingMaxLipschitz(BlockingMax rule);
 void boundSampleChangePerAzimuth(const MaxChangePyramid& dv, const HeightPyramid& field, int tileReceivers,
                                  int azimuths, std::vector<float>& tileBound);
 
+/// The same, and per tile the largest D_ij over the azimuths and the steps
+/// of each distance group g (gi/pyramid.h, distanceGroup of the step's tau):
+/// groupBound[t kDistanceGroups + g]. A far change moves the samples of the
+/// far groups alone.
+void boundSampleChangePerAzimuthAndGroup(const MaxChangePyramid& dv, const HeightPyramid& field, int tileReceivers,
+                                         int azimuths, std::vector<float>& tileBound, std::vector<float>& groupBound);
+
 // ---- tangent planes and normals per tile -------------------------------------------
 // omega_min (gi/visibility.h) reads the height gradient at the receiver, or
 // with sub-sampling the box of gradients over its footprint texels (offsets

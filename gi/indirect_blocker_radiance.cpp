@@ -89,8 +89,12 @@ void BlockerRadianceIndirect::scanBlock(int block, bool horizons) {
     // the rows' receiver heights and gradients; E sums zeroed
     scan_.loadRows(rb, sc);
     std::fill(sc.irradiance.data(), sc.irradiance.data() + 3 * static_cast<std::size_t>(rb.rows) * pad, 0.0f);
+    // with the horizons, each distance group's occlusion (the indirect cache's weights)
+    if (horizons)
+        for (int r = 0; r < rb.rows; ++r)
+            std::fill_n(sc.groupOccludersOf(r), static_cast<std::size_t>(kDistanceGroups) * pad, 0.0f);
     for (int j = 0; j < in_.op.azimuths; ++j) {
-        const AzimuthSteps az = scan_.azimuth(j);
+        const AzimuthSteps az = scan_.azimuth(j, false, horizons);
         scan_.castRows(az, j, rb, sc);
         for (int r = 0; r < rb.rows; ++r) {
             const int Y = rb.yBegin + r;
@@ -107,6 +111,23 @@ void BlockerRadianceIndirect::scanBlock(int block, bool horizons) {
         }
     }
     receiverIrradiance(rb, sc);
+    if (horizons) storeGroupOcclusion(rb, sc);
+}
+
+// Each distance group's occlusion at the block's receivers, summed over the
+// azimuths by the walks (BlockerRadianceState::receiverGroupOcclusion).
+void BlockerRadianceIndirect::storeGroupOcclusion(const RowBlock& rb, IndirectScratch& sc) {
+    const int nxr = in_.heights.nxr, pad = scan_.pad();
+    const std::size_t planeR = static_cast<std::size_t>(nxr) * in_.heights.nyr;
+    for (int r = 0; r < rb.rows; ++r) {
+        const std::size_t at = static_cast<std::size_t>(rb.yBegin + r) * nxr;
+        for (int g = 0; g < kDistanceGroups; ++g) {
+            const float* sums = sc.groupOccludersOf(r) + static_cast<std::size_t>(g) * pad;
+            float* out = st_.blocker.receiverGroupOcclusion.data() + static_cast<std::size_t>(g) * planeR + at;
+            for (const ColumnSpan& span : scan_.spans(rb.yBegin + r))
+                std::copy(sums + span.x0, sums + span.x1, out + span.x0);
+        }
+    }
 }
 
 // E / pi at the block's receivers (BlockerRadianceState::receiverShade):

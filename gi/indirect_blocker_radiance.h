@@ -26,6 +26,7 @@ public:
 private:
     void scanBlock(int block, bool horizons);
     void receiverIrradiance(const RowBlock& rb, const IndirectScratch& sc);
+    void storeGroupOcclusion(const RowBlock& rb, IndirectScratch& sc);
 
     const IndirectInputs& in_;
     const IndirectSettings& settings_;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <limits>
 
 #include "core/parallel.h"
 #include "gi/texel_runs.h"
@@ -28,9 +29,11 @@ bool cacheFits(const IndirectPlanInputs& in, const IndirectCache& cache) {
 bool hasOcclusions(const IndirectPlanInputs& in) {
     const BlockerRadianceState* b = in.blocker;
     const HeightPyramid& h = in.heights;
+    const std::size_t planeR = static_cast<std::size_t>(h.nxr) * h.nyr;
     return b && b->occlusionValid && h.subsample > 1 && b->nx == h.nx && b->ny == h.ny && b->nxr == h.nxr &&
            b->nyr == h.nyr && b->azimuths == in.azimuths && b->occlusion.nx == h.nx && b->occlusion.ny == h.ny &&
-           b->receiverOcclusionRunning.size() == static_cast<std::size_t>(in.azimuths) * h.nxr * h.nyr;
+           b->receiverOcclusionRunning.size() == static_cast<std::size_t>(in.azimuths) * planeR &&
+           b->receiverGroupOcclusion.size() == static_cast<std::size_t>(kDistanceGroups) * planeR;
 }
 
 // A receiver's occlusion sum (unnormalised, over the azimuths) at or below
@@ -39,22 +42,38 @@ bool hasOcclusions(const IndirectPlanInputs& in) {
 // measures are well above their rounding.
 constexpr float kNoShareBelow = 1e-6f;
 
-// rho_k of receiver k (row-major index): the azimuth bounds D_j weighed by
-// its shares of its occlusion, sum_j (O_kj / O_k) D_j (gi/indirect_cache.h);
+// The weighed mean sum_i w_i D_i / sum_i w_i, rounded up by the weights' and
+// the sums' rounding (a few ulp of the total; products in double, so that a
+// positive term never rounds to 0), or `largest` (max D) for weights of
+// (next to) no total occlusion.
+float shareWeighedBound(double weighed, double total, float largest) {
+    if (!(total > kNoShareBelow)) return largest;  // no occlusion to share, up to rounding
+    const float bound = static_cast<float>(weighed / total * (1.0 + 1e-5));
+    return std::min(largest, weighed > 0.0 ? std::max(bound, std::numeric_limits<float>::denorm_min()) : 0.0f);
+}
+
+// rho_k of receiver k (row-major index): the smaller of two weighings of its
+// occlusion (gi/indirect_cache.h): the azimuth bounds D_j by its shares per
+// azimuth, sum_j (O_kj / O_k) D_j, and the distance groups' bounds G_g
+// (over every azimuth) by its shares per group, sum_g (O_kg / O_k) G_g;
 // `largest` (max_j D_j) for a receiver with (next to) no occlusion.
-float receiverShareBound(const BlockerRadianceState& b, std::size_t k, const float* D, float largest) {
+float receiverShareBound(const BlockerRadianceState& b, std::size_t k, const float* D, const float* G, float largest) {
     const std::size_t m = static_cast<std::size_t>(b.azimuths), plane = static_cast<std::size_t>(b.nxr) * b.nyr;
     const float* running = b.receiverOcclusionRunning.data() + k;
-    const float total = running[(m - 1) * plane];
-    if (!(total > kNoShareBelow)) return largest;  // no occlusion to share, up to rounding
-    float weighed = 0.0f, before = 0.0f;
+    double weighed = 0.0, before = 0.0;
     for (std::size_t j = 0; j < m; ++j) {
-        const float now = running[j * plane];
-        weighed += std::max(0.0f, now - before) * D[j];
+        const double now = running[j * plane];
+        weighed += std::max(0.0, now - before) * D[j];
         before = now;
     }
-    // the shares' rounding: up by a few ulp of the total
-    return std::min(largest, weighed / total * (1.0f + 1e-5f));
+    const float byAzimuth = shareWeighedBound(weighed, running[(m - 1) * plane], largest);
+    const float* group = b.receiverGroupOcclusion.data() + k;
+    double groupWeighed = 0.0, groupTotal = 0.0;
+    for (std::size_t g = 0; g < kDistanceGroups; ++g) {
+        groupWeighed += static_cast<double>(group[g * plane]) * G[g];
+        groupTotal += group[g * plane];
+    }
+    return std::min(byAzimuth, shareWeighedBound(groupWeighed, groupTotal, largest));
 }
 
 // Per tile: the radiance bound, the largest rho_k over its receivers (max_j
@@ -65,14 +84,14 @@ void sharedBounds(const IndirectPlanInputs& in, IndirectCache& cache) {
     const int tilesX = tileCount(h.nxr, kVisibilityTile), tilesY = tileCount(h.nyr, kVisibilityTile);
     const std::size_t m = static_cast<std::size_t>(in.azimuths);
     const bool shares = hasOcclusions(in);
-    const auto tileBound = [&](int tx, int ty, const float* D) {
+    const auto tileBound = [&](int tx, int ty, const float* D, const float* G) {
         const float largest = *std::max_element(D, D + m);
         if (!shares) return largest;
         float bound = 0.0f;
         for (int Y = ty * kVisibilityTile; Y < std::min(h.nyr, (ty + 1) * kVisibilityTile); ++Y)
             for (int X = tx * kVisibilityTile; X < std::min(h.nxr, (tx + 1) * kVisibilityTile); ++X)
-                bound = std::max(bound,
-                                 receiverShareBound(*in.blocker, static_cast<std::size_t>(Y) * h.nxr + X, D, largest));
+                bound = std::max(
+                    bound, receiverShareBound(*in.blocker, static_cast<std::size_t>(Y) * h.nxr + X, D, G, largest));
         return bound;
     };
     parallelFor(0, tilesY, 1, [&](int ty0, int ty1) {
@@ -80,7 +99,8 @@ void sharedBounds(const IndirectPlanInputs& in, IndirectCache& cache) {
             for (int tx = 0; tx < tilesX; ++tx) {
                 const std::size_t t = static_cast<std::size_t>(ty) * tilesX + tx;
                 cache.radianceBound[t] =
-                    cache.occlusionFactor[t] * tileBound(tx, ty, cache.azimuthBound.data() + t * m);
+                    cache.occlusionFactor[t] *
+                    tileBound(tx, ty, cache.azimuthBound.data() + t * m, cache.groupBound.data() + t * kDistanceGroups);
             }
     });
 }
@@ -136,8 +156,8 @@ void boundRadianceChange(const IndirectPlanInputs& in, IndirectCache& cache) {
     buildMaxChangePyramid(before, after, cache.change);
     cache.radianceBound.assign(tiles, 0.0f);
     if (maxChangeAll(cache.change) == 0.0f) return;
-    boundSampleChangePerAzimuth(cache.change, in.lastPyramid.fields[0], kVisibilityTile, in.azimuths,
-                                cache.azimuthBound);
+    boundSampleChangePerAzimuthAndGroup(cache.change, in.lastPyramid.fields[0], kVisibilityTile, in.azimuths,
+                                        cache.azimuthBound, cache.groupBound);
     occlusionFactors(in, cache);
     sharedBounds(in, cache);
 }

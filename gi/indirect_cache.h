@@ -20,10 +20,16 @@
 //    by at most sum_j O_kj D_j (D_j: the largest sample move along j), the
 //    mean blocker radiance by at most rho_k = sum_j (O_kj / O_k) D_j <= max_j
 //    D_j, and the texel's light by at most O(x) max_k rho_k, O(x) = O / pi
-//    <= 1. Per tile the bound is the largest rho_k of its receivers times the
-//    largest O(x) of the texels that read them. A far change (a pit, a
-//    crater) that moves coarse samples of every tile then counts by the
-//    share of the sky its azimuths' blockers cover. The occlusions are the
+//    <= 1. The same holds per distance group of the steps (gi/pyramid.h):
+//    the segments of group g's members, over every azimuth, measure O_kg
+//    (the scan sums them, BlockerRadianceState::receiverGroupOcclusion;
+//    sum_g O_kg = O_k), and with G_g the largest sample move of group g's
+//    steps along any azimuth, rho_k <= sum_g (O_kg / O_k) G_g; the smaller of
+//    the two weighings is taken. Per tile the bound is the largest rho_k of
+//    its receivers times the largest O(x) of the texels that read them. A
+//    far change (a pit, a crater) moves the coarse, far samples of every
+//    tile: it then counts by the share of the sky the far members of its
+//    azimuths cover, not the whole occlusion along them. The occlusions are the
 //    last pass's; the geometry may have moved since by no more than the
 //    tolerance (else the tile re-gathers), so the factor is that largest
 //    O(x) plus the tolerance, at most 1. Without sub-sampling (every texel a
@@ -67,6 +73,7 @@ struct IndirectCache {
     std::array<Grid, 3> lastSource;      // L_0 the last indirect pass read
     MaxChangePyramid change;             // this frame: max over the channels of |L_0 - lastSource|
     std::vector<float> azimuthBound;     // per tile and indirect azimuth (tile-major)
+    std::vector<float> groupBound;       // per tile and distance group (gi/pyramid.h), over every azimuth
     std::vector<float> drift;            // per tile: bound of the radiance change since its result was gathered
     std::vector<float> occlusionFactor;  // per tile: this frame's factor of the radiance bound
     std::vector<float> radianceBound;    // per tile: this frame's bound (boundRadianceChange)

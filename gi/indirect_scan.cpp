@@ -47,6 +47,10 @@ void IndirectScan::beginFrame() {
     } else {
         st_.radianceSteps.resize(3 * tableSize_);
     }
+    st_.distanceGroups.resize(static_cast<std::size_t>(nSteps_));
+    for (int i = 0; i < nSteps_; ++i)
+        st_.distanceGroups[static_cast<std::size_t>(i)] =
+            static_cast<std::uint8_t>(distanceGroup(in_.heights.steps[static_cast<std::size_t>(i)].tauCells));
     st_.stepsPerColumn.resize(static_cast<std::size_t>(m) * pad_);
     st_.stepsPerRow.resize(static_cast<std::size_t>(m) * nyr);
     dirtySpans(in_.only, in_.heights.nxr, nyr, st_.spans);
@@ -105,7 +109,7 @@ void IndirectScan::loadRows(const RowBlock& rb, IndirectScratch& sc) const {
     }
 }
 
-AzimuthSteps IndirectScan::azimuth(int j, bool clampNegative) const {
+AzimuthSteps IndirectScan::azimuth(int j, bool clampNegative, bool distanceGroups) const {
     const std::size_t base = static_cast<std::size_t>(j) * nSteps_;
     const double phi = in_.op.phi[static_cast<std::size_t>(j)];
     AzimuthSteps az{st_.heightSteps.data() + base,
@@ -120,6 +124,7 @@ AzimuthSteps IndirectScan::azimuth(int j, bool clampNegative) const {
         return az;
     }
     for (std::size_t c = 0; c < 3; ++c) az.radiance[c] = st_.radianceSteps.data() + c * tableSize_ + base;
+    if (distanceGroups && moments_ == CastingMoments::Irradiance) az.distanceGroups = st_.distanceGroups.data();
     return az;
 }
 

@@ -64,8 +64,10 @@ public:
     bool hasWork(const RowBlock& rb) const;
     /// The block's receiver rows (loadReceiverRow) into its scratch.
     void loadRows(const RowBlock& rb, IndirectScratch& sc) const;
-    /// Azimuth j's step tables; clampNegative: GlossyNlp's members send max(0, u).
-    AzimuthSteps azimuth(int j, bool clampNegative = false) const;
+    /// Azimuth j's step tables; clampNegative: GlossyNlp's members send
+    /// max(0, u); distanceGroups: Irradiance sums each distance group's
+    /// occlusion (IndirectScratch::groupOccludersOf).
+    AzimuthSteps azimuth(int j, bool clampNegative = false, bool distanceGroups = false) const;
     /// Scans the block's rows along azimuth j (loaded by loadRows): row r's
     /// results in sc.resultOf(r), at the receivers of spans(yBegin + r).
     void castRows(const AzimuthSteps& az, int j, const RowBlock& rb, IndirectScratch& sc) const;

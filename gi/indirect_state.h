@@ -3,6 +3,7 @@
 // bounces' sums, U, and each strategy's scratch. Sized on the first frame of
 // a given size and settings; no allocation after it.
 #include <array>
+#include <cstdint>
 #include <vector>
 
 #include "core/grid.h"
@@ -34,8 +35,9 @@ struct IndirectState {
     std::vector<ScanStep> heightSteps;    // azimuths x steps
     std::vector<ScanStep> radianceSteps;  // RGB pyramids: channels x azimuths x steps
     std::vector<int> stepsPerColumn, stepsPerRow;
-    DirtySpans spans;                      // the receiver columns to scan, per row
-    std::vector<IndirectScratch> blocks;   // per worker slot (IndirectScan::scratch)
+    std::vector<std::uint8_t> distanceGroups;  // per step (gi/pyramid.h, distanceGroup)
+    DirtySpans spans;                          // the receiver columns to scan, per row
+    std::vector<IndirectScratch> blocks;       // per worker slot (IndirectScan::scratch)
     std::array<VisibilityField, 3> u;      // U per channel (16 SH planes at the receivers; not with BlockerRadiance)
     int uZeroFrom = kShCount;              // U's planes from this one on are known to be 0
     std::array<ShadingLight, 3> lights;    // the shading lights of U

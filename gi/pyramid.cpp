@@ -36,6 +36,12 @@ auto& octaveField(Pyramid& p, int o) {
 
 const PaddedField& octaveSynthesis(const HeightPyramid& p, int o) { return octaveField(p, o); }
 
+int distanceGroup(double tauCells) {
+    int g = 0;
+    for (double edge = 4.0; g + 1 < kDistanceGroups && tauCells >= edge; edge *= 2.0) ++g;
+    return g;
+}
+
 int pyramidStepCount(int nx, int ny, int levelsPerOctave) {
     const double diag = std::sqrt(static_cast<double>(nx - 1) * (nx - 1) + static_cast<double>(ny - 1) * (ny - 1));
     if (diag <= 1.0) return 1;
@@ -70,8 +76,7 @@ void decimateRowsOf(ConstGridView src, Grid& dst, int y0, int y1) {
         const float* ra = src.row(std::min(2 * y, src.ny - 1));
         const float* rb = src.row(std::min(2 * y + 1, src.ny - 1));
         float* out = dst.data() + static_cast<std::size_t>(y) * dst.nx;
-        for (int x = 0; x < inside; ++x)
-            out[x] = decimated<UseMax>(ra[2 * x], ra[2 * x + 1], rb[2 * x], rb[2 * x + 1]);
+        for (int x = 0; x < inside; ++x) out[x] = decimated<UseMax>(ra[2 * x], ra[2 * x + 1], rb[2 * x], rb[2 * x + 1]);
         for (int x = inside; x < dst.nx; ++x) {
             const int xa = std::min(2 * x, src.nx - 1), xb = std::min(2 * x + 1, src.nx - 1);
             out[x] = decimated<UseMax>(ra[xa], ra[xb], rb[xa], rb[xb]);

@@ -110,6 +110,14 @@ struct HeightPyramid {
     std::vector<float> tapWeight;
 };
 
+/// The steps grouped by distance, in doubling bands of tau (cells): [0, 4),
+/// [4, 8), ..., [256, inf). A group's members cover a part of a receiver's
+/// occlusion, and the indirect cache weighs a change of the group's samples
+/// by that part (gi/indirect_cache.h): a far change (a pit, a crater) then
+/// counts by the share of the sky the far members cover.
+inline constexpr int kDistanceGroups = 8;
+int distanceGroup(double tauCells);
+
 /// Receiver grid size along one axis for n cells and sub-sampling s.
 inline int receiverCount(int n, int s) { return n <= 0 ? 0 : (n - 1) / s + 1; }
 
