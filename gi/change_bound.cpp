@@ -259,19 +259,28 @@ int stepOctave(const HeightPyramid& pyr, int i) {
     return std::min(level / kv, pyr.octaves - 1);
 }
 
-// Per axis, the largest weight of one cell in a texel of the mean octave o:
-// 2^-o in whole blocks, larger in the last block when the grid's edge cuts it
-// (replicated cells count twice in a 2 x 2 mean).
+// Per axis, the largest weight of one cell in a level sample of the mean
+// octave o >= 1 over the cells [a0, a1]: its weight in its texel of B_o
+// (2^-o in whole blocks, larger in the last block when the grid's edge cuts
+// it: replicated cells count twice in a 2 x 2 mean) times the largest weight
+// the sample gives that texel. The sample is a convex combination (bilinear
+// read, level blend) of B-spline syntheses, each of which weighs a texel by
+// one tap's weight, at most 2/3 (w_1 at fraction 0; kTapWeight covers the
+// float weights' rounding), except where clamping at the image's edge puts
+// several taps on its first or last texel (then up to 1).
 struct AxisWeights {
+    static constexpr double kTapWeight = 2.0 / 3.0 * (1.0 + 1e-6);
     std::vector<int> lastStart;               // per octave: first cell of the last block
     std::vector<std::vector<double>> suffix;  // per octave: max weight from cell lastStart + k on
     double maxOver(int o, int a0, int a1) const {
         const double inside = std::ldexp(1.0, -o);
         const int start = lastStart[static_cast<std::size_t>(o)];
-        if (a1 < start) return inside;
+        const bool edgeTexel = a0 < (1 << o) || a1 >= start;
+        const double tap = edgeTexel ? 1.0 : kTapWeight;
+        if (a1 < start) return tap * inside;
         const std::vector<double>& suf = suffix[static_cast<std::size_t>(o)];
         const int k = std::clamp(a0 - start, 0, static_cast<int>(suf.size()) - 1);
-        return std::max(inside, suf[static_cast<std::size_t>(k)]);
+        return tap * std::max(inside, suf[static_cast<std::size_t>(k)]);
     }
 };
 

@@ -154,9 +154,13 @@ void boundSlopeChange(const MaxChangePyramid& dh, const HeightPyramid& pyr, int 
 // peakBlend). A max texel moves by at most M_ij. A mean texel is the 2 x 2
 // mean applied o times, the edge replicated: a separable weight w_o(x) w_o(y)
 // per cell, 2^-o per axis inside whole blocks and up to 1 in the block the
-// grid's edge cuts. So it moves by at most min(M_ij, W S_ij), S_ij the sum of
-// |dh| over the box (sumChangeInBox) and W the largest cell weight there (of
-// the finer octave for a blended level, whose weights are the larger), and
+// grid's edge cuts. Each cell lies in one texel of B_o, and the sample
+// weighs that texel by at most 2/3 per axis (the B-spline's largest tap; the
+// convex combinations keep it), or 1 on the image's first and last texels,
+// where clamped taps coincide. So it moves by at most min(M_ij, W S_ij),
+// S_ij the sum of |dh| over the box (sumChangeInBox) and W the largest cell
+// weight there times those tap weights (of the finer octave for a blended
+// level, whose weights are the larger), and
 //   D_ij = |1 - b| min(M_ij, W S_ij) + |b| M_ij.
 // A far change of small area then counts by its share of the filter, not by
 // its full height. Raw steps and octave 0 read heights: D_ij = M_ij.

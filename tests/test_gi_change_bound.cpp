@@ -296,6 +296,44 @@ TEST_CASE("gi.change_bound: a height change moves pyramid levels only within the
         }
 }
 
+TEST_CASE("gi.change_bound: away from the image edges a mean level weighs one cell by at most (2/3)^2 4^-o") {
+    // the B-spline's largest tap is 2/3 per axis; a cell lies in one texel of
+    // the mean octave o, with weight 4^-o, and the level blend and the
+    // bilinear read are convex: a change of one cell by 1 moves every texel
+    // of a level whose finer octave is o by at most (2/3)^2 4^-o, where no
+    // clamped tap lands on the cell's texel
+    const int nx = 300, ny = 260, cx = 150, cy = 131;
+    const Grid base = baseTerrain(nx, ny);
+    for (int s : {1, 2}) {
+        PyramidSettings ps;
+        ps.peakBlend = 0.0f;  // the mean octaves alone
+        HeightPyramid p0, p1;
+        buildHeightPyramid(base.cview(), kCell, s, ps, p0);
+        Grid h = base;
+        h(cx, cy) += 1.0f;
+        buildHeightPyramid(h.cview(), kCell, s, ps, p1);
+        const int kv = std::max(1, ps.levelsPerOctave);
+        double tightest = 0.0;
+        int checked = 0;
+        for (std::size_t l = 0; l < p0.levels.size(); ++l) {
+            const int o = std::min(static_cast<int>(l) / kv, p0.octaves - 1);
+            // the cell's texel is neither the first nor the last of octaves o and o + 1
+            const int block = 1 << (o + 1);
+            if (o < 1 || cx < block || cy < block || nx - cx <= 2 * block || ny - cy <= 2 * block) continue;
+            const double bound = 4.0 / 9.0 * std::ldexp(1.0, -2 * o);
+            float worst = 0.0f;
+            for (int Y = 0; Y < p0.nyr; ++Y)
+                for (int X = 0; X < p0.nxr; ++X)
+                    worst = std::max(worst, std::fabs(p1.levels[l].row(Y)[X] - p0.levels[l].row(Y)[X]));
+            CHECK(worst <= bound * (1.0 + 1e-4) + 1e-6);
+            tightest = std::max(tightest, worst / bound);
+            ++checked;
+        }
+        CHECK(checked >= 2);
+        MESSAGE("s=" << s << ": " << checked << " levels, largest move / (2/3)^2 4^-o " << tightest);
+    }
+}
+
 TEST_CASE("gi.change_bound: SH constants cover the engine's horizon kernel") {
     // k(t) = sum_l z_l sqrt((2l + 1) / (4 pi)) P_l(t) / pi: lam(N) . V is the integral of W k(N . w)
     const double* zh = lambertZonal();
