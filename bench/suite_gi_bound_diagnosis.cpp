@@ -112,6 +112,16 @@ double refreshTiles(const std::vector<double>& deviation, float tolerance, const
     return deviation.empty() ? 0.0 : dirty / static_cast<double>(deviation.size());
 }
 
+// The SH ambient map of the environment V `v` at the frame's normals: what
+// the visibility bounds cover (the frame's own ambient map may be the exact
+// one, which does not read V, so both sides of a comparison come from here).
+void ambientOfV(const GiState& now, const gi::VisibilityField& v, const gi::GiSettings& settings, gi::ShadeMaps& out) {
+    gi::ShadingLight env = now.shadingLights[0];
+    env.visibility = &v;
+    gi::shadeTexels(now.gradX.cview(), now.gradY.cview(), settings.subsample, v, &env, 1, nullptr, settings.shading,
+                    out);
+}
+
 // One frame of the oracle (the first frame fills its caches).
 void oracleFrame(Track& t, const gi::GiSettings& settings, float tolerance) {
     if (t.oracleV.sh.empty()) {
@@ -120,11 +130,10 @@ void oracleFrame(Track& t, const gi::GiSettings& settings, float tolerance) {
         return;
     }
     const int s = settings.subsample;
-    gi::ShadeMaps cached;
-    gi::ShadingLight env = t.now.shadingLights[0];
-    env.visibility = &t.oracleV;
-    gi::shadeTexels(t.now.gradX.cview(), t.now.gradY.cview(), s, t.oracleV, &env, 1, nullptr, settings.shading, cached);
-    const std::vector<double> v = perTile({&cached.ambient}, {&t.now.shade.ambient}, t.now, s);
+    gi::ShadeMaps cached, fresh;
+    ambientOfV(t.now, t.oracleV, settings, cached);
+    ambientOfV(t.now, t.now.envVisibility, settings, fresh);
+    const std::vector<double> v = perTile({&cached.ambient}, {&fresh.ambient}, t.now, s);
     t.oracleVShare.push_back(refreshTiles(v, tolerance, t.now, s, &t.oracleV, nullptr));
     const std::vector<double> ind =
         perTile({&t.oracleIndirect[0], &t.oracleIndirect[1], &t.oracleIndirect[2]},
@@ -168,14 +177,6 @@ std::vector<double> indirectRadianceBound(const GiState& now, const GiState& las
     return std::vector<double>(cache.radianceBound.begin(), cache.radianceBound.end());
 }
 
-// The ambient map at the new normals with the last frame's environment V.
-void ambientWithCachedV(const GiState& now, const GiState& last, const gi::GiSettings& settings, gi::ShadeMaps& out) {
-    gi::ShadingLight env = now.shadingLights[0];
-    env.visibility = &last.envVisibility;
-    gi::shadeTexels(now.gradX.cview(), now.gradY.cview(), settings.subsample, last.envVisibility, &env, 1, nullptr,
-                    settings.shading, out);
-}
-
 void measureFrame(Track& t, const gi::GiSettings& settings, float cell, float tolerance) {
     const gi::GiLighting sky;  // uniform unit sky
     gi::runGiFrame(t.heights.cview(), cell, sky, settings, t.now);
@@ -186,10 +187,11 @@ void measureFrame(Track& t, const gi::GiSettings& settings, float cell, float to
     gi::VisibilityCache cache;  // a fresh drift: after one plan it holds the frame's bound per tile
     gi::planVisibilityTiles(t.lastHeights.cview(), t.heights.cview(), t.now.pyramid, settings.visibility, {}, 1e30f,
                             cache);
-    gi::ShadeMaps cached;
-    ambientWithCachedV(t.now, t.last, settings, cached);
+    gi::ShadeMaps cached, fresh;
+    ambientOfV(t.now, t.last.envVisibility, settings, cached);
+    ambientOfV(t.now, t.now.envVisibility, settings, fresh);
     const int s = settings.subsample;
-    const std::vector<double> v = perTile({&cached.ambient}, {&t.now.shade.ambient}, t.now, s);
+    const std::vector<double> v = perTile({&cached.ambient}, {&fresh.ambient}, t.now, s);
     const std::vector<double> ind =
         perTile({&t.last.indirect.indirect[0], &t.last.indirect.indirect[1], &t.last.indirect.indirect[2]},
                 {&t.now.indirect.indirect[0], &t.now.indirect.indirect[1], &t.now.indirect.indirect[2]}, t.now, s);
@@ -206,7 +208,8 @@ const char* kIntro =
     "Full GI frames (2x, one bounce, uniform unit sky: shade units are the tolerance's, 2 threads), consecutive "
     "frames compared per visibility tile (32 x 32 receivers). One-frame V bound: the drift "
     "gi/visibility_cache.h adds for the frame (environment, per azimuth, V alone). True change of the cached V: "
-    "the ambient map at the new normals shaded with the last frame's V against the new V, largest over the tile's "
+    "the SH ambient map at the new normals shaded with the last frame's V against the one shaded with the new V "
+    "(the frame's own ambient map is the exact one, which does not read V), largest over the tile's "
     "texels. Largest radiance sample move: the largest over the indirect azimuths of boundSampleChangePerAzimuth "
     "for the frame's change of the direct light; radiance bound of the indirect light: what gi/indirect_cache.h "
     "adds for it (the sample moves weighed by each receiver's occlusion shares per azimuth and per distance "
