@@ -165,7 +165,7 @@ std::vector<double> indirectSampleBound(const GiState& now, const GiState& last,
 // sample moves weighed by the last frame's receivers' occlusion shares.
 std::vector<double> indirectRadianceBound(const GiState& now, const GiState& last, int azimuths) {
     gi::IndirectCache cache;
-    cache.reference = last.shade.rgb;
+    cache.lastSource = last.shade.rgb;
     const gi::IndirectPlanInputs plan{.source = now.shade.rgb,
                                       .heights = now.pyramid,
                                       .lastPyramid = last.indirect.radiance,

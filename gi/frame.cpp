@@ -33,19 +33,6 @@ const FoldedWedgeOperator& indirectScanOperator(const GiSettings& settings, GiSt
     return st.indirectOperator;
 }
 
-// What the indirect cache reads of the frame (gi/indirect_cache.h): before
-// the pass, the last pass's radiance pyramid and occlusions; after it, this one's.
-IndirectPlanInputs indirectPlanInputs(const GiSettings& settings, const FrameChange& change, int azimuths,
-                                      const GiState& st) {
-    return {.source = st.shade.rgb,
-            .heights = st.pyramid,
-            .lastPyramid = st.indirect.radiance,
-            .geometryTiles = change.geometry ? &st.visibilityCache.geometryTiles : nullptr,
-            .azimuths = azimuths,
-            .tolerance = settings.tolerance,
-            .blocker = &st.indirect.blocker};
-}
-
 // The receivers whose indirect light is re-gathered this frame
 // (gi/indirect_cache.h); null: every receiver. `cached`: the frame keeps an
 // indirect cache (incremental frames, a strategy that gathers by tiles).
@@ -55,7 +42,14 @@ const ReceiverTiles* planIndirect(const GiSettings& settings, const FrameChange&
         invalidateIndirectCache(st.indirectCache);
         return nullptr;
     }
-    return planIndirectTiles(indirectPlanInputs(settings, change, azimuths, st), st.indirectCache);
+    const IndirectPlanInputs in{.source = st.shade.rgb,
+                                .heights = st.pyramid,
+                                .lastPyramid = st.indirect.radiance,
+                                .geometryTiles = change.geometry ? &st.visibilityCache.geometryTiles : nullptr,
+                                .azimuths = azimuths,
+                                .tolerance = settings.tolerance,
+                                .blocker = &st.indirect.blocker};
+    return planIndirectTiles(in, st.indirectCache);
 }
 
 // The texel tiles the indirect light's texel passes redo (gi/indirect_cache.h).
@@ -100,7 +94,7 @@ void runIndirectStage(ConstGridView heights, const GiSettings& settings, const F
                             .texels = texels,
                             .sameGeometry = !change.geometry};
     computeIndirect(in, settings.indirect, st.indirect);
-    if (cached) recordIndirectPass(indirectPlanInputs(settings, change, op.azimuths, st), only, st.indirectCache);
+    if (cached) recordIndirectSource(st.shade.rgb, st.pyramid, only == nullptr, st.indirectCache);
     st.indirectCache.geometryVersion = st.geometryVersion;
     st.indirectRecomputed = only ? only->dirtyFraction() : 1.0;
     st.timings.indirect = msSince(t);

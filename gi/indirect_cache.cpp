@@ -18,10 +18,10 @@ bool cacheFits(const IndirectPlanInputs& in, const IndirectCache& cache) {
     const HeightPyramid& h = in.heights;
     if (!cache.valid || in.lastPyramid.fields.empty()) return false;
     const HeightPyramid& r = in.lastPyramid.fields[0];
-    const Grid& last = cache.reference[0];
+    const Grid& last = cache.lastSource[0];
     return r.nx == h.nx && r.ny == h.ny && r.nxr == h.nxr && r.nyr == h.nyr && r.steps.size() == h.steps.size() &&
            last.nx == h.nx && last.ny == h.ny && in.source[0].nx == h.nx && in.source[0].ny == h.ny &&
-           cache.tiles.nxr == h.nxr && cache.tiles.nyr == h.nyr && cache.offset.size() == cache.tiles.dirty.size() &&
+           cache.tiles.nxr == h.nxr && cache.tiles.nyr == h.nyr && cache.drift.size() == cache.tiles.dirty.size() &&
            (!in.geometryTiles || in.geometryTiles->dirty.size() == cache.tiles.dirty.size());
 }
 
@@ -76,10 +76,10 @@ float receiverShareBound(const BlockerRadianceState& b, std::size_t k, const flo
     return std::min(byAzimuth, shareWeighedBound(groupWeighed, groupTotal, largest));
 }
 
-// Per tile (of `only`; null: every tile): the radiance bound, the largest
-// rho_k over its receivers (max_j D_tj without the last pass's occlusions)
-// times its occlusion factor. Tile rows in parallel (each tile's value alone).
-void sharedBounds(const IndirectPlanInputs& in, const ReceiverTiles* only, IndirectCache& cache) {
+// Per tile: the radiance bound, the largest rho_k over its receivers (max_j
+// D_tj without the last pass's occlusions) times its occlusion factor.
+// Tile rows in parallel (each tile's value alone).
+void sharedBounds(const IndirectPlanInputs& in, IndirectCache& cache) {
     const HeightPyramid& h = in.heights;
     const int tilesX = tileCount(h.nxr, kVisibilityTile), tilesY = tileCount(h.nyr, kVisibilityTile);
     const std::size_t m = static_cast<std::size_t>(in.azimuths);
@@ -98,7 +98,6 @@ void sharedBounds(const IndirectPlanInputs& in, const ReceiverTiles* only, Indir
         for (int ty = ty0; ty < ty1; ++ty)
             for (int tx = 0; tx < tilesX; ++tx) {
                 const std::size_t t = static_cast<std::size_t>(ty) * tilesX + tx;
-                if (only && only->dirty[t] == 0) continue;
                 cache.radianceBound[t] =
                     cache.occlusionFactor[t] *
                     tileBound(tx, ty, cache.azimuthBound.data() + t * m, cache.groupBound.data() + t * kDistanceGroups);
@@ -118,10 +117,10 @@ float largestOf(const float* v, int n) {
     return *std::max_element(lanes, lanes + 8);
 }
 
-// Per tile (of `only`; null: every tile): min(1, the largest O / pi of the
-// texels that read its receivers + the tolerance), or 1 without a texel
-// occlusion (the occlusion factor of gi/indirect_cache.h).
-void occlusionFactors(const IndirectPlanInputs& in, const ReceiverTiles* only, IndirectCache& cache) {
+// Per tile: min(1, the largest O / pi of the texels that read its
+// receivers + the tolerance), or 1 without a texel occlusion (the
+// occlusion factor of gi/indirect_cache.h).
+void occlusionFactors(const IndirectPlanInputs& in, IndirectCache& cache) {
     const HeightPyramid& h = in.heights;
     const int tilesX = tileCount(h.nxr, kVisibilityTile), tilesY = tileCount(h.nyr, kVisibilityTile);
     cache.occlusionFactor.assign(static_cast<std::size_t>(tilesX) * tilesY, 1.0f);
@@ -133,7 +132,6 @@ void occlusionFactors(const IndirectPlanInputs& in, const ReceiverTiles* only, I
     parallelFor(0, tilesY, 1, [&](int ty0, int ty1) {
         for (int ty = ty0; ty < ty1; ++ty)
             for (int tx = 0; tx < tilesX; ++tx) {
-                if (only && only->dirty[static_cast<std::size_t>(ty) * tilesX + tx] == 0) continue;
                 float largest = 0.0f;
                 for (int y = y0[static_cast<std::size_t>(ty)]; y <= y1[static_cast<std::size_t>(ty)]; ++y) {
                     const int a = x0[static_cast<std::size_t>(tx)], b = x1[static_cast<std::size_t>(tx)];
@@ -152,16 +150,16 @@ void boundRadianceChange(const IndirectPlanInputs& in, IndirectCache& cache) {
     const HeightPyramid& h = in.heights;
     const std::size_t tiles =
         static_cast<std::size_t>(tileCount(h.nxr, kVisibilityTile)) * tileCount(h.nyr, kVisibilityTile);
-    const std::array<ConstGridView, 3> before{cache.reference[0].cview(), cache.reference[1].cview(),
-                                              cache.reference[2].cview()};
+    const std::array<ConstGridView, 3> before{cache.lastSource[0].cview(), cache.lastSource[1].cview(),
+                                              cache.lastSource[2].cview()};
     const std::array<ConstGridView, 3> after{in.source[0].cview(), in.source[1].cview(), in.source[2].cview()};
     buildMaxChangePyramid(before, after, cache.change);
     cache.radianceBound.assign(tiles, 0.0f);
     if (maxChangeAll(cache.change) == 0.0f) return;
     boundSampleChangePerAzimuthAndGroup(cache.change, in.lastPyramid.fields[0], kVisibilityTile, in.azimuths,
                                         cache.azimuthBound, cache.groupBound);
-    occlusionFactors(in, nullptr, cache);
-    sharedBounds(in, nullptr, cache);
+    occlusionFactors(in, cache);
+    sharedBounds(in, cache);
 }
 
 const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCache& cache) {
@@ -173,44 +171,24 @@ const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCac
     }
     if (skipsPlan(cache.framesWithoutPlan)) return nullptr;
     boundRadianceChange(in, cache);
-    for (std::size_t t = 0; t < cache.offset.size(); ++t) {
+    for (std::size_t t = 0; t < cache.drift.size(); ++t) cache.drift[t] += cache.radianceBound[t];
+    for (std::size_t t = 0; t < cache.drift.size(); ++t) {
         const bool geometry = in.geometryTiles && in.geometryTiles->dirty[t] != 0;
-        cache.tiles.dirty[t] = geometry || cache.radianceBound[t] + cache.offset[t] > in.tolerance ? 1 : 0;
+        const bool dirty = geometry || cache.drift[t] > in.tolerance;
+        if (dirty) cache.drift[t] = 0.0f;
+        cache.tiles.dirty[t] = dirty ? 1 : 0;
     }
-    const int dirty = cache.tiles.dirtyCount(), all = static_cast<int>(cache.tiles.dirty.size());
-    cache.rebase = 2 * dirty >= all;
-    countAfterPlan(dirty == all, cache.framesWithoutPlan);
+    countAfterPlan(cache.tiles.dirtyCount() == static_cast<int>(cache.tiles.dirty.size()), cache.framesWithoutPlan);
     return &cache.tiles;
 }
 
-void recordIndirectPass(const IndirectPlanInputs& in, const ReceiverTiles* gathered, IndirectCache& cache) {
-    if (!gathered) {
-        cache.reference = in.source;
-        cache.tiles.reset(in.heights.nxr, in.heights.nyr, kVisibilityTile, false);
-        cache.offset.assign(cache.tiles.dirty.size(), 0.0f);
-        cache.valid = true;
-        return;
-    }
-    if (cache.rebase) {
-        // this frame's source is the new reference: the re-gathered tiles
-        // are at it, the others at most their bound from it
-        for (std::size_t t = 0; t < cache.offset.size(); ++t)
-            cache.offset[t] = gathered->dirty[t] != 0 ? 0.0f : cache.offset[t] + cache.radianceBound[t];
-        cache.reference = in.source;
-        return;
-    }
-    // the re-gathered tiles' results are at this frame's source: their
-    // offset is this frame's bound, weighed by the occlusions of the pass
-    // that gathered them
-    if (maxChangeAll(cache.change) == 0.0f) {
-        for (std::size_t t = 0; t < cache.offset.size(); ++t)
-            if (gathered->dirty[t] != 0) cache.offset[t] = 0.0f;
-        return;
-    }
-    occlusionFactors(in, gathered, cache);
-    sharedBounds(in, gathered, cache);
-    for (std::size_t t = 0; t < cache.offset.size(); ++t)
-        if (gathered->dirty[t] != 0) cache.offset[t] = cache.radianceBound[t];
+void recordIndirectSource(const std::array<Grid, 3>& source, const HeightPyramid& heights, bool all,
+                          IndirectCache& cache) {
+    cache.lastSource = source;
+    if (!all) return;
+    cache.tiles.reset(heights.nxr, heights.nyr, kVisibilityTile, false);
+    cache.drift.assign(cache.tiles.dirty.size(), 0.0f);
+    cache.valid = true;
 }
 
 namespace {

@@ -5,23 +5,12 @@
 // One bounce of LambertIndirect::BlockerRadiance gathers, at each receiver,
 // the direct light L_0 of its casting sets. Its result can move for two
 // reasons, and a tile re-gathers when either says so:
-//  - the blockers' radiance: each frame bounds, per tile, how far the
-//    change of L_0 since a reference source L_ref moves the samples the
-//    tile's scan reads (gi/change_bound.h, boundSampleChangePerAzimuthAndGroup),
-//    weighed and scaled as below, and adds the tile's offset: the same bound
-//    from L_ref to the source L_t its cached result gathered, taken right
-//    after that pass with its occlusions. By the triangle inequality
-//    |E(L) - E(L_t)| <= |E(L) - E(L_ref)| + |E(L_ref) - E(L_t)|, so beyond
-//    the tolerance the tile re-gathers. L_ref is the source of the last pass
-//    that re-gathered every tile or at least half of them; such a pass sets
-//    the offsets anew: 0 for the re-gathered tiles, this frame's bound for
-//    the others (the same inequality). A change that comes and goes (a pit
-//    dropped and filled, a wave passing) then counts by its size, where a
-//    sum of per-frame bounds grows every frame; a change that keeps growing
-//    passes the tolerance, as that sum would, and re-bases the reference
-//    once half the tiles re-gather. The bound is monotone in the pointwise
-//    change, so against a reference it is never above the sum of per-frame
-//    bounds from it.
+//  - the blockers' radiance: each frame adds, per tile, the bound of
+//    gi/change_bound.h on how far the frame's change of L_0 moves the
+//    samples the tile's scan reads (boundSampleChangePerAzimuth, the largest
+//    per indirect azimuth), weighed and scaled as below. The sum of these
+//    bounds since the tile's cached result was computed bounds its drift
+//    (triangle inequality); beyond the tolerance, the tile re-gathers.
 //
 //    Weights and scale (sub-sampling): a texel's light is O(x) times its
 //    receivers' interpolated mean blocker radiance sum w_k E_k / sum w_k O_k
@@ -81,14 +70,13 @@ namespace terrain::gi {
 
 struct IndirectCache {
     bool valid = false;                  // the fields below describe the cached indirect result
-    std::array<Grid, 3> reference;       // L_ref: L_0 of the last pass that re-based the offsets
-    MaxChangePyramid change;             // this frame: max over the channels of |L_0 - reference|
+    std::array<Grid, 3> lastSource;      // L_0 the last indirect pass read
+    MaxChangePyramid change;             // this frame: max over the channels of |L_0 - lastSource|
     std::vector<float> azimuthBound;     // per tile and indirect azimuth (tile-major)
     std::vector<float> groupBound;       // per tile and distance group (gi/pyramid.h), over every azimuth
-    std::vector<float> offset;           // per tile: bound from L_ref to the source its cached result gathered
+    std::vector<float> drift;            // per tile: bound of the radiance change since its result was gathered
     std::vector<float> occlusionFactor;  // per tile: this frame's factor of the radiance bound
-    std::vector<float> radianceBound;    // per tile: this frame's bound from L_ref (boundRadianceChange)
-    bool rebase = false;                 // the coming pass re-bases the reference (at least half the tiles)
+    std::vector<float> radianceBound;    // per tile: this frame's bound (boundRadianceChange)
     ReceiverTiles tiles;                 // this frame's tiles to re-gather
     ReceiverTiles texels;                // this frame's texel tiles to redo
     std::uint64_t geometryVersion = 0;   // GiState::geometryVersion of the last pass
@@ -111,11 +99,11 @@ struct IndirectPlanInputs {
 };
 
 /// This frame's bound per tile (cache.radianceBound, shade units; 0 where L_0
-/// did not change) on how far the change of L_0 from cache.reference to
+/// did not change) on how far the change of L_0 from cache.lastSource to
 /// in.source moves the indirect light of every texel that reads one of the
 /// tile's receivers, the geometry being the last pass's: the largest sample
-/// moves weighed by each receiver's shares of its occlusion, times the
-/// occlusion factor (above).
+/// move over the tile's azimuths weighed by each receiver's shares of its
+/// occlusion, times the occlusion factor (above).
 void boundRadianceChange(const IndirectPlanInputs& in, IndirectCache& cache);
 
 /// The tiles to re-gather (cache.tiles), or null when every receiver must be
@@ -125,12 +113,11 @@ void boundRadianceChange(const IndirectPlanInputs& in, IndirectCache& cache);
 /// computing the bound, whose cost would only be added to a full pass.
 const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCache& cache);
 
-/// After an indirect pass over in.source, in.blocker holding its
-/// occlusions; `gathered`: its tiles (planIndirectTiles), null when it
-/// gathered every receiver. Re-bases the reference (every receiver, or the
-/// plan's rebase: offsets anew, above) or sets the offsets of the
-/// re-gathered tiles from this frame's sample moves and the pass's occlusions.
-void recordIndirectPass(const IndirectPlanInputs& in, const ReceiverTiles* gathered, IndirectCache& cache);
+/// After an indirect pass over `source` (on the receiver grid of `heights`):
+/// it is what the next frame compares with; `all` when the pass gathered
+/// every receiver (the tiles and drifts start again at 0).
+void recordIndirectSource(const std::array<Grid, 3>& source, const HeightPyramid& heights, bool all,
+                          IndirectCache& cache);
 
 /// What the frame knows of the texels' inputs since the last pass.
 struct IndirectTexelInputs {
