@@ -1,7 +1,9 @@
 #include "gi/change_bound.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "core/error.h"
@@ -17,11 +19,13 @@ constexpr int kBlocksPerAxis = 4;  // blocks a box query reads per axis at most
 constexpr double kHalfDiagonal = 0.70710679;  // 1 / sqrt2
 constexpr double kSqrt2Up = 1.41421357;       // sqrt2
 
-// A float not below the non-negative double v.
-float roundUp(double v) {
-    float f = static_cast<float>(v);
-    if (static_cast<double>(f) < v) f = std::nextafter(f, std::numeric_limits<float>::infinity());
-    return f;
+// A float not below the non-negative double v: the nearest float, or the
+// next one up where that fell below v (for a non-negative finite float the
+// next one up is its bit pattern plus one; a branch-free select the
+// compiler can vectorise, where nextafter is a library call per cell).
+inline float roundUp(double v) {
+    const float f = static_cast<float>(v);
+    return std::bit_cast<float>(std::bit_cast<std::uint32_t>(f) + (static_cast<double>(f) < v ? 1u : 0u));
 }
 
 void sizeLevels(int nx, int ny, MaxChangePyramid& p) {
@@ -384,8 +388,10 @@ double sampleBoundFrom(const MaxChangePyramid& dv, const StepTable& steps, const
     const double mAll = maxChangeAll(dv);
     double best = 0.0;
     for (std::size_t i = static_cast<std::size_t>(first); i < steps.extent.size(); ++i) {
+        // nothing to gain where this azimuth's and the group's maxima (the
+        // group's over every azimuth so far) are already the largest change
         double* group = groupBest ? groupBest + steps.group[i] : nullptr;
-        if (group ? *group >= mAll : best >= mAll) continue;
+        if (best >= mAll && (!group || *group >= mAll)) continue;
         const CellBox box = stepBoxOver(steps.extent[i], c, oneDirection(cs, sn));
         const double d = filteredChange(dv, steps, static_cast<int>(i), box);
         best = std::max(best, d);

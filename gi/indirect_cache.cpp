@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/parallel.h"
+#include "core/simd.h"
 #include "gi/texel_runs.h"
 #include "gi/visibility_cache.h"
 
@@ -42,38 +43,55 @@ bool hasOcclusions(const IndirectPlanInputs& in) {
 // measures are well above their rounding.
 constexpr float kNoShareBelow = 1e-6f;
 
-// The weighed mean sum_i w_i D_i / sum_i w_i, rounded up by the weights' and
-// the sums' rounding (a few ulp of the total; products in double, so that a
-// positive term never rounds to 0), or `largest` (max D) for weights of
-// (next to) no total occlusion.
-float shareWeighedBound(double weighed, double total, float largest) {
-    if (!(total > kNoShareBelow)) return largest;  // no occlusion to share, up to rounding
-    const float bound = static_cast<float>(weighed / total * (1.0 + 1e-5));
-    return std::min(largest, weighed > 0.0 ? std::max(bound, std::numeric_limits<float>::denorm_min()) : 0.0f);
-}
-
-// rho_k of receiver k (row-major index): the smaller of two weighings of its
-// occlusion (gi/indirect_cache.h): the azimuth bounds D_j by its shares per
-// azimuth, sum_j (O_kj / O_k) D_j, and the distance groups' bounds G_g
-// (over every azimuth) by its shares per group, sum_g (O_kg / O_k) G_g;
-// `largest` (max_j D_j) for a receiver with (next to) no occlusion.
-float receiverShareBound(const BlockerRadianceState& b, std::size_t k, const float* D, const float* G, float largest) {
+// The largest rho_k of the receivers [x0, x1) of row Y (at most one tile's
+// width): the smaller of two weighings of each one's occlusion
+// (gi/indirect_cache.h), the azimuth bounds D_j by its shares per azimuth,
+// sum_j (O_kj / O_k) D_j, and the distance groups' bounds G_g (over every
+// azimuth) by its shares per group, sum_g (O_kg / O_k) G_g; `largest`
+// (max_j D_j) for a receiver with (next to) no occlusion. Sums of at most 8
+// positive float terms and a division, rounded up by 1e-5, far above their
+// few ulp; a positive term w D never rounds to 0 (at least the smallest
+// float), so that tolerance 0 sees every change a member may carry. Four
+// receivers per vector (the run copied into zero-padded lanes).
+float rowShareBound(const BlockerRadianceState& b, int Y, int x0, int x1, const float* D, const float* G,
+                    float largest) {
+    using simd::F4;
+    constexpr int kGroups = kVisibilityTile / 4;
     const std::size_t m = static_cast<std::size_t>(b.azimuths), plane = static_cast<std::size_t>(b.nxr) * b.nyr;
-    const float* running = b.receiverOcclusionRunning.data() + k;
-    double weighed = 0.0, before = 0.0;
-    for (std::size_t j = 0; j < m; ++j) {
-        const double now = running[j * plane];
-        weighed += std::max(0.0, now - before) * D[j];
-        before = now;
+    const std::size_t at = static_cast<std::size_t>(Y) * b.nxr + static_cast<std::size_t>(x0);
+    const int n = x1 - x0, groups = (n + 3) / 4;
+    const F4 zero = simd::splat<F4>(0.0f);
+    F4 azWeighed[kGroups], azTotal[kGroups], grWeighed[kGroups], grTotal[kGroups];
+    for (int q = 0; q < groups; ++q) azWeighed[q] = azTotal[q] = grWeighed[q] = grTotal[q] = zero;
+    alignas(16) float lanes[kVisibilityTile] = {};
+    const auto weighed = [&](const float* v, float d, F4* sum, F4* total, bool running) {
+        std::copy(v, v + n, lanes);
+        const F4 dv = simd::splat<F4>(d);
+        const F4 tiny = simd::splat<F4>(d > 0.0f ? std::numeric_limits<float>::denorm_min() : 0.0f);
+        for (int q = 0; q < groups; ++q) {
+            const F4 x = simd::load<F4>(lanes + 4 * q);
+            const F4 w = running ? x - total[q] : x;  // an azimuth's share: the running sum's step
+            sum[q] += w > zero ? simd::vmax(w * dv, tiny) : zero;
+            total[q] = running ? x : total[q] + x;
+        }
+    };
+    for (std::size_t j = 0; j < m; ++j)
+        weighed(b.receiverOcclusionRunning.data() + j * plane + at, D[j], azWeighed, azTotal, true);
+    for (std::size_t g = 0; g < kDistanceGroups; ++g)
+        weighed(b.receiverGroupOcclusion.data() + g * plane + at, G[g], grWeighed, grTotal, false);
+    // sum / total, positive when the sum is, or `largest` for (next to) no occlusion
+    const F4 big = simd::splat<F4>(largest), floor = simd::splat<F4>(kNoShareBelow);
+    const F4 denorm = simd::splat<F4>(std::numeric_limits<float>::denorm_min());
+    const auto mean = [&](F4 sum, F4 total) {
+        const F4 ratio = sum > zero ? simd::vmax(sum / total, denorm) : zero;
+        return total > floor ? ratio : big;
+    };
+    float bound = 0.0f;
+    for (int q = 0; q < groups; ++q) {
+        const F4 rho = simd::vmin(mean(azWeighed[q], azTotal[q]), mean(grWeighed[q], grTotal[q]));
+        for (int l = 0; l < 4 && 4 * q + l < n; ++l) bound = std::max(bound, rho[l]);
     }
-    const float byAzimuth = shareWeighedBound(weighed, running[(m - 1) * plane], largest);
-    const float* group = b.receiverGroupOcclusion.data() + k;
-    double groupWeighed = 0.0, groupTotal = 0.0;
-    for (std::size_t g = 0; g < kDistanceGroups; ++g) {
-        groupWeighed += static_cast<double>(group[g * plane]) * G[g];
-        groupTotal += group[g * plane];
-    }
-    return std::min(byAzimuth, shareWeighedBound(groupWeighed, groupTotal, largest));
+    return std::min(largest, bound * (1.0f + 1e-5f));
 }
 
 // Per tile: the radiance bound, the largest rho_k over its receivers (max_j
@@ -88,10 +106,9 @@ void sharedBounds(const IndirectPlanInputs& in, IndirectCache& cache) {
         const float largest = *std::max_element(D, D + m);
         if (!shares) return largest;
         float bound = 0.0f;
+        const int x0 = tx * kVisibilityTile, x1 = std::min(h.nxr, x0 + kVisibilityTile);
         for (int Y = ty * kVisibilityTile; Y < std::min(h.nyr, (ty + 1) * kVisibilityTile); ++Y)
-            for (int X = tx * kVisibilityTile; X < std::min(h.nxr, (tx + 1) * kVisibilityTile); ++X)
-                bound = std::max(
-                    bound, receiverShareBound(*in.blocker, static_cast<std::size_t>(Y) * h.nxr + X, D, G, largest));
+            bound = std::max(bound, rowShareBound(*in.blocker, Y, x0, x1, D, G, largest));
         return bound;
     };
     parallelFor(0, tilesY, 1, [&](int ty0, int ty1) {

@@ -147,6 +147,18 @@ TEST_CASE("gi.indirect_cache: the radiance bound holds for local, global and edg
             boundSampleChangePerAzimuth(changePyramid, later.radiance.fields[0], kVisibilityTile, op.azimuths,
                                         sampleBound);
             const int m = op.azimuths, tilesX = tileCount(st.pyramid.nxr, kVisibilityTile);
+            // the per-group pass gives every azimuth the same bound, and per
+            // tile its groups' largest is its azimuths' largest (every step
+            // of every azimuth, grouped two ways)
+            std::vector<float> sameAzimuths, groupBound;
+            boundSampleChangePerAzimuthAndGroup(changePyramid, later.radiance.fields[0], kVisibilityTile, op.azimuths,
+                                                sameAzimuths, groupBound);
+            CHECK(sameAzimuths == sampleBound);
+            for (std::size_t t = 0; t < bound.size(); ++t) {
+                const auto g = groupBound.begin() + static_cast<std::ptrdiff_t>(t * kDistanceGroups);
+                const auto a = sampleBound.begin() + static_cast<std::ptrdiff_t>(t * m);
+                CHECK(*std::max_element(g, g + kDistanceGroups) == *std::max_element(a, a + m));
+            }
             for (std::size_t t = 0; t < bound.size(); ++t) {
                 const auto az = sampleBound.begin() + static_cast<std::ptrdiff_t>(t * m);
                 CHECK(bound[t] <= *std::max_element(az, az + m));
