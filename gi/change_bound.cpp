@@ -1,9 +1,7 @@
 #include "gi/change_bound.h"
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
-#include <cstdint>
 #include <limits>
 
 #include "core/error.h"
@@ -19,13 +17,11 @@ constexpr int kBlocksPerAxis = 4;  // blocks a box query reads per axis at most
 constexpr double kHalfDiagonal = 0.70710679;  // 1 / sqrt2
 constexpr double kSqrt2Up = 1.41421357;       // sqrt2
 
-// A float not below the non-negative double v: the nearest float, or the
-// next one up where that fell below v (for a non-negative finite float the
-// next one up is its bit pattern plus one; a branch-free select the
-// compiler can vectorise, where nextafter is a library call per cell).
-inline float roundUp(double v) {
-    const float f = static_cast<float>(v);
-    return std::bit_cast<float>(std::bit_cast<std::uint32_t>(f) + (static_cast<double>(f) < v ? 1u : 0u));
+// A float not below the non-negative double v.
+float roundUp(double v) {
+    float f = static_cast<float>(v);
+    if (static_cast<double>(f) < v) f = std::nextafter(f, std::numeric_limits<float>::infinity());
+    return f;
 }
 
 void sizeLevels(int nx, int ny, MaxChangePyramid& p) {
