@@ -48,11 +48,12 @@ constexpr float kNoShareBelow = 1e-6f;
 // (gi/indirect_cache.h), the azimuth bounds D_j by its shares per azimuth,
 // sum_j (O_kj / O_k) D_j, and the distance groups' bounds G_g (over every
 // azimuth) by its shares per group, sum_g (O_kg / O_k) G_g; `largest`
-// (max_j D_j) for a receiver with (next to) no occlusion. Sums of at most 8
-// positive float terms and a division, rounded up by 1e-5, far above their
-// few ulp; a positive term w D never rounds to 0 (at least the smallest
-// float), so that tolerance 0 sees every change a member may carry. Four
-// receivers per vector (the run copied into zero-padded lanes).
+// (max_j D_j) for a receiver with (next to) no occlusion. Sums of m (or 8)
+// positive float terms and a division, rounded up by 1e-5 plus one float
+// epsilon per azimuth, above their rounding for any m; a positive term w D
+// never rounds to 0 (at least the smallest float), so that tolerance 0 sees
+// every change a member may carry. Four receivers per vector (the run
+// copied into zero-padded lanes).
 float rowShareBound(const BlockerRadianceState& b, int Y, int x0, int x1, const float* D, const float* G,
                     float largest) {
     using simd::F4;
@@ -91,7 +92,8 @@ float rowShareBound(const BlockerRadianceState& b, int Y, int x0, int x1, const 
         const F4 rho = simd::vmin(mean(azWeighed[q], azTotal[q]), mean(grWeighed[q], grTotal[q]));
         for (int l = 0; l < 4 && 4 * q + l < n; ++l) bound = std::max(bound, rho[l]);
     }
-    return std::min(largest, bound * (1.0f + 1e-5f));
+    const float up = 1.0f + 1e-5f + static_cast<float>(m) * std::numeric_limits<float>::epsilon();
+    return std::min(largest, bound * up);
 }
 
 // Per tile: the radiance bound, the largest rho_k over its receivers (max_j
