@@ -123,16 +123,16 @@ void ambientOfV(const GiState& now, const gi::VisibilityField& v, const gi::GiSe
 }
 
 // One frame of the oracle (the first frame fills its caches).
-void oracleFrame(Track& t, const gi::GiSettings& settings, float tolerance) {
+// `fresh`: the SH ambient map of this frame's V (ambientOfV).
+void oracleFrame(Track& t, const gi::GiSettings& settings, float tolerance, const gi::ShadeMaps& fresh) {
     if (t.oracleV.sh.empty()) {
         t.oracleV = t.now.envVisibility;
         t.oracleIndirect = t.now.indirect.indirect;
         return;
     }
     const int s = settings.subsample;
-    gi::ShadeMaps cached, fresh;
+    gi::ShadeMaps cached;
     ambientOfV(t.now, t.oracleV, settings, cached);
-    ambientOfV(t.now, t.now.envVisibility, settings, fresh);
     const std::vector<double> v = perTile({&cached.ambient}, {&fresh.ambient}, t.now, s);
     t.oracleVShare.push_back(refreshTiles(v, tolerance, t.now, s, &t.oracleV, nullptr));
     const std::vector<double> ind =
@@ -141,29 +141,14 @@ void oracleFrame(Track& t, const gi::GiSettings& settings, float tolerance) {
     t.oracleIndirectShare.push_back(refreshTiles(ind, tolerance, t.now, s, nullptr, &t.oracleIndirect));
 }
 
-// Per tile, the largest move of the indirect scan's radiance samples for the
-// change of the direct light from the last frame to this one (the largest
-// over the indirect azimuths of boundSampleChangePerAzimuth).
-std::vector<double> indirectSampleBound(const GiState& now, const GiState& last, int azimuths) {
-    const std::array<ConstGridView, 3> before{last.shade.rgb[0].cview(), last.shade.rgb[1].cview(),
-                                              last.shade.rgb[2].cview()};
-    const std::array<ConstGridView, 3> after{now.shade.rgb[0].cview(), now.shade.rgb[1].cview(),
-                                             now.shade.rgb[2].cview()};
-    gi::MaxChangePyramid change;
-    gi::buildMaxChangePyramid(before, after, change);
-    std::vector<float> perAzimuth;
-    gi::boundSampleChangePerAzimuth(change, now.indirect.radiance.fields[0], gi::kVisibilityTile, azimuths, perAzimuth);
-    std::vector<double> out(perAzimuth.size() / static_cast<std::size_t>(azimuths), 0.0);
-    for (std::size_t i = 0; i < perAzimuth.size(); ++i) {
-        double& t = out[i / static_cast<std::size_t>(azimuths)];
-        t = std::max(t, static_cast<double>(perAzimuth[i]));
-    }
-    return out;
-}
-
-// Per tile, the radiance bound gi/indirect_cache.h adds for that change: the
-// sample moves weighed by the last frame's receivers' occlusion shares.
-std::vector<double> indirectRadianceBound(const GiState& now, const GiState& last, int azimuths) {
+// Per tile, for the change of the direct light from the last frame to this
+// one: the largest move of the indirect scan's radiance samples (over the
+// indirect azimuths) and the radiance bound gi/indirect_cache.h adds for it
+// (those moves weighed by the last frame's receivers' occlusion shares).
+struct IndirectBounds {
+    std::vector<double> sampleMove, bound;
+};
+IndirectBounds indirectBounds(const GiState& now, const GiState& last, int azimuths) {
     gi::IndirectCache cache;
     cache.lastSource = last.shade.rgb;
     const gi::IndirectPlanInputs plan{.source = now.shade.rgb,
@@ -174,31 +159,37 @@ std::vector<double> indirectRadianceBound(const GiState& now, const GiState& las
                                       .tolerance = 0.0f,
                                       .blocker = &last.indirect.blocker};
     gi::boundRadianceChange(plan, cache);
-    return std::vector<double>(cache.radianceBound.begin(), cache.radianceBound.end());
+    IndirectBounds out{std::vector<double>(cache.radianceBound.size(), 0.0),
+                       std::vector<double>(cache.radianceBound.begin(), cache.radianceBound.end())};
+    if (gi::maxChangeAll(cache.change) == 0.0f) return out;  // no change: no sample moved
+    const std::size_t m = static_cast<std::size_t>(azimuths);
+    for (std::size_t i = 0; i < cache.azimuthBound.size(); ++i)
+        out.sampleMove[i / m] = std::max(out.sampleMove[i / m], static_cast<double>(cache.azimuthBound[i]));
+    return out;
 }
 
 void measureFrame(Track& t, const gi::GiSettings& settings, float cell, float tolerance) {
     const gi::GiLighting sky;  // uniform unit sky
     gi::runGiFrame(t.heights.cview(), cell, sky, settings, t.now);
-    oracleFrame(t, settings, tolerance);
+    gi::ShadeMaps fresh;
+    ambientOfV(t.now, t.now.envVisibility, settings, fresh);
+    oracleFrame(t, settings, tolerance, fresh);
     if (t.lastHeights.empty()) return;
     for (std::size_t i = 0; i < t.heights.v.size(); ++i)
         t.dh.push_back(std::fabs(static_cast<double>(t.heights.v[i]) - t.lastHeights.v[i]));
     gi::VisibilityCache cache;  // a fresh drift: after one plan it holds the frame's bound per tile
     gi::planVisibilityTiles(t.lastHeights.cview(), t.heights.cview(), t.now.pyramid, settings.visibility, {}, 1e30f,
                             cache);
-    gi::ShadeMaps cached, fresh;
+    gi::ShadeMaps cached;
     ambientOfV(t.now, t.last.envVisibility, settings, cached);
-    ambientOfV(t.now, t.now.envVisibility, settings, fresh);
     const int s = settings.subsample;
     const std::vector<double> v = perTile({&cached.ambient}, {&fresh.ambient}, t.now, s);
     const std::vector<double> ind =
         perTile({&t.last.indirect.indirect[0], &t.last.indirect.indirect[1], &t.last.indirect.indirect[2]},
                 {&t.now.indirect.indirect[0], &t.now.indirect.indirect[1], &t.now.indirect.indirect[2]}, t.now, s);
-    const std::vector<double> indSample = indirectSampleBound(t.now, t.last, settings.indirect.azimuths);
-    t.indirectSampleBound.insert(t.indirectSampleBound.end(), indSample.begin(), indSample.end());
-    const std::vector<double> indBound = indirectRadianceBound(t.now, t.last, settings.indirect.azimuths);
-    t.indirectBound.insert(t.indirectBound.end(), indBound.begin(), indBound.end());
+    const IndirectBounds ib = indirectBounds(t.now, t.last, settings.indirect.azimuths);
+    t.indirectSampleBound.insert(t.indirectSampleBound.end(), ib.sampleMove.begin(), ib.sampleMove.end());
+    t.indirectBound.insert(t.indirectBound.end(), ib.bound.begin(), ib.bound.end());
     t.bound.insert(t.bound.end(), cache.drift.begin(), cache.drift.end());
     t.vChange.insert(t.vChange.end(), v.begin(), v.end());
     t.indirectChange.insert(t.indirectChange.end(), ind.begin(), ind.end());

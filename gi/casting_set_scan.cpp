@@ -106,8 +106,9 @@ struct CastingRow {
     // slope, q1 (Nlp) the sin of the last segment end, F (Irradiance) F at the
     // last segment end, then 3 x nMo sums A
     float *M = nullptr, *g = nullptr, *q1 = nullptr, *F = nullptr, *A = nullptr;
-    int* steps = nullptr;   // per lane: the valid prefix (row limit applied)
-    int* active = nullptr;  // groups still walking
+    float* groupOcc = nullptr;  // Irradiance: each distance group's |Delta F| (IndirectScratch::groupOccludersOf)
+    int* steps = nullptr;       // per lane: the valid prefix (row limit applied)
+    int* active = nullptr;      // groups still walking
     int nActive = 0;
     const V one = splat<V>(1.0f), half = splat<V>(0.5f), zero = splat<V>(0.0f);
     const V lim = splat<V>(1e6f), nlim = splat<V>(-1e6f);
@@ -121,6 +122,7 @@ struct CastingRow {
         q1 = M + 2 * pad;
         F = M + 3 * pad;
         A = M + 4 * pad;
+        groupOcc = sc.groupOccludersOf(r);
         steps = sc.groupSteps.data() + static_cast<std::size_t>(r) * pad;
         active = sc.active.data() + static_cast<std::size_t>(r) * pad;
     }
@@ -214,7 +216,7 @@ struct CastingRow {
             store(F + X0, fv);
             if (tp.group >= 0) {
                 // |Delta F|: float rounding may make a difference of increasing F negative
-                float* occ = A + static_cast<std::size_t>(3 + tp.group) * pad + X0;
+                float* occ = groupOcc + static_cast<std::size_t>(tp.group) * pad + X0;
                 store(occ, load<V>(occ) + (mo[0] < zero ? zero - mo[0] : mo[0]));
             }
         }

@@ -57,19 +57,19 @@ constexpr float kNoShareBelow = 1e-6f;
 float rowShareBound(const BlockerRadianceState& b, int Y, int x0, int x1, const float* D, const float* G,
                     float largest) {
     using simd::F4;
-    constexpr int kGroups = kVisibilityTile / 4;
+    constexpr int kLaneGroups = kVisibilityTile / 4;
     const std::size_t m = static_cast<std::size_t>(b.azimuths), plane = static_cast<std::size_t>(b.nxr) * b.nyr;
     const std::size_t at = static_cast<std::size_t>(Y) * b.nxr + static_cast<std::size_t>(x0);
-    const int n = x1 - x0, groups = (n + 3) / 4;
+    const int n = x1 - x0, laneGroups = (n + 3) / 4;
     const F4 zero = simd::splat<F4>(0.0f);
-    F4 azWeighed[kGroups], azTotal[kGroups], grWeighed[kGroups], grTotal[kGroups];
-    for (int q = 0; q < groups; ++q) azWeighed[q] = azTotal[q] = grWeighed[q] = grTotal[q] = zero;
+    F4 azWeighed[kLaneGroups], azTotal[kLaneGroups], grWeighed[kLaneGroups], grTotal[kLaneGroups];
+    for (int q = 0; q < laneGroups; ++q) azWeighed[q] = azTotal[q] = grWeighed[q] = grTotal[q] = zero;
     alignas(16) float lanes[kVisibilityTile] = {};
     const auto weighed = [&](const float* v, float d, F4* sum, F4* total, bool running) {
         std::copy(v, v + n, lanes);
         const F4 dv = simd::splat<F4>(d);
         const F4 tiny = simd::splat<F4>(d > 0.0f ? std::numeric_limits<float>::denorm_min() : 0.0f);
-        for (int q = 0; q < groups; ++q) {
+        for (int q = 0; q < laneGroups; ++q) {
             const F4 x = simd::load<F4>(lanes + 4 * q);
             const F4 w = running ? x - total[q] : x;  // an azimuth's share: the running sum's step
             sum[q] += w > zero ? simd::vmax(w * dv, tiny) : zero;
@@ -88,7 +88,7 @@ float rowShareBound(const BlockerRadianceState& b, int Y, int x0, int x1, const 
         return total > floor ? ratio : big;
     };
     float bound = 0.0f;
-    for (int q = 0; q < groups; ++q) {
+    for (int q = 0; q < laneGroups; ++q) {
         const F4 rho = simd::vmin(mean(azWeighed[q], azTotal[q]), mean(grWeighed[q], grTotal[q]));
         for (int l = 0; l < 4 && 4 * q + l < n; ++l) bound = std::max(bound, rho[l]);
     }
