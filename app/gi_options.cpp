@@ -89,6 +89,8 @@ void checkGiFlags(const gi::GiSettings& s) {
     checkRange(r::kRadianceLevelsPerOctave, s.indirect.radiance.levelsPerOctave, "--radiance-levels-per-octave");
     checkRange(r::kRadianceLevelOffset, s.indirect.radiance.levelOffset, "--radiance-level-offset");
     checkRange(r::kIndirectAzimuths, s.indirect.azimuths, "--indirect-azimuths");
+    checkRange(r::kLobeRings, s.indirect.lobeRings, "--glossy-lobe-rings");
+    checkRange(r::kLobeAzimuths, s.indirect.lobeAzimuths, "--glossy-lobe-azimuths");
 }
 
 // The output files, before any work: each must be a file in a folder we can write to.
@@ -192,6 +194,11 @@ void addLightTransportFlags(CLI::App* sub, GiOptions& o) {
         ->capture_default_str();
     sub->add_option("--indirect-azimuths", gs.indirect.azimuths, gi::describe(r::kIndirectAzimuths))
         ->capture_default_str();
+    sub->add_option("--glossy-lobe-rings", gs.indirect.lobeRings, gi::describe(r::kLobeRings) + " (--glossy lobe)")
+        ->capture_default_str();
+    sub->add_option("--glossy-lobe-azimuths", gs.indirect.lobeAzimuths,
+                    gi::describe(r::kLobeAzimuths) + " (--glossy lobe)")
+        ->capture_default_str();
     sub->add_option(
         "--indirect-kernel", o.indirectKernel,
         "Lambert indirect light: blocker (exact cosine at the receivers, between them the blockers' mean radiance "
@@ -200,9 +207,11 @@ void addLightTransportFlags(CLI::App* sub, GiOptions& o) {
         ->capture_default_str();
     sub->add_option("--reference-lobe-rings", o.referenceLobeRings, describe(opt::kReferenceLobeRings))
         ->capture_default_str();
-    sub->add_option("--glossy", o.glossy,
-                    "Glossy indirect light (phong/mix BRDFs): vector (SH radiance-vector pyramid, Fig. 5 middle) | "
-                    "scalar (shade pyramid, Fig. 5 right)");
+    sub->add_option(
+        "--glossy", o.glossy,
+        "Glossy indirect light (phong/mix BRDFs): vector (SH radiance-vector pyramid, Fig. 5 middle) | "
+        "scalar (shade pyramid, Fig. 5 right) | lobe (the vector pyramid's members gathered by each receiver's own "
+        "Phong lobe)");
     sub->add_option("--glossy-positivity", o.glossyPositivity,
                     "Phong / mix shading and glossy indirect light: clamp (no negative radiance: members send and "
                     "texels shade max(0, .), engine default) | off (the order-4 SH lobe's linear values, paper)");
@@ -256,9 +265,10 @@ gi::GiSettings giSettingsFrom(const GiOptions& o, ExponentSource& exponent) {
     gi::GiSettings settings = o.settings;
     parseBrdf(o.brdf, settings.shading);
     if (!o.glossy.empty())
-        settings.indirect.glossy = namedChoice<gi::GlossyIndirect>(
-            "--glossy", o.glossy,
-            {{"vector", gi::GlossyIndirect::VectorPyramid}, {"scalar", gi::GlossyIndirect::ScalarPyramid}});
+        settings.indirect.glossy = namedChoice<gi::GlossyIndirect>("--glossy", o.glossy,
+                                                                   {{"vector", gi::GlossyIndirect::VectorPyramid},
+                                                                    {"scalar", gi::GlossyIndirect::ScalarPyramid},
+                                                                    {"lobe", gi::GlossyIndirect::LobeScan}});
     if (!o.glossyPositivity.empty())
         settings.shading.positivity = namedChoice<gi::GlossyPositivity>(
             "--glossy-positivity", o.glossyPositivity,

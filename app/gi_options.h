@@ -41,7 +41,7 @@ struct GiOptions {
     std::string outHorizons;        // horizon elevation angles per azimuth (gi/horizon_angles.h)
     int referenceDirections = 2048;
     int referenceLobeRings = 12;   // glossy reference: lobe quadrature rings (ReferenceGiSettings::lobeRings)
-    std::string glossy;            // vector | scalar (glossy indirect light)
+    std::string glossy;            // vector | scalar | lobe (glossy indirect light)
     std::string glossyPositivity;  // clamp | off (negative Phong radiance clamped, or the paper's linear values)
     std::string phongExponent;     // VALUE or a 16-bit PNG
     std::string phongExponentRange = "1,1000";

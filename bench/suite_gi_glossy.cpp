@@ -1,6 +1,7 @@
 // `terrain_bench gi-glossy`: glossy indirect light - the SH radiance-vector
-// pyramid (GlossyIndirect::VectorPyramid, Fig. 5 middle) and the scalar shade
-// pyramid (ScalarPyramid, Fig. 5 right) against the glossy reference
+// pyramid (GlossyIndirect::VectorPyramid, Fig. 5 middle), the scalar shade
+// pyramid (ScalarPyramid, Fig. 5 right) and the lobe gather (LobeScan)
+// against the glossy reference
 // (gi/reference_glossy, exact), with and without the positivity clamp, and
 // the frame time of the glossy bounce. Writes gi_glossy.md and gi_glossy.csv.
 #include <chrono>
@@ -123,9 +124,16 @@ RowReferences rowReferences(const Grid& h, float cell, const GiLighting& light, 
 // The engine's errors of one row at sub-sampling s: e [vector, scalar][clamp,
 // off] against the exact reference; d, the vector mode [clamp, off] against
 // the diagnostic reference; az, the vector mode (clamp) with 16 and 32 scan
-// azimuths. Each also a CSV line.
+// azimuths; lobe, the lobe gather (engine default quadrature) and quad, the
+// lobe gather at kLobeQuadratures. Each also a CSV line.
+struct LobeQuadrature {
+    int rings, azimuths;
+};
+constexpr LobeQuadrature kLobeQuadratures[] = {{2, 16}, {2, 32}, {3, 16}, {3, 32}, {3, 64}, {4, 32}, {4, 64}};
+constexpr int kLobeQuadratureCount = sizeof kLobeQuadratures / sizeof kLobeQuadratures[0];
+
 struct RowErrors {
-    EngineError e[2][2], d[2], az[2];
+    EngineError e[2][2], d[2], az[2], lobe, quad[kLobeQuadratureCount];
 };
 
 RowErrors rowErrors(const Grid& h, float cell, const GiLighting& light, const AlbedoMap& a, const AccuracyRow& row,
@@ -154,6 +162,17 @@ RowErrors rowErrors(const Grid& h, float cell, const GiLighting& light, const Al
         r.az[k] = engineError(h, cell, light, a, g, GlossyPositivity::Clamp, ref.exact);
         csvLine("vector " + std::to_string(16 << k) + " azimuths", "clamp", r.az[k]);
     }
+    r.lobe = engineError(h, cell, light, a, settingsFor(row.brdf, row.S, s, 1, GlossyIndirect::LobeScan),
+                         GlossyPositivity::Clamp, ref.exact);
+    csvLine("lobe", "clamp", r.lobe);
+    for (int q = 0; q < kLobeQuadratureCount; ++q) {
+        GiSettings g = settingsFor(row.brdf, row.S, s, 1, GlossyIndirect::LobeScan);
+        g.indirect.lobeRings = kLobeQuadratures[q].rings;
+        g.indirect.lobeAzimuths = kLobeQuadratures[q].azimuths;
+        r.quad[q] = engineError(h, cell, light, a, g, GlossyPositivity::Clamp, ref.exact);
+        csvLine(strprintf("lobe %d rings %d azimuths", kLobeQuadratures[q].rings, kLobeQuadratures[q].azimuths),
+                "clamp", r.quad[q]);
+    }
     return r;
 }
 
@@ -161,7 +180,7 @@ RowErrors rowErrors(const Grid& h, float cell, const GiLighting& light, const Al
 // Mont Blanc: both glossy modes, with the positivity clamp (engine default)
 // and without it (paper), 1x and 2x.
 std::string accuracySection(const GlossyOptions& o, const BenchContext& ctx, std::string& csv) {
-    std::string md, diag, azim;
+    std::string md, diag, azim, quad;
     float cell = 1.0f;
     const Grid h = alpsCentreCrop(ctx.dataDir, o.size, cell);
     const AlbedoMap a = uniformAlbedo(o.size, o.size, albedo);
@@ -174,11 +193,14 @@ std::string accuracySection(const GlossyOptions& o, const BenchContext& ctx, std
         " lobe quadrature directions per lobe, " + std::to_string(o.directions) +
         " fixed directions for the Lambert part. Relative RMSE and bias of the indirect light (bounce 1, RGB, 10 % "
         "border left out); clamp: `--glossy-positivity clamp` (engine default), off: the paper's linear SH "
-        "values; neg: share of negative indirect values without the clamp (with it: none).\n\n";
+        "values; neg: share of negative indirect values without the clamp (with it: none); lobe: `--glossy lobe` "
+        "(the lobe gather, never negative).\n\n";
     md +=
         "| BRDF | S | sub-sampling | vector clamp RMSE | bias | vector off RMSE | bias | vector off neg | scalar clamp "
-        "RMSE | bias | scalar off RMSE | bias | scalar off neg | reference mean indirect | reference time (s) |\n";
-    md += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+        "RMSE | bias | scalar off RMSE | bias | scalar off neg | lobe RMSE | bias | reference mean indirect | "
+        "reference "
+        "time (s) |\n";
+    md += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     csv += "brdf,S,subsample,mode,positivity,rel_rmse,bias,negative_share,reference_mean,reference_seconds\n";
     for (const AccuracyRow& row :
          {AccuracyRow{Brdf::Phong, 8.0f}, AccuracyRow{Brdf::Phong, 16.0f}, AccuracyRow{Brdf::Phong, 32.0f},
@@ -188,14 +210,17 @@ std::string accuracySection(const GlossyOptions& o, const BenchContext& ctx, std
             const RowErrors r = rowErrors(h, cell, light, a, row, s, ref, csv);
             azim += strprintf("| %s | %g | %dx | %.4f | %.4f | %.4f |\n", brdfName(row.brdf), row.S, s, r.e[0][0].rmse,
                               r.az[0].rmse, r.az[1].rmse);
+            quad += strprintf("| %s | %g | %dx |", brdfName(row.brdf), row.S, s);
+            for (const EngineError& q : r.quad) quad += strprintf(" %.4f |", q.rmse);
+            quad += "\n";
             diag += strprintf("| %s | %g | %dx | %.4f | %+.4f | %.4f | %+.4f |\n", brdfName(row.brdf), row.S, s,
                               r.d[0].rmse, r.d[0].bias, r.d[1].rmse, r.d[1].bias);
             const std::string line = strprintf(
                 "| %s | %g | %dx | %.4f | %+.4f | %.4f | %+.4f | %.1f %% | %.4f | %+.4f | %.4f | %+.4f | %.1f "
-                "%% | %.4f | %.1f |\n",
+                "%% | %.4f | %+.4f | %.4f | %.1f |\n",
                 brdfName(row.brdf), row.S, s, r.e[0][0].rmse, r.e[0][0].bias, r.e[0][1].rmse, r.e[0][1].bias,
                 100.0 * r.e[0][1].negative, r.e[1][0].rmse, r.e[1][0].bias, r.e[1][1].rmse, r.e[1][1].bias,
-                100.0 * r.e[1][1].negative, ref.mean, ref.seconds);
+                100.0 * r.e[1][1].negative, r.lobe.rmse, r.lobe.bias, ref.mean, ref.seconds);
             std::fprintf(stderr, "%s", line.c_str());
             md += line;
         }
@@ -214,6 +239,16 @@ std::string accuracySection(const GlossyOptions& o, const BenchContext& ctx, std
           "): relative RMSE of the vector pyramid (clamp) against the exact reference.\n\n";
     md += "| BRDF | S | sub-sampling | default | 16 azimuths | 32 azimuths |\n|---|---|---|---|---|---|\n";
     md += azim;
+    md += "\nLobe quadrature (`--glossy lobe`, engine default " + std::to_string(IndirectSettings{}.lobeRings) +
+          " rings, " + std::to_string(IndirectSettings{}.lobeAzimuths) +
+          " azimuths): relative RMSE of the lobe gather against the exact reference with n rings (n x 2n rays per "
+          "lobe) and M global azimuths.\n\n| BRDF | S | sub-sampling |";
+    std::string rule = "|---|---|---|";
+    for (const LobeQuadrature& q : kLobeQuadratures) {
+        md += strprintf(" %d rings, %d az |", q.rings, q.azimuths);
+        rule += "---|";
+    }
+    md += "\n" + rule + "\n" + quad;
     return md;
 }
 
@@ -236,7 +271,8 @@ std::string frameTimeSection(const GlossyOptions& o, const BenchContext& ctx) {
         };
         for (const Case& cs : {Case{"lambert", Brdf::Lambert, GlossyIndirect::ScalarPyramid},
                                Case{"phong:32, scalar pyramid", Brdf::Phong, GlossyIndirect::ScalarPyramid},
-                               Case{"phong:32, vector pyramid", Brdf::Phong, GlossyIndirect::VectorPyramid}}) {
+                               Case{"phong:32, vector pyramid", Brdf::Phong, GlossyIndirect::VectorPyramid},
+                               Case{"phong:32, lobe gather", Brdf::Phong, GlossyIndirect::LobeScan}}) {
             const GiSettings g = settingsFor(cs.brdf, 32.0f, 2, 1, cs.mode);
             GiState st;
             std::vector<double> frame, ind, pyr, scan, shade;
@@ -350,7 +386,7 @@ void floorsSection(const GlossyOptions& o, const BenchContext& ctx) {
 }
 
 int runGlossy(const GlossyOptions& o, const BenchContext& ctx) {
-    std::string md = "# Glossy indirect light: vector vs scalar pyramid\n\n";
+    std::string md = "# Glossy indirect light: vector pyramid, scalar pyramid, lobe gather\n\n";
     md += "Machine: " + machineDescription() +
           " (shared with another engineer's builds and benchmarks while this ran: timings are indicative).\n\n";
     md += "Lighting: sun-and-sky SH environment (`sunSkyLight()`), viewer overhead, albedo " +
@@ -369,8 +405,8 @@ int runGlossy(const GlossyOptions& o, const BenchContext& ctx) {
 
 Runner addGiGlossySuite(CLI::App& app, const BenchContext& ctx) {
     auto o = std::make_shared<GlossyOptions>();
-    CLI::App* sub =
-        app.add_subcommand("gi-glossy", "Glossy indirect light: vector vs scalar pyramid, accuracy and frame time");
+    CLI::App* sub = app.add_subcommand(
+        "gi-glossy", "Glossy indirect light: vector pyramid, scalar pyramid and lobe gather, accuracy and frame time");
     addRunsOption(*sub, o->runs, "Frames per timing (the median is reported)");
     sub->add_option("--size", o->size, "Side of the accuracy crop")->check(CLI::Range(16, 4096))->capture_default_str();
     sub->add_option("--directions", o->directions, "Directions of the glossy reference")

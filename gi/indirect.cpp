@@ -19,7 +19,7 @@ void computeIndirect(const IndirectInputs& in, const IndirectSettings& settings,
 }
 
 bool readsIncidentSh(const IndirectSettings& settings, const ShadingSettings& shading) {
-    return settings.glossy == GlossyIndirect::VectorPyramid && shading.brdf != Brdf::Lambert && settings.bounces > 0;
+    return settings.glossy != GlossyIndirect::ScalarPyramid && shading.brdf != Brdf::Lambert && settings.bounces > 0;
 }
 
 bool gathersByTiles(const IndirectSettings& settings, const ShadingSettings& shading) {

@@ -73,21 +73,11 @@ void IndirectScan::buildStepTable() {
                            channelSteps);
 }
 
-// The exit-radiance planes' steps: one geometry (the 48 pyramids share
-// their layout) and each plane's origin.
+// The exit-radiance planes' steps (IndirectState::glossy's pyramid).
 void IndirectScan::buildGlossyStepTable() {
     GlossyIndirectState& gs = st_.glossy;
-    const HeightPyramid& geometry = gs.pyramid.geometry;
-    const auto planeSteps = [&](int i, double c, double sn, std::size_t at, ValidPrefix& prefix) {
-        const ScanStepInfo r = scanStepInfo(geometry, i, c, sn);
-        gs.steps[at] = r.step;
-        const std::uint16_t** origins = gs.fields.data() + at * kGlossyFields;
-        const int level = geometry.steps[static_cast<std::size_t>(i)].level;
-        for (int f = 0; f < kGlossyFields; ++f) origins[f] = gs.pyramid.address(f, level, r.step.field + r.step.offA);
-        prefix.narrow(r);
-    };
-    buildIndirectStepTable(in_.heights, in_.op.phi, pad_, st_.heightSteps, st_.stepsPerColumn, st_.stepsPerRow,
-                           planeSteps);
+    gi::buildGlossyStepTable(in_.heights, gs.pyramid, in_.op.phi, pad_, st_.heightSteps, st_.stepsPerColumn,
+                             st_.stepsPerRow, gs.steps, gs.fields);
 }
 
 RowBlock IndirectScan::rowBlock(int block) const {

@@ -44,4 +44,22 @@ void buildIndirectStepTable(const HeightPyramid& pyr, const std::vector<double>&
     });
 }
 
+// The planes share one layout (PackedPyramids::geometry): one step geometry,
+// each plane's origin.
+void buildGlossyStepTable(const HeightPyramid& pyr, const PackedPyramids& planes, const std::vector<double>& phi,
+                          int pad, std::vector<ScanStep>& heightSteps, std::vector<int>& stepsPerColumn,
+                          std::vector<int>& stepsPerRow, std::vector<ScanStep>& planeSteps,
+                          std::vector<const std::uint16_t*>& planeOrigins) {
+    const HeightPyramid& geometry = planes.geometry;
+    const auto steps = [&](int i, double c, double sn, std::size_t at, ValidPrefix& prefix) {
+        const ScanStepInfo r = scanStepInfo(geometry, i, c, sn);
+        planeSteps[at] = r.step;
+        const std::uint16_t** origins = planeOrigins.data() + at * static_cast<std::size_t>(planes.count);
+        const int level = geometry.steps[static_cast<std::size_t>(i)].level;
+        for (int f = 0; f < planes.count; ++f) origins[f] = planes.address(f, level, r.step.field + r.step.offA);
+        prefix.narrow(r);
+    };
+    buildIndirectStepTable(pyr, phi, pad, heightSteps, stepsPerColumn, stepsPerRow, steps);
+}
+
 }  // namespace terrain::gi

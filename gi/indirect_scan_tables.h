@@ -19,6 +19,7 @@
 
 #include "core/grid.h"
 #include "gi/pyramid.h"
+#include "gi/radiance_pyramid.h"
 #include "gi/visibility.h"
 
 namespace terrain::gi {
@@ -44,5 +45,14 @@ using RadianceStepFn = std::function<void(int, double, double, std::size_t, Vali
 void buildIndirectStepTable(const HeightPyramid& pyr, const std::vector<double>& phi, int pad,
                             std::vector<ScanStep>& heightSteps, std::vector<int>& stepsPerColumn,
                             std::vector<int>& stepsPerRow, const RadianceStepFn& radiance);
+
+/// buildIndirectStepTable over the pyramids of the exit-radiance planes (the
+/// glossy members, gi/glossy_exit_radiance.h): per step the planes' shared
+/// geometry (planeSteps[j * steps + i]) and each plane's origin, field + offA
+/// (planeOrigins[(j * steps + i) * planes.count + f]).
+void buildGlossyStepTable(const HeightPyramid& pyr, const PackedPyramids& planes, const std::vector<double>& phi,
+                          int pad, std::vector<ScanStep>& heightSteps, std::vector<int>& stepsPerColumn,
+                          std::vector<int>& stepsPerRow, std::vector<ScanStep>& planeSteps,
+                          std::vector<const std::uint16_t*>& planeOrigins);
 
 }  // namespace terrain::gi

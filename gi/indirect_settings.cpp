@@ -9,6 +9,8 @@ void validateIndirectSettings(const IndirectSettings& s) {
     checkRange(ranges::kRadianceLevelsPerOctave, s.radiance.levelsPerOctave);
     checkRange(ranges::kRadianceLevelOffset, s.radiance.levelOffset);
     checkRange(ranges::kIndirectAzimuths, s.azimuths);
+    checkRange(ranges::kLobeAzimuths, s.lobeAzimuths);
+    checkRange(ranges::kLobeRings, s.lobeRings);
 }
 
 }  // namespace terrain::gi

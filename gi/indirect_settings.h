@@ -14,6 +14,10 @@ enum class GlossyIndirect {
     // A pyramid of SH exit-radiance vectors, evaluated towards each receiver
     // (Fig. 5 middle; gi/indirect_sh_kernel.h).
     VectorPyramid,
+    // The vector pyramid's members, gathered by each receiver's own Phong
+    // lobe along the global azimuths it covers instead of shading the
+    // order-4 SH projection of U (gi/glossy_lobe_gather.h).
+    LobeScan,
 };
 
 // How Lambert receivers turn their casting sets into irradiance.
@@ -43,6 +47,10 @@ struct IndirectSettings {
     LambertIndirect lambert = LambertIndirect::BlockerRadiance;  // paper: ShKernel
     // Azimuths of the indirect scan (0: the visibility's m; paper: 0).
     int azimuths = 8;
+    // GlossyIndirect::LobeScan: the global azimuths the lobes are gathered
+    // along, and the lobe quadrature's rings (rings x 2 rings directions).
+    int lobeAzimuths = 32;
+    int lobeRings = 3;
     bool operator==(const IndirectSettings&) const = default;
 };
 

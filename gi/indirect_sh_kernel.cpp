@@ -58,6 +58,7 @@ ShKernelIndirect::ShKernelIndirect(const IndirectInputs& in, const IndirectSetti
       settings_(settings),
       st_(st),
       exitVectors_(readsIncidentSh(settings, in.shading)),
+      lobes_(exitVectors_ && settings.glossy == GlossyIndirect::LobeScan),
       scan_(in, exitVectors_ ? CastingMoments::GlossyNlp : CastingMoments::Nlp, st),
       nRows_(in.shading.brdf == Brdf::Lambert ? 9 : kShCount) {}  // Lambert reads bands 0..2 only
 
@@ -111,7 +112,18 @@ void ShKernelIndirect::buildPyramid(const BounceSource& previous) {
     buildPackedPyramids(gs.exitSh.data(), kGlossyFields, pyr, settings_.radiance, gs.pyramid);
 }
 
-void ShKernelIndirect::scan(int) {
+bool ShKernelIndirect::needsU(int b) const {
+    return b < settings_.bounces || in_.shading.brdf == Brdf::LambertPlusPhong;
+}
+
+void ShKernelIndirect::scan(int b) {
+    if (lobes_) {
+        const GlossyLobeInputs lobeIn{in_.heights,        in_.gradX,   in_.gradY,         st_.glossy.pyramid,
+                                      in_.albedo,         in_.shading, scan_.topHeight(), settings_.lobeAzimuths,
+                                      settings_.lobeRings};
+        gatherGlossyLobes(lobeIn, st_.glossy.lobes);
+        if (!needsU(b)) return;
+    }
     scan_.buildStepTable();
     parallelFor(0, scan_.blockCount(), 1, [&](int b0, int b1) {
         for (int block = b0; block < b1; ++block) scanBlock(block);
@@ -168,10 +180,24 @@ void ShKernelIndirect::scanBlock(int block) {
 // The texel pass stays whole with receiver tiles: it costs little beside the
 // scan, and interpolates the clean receivers' cached U. With the exit-radiance
 // vectors its incident SH feeds bounce b + 1.
-void ShKernelIndirect::shade(int, ShadeMaps& out) {
+// LobeScan: the gathered lobes are the Phong part; U, where it was scanned,
+// gives the diffuse part of a mixture (shaded with no Phong weight) and the
+// incident SH of the next bounce (a pure Phong shade of U is then replaced).
+void ShKernelIndirect::shade(int b, ShadeMaps& out) {
     if (exitVectors_) out.keepIncident = true;
-    shadeTexels(in_.gradX, in_.gradY, in_.heights.subsample, in_.envVisibility, st_.lights.data(), 3, in_.albedo,
-                in_.shading, out, false);
+    if (!lobes_)
+        return shadeTexels(in_.gradX, in_.gradY, in_.heights.subsample, in_.envVisibility, st_.lights.data(), 3,
+                           in_.albedo, in_.shading, out, false);
+    const bool mixture = in_.shading.brdf == Brdf::LambertPlusPhong;
+    if (needsU(b)) {
+        ShadingSettings diffuseOnly = in_.shading;
+        diffuseOnly.specularWeight = 0.0f;
+        shadeTexels(in_.gradX, in_.gradY, in_.heights.subsample, in_.envVisibility, st_.lights.data(), 3, in_.albedo,
+                    mixture ? diffuseOnly : in_.shading, out, false);
+    }
+    out.nx = in_.heights.nx;
+    out.ny = in_.heights.ny;
+    shadeGlossyLobes(st_.glossy.lobes, in_.heights, in_.shading, mixture, out.rgb);
 }
 
 }  // namespace terrain::gi

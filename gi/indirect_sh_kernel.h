@@ -26,6 +26,11 @@
 //   member t_i sends Ebar(t_i) . Y(-d_i) back to its receiver. Accuracy and
 //   cost against the scalar pyramid and the glossy reference
 //   (gi/reference_gi.h): bench/results/gi_glossy.md.
+// GlossyIndirect::LobeScan reads the same exit-radiance pyramid, but the
+// Phong part of each bounce's shade is each receiver's own lobe gathered
+// along the directions it covers (gi/glossy_lobe_gather.h), not the order-4
+// lobe applied to U; U is scanned only where something still reads it: the
+// diffuse part of a mixture and the next bounce's incident SH.
 #include "gi/indirect_bounces.h"
 #include "gi/indirect_scan.h"
 
@@ -48,7 +53,11 @@ private:
     const IndirectInputs& in_;
     const IndirectSettings& settings_;
     IndirectState& st_;
-    bool exitVectors_;  // the members send E . Y(-d) (GlossyIndirect::VectorPyramid)
+    /// LobeScan: bounce b reads U (its diffuse part, or a bounce after it).
+    bool needsU(int b) const;
+
+    bool exitVectors_;  // the members send E . Y(-d) (GlossyIndirect::VectorPyramid, LobeScan)
+    bool lobes_;        // the receivers gather their own lobes (GlossyIndirect::LobeScan)
     IndirectScan scan_;
     int nRows_;  // SH rows of U that shading reads
 };

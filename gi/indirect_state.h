@@ -10,6 +10,7 @@
 #include "gi/blocker_radiance.h"
 #include "gi/casting_set_scan.h"
 #include "gi/glossy_exit_radiance.h"
+#include "gi/glossy_lobe_gather.h"
 #include "gi/radiance_pyramid.h"
 #include "gi/receiver_tiles.h"
 #include "gi/shading.h"
@@ -21,13 +22,15 @@ struct IndirectTimings {
     double pyramid = 0.0, scan = 0.0, shading = 0.0, total = 0.0;
 };
 
-/// Buffers of the vector-pyramid bounce (GlossyIndirect::VectorPyramid, gi/indirect_sh_kernel.h).
+/// Buffers of the vector-pyramid bounce (GlossyIndirect::VectorPyramid and
+/// LobeScan, gi/indirect_sh_kernel.h).
 struct GlossyIndirectState {
     std::vector<float> exitSh;                 // 3 x 16 planes of nx * ny: E at full resolution (plane c * 16 + k)
     PackedPyramids pyramid;                    // one field per plane of exitSh, bfloat16
     std::vector<ScanStep> steps;               // azimuths x steps: geometry and weights (field 0)
     std::vector<const std::uint16_t*> fields;  // azimuths x steps x 48: field + offA of each plane
     GlossyExitScratch exitScratch;             // E's rows and columns
+    GlossyLobeState lobes;                     // GlossyIndirect::LobeScan: the receivers' gathered lobes
 };
 
 struct IndirectState {

@@ -57,31 +57,6 @@ void buildSkyHorizons(ConstGridView heights, float cellSize, int azimuths, SkyHo
     });
 }
 
-void lobeFrame(const double r[3], double t[3], double b[3]) {
-    // the axis least aligned with r gives a well-conditioned cross product
-    const double ax = std::fabs(r[0]), ay = std::fabs(r[1]), az = std::fabs(r[2]);
-    const double e[3] = {ax <= ay && ax <= az ? 1.0 : 0.0, ay < ax && ay <= az ? 1.0 : 0.0,
-                         az < ax && az < ay ? 1.0 : 0.0};
-    t[0] = r[1] * e[2] - r[2] * e[1];
-    t[1] = r[2] * e[0] - r[0] * e[2];
-    t[2] = r[0] * e[1] - r[1] * e[0];
-    const double len = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
-    for (int k = 0; k < 3; ++k) t[k] /= len;
-    b[0] = r[1] * t[2] - r[2] * t[1];
-    b[1] = r[2] * t[0] - r[0] * t[2];
-    b[2] = r[0] * t[1] - r[1] * t[0];
-}
-
-void lobeDirection(const double r[3], const double t[3], const double b[3], double S, int n, int i, int j,
-                   double w[3]) {
-    // ring i: the midpoint of [i / n, (i + 1) / n] in t = cos^(S + 1)
-    const double tm = (i + 0.5) / n;
-    const double c = std::exp(std::log(tm) / (S + 1.0)), s = std::sqrt(std::max(0.0, 1.0 - c * c));
-    const double psi = kPi * (j + 0.5) / n;
-    const double cp = std::cos(psi), sp = std::sin(psi);
-    for (int k = 0; k < 3; ++k) w[k] = c * r[k] + s * (cp * t[k] + sp * b[k]);
-}
-
 bool skyVisible(const SkyHorizons& hz, float px, float py, const double n[3], const double w[3]) {
     if (n[0] * w[0] + n[1] * w[1] + n[2] * w[2] <= 0.0) return false;
     const double horiz = std::sqrt(w[0] * w[0] + w[1] * w[1]);

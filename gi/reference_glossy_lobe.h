@@ -19,16 +19,14 @@
 // M azimuths phi_a = 2 pi (a + 0.5) / M; between azimuths linear, at a first
 // hit between grid points bilinear.
 //
-// Quadrature. The substitution t = (w . R)^(S + 1) turns the lobe's measure
-// into a uniform one: int I f dw = int_0^1 dt int_0^{2 pi} I(w(t, psi)) dpsi / (2 pi),
-// psi the azimuth about R. A midpoint rule with n rings in t and 2n azimuths
-// in psi therefore integrates every exponent alike (the lobe's peak is
-// absorbed by the substitution); the error comes from the horizon edge and
-// the sky's variation only. The convergence in n is tested by doubling it.
+// Quadrature: gi/phong_lobe_quadrature.h (n rings in t = (w . R)^(S + 1) x
+// 2n azimuths about R); the error comes from the horizon edge and the sky's
+// variation only. The convergence in n is tested by doubling it.
 #include <vector>
 
 #include "core/grid.h"
 #include "gi/lights.h"
+#include "gi/phong_lobe_quadrature.h"
 
 namespace terrain::gi {
 
@@ -43,14 +41,6 @@ struct SkyHorizons {
 };
 
 void buildSkyHorizons(ConstGridView heights, float cellSize, int azimuths, SkyHorizons& out);
-
-/// Orthonormal frame (t, b) about the unit vector r.
-void lobeFrame(const double r[3], double t[3], double b[3]);
-
-/// Quadrature direction (ring i of n, azimuth j of 2n) of the Phong lobe of
-/// exponent S about r (frame t, b from lobeFrame); each carries the weight
-/// 1 / (2 n^2) of the lobe's unit mass.
-void lobeDirection(const double r[3], const double t[3], const double b[3], double S, int n, int i, int j, double w[3]);
 
 /// True when direction w is above the tangent plane of normal n and above the
 /// horizon at (px, py).

@@ -36,6 +36,10 @@ inline constexpr SettingRange<int> kRadianceLevelsPerOctave{"radiance levels per
                                                             "Radiance pyramid levels per octave k_u"};
 inline constexpr SettingRange<int> kRadianceLevelOffset{"radiance level offset", 0, 32,
                                                         "Radiance pyramid level offset o_u, octaves"};
+inline constexpr SettingRange<int> kLobeAzimuths{"glossy lobe azimuths", 4, 4096,
+                                                 "Global azimuths of the glossy lobe gather"};
+inline constexpr SettingRange<int> kLobeRings{"glossy lobe rings", 1, 64,
+                                              "Rings of the glossy lobe quadrature (rings x 2 rings directions)"};
 inline constexpr SettingRange<int> kIndirectAzimuths{"indirect azimuths", 3, 4096,
                                                      "Azimuths of the indirect scan (0: the visibility's)", true};
 

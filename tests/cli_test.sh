@@ -75,6 +75,14 @@ hm16="$tmp/g16/frame_000000.png"
 # the paper's linear glossy values stay reachable
 "$T" gi --heightmap "$hm24" --cell-size 10 --brdf phong:64 --bounces 1 --glossy vector --glossy-positivity off \
   --out-indirect "$tmp/goff.npy" >/dev/null 2>&1 && [ -s "$tmp/goff.npy" ] && ok || bad "gi --glossy-positivity off"
+# the lobe gather, and its quadrature out of range
+"$T" gi --heightmap "$hm24" --cell-size 10 --brdf phong:64 --bounces 2 --glossy lobe --glossy-lobe-rings 2 \
+  --glossy-lobe-azimuths 16 --phong-exponent "$hm24" --out-indirect "$tmp/globe.npy" >/dev/null 2>&1 &&
+  [ -s "$tmp/globe.npy" ] && ok || bad "gi --glossy lobe"
+expect_error "glossy lobe rings out of range" "glossy-lobe-rings" "$T" gi --heightmap "$hm24" --cell-size 10 \
+  --brdf phong:20 --glossy lobe --glossy-lobe-rings 0
+expect_error "glossy lobe azimuths out of range" "glossy-lobe-azimuths" "$T" gi --heightmap "$hm24" --cell-size 10 \
+  --brdf phong:20 --glossy lobe --glossy-lobe-azimuths 100000
 expect_error "lobe rings out of range" "reference-lobe-rings" "$T" gi --heightmap "$hm24" --cell-size 10 \
   --brdf phong:20 --reference --reference-lobe-rings 0
 expect_error "bad glossy positivity" "glossy-positivity" "$T" gi --heightmap "$hm24" --cell-size 10 --brdf phong:20 \

@@ -77,6 +77,7 @@ compare gi-bounce2-sh gi "${hm[@]}" "${maps[@]}" "${ind[@]}" --bounces 2 --indir
 compare gi-glossy-vector gi "${hm[@]}" "${maps[@]}" "${ind[@]}" --bounces 1 --brdf mix:0.5,40 --glossy vector
 compare gi-glossy-scalar-2x gi "${hm[@]}" "${maps[@]}" "${ind[@]}" --bounces 2 --subsample 2 \
   --brdf phong:20 --glossy scalar
+compare gi-glossy-lobe gi "${hm[@]}" "${maps[@]}" "${ind[@]}" --bounces 2 --brdf mix:0.5,40 --glossy lobe
 compare gi-sun-frames gi "${hm[@]}" "${maps[@]}" --sun 9,1,45,172 --frames 3 --bounces 1
 compare gi-reference gi "${hm[@]}" --out-ambient ambient.npy --reference --bounces 1 \
   --reference-directions 64

@@ -50,6 +50,17 @@ ReferenceGiSettings glossyReference(float S, int directions, int azimuths, int l
     return rs;
 }
 
+// The one-bounce reference of the 41 x 41 V valley tests: many directions and
+// horizon azimuths, the given shading.
+ReferenceGiSettings valleyReference(const ShadingSettings& shading) {
+    ReferenceGiSettings rs;
+    rs.directions = 2048;
+    rs.azimuths = 128;
+    rs.bounces = 1;
+    rs.shading = shading;
+    return rs;
+}
+
 // Relative RMS difference of a's green indirect light from b's over the
 // interior of an n x 9 valley (two cells of border left out).
 double valleyInteriorChange(const ReferenceGiResult& a, const ReferenceGiResult& b, int n) {
@@ -114,12 +125,14 @@ TEST_CASE("gi.glossy: a flat plane gets exactly no glossy indirect light (fast p
     const AlbedoMap a = uniformAlbedo(37, 23, 0.8f);
     for (Brdf brdf : {Brdf::Phong, Brdf::LambertPlusPhong})
         for (int b : {1, 3}) {
-            GiState st;
             GiLighting light;
             light.environment = sunSkyLight();
-            runGiFrame(h.view(), 2.0f, light, glossySettings(brdf, 20.0f, b, GlossyIndirect::VectorPyramid, 2), st, &a);
-            for (const Grid& g : st.indirect.indirect)
-                for (float v : g.v) REQUIRE(v == 0.0f);
+            for (GlossyIndirect mode : {GlossyIndirect::VectorPyramid, GlossyIndirect::LobeScan}) {
+                GiState st;
+                runGiFrame(h.view(), 2.0f, light, glossySettings(brdf, 20.0f, b, mode, 2), st, &a);
+                for (const Grid& g : st.indirect.indirect)
+                    for (float v : g.v) REQUIRE(v == 0.0f);
+            }
             ReferenceGiSettings rs;
             rs.directions = 256;
             rs.azimuths = 32;
@@ -194,28 +207,29 @@ TEST_CASE(
                                            {"flat", Grid(32, 24, 100.0f)}};
     GiLighting light;
     light.environment = sunSkyLight();
-    int negativeWithoutClamp = 0;
+    int negativeWithoutClamp = 0, cases = 0;
     for (const Terrain& t : terrains) {
         const AlbedoMap a = uniformAlbedo(t.h.nx, t.h.ny, 0.8f);
         for (float S : {1.0f, 4.0f, 16.0f, 64.0f, 256.0f, 1000.0f})
-            for (GlossyIndirect mode : {GlossyIndirect::VectorPyramid, GlossyIndirect::ScalarPyramid})
+            for (GlossyIndirect mode :
+                 {GlossyIndirect::VectorPyramid, GlossyIndirect::ScalarPyramid, GlossyIndirect::LobeScan})
                 for (Brdf brdf : {Brdf::Phong, Brdf::LambertPlusPhong}) {
                     GiSettings s = glossySettings(brdf, S, 1, mode, S < 10.0f ? 1 : 2);
                     GiState st;
                     runGiFrame(t.h.view(), 1.0f, light, s, st, &a);
                     const float lo = smallest({&st.shade.rgb, &st.indirect.indirect, &st.indirect.total});
                     if (lo < 0.0f)
-                        FAIL_CHECK(t.name << ", S = " << S << ", "
-                                          << (mode == GlossyIndirect::VectorPyramid ? "vector" : "scalar")
-                                          << ": smallest value " << lo);
+                        FAIL_CHECK(t.name << ", S = " << S << ", mode " << static_cast<int>(mode) << ": smallest value "
+                                          << lo);
                     s.shading.positivity = GlossyPositivity::Off;  // the paper's linear values
                     GiState off;
                     runGiFrame(t.h.view(), 1.0f, light, s, off, &a);
                     negativeWithoutClamp += smallest({&off.indirect.indirect}) < 0.0f;
+                    ++cases;
                 }
     }
     // the clamp is what makes them non-negative: without it the SH lobe rings below zero
-    MESSAGE("cases with negative indirect light without the clamp: " << negativeWithoutClamp << " of 120");
+    MESSAGE("cases with negative indirect light without the clamp: " << negativeWithoutClamp << " of " << cases);
     CHECK(negativeWithoutClamp > 10);
 }
 
@@ -303,11 +317,7 @@ TEST_CASE(
         sc.indirect.glossy = GlossyIndirect::ScalarPyramid;
         runGiFrame(h.view(), 1.0f, light, sv, vs, &a);
         runGiFrame(h.view(), 1.0f, light, sc, ss, &a);
-        ReferenceGiSettings rs;
-        rs.directions = 2048;
-        rs.azimuths = 128;
-        rs.bounces = 1;
-        rs.shading = sv.shading;
+        const ReferenceGiSettings rs = valleyReference(sv.shading);
         ReferenceGiResult ref;
         renderReferenceGi(h.view(), 1.0f, light.environment, &a, rs, ref);
         const double wallV = meanOver(vs.indirect.indirect[0], c + 3, c + 10, 10, n - 10);
@@ -318,6 +328,79 @@ TEST_CASE(
         CHECK(wallR > 0.01);
         CHECK(wallV == doctest::Approx(wallR).epsilon(0.15));
         if (exponent > 10.0f) CHECK(std::fabs(wallV - wallR) < 0.5 * std::fabs(wallS - wallR));
+    }
+}
+
+TEST_CASE("gi.glossy: V valley with Phong walls: the lobe gather against the exact reference and its idealisation") {
+    // The valley above: a wall's glossy light comes from the opposite wall
+    // along the viewer's reflection. The lobe gather integrates each
+    // receiver's own lobe; what the opposite wall sends it is the wall's
+    // order-4 exit radiance E . Y, whose error the reference's membersSh
+    // diagnostic isolates. With the gather's quadrature (3 rings, 32
+    // azimuths) and order-4 members, the reference is the gather's
+    // idealisation: the gather must follow it closely, and the exact
+    // reference up to the members' order-4 floor.
+    const int n = 41;
+    const Grid h = valley(n, n, 1.0f);
+    const AlbedoMap a = uniformAlbedo(n, n, 1.0f);
+    const int c = n / 2;
+    for (float exponent : {8.0f, 64.0f, 256.0f}) {
+        GiLighting light;
+        GiSettings sl = glossySettings(Brdf::Phong, exponent, 1, GlossyIndirect::LobeScan);
+        sl.visibility.azimuths = 32;
+        GiState ls;
+        runGiFrame(h.view(), 1.0f, light, sl, ls, &a);
+        ReferenceGiSettings rs = valleyReference(sl.shading);
+        ReferenceGiResult exact, ideal, membersSh;
+        renderReferenceGi(h.view(), 1.0f, light.environment, &a, rs, exact);
+        rs.membersSh = true;
+        renderReferenceGi(h.view(), 1.0f, light.environment, &a, rs, membersSh);
+        rs.lobeRings = sl.indirect.lobeRings;
+        rs.receiverAzimuths = sl.indirect.lobeAzimuths;
+        renderReferenceGi(h.view(), 1.0f, light.environment, &a, rs, ideal);
+        auto wall = [&](const Grid& g) { return meanOver(g, c + 3, c + 10, 10, n - 10); };
+        const double wallL = wall(ls.indirect.indirect[0]), wallR = wall(exact.indirect[0]);
+        const double wallI = wall(ideal.indirect[0]), wallM = wall(membersSh.indirect[0]);
+        MESSAGE("S = " << exponent << ": wall indirect lobe gather " << wallL << ", idealisation " << wallI
+                       << ", exact reference " << wallR << " (members SH " << wallM << ")");
+        CHECK(wallR > 0.01);
+        CHECK(wallL == doctest::Approx(wallI).epsilon(0.05));
+        CHECK(std::fabs(wallL - wallR) < std::fabs(wallM - wallR) + 0.05 * wallR);
+    }
+}
+
+TEST_CASE("gi.glossy: the lobe gather against the reference's own idealisation of it on hills") {
+    // The reference with the gather's quadrature (3 rings, 32 azimuths) and
+    // order-4 members (membersSh) is what the gather would give without the
+    // pyramids' steps and filtering: the difference is the scan's own error.
+    const Grid h = hills(48, 8.0f);
+    const AlbedoMap a = uniformAlbedo(48, 48, 0.8f);
+    GiLighting light;
+    light.environment = sunSkyLight();
+    for (float S : {8.0f, 64.0f}) {
+        const GiSettings g = glossySettings(Brdf::Phong, S, 1, GlossyIndirect::LobeScan);
+        GiState st;
+        runGiFrame(h.view(), 1.0f, light, g, st, &a);
+        ReferenceGiSettings rs = glossyReference(S, 512, 64, 3);
+        rs.membersSh = true;
+        rs.receiverAzimuths = 32;
+        ReferenceGiResult ideal, exact;
+        renderReferenceGi(h.view(), 1.0f, light.environment, &a, rs, ideal);
+        rs = glossyReference(S, 512, 64, 8);
+        renderReferenceGi(h.view(), 1.0f, light.environment, &a, rs, exact);
+        double d2 = 0.0, e2 = 0.0, r2 = 0.0;
+        for (int y = 5; y < 43; ++y)
+            for (int x = 5; x < 43; ++x) {
+                const double v = st.indirect.indirect[1](x, y), w = ideal.indirect[1](x, y),
+                             r = exact.indirect[1](x, y);
+                d2 += (v - w) * (v - w);
+                e2 += (v - r) * (v - r);
+                r2 += r * r;
+            }
+        MESSAGE("S = " << S << ": relative RMS difference gather vs its idealisation " << std::sqrt(d2 / r2)
+                       << ", vs the exact reference " << std::sqrt(e2 / r2));
+        CHECK(std::sqrt(d2 / r2) < 0.2);
+        CHECK(std::sqrt(e2 / r2) < 0.25);
     }
 }
 
@@ -349,27 +432,28 @@ TEST_CASE("gi.glossy: as the lobe widens (S -> 0) the vector pyramid becomes the
     CHECK(prev < 1e-3);
 }
 
-TEST_CASE("gi.glossy: bit-identical for 1, 2, 3 and 8 threads (vector pyramid, exponent map, 2 bounces)") {
+TEST_CASE("gi.glossy: bit-identical for 1, 2, 3 and 8 threads (vector pyramid, lobe gather, exponent map, 2 bounces)") {
     const Grid h = hills(53, 10.0f);
     AlbedoMap a = uniformAlbedo(53, 53, 0.7f);
     Grid e(53, 53);
     for (int y = 0; y < 53; ++y)
         for (int x = 0; x < 53; ++x) e(x, y) = 2.0f + static_cast<float>((x * 5 + y * 3) % 17) * 4.0f;
     setPhongExponentMap(a, e);
-    for (int s : {1, 2}) {
-        std::vector<std::vector<float>> results;
-        for (int threads : {1, 2, 3, 8}) {
-            GiState st;
-            GiLighting light;
-            light.environment = sunSkyLight();
-            withThreads(threads, [&] {
-                runGiFrame(h.view(), 1.5f, light,
-                           glossySettings(Brdf::LambertPlusPhong, 10.0f, 2, GlossyIndirect::VectorPyramid, s), st, &a);
-            });
-            results.push_back(allChannels(st.indirect.total));
+    for (GlossyIndirect mode : {GlossyIndirect::VectorPyramid, GlossyIndirect::LobeScan})
+        for (int s : {1, 2}) {
+            std::vector<std::vector<float>> results;
+            for (int threads : {1, 2, 3, 8}) {
+                GiState st;
+                GiLighting light;
+                light.environment = sunSkyLight();
+                withThreads(threads, [&] {
+                    runGiFrame(h.view(), 1.5f, light, glossySettings(Brdf::LambertPlusPhong, 10.0f, 2, mode, s), st,
+                               &a);
+                });
+                results.push_back(allChannels(st.indirect.total));
+            }
+            for (std::size_t i = 1; i < results.size(); ++i) CHECK(results[i] == results[0]);
         }
-        for (std::size_t i = 1; i < results.size(); ++i) CHECK(results[i] == results[0]);
-    }
 }
 
 TEST_CASE("gi.glossy: an exponent map of constant S shades bit for bit like the scalar exponent S") {
@@ -377,7 +461,8 @@ TEST_CASE("gi.glossy: an exponent map of constant S shades bit for bit like the 
     for (float S : {1.0f, 12.5f, 300.0f}) {
         AlbedoMap plain = uniformAlbedo(36, 36, 0.75f), mapped = plain;
         setPhongExponentMap(mapped, Grid(36, 36, S));
-        for (GlossyIndirect mode : {GlossyIndirect::VectorPyramid, GlossyIndirect::ScalarPyramid}) {
+        for (GlossyIndirect mode :
+             {GlossyIndirect::VectorPyramid, GlossyIndirect::ScalarPyramid, GlossyIndirect::LobeScan}) {
             GiState a, b;
             const GiSettings s = glossySettings(Brdf::LambertPlusPhong, S, 1, mode, 2);
             runGiFrame(h.view(), 1.0f, GiLighting{}, s, a, &plain);
@@ -435,16 +520,16 @@ TEST_CASE("gi.glossy: hard cases stay finite") {
     cases.push_back(Grid(2, 2, 3.0f));
     cases.push_back(valley(2, 7, 5.0f));
     for (const Grid& g : cases)
-        for (int s : {1, 2, 4}) {
-            const AlbedoMap a = uniformAlbedo(g.nx, g.ny, 0.9f);
-            GiState st;
-            GiLighting light;
-            light.environment = sunSkyLight();
-            runGiFrame(g.view(), 1.0f, light,
-                       glossySettings(Brdf::LambertPlusPhong, 50.0f, 2, GlossyIndirect::VectorPyramid, s), st, &a);
-            for (const Grid& c : st.indirect.total)
-                for (float v : c.v) REQUIRE(std::isfinite(v));
-        }
+        for (int s : {1, 2, 4})
+            for (GlossyIndirect mode : {GlossyIndirect::VectorPyramid, GlossyIndirect::LobeScan}) {
+                const AlbedoMap a = uniformAlbedo(g.nx, g.ny, 0.9f);
+                GiState st;
+                GiLighting light;
+                light.environment = sunSkyLight();
+                runGiFrame(g.view(), 1.0f, light, glossySettings(Brdf::LambertPlusPhong, 50.0f, 2, mode, s), st, &a);
+                for (const Grid& c : st.indirect.total)
+                    for (float v : c.v) REQUIRE(std::isfinite(v));
+            }
     // the reference too
     ReferenceGiSettings rs;
     rs.directions = 128;
@@ -475,6 +560,15 @@ TEST_CASE("gi.glossy: a second frame allocates nothing new") {
     CHECK(st.indirect.glossy.exitSh.data() == p0);
     CHECK(packed.block.data() == p1);
     CHECK(st.indirect.blocks.at(0).state.data() == p2);
+    GiSettings lobe = s;
+    lobe.indirect.glossy = GlossyIndirect::LobeScan;
+    GiState ls;
+    runGiFrame(h.view(), 1.0f, GiLighting{}, lobe, ls, &a);
+    const float* p3 = ls.indirect.glossy.lobes.gathered.data();
+    const ScanStep* p4 = ls.indirect.glossy.lobes.heightSteps.data();
+    runGiFrame(h2.view(), 1.0f, GiLighting{}, lobe, ls, &a);
+    CHECK(ls.indirect.glossy.lobes.gathered.data() == p3);
+    CHECK(ls.indirect.glossy.lobes.heightSteps.data() == p4);
 }
 
 TEST_CASE("gi.glossy reference: the order-4 diagnostics change what they name and nothing else") {

@@ -1,0 +1,103 @@
+#pragma once
+// The glossy receivers' own lobe, gathered along the scan directions it
+// covers (GlossyIndirect::LobeScan): the engine's answer to the order-4 floor
+// of the vector pyramid (gi/indirect_sh_kernel.h, README "Glossy indirect
+// light").
+//
+// Why. The vector pyramid shades each receiver's SH-projected incident
+// radiance U with the order-4 Phong lobe factors (Section 7). Measured
+// against the exact glossy reference that projection is the vector mode's
+// floor, and the sharper the lobe the higher it lies; the scan's few azimuths
+// are another (a sharp lobe lies between two of them). What the members
+// send, E . Y from the exit-radiance pyramid, costs less (README, "Glossy
+// indirect light", gives the measured floors).
+//
+// What is gathered. The Phong part of a receiver's first-bounce exit
+// radiance towards the viewer, int I(w) f(w) dw with f the normalised Phong
+// lobe about the viewer's reflection R (gi/phong_lobe_quadrature.h), by the
+// lobe quadrature's n rings x 2n directions (IndirectSettings::lobeRings).
+// Each direction w is seen along the scan's global azimuths phi_j = 2 pi j /
+// M (IndirectSettings::lobeAzimuths): at w's own elevation along the two
+// azimuths on either side of w's, weighted linearly (the reference's
+// receiverAzimuths diagnostic, gi/reference_gi.h). Along azimuth j the
+// receiver walks the height pyramid's exponential steps (Eq. 14, the
+// casting-set scan's tables at M azimuths); a ray of slope tan(elevation) te
+// meets the first step whose blocking slope t reaches te (Eq. 17's casting
+// set: that step is the member whose segment holds te, Eq. 8), and brings
+// back what the member sends towards the receiver, Ebar . Y(-w_j) (the ray's
+// direction, not the member's own elevation), max(0, .) with
+// GlossyPositivity::Clamp. A ray below the tangent plane along phi_j carries
+// nothing; one that meets no step sees the sky (direct light, bounce 0).
+// Only the azimuths some ray of the receiver reads are walked, and a walk
+// stops once the field's highest height cannot reach its lowest unmet ray:
+// narrow lobes walk 2-4 azimuths, and rays high above the horizon stop after
+// a few steps.
+//
+// Where. At the receivers (the sub-sampled grid), with each receiver's own
+// normal, exponent (AlbedoMap::phongExponent) and reflection; full-resolution
+// texels interpolate the gathered radiance bilinearly (Fig. 7), like every
+// other receiver quantity. The diffuse part of a mixture and the bounces after
+// the first keep the SH kernel (U); their incident SH comes from U as in the
+// vector mode.
+//
+// Deterministic: per receiver a pure function of its inputs, rows in parallel.
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "core/grid.h"
+#include "gi/phong_lobe_quadrature.h"
+#include "gi/pyramid.h"
+#include "gi/radiance_pyramid.h"
+#include "gi/shading.h"
+#include "gi/visibility.h"
+
+namespace terrain::gi {
+
+/// Per worker slot: one receiver row's inputs and the rays of one receiver.
+struct GlossyLobeScratch {
+    std::vector<float> gx, gy, h0, margin;  // loadReceiverRow, padded row
+    struct Ray {
+        int azimuth;    // global azimuth j of the walk that reads the ray
+        float slope;    // tan of the ray's elevation
+        float weight;   // quadrature weight x the linear azimuth weight
+        float back[3];  // unit direction from the member back to the receiver
+    };
+    std::vector<Ray> rays;
+    LobeQuadrature quadrature;  // the lobe directions of the last exponent
+};
+
+/// The gather's step tables and its result (reused: no allocation after the
+/// first frame of a size and settings).
+struct GlossyLobeState {
+    std::vector<double> phi;                        // the M global azimuths 2 pi j / M
+    std::vector<float> cosPhi, sinPhi;              // their directions
+    std::vector<ScanStep> heightSteps, planeSteps;  // M x steps (gi/indirect_scan_tables.h)
+    std::vector<const std::uint16_t*> planeOrigins;
+    std::vector<int> stepsPerColumn, stepsPerRow;
+    std::vector<float> gathered;  // 3 planes of nxr * nyr: int I f dw per receiver (RGB)
+    std::vector<GlossyLobeScratch> scratch;
+};
+
+/// What the gather reads of a frame.
+struct GlossyLobeInputs {
+    const HeightPyramid& heights;  // the frame's height pyramid (receivers, steps)
+    ConstGridView gradX, gradY;    // full-resolution height gradients
+    const PackedPyramids& exit;    // the exit-radiance SH planes' pyramid (gi/glossy_exit_radiance.h)
+    const AlbedoMap* surface;      // per-texel exponent (null or empty: the settings')
+    const ShadingSettings& shading;
+    float topHeight;  // the field's highest height (no sample rises above it)
+    int azimuths;     // M, the global azimuths
+    int rings;        // n: n rings x 2n directions per lobe
+};
+
+/// GlossyLobeState::gathered at every receiver (see above).
+void gatherGlossyLobes(const GlossyLobeInputs& in, GlossyLobeState& st);
+
+/// out[c] = base[c] + w_s gathered (interpolated to full resolution, Fig. 7;
+/// base: out's own values, or 0 when `addToOut` is false); a value that is not
+/// finite becomes 0, and below 0 becomes 0 with GlossyPositivity::Clamp.
+void shadeGlossyLobes(const GlossyLobeState& st, const HeightPyramid& heights, const ShadingSettings& shading,
+                      bool addToOut, std::array<Grid, 3>& out);
+
+}  // namespace terrain::gi

@@ -1,0 +1,43 @@
+#pragma once
+// Quadrature of the normalised Phong lobe (Section 7's lobe, integrated
+// exactly instead of through its order-4 SH factors): shared by the glossy
+// reference (gi/reference_glossy_lobe.h) and the lobe-directed gather of the
+// fast path (gi/glossy_lobe_gather.h).
+//
+// The lobe of exponent S about the unit vector R,
+//   f(w) = (S + 1) / (2 pi) max(0, w . R)^S,  integral 1 over the sphere.
+// The substitution t = (w . R)^(S + 1) turns its measure into a uniform one:
+// int I f dw = int_0^1 dt int_0^{2 pi} I(w(t, psi)) dpsi / (2 pi), psi the
+// azimuth about R. A midpoint rule with n rings in t and 2n azimuths in psi
+// therefore integrates every exponent alike (the lobe's peak is absorbed by
+// the substitution); each direction carries the weight 1 / (2 n^2).
+
+#include <vector>
+
+namespace terrain::gi {
+
+/// Orthonormal frame (t, b) about the unit vector r.
+void lobeFrame(const double r[3], double t[3], double b[3]);
+
+/// Quadrature direction (ring i of n, azimuth j of 2n) of the Phong lobe of
+/// exponent S about r (frame t, b from lobeFrame); each carries the weight
+/// 1 / (2 n^2) of the lobe's unit mass.
+void lobeDirection(const double r[3], const double t[3], const double b[3], double S, int n, int i, int j, double w[3]);
+
+/// lobeDirection's directions with their cosines and sines kept for one
+/// (S, n): a gather that evaluates the lobes of many receivers of the same
+/// exponent computes them once (set is free while S and n do not change).
+/// The same values as lobeDirection's, bit for bit.
+class LobeQuadrature {
+public:
+    void set(double S, int n);
+    int rings() const { return n_; }
+    void direction(const double r[3], const double t[3], const double b[3], int i, int j, double w[3]) const;
+
+private:
+    double S_ = -1.0;
+    int n_ = 0;
+    std::vector<double> ringCos_, ringSin_, psiCos_, psiSin_;  // n rings, 2n azimuths
+};
+
+}  // namespace terrain::gi
