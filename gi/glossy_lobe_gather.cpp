@@ -35,13 +35,12 @@ ReceiverLobe receiverLobe(float gx, float gy, const float view[3], double S) {
     return L;
 }
 
-// The receiver's rays as the walks read them: each lobe direction split
-// between the two global azimuths on either side of it (linear weights),
-// those above the tangent plane along their azimuth only, sorted by azimuth
-// and then slope (insertion sort: a few dozen rays, a fixed order).
-void lobeRays(const ReceiverLobe& L, const GlossyLobeState& st, float gx, float gy, GlossyLobeScratch& sc) {
-    std::vector<GlossyLobeScratch::Ray>& rays = sc.rays;
-    rays.clear();
+// A texel's rays as the walks read them, appended to sc.rays: each lobe
+// direction split between the two global azimuths on either side of it
+// (linear weights), those above the texel's tangent plane along their azimuth
+// only.
+void appendLobeRays(const ReceiverLobe& L, const GlossyLobeState& st, float gx, float gy, int texel,
+                    GlossyLobeScratch& sc) {
     sc.quadrature.set(L.S, sc.quadrature.rings());
     const int rings = sc.quadrature.rings(), M = static_cast<int>(st.phi.size());
     const double dphi = 2.0 * kPi / M;
@@ -64,18 +63,31 @@ void lobeRays(const ReceiverLobe& L, const GlossyLobeState& st, float gx, float 
                 const float weight = w0 * static_cast<float>(side == 0 ? 1.0 - f : f);
                 const float c = st.cosPhi[static_cast<std::size_t>(j)], s = st.sinPhi[static_cast<std::size_t>(j)];
                 if (weight <= 0.0f || slope <= gx * c + gy * s) continue;  // below the tangent plane
-                rays.push_back({j, slope, weight, {-c * cosE, -s * cosE, -sinE}});
+                sc.rays.push_back({j, texel, slope, weight, {-c * cosE, -s * cosE, -sinE}});
             }
         }
-    for (std::size_t a = 1; a < rays.size(); ++a) {
-        const GlossyLobeScratch::Ray x = rays[a];
-        std::size_t b = a;
-        for (; b > 0 &&
-               (rays[b - 1].azimuth > x.azimuth || (rays[b - 1].azimuth == x.azimuth && rays[b - 1].slope > x.slope));
-             --b)
-            rays[b] = rays[b - 1];
-        rays[b] = x;
-    }
+}
+
+// sc.rays in walk order into sc.sorted: by azimuth (a counting sort, M
+// buckets), then by slope within an azimuth (insertion sort, stable: equal
+// slopes keep the order they were appended in, so the sums are fixed).
+void sortRays(int M, GlossyLobeScratch& sc) {
+    using Ray = GlossyLobeScratch::Ray;
+    std::vector<int>& start = sc.bucketStart;
+    start.assign(static_cast<std::size_t>(M + 1), 0);
+    for (const Ray& r : sc.rays) ++start[static_cast<std::size_t>(r.azimuth + 1)];
+    for (int j = 0; j < M; ++j) start[static_cast<std::size_t>(j + 1)] += start[static_cast<std::size_t>(j)];
+    sc.sorted.resize(sc.rays.size());
+    for (const Ray& r : sc.rays) sc.sorted[static_cast<std::size_t>(start[static_cast<std::size_t>(r.azimuth)]++)] = r;
+    // start[j] is now the end of bucket j
+    for (int j = 0, begin = 0; j < M; begin = start[static_cast<std::size_t>(j)], ++j)
+        for (int a = begin + 1; a < start[static_cast<std::size_t>(j)]; ++a) {
+            const Ray x = sc.sorted[static_cast<std::size_t>(a)];
+            int b = a;
+            for (; b > begin && sc.sorted[static_cast<std::size_t>(b - 1)].slope > x.slope; --b)
+                sc.sorted[static_cast<std::size_t>(b)] = sc.sorted[static_cast<std::size_t>(b - 1)];
+            sc.sorted[static_cast<std::size_t>(b)] = x;
+        }
 }
 
 // What the member at step i of azimuth j sends along each of `rays` (sorted
@@ -92,21 +104,22 @@ void readMember(const GlossyLobeState& st, std::size_t at, int X, int Y, MemberS
     for (int f = 0; f < kPlanes; ++f) m.e[f] = wa * fromBfloat16(origins[f][o]) + wb * fromBfloat16(origins[f][o + dB]);
 }
 
-void addSent(const MemberSamples& m, const GlossyLobeScratch::Ray& ray, bool clamp, double acc[3]) {
+void addSent(const MemberSamples& m, const GlossyLobeScratch::Ray& ray, bool clamp, double* acc) {
     float y[kShCount];
     shBasisLanes<float>(ray.back[0], ray.back[1], ray.back[2], y);
     for (int c = 0; c < 3; ++c) {
         float u = 0.0f;
         for (int f = 0; f < kShCount; ++f) u += m.e[c * kShCount + f] * y[f];
         if (clamp) u = std::max(u, 0.0f);
-        acc[c] += static_cast<double>(ray.weight) * u;
+        acc[3 * ray.texel + c] += static_cast<double>(ray.weight) * u;
     }
 }
 
 // Receiver (X, Y)'s rays [begin, end) of one azimuth (sorted by slope):
-// the walk over the steps, each ray brought what its first reaching step sends.
+// the walk over the steps, each ray brought what its first reaching step
+// sends into its texel's acc (3 per texel).
 void walkAzimuth(const GlossyLobeInputs& in, const GlossyLobeState& st, const GlossyLobeScratch::Ray* begin,
-                 const GlossyLobeScratch::Ray* end, int X, int Y, float h0, float margin, double acc[3]) {
+                 const GlossyLobeScratch::Ray* end, int X, int Y, float h0, float margin, double* acc) {
     const int j = begin->azimuth, nSteps = static_cast<int>(in.heights.steps.size());
     const int pad = static_cast<int>(st.stepsPerColumn.size() / st.phi.size());
     const int prefix =
@@ -129,29 +142,56 @@ void walkAzimuth(const GlossyLobeInputs& in, const GlossyLobeState& st, const Gl
     }
 }
 
-// Receiver row Y: every receiver's lobe rays and walks into st.gathered.
+// The texels [first, last] along one axis of n that receiver i of nr owns:
+// those nearer to it than to the next (ties to the later one), the last
+// receiver to the end.
+struct OwnedSpan {
+    int first, last;
+};
+OwnedSpan ownedTexels(int i, int s, int nr, int n) {
+    const int first = std::max(0, s * i - s / 2);
+    const int last = i == nr - 1 ? n - 1 : std::min(n - 1, s * i + s - s / 2 - 1);
+    return {first, last};
+}
+
+// Receiver row Y: the lobes of the texels every receiver of it owns, walked
+// from the receiver, into st.gathered.
 void gatherRow(const GlossyLobeInputs& in, GlossyLobeState& st, int Y, GlossyLobeScratch& sc) {
     const HeightPyramid& pyr = in.heights;
-    const int nxr = pyr.nxr, s = pyr.subsample;
-    const std::size_t planeR = static_cast<std::size_t>(nxr) * pyr.nyr;
+    const int nxr = pyr.nxr, nx = pyr.nx, s = pyr.subsample;
+    const std::size_t plane = static_cast<std::size_t>(nx) * pyr.ny;
     const int pad = static_cast<int>(sc.gx.size());
     loadReceiverRow(pyr, in.gradX, in.gradY, Y, pad, sc.gx.data(), sc.gy.data(), sc.h0.data(), sc.margin.data());
     const bool expMap = in.surface && !in.surface->phongExponent.empty();
+    const OwnedSpan rows = ownedTexels(Y, s, pyr.nyr, pyr.ny);
     for (int X = 0; X < nxr; ++X) {
-        const double S = expMap ? in.surface->phongExponent(s * X, s * Y) : in.shading.phongExponent;
-        const ReceiverLobe L = receiverLobe(sc.gx[X], sc.gy[X], in.shading.viewDir, S);
-        lobeRays(L, st, sc.gx[X], sc.gy[X], sc);
-        double acc[3] = {0.0, 0.0, 0.0};
-        const GlossyLobeScratch::Ray* rays = sc.rays.data();
-        const std::size_t n = sc.rays.size();
+        const OwnedSpan cols = ownedTexels(X, s, nxr, nx);
+        const int width = cols.last - cols.first + 1;
+        const int texels = width * (rows.last - rows.first + 1);
+        sc.rays.clear();
+        for (int y = rows.first; y <= rows.last; ++y)
+            for (int x = cols.first; x <= cols.last; ++x) {
+                const double S = expMap ? in.surface->phongExponent(x, y) : in.shading.phongExponent;
+                const float gx = in.gradX(x, y), gy = in.gradY(x, y);
+                const ReceiverLobe L = receiverLobe(gx, gy, in.shading.viewDir, S);
+                appendLobeRays(L, st, gx, gy, (y - rows.first) * width + (x - cols.first), sc);
+            }
+        sortRays(static_cast<int>(st.phi.size()), sc);
+        sc.acc.assign(static_cast<std::size_t>(3 * texels), 0.0);
+        const GlossyLobeScratch::Ray* rays = sc.sorted.data();
+        const std::size_t n = sc.sorted.size();
         for (std::size_t a = 0; a < n;) {
             std::size_t b = a + 1;
             while (b < n && rays[b].azimuth == rays[a].azimuth) ++b;
-            walkAzimuth(in, st, rays + a, rays + b, X, Y, sc.h0[X], sc.margin[X], acc);
+            walkAzimuth(in, st, rays + a, rays + b, X, Y, sc.h0[X], sc.margin[X], sc.acc.data());
             a = b;
         }
-        const std::size_t i = static_cast<std::size_t>(Y) * nxr + X;
-        for (int c = 0; c < 3; ++c) st.gathered[static_cast<std::size_t>(c) * planeR + i] = static_cast<float>(acc[c]);
+        for (int t = 0; t < texels; ++t) {
+            const std::size_t i = static_cast<std::size_t>(rows.first + t / width) * nx + cols.first + t % width;
+            for (int c = 0; c < 3; ++c)
+                st.gathered[static_cast<std::size_t>(c) * plane + i] =
+                    static_cast<float>(sc.acc[static_cast<std::size_t>(3 * t + c)]);
+        }
     }
 }
 
@@ -177,7 +217,7 @@ void gatherGlossyLobes(const GlossyLobeInputs& in, GlossyLobeState& st) {
     st.stepsPerRow.resize(static_cast<std::size_t>(M) * pyr.nyr);
     buildGlossyStepTable(pyr, in.exit, st.phi, pad, st.heightSteps, st.stepsPerColumn, st.stepsPerRow, st.planeSteps,
                          st.planeOrigins);
-    st.gathered.resize(static_cast<std::size_t>(3) * pyr.nxr * pyr.nyr);
+    st.gathered.resize(static_cast<std::size_t>(3) * pyr.nx * pyr.ny);
     st.scratch.resize(static_cast<std::size_t>(workerSlots()));
     for (GlossyLobeScratch& sc : st.scratch) {
         for (std::vector<float>* v : {&sc.gx, &sc.gy, &sc.h0, &sc.margin}) v->resize(static_cast<std::size_t>(pad));
@@ -191,29 +231,19 @@ void gatherGlossyLobes(const GlossyLobeInputs& in, GlossyLobeState& st) {
 
 void shadeGlossyLobes(const GlossyLobeState& st, const HeightPyramid& heights, const ShadingSettings& shading,
                       bool addToOut, std::array<Grid, 3>& out) {
-    const int nx = heights.nx, ny = heights.ny, nxr = heights.nxr, nyr = heights.nyr, s = heights.subsample;
-    const std::size_t planeR = static_cast<std::size_t>(nxr) * nyr;
+    const int nx = heights.nx, ny = heights.ny;
+    const std::size_t plane = static_cast<std::size_t>(nx) * ny;
     const float ws = specularWeightOf(shading);
     const float floor = shading.positivity == GlossyPositivity::Clamp ? 0.0f : -std::numeric_limits<float>::infinity();
     for (Grid& g : out)
         if (!addToOut) g.ensureSize(nx, ny);
-    std::vector<ReceiverLerp> columns;
-    receiverLerps(nx, s, nxr, columns);
     parallelFor(0, ny, 8, [&](int y0, int y1) {
-        std::vector<float> vert(static_cast<std::size_t>(nxr)), row(static_cast<std::size_t>(nx));
-        for (int y = y0; y < y1; ++y) {
-            const ReceiverLerp ry = receiverLerp(y, s, nyr);
-            for (int c = 0; c < 3; ++c) {
-                const float* g = st.gathered.data() + static_cast<std::size_t>(c) * planeR;
-                const float* a = g + static_cast<std::size_t>(ry.i0) * nxr;
-                const float* b = g + static_cast<std::size_t>(ry.i1) * nxr;
-                for (int X = 0; X < nxr; ++X) vert[static_cast<std::size_t>(X)] = a[X] + ry.f * (b[X] - a[X]);
-                lerpReceiverRow(vert.data(), nxr, s, columns.data(), nx, row.data());
-                float* o = out[static_cast<std::size_t>(c)].data() + static_cast<std::size_t>(y) * nx;
-                for (int x = 0; x < nx; ++x) {
-                    const float v = (addToOut ? o[x] : 0.0f) + ws * row[static_cast<std::size_t>(x)];
-                    o[x] = std::isfinite(v) ? std::max(v, floor) : 0.0f;
-                }
+        for (int c = 0; c < 3; ++c) {
+            const float* g = st.gathered.data() + static_cast<std::size_t>(c) * plane;
+            float* o = out[static_cast<std::size_t>(c)].data();
+            for (std::size_t i = static_cast<std::size_t>(y0) * nx; i < static_cast<std::size_t>(y1) * nx; ++i) {
+                const float v = (addToOut ? o[i] : 0.0f) + ws * g[i];
+                o[i] = std::isfinite(v) ? std::max(v, floor) : 0.0f;
             }
         }
     });

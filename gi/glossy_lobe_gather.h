@@ -33,14 +33,19 @@
 // narrow lobes walk 2-4 azimuths, and rays high above the horizon stop after
 // a few steps.
 //
-// Where. At the receivers (the sub-sampled grid), with each receiver's own
-// normal, exponent (AlbedoMap::phongExponent) and reflection; full-resolution
-// texels interpolate the gathered radiance bilinearly (Fig. 7), like every
-// other receiver quantity. The diffuse part of a mixture and the bounces after
-// the first keep the SH kernel (U); their incident SH comes from U as in the
-// vector mode.
+// Where. Every texel gathers its own lobe (its normal, exponent from
+// AlbedoMap::phongExponent, and reflection), walked from the receiver that
+// owns it, the nearest one (with sub-sampling s the walks start up to s / 2
+// cells from the texel; the receivers' step tables serve all). A receiver's
+// texels share its walks: their rays are merged into one list per azimuth,
+// and a member met by several rays is read once. Interpolating receivers'
+// gathered radiance instead (Fig. 7) would lose what makes a glossy texel
+// glossy: its lobe follows its own normal. The diffuse part of a mixture and
+// the bounces after the first keep the SH kernel (U); their incident SH
+// comes from U as in the vector mode.
 //
-// Deterministic: per receiver a pure function of its inputs, rows in parallel.
+// Deterministic: per receiver a pure function of its inputs (the rays sorted
+// by a total order), receiver rows in parallel.
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -54,17 +59,20 @@
 
 namespace terrain::gi {
 
-/// Per worker slot: one receiver row's inputs and the rays of one receiver.
+/// Per worker slot: one receiver row's inputs and the rays of one receiver's texels.
 struct GlossyLobeScratch {
     std::vector<float> gx, gy, h0, margin;  // loadReceiverRow, padded row
     struct Ray {
         int azimuth;    // global azimuth j of the walk that reads the ray
+        int texel;      // which of the receiver's texels it serves
         float slope;    // tan of the ray's elevation
         float weight;   // quadrature weight x the linear azimuth weight
         float back[3];  // unit direction from the member back to the receiver
     };
-    std::vector<Ray> rays;
-    LobeQuadrature quadrature;  // the lobe directions of the last exponent
+    std::vector<Ray> rays, sorted;  // as appended, and in walk order
+    std::vector<int> bucketStart;   // the counting sort's buckets (one per azimuth)
+    std::vector<double> acc;        // 3 per texel of the receiver
+    LobeQuadrature quadrature;      // the lobe directions of the last exponent
 };
 
 /// The gather's step tables and its result (reused: no allocation after the
@@ -75,7 +83,7 @@ struct GlossyLobeState {
     std::vector<ScanStep> heightSteps, planeSteps;  // M x steps (gi/indirect_scan_tables.h)
     std::vector<const std::uint16_t*> planeOrigins;
     std::vector<int> stepsPerColumn, stepsPerRow;
-    std::vector<float> gathered;  // 3 planes of nxr * nyr: int I f dw per receiver (RGB)
+    std::vector<float> gathered;  // 3 planes of nx * ny: int I f dw per texel (RGB)
     std::vector<GlossyLobeScratch> scratch;
 };
 
@@ -91,12 +99,12 @@ struct GlossyLobeInputs {
     int rings;        // n: n rings x 2n directions per lobe
 };
 
-/// GlossyLobeState::gathered at every receiver (see above).
+/// GlossyLobeState::gathered at every texel (see above).
 void gatherGlossyLobes(const GlossyLobeInputs& in, GlossyLobeState& st);
 
-/// out[c] = base[c] + w_s gathered (interpolated to full resolution, Fig. 7;
-/// base: out's own values, or 0 when `addToOut` is false); a value that is not
-/// finite becomes 0, and below 0 becomes 0 with GlossyPositivity::Clamp.
+/// out[c] = base[c] + w_s gathered (base: out's own values, or 0 when
+/// `addToOut` is false); a value that is not finite becomes 0, and below 0
+/// becomes 0 with GlossyPositivity::Clamp.
 void shadeGlossyLobes(const GlossyLobeState& st, const HeightPyramid& heights, const ShadingSettings& shading,
                       bool addToOut, std::array<Grid, 3>& out);
 
