@@ -69,7 +69,12 @@ struct GlossyLobeScratch {
         float weight;   // quadrature weight x the linear azimuth weight
         float back[3];  // unit direction from the member back to the receiver
     };
+    struct RayKey {
+        float slope;
+        int index;  // into rays
+    };
     std::vector<Ray> rays, sorted;  // as appended, and in walk order
+    std::vector<RayKey> keys;       // sortRays' keys
     std::vector<int> bucketStart;   // the counting sort's buckets (one per azimuth)
     std::vector<double> acc;        // 3 per texel of the receiver
     LobeQuadrature quadrature;      // the lobe directions of the last exponent
