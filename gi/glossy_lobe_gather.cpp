@@ -109,12 +109,12 @@ void sortRays(int M, GlossyLobeScratch& sc) {
     for (std::size_t k = 0; k < keys.size(); ++k) sc.sorted[k] = sc.rays[static_cast<std::size_t>(keys[k].index)];
 }
 
-// What the member at step i of azimuth j sends along each of `rays` (sorted
-// by slope) into acc, weighted: the 48 planes read once, dotted with Y(back).
+// A met member's exit radiance E (48 planes), read once for all the rays it meets.
 struct MemberSamples {
     float e[kPlanes];
 };
 
+// The member at table entry `at` (azimuth j, step i) of receiver (X, Y)'s walk.
 void readMember(const GlossyLobeState& st, std::size_t at, int X, int Y, MemberSamples& m) {
     const ScanStep& ps = st.planeSteps[at];
     const std::uint16_t* const* origins = st.planeOrigins.data() + at * kPlanes;
@@ -123,6 +123,8 @@ void readMember(const GlossyLobeState& st, std::size_t at, int X, int Y, MemberS
     for (int f = 0; f < kPlanes; ++f) m.e[f] = wa * fromBfloat16(origins[f][o]) + wb * fromBfloat16(origins[f][o + dB]);
 }
 
+// What the member sends back along `ray`, E . Y(back) (max(0, .) with the
+// clamp), weighted into the accumulator of the ray's texel (3 per texel).
 void addSent(const MemberSamples& m, const GlossyLobeScratch::Ray& ray, bool clamp, double* acc) {
     float y[kShCount];
     shBasisLanes<float>(ray.back[0], ray.back[1], ray.back[2], y);
