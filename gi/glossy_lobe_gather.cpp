@@ -117,10 +117,11 @@ struct MemberSamples {
 // The member at table entry `at` (azimuth j, step i) of receiver (X, Y)'s walk.
 void readMember(const GlossyLobeState& st, std::size_t at, int X, int Y, MemberSamples& m) {
     const ScanStep& ps = st.planeSteps[at];
-    const std::uint16_t* const* origins = st.planeOrigins.data() + at * kPlanes;
     const std::ptrdiff_t o = Y * ps.rowStep + X, dB = ps.offB - ps.offA;
+    const std::uint16_t* a = st.memberOrigins[at] + o * kPlanes;
+    const std::uint16_t* b = a + dB * kPlanes;
     const float wa = ps.w[0][0], wb = ps.w[1][0];
-    for (int f = 0; f < kPlanes; ++f) m.e[f] = wa * fromBfloat16(origins[f][o]) + wb * fromBfloat16(origins[f][o + dB]);
+    for (int f = 0; f < kPlanes; ++f) m.e[f] = wa * fromBfloat16(a[f]) + wb * fromBfloat16(b[f]);
 }
 
 // What the member sends back along `ray`, E . Y(back) (max(0, .) with the
@@ -216,6 +217,31 @@ void gatherRow(const GlossyLobeInputs& in, GlossyLobeState& st, int Y, GlossyLob
     }
 }
 
+// st.members and st.memberOrigins from the exit pyramid: its fields are laid
+// out one after the other with the same regions, so interleaving them is a
+// transpose of a 48 x (one field's length) matrix.
+void interleaveMembers(const PackedPyramids& exit, GlossyLobeState& st) {
+    const std::size_t regions = exit.geometry.levels.size() + 1;
+    const std::size_t length = exit.regionAt[regions] - exit.regionAt[0];
+    st.members.resize(length * kPlanes);
+    const std::uint16_t* block = exit.block.data() + exit.regionAt[0];
+    constexpr int kChunk = 64;
+    const int chunks = static_cast<int>((length + kChunk - 1) / kChunk);
+    parallelFor(0, chunks, 64, [&](int c0, int c1) {
+        for (int c = c0; c < c1; ++c) {
+            const std::size_t k0 = static_cast<std::size_t>(c) * kChunk;
+            const std::size_t k1 = std::min(length, k0 + kChunk);
+            for (int f = 0; f < kPlanes; ++f) {
+                const std::uint16_t* src = block + static_cast<std::size_t>(f) * length;
+                for (std::size_t k = k0; k < k1; ++k) st.members[k * kPlanes + static_cast<std::size_t>(f)] = src[k];
+            }
+        }
+    });
+    st.memberOrigins.resize(st.planeSteps.size());
+    for (std::size_t at = 0; at < st.memberOrigins.size(); ++at)
+        st.memberOrigins[at] = st.members.data() + (st.planeOrigins[at * kPlanes] - block) * kPlanes;
+}
+
 }  // namespace
 
 void gatherGlossyLobes(const GlossyLobeInputs& in, GlossyLobeState& st) {
@@ -238,6 +264,7 @@ void gatherGlossyLobes(const GlossyLobeInputs& in, GlossyLobeState& st) {
     st.stepsPerRow.resize(static_cast<std::size_t>(M) * pyr.nyr);
     buildGlossyStepTable(pyr, in.exit, st.phi, pad, st.heightSteps, st.stepsPerColumn, st.stepsPerRow, st.planeSteps,
                          st.planeOrigins);
+    interleaveMembers(in.exit, st);
     st.gathered.resize(static_cast<std::size_t>(3) * pyr.nx * pyr.ny);
     st.scratch.resize(static_cast<std::size_t>(workerSlots()));
     for (GlossyLobeScratch& sc : st.scratch) {

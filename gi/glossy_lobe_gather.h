@@ -87,6 +87,12 @@ struct GlossyLobeState {
     std::vector<float> cosPhi, sinPhi;              // their directions
     std::vector<ScanStep> heightSteps, planeSteps;  // M x steps (gi/indirect_scan_tables.h)
     std::vector<const std::uint16_t*> planeOrigins;
+    // The exit-radiance pyramid's 48 planes interleaved (value k of plane f at
+    // k * 48 + f): a met member's E is two runs of 96 bytes instead of 96
+    // scattered reads; memberOrigins: per table entry, planeOrigins' first
+    // plane's address in it.
+    std::vector<std::uint16_t> members;
+    std::vector<const std::uint16_t*> memberOrigins;
     std::vector<int> stepsPerColumn, stepsPerRow;
     std::vector<float> gathered;  // 3 planes of nx * ny: int I f dw per texel (RGB)
     std::vector<GlossyLobeScratch> scratch;
