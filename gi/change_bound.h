@@ -304,4 +304,27 @@ float ambientChangeBound(float slopeBound, float gradientBound, float maxSkyRadi
 float ambientChangeBoundPerAzimuth(const float* slopeBound, int azimuths, float gradientBound, float maxSkyRadiance,
                                    bool withNormals);
 
+// ---- a key light's shade ----------------------------------------------------------
+// With the exact cosine (gi/key_light_exact.h) a key light adds rgb f
+// max(0, N . l) at white albedo, f in [0, 1] the visible fraction of its
+// window [phi0, phi1] x [sinLow, sinHigh] (Section 6): its visibility's band-0
+// coefficient over the window's solid angle. Along each of the light's
+// azimuths the visible part of the window is sinHigh - clamp(sin sigma,
+// sinLow, sinHigh), and the folded operator averages these over the
+// azimuths with non-negative weights (gi/wedge.h), so f moves by at most
+// max |d sin sigma| / (sinHigh - sinLow) <= max |dt| / (sinHigh - sinLow),
+// and by no more than 1. sigma is the larger of the blocking and the
+// tangent-plane elevation, so |dt| <= max(slope bound, sqrt2 G) as for the
+// ambient. The shading itself reruns at the new normals (only f is cached),
+// so the shade moves by at most max(rgb) times that: a small light (a sun of
+// 3 degrees at 30 degrees is a window 0.09 high in sin) turns a slope change
+// into a shade change ten times larger than the ambient map's.
+
+/// Bound on |change| of one key light's exact-cosine shade (any channel, white
+/// albedo) at the receiver texels of a tile, from the tile's slope bound over
+/// the light's azimuths (its maximum blocking slope's: rangeBoundOfTile times
+/// blockingMaxLipschitz) and its gradient bound; maxRgb is the light's largest
+/// channel. 0 when both bounds are 0.
+float keyLightChangeBound(float slopeBound, float gradientBound, float maxRgb, float sinLow, float sinHigh);
+
 }  // namespace terrain::gi

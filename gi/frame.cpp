@@ -377,12 +377,13 @@ struct GeometryPlan {
     bool withinTolerance = false;  // tiled, and no tile's V drifted beyond the tolerance
 };
 
-// The azimuths each key light's visibility reads.
-std::vector<AzimuthRange> keyAzimuthRanges(const GiLighting& lighting) {
-    std::vector<AzimuthRange> out;
+// What each key light's cached visibility answers for.
+std::vector<KeyLightRegion> keyLightRegions(const GiLighting& lighting, const GiSettings& settings) {
+    std::vector<KeyLightRegion> out;
     for (const KeyLight& k : lighting.keys) {
         const KeyLightExtent e = keyLightExtent(k);
-        out.push_back({e.phiStart, e.phiEnd});
+        out.push_back({e.phiStart, e.phiEnd, e.sinLow, e.sinHigh, std::max({k.rgb[0], k.rgb[1], k.rgb[2]}),
+                       settings.keyLightExactCosine});
     }
     return out;
 }
@@ -396,7 +397,7 @@ GeometryPlan planGeometry(ConstGridView heights, const GiLighting& lighting, con
     if (plan.tiled) {
         VisibilityCache& cache = st.visibilityCache;
         planVisibilityTiles(st.lastInputs.heights.cview(), heights, st.pyramid, settings.visibility,
-                            keyAzimuthRanges(lighting), settings.tolerance, cache);
+                            keyLightRegions(lighting, settings), settings.tolerance, cache);
         plan.withinTolerance =
             cache.tiles.dirtyCount() == 0 && cache.keyTiles.dirtyCount() == 0 && cache.geometryTiles.dirtyCount() == 0;
     }

@@ -1,6 +1,7 @@
 #include "gi/visibility_cache.h"
 
 #include <algorithm>
+#include <limits>
 
 namespace terrain::gi {
 
@@ -31,20 +32,27 @@ bool shouldPlanTiles(VisibilityCache& cache) { return !skipsPlan(cache.framesWit
 
 namespace {
 
-// Per tile, the largest slope bound over the key lights' azimuth ranges (0 without key lights).
-void boundKeyRanges(const HeightPyramid& pyr, const std::vector<AzimuthRange>& keyRanges, VisibilityCache& cache) {
+// Per tile, the sum over the key lights of the bound on each one's shade
+// (keyLightChangeBound; an SH-shaded light: infinite where its slopes may
+// have moved at all). 0 without key lights.
+void boundKeyShades(const HeightPyramid& pyr, const std::vector<KeyLightRegion>& keys, float lipschitz,
+                    VisibilityCache& cache) {
     cache.keyBound.assign(cache.slopeBound.size(), 0.0f);
-    for (const AzimuthRange& r : keyRanges) {
-        boundSlopeChangeOverRange(cache.change, pyr, kVisibilityTile, r.phi0, r.phi1, cache.rangeBound);
-        for (std::size_t t = 0; t < cache.keyBound.size(); ++t)
-            cache.keyBound[t] = std::max(cache.keyBound[t], cache.rangeBound[t]);
+    for (const KeyLightRegion& k : keys) {
+        boundSlopeChangeOverRange(cache.change, pyr, kVisibilityTile, k.phi0, k.phi1, cache.rangeBound);
+        for (std::size_t t = 0; t < cache.keyBound.size(); ++t) {
+            const float slope = lipschitz * cache.rangeBound[t], grad = cache.gradBound[t];
+            float shade = keyLightChangeBound(slope, grad, k.maxRgb, k.sinLow, k.sinHigh);
+            if (!k.exactCosine && shade > 0.0f) shade = std::numeric_limits<float>::infinity();
+            cache.keyBound[t] += shade;
+        }
     }
 }
 
 }  // namespace
 
 void planVisibilityTiles(ConstGridView before, ConstGridView after, const HeightPyramid& pyr,
-                         const VisibilitySettings& vis, const std::vector<AzimuthRange>& keyRanges, float tolerance,
+                         const VisibilitySettings& vis, const std::vector<KeyLightRegion>& keys, float tolerance,
                          VisibilityCache& cache) {
     if (cache.tiles.nxr != pyr.nxr || cache.tiles.nyr != pyr.nyr || cache.drift.size() != cache.tiles.dirty.size())
         resetVisibilityCache(pyr, cache);
@@ -52,12 +60,12 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
     boundSlopeChange(cache.change, pyr, kVisibilityTile, cache.slopeBound);
     boundSlopeChangePerAzimuth(cache.change, pyr, kVisibilityTile, vis.azimuths, cache.azimuthBound);
     boundGradientChange(cache.change, pyr, kVisibilityTile, cache.gradBound);
-    boundKeyRanges(pyr, keyRanges, cache);
     // V depends on the heights through the maximum blocking slope and, below
     // it, the tangent plane's slope along the azimuth (moving by at most
     // sqrt2 times a gradient component's bound); shading reruns at the new
     // normals every frame, so only V's own change counts.
     const float lipschitz = blockingMaxLipschitz(vis.blockingMax);
+    boundKeyShades(pyr, keys, lipschitz, cache);
     const std::size_t m = static_cast<std::size_t>(vis.azimuths);
     std::vector<float>& perAzimuth = cache.tileAzimuths;
     perAzimuth.resize(m);  // no allocation after the first frame of these settings
@@ -66,8 +74,7 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
         const float env =
             ambientChangeBoundPerAzimuth(perAzimuth.data(), vis.azimuths, cache.gradBound[t], 1.0f, false);
         cache.tiles.dirty[t] = addDrift(env, tolerance, cache.drift[t]) ? 1 : 0;
-        const float key = ambientChangeBound(lipschitz * cache.keyBound[t], cache.gradBound[t], 1.0f, false);
-        cache.keyTiles.dirty[t] = addDrift(key, tolerance, cache.keyDrift[t]) ? 1 : 0;
+        cache.keyTiles.dirty[t] = addDrift(cache.keyBound[t], tolerance, cache.keyDrift[t]) ? 1 : 0;
         const float any = ambientChangeBound(lipschitz * cache.slopeBound[t], cache.gradBound[t], 1.0f, false);
         cache.geometryTiles.dirty[t] = addDrift(any, tolerance, cache.geometryDrift[t]) ? 1 : 0;
     }

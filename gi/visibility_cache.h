@@ -15,10 +15,14 @@
 // too.
 //
 // Key lights sample their own azimuths, between the environment's, within
-// their region of the sky: their tiles (keyTiles) keep a drift of their own
-// from the bound over the azimuth ranges of the key lights
-// (boundSlopeChangeOverRange, the largest over the lights), in the
-// full-circle form (kShadePerSlope times the largest move). The geometry
+// their region of the sky: their tiles (keyTiles) keep a drift of their own,
+// the sum over the lights of each light's shade bound (keyLightChangeBound:
+// the slope bound over the light's azimuths, boundSlopeChangeOverRange,
+// scaled by its brightness over its window's height), in the shade units of
+// the light itself, not of a unit sky: a shadow edge that moved across a
+// texel is a change of the light's whole shade there. A key light shaded
+// through SH (the paper's settings) recomputes every tile whose bound is not
+// 0, where its order-4 product has no such bound. The geometry
 // tiles (geometryTiles) do the same with the bound over every azimuth: what
 // the indirect light's casting sets may have moved (gi/indirect_cache.h).
 #include <vector>
@@ -53,16 +57,22 @@ inline void countAfterPlan(bool everyTileDirty, int& framesWithoutPlan) {
     if (everyTileDirty) framesWithoutPlan = kFramesWithoutPlan;
 }
 
-/// The azimuths [phi0, phi1] (radians) a key light's visibility reads.
-struct AzimuthRange {
+/// What a key light's cached visibility answers for: the azimuths [phi0,
+/// phi1] (radians) it reads, its window's sines and its largest channel
+/// (gi/lights.h, keyLightExtent), and whether it is shaded with the exact
+/// cosine (else through SH).
+struct KeyLightRegion {
     double phi0 = 0.0, phi1 = 0.0;
+    float sinLow = -1.0f, sinHigh = 1.0f;
+    float maxRgb = 1.0f;
+    bool exactCosine = true;
 };
 
 struct VisibilityCache {
     MaxChangePyramid change;                   // |dh| of this frame
     std::vector<float> slopeBound, gradBound;  // this frame's bounds per tile (all azimuths)
     std::vector<float> azimuthBound;           // per tile and environment azimuth (tile-major)
-    std::vector<float> keyBound, rangeBound;   // per tile: over the key lights' azimuths; scratch: one light's
+    std::vector<float> keyBound, rangeBound;   // per tile: the key lights' shade bound; scratch: one light's slopes
     std::vector<float> drift, keyDrift;        // per tile: ambient-map change allowed since its V was computed
     std::vector<float> geometryDrift;          // per tile: the same over every azimuth
     std::vector<float> tileAzimuths;           // scratch: one tile's per-azimuth slope bounds
@@ -87,11 +97,11 @@ void forgetEnvironmentDrift(VisibilityCache& cache);
 /// Adds the change from `before` to the pyramid's heights `after` to every
 /// tile's drifts and marks the tiles whose drift exceeds `tolerance` (their
 /// drift reset to 0): cache.tiles for the environment's V (`vis`: its
-/// azimuths and maximum rule), cache.keyTiles for the key lights' (reading
-/// `keyRanges`, one per light; none: no key tile), cache.geometryTiles over
-/// every azimuth. `pyr` is the pyramid of `after`.
+/// azimuths and maximum rule), cache.keyTiles for the key lights' (one region
+/// per light; none: no key tile), cache.geometryTiles over every azimuth.
+/// `pyr` is the pyramid of `after`.
 void planVisibilityTiles(ConstGridView before, ConstGridView after, const HeightPyramid& pyr,
-                         const VisibilitySettings& vis, const std::vector<AzimuthRange>& keyRanges, float tolerance,
+                         const VisibilitySettings& vis, const std::vector<KeyLightRegion>& keys, float tolerance,
                          VisibilityCache& cache);
 
 }  // namespace terrain::gi

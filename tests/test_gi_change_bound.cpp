@@ -487,7 +487,7 @@ TEST_CASE("gi.change_bound: azimuth-range bounds hold for a key light's slopes a
     const float azimuths[] = {2.0f, 250.0f, 130.0f};
     const float radii[] = {12.0f, 40.0f, 3.0f};
     const Config configs[] = {{97, 70, 1, 8, false}, {120, 83, 2, 8, false}, {80, 96, 1, 6, true}};
-    double worst = 0.0;
+    double worst = 0.0, worstFraction = 0.0;
     int smallerTiles = 0;
     for (const Config& cfg : configs)
         for (int k = 0; k < 3; ++k) {
@@ -538,6 +538,26 @@ TEST_CASE("gi.change_bound: azimuth-range bounds hold for a key light's slopes a
                         }
                     }
                 CHECK(over == 0);
+                // the light's visible fraction f (its shade at rgb 1, before the
+                // cosine) at every receiver against keyLightChangeBound
+                std::vector<float> grad;
+                boundGradientChange(dh, p, cfg.tile, grad);
+                const double toFrac = std::sqrt(4.0 * 3.14159265358979) /
+                                      ((ext.phiEnd - ext.phiStart) * (static_cast<double>(ext.sinHigh) - ext.sinLow));
+                int fractionOver = 0;
+                for (int Y = 0; Y < nyr; ++Y)
+                    for (int X = 0; X < nxr; ++X) {
+                        const std::size_t t =
+                            static_cast<std::size_t>(Y / cfg.tile) * tilesX + static_cast<std::size_t>(X / cfg.tile);
+                        const std::size_t i = static_cast<std::size_t>(Y) * nxr + X;
+                        const double f0 = std::clamp(va.plane(0)[i] * toFrac, 0.0, 1.0);
+                        const double f1 = std::clamp(vb.plane(0)[i] * toFrac, 0.0, 1.0);
+                        const double b =
+                            keyLightChangeBound(lipschitz * range[t], grad[t], 1.0f, ext.sinLow, ext.sinHigh);
+                        fractionOver += std::fabs(f1 - f0) > b + 1e-5;
+                        if (b > 0.0 && b < 1.0) worstFraction = std::max(worstFraction, std::fabs(f1 - f0) / b);
+                    }
+                CHECK(fractionOver == 0);
                 for (std::size_t t = 0; t < range.size(); ++t) {
                     CHECK(range[t] <= all[t]);
                     smallerTiles += range[t] < all[t];
@@ -545,9 +565,16 @@ TEST_CASE("gi.change_bound: azimuth-range bounds hold for a key light's slopes a
                 CHECK(rangeBoundOfTile(dh, p, cfg.tile, 1, 1, ext.phiStart, ext.phiEnd) == range[tilesX + 1]);
             }
         }
-    MESSAGE("key-light slopes: worst change / range bound " << worst << "; " << smallerTiles
-                                                            << " tile bounds below the bound over every azimuth");
+    MESSAGE("key-light slopes: worst change / range bound "
+            << worst << "; " << smallerTiles << " tile bounds below the bound over every azimuth"
+            << "; visible fraction: worst change / shade bound " << worstFraction);
     CHECK(smallerTiles > 0);
+    CHECK(worstFraction > 0.01);  // the bound is met by changes of its own order somewhere
+    // the shade bound: the light's brightness over its window's height, at most the whole light
+    CHECK(keyLightChangeBound(0.0f, 0.0f, 2.0f, 0.4f, 0.5f) == 0.0f);
+    CHECK(keyLightChangeBound(0.01f, 0.0f, 2.0f, 0.4f, 0.5f) == doctest::Approx(0.2));
+    CHECK(keyLightChangeBound(0.0f, 0.01f, 2.0f, 0.4f, 0.5f) == doctest::Approx(0.2 * std::sqrt(2.0)));
+    CHECK(keyLightChangeBound(1.0f, 0.0f, 2.0f, 0.4f, 0.5f) == 2.0f);
     MaxChangePyramid dh;
     const Grid flat = baseTerrain(40, 40);
     buildMaxChangePyramid(flat.cview(), flat.cview(), dh);
