@@ -32,8 +32,8 @@ struct DiagnosisOptions {
     int size = 512;
     int frames = 6;
     int ticksPerFrame = 60;
-    float tolerance = 0.02f;
-    std::vector<int> pits = {16, 51};  // then the DEM with a pit of each side
+    float tolerance = gi::GiSettings{}.tolerance;  // the engine's default
+    std::vector<int> pits = {16, 51};              // then the DEM with a pit of each side
 };
 
 double quantile(std::vector<double> v, double q) {
