@@ -623,12 +623,11 @@ float ambientChangeBoundPerAzimuth(const float* slopeBound, int azimuths, float 
     return roundUp(v);
 }
 
-float keyLightChangeBound(float slopeBound, float gradientBound, float maxRgb, float sinLow, float sinHigh) {
+float keyLightFractionBound(float slopeBound, float gradientBound, float sinLow, float sinHigh) {
     const double dt = std::max<double>(slopeBound, kSqrt2Up * gradientBound);
     if (dt == 0.0) return 0.0f;
     const double window = static_cast<double>(sinHigh) - sinLow;
-    const double fraction = window > 0.0 ? std::min(1.0, dt / window) : 1.0;
-    return roundUp(std::fabs(static_cast<double>(maxRgb)) * fraction);
+    return window > 0.0 ? roundUp(std::min(1.0, dt / window)) : 1.0f;
 }
 
 float rangeBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int tx, int ty,

@@ -320,11 +320,11 @@ float ambientChangeBoundPerAzimuth(const float* slopeBound, int azimuths, float 
 // 3 degrees at 30 degrees is a window 0.09 high in sin) turns a slope change
 // into a shade change ten times larger than the ambient map's.
 
-/// Bound on |change| of one key light's exact-cosine shade (any channel, white
-/// albedo) at the receiver texels of a tile, from the tile's slope bound over
-/// the light's azimuths (its maximum blocking slope's: rangeBoundOfTile times
-/// blockingMaxLipschitz) and its gradient bound; maxRgb is the light's largest
-/// channel. 0 when both bounds are 0.
-float keyLightChangeBound(float slopeBound, float gradientBound, float maxRgb, float sinLow, float sinHigh);
+/// Bound on |change| of one key light's visible fraction f at the receiver
+/// texels of a tile (in [0, 1]; times the light's largest channel, a bound
+/// on its exact-cosine shade at white albedo), from the tile's slope bound
+/// over the light's azimuths (its maximum blocking slope's: rangeBoundOfTile
+/// times blockingMaxLipschitz) and its gradient bound. 0 when both bounds are 0.
+float keyLightFractionBound(float slopeBound, float gradientBound, float sinLow, float sinHigh);
 
 }  // namespace terrain::gi

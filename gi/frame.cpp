@@ -237,16 +237,18 @@ void environmentVisibility(const GiSettings& settings, int shRows, const Receive
 // Each key light's own visibility over its azimuthal extent and elevation
 // interval (Section 6); operators cached per light.
 // With `only`, a key light whose region of the sky is the same as last frame
-// recomputes only those tiles (the heights changed); a new region, all.
+// recomputes only those tiles (the heights changed, or `brighter`: on the
+// same heights the lights are brighter than the tiles' drift allows); a new
+// region, all.
 void keyLightVisibility(const GiLighting& lighting, const GiSettings& settings, const FrameChange& change,
-                        const ReceiverTiles* only, GiState& st) {
+                        const ReceiverTiles* only, bool brighter, GiState& st) {
     const std::size_t nKeys = lighting.keys.size();
     st.keyOperators.resize(nKeys);
     st.keyOperatorLights.resize(nKeys);
     st.keyVisibility.resize(nKeys);
     const bool footprint = settings.subsample > 1 && settings.visibility.footprintTangent;
     for (std::size_t k = 0; k < nKeys; ++k) {
-        if (!change.keyVisibility(k)) continue;
+        if (!change.keyVisibility(k) && !brighter) continue;
         ++st.keyVisibilitiesRecomputed;
         const KeyLight& light = lighting.keys[k];
         const KeyLightExtent ext = keyLightExtent(light);
@@ -457,7 +459,12 @@ void runDirectStages(ConstGridView heights, float cellSize, const GiLighting& li
         st.receiversRecomputed = tiled ? st.visibilityCache.tiles.dirtyFraction() : 1.0;
     }
     t = Clock::now();
-    keyLightVisibility(lighting, settings, change, keyOnly, st);
+    // the same heights under brighter key lights: the key tiles whose drift now counts beyond the tolerance
+    const bool brighter =
+        !change.geometry && change.radiance && !lighting.keys.empty() &&
+        planKeyBrightness(keyLightRegions(lighting, settings), settings.tolerance, st.visibilityCache);
+    if (brighter) keyOnly = &st.visibilityCache.keyTiles;
+    keyLightVisibility(lighting, settings, change, keyOnly, brighter, st);
     st.timings.keyVisibility = msSince(t);
     t = Clock::now();
     const TexelRuns* runs = shadingRuns(heights, change, plan, st);

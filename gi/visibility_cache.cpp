@@ -1,6 +1,7 @@
 #include "gi/visibility_cache.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace terrain::gi {
@@ -32,24 +33,49 @@ bool shouldPlanTiles(VisibilityCache& cache) { return !skipsPlan(cache.framesWit
 
 namespace {
 
-// Per tile, the sum over the key lights of the bound on each one's shade
-// (keyLightChangeBound; an SH-shaded light: infinite where its slopes may
-// have moved at all). 0 without key lights.
-void boundKeyShades(const HeightPyramid& pyr, const std::vector<KeyLightRegion>& keys, float lipschitz,
-                    VisibilityCache& cache) {
+// Per tile, the largest over the key lights of the bound on each one's
+// visible fraction (keyLightFractionBound; an SH-shaded light: infinite
+// where its slopes may have moved at all). 0 without key lights.
+void boundKeyFractions(const HeightPyramid& pyr, const std::vector<KeyLightRegion>& keys, float lipschitz,
+                       VisibilityCache& cache) {
     cache.keyBound.assign(cache.slopeBound.size(), 0.0f);
     for (const KeyLightRegion& k : keys) {
         boundSlopeChangeOverRange(cache.change, pyr, kVisibilityTile, k.phi0, k.phi1, cache.rangeBound);
         for (std::size_t t = 0; t < cache.keyBound.size(); ++t) {
-            const float slope = lipschitz * cache.rangeBound[t], grad = cache.gradBound[t];
-            float shade = keyLightChangeBound(slope, grad, k.maxRgb, k.sinLow, k.sinHigh);
-            if (!k.exactCosine && shade > 0.0f) shade = std::numeric_limits<float>::infinity();
-            cache.keyBound[t] += shade;
+            float f = keyLightFractionBound(lipschitz * cache.rangeBound[t], cache.gradBound[t], k.sinLow, k.sinHigh);
+            if (!k.exactCosine && f > 0.0f) f = std::numeric_limits<float>::infinity();
+            cache.keyBound[t] = std::max(cache.keyBound[t], f);
         }
     }
 }
 
+// The key lights' shade per unit of visible fraction: the sum of their
+// largest channels (a texel's key shade is sum_k rgb_k f_k max(0, N . l_k)).
+float keyShadePerFraction(const std::vector<KeyLightRegion>& keys) {
+    double sum = 0.0;
+    for (const KeyLightRegion& k : keys) sum += std::fabs(static_cast<double>(k.maxRgb));
+    return static_cast<float>(sum);
+}
+
+// Marks key tile t when its drift, at this frame's brightness, exceeds the
+// tolerance (its drift reset to 0); a light brightened since the tile's key
+// V was computed counts at its new brightness.
+bool markKeyTile(std::size_t t, float keyScale, float tolerance, VisibilityCache& cache) {
+    const bool dirty = cache.keyDrift[t] * keyScale > tolerance;
+    if (dirty) cache.keyDrift[t] = 0.0f;
+    cache.keyTiles.dirty[t] = dirty ? 1 : 0;
+    return dirty;
+}
+
 }  // namespace
+
+bool planKeyBrightness(const std::vector<KeyLightRegion>& keys, float tolerance, VisibilityCache& cache) {
+    if (cache.keyDrift.size() != cache.keyTiles.dirty.size()) return false;
+    const float keyScale = keyShadePerFraction(keys);
+    bool any = false;
+    for (std::size_t t = 0; t < cache.keyDrift.size(); ++t) any = markKeyTile(t, keyScale, tolerance, cache) || any;
+    return any;
+}
 
 void planVisibilityTiles(ConstGridView before, ConstGridView after, const HeightPyramid& pyr,
                          const VisibilitySettings& vis, const std::vector<KeyLightRegion>& keys, float tolerance,
@@ -65,7 +91,8 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
     // sqrt2 times a gradient component's bound); shading reruns at the new
     // normals every frame, so only V's own change counts.
     const float lipschitz = blockingMaxLipschitz(vis.blockingMax);
-    boundKeyShades(pyr, keys, lipschitz, cache);
+    boundKeyFractions(pyr, keys, lipschitz, cache);
+    const float keyScale = keyShadePerFraction(keys);
     const std::size_t m = static_cast<std::size_t>(vis.azimuths);
     std::vector<float>& perAzimuth = cache.tileAzimuths;
     perAzimuth.resize(m);  // no allocation after the first frame of these settings
@@ -74,7 +101,8 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
         const float env =
             ambientChangeBoundPerAzimuth(perAzimuth.data(), vis.azimuths, cache.gradBound[t], 1.0f, false);
         cache.tiles.dirty[t] = addDrift(env, tolerance, cache.drift[t]) ? 1 : 0;
-        cache.keyTiles.dirty[t] = addDrift(cache.keyBound[t], tolerance, cache.keyDrift[t]) ? 1 : 0;
+        cache.keyDrift[t] += cache.keyBound[t];
+        markKeyTile(t, keyScale, tolerance, cache);
         const float any = ambientChangeBound(lipschitz * cache.slopeBound[t], cache.gradBound[t], 1.0f, false);
         cache.geometryTiles.dirty[t] = addDrift(any, tolerance, cache.geometryDrift[t]) ? 1 : 0;
     }

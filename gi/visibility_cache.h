@@ -15,14 +15,17 @@
 // too.
 //
 // Key lights sample their own azimuths, between the environment's, within
-// their region of the sky: their tiles (keyTiles) keep a drift of their own,
-// the sum over the lights of each light's shade bound (keyLightChangeBound:
-// the slope bound over the light's azimuths, boundSlopeChangeOverRange,
-// scaled by its brightness over its window's height), in the shade units of
-// the light itself, not of a unit sky: a shadow edge that moved across a
-// texel is a change of the light's whole shade there. A key light shaded
-// through SH (the paper's settings) recomputes every tile whose bound is not
-// 0, where its order-4 product has no such bound. The geometry
+// their region of the sky: their tiles (keyTiles) keep a drift of their own
+// in visible fraction, the largest over the lights of each one's bound
+// (keyLightFractionBound: the slope bound over the light's azimuths,
+// boundSlopeChangeOverRange, over its window's height), and recompute when
+// it, times the sum of the lights' largest channels this frame, exceeds the
+// tolerance: the key lights' shade may then have drifted beyond it, in the
+// shade units of the lights themselves, not of a unit sky (a shadow edge
+// that moved across a texel is a change of the light's whole shade there),
+// and a light made brighter since counts at its new brightness. A key light
+// shaded through SH (the paper's settings) recomputes every tile whose bound
+// is not 0, where its order-4 product has no such bound. The geometry
 // tiles (geometryTiles) do the same with the bound over every azimuth: what
 // the indirect light's casting sets may have moved (gi/indirect_cache.h).
 #include <vector>
@@ -58,9 +61,9 @@ inline void countAfterPlan(bool everyTileDirty, int& framesWithoutPlan) {
 }
 
 /// What a key light's cached visibility answers for: the azimuths [phi0,
-/// phi1] (radians) it reads, its window's sines and its largest channel
-/// (gi/lights.h, keyLightExtent), and whether it is shaded with the exact
-/// cosine (else through SH).
+/// phi1] (radians) it reads and its window's sines (gi/lights.h,
+/// keyLightExtent); with its largest channel this frame and whether it is
+/// shaded with the exact cosine (else through SH).
 struct KeyLightRegion {
     double phi0 = 0.0, phi1 = 0.0;
     float sinLow = -1.0f, sinHigh = 1.0f;
@@ -72,8 +75,8 @@ struct VisibilityCache {
     MaxChangePyramid change;                   // |dh| of this frame
     std::vector<float> slopeBound, gradBound;  // this frame's bounds per tile (all azimuths)
     std::vector<float> azimuthBound;           // per tile and environment azimuth (tile-major)
-    std::vector<float> keyBound, rangeBound;   // per tile: the key lights' shade bound; scratch: one light's slopes
-    std::vector<float> drift, keyDrift;        // per tile: ambient-map change allowed since its V was computed
+    std::vector<float> keyBound, rangeBound;   // per tile: the key lights' fraction bound; scratch: one light's slopes
+    std::vector<float> drift, keyDrift;        // per tile: ambient-map (key: visible-fraction) change since computed
     std::vector<float> geometryDrift;          // per tile: the same over every azimuth
     std::vector<float> tileAzimuths;           // scratch: one tile's per-azimuth slope bounds
     ReceiverTiles tiles;                       // this frame's tiles to recompute (environment)
@@ -81,6 +84,13 @@ struct VisibilityCache {
     ReceiverTiles geometryTiles;               // tiles whose geometry moved beyond the tolerance along any azimuth
     int framesWithoutPlan = 0;                 // frames left that recompute everything unplanned
 };
+
+/// A frame whose heights did not change but whose lights did: marks the key
+/// tiles (cache.keyTiles, their drift reset to 0) whose drift, times this
+/// frame's key-light brightness, exceeds the tolerance: a light made brighter
+/// since counts at its new brightness. True when any tile is marked (false
+/// too when the cache holds no drift of this grid).
+bool planKeyBrightness(const std::vector<KeyLightRegion>& keys, float tolerance, VisibilityCache& cache);
 
 /// Whether this frame's changed heights should be planned tile by tile
 /// (false: recompute everything, resetVisibilityCache); counts the frames

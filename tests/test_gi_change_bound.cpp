@@ -539,7 +539,7 @@ TEST_CASE("gi.change_bound: azimuth-range bounds hold for a key light's slopes a
                     }
                 CHECK(over == 0);
                 // the light's visible fraction f (its shade at rgb 1, before the
-                // cosine) at every receiver against keyLightChangeBound
+                // cosine) at every receiver against keyLightFractionBound
                 std::vector<float> grad;
                 boundGradientChange(dh, p, cfg.tile, grad);
                 const double toFrac = std::sqrt(4.0 * 3.14159265358979) /
@@ -552,8 +552,7 @@ TEST_CASE("gi.change_bound: azimuth-range bounds hold for a key light's slopes a
                         const std::size_t i = static_cast<std::size_t>(Y) * nxr + X;
                         const double f0 = std::clamp(va.plane(0)[i] * toFrac, 0.0, 1.0);
                         const double f1 = std::clamp(vb.plane(0)[i] * toFrac, 0.0, 1.0);
-                        const double b =
-                            keyLightChangeBound(lipschitz * range[t], grad[t], 1.0f, ext.sinLow, ext.sinHigh);
+                        const double b = keyLightFractionBound(lipschitz * range[t], grad[t], ext.sinLow, ext.sinHigh);
                         fractionOver += std::fabs(f1 - f0) > b + 1e-5;
                         if (b > 0.0 && b < 1.0) worstFraction = std::max(worstFraction, std::fabs(f1 - f0) / b);
                     }
@@ -567,14 +566,14 @@ TEST_CASE("gi.change_bound: azimuth-range bounds hold for a key light's slopes a
         }
     MESSAGE("key-light slopes: worst change / range bound "
             << worst << "; " << smallerTiles << " tile bounds below the bound over every azimuth"
-            << "; visible fraction: worst change / shade bound " << worstFraction);
+            << "; visible fraction: worst change / fraction bound " << worstFraction);
     CHECK(smallerTiles > 0);
     CHECK(worstFraction > 0.01);  // the bound is met by changes of its own order somewhere
-    // the shade bound: the light's brightness over its window's height, at most the whole light
-    CHECK(keyLightChangeBound(0.0f, 0.0f, 2.0f, 0.4f, 0.5f) == 0.0f);
-    CHECK(keyLightChangeBound(0.01f, 0.0f, 2.0f, 0.4f, 0.5f) == doctest::Approx(0.2));
-    CHECK(keyLightChangeBound(0.0f, 0.01f, 2.0f, 0.4f, 0.5f) == doctest::Approx(0.2 * std::sqrt(2.0)));
-    CHECK(keyLightChangeBound(1.0f, 0.0f, 2.0f, 0.4f, 0.5f) == 2.0f);
+    // the fraction bound: the slope bound over the window's height, at most the whole light
+    CHECK(keyLightFractionBound(0.0f, 0.0f, 0.4f, 0.5f) == 0.0f);
+    CHECK(keyLightFractionBound(0.01f, 0.0f, 0.4f, 0.5f) == doctest::Approx(0.1));
+    CHECK(keyLightFractionBound(0.0f, 0.01f, 0.4f, 0.5f) == doctest::Approx(0.1 * std::sqrt(2.0)));
+    CHECK(keyLightFractionBound(1.0f, 0.0f, 0.4f, 0.5f) == 1.0f);
     MaxChangePyramid dh;
     const Grid flat = baseTerrain(40, 40);
     buildMaxChangePyramid(flat.cview(), flat.cview(), dh);
