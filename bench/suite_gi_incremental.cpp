@@ -292,13 +292,12 @@ LongRun runLong(const char* scene, int size, const IncrementalOptions& o) {
     return out;
 }
 
-// The largest tolerance whose worst frame in every long run stays within
-// 0.2 % relative RMS and 1 % of the mean at any texel (0 when none does).
 // Within 0.2 % relative RMS and 1 % of the mean at any texel in every frame.
 bool withinCriterion(const Difference& d) { return d.rms <= 0.002 && d.maxRel <= 0.01; }
 
 // The largest of the long runs' tolerances that meets the criterion in both
-// long runs and in every case and sweep row run at the same tolerance.
+// long runs and in every case and sweep row run at the same tolerance (0
+// when none does).
 float chooseTolerance(const std::vector<LongRun>& runs, const std::vector<CaseResult>& cases,
                       const IncrementalOptions& o) {
     float best = 0.0f;

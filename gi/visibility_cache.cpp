@@ -1,7 +1,6 @@
 #include "gi/visibility_cache.h"
 
 #include <algorithm>
-#include <cmath>
 #include <limits>
 
 namespace terrain::gi {
@@ -53,7 +52,7 @@ void boundKeyFractions(const HeightPyramid& pyr, const std::vector<KeyLightRegio
 // largest channels (a texel's key shade is sum_k rgb_k f_k max(0, N . l_k)).
 float keyShadePerFraction(const std::vector<KeyLightRegion>& keys) {
     double sum = 0.0;
-    for (const KeyLightRegion& k : keys) sum += std::fabs(static_cast<double>(k.maxRgb));
+    for (const KeyLightRegion& k : keys) sum += k.maxRgb;  // >= 0 (validateKeyLight)
     return static_cast<float>(sum);
 }
 

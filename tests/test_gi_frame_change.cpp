@@ -233,9 +233,12 @@ TEST_CASE("gi.frame_change: a key light's shade stays within the tolerance of a 
     // of a full recompute while most tiles keep their cached visibility,
     // also after the light is made brighter on a frame whose heights did not
     // change (a large tolerance lets the cached shadows lag far enough to show it).
-    for (const float tolerance : {0.02f, 0.2f}) {
-        const RidgeRun r =
-            ridgeUnderKeyLight(tolerance, tolerance < 0.1f ? 3.0f : 1.0f, tolerance < 0.1f ? 2.0f : 1.0f);
+    struct Case {
+        float tolerance, red, green;
+    };
+    for (const Case& c : {Case{0.02f, 3.0f, 2.0f}, Case{0.2f, 1.0f, 1.0f}}) {
+        const float tolerance = c.tolerance;
+        const RidgeRun r = ridgeUnderKeyLight(tolerance, c.red, c.green);
         MESSAGE("rising ridge, key light alone, tolerance "
                 << tolerance << ": largest shade difference from full frames " << r.worst << ", " << 100.0 * r.keptShare
                 << " % of the key tiles kept per frame");
