@@ -407,20 +407,29 @@ GeometryPlan planGeometry(ConstGridView heights, const GiLighting& lighting, con
     return plan;
 }
 
-// The texels whose direct light can differ from the last frame's
-// (gi/shading_tiles.h), or null for every texel: only when the heights alone
-// changed, the visibility was recomputed by tiles and the last direct
-// shading is of the recorded inputs.
-const TexelRuns* shadingRuns(ConstGridView heights, const FrameChange& change, const GeometryPlan& plan, GiState& st) {
+// The texels whose direct light, and those whose exact ambient, can differ
+// from the last frame's (gi/shading_tiles.h), or null for every texel: only
+// when the heights alone changed, the visibility was recomputed by tiles and
+// the last direct shading is of the recorded inputs.
+struct DirectRuns {
+    const TexelRuns* shading = nullptr;
+    const TexelRuns* ambient = nullptr;
+};
+
+DirectRuns directRuns(ConstGridView heights, const FrameChange& change, const GeometryPlan& plan, GiState& st) {
     const bool keyRegions = std::find(change.keyRegion.begin(), change.keyRegion.end(), true) != change.keyRegion.end();
     if (!plan.tiled || change.radiance || keyRegions || st.directStale || !st.lastInputs.valid ||
         st.shade.nx != heights.nx || st.shade.ny != heights.ny || st.lastInputs.heights.nx != heights.nx ||
         st.lastInputs.heights.ny != heights.ny)
-        return nullptr;
-    changedShadingTiles(st.lastInputs.heights.cview(), heights, st.visibilityCache.tiles, st.visibilityCache.keyTiles,
-                        st.pyramid.subsample, st.shadingTiles);
-    texelRunsOfTiles(&st.shadingTiles, heights.nx, heights.ny, st.pyramid.subsample, st.shadingRuns);
-    return &st.shadingRuns;
+        return {};
+    const VisibilityCache& cache = st.visibilityCache;
+    const int s = st.pyramid.subsample;
+    changedDirectTiles(st.lastInputs.heights.cview(), heights, cache.tiles, cache.keyTiles, s, st.ambientTiles,
+                       st.shadingTiles);
+    texelRunsOfTiles(&st.shadingTiles, heights.nx, heights.ny, s, st.shadingRuns);
+    if (cache.keyTiles.dirtyCount() == 0) return {&st.shadingRuns, &st.shadingRuns};
+    texelRunsOfTiles(&st.ambientTiles, heights.nx, heights.ny, s, st.ambientRuns);
+    return {&st.shadingRuns, &st.ambientRuns};
 }
 
 // The direct light's stages: geometry (gradient, pyramid, environment V)
@@ -467,16 +476,17 @@ void runDirectStages(ConstGridView heights, float cellSize, const GiLighting& li
     keyLightVisibility(lighting, settings, change, keyOnly, brighter, st);
     st.timings.keyVisibility = msSince(t);
     t = Clock::now();
-    const TexelRuns* runs = shadingRuns(heights, change, plan, st);
+    const DirectRuns runs = directRuns(heights, change, plan, st);
     if (settings.ambient == AmbientMethod::Horizons) {
         // the sky's parts ride with the ambient; a sky gradient new to this
         // geometry needs them over the whole field
         const bool withSkyParts = lighting.gradient.has_value();
         const bool partsMissing = withSkyParts && !st.shade.skyParts;
         if (change.geometry || partsMissing || shMissing)
-            exactAmbient(heights, cellSize, settings, withSkyParts, st, partsMissing || shMissing ? nullptr : runs);
+            exactAmbient(heights, cellSize, settings, withSkyParts, st,
+                         partsMissing || shMissing ? nullptr : runs.ambient);
     }
-    directShading(lighting, settings, albedo, st, runs);
+    directShading(lighting, settings, albedo, st, runs.shading);
     st.timings.shading = msSince(t);
 }
 

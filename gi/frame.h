@@ -61,6 +61,8 @@ struct GiState {
     bool directStale = false, indirectStale = false;
     ReceiverTiles shadingTiles;         // this frame's texel tiles whose direct light was redone (gi/shading_tiles.h)
     TexelRuns shadingRuns;              // and their texels
+    ReceiverTiles ambientTiles;         // of those, the tiles whose exact ambient was redone
+    TexelRuns ambientRuns;              // and their texels
     double receiversRecomputed = 0.0;   // fraction of the receivers whose environment V the last frame recomputed
     int keyVisibilitiesRecomputed = 0;  // key lights whose V the last frame recomputed
     int framesSinceRefresh = 0;         // incremental frames since the last full one (GiSettings::refreshEvery)

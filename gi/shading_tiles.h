@@ -18,7 +18,11 @@
 // last frame's inputs bit for bit unless a height within s + s / 2 + 1 cells
 // of them changed or they read a receiver of a tile whose environment or
 // key-light visibility was recomputed; the others keep their light,
-// identical to recomputing it.
+// identical to recomputing it. The exact ambient (and the analytic sky's
+// parts) reads the environment's horizons, not the key lights': its texels
+// are those of the environment's dirty tiles and the changed heights alone,
+// so a local change that a low key light looks across redoes the shade of a
+// strip of tiles but the ambient of a few.
 #include "core/grid.h"
 #include "gi/receiver_tiles.h"
 #include "gi/texel_runs.h"
@@ -35,5 +39,11 @@ inline int shadingReach(int subsample) { return subsample + subsample / 2 + 1; }
 /// differ.
 void changedShadingTiles(ConstGridView before, ConstGridView after, const ReceiverTiles& env, const ReceiverTiles& keys,
                          int subsample, ReceiverTiles& out);
+
+/// The texel tiles whose exact ambient must be redone (`ambient`: as
+/// changedShadingTiles without the key lights' tiles) and those whose direct
+/// light must be (`shading`: changedShadingTiles), the heights compared once.
+void changedDirectTiles(ConstGridView before, ConstGridView after, const ReceiverTiles& env, const ReceiverTiles& keys,
+                        int subsample, ReceiverTiles& ambient, ReceiverTiles& shading);
 
 }  // namespace terrain::gi

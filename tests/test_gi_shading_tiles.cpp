@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "gi/ambient_horizon.h"
 #include "gi/frame.h"
 #include "gi/shading_tiles.h"
 #include "tests/gi_test_terrain.h"
@@ -56,6 +57,21 @@ TEST_CASE("gi.shading_tiles: the tiles within reach of changed heights, and thos
     keys.setDirty(1, 1);
     changedShadingTiles(before.cview(), before.cview(), env, keys, s, out);
     CHECK(dirtyOf(out) == std::vector<int>{0, 1, 2, 3});
+    // the ambient reads no key light: with a changed height as well, it redoes
+    // the height's tiles, the shading those and the key tile's readers
+    ReceiverTiles ambient, shading;
+    after = before;
+    after(7, 29) += 0.5f;
+    changedDirectTiles(before.cview(), after.cview(), env, keys, s, ambient, shading);
+    CHECK(dirtyOf(ambient) == std::vector<int>{0, 2});
+    changedShadingTiles(before.cview(), after.cview(), env, keys, s, out);
+    CHECK(dirtyOf(shading) == dirtyOf(out));
+    CHECK(dirtyOf(shading) == std::vector<int>{0, 1, 2, 3});
+    env.setDirty(0, 2);  // an environment tile: both read it
+    changedDirectTiles(before.cview(), after.cview(), env, keys, s, ambient, shading);
+    CHECK(dirtyOf(ambient) == std::vector<int>{0, 2, 4});
+    CHECK(dirtyOf(shading) == std::vector<int>{0, 1, 2, 3, 4});
+    env.setDirty(0, 2, false);
     CHECK_THROWS_AS(changedShadingTiles(bumpy(40, 69).cview(), before.cview(), env, keys, s, out), InputError);
 }
 
@@ -67,6 +83,23 @@ std::array<Grid, 3> reshadeEveryTexel(const GiState& st, const GiSettings& setti
     GiState fresh = st;
     shadeDirect(light, settings, nullptr, fresh);
     return fresh.shade.rgb;
+}
+
+// The exact ambient of the state's current horizons and gradients over every
+// texel (the sky's parts too when the state keeps them).
+bool ambientAsEveryTexelWould(const GiState& st, const GiSettings& settings, ConstGridView heights) {
+    const bool footprint = settings.subsample > 1 && settings.visibility.footprintTangent;
+    const AmbientInputs in{st.gradX.cview(),   st.gradY.cview(),  heights,      kCell,
+                           settings.subsample, &st.envVisibility, st.envCosSin, footprint ? &st.footprint : nullptr};
+    Grid ambient, below, rising;
+    AmbientScratch scratch;
+    ambientFromHorizons(in, {ambient, st.shade.skyParts ? &below : nullptr, st.shade.skyParts ? &rising : nullptr},
+                        scratch, nullptr);
+    bool same = gi_test::sameBits(ambient.v, st.shade.ambient.v);
+    if (st.shade.skyParts)
+        same = same && gi_test::sameBits(below.v, st.shade.skyBelow.v) &&
+               gi_test::sameBits(rising.v, st.shade.skyRising.v);
+    return same;
 }
 
 bool sameRgb(const std::array<Grid, 3>& a, const std::array<Grid, 3>& b) {
@@ -98,7 +131,7 @@ TEST_CASE("gi.shading_tiles: local height changes shade some tiles, the rest is 
                 settings.keyLightExactCosine = exactKey;
                 settings.tolerance = tolerance;
                 std::vector<GiState> states(4);
-                int kept = 0;
+                int kept = 0, ambientFewer = 0;
                 for (std::size_t f = 0; f < surfaces.size(); ++f) {
                     CAPTURE(f);
                     for (std::size_t i = 0; i < states.size(); ++i)
@@ -111,11 +144,20 @@ TEST_CASE("gi.shading_tiles: local height changes shade some tiles, the rest is 
                     for (std::size_t i = 1; i < states.size(); ++i) CHECK(sameOutputs(states[i], states[0]));
                     // the texels kept are those every texel's shading would give
                     CHECK(sameRgb(states[0].shade.rgb, reshadeEveryTexel(states[0], settings, light)));
+                    CHECK(ambientAsEveryTexelWould(states[0], settings, surfaces[f].cview()));
                     const ReceiverTiles& t = states[0].shadingTiles;
                     if (f > 0) kept += static_cast<int>(t.dirty.size()) - t.dirtyCount();
+                    // the ambient redoes no tile the shading keeps, and fewer where the key light looked across
+                    if (f > 0 && states[0].visibilityCache.keyTiles.dirtyCount() > 0) {
+                        const ReceiverTiles& a = states[0].ambientTiles;
+                        for (std::size_t i = 0; i < a.dirty.size(); ++i)
+                            if (a.dirty[i] != 0) CHECK(t.dirty[i] != 0);
+                        ambientFewer += a.dirtyCount() < t.dirtyCount() ? 1 : 0;
+                    }
                 }
                 MESSAGE(s << "x, exact key " << exactKey << ", tolerance " << tolerance << ": " << kept
                           << " texel tiles kept over 3 local changes");
                 if (tolerance > 0.0f) CHECK(kept > 0);
+                if (tolerance > 0.0f) CHECK(ambientFewer > 0);
             }
 }
