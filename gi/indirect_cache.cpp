@@ -188,7 +188,7 @@ const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCac
         cache.valid = false;
         return nullptr;
     }
-    if (skipsPlan(cache.framesWithoutPlan)) return nullptr;
+    if (skipsPlan(cache.skips)) return nullptr;
     boundRadianceChange(in, cache);
     for (std::size_t t = 0; t < cache.drift.size(); ++t) cache.drift[t] += cache.radianceBound[t];
     for (std::size_t t = 0; t < cache.drift.size(); ++t) {
@@ -197,7 +197,7 @@ const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCac
         if (dirty) cache.drift[t] = 0.0f;
         cache.tiles.dirty[t] = dirty ? 1 : 0;
     }
-    countAfterPlan(cache.tiles.dirtyCount() == static_cast<int>(cache.tiles.dirty.size()), cache.framesWithoutPlan);
+    countAfterPlan(cache.tiles.dirtyCount(), static_cast<int>(cache.tiles.dirty.size()), cache.skips);
     return &cache.tiles;
 }
 

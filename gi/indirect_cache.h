@@ -61,6 +61,7 @@
 #include "core/grid.h"
 #include "gi/blocker_radiance.h"
 #include "gi/change_bound.h"
+#include "gi/plan_skips.h"
 #include "gi/pyramid.h"
 #include "gi/radiance_pyramid.h"
 #include "gi/receiver_tiles.h"
@@ -80,7 +81,7 @@ struct IndirectCache {
     ReceiverTiles tiles;                 // this frame's tiles to re-gather
     ReceiverTiles texels;                // this frame's texel tiles to redo
     std::uint64_t geometryVersion = 0;   // GiState::geometryVersion of the last pass
-    int framesWithoutPlan = 0;           // frames left that re-gather everything unplanned
+    PlanSkips skips;                     // frames that re-gather everything unplanned
     bool hadAlbedo = false;              // the last pass's albedo channels (empty: 1)
     std::array<Grid, 3> lastAlbedo;
 };
@@ -108,9 +109,9 @@ void boundRadianceChange(const IndirectPlanInputs& in, IndirectCache& cache);
 
 /// The tiles to re-gather (cache.tiles), or null when every receiver must be
 /// (no valid cache of this grid: the drifts start again at 0). As for the
-/// visibility (kFramesWithoutPlan, gi/visibility_cache.h): after a plan that
-/// found every tile dirty, that many frames re-gather everything without
-/// computing the bound, whose cost would only be added to a full pass.
+/// visibility (gi/plan_skips.h): after a plan that found
+/// most tiles dirty, frames re-gather everything without computing the
+/// bound, whose cost would only be added to a full pass.
 const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCache& cache);
 
 /// After an indirect pass over `source` (on the receiver grid of `heights`):

@@ -28,7 +28,7 @@ void resetVisibilityCache(const HeightPyramid& pyr, VisibilityCache& cache) {
 
 void forgetEnvironmentDrift(VisibilityCache& cache) { std::fill(cache.drift.begin(), cache.drift.end(), 0.0f); }
 
-bool shouldPlanTiles(VisibilityCache& cache) { return !skipsPlan(cache.framesWithoutPlan); }
+bool shouldPlanTiles(VisibilityCache& cache) { return !skipsPlan(cache.skips); }
 
 namespace {
 
@@ -106,7 +106,8 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
         cache.geometryTiles.dirty[t] = addDrift(any, tolerance, cache.geometryDrift[t]) ? 1 : 0;
     }
     const int all = static_cast<int>(cache.drift.size());
-    countAfterPlan(cache.tiles.dirtyCount() == all && cache.geometryTiles.dirtyCount() == all, cache.framesWithoutPlan);
+    // the indirect light re-gathers the geometry's dirty tiles: both count
+    countAfterPlan(std::min(cache.tiles.dirtyCount(), cache.geometryTiles.dirtyCount()), all, cache.skips);
 }
 
 }  // namespace terrain::gi

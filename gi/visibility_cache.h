@@ -32,6 +32,7 @@
 
 #include "core/grid.h"
 #include "gi/change_bound.h"
+#include "gi/plan_skips.h"
 #include "gi/pyramid.h"
 #include "gi/receiver_tiles.h"
 #include "gi/visibility.h"
@@ -40,25 +41,6 @@ namespace terrain::gi {
 
 /// Receivers per side of a visibility tile (a multiple of ReceiverTiles::kTileAlign).
 inline constexpr int kVisibilityTile = 32;
-
-/// After a plan that found every tile dirty, this many frames recompute
-/// everything without computing the bounds: a terrain that changes
-/// everywhere (rain on an eroding terrain) would dirty every tile again, and
-/// the bounds would only add their cost. Recomputing is always within the
-/// tolerance, and the choice depends on the frames alone (deterministic).
-inline constexpr int kFramesWithoutPlan = 7;
-
-/// The count-down of kFramesWithoutPlan, for every cache that plans tiles
-/// (this one, gi/indirect_cache.h): whether this frame skips its plan (and
-/// counts it), and the count set again after a plan that found every tile dirty.
-inline bool skipsPlan(int& framesWithoutPlan) {
-    if (framesWithoutPlan == 0) return false;
-    --framesWithoutPlan;
-    return true;
-}
-inline void countAfterPlan(bool everyTileDirty, int& framesWithoutPlan) {
-    if (everyTileDirty) framesWithoutPlan = kFramesWithoutPlan;
-}
 
 /// What a key light's cached visibility answers for: the azimuths [phi0,
 /// phi1] (radians) it reads and its window's sines (gi/lights.h,
@@ -82,7 +64,7 @@ struct VisibilityCache {
     ReceiverTiles tiles;                       // this frame's tiles to recompute (environment)
     ReceiverTiles keyTiles;                    // the same for the key lights
     ReceiverTiles geometryTiles;               // tiles whose geometry moved beyond the tolerance along any azimuth
-    int framesWithoutPlan = 0;                 // frames left that recompute everything unplanned
+    PlanSkips skips;                           // frames that recompute everything unplanned
 };
 
 /// A frame whose heights did not change but whose lights did: marks the key
@@ -94,7 +76,7 @@ bool planKeyBrightness(const std::vector<KeyLightRegion>& keys, float tolerance,
 
 /// Whether this frame's changed heights should be planned tile by tile
 /// (false: recompute everything, resetVisibilityCache); counts the frames
-/// of kFramesWithoutPlan down.
+/// without a plan down.
 bool shouldPlanTiles(VisibilityCache& cache);
 
 /// Forgets the drift: every tile's V is about to be computed from scratch.
