@@ -109,9 +109,9 @@ void boundRadianceChange(const IndirectPlanInputs& in, IndirectCache& cache);
 
 /// The tiles to re-gather (cache.tiles), or null when every receiver must be
 /// (no valid cache of this grid: the drifts start again at 0). As for the
-/// visibility (gi/plan_skips.h): after a plan that found
-/// most tiles dirty, frames re-gather everything without computing the
-/// bound, whose cost would only be added to a full pass.
+/// visibility (gi/plan_skips.h): after a plan that found most tiles dirty,
+/// frames re-gather everything without computing the bound, whose cost
+/// would only be added to a full pass.
 const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCache& cache);
 
 /// After an indirect pass over `source` (on the receiver grid of `heights`):
