@@ -508,6 +508,9 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
     st.keyVisibilitiesRecomputed = 0;
     if (!change.any() && !st.directStale && !st.indirectStale) {
         st.directUpdated = st.indirectUpdated = false;  // the cached results are this frame's
+        // the terrain stopped changing everywhere: the next change is planned (gi/plan_skips.h)
+        st.visibilityCache.skips = {};
+        st.indirectCache.skips = {};
         st.timings.total = msSince(t0);
         return;
     }

@@ -19,8 +19,10 @@ inline constexpr double kMostlyDirty = 0.75;
 /// their cost. kFramesWithoutPlan frames after the first such plan, and
 /// after each next one in a row twice as many plus one, up to
 /// kMostFramesWithoutPlan; a plan that keeps more tiles starts again from
-/// kFramesWithoutPlan. Recomputing is always within the tolerance, and the
-/// choice depends on the frames alone (deterministic).
+/// kFramesWithoutPlan, and a frame whose inputs did not change ends the run
+/// (the terrain stopped changing everywhere; runGiFrame). Recomputing is
+/// always within the tolerance, and the choice depends on the frames alone
+/// (deterministic).
 inline constexpr int kFramesWithoutPlan = 7;
 inline constexpr int kMostFramesWithoutPlan = 31;
 

@@ -277,6 +277,26 @@ TEST_CASE("gi.indirect_cache: after a plan that finds most tiles dirty, frames r
     CHECK(inc.indirectCache.skips.length == 0);  // a plan that kept the tiles: the next run starts short again
 }
 
+TEST_CASE("gi.indirect_cache: a frame without a change ends the frames without a plan") {
+    // A terrain that stopped changing everywhere (a paused erosion) and then
+    // changes a little: that change is planned, not re-gathered in full.
+    KeyLitField field;
+    const Grid& h = field.h;
+    GiLighting& light = field.light;
+    const GiSettings& settings = field.settings;
+    GiState inc;
+    runGiFrame(h.cview(), kCell, light, settings, inc);
+    light.keys[0].rgb[0] *= 3.0f;
+    runGiFrame(h.cview(), kCell, light, settings, inc);
+    REQUIRE(inc.indirectCache.skips.left == kFramesWithoutPlan);
+    runGiFrame(h.cview(), kCell, light, settings, inc);  // the same inputs
+    CHECK(inc.indirectCache.skips.left == 0);
+    CHECK(inc.indirectCache.skips.length == 0);
+    light.keys[0].rgb[0] *= 1.0001f;
+    runGiFrame(h.cview(), kCell, light, settings, inc);
+    CHECK(inc.indirectRecomputed == 0.0);
+}
+
 TEST_CASE("gi.indirect_cache: with a local height change the indirect light stays within the tolerance") {
     const Grid h = bumpy(256, 256);
     GiLighting light;  // uniform unit sky: shade units are the ambient map's
