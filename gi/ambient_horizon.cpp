@@ -186,9 +186,9 @@ struct RaisedWindow {
 
 // Horizon slopes of azimuth a at the texels of a run of the row the window
 // covers, bilinear from the raised receivers (Fig. 7): the vertical mix of
-// the receivers the run reads, then along the row, by lerpReceiverRow over a
-// whole row and by the columns' receivers and fraction over a part of one
-// (the same operations). vert: nxr floats of scratch.
+// the receivers the run reads, then along the row (lerpReceiverSpan: the
+// same operations over a whole row or a part of one). vert: nxr floats of
+// scratch.
 void interpolatedHorizons(const AmbientJob& j, const RaisedWindow& window, int a, ColumnSpan run, float* vert,
                           float* out) {
     const bool wholeRow = run.x0 == 0 && run.x1 == j.nx;
@@ -197,11 +197,7 @@ void interpolatedHorizons(const AmbientJob& j, const RaisedWindow& window, int a
     const float* t0 = window.row0(a);
     const float* t1 = window.row1(a);
     for (int X = read.x0; X < read.x1; ++X) vert[X] = t0[X] + window.f * (t1[X] - t0[X]);
-    if (wholeRow) return lerpReceiverRow(vert, j.nxr, j.in.subsample, j.columns, j.nx, out);
-    for (int x = run.x0; x < run.x1; ++x) {
-        const ReceiverLerp& r = j.columns[x];
-        out[x] = vert[r.i0] + r.f * (vert[r.i1] - vert[r.i0]);
-    }
+    lerpReceiverSpan(vert, j.nxr, j.in.subsample, j.columns, run.x0, run.x1, out);
 }
 
 // One texel row's runs: every azimuth's horizons (at sub-sampling

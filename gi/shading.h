@@ -131,30 +131,39 @@ inline void receiverLerps(int count, int s, int n, std::vector<ReceiverLerp>& ou
 }
 
 /// A row of receiver values v (nxr of them) interpolated to the texel
-/// columns 0..nx-1 (Fig. 7): out[x] = v[i0] + f (v[i1] - v[i0]), `columns`
-/// the row's receiverLerps. At s = 2 and 4 the whole receiver intervals are
-/// unrolled with the fractions k / s (the same operations) so that the
-/// compiler vectorises them; the columns past the last whole interval, and
-/// every column at other s, from the table.
+/// columns [x0, x1) (Fig. 7): out[x] = v[i0] + f (v[i1] - v[i0]), `columns`
+/// the row's receiverLerps. At s = 2 and 4 the whole receiver intervals
+/// inside [x0, x1) are unrolled with the fractions k / s (the same
+/// operations: there i0 = x / s and f = k / s) so that the compiler
+/// vectorises them; the other columns, and every column at other s, come
+/// from the table.
 template <int S>
-inline int lerpReceiverIntervals(const float* v, int nxr, int nx, float* out) {
+inline ColumnSpan lerpReceiverIntervals(const float* v, int nxr, int x0, int x1, float* out) {
     float frac[S];
     for (int k = 0; k < S; ++k) frac[k] = static_cast<float>(k) / static_cast<float>(S);
     const int intervals = nxr > 1 ? nxr - 1 : 0;
-    for (int X = 0; X < intervals; ++X) {
+    const int first = (x0 + S - 1) / S, last = x1 / S < intervals ? x1 / S : intervals;
+    for (int X = first; X < last; ++X) {
         const float v0 = v[X], d = v[X + 1] - v[X];
         for (int k = 0; k < S; ++k) out[S * X + k] = v0 + frac[k] * d;
     }
-    return S * intervals < nx ? S * intervals : nx;
+    return last > first ? ColumnSpan{S * first, S * last} : ColumnSpan{x0, x0};
+}
+inline void lerpReceiverSpan(const float* v, int nxr, int s, const ReceiverLerp* columns, int x0, int x1, float* out) {
+    ColumnSpan unrolled{x0, x0};
+    if (s == 2) unrolled = lerpReceiverIntervals<2>(v, nxr, x0, x1, out);
+    if (s == 4) unrolled = lerpReceiverIntervals<4>(v, nxr, x0, x1, out);
+    const auto fromTable = [&](int a, int b) {
+        for (int x = a; x < b; ++x) {
+            const ReceiverLerp& r = columns[x];
+            out[x] = v[r.i0] + r.f * (v[r.i1] - v[r.i0]);
+        }
+    };
+    fromTable(x0, unrolled.x0);
+    fromTable(unrolled.x1, x1);
 }
 inline void lerpReceiverRow(const float* v, int nxr, int s, const ReceiverLerp* columns, int nx, float* out) {
-    int x = 0;
-    if (s == 2) x = lerpReceiverIntervals<2>(v, nxr, nx, out);
-    if (s == 4) x = lerpReceiverIntervals<4>(v, nxr, nx, out);
-    for (; x < nx; ++x) {
-        const ReceiverLerp& r = columns[x];
-        out[x] = v[r.i0] + r.f * (v[r.i1] - v[r.i0]);
-    }
+    lerpReceiverSpan(v, nxr, s, columns, 0, nx, out);
 }
 
 /// An albedo map of one value everywhere (every channel).
