@@ -150,7 +150,7 @@ struct IndirectBounds {
 };
 IndirectBounds indirectBounds(const GiState& now, const GiState& last, int azimuths) {
     gi::IndirectCache cache;
-    cache.lastSource = last.shade.rgb;
+    cache.anchorSource = last.shade.rgb;
     const gi::IndirectPlanInputs plan{.source = now.shade.rgb,
                                       .heights = now.pyramid,
                                       .lastPyramid = last.indirect.radiance,
@@ -177,7 +177,7 @@ void measureFrame(Track& t, const gi::GiSettings& settings, float cell, float to
     if (t.lastHeights.empty()) return;
     for (std::size_t i = 0; i < t.heights.v.size(); ++i)
         t.dh.push_back(std::fabs(static_cast<double>(t.heights.v[i]) - t.lastHeights.v[i]));
-    gi::VisibilityCache cache;  // a fresh drift: after one plan it holds the frame's bound per tile
+    gi::VisibilityCache cache;  // fresh, anchored at the last heights: one plan's excursion is the frame's bound
     gi::planVisibilityTiles(t.lastHeights.cview(), t.heights.cview(), t.now.pyramid, settings.visibility, {}, 1e30f,
                             cache);
     gi::ShadeMaps cached;
@@ -190,7 +190,7 @@ void measureFrame(Track& t, const gi::GiSettings& settings, float cell, float to
     const IndirectBounds ib = indirectBounds(t.now, t.last, settings.indirect.azimuths);
     t.indirectSampleBound.insert(t.indirectSampleBound.end(), ib.sampleMove.begin(), ib.sampleMove.end());
     t.indirectBound.insert(t.indirectBound.end(), ib.bound.begin(), ib.bound.end());
-    t.bound.insert(t.bound.end(), cache.drift.begin(), cache.drift.end());
+    t.bound.insert(t.bound.end(), cache.drift.lastExcursion.begin(), cache.drift.lastExcursion.end());
     t.vChange.insert(t.vChange.end(), v.begin(), v.end());
     t.indirectChange.insert(t.indirectChange.end(), ind.begin(), ind.end());
 }

@@ -116,4 +116,11 @@ struct Grid {
     ConstGridView cview() const { return {v.data(), nx, ny, nx}; }
 };
 
+/// Copies a view into an owning grid (its storage kept when the size is the same).
+inline void copyGrid(ConstGridView from, Grid& to) {
+    to.ensureSize(from.nx, from.ny);
+    for (int y = 0; y < from.ny; ++y)
+        std::memcpy(to.data() + static_cast<std::size_t>(y) * from.nx, from.row(y), sizeof(float) * from.nx);
+}
+
 }  // namespace terrain

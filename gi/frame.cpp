@@ -94,7 +94,7 @@ void runIndirectStage(ConstGridView heights, const GiSettings& settings, const F
                             .texels = texels,
                             .sameGeometry = !change.geometry};
     computeIndirect(in, settings.indirect, st.indirect);
-    if (cached) recordIndirectSource(st.shade.rgb, st.pyramid, only == nullptr, st.indirectCache);
+    if (cached && only == nullptr) recordIndirectSource(st.shade.rgb, st.pyramid, st.indirectCache);
     st.indirectCache.geometryVersion = st.geometryVersion;
     st.indirectRecomputed = only ? only->dirtyFraction() : 1.0;
     st.timings.indirect = msSince(t);
@@ -458,7 +458,7 @@ void runDirectStages(ConstGridView heights, float cellSize, const GiLighting& li
     if (change.geometry || shMissing) {
         const bool tiled = plan.tiled && samePlanes;
         if (change.geometry && !plan.tiled)
-            resetVisibilityCache(st.pyramid, st.visibilityCache);
+            resetVisibilityCache(st.pyramid, heights, st.visibilityCache);
         else if (!tiled)
             forgetEnvironmentDrift(st.visibilityCache);
         only = tiled ? &st.visibilityCache.tiles : nullptr;

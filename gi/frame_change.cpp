@@ -30,12 +30,6 @@ bool sameKeyRadiance(const KeyLight& a, const KeyLight& b) {
     return a.rgb[0] == b.rgb[0] && a.rgb[1] == b.rgb[1] && a.rgb[2] == b.rgb[2];
 }
 
-void copyGrid(ConstGridView from, Grid& to) {
-    to.ensureSize(from.nx, from.ny);
-    for (int y = 0; y < from.ny; ++y)
-        std::memcpy(to.data() + static_cast<std::size_t>(y) * from.nx, from.row(y), sizeof(float) * from.nx);
-}
-
 }  // namespace
 
 bool FrameChange::any() const {

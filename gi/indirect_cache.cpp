@@ -19,10 +19,10 @@ bool cacheFits(const IndirectPlanInputs& in, const IndirectCache& cache) {
     const HeightPyramid& h = in.heights;
     if (!cache.valid || in.lastPyramid.fields.empty()) return false;
     const HeightPyramid& r = in.lastPyramid.fields[0];
-    const Grid& last = cache.lastSource[0];
+    const Grid& last = cache.anchorSource[0];
     return r.nx == h.nx && r.ny == h.ny && r.nxr == h.nxr && r.nyr == h.nyr && r.steps.size() == h.steps.size() &&
            last.nx == h.nx && last.ny == h.ny && in.source[0].nx == h.nx && in.source[0].ny == h.ny &&
-           cache.tiles.nxr == h.nxr && cache.tiles.nyr == h.nyr && cache.drift.size() == cache.tiles.dirty.size() &&
+           cache.tiles.nxr == h.nxr && cache.tiles.nyr == h.nyr && cache.drift.fits(cache.tiles.dirty.size()) &&
            (!in.geometryTiles || in.geometryTiles->dirty.size() == cache.tiles.dirty.size());
 }
 
@@ -169,8 +169,8 @@ void boundRadianceChange(const IndirectPlanInputs& in, IndirectCache& cache) {
     const HeightPyramid& h = in.heights;
     const std::size_t tiles =
         static_cast<std::size_t>(tileCount(h.nxr, kVisibilityTile)) * tileCount(h.nyr, kVisibilityTile);
-    const std::array<ConstGridView, 3> before{cache.lastSource[0].cview(), cache.lastSource[1].cview(),
-                                              cache.lastSource[2].cview()};
+    const std::array<ConstGridView, 3> before{cache.anchorSource[0].cview(), cache.anchorSource[1].cview(),
+                                              cache.anchorSource[2].cview()};
     const std::array<ConstGridView, 3> after{in.source[0].cview(), in.source[1].cview(), in.source[2].cview()};
     buildMaxChangePyramid(before, after, cache.change);
     cache.radianceBound.assign(tiles, 0.0f);
@@ -190,23 +190,18 @@ const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCac
     }
     if (skipsPlan(cache.skips)) return nullptr;
     boundRadianceChange(in, cache);
-    for (std::size_t t = 0; t < cache.drift.size(); ++t) cache.drift[t] += cache.radianceBound[t];
-    for (std::size_t t = 0; t < cache.drift.size(); ++t) {
-        const bool geometry = in.geometryTiles && in.geometryTiles->dirty[t] != 0;
-        const bool dirty = geometry || cache.drift[t] > in.tolerance;
-        if (dirty) cache.drift[t] = 0.0f;
-        cache.tiles.dirty[t] = dirty ? 1 : 0;
-    }
+    const std::span<const std::uint8_t> geometry =
+        in.geometryTiles ? std::span<const std::uint8_t>(in.geometryTiles->dirty) : std::span<const std::uint8_t>();
+    if (planAnchoredDrift(cache.radianceBound, geometry, in.tolerance, cache.drift, cache.tiles.dirty))
+        cache.anchorSource = in.source;
     countAfterPlan(cache.tiles.dirtyCount(), static_cast<int>(cache.tiles.dirty.size()), cache.skips);
     return &cache.tiles;
 }
 
-void recordIndirectSource(const std::array<Grid, 3>& source, const HeightPyramid& heights, bool all,
-                          IndirectCache& cache) {
-    cache.lastSource = source;
-    if (!all) return;
+void recordIndirectSource(const std::array<Grid, 3>& source, const HeightPyramid& heights, IndirectCache& cache) {
+    cache.anchorSource = source;
     cache.tiles.reset(heights.nxr, heights.nyr, kVisibilityTile, false);
-    cache.drift.assign(cache.tiles.dirty.size(), 0.0f);
+    cache.drift.reset(cache.tiles.dirty.size());
     cache.valid = true;
 }
 

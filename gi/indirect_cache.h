@@ -5,12 +5,14 @@
 // One bounce of LambertIndirect::BlockerRadiance gathers, at each receiver,
 // the direct light L_0 of its casting sets. Its result can move for two
 // reasons, and a tile re-gathers when either says so:
-//  - the blockers' radiance: each frame adds, per tile, the bound of
-//    gi/change_bound.h on how far the frame's change of L_0 moves the
-//    samples the tile's scan reads (boundSampleChangePerAzimuth, the largest
-//    per indirect azimuth), weighed and scaled as below. The sum of these
-//    bounds since the tile's cached result was computed bounds its drift
-//    (triangle inequality); beyond the tolerance, the tile re-gathers.
+//  - the blockers' radiance: per tile, the bound of gi/change_bound.h on
+//    how far the change of L_0 since the anchor (gi/anchored_drift.h: the
+//    L_0 of an earlier pass, kept while it pays) moves the samples the
+//    tile's scan reads (boundSampleChangePerAzimuth, the largest per
+//    indirect azimuth), weighed and scaled as below, plus how far the tile's
+//    cached result was from the anchor's, bounds its drift (triangle
+//    inequality); beyond the tolerance, the tile re-gathers. A change that
+//    comes and goes (a pit dropped and filled) costs nothing once it is gone.
 //
 //    Weights and scale (sub-sampling): a texel's light is O(x) times its
 //    receivers' interpolated mean blocker radiance sum w_k E_k / sum w_k O_k
@@ -59,6 +61,7 @@
 #include <vector>
 
 #include "core/grid.h"
+#include "gi/anchored_drift.h"
 #include "gi/blocker_radiance.h"
 #include "gi/change_bound.h"
 #include "gi/plan_skips.h"
@@ -71,13 +74,13 @@ namespace terrain::gi {
 
 struct IndirectCache {
     bool valid = false;                  // the fields below describe the cached indirect result
-    std::array<Grid, 3> lastSource;      // L_0 the last indirect pass read
-    MaxChangePyramid change;             // this frame: max over the channels of |L_0 - lastSource|
+    std::array<Grid, 3> anchorSource;    // L_0 at the anchor (gi/anchored_drift.h)
+    MaxChangePyramid change;             // this frame: max over the channels of |L_0 - anchorSource|
     std::vector<float> azimuthBound;     // per tile and indirect azimuth (tile-major)
     std::vector<float> groupBound;       // per tile and distance group (gi/pyramid.h), over every azimuth
-    std::vector<float> drift;            // per tile: bound of the radiance change since its result was gathered
+    AnchoredDrift drift;                 // per tile: how far its result was from the anchor's
     std::vector<float> occlusionFactor;  // per tile: this frame's factor of the radiance bound
-    std::vector<float> radianceBound;    // per tile: this frame's bound (boundRadianceChange)
+    std::vector<float> radianceBound;    // per tile: this frame's bound from the anchor (boundRadianceChange)
     ReceiverTiles tiles;                 // this frame's tiles to re-gather
     ReceiverTiles texels;                // this frame's texel tiles to redo
     std::uint64_t geometryVersion = 0;   // GiState::geometryVersion of the last pass
@@ -100,7 +103,7 @@ struct IndirectPlanInputs {
 };
 
 /// This frame's bound per tile (cache.radianceBound, shade units; 0 where L_0
-/// did not change) on how far the change of L_0 from cache.lastSource to
+/// did not change) on how far the change of L_0 from cache.anchorSource to
 /// in.source moves the indirect light of every texel that reads one of the
 /// tile's receivers, the geometry being the last pass's: the largest sample
 /// move over the tile's azimuths weighed by each receiver's shares of its
@@ -114,11 +117,11 @@ void boundRadianceChange(const IndirectPlanInputs& in, IndirectCache& cache);
 /// would only be added to a full pass.
 const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCache& cache);
 
-/// After an indirect pass over `source` (on the receiver grid of `heights`):
-/// it is what the next frame compares with; `all` when the pass gathered
-/// every receiver (the tiles and drifts start again at 0).
-void recordIndirectSource(const std::array<Grid, 3>& source, const HeightPyramid& heights, bool all,
-                          IndirectCache& cache);
+/// After an indirect pass over `source` (on the receiver grid of `heights`)
+/// that gathered every receiver: `source` is the anchor the next frames
+/// compare with, the drifts start again at 0. (A planned pass moved the
+/// anchor, if at all, in planIndirectTiles.)
+void recordIndirectSource(const std::array<Grid, 3>& source, const HeightPyramid& heights, IndirectCache& cache);
 
 /// What the frame knows of the texels' inputs since the last pass.
 struct IndirectTexelInputs {

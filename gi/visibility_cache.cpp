@@ -5,28 +5,17 @@
 
 namespace terrain::gi {
 
-namespace {
-
-// Adds one frame's bound to a tile's drift; true (drift reset) when the tile recomputes.
-bool addDrift(float bound, float tolerance, float& drift) {
-    drift += bound;
-    const bool recompute = drift > tolerance;
-    if (recompute) drift = 0.0f;
-    return recompute;
-}
-
-}  // namespace
-
-void resetVisibilityCache(const HeightPyramid& pyr, VisibilityCache& cache) {
+void resetVisibilityCache(const HeightPyramid& pyr, ConstGridView heights, VisibilityCache& cache) {
     cache.tiles.reset(pyr.nxr, pyr.nyr, kVisibilityTile, true);
     cache.keyTiles.reset(pyr.nxr, pyr.nyr, kVisibilityTile, true);
     cache.geometryTiles.reset(pyr.nxr, pyr.nyr, kVisibilityTile, true);
-    cache.drift.assign(cache.tiles.dirty.size(), 0.0f);
-    cache.keyDrift.assign(cache.tiles.dirty.size(), 0.0f);
-    cache.geometryDrift.assign(cache.tiles.dirty.size(), 0.0f);
+    cache.drift.reset(cache.tiles.dirty.size());
+    cache.keyDrift.reset(cache.tiles.dirty.size());
+    cache.geometryDrift.reset(cache.tiles.dirty.size());
+    copyGrid(heights, cache.anchorHeights);
 }
 
-void forgetEnvironmentDrift(VisibilityCache& cache) { std::fill(cache.drift.begin(), cache.drift.end(), 0.0f); }
+void forgetEnvironmentDrift(VisibilityCache& cache) { cache.drift.recomputedAll(); }
 
 bool shouldPlanTiles(VisibilityCache& cache) { return !skipsPlan(cache.skips); }
 
@@ -56,32 +45,19 @@ float keyShadePerFraction(const std::vector<KeyLightRegion>& keys) {
     return static_cast<float>(sum);
 }
 
-// Marks key tile t when its drift, at this frame's brightness, exceeds the
-// tolerance (its drift reset to 0); a light brightened since the tile's key
-// V was computed counts at its new brightness.
-bool markKeyTile(std::size_t t, float keyScale, float tolerance, VisibilityCache& cache) {
-    const bool dirty = cache.keyDrift[t] * keyScale > tolerance;
-    if (dirty) cache.keyDrift[t] = 0.0f;
-    cache.keyTiles.dirty[t] = dirty ? 1 : 0;
-    return dirty;
-}
-
 }  // namespace
 
 bool planKeyBrightness(const std::vector<KeyLightRegion>& keys, float tolerance, VisibilityCache& cache) {
-    if (cache.keyDrift.size() != cache.keyTiles.dirty.size()) return false;
-    const float keyScale = keyShadePerFraction(keys);
-    bool any = false;
-    for (std::size_t t = 0; t < cache.keyDrift.size(); ++t) any = markKeyTile(t, keyScale, tolerance, cache) || any;
-    return any;
+    return markDriftAgain(keyShadePerFraction(keys), tolerance, cache.keyDrift, cache.keyTiles.dirty);
 }
 
 void planVisibilityTiles(ConstGridView before, ConstGridView after, const HeightPyramid& pyr,
                          const VisibilitySettings& vis, const std::vector<KeyLightRegion>& keys, float tolerance,
                          VisibilityCache& cache) {
-    if (cache.tiles.nxr != pyr.nxr || cache.tiles.nyr != pyr.nyr || cache.drift.size() != cache.tiles.dirty.size())
-        resetVisibilityCache(pyr, cache);
-    buildMaxChangePyramid(before, after, cache.change);
+    if (cache.tiles.nxr != pyr.nxr || cache.tiles.nyr != pyr.nyr || !cache.drift.fits(cache.tiles.dirty.size()) ||
+        cache.anchorHeights.nx != after.nx || cache.anchorHeights.ny != after.ny)
+        resetVisibilityCache(pyr, before, cache);
+    buildMaxChangePyramid(cache.anchorHeights.cview(), after, cache.change);
     boundSlopeChange(cache.change, pyr, kVisibilityTile, cache.slopeBound);
     boundSlopeChangePerAzimuth(cache.change, pyr, kVisibilityTile, vis.azimuths, cache.azimuthBound);
     boundGradientChange(cache.change, pyr, kVisibilityTile, cache.gradBound);
@@ -91,21 +67,29 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
     // normals every frame, so only V's own change counts.
     const float lipschitz = blockingMaxLipschitz(vis.blockingMax);
     boundKeyFractions(pyr, keys, lipschitz, cache);
-    const float keyScale = keyShadePerFraction(keys);
-    const std::size_t m = static_cast<std::size_t>(vis.azimuths);
+    const std::size_t m = static_cast<std::size_t>(vis.azimuths), tiles = cache.slopeBound.size();
     std::vector<float>& perAzimuth = cache.tileAzimuths;
     perAzimuth.resize(m);  // no allocation after the first frame of these settings
-    for (std::size_t t = 0; t < cache.drift.size(); ++t) {
+    cache.envBound.resize(tiles);
+    cache.geometryBound.resize(tiles);
+    for (std::size_t t = 0; t < tiles; ++t) {
         for (std::size_t j = 0; j < m; ++j) perAzimuth[j] = lipschitz * cache.azimuthBound[t * m + j];
-        const float env =
+        cache.envBound[t] =
             ambientChangeBoundPerAzimuth(perAzimuth.data(), vis.azimuths, cache.gradBound[t], 1.0f, false);
-        cache.tiles.dirty[t] = addDrift(env, tolerance, cache.drift[t]) ? 1 : 0;
-        cache.keyDrift[t] += cache.keyBound[t];
-        markKeyTile(t, keyScale, tolerance, cache);
-        const float any = ambientChangeBound(lipschitz * cache.slopeBound[t], cache.gradBound[t], 1.0f, false);
-        cache.geometryTiles.dirty[t] = addDrift(any, tolerance, cache.geometryDrift[t]) ? 1 : 0;
+        cache.geometryBound[t] = ambientChangeBound(lipschitz * cache.slopeBound[t], cache.gradBound[t], 1.0f, false);
     }
-    const int all = static_cast<int>(cache.drift.size());
+    // one anchor for the three drifts: they vote together on moving it
+    AnchorVotes votes;
+    markAnchoredDrift(cache.envBound, {}, 1.0f, tolerance, cache.drift, cache.tiles.dirty, votes);
+    markAnchoredDrift(cache.keyBound, {}, keyShadePerFraction(keys), tolerance, cache.keyDrift, cache.keyTiles.dirty,
+                      votes);
+    markAnchoredDrift(cache.geometryBound, {}, 1.0f, tolerance, cache.geometryDrift, cache.geometryTiles.dirty, votes);
+    const bool reanchor = votes.reanchor();
+    advanceAnchoredDrift(cache.envBound, cache.tiles.dirty, reanchor, cache.drift);
+    advanceAnchoredDrift(cache.keyBound, cache.keyTiles.dirty, reanchor, cache.keyDrift);
+    advanceAnchoredDrift(cache.geometryBound, cache.geometryTiles.dirty, reanchor, cache.geometryDrift);
+    if (reanchor) copyGrid(after, cache.anchorHeights);
+    const int all = static_cast<int>(tiles);
     // the indirect light re-gathers the geometry's dirty tiles: both count
     countAfterPlan(std::min(cache.tiles.dirtyCount(), cache.geometryTiles.dirtyCount()), all, cache.skips);
 }

@@ -3,16 +3,18 @@
 // changed (the frame's one place for it; the scans only take the tiles).
 //
 // Per tile of kVisibilityTile x kVisibilityTile receivers the cache keeps how
-// far its cached V can have drifted since it was computed: each frame with
-// new heights adds the frame's conservative bounds (gi/change_bound.h: the
-// move of the blocking slopes of each environment azimuth, and of the height
-// gradients behind the tangent planes), turned into the largest change of the
-// ambient map (unit sky) they allow. A tile is recomputed, and its drift
-// reset to 0, when its drift exceeds the tolerance; tolerance 0 recomputes
+// far its cached V can have drifted since it was computed, from an anchor
+// (gi/anchored_drift.h: the heights of an earlier frame): each frame with new
+// heights takes the conservative bounds (gi/change_bound.h) of the change
+// from the anchor's heights to its own (the move of the blocking slopes of
+// each environment azimuth, and of the height gradients behind the tangent
+// planes), turned into the largest change of the ambient map (unit sky)
+// they allow, and adds how far the tile's V was from the anchor's. A tile is
+// recomputed when that drift exceeds the tolerance; tolerance 0 recomputes
 // every tile whose inputs may have changed at all, which reproduces a full
-// recompute bit for bit. Sums of per-frame bounds bound the accumulated
-// change (triangle inequality), so slow changes over many frames are caught
-// too.
+// recompute bit for bit. The drift bounds the accumulated change (triangle
+// inequality), so slow changes over many frames are caught too, and a
+// change that comes and goes is not counted again each time.
 //
 // Key lights sample their own azimuths, between the environment's, within
 // their region of the sky: their tiles (keyTiles) keep a drift of their own
@@ -31,6 +33,7 @@
 #include <vector>
 
 #include "core/grid.h"
+#include "gi/anchored_drift.h"
 #include "gi/change_bound.h"
 #include "gi/plan_skips.h"
 #include "gi/pyramid.h"
@@ -54,17 +57,19 @@ struct KeyLightRegion {
 };
 
 struct VisibilityCache {
-    MaxChangePyramid change;                   // |dh| of this frame
+    Grid anchorHeights;                        // the heights the drifts are measured from
+    MaxChangePyramid change;                   // |dh| from the anchor to this frame
     std::vector<float> slopeBound, gradBound;  // this frame's bounds per tile (all azimuths)
     std::vector<float> azimuthBound;           // per tile and environment azimuth (tile-major)
     std::vector<float> keyBound, rangeBound;   // per tile: the key lights' fraction bound; scratch: one light's slopes
-    std::vector<float> drift, keyDrift;        // per tile: ambient-map (key: visible-fraction) change since computed
-    std::vector<float> geometryDrift;          // per tile: the same over every azimuth
-    std::vector<float> tileAzimuths;           // scratch: one tile's per-azimuth slope bounds
-    ReceiverTiles tiles;                       // this frame's tiles to recompute (environment)
-    ReceiverTiles keyTiles;                    // the same for the key lights
-    ReceiverTiles geometryTiles;               // tiles whose geometry moved beyond the tolerance along any azimuth
-    PlanSkips skips;                           // frames that recompute everything unplanned
+    std::vector<float> envBound, geometryBound;  // per tile: the ambient-map bound (environment, every azimuth)
+    AnchoredDrift drift, keyDrift;               // per tile: ambient-map (key: visible-fraction) change
+    AnchoredDrift geometryDrift;                 // per tile: the same over every azimuth
+    std::vector<float> tileAzimuths;             // scratch: one tile's per-azimuth slope bounds
+    ReceiverTiles tiles;                         // this frame's tiles to recompute (environment)
+    ReceiverTiles keyTiles;                      // the same for the key lights
+    ReceiverTiles geometryTiles;                 // tiles whose geometry moved beyond the tolerance along any azimuth
+    PlanSkips skips;                             // frames that recompute everything unplanned
 };
 
 /// A frame whose heights did not change but whose lights did: marks the key
@@ -79,19 +84,22 @@ bool planKeyBrightness(const std::vector<KeyLightRegion>& keys, float tolerance,
 /// without a plan down.
 bool shouldPlanTiles(VisibilityCache& cache);
 
-/// Forgets the drift: every tile's V is about to be computed from scratch.
-void resetVisibilityCache(const HeightPyramid& pyr, VisibilityCache& cache);
+/// Forgets the drift: every tile's V is about to be computed from scratch,
+/// from `heights` (the new anchor).
+void resetVisibilityCache(const HeightPyramid& pyr, ConstGridView heights, VisibilityCache& cache);
 
-/// Every receiver's environment V has just been computed: its drifts are 0
-/// (the key lights' and the geometry's are kept, their results were not).
+/// Every receiver's environment V has just been computed from the last
+/// planned heights: its drift is theirs (the key lights' and the geometry's
+/// are kept, their results were not recomputed).
 void forgetEnvironmentDrift(VisibilityCache& cache);
 
-/// Adds the change from `before` to the pyramid's heights `after` to every
-/// tile's drifts and marks the tiles whose drift exceeds `tolerance` (their
-/// drift reset to 0): cache.tiles for the environment's V (`vis`: its
-/// azimuths and maximum rule), cache.keyTiles for the key lights' (one region
-/// per light; none: no key tile), cache.geometryTiles over every azimuth.
-/// `pyr` is the pyramid of `after`.
+/// Bounds the change from the anchor's heights to the pyramid's heights
+/// `after`, adds every tile's drift from the anchor, and marks the tiles
+/// whose drift exceeds `tolerance`: cache.tiles for the environment's V
+/// (`vis`: its azimuths and maximum rule), cache.keyTiles for the key lights'
+/// (one region per light; none: no key tile), cache.geometryTiles over every
+/// azimuth. `before`: the last frame's heights, the anchor when the cache
+/// starts afresh (no drift of this grid). `pyr` is the pyramid of `after`.
 void planVisibilityTiles(ConstGridView before, ConstGridView after, const HeightPyramid& pyr,
                          const VisibilitySettings& vis, const std::vector<KeyLightRegion>& keys, float tolerance,
                          VisibilityCache& cache);
