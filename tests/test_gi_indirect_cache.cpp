@@ -297,21 +297,43 @@ TEST_CASE("gi.indirect_cache: a frame without a change ends the frames without a
     CHECK(inc.indirectRecomputed == 0.0);
 }
 
+namespace {
+
+// A bumpy 256^2 field and the same with a 16 x 16-cell crater 6 m deep at
+// its centre, under a uniform unit sky (shade units are the ambient map's),
+// lit at 2x with one bounce.
+struct CraterField {
+    Grid h = bumpy(256, 256);
+    Grid crater = withCrater(h);
+    GiLighting light;
+    static Grid withCrater(Grid g) {
+        for (int y = 120; y < 136; ++y)
+            for (int x = 120; x < 136; ++x) g(x, y) -= 6.0f;
+        return g;
+    }
+    static GiSettings settings(float tolerance) {
+        GiSettings s = withBounces(GiSettings{}, 2, 1);
+        s.tolerance = tolerance;
+        return s;
+    }
+    // A full recompute of `g` with these settings otherwise.
+    GiState fullFrame(const Grid& g, GiSettings s) const {
+        s.incremental = false;
+        GiState full;
+        runGiFrame(g.cview(), 10.0f, light, s, full);
+        return full;
+    }
+};
+
+}  // namespace
+
 TEST_CASE("gi.indirect_cache: with a local height change the indirect light stays within the tolerance") {
-    const Grid h = bumpy(256, 256);
-    GiLighting light;  // uniform unit sky: shade units are the ambient map's
-    Grid crater = h;
-    for (int y = 120; y < 136; ++y)
-        for (int x = 120; x < 136; ++x) crater(x, y) -= 6.0f;
-    GiSettings settings = withBounces(GiSettings{}, 2, 1);
-    settings.tolerance = 0.02f;
+    const CraterField field;
+    const GiSettings settings = CraterField::settings(0.02f);
     GiState inc;
-    runGiFrame(h.cview(), 10.0f, light, settings, inc);
-    runGiFrame(crater.cview(), 10.0f, light, settings, inc);
-    GiSettings off = settings;
-    off.incremental = false;
-    GiState full;
-    runGiFrame(crater.cview(), 10.0f, light, off, full);
+    runGiFrame(field.h.cview(), 10.0f, field.light, settings, inc);
+    runGiFrame(field.crater.cview(), 10.0f, field.light, settings, inc);
+    const GiState full = field.fullFrame(field.crater, settings);
     const double direct = largestDifference(inc.shade.rgb, full.shade.rgb);
     const double indirect = largestDifference(inc.indirect.indirect, full.indirect.indirect);
     MESSAGE("crater, tolerance " << settings.tolerance << ": V recomputed at " << 100.0 * inc.receiversRecomputed
@@ -328,24 +350,16 @@ TEST_CASE("gi.indirect_cache: a crater dropped and filled again and again costs 
     // that comes and goes is not added up frame after frame, so the tiles
     // recomputed on the tenth drop and fill are those of the second, and every
     // frame stays within the tolerance of a full one.
-    const Grid h = bumpy(256, 256);
-    GiLighting light;  // uniform unit sky: shade units are the ambient map's
-    Grid crater = h;
-    for (int y = 120; y < 136; ++y)
-        for (int x = 120; x < 136; ++x) crater(x, y) -= 6.0f;
-    GiSettings settings = withBounces(GiSettings{}, 2, 1);
-    settings.tolerance = 0.05f;
-    GiSettings off = settings;
-    off.incremental = false;
+    const CraterField field;
+    const GiSettings settings = CraterField::settings(0.05f);
     GiState inc;
-    runGiFrame(h.cview(), 10.0f, light, settings, inc);
+    runGiFrame(field.h.cview(), 10.0f, field.light, settings, inc);
     std::vector<double> v, indirect;
     double worst = 0.0;
     for (int f = 1; f <= 20; ++f) {
-        const Grid& now = f % 2 == 1 ? crater : h;
-        runGiFrame(now.cview(), 10.0f, light, settings, inc);
-        GiState full;
-        runGiFrame(now.cview(), 10.0f, light, off, full);
+        const Grid& now = f % 2 == 1 ? field.crater : field.h;
+        runGiFrame(now.cview(), 10.0f, field.light, settings, inc);
+        const GiState full = field.fullFrame(now, settings);
         worst = std::max({worst, largestDifference(inc.shade.rgb, full.shade.rgb),
                           largestDifference(inc.indirect.indirect, full.indirect.indirect)});
         v.push_back(inc.receiversRecomputed);
