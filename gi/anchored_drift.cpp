@@ -33,7 +33,7 @@ void advanceAnchoredDrift(std::span<const float> excursion, std::span<const std:
         const float e = excursion[t];
         drift.sinceInputs[t] = dirty[t] ? 0.0f : drift.fromAnchor[t] + e;
         if (reanchor) {
-            drift.fromAnchor[t] = dirty[t] ? 0.0f : drift.fromAnchor[t] + e;
+            drift.fromAnchor[t] = drift.sinceInputs[t];  // this frame's inputs are the anchor
             drift.lastExcursion[t] = 0.0f;
         } else {
             if (dirty[t]) drift.fromAnchor[t] = e;
