@@ -159,8 +159,17 @@ IndirectBounds indirectBounds(const GiState& now, const GiState& last, int azimu
                                       .tolerance = 0.0f,
                                       .blocker = &last.indirect.blocker};
     gi::boundRadianceChange(plan, cache);
-    IndirectBounds out{std::vector<double>(cache.radianceBound.size(), 0.0),
-                       std::vector<double>(cache.radianceBound.begin(), cache.radianceBound.end())};
+    // per visibility tile: the largest bound of the indirect tiles it holds
+    const int tilesX = gi::tileCount(now.pyramid.nxr, gi::kVisibilityTile);
+    const std::size_t tiles = static_cast<std::size_t>(tilesX) * gi::tileCount(now.pyramid.nyr, gi::kVisibilityTile);
+    IndirectBounds out{std::vector<double>(tiles, 0.0), std::vector<double>(tiles, 0.0)};
+    const int indirectX = gi::tileCount(now.pyramid.nxr, gi::kIndirectTile),
+              per = gi::kVisibilityTile / gi::kIndirectTile;
+    for (std::size_t i = 0; i < cache.radianceBound.size(); ++i) {
+        const std::size_t t = static_cast<std::size_t>(static_cast<int>(i) / indirectX / per) * tilesX +
+                              static_cast<std::size_t>(static_cast<int>(i) % indirectX / per);
+        out.bound[t] = std::max(out.bound[t], static_cast<double>(cache.radianceBound[i]));
+    }
     if (gi::maxChangeAll(cache.change) == 0.0f) return out;  // no change: no sample moved
     const std::size_t m = static_cast<std::size_t>(azimuths);
     for (std::size_t i = 0; i < cache.azimuthBound.size(); ++i)
@@ -204,7 +213,8 @@ const char* kIntro =
     "texels. Largest radiance sample move: the largest over the indirect azimuths of boundSampleChangePerAzimuth "
     "for the frame's change of the direct light; radiance bound of the indirect light: what gi/indirect_cache.h "
     "adds for it (the sample moves weighed by each receiver's occlusion shares per azimuth and per distance "
-    "group, times the occlusion factor); the true change of the indirect light is that of the whole frame (sources and "
+    "group, times the occlusion factor; the largest over the indirect tiles of 16 x 16 receivers the tile holds); "
+    "the true change of the indirect light is that of the whole frame (sources and "
     "geometry), largest over the tile's texels and "
     "channels. Quantiles over every tile of every frame after the first. The oracle knows the true results: per "
     "tile it keeps its cached V (or indirect light) until the tile's texels are more than the tolerance from the "

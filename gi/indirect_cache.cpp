@@ -13,6 +13,8 @@ namespace terrain::gi {
 
 namespace {
 
+constexpr int kPerBoundTile = kVisibilityTile / kIndirectTile;  // indirect tiles per side of a bound's tile
+
 // The cache describes a result of this grid, with the tiles and a radiance
 // pyramid of the same receivers and steps.
 bool cacheFits(const IndirectPlanInputs& in, const IndirectCache& cache) {
@@ -23,7 +25,8 @@ bool cacheFits(const IndirectPlanInputs& in, const IndirectCache& cache) {
     return r.nx == h.nx && r.ny == h.ny && r.nxr == h.nxr && r.nyr == h.nyr && r.steps.size() == h.steps.size() &&
            last.nx == h.nx && last.ny == h.ny && in.source[0].nx == h.nx && in.source[0].ny == h.ny &&
            cache.tiles.nxr == h.nxr && cache.tiles.nyr == h.nyr && cache.drift.fits(cache.tiles.dirty.size()) &&
-           (!in.geometryTiles || in.geometryTiles->dirty.size() == cache.tiles.dirty.size());
+           (!in.geometryTiles || (in.geometryTiles->nxr == h.nxr && in.geometryTiles->nyr == h.nyr &&
+                                  in.geometryTiles->tileSize == kVisibilityTile));
 }
 
 // The last pass kept the occlusions of this grid (sub-sampling).
@@ -57,14 +60,14 @@ constexpr float kNoShareBelow = 1e-6f;
 float rowShareBound(const BlockerRadianceState& b, int Y, int x0, int x1, const float* D, const float* G,
                     float largest) {
     using simd::F4;
-    constexpr int kLaneGroups = kVisibilityTile / 4;
+    constexpr int kLaneGroups = kIndirectTile / 4;
     const std::size_t m = static_cast<std::size_t>(b.azimuths), plane = static_cast<std::size_t>(b.nxr) * b.nyr;
     const std::size_t at = static_cast<std::size_t>(Y) * b.nxr + static_cast<std::size_t>(x0);
     const int n = x1 - x0, laneGroups = (n + 3) / 4;
     const F4 zero = simd::splat<F4>(0.0f);
     F4 azWeighed[kLaneGroups], azTotal[kLaneGroups], grWeighed[kLaneGroups], grTotal[kLaneGroups];
     for (int q = 0; q < laneGroups; ++q) azWeighed[q] = azTotal[q] = grWeighed[q] = grTotal[q] = zero;
-    alignas(16) float lanes[kVisibilityTile] = {};
+    alignas(16) float lanes[kIndirectTile] = {};
     const auto weighed = [&](const float* v, float d, F4* sum, F4* total, bool running) {
         std::copy(v, v + n, lanes);
         const F4 dv = simd::splat<F4>(d);
@@ -97,19 +100,21 @@ float rowShareBound(const BlockerRadianceState& b, int Y, int x0, int x1, const 
 }
 
 // Per tile: the radiance bound, the largest rho_k over its receivers (max_j
-// D_tj without the last pass's occlusions) times its occlusion factor.
-// Tile rows in parallel (each tile's value alone).
+// D_tj without the last pass's occlusions, D and G those of the sample
+// bounds' larger tile that holds it) times its occlusion factor. Tile rows
+// in parallel (each tile's value alone).
 void sharedBounds(const IndirectPlanInputs& in, IndirectCache& cache) {
     const HeightPyramid& h = in.heights;
-    const int tilesX = tileCount(h.nxr, kVisibilityTile), tilesY = tileCount(h.nyr, kVisibilityTile);
+    const int tilesX = tileCount(h.nxr, kIndirectTile), tilesY = tileCount(h.nyr, kIndirectTile);
+    const int boundTilesX = tileCount(h.nxr, kVisibilityTile);
     const std::size_t m = static_cast<std::size_t>(in.azimuths);
     const bool shares = hasOcclusions(in);
     const auto tileBound = [&](int tx, int ty, const float* D, const float* G) {
         const float largest = *std::max_element(D, D + m);
         if (!shares) return largest;
         float bound = 0.0f;
-        const int x0 = tx * kVisibilityTile, x1 = std::min(h.nxr, x0 + kVisibilityTile);
-        for (int Y = ty * kVisibilityTile; Y < std::min(h.nyr, (ty + 1) * kVisibilityTile); ++Y)
+        const int x0 = tx * kIndirectTile, x1 = std::min(h.nxr, x0 + kIndirectTile);
+        for (int Y = ty * kIndirectTile; Y < std::min(h.nyr, (ty + 1) * kIndirectTile); ++Y)
             bound = std::max(bound, rowShareBound(*in.blocker, Y, x0, x1, D, G, largest));
         return bound;
     };
@@ -117,9 +122,11 @@ void sharedBounds(const IndirectPlanInputs& in, IndirectCache& cache) {
         for (int ty = ty0; ty < ty1; ++ty)
             for (int tx = 0; tx < tilesX; ++tx) {
                 const std::size_t t = static_cast<std::size_t>(ty) * tilesX + tx;
+                const std::size_t b = static_cast<std::size_t>(ty / kPerBoundTile) * boundTilesX +
+                                      static_cast<std::size_t>(tx / kPerBoundTile);
                 cache.radianceBound[t] =
                     cache.occlusionFactor[t] *
-                    tileBound(tx, ty, cache.azimuthBound.data() + t * m, cache.groupBound.data() + t * kDistanceGroups);
+                    tileBound(tx, ty, cache.azimuthBound.data() + b * m, cache.groupBound.data() + b * kDistanceGroups);
             }
     });
 }
@@ -141,13 +148,13 @@ float largestOf(const float* v, int n) {
 // occlusion factor of gi/indirect_cache.h).
 void occlusionFactors(const IndirectPlanInputs& in, IndirectCache& cache) {
     const HeightPyramid& h = in.heights;
-    const int tilesX = tileCount(h.nxr, kVisibilityTile), tilesY = tileCount(h.nyr, kVisibilityTile);
+    const int tilesX = tileCount(h.nxr, kIndirectTile), tilesY = tileCount(h.nyr, kIndirectTile);
     cache.occlusionFactor.assign(static_cast<std::size_t>(tilesX) * tilesY, 1.0f);
     if (!hasOcclusions(in)) return;
     const Grid* occ = &in.blocker->occlusion;
     std::vector<int> x0, x1, y0, y1;
-    texelsReadingTiles(h.nx, h.subsample, h.nxr, kVisibilityTile, x0, x1);
-    texelsReadingTiles(h.ny, h.subsample, h.nyr, kVisibilityTile, y0, y1);
+    texelsReadingTiles(h.nx, h.subsample, h.nxr, kIndirectTile, x0, x1);
+    texelsReadingTiles(h.ny, h.subsample, h.nyr, kIndirectTile, y0, y1);
     parallelFor(0, tilesY, 1, [&](int ty0, int ty1) {
         for (int ty = ty0; ty < ty1; ++ty)
             for (int tx = 0; tx < tilesX; ++tx) {
@@ -168,7 +175,7 @@ void occlusionFactors(const IndirectPlanInputs& in, IndirectCache& cache) {
 void boundRadianceChange(const IndirectPlanInputs& in, IndirectCache& cache) {
     const HeightPyramid& h = in.heights;
     const std::size_t tiles =
-        static_cast<std::size_t>(tileCount(h.nxr, kVisibilityTile)) * tileCount(h.nyr, kVisibilityTile);
+        static_cast<std::size_t>(tileCount(h.nxr, kIndirectTile)) * tileCount(h.nyr, kIndirectTile);
     const std::array<ConstGridView, 3> before{cache.anchorSource[0].cview(), cache.anchorSource[1].cview(),
                                               cache.anchorSource[2].cview()};
     const std::array<ConstGridView, 3> after{in.source[0].cview(), in.source[1].cview(), in.source[2].cview()};
@@ -190,8 +197,17 @@ const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCac
     }
     if (skipsPlan(cache.skips)) return nullptr;
     boundRadianceChange(in, cache);
-    const std::span<const std::uint8_t> geometry =
-        in.geometryTiles ? std::span<const std::uint8_t>(in.geometryTiles->dirty) : std::span<const std::uint8_t>();
+    std::span<const std::uint8_t> geometry;
+    if (in.geometryTiles) {
+        // each geometry tile's dirty flag on the indirect tiles it holds
+        const ReceiverTiles& g = *in.geometryTiles;
+        cache.geometry.resize(cache.tiles.dirty.size());
+        for (int ty = 0; ty < cache.tiles.tilesY; ++ty)
+            for (int tx = 0; tx < cache.tiles.tilesX; ++tx)
+                cache.geometry[static_cast<std::size_t>(ty) * cache.tiles.tilesX + tx] =
+                    g.isDirty(tx / kPerBoundTile, ty / kPerBoundTile) ? 1 : 0;
+        geometry = cache.geometry;
+    }
     if (planAnchoredDrift(cache.radianceBound, geometry, in.tolerance, cache.drift, cache.tiles.dirty))
         cache.anchorSource = in.source;
     countAfterPlan(cache.tiles.dirtyCount(), static_cast<int>(cache.tiles.dirty.size()), cache.skips);
@@ -200,7 +216,7 @@ const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCac
 
 void recordIndirectSource(const std::array<Grid, 3>& source, const HeightPyramid& heights, IndirectCache& cache) {
     cache.anchorSource = source;
-    cache.tiles.reset(heights.nxr, heights.nyr, kVisibilityTile, false);
+    cache.tiles.reset(heights.nxr, heights.nyr, kIndirectTile, false);
     cache.drift.reset(cache.tiles.dirty.size());
     cache.valid = true;
 }

@@ -72,6 +72,11 @@
 
 namespace terrain::gi {
 
+/// Receivers per side of an indirect tile: a divisor of kVisibilityTile (the
+/// sample bounds and the geometry tiles are per visibility tile) and a
+/// multiple of ReceiverTiles::kTileAlign.
+inline constexpr int kIndirectTile = 16;
+
 struct IndirectCache {
     bool valid = false;                  // the fields below describe the cached indirect result
     std::array<Grid, 3> anchorSource;    // L_0 at the anchor (gi/anchored_drift.h)
@@ -82,6 +87,7 @@ struct IndirectCache {
     std::vector<float> occlusionFactor;  // per tile: this frame's factor of the radiance bound
     std::vector<float> radianceBound;    // per tile: this frame's bound from the anchor (boundRadianceChange)
     ReceiverTiles tiles;                 // this frame's tiles to re-gather
+    std::vector<std::uint8_t> geometry;  // scratch: the geometry tiles' flags on these tiles
     ReceiverTiles texels;                // this frame's texel tiles to redo
     std::uint64_t geometryVersion = 0;   // GiState::geometryVersion of the last pass
     PlanSkips skips;                     // frames that re-gather everything unplanned
