@@ -1,6 +1,10 @@
 #pragma once
 // Which receiver tiles must re-gather their indirect light (the frame's one
 // place for it; the Lambert scan only takes the tiles, IndirectInputs::only).
+// Its tiles (kIndirectTile receivers a side) are a quarter of the
+// visibility's: the sample bounds below are per visibility tile, but each
+// receiver's weighing is its own, so the smaller tiles keep the light of
+// receivers that a larger one's worst receiver would re-gather.
 //
 // One bounce of LambertIndirect::BlockerRadiance gathers, at each receiver,
 // the direct light L_0 of its casting sets. Its result can move for two
@@ -28,7 +32,8 @@
 //    sum_g O_kg = O_k), and with G_g the largest sample move of group g's
 //    steps along any azimuth, rho_k <= sum_g (O_kg / O_k) G_g; the smaller of
 //    the two weighings is taken. Per tile the bound is the largest rho_k of
-//    its receivers times the largest O(x) of the texels that read them. A
+//    its receivers (D_j and G_g those of the visibility tile holding it)
+//    times the largest O(x) of the texels that read them. A
 //    far change (a pit, a crater) moves the coarse, far samples of every
 //    tile: it then counts by the share of the sky the far members of its
 //    azimuths cover, not the whole occlusion along them. The occlusions are the
@@ -36,10 +41,11 @@
 //    tolerance (else the tile re-gathers), so the factor is that largest
 //    O(x) plus the tolerance, at most 1. Without sub-sampling (every texel a
 //    receiver, no texel occlusion kept) the bound is max_j D_j.
-//  - the geometry within reach: the tiles whose geometry drifted beyond the
-//    tolerance this frame (VisibilityCache::geometryTiles, the bound over
-//    every azimuth, so it covers the indirect azimuths): their casting sets
-//    have drifted beyond the tolerance in the ambient map's units.
+//  - the geometry within reach: the tiles in a visibility tile whose
+//    geometry drifted beyond the tolerance this frame
+//    (VisibilityCache::geometryTiles, the bound over every azimuth, so it
+//    covers the indirect azimuths): their casting sets have drifted beyond
+//    the tolerance in the ambient map's units.
 // Tolerance 0 re-gathers every tile where either bound is not 0, which gives
 // the full recompute bit for bit. More than one bounce, or another strategy:
 // every receiver (no per-bounce cache).
