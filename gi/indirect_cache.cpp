@@ -14,6 +14,8 @@ namespace terrain::gi {
 namespace {
 
 constexpr int kPerBoundTile = kVisibilityTile / kIndirectTile;  // indirect tiles per side of a bound's tile
+static_assert(kPerBoundTile * kIndirectTile == kVisibilityTile && kIndirectTile % ReceiverTiles::kTileAlign == 0,
+              "indirect tiles split visibility tiles into whole receiver groups");
 
 // The cache describes a result of this grid, with the tiles and a radiance
 // pyramid of the same receivers and steps.
