@@ -163,11 +163,10 @@ IndirectBounds indirectBounds(const GiState& now, const GiState& last, int azimu
     const int tilesX = gi::tileCount(now.pyramid.nxr, gi::kVisibilityTile);
     const std::size_t tiles = static_cast<std::size_t>(tilesX) * gi::tileCount(now.pyramid.nyr, gi::kVisibilityTile);
     IndirectBounds out{std::vector<double>(tiles, 0.0), std::vector<double>(tiles, 0.0)};
-    const int indirectX = gi::tileCount(now.pyramid.nxr, gi::kIndirectTile),
-              per = gi::kVisibilityTile / gi::kIndirectTile;
+    const int indirectX = gi::tileCount(now.pyramid.nxr, gi::kIndirectTile);
     for (std::size_t i = 0; i < cache.radianceBound.size(); ++i) {
-        const std::size_t t = static_cast<std::size_t>(static_cast<int>(i) / indirectX / per) * tilesX +
-                              static_cast<std::size_t>(static_cast<int>(i) % indirectX / per);
+        const int tx = static_cast<int>(i) % indirectX, ty = static_cast<int>(i) / indirectX;
+        const std::size_t t = gi::visibilityTileHolding(tx, ty, now.pyramid.nxr);
         out.bound[t] = std::max(out.bound[t], static_cast<double>(cache.radianceBound[i]));
     }
     if (gi::maxChangeAll(cache.change) == 0.0f) return out;  // no change: no sample moved

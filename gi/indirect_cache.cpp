@@ -13,10 +13,6 @@ namespace terrain::gi {
 
 namespace {
 
-constexpr int kPerBoundTile = kVisibilityTile / kIndirectTile;  // indirect tiles per side of a bound's tile
-static_assert(kPerBoundTile * kIndirectTile == kVisibilityTile && kIndirectTile % ReceiverTiles::kTileAlign == 0,
-              "indirect tiles split visibility tiles into whole receiver groups");
-
 // The cache describes a result of this grid, with the tiles and a radiance
 // pyramid of the same receivers and steps.
 bool cacheFits(const IndirectPlanInputs& in, const IndirectCache& cache) {
@@ -108,7 +104,6 @@ float rowShareBound(const BlockerRadianceState& b, int Y, int x0, int x1, const 
 void sharedBounds(const IndirectPlanInputs& in, IndirectCache& cache) {
     const HeightPyramid& h = in.heights;
     const int tilesX = tileCount(h.nxr, kIndirectTile), tilesY = tileCount(h.nyr, kIndirectTile);
-    const int boundTilesX = tileCount(h.nxr, kVisibilityTile);
     const std::size_t m = static_cast<std::size_t>(in.azimuths);
     const bool shares = hasOcclusions(in);
     const auto tileBound = [&](int tx, int ty, const float* D, const float* G) {
@@ -124,8 +119,7 @@ void sharedBounds(const IndirectPlanInputs& in, IndirectCache& cache) {
         for (int ty = ty0; ty < ty1; ++ty)
             for (int tx = 0; tx < tilesX; ++tx) {
                 const std::size_t t = static_cast<std::size_t>(ty) * tilesX + tx;
-                const std::size_t b = static_cast<std::size_t>(ty / kPerBoundTile) * boundTilesX +
-                                      static_cast<std::size_t>(tx / kPerBoundTile);
+                const std::size_t b = visibilityTileHolding(tx, ty, h.nxr);
                 cache.radianceBound[t] =
                     cache.occlusionFactor[t] *
                     tileBound(tx, ty, cache.azimuthBound.data() + b * m, cache.groupBound.data() + b * kDistanceGroups);
@@ -207,7 +201,7 @@ const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCac
         for (int ty = 0; ty < cache.tiles.tilesY; ++ty)
             for (int tx = 0; tx < cache.tiles.tilesX; ++tx)
                 cache.geometry[static_cast<std::size_t>(ty) * cache.tiles.tilesX + tx] =
-                    g.isDirty(tx / kPerBoundTile, ty / kPerBoundTile) ? 1 : 0;
+                    g.dirty[visibilityTileHolding(tx, ty, g.nxr)];
         geometry = cache.geometry;
     }
     if (planAnchoredDrift(cache.radianceBound, geometry, in.tolerance, cache.drift, cache.tiles.dirty))

@@ -75,6 +75,7 @@
 #include "gi/radiance_pyramid.h"
 #include "gi/receiver_tiles.h"
 #include "gi/shading.h"
+#include "gi/visibility_cache.h"
 
 namespace terrain::gi {
 
@@ -82,6 +83,15 @@ namespace terrain::gi {
 /// sample bounds and the geometry tiles are per visibility tile) and a
 /// multiple of ReceiverTiles::kTileAlign.
 inline constexpr int kIndirectTile = 16;
+static_assert(kVisibilityTile % kIndirectTile == 0 && kIndirectTile % ReceiverTiles::kTileAlign == 0,
+              "indirect tiles split visibility tiles into whole receiver groups");
+
+/// The visibility tile (its row-major index over nxr receivers) holding indirect tile (tx, ty).
+inline std::size_t visibilityTileHolding(int tx, int ty, int nxr) {
+    constexpr int kPer = kVisibilityTile / kIndirectTile;
+    return static_cast<std::size_t>(ty / kPer) * static_cast<std::size_t>(tileCount(nxr, kVisibilityTile)) +
+           static_cast<std::size_t>(tx / kPer);
+}
 
 struct IndirectCache {
     bool valid = false;                  // the fields below describe the cached indirect result
