@@ -459,10 +459,7 @@ void buildMaxChangePyramid(std::span<const ConstGridView> before, std::span<cons
             for (std::size_t c = 0; c < before.size(); ++c) {
                 const float* a = before[c].row(y);
                 const float* b = after[c].row(y);
-                // the difference of two floats is exact in double
-                for (int x = 0; x < nx; ++x)
-                    out[x] =
-                        std::max(out[x], roundUp(std::fabs(static_cast<double>(b[x]) - static_cast<double>(a[x]))));
+                for (int x = 0; x < nx; ++x) out[x] = std::max(out[x], absDifferenceUp(a[x], b[x]));
             }
         }
     });

@@ -19,6 +19,9 @@
 // slope); a caller's tolerance is far above it. Where no height within a
 // result's reach changed, the result is recomputed from the same floats by
 // the same operations, so a zero bound means bit-identical results.
+#include <bit>
+#include <cmath>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -39,6 +42,19 @@ struct MaxChangePyramid {
     std::vector<Grid> levels;
     std::vector<Grid> sums;
 };
+
+/// The smallest float not below the real |b - a| (a, b finite), in float
+/// arithmetic: the rounded difference s and its rounding error e (Knuth's
+/// TwoSum, exact in round-to-nearest), then s's magnitude one float up when
+/// e pointed away from zero. A few operations the compiler vectorises; the
+/// double difference is exact only for exponents less than 30 apart.
+inline float absDifferenceUp(float a, float b) {
+    const float s = b - a;
+    const float bPart = s + a, aPart = s - bPart;  // TwoSum(b, -a)
+    const float e = (b - bPart) - (a + aPart);
+    const bool up = s >= 0.0f ? e > 0.0f : e < 0.0f;
+    return std::bit_cast<float>(std::bit_cast<std::uint32_t>(std::fabs(s)) + (up ? 1u : 0u));
+}
 
 /// Builds (or rebuilds, reusing every buffer of the same size) the pyramid
 /// of |dh|; the sign of dh does not matter.

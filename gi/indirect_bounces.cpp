@@ -4,6 +4,8 @@
 #include <chrono>
 #include <utility>
 
+#include "core/parallel.h"
+
 namespace terrain::gi {
 
 namespace {
@@ -22,11 +24,26 @@ void prepareIndirectSum(int nx, int ny, int bounces, IndirectState& st) {
     st.bounceMean.resize(static_cast<std::size_t>(bounces));
 }
 
-// Mean over the texels and channels (RGB average).
+// Mean over the texels and channels (RGB average): rows summed in
+// parallel, each into four partial sums (independent additions, so the
+// loop is not one long chain of dependent ones), folded in row order.
 double meanOf(const std::array<Grid, 3>& rgb) {
-    double sum = 0.0;
-    for (const Grid& g : rgb)
-        for (float v : g.v) sum += v;
+    const int nx = rgb[0].nx, ny = rgb[0].ny;
+    const double sum = deterministicReduce(
+        0, ny, 16, 0.0,
+        [&](int y0, int y1) {
+            double lanes[4] = {};
+            for (const Grid& g : rgb)
+                for (int y = y0; y < y1; ++y) {
+                    const float* row = g.data() + static_cast<std::size_t>(y) * nx;
+                    int x = 0;
+                    for (; x + 4 <= nx; x += 4)
+                        for (int k = 0; k < 4; ++k) lanes[k] += row[x + k];
+                    for (; x < nx; ++x) lanes[0] += row[x];
+                }
+            return (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
+        },
+        [](double a, double b) { return a + b; });
     return sum / (3.0 * static_cast<double>(std::max<std::size_t>(1, rgb[0].v.size())));
 }
 
@@ -85,7 +102,10 @@ void sumDirectAndIndirect(const std::array<Grid, 3>& direct, IndirectState& st) 
         const Grid& ind = st.indirect[static_cast<std::size_t>(c)];
         tot.ensureSize(ind.nx, ind.ny);
         const Grid& d = direct[static_cast<std::size_t>(c)];
-        for (std::size_t i = 0; i < tot.v.size(); ++i) tot.v[i] = d.v[i] + ind.v[i];
+        parallelForRows(ind.ny, ind.nx, [&](int y0, int y1) {
+            const std::size_t a = static_cast<std::size_t>(y0) * ind.nx, b = static_cast<std::size_t>(y1) * ind.nx;
+            for (std::size_t i = a; i < b; ++i) tot.v[i] = d.v[i] + ind.v[i];
+        });
     }
 }
 

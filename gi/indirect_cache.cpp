@@ -53,8 +53,8 @@ constexpr float kNoShareBelow = 1e-6f;
 // positive float terms and a division, rounded up by 1e-5 plus one float
 // epsilon per azimuth, above their rounding for any m; a positive term w D
 // never rounds to 0 (at least the smallest float), so that tolerance 0 sees
-// every change a member may carry. Four receivers per vector (the run
-// copied into zero-padded lanes).
+// every change a member may carry. Four receivers per vector (a run cut
+// by the grid's edge copied into zero-padded lanes).
 float rowShareBound(const BlockerRadianceState& b, int Y, int x0, int x1, const float* D, const float* G,
                     float largest) {
     using simd::F4;
@@ -67,11 +67,14 @@ float rowShareBound(const BlockerRadianceState& b, int Y, int x0, int x1, const 
     for (int q = 0; q < laneGroups; ++q) azWeighed[q] = azTotal[q] = grWeighed[q] = grTotal[q] = zero;
     alignas(16) float lanes[kIndirectTile] = {};
     const auto weighed = [&](const float* v, float d, F4* sum, F4* total, bool running) {
-        std::copy(v, v + n, lanes);
+        if (n % 4 != 0) {  // a cut run: zero-padded lanes
+            std::copy(v, v + n, lanes);
+            v = lanes;
+        }
         const F4 dv = simd::splat<F4>(d);
         const F4 tiny = simd::splat<F4>(d > 0.0f ? std::numeric_limits<float>::denorm_min() : 0.0f);
         for (int q = 0; q < laneGroups; ++q) {
-            const F4 x = simd::load<F4>(lanes + 4 * q);
+            const F4 x = simd::load<F4>(v + 4 * q);
             const F4 w = running ? x - total[q] : x;  // an azimuth's share: the running sum's step
             sum[q] += w > zero ? simd::vmax(w * dv, tiny) : zero;
             total[q] = running ? x : total[q] + x;

@@ -1,6 +1,7 @@
 #include "gi/visibility.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -596,25 +597,39 @@ void computeFootprintBox(ConstGridView gradX, ConstGridView gradY, int s, Footpr
     out.hiX.resize(n);
     out.loY.resize(n);
     out.hiY.resize(n);
+    // receivers whose footprint columns need no clamping: s X - half >= 0, s X + half <= nx - 1
+    const int inFirst = half > 0 ? 1 : 0, inEnd = std::max(inFirst, std::min(nxr, (nx - 1 - half) / s + 1));
     parallelForRows(nyr, nxr, [&](int y0, int y1) {
-        for (int Y = y0; Y < y1; ++Y)
-            for (int X = 0; X < nxr; ++X) {
+        for (int Y = y0; Y < y1; ++Y) {
+            // the footprint's rows (one without sub-sampling), clamped to the field
+            std::array<int, 3> rows{s * Y, s * Y, s * Y};
+            if (half > 0) rows = {std::max(s * Y - half, 0), s * Y, std::min(s * Y + half, ny - 1)};
+            const std::size_t at = static_cast<std::size_t>(Y) * nxr;
+            float* loX = out.loX.data() + at;
+            float* hiX = out.hiX.data() + at;
+            float* loY = out.loY.data() + at;
+            float* hiY = out.hiY.data() + at;
+            const auto boxAt = [&](int X, auto column) {
                 float ax = gradX(s * X, s * Y), bx = ax, ay = gradY(s * X, s * Y), by = ay;
-                for (int oy = -half; oy <= half && half > 0; oy += half)
-                    for (int ox = -half; ox <= half; ox += half) {
-                        const int xx = std::clamp(s * X + ox, 0, nx - 1), yy = std::clamp(s * Y + oy, 0, ny - 1);
-                        const float vx = gradX(xx, yy), vy = gradY(xx, yy);
-                        ax = std::min(ax, vx);
-                        bx = std::max(bx, vx);
-                        ay = std::min(ay, vy);
-                        by = std::max(by, vy);
+                for (int yy : rows)
+                    for (int ox = -half; ox <= half; ox += std::max(half, 1)) {
+                        const int xx = column(s * X + ox);
+                        ax = std::min(ax, gradX(xx, yy));
+                        bx = std::max(bx, gradX(xx, yy));
+                        ay = std::min(ay, gradY(xx, yy));
+                        by = std::max(by, gradY(xx, yy));
                     }
-                const std::size_t at = static_cast<std::size_t>(Y) * nxr + static_cast<std::size_t>(X);
-                out.loX[at] = ax;
-                out.hiX[at] = bx;
-                out.loY[at] = ay;
-                out.hiY[at] = by;
-            }
+                loX[X] = ax;
+                hiX[X] = bx;
+                loY[X] = ay;
+                hiY[X] = by;
+            };
+            const auto clamped = [&](int x) { return std::clamp(x, 0, nx - 1); };
+            const auto inside = [](int x) { return x; };
+            for (int X = 0; X < inFirst; ++X) boxAt(X, clamped);
+            for (int X = inFirst; X < inEnd; ++X) boxAt(X, inside);  // the same samples, no clamps
+            for (int X = inEnd; X < nxr; ++X) boxAt(X, clamped);
+        }
     });
 }
 

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <sstream>
 #include <vector>
@@ -209,6 +210,39 @@ struct Config {
 };
 
 }  // namespace
+
+TEST_CASE("gi.change_bound: |b - a| rounded up in float arithmetic is the exact difference rounded up") {
+    // exponents within 28 of each other: the difference of two floats is then
+    // exact in double (24 + 28 bits), and rounding it up is the reference
+    const auto reference = [](float a, float b) {
+        const double v = std::fabs(static_cast<double>(b) - static_cast<double>(a));
+        float f = static_cast<float>(v);
+        if (static_cast<double>(f) < v) f = std::nextafter(f, std::numeric_limits<float>::infinity());
+        return f;
+    };
+    std::mt19937 rng(11);
+    std::uniform_int_distribution<int> exponent(-14, 14);
+    const auto randomFloat = [&](int e) {
+        const float m = 1.0f + static_cast<float>(rng() % (1u << 23)) * 0x1p-23f;
+        return (rng() % 2 ? m : -m) * std::ldexp(1.0f, e);
+    };
+    int inexact = 0;
+    for (int i = 0; i < 200000; ++i) {
+        const float a = randomFloat(exponent(rng));
+        // a near neighbour half of the time (exact float differences), any float the rest
+        const float b = i % 2 ? a + randomFloat(std::max(-14, exponent(rng) / 2 - 8)) : randomFloat(exponent(rng));
+        const float got = absDifferenceUp(a, b);
+        REQUIRE(got == reference(a, b));
+        CHECK(absDifferenceUp(b, a) == got);
+        inexact += static_cast<double>(got) != std::fabs(static_cast<double>(b) - static_cast<double>(a));
+    }
+    CHECK(inexact > 10000);  // both kinds were met
+    CHECK(absDifferenceUp(3.0f, 3.0f) == 0.0f);
+    CHECK(absDifferenceUp(0.0f, std::numeric_limits<float>::denorm_min()) == std::numeric_limits<float>::denorm_min());
+    // far apart the double difference is rounded itself; the float one still bounds it
+    const float big = 0x1.eae2b4p+28f, tiny = -0x1.221ba4p-28f;
+    CHECK(absDifferenceUp(tiny, big) > big);
+}
 
 TEST_CASE("gi.change_bound: box maxima equal the brute-force maximum, box sums bound the brute-force sum") {
     std::mt19937 rng(7);
