@@ -459,7 +459,12 @@ void buildMaxChangePyramid(std::span<const ConstGridView> before, std::span<cons
             for (std::size_t c = 0; c < before.size(); ++c) {
                 const float* a = before[c].row(y);
                 const float* b = after[c].row(y);
-                for (int x = 0; x < nx; ++x) out[x] = std::max(out[x], absDifferenceUp(a[x], b[x]));
+                int x = 0;
+                for (; x + 4 <= nx; x += 4)
+                    simd::store(out + x,
+                                simd::vmax(simd::load<simd::F4>(out + x),
+                                           absDifferenceUp(simd::load<simd::F4>(a + x), simd::load<simd::F4>(b + x))));
+                for (; x < nx; ++x) out[x] = std::max(out[x], absDifferenceUp(a[x], b[x]));
             }
         }
     });

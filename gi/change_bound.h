@@ -23,9 +23,11 @@
 #include <cmath>
 #include <cstdint>
 #include <span>
+#include <type_traits>
 #include <vector>
 
 #include "core/grid.h"
+#include "core/simd.h"
 #include "gi/pyramid.h"
 #include "gi/receiver_tiles.h"
 #include "gi/visibility.h"
@@ -44,16 +46,25 @@ struct MaxChangePyramid {
 };
 
 /// The smallest float not below the real |b - a| (a, b finite), in float
-/// arithmetic: the rounded difference s and its rounding error e (Knuth's
-/// TwoSum, exact in round-to-nearest), then s's magnitude one float up when
-/// e pointed away from zero. A few operations the compiler vectorises; the
-/// double difference is exact only for exponents less than 30 apart.
-inline float absDifferenceUp(float a, float b) {
-    const float s = b - a;
-    const float bPart = s + a, aPart = s - bPart;  // TwoSum(b, -a)
-    const float e = (b - bPart) - (a + aPart);
-    const bool up = s >= 0.0f ? e > 0.0f : e < 0.0f;
-    return std::bit_cast<float>(std::bit_cast<std::uint32_t>(std::fabs(s)) + (up ? 1u : 0u));
+/// arithmetic, per lane (V = float or a simd lane type): the rounded
+/// difference s and its rounding error e (Knuth's TwoSum, exact in
+/// round-to-nearest), then s's magnitude one float up when e pointed away
+/// from zero. (The double difference is exact only for exponents less than
+/// 30 apart.)
+template <class V>
+[[gnu::always_inline]] inline V absDifferenceUp(V a, V b) {
+    const V s = b - a;
+    const V bPart = s + a, aPart = s - bPart;  // TwoSum(b, -a)
+    const V e = (b - bPart) - (a + aPart);
+    if constexpr (std::is_same_v<V, float>) {
+        const bool up = s >= 0.0f ? e > 0.0f : e < 0.0f;
+        return std::bit_cast<float>(std::bit_cast<std::uint32_t>(std::fabs(s)) + (up ? 1u : 0u));
+    } else {
+        using I = typename simd::LaneTraits<V>::I;
+        const V zero = simd::splat<V>(0.0f);
+        const I up = s >= zero ? e > zero : e < zero;  // -1 where rounding up
+        return std::bit_cast<V>((std::bit_cast<I>(s) & 0x7fffffff) - up);
+    }
 }
 
 /// Builds (or rebuilds, reusing every buffer of the same size) the pyramid

@@ -233,6 +233,8 @@ TEST_CASE("gi.change_bound: |b - a| rounded up in float arithmetic is the exact 
         const float b = i % 2 ? a + randomFloat(std::max(-14, exponent(rng) / 2 - 8)) : randomFloat(exponent(rng));
         const float got = absDifferenceUp(a, b);
         REQUIRE(got == reference(a, b));
+        const simd::F4 lanes = absDifferenceUp(simd::splat<simd::F4>(a), simd::F4{b, a, b, 0.0f});
+        CHECK((lanes[0] == got && lanes[1] == 0.0f && lanes[2] == got));
         CHECK(absDifferenceUp(b, a) == got);
         inexact += static_cast<double>(got) != std::fabs(static_cast<double>(b) - static_cast<double>(a));
     }
