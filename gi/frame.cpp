@@ -423,12 +423,8 @@ DirectRuns directRuns(ConstGridView heights, const FrameChange& change, const Ge
         st.lastInputs.heights.ny != heights.ny)
         return {};
     const VisibilityCache& cache = st.visibilityCache;
-    const int s = st.pyramid.subsample;
-    changedDirectTiles(st.lastInputs.heights.cview(), heights, cache.tiles, cache.keyTiles, s, st.ambientTiles,
-                       st.shadingTiles);
-    texelRunsOfTiles(&st.shadingTiles, heights.nx, heights.ny, s, st.shadingRuns);
-    if (cache.keyTiles.dirtyCount() == 0) return {&st.shadingRuns, &st.shadingRuns};
-    texelRunsOfTiles(&st.ambientTiles, heights.nx, heights.ny, s, st.ambientRuns);
+    changedDirectTexels(st.lastInputs.heights.cview(), heights, cache.tiles, cache.keyTiles, st.pyramid.subsample,
+                        st.texelRects, st.ambientRuns, st.shadingRuns);
     return {&st.shadingRuns, &st.ambientRuns};
 }
 

@@ -59,10 +59,9 @@ struct GiState {
     VisibilityCache visibilityCache;  // per tile, how far the cached V may have drifted
     IndirectCache indirectCache;      // per tile, how far the cached indirect light may have drifted
     bool directStale = false, indirectStale = false;
-    ReceiverTiles shadingTiles;         // this frame's texel tiles whose direct light was redone (gi/shading_tiles.h)
-    TexelRuns shadingRuns;              // and their texels
-    ReceiverTiles ambientTiles;         // of those, the tiles whose exact ambient was redone
-    TexelRuns ambientRuns;              // and their texels
+    TexelRuns shadingRuns;              // this frame's texels whose direct light was redone (gi/shading_tiles.h)
+    TexelRuns ambientRuns;              // of those, the texels whose exact ambient was redone
+    std::vector<TexelRect> texelRects;  // their scratch
     double receiversRecomputed = 0.0;   // fraction of the receivers whose environment V the last frame recomputed
     int keyVisibilitiesRecomputed = 0;  // key lights whose V the last frame recomputed
     int framesSinceRefresh = 0;         // incremental frames since the last full one (GiSettings::refreshEvery)

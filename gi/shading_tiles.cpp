@@ -15,27 +15,18 @@ void checkSizes(ConstGridView before, ConstGridView after, const ReceiverTiles& 
 
 }  // namespace
 
-void changedShadingTiles(ConstGridView before, ConstGridView after, const ReceiverTiles& env, const ReceiverTiles& keys,
-                         int subsample, ReceiverTiles& out) {
+void changedDirectTexels(ConstGridView before, ConstGridView after, const ReceiverTiles& env, const ReceiverTiles& keys,
+                         int subsample, std::vector<TexelRect>& rects, TexelRuns& ambient, TexelRuns& shading) {
     checkSizes(before, after, env, keys);
-    const ReceiverTiles* recomputed[] = {&env, &keys};
-    texelTilesToRedo(recomputed, &before, after, subsample, shadingReach(subsample), out);
-}
-
-void changedDirectTiles(ConstGridView before, ConstGridView after, const ReceiverTiles& env, const ReceiverTiles& keys,
-                        int subsample, ReceiverTiles& ambient, ReceiverTiles& shading) {
-    checkSizes(before, after, env, keys);
-    const int reach = shadingReach(subsample);
-    const ReceiverTiles* envOnly[] = {&env};
-    texelTilesToRedo(envOnly, &before, after, subsample, reach, ambient);
+    rects.clear();
+    appendTexelsToRedo(env, &before, after, subsample, shadingReach(subsample), rects);
+    texelRunsOfRects(rects, after.nx, after.ny, ambient);
     if (keys.dirtyCount() == 0) {
         shading = ambient;
         return;
     }
-    // the texels that read a recomputed key tile, the heights already counted in `ambient`
-    const ReceiverTiles* keysOnly[] = {&keys};
-    texelTilesToRedo(keysOnly, nullptr, after, subsample, reach, shading);
-    for (std::size_t i = 0; i < shading.dirty.size(); ++i) shading.dirty[i] |= ambient.dirty[i];
+    appendTexelsToRedo(keys, nullptr, after, subsample, 0, rects);  // the heights are counted already
+    texelRunsOfRects(rects, after.nx, after.ny, shading);
 }
 
 }  // namespace terrain::gi

@@ -14,15 +14,17 @@
 //    of the texel),
 //  - the lights and the albedo.
 // When only the heights changed and the visibility was recomputed by tiles
-// (gi/visibility_cache.h), the texels of a tile (gi/texel_runs.h) have the
-// last frame's inputs bit for bit unless a height within s + s / 2 + 1 cells
-// of them changed or they read a receiver of a tile whose environment or
-// key-light visibility was recomputed; the others keep their light,
+// (gi/visibility_cache.h), a texel has the last frame's inputs bit for bit
+// unless it reads a receiver of a tile whose environment or key-light
+// visibility was recomputed, or a height within s + s / 2 + 1 cells of the
+// texels of its tile (gi/texel_runs.h) changed; the others keep their light,
 // identical to recomputing it. The exact ambient (and the analytic sky's
 // parts) reads the environment's horizons, not the key lights': its texels
 // are those of the environment's dirty tiles and the changed heights alone,
 // so a local change that a low key light looks across redoes the shade of a
 // strip of tiles but the ambient of a few.
+#include <vector>
+
 #include "core/grid.h"
 #include "gi/receiver_tiles.h"
 #include "gi/texel_runs.h"
@@ -32,18 +34,15 @@ namespace terrain::gi {
 /// The cells within this many of a texel that its direct light reads.
 inline int shadingReach(int subsample) { return subsample + subsample / 2 + 1; }
 
-/// The texel tiles (out, on the layout of env) whose direct light must be
-/// redone after the heights went from `before` to `after` (same size) and
-/// the visibility of the dirty tiles of `env` and `keys` (on the receiver
-/// grid of `subsample`) was recomputed. Throws InputError when the sizes
-/// differ.
-void changedShadingTiles(ConstGridView before, ConstGridView after, const ReceiverTiles& env, const ReceiverTiles& keys,
-                         int subsample, ReceiverTiles& out);
-
-/// The texel tiles whose exact ambient must be redone (`ambient`: as
-/// changedShadingTiles without the key lights' tiles) and those whose direct
-/// light must be (`shading`: changedShadingTiles), the heights compared once.
-void changedDirectTiles(ConstGridView before, ConstGridView after, const ReceiverTiles& env, const ReceiverTiles& keys,
-                        int subsample, ReceiverTiles& ambient, ReceiverTiles& shading);
+/// The texels whose exact ambient (`ambient`) and whose direct light
+/// (`shading`) must be redone after the heights went from `before` to
+/// `after` (same size) and the visibility of the dirty tiles of `env` and
+/// `keys` (on the receiver grid of `subsample`, one layout) was recomputed:
+/// the texels that read a receiver of a dirty tile (the ambient: of `env`
+/// alone) and those of the texel tiles within shadingReach of a changed
+/// height (appendTexelsToRedo). `rects` is scratch. Throws InputError when
+/// the sizes differ.
+void changedDirectTexels(ConstGridView before, ConstGridView after, const ReceiverTiles& env, const ReceiverTiles& keys,
+                         int subsample, std::vector<TexelRect>& rects, TexelRuns& ambient, TexelRuns& shading);
 
 }  // namespace terrain::gi

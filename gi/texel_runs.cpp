@@ -134,3 +134,58 @@ void texelTilesToRedo(std::span<const ReceiverTiles* const> recomputed, const Co
 }
 
 }  // namespace terrain::gi
+
+namespace terrain::gi {
+
+void texelRunsOfRects(std::span<const TexelRect> rects, int nx, int ny, TexelRuns& out) {
+    out.ny = ny;
+    out.first.assign(static_cast<std::size_t>(ny) + 1, 0);
+    out.runs.clear();
+    std::vector<ColumnSpan> row;
+    for (int y = 0; y < ny; ++y) {
+        row.clear();
+        for (const TexelRect& r : rects)
+            if (r.y0 <= y && y < r.y1 && std::max(r.x0, 0) < std::min(r.x1, nx))
+                row.push_back({std::max(r.x0, 0), std::min(r.x1, nx)});
+        std::sort(row.begin(), row.end(), [](const ColumnSpan& a, const ColumnSpan& b) { return a.x0 < b.x0; });
+        const std::size_t rowStart = out.runs.size();
+        for (const ColumnSpan& c : row)
+            if (out.runs.size() > rowStart && c.x0 <= out.runs.back().x1)
+                out.runs.back().x1 = std::max(out.runs.back().x1, c.x1);
+            else
+                out.runs.push_back(c);
+        out.first[static_cast<std::size_t>(y) + 1] = static_cast<int>(out.runs.size());
+    }
+}
+
+long long texelCount(const TexelRuns& runs) {
+    long long n = 0;
+    for (const ColumnSpan& r : runs.runs) n += r.x1 - r.x0;
+    return n;
+}
+
+void appendTexelsToRedo(const ReceiverTiles& recomputed, const ConstGridView* before, ConstGridView after,
+                        int subsample, int reach, std::vector<TexelRect>& out) {
+    const ReceiverTiles& t = recomputed;
+    const int s = subsample, T = t.tileSize;
+    std::vector<int> readX0, readX1, readY0, readY1;
+    texelsReadingTiles(after.nx, s, t.nxr, T, readX0, readX1);
+    texelsReadingTiles(after.ny, s, t.nyr, T, readY0, readY1);
+    std::vector<int> ownX, ownY;  // the texels of each tile: those whose lower receiver it holds
+    firstTexels(after.nx, s, t.nxr, ownX);
+    firstTexels(after.ny, s, t.nyr, ownY);
+    for (int ty = 0; ty < t.tilesY; ++ty)
+        for (int tx = 0; tx < t.tilesX; ++tx) {
+            const auto x = static_cast<std::size_t>(tx), y = static_cast<std::size_t>(ty);
+            if (t.isDirty(tx, ty)) {
+                out.push_back({readX0[x], readY0[y], readX1[x] + 1, readY1[y] + 1});
+                continue;
+            }
+            if (before && cellsDiffer(*before, after, texelCellsOfTile(t, tx, ty, after.nx, after.ny, s, reach)))
+                out.push_back({ownX[static_cast<std::size_t>(tx * T)], ownY[static_cast<std::size_t>(ty * T)],
+                               ownX[static_cast<std::size_t>(std::min(t.nxr, (tx + 1) * T))],
+                               ownY[static_cast<std::size_t>(std::min(t.nyr, (ty + 1) * T))]});
+        }
+}
+
+}  // namespace terrain::gi

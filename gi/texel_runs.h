@@ -41,6 +41,19 @@ struct TexelRuns {
 /// Throws InputError when the tiles are not of that receiver grid.
 void texelRunsOfTiles(const ReceiverTiles* tiles, int nx, int ny, int subsample, TexelRuns& out);
 
+/// A rectangle of texels, columns [x0, x1) of rows [y0, y1).
+struct TexelRect {
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+};
+
+/// The runs of the union of `rects` (cut to an nx x ny field): per row the
+/// columns of the rectangles holding it, sorted, overlapping and adjacent
+/// ones merged.
+void texelRunsOfRects(std::span<const TexelRect> rects, int nx, int ny, TexelRuns& out);
+
+/// Texels in the runs.
+long long texelCount(const TexelRuns& runs);
+
 /// Row y's runs, or `whole` (a caller's run [0, nx)) when there are no runs
 /// (null: every texel).
 inline std::span<const ColumnSpan> runsOfRow(const TexelRuns* runs, int y, const ColumnSpan& whole) {
@@ -84,5 +97,15 @@ ColumnSpan receiverColumnsRead(const TexelRuns* runs, int y0, int y1, int n, Low
 /// sub-sampling s of the tiles' receiver grid.
 void texelTilesToRedo(std::span<const ReceiverTiles* const> recomputed, const ConstGridView* before,
                       ConstGridView after, int subsample, int reach, ReceiverTiles& out);
+
+/// The texels to redo as rectangles, appended to `out`: per dirty tile of
+/// `recomputed`, the texels that read one of its receivers (its own and the
+/// last row and column of texels of the tiles before it: texelsReadingTiles
+/// along each axis), and, with `before`, per texel tile within `reach`
+/// cells of a height that differs bit for bit, its texels. Finer than
+/// texelTilesToRedo, which takes the whole tiles before a dirty one too.
+/// The heights are an nx x ny field at sub-sampling s of the tiles' grid.
+void appendTexelsToRedo(const ReceiverTiles& recomputed, const ConstGridView* before, ConstGridView after,
+                        int subsample, int reach, std::vector<TexelRect>& out);
 
 }  // namespace terrain::gi

@@ -1,7 +1,10 @@
 // gi/shading_tiles: an incremental frame after a local height change shades
-// only the texel tiles whose inputs changed, and its output is a full
+// only the texels whose inputs changed, and its output is a full
 // recompute's bit for bit, for any thread count.
+#include <algorithm>
 #include <array>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include <doctest/doctest.h>
@@ -25,54 +28,90 @@ namespace {
 
 constexpr float kCell = 10.0f;  // metres: the local changes stay within the tolerance of far tiles
 
-std::vector<int> dirtyOf(const ReceiverTiles& t) {
-    std::vector<int> out;
-    for (int i = 0; i < static_cast<int>(t.dirty.size()); ++i)
-        if (t.dirty[static_cast<std::size_t>(i)] != 0) out.push_back(i);
-    return out;
+// The runs as rows [y0, y1) that share their runs: "y0-y1:x0-x1,x0-x1 ...".
+std::string summary(const TexelRuns& r) {
+    std::ostringstream out;
+    const char* gap = "";
+    for (int y = 0; y < r.ny;) {
+        int y1 = y + 1;
+        const auto same = [&](int a, int b) {
+            const auto ra = r.ofRow(a), rb = r.ofRow(b);
+            return std::equal(ra.begin(), ra.end(), rb.begin(), rb.end(),
+                              [](const ColumnSpan& p, const ColumnSpan& q) { return p.x0 == q.x0 && p.x1 == q.x1; });
+        };
+        while (y1 < r.ny && same(y, y1)) ++y1;
+        if (r.hasRow(y)) {
+            out << gap << y << "-" << y1 << ":";
+            const char* comma = "";
+            for (const ColumnSpan& c : r.ofRow(y)) {
+                out << comma << c.x0 << "-" << c.x1;
+                comma = ",";
+            }
+            gap = " ";
+        }
+        y = y1;
+    }
+    return out.str();
 }
 
 }  // namespace
 
-TEST_CASE("gi.shading_tiles: the tiles within reach of changed heights, and those reading the dirty tiles' receivers") {
+TEST_CASE(
+    "gi.shading_tiles: the texels within reach of changed heights, and those reading the dirty tiles' receivers") {
     // 40 x 70 texels at 2x: 20 x 35 receivers, tiles of 16: 2 x 3 tiles,
     // texel columns 0..31 and 32..39, rows 0..31, 32..63 and 64..69; reach 4
     const Grid before = bumpy(40, 70);
-    ReceiverTiles env, keys, out;
+    ReceiverTiles env, keys;
+    TexelRuns ambient, shading;
+    std::vector<TexelRect> rects;
     const int s = 2;
     env.reset(20, 35, 16, false);
     keys.reset(20, 35, 16, false);
     CHECK(shadingReach(s) == 4);
-    changedShadingTiles(before.cview(), before.cview(), env, keys, s, out);
-    CHECK(dirtyOf(out).empty());  // nothing changed: nothing to shade
+    const auto redo = [&](const Grid& after) {
+        changedDirectTexels(before.cview(), after.cview(), env, keys, s, rects, ambient, shading);
+    };
+    redo(before);
+    CHECK(summary(shading).empty());  // nothing changed: nothing to shade
+    CHECK(texelCount(shading) == 0);
     Grid after = before;
     after(7, 29) += 0.5f;  // within 4 rows of tile row 1 (from row 32), 25 columns from column 32
-    changedShadingTiles(before.cview(), after.cview(), env, keys, s, out);
-    CHECK(dirtyOf(out) == std::vector<int>{0, 2});
+    redo(after);
+    CHECK(summary(shading) == "0-64:0-32");
+    CHECK(summary(ambient) == summary(shading));
     after = before;
     after(39, 69) = -0.0f == before(39, 69) ? 1.0f : -0.0f;  // a bit changed in the last texel
-    changedShadingTiles(before.cview(), after.cview(), env, keys, s, out);
-    CHECK(dirtyOf(out) == std::vector<int>{5});
-    // a dirty key-light tile (1, 1): the texels that read its receivers
+    redo(after);
+    CHECK(summary(shading) == "64-70:32-40");
+    // a dirty key-light tile (1, 1), receivers 16..19 x 16..31: the texels
+    // that read them, from the last texels of the receivers before (15)
     keys.setDirty(1, 1);
-    changedShadingTiles(before.cview(), before.cview(), env, keys, s, out);
-    CHECK(dirtyOf(out) == std::vector<int>{0, 1, 2, 3});
-    // the ambient reads no key light: with a changed height as well, it redoes
-    // the height's tiles, the shading those and the key tile's readers
-    ReceiverTiles ambient, shading;
+    redo(before);
+    CHECK(summary(shading) == "30-64:30-40");
+    CHECK(summary(ambient).empty());  // the ambient reads no key light
+    CHECK(texelCount(shading) == 34 * 10);
+    // with a changed height as well: the ambient redoes the height's tiles,
+    // the shading those and the key tile's readers
     after = before;
     after(7, 29) += 0.5f;
-    changedDirectTiles(before.cview(), after.cview(), env, keys, s, ambient, shading);
-    CHECK(dirtyOf(ambient) == std::vector<int>{0, 2});
-    changedShadingTiles(before.cview(), after.cview(), env, keys, s, out);
-    CHECK(dirtyOf(shading) == dirtyOf(out));
-    CHECK(dirtyOf(shading) == std::vector<int>{0, 1, 2, 3});
-    env.setDirty(0, 2);  // an environment tile: both read it
-    changedDirectTiles(before.cview(), after.cview(), env, keys, s, ambient, shading);
-    CHECK(dirtyOf(ambient) == std::vector<int>{0, 2, 4});
-    CHECK(dirtyOf(shading) == std::vector<int>{0, 1, 2, 3, 4});
+    redo(after);
+    CHECK(summary(ambient) == "0-64:0-32");
+    CHECK(summary(shading) == "0-30:0-32 30-64:0-40");
+    env.setDirty(0, 2);  // an environment tile (receivers 0..15 x 32..34, the last texel rows): both read it
+    redo(after);
+    CHECK(summary(ambient) == "0-70:0-32");
+    CHECK(summary(shading) == "0-30:0-32 30-64:0-40 64-70:0-32");
     env.setDirty(0, 2, false);
-    CHECK_THROWS_AS(changedShadingTiles(bumpy(40, 69).cview(), before.cview(), env, keys, s, out), InputError);
+    CHECK_THROWS_AS(changedDirectTexels(bumpy(40, 69).cview(), before.cview(), env, keys, s, rects, ambient, shading),
+                    InputError);
+}
+
+TEST_CASE("gi.shading_tiles: the runs of rectangles are merged per row and cut to the field") {
+    TexelRuns r;
+    const std::vector<TexelRect> rects{{5, 0, 10, 2}, {8, 1, 12, 3}, {12, 1, 14, 2}, {-3, 2, 2, 4}, {20, 0, 30, 1}};
+    texelRunsOfRects(rects, 25, 5, r);
+    CHECK(summary(r) == "0-1:5-10,20-25 1-2:5-14 2-3:0-2,8-12 3-4:0-2");
+    CHECK(texelCount(r) == 5 + 5 + 9 + 2 + 4 + 2);
 }
 
 namespace {
@@ -131,7 +170,8 @@ TEST_CASE("gi.shading_tiles: local height changes shade some tiles, the rest is 
                 settings.keyLightExactCosine = exactKey;
                 settings.tolerance = tolerance;
                 std::vector<GiState> states(4);
-                int kept = 0, ambientFewer = 0;
+                long long kept = 0;
+                int ambientFewer = 0;
                 for (std::size_t f = 0; f < surfaces.size(); ++f) {
                     CAPTURE(f);
                     for (std::size_t i = 0; i < states.size(); ++i)
@@ -145,18 +185,24 @@ TEST_CASE("gi.shading_tiles: local height changes shade some tiles, the rest is 
                     // the texels kept are those every texel's shading would give
                     CHECK(sameRgb(states[0].shade.rgb, reshadeEveryTexel(states[0], settings, light)));
                     CHECK(ambientAsEveryTexelWould(states[0], settings, surfaces[f].cview()));
-                    const ReceiverTiles& t = states[0].shadingTiles;
-                    if (f > 0) kept += static_cast<int>(t.dirty.size()) - t.dirtyCount();
-                    // the ambient redoes no tile the shading keeps, and fewer where the key light looked across
+                    const TexelRuns& t = states[0].shadingRuns;
+                    const long long texels = static_cast<long long>(surfaces[f].nx) * surfaces[f].ny;
+                    if (f > 0) kept += texels - texelCount(t);
+                    // the ambient redoes no texel the shading keeps, and fewer where the key light looked across
                     if (f > 0 && states[0].visibilityCache.keyTiles.dirtyCount() > 0) {
-                        const ReceiverTiles& a = states[0].ambientTiles;
-                        for (std::size_t i = 0; i < a.dirty.size(); ++i)
-                            if (a.dirty[i] != 0) CHECK(t.dirty[i] != 0);
-                        ambientFewer += a.dirtyCount() < t.dirtyCount() ? 1 : 0;
+                        const TexelRuns& a = states[0].ambientRuns;
+                        for (int y = 0; y < a.ny; ++y)
+                            for (const ColumnSpan& run : a.ofRow(y)) {
+                                const auto in = t.ofRow(y);
+                                CHECK(std::any_of(in.begin(), in.end(), [&](const ColumnSpan& c) {
+                                    return c.x0 <= run.x0 && run.x1 <= c.x1;
+                                }));
+                            }
+                        ambientFewer += texelCount(a) < texelCount(t) ? 1 : 0;
                     }
                 }
                 MESSAGE(s << "x, exact key " << exactKey << ", tolerance " << tolerance << ": " << kept
-                          << " texel tiles kept over 3 local changes");
+                          << " texels kept over 3 local changes");
                 if (tolerance > 0.0f) CHECK(kept > 0);
                 if (tolerance > 0.0f) CHECK(ambientFewer > 0);
             }
