@@ -142,7 +142,12 @@ void occlusionOfRow(ConstGridView gradX, ConstGridView gradY, const PointRow& p,
 // `stride` floats (column x is column x / s of phase plane x % s).
 void fillBorderedHeights(const HeightPyramid& pyr, int B, std::ptrdiff_t stride, BlockerRadianceState& st) {
     const int nx = pyr.nx, ny = pyr.ny, s = pyr.subsample;
-    st.heights.assign(static_cast<std::size_t>(stride) * (ny + 2 * B + 1), kOutside);
+    // the border and the padding keep kOutside from the first fill of this layout
+    const std::array<std::ptrdiff_t, 4> layout{nx, ny, B, stride};
+    if (st.heightsLayout != layout) {
+        st.heights.assign(static_cast<std::size_t>(stride) * (ny + 2 * B + 1), kOutside);
+        st.heightsLayout = layout;
+    }
     parallelForRows(ny, nx, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
             float* row = st.heights.data() + (y + B) * stride + B;

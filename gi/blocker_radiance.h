@@ -56,11 +56,12 @@ struct NearTap {
 
 struct BlockerRadianceState {
     int nx = 0, ny = 0, nxr = 0, nyr = 0, subsample = 1, azimuths = 0;
-    std::vector<float> farSlope;           // azimuths planes of nxr * nyr: the receivers' horizons (tan), from the scan
-    std::vector<float> heights;            // full-resolution heights with a border of s cells (outside: no blocker)
-    Grid occlusion;                        // O / pi at every texel
-    bool occlusionValid = false;           // occlusion and receiverOcclusion hold a result of this grid
-    std::vector<float> receiverOcclusion;  // O / pi at the receivers
+    std::vector<float> farSlope;  // azimuths planes of nxr * nyr: the receivers' horizons (tan), from the scan
+    std::vector<float> heights;   // full-resolution heights with a border of s cells (outside: no blocker)
+    std::array<std::ptrdiff_t, 4> heightsLayout{};  // its nx, ny, border and row stride (0: not laid out yet)
+    Grid occlusion;                                 // O / pi at every texel
+    bool occlusionValid = false;                    // occlusion and receiverOcclusion hold a result of this grid
+    std::vector<float> receiverOcclusion;           // O / pi at the receivers
     // per azimuth j (planes of nxr * nyr): the receivers' occlusion sum over
     // the azimuths 0..j, unnormalised (azimuth j's share of O_k is
     // (running_j - running_(j-1)) / running_(m-1); gi/indirect_cache.h)

@@ -58,6 +58,36 @@ void sumLevel(const Grid& src, Grid& dst) {
     });
 }
 
+// The blocks with a change at the first level of at most 64 x 64 blocks.
+void findChangedBox(MaxChangePyramid& p) {
+    auto& c = p.changed;
+    c = {};
+    std::size_t k = 0;
+    while (k + 1 < p.levels.size() && p.levels[k].v.size() > 64 * 64) ++k;
+    if (p.levels.empty()) return;
+    const Grid& g = p.levels[k];
+    int bx0 = g.nx, by0 = g.ny, bx1 = -1, by1 = -1;
+    for (int by = 0; by < g.ny; ++by)
+        for (int bx = 0; bx < g.nx; ++bx)
+            if (g.v[static_cast<std::size_t>(by) * g.nx + bx] > 0.0f) {
+                bx0 = std::min(bx0, bx);
+                bx1 = std::max(bx1, bx);
+                by0 = std::min(by0, by);
+                by1 = std::max(by1, by);
+            }
+    if (bx1 < 0) return;
+    c.x0 = bx0 << k;
+    c.y0 = by0 << k;
+    c.x1 = std::min(((bx1 + 1) << k) - 1, p.nx - 1);
+    c.y1 = std::min(((by1 + 1) << k) - 1, p.ny - 1);
+}
+
+// Whether the cells [x0, x1] x [y0, y1] miss the changed box.
+bool missesChange(const MaxChangePyramid& p, int x0, int y0, int x1, int y1) {
+    const auto& c = p.changed;
+    return x1 < c.x0 || y1 < c.y0 || x0 > c.x1 || y0 > c.y1;
+}
+
 // Levels 1.. from level 0: 2 x 2 maxima, the edge replicated inside its block.
 void decimateLevels(MaxChangePyramid& p) {
     for (std::size_t k = 1; k < p.levels.size(); ++k) {
@@ -76,6 +106,7 @@ void decimateLevels(MaxChangePyramid& p) {
         });
         sumLevel(k == 1 ? p.levels[0] : p.sums[k - 1], p.sums[k]);
     }
+    findChangedBox(p);
 }
 
 // Cells [x0, x1] x [y0, y1], inclusive.
@@ -490,6 +521,7 @@ int clampBoxToLevel(const MaxChangePyramid& p, int& x0, int& y0, int& x1, int& y
 }  // namespace
 
 float maxChangeInBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1) {
+    if (missesChange(p, x0, y0, x1, y1)) return 0.0f;
     const int k = clampBoxToLevel(p, x0, y0, x1, y1);
     if (k < 0) return 0.0f;
     const CellBox box{x0, y0, x1, y1};
@@ -502,6 +534,9 @@ float maxChangeInBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1) 
 double sumChangeInBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1) {
     const int k = clampBoxToLevel(p, x0, y0, x1, y1);
     if (k < 0) return 0.0;
+    // the blocks read cover the box, rounded out to level k's blocks
+    if (missesChange(p, (x0 >> k) << k, (y0 >> k) << k, (((x1 >> k) + 1) << k) - 1, (((y1 >> k) + 1) << k) - 1))
+        return 0.0;
     const Grid& g = k == 0 ? p.levels[0] : p.sums[static_cast<std::size_t>(k)];
     double sum = 0.0;
     for (int by = y0 >> k; by <= y1 >> k; ++by) {

@@ -39,10 +39,16 @@ namespace terrain::gi {
 /// ones cut by the grid's edge); level 0 is |dh| itself, the last level 1 x 1.
 /// `sums` holds the sums of |dh| over the same blocks (sums[0] is empty:
 /// level 0 is its own sum; each sum rounded up to the next float).
+/// `changed` is a box of cells (inclusive; empty when x0 > x1) that holds
+/// every cell with |dh| > 0, from a coarse level's blocks: queries of boxes
+/// outside it answer 0 at once, as they would after their walk.
 struct MaxChangePyramid {
     int nx = 0, ny = 0;
     std::vector<Grid> levels;
     std::vector<Grid> sums;
+    struct {
+        int x0 = 0, y0 = 0, x1 = -1, y1 = -1;
+    } changed;
 };
 
 /// The smallest float not below the real |b - a| (a, b finite), in float
