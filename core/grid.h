@@ -2,11 +2,13 @@
 // Plain float grids: one contiguous std::vector<float> per quantity, row-major
 // (i = y * stride + x). Kernels take the non-owning views below and never
 // allocate.
+#include <algorithm>
 #include <atomic>
 #include <cassert>
 #include <cstddef>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <new>
 #include <vector>
 
@@ -116,10 +118,21 @@ struct Grid {
     ConstGridView cview() const { return {v.data(), nx, ny, nx}; }
 };
 
-/// Copies a view into an owning grid (its storage kept when the size is the same).
-inline void copyGrid(ConstGridView from, Grid& to) {
+/// Rows [y0, y1) of a grid, cut to it where used; by default every row.
+struct RowSpan {
+    int y0 = 0, y1 = std::numeric_limits<int>::max();
+    RowSpan cut(int ny) const { return {std::max(y0, 0), std::max(std::max(y0, 0), std::min(y1, ny))}; }
+    /// d more rows on each side (every row stays every row).
+    RowSpan grown(int d) const { return {y0 - d, y1 > std::numeric_limits<int>::max() - d ? y1 : y1 + d}; }
+};
+
+/// Copies a view into an owning grid (its storage kept when the size is the
+/// same), only `rows` when the size is the same.
+inline void copyGrid(ConstGridView from, Grid& to, RowSpan rows = {}) {
+    if (to.nx != from.nx || to.ny != from.ny) rows = {};
     to.ensureSize(from.nx, from.ny);
-    for (int y = 0; y < from.ny; ++y)
+    rows = rows.cut(from.ny);
+    for (int y = rows.y0; y < rows.y1; ++y)
         std::memcpy(to.data() + static_cast<std::size_t>(y) * from.nx, from.row(y), sizeof(float) * from.nx);
 }
 

@@ -129,13 +129,15 @@ void checkHeightsFinite(ConstGridView h) {
                 throw InputError("heights: NaN or Inf at column " + std::to_string(x) + ", row " + std::to_string(y));
 }
 
-void computeGradient(ConstGridView h, float cellSize, Grid& gx, Grid& gy) {
+void computeGradient(ConstGridView h, float cellSize, Grid& gx, Grid& gy, RowSpan changed) {
     const int nx = h.nx, ny = h.ny;
+    if (gx.nx != nx || gx.ny != ny || gy.nx != nx || gy.ny != ny) changed = {};
     gx.ensureSize(nx, ny);
     gy.ensureSize(nx, ny);
     const float inv2 = 0.5f / cellSize, inv1 = 1.0f / cellSize;
-    parallelForRows(ny, nx, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y)
+    const RowSpan rows = changed.grown(1).cut(ny);  // the central differences read one row either side
+    parallelForRows(rows.y1 - rows.y0, nx, [&](int r0, int r1) {
+        for (int y = rows.y0 + r0; y < rows.y0 + r1; ++y)
             for (int x = 0; x < nx; ++x) {
                 float dx = 0.0f, dy = 0.0f;
                 if (nx > 1) {
@@ -210,7 +212,9 @@ void planAmortisation(ConstGridView heights, const GiSettings& settings, GiState
 
 // The environment's visibility V at the receivers; with sub-sampling and
 // footprint tangent planes, omega_min from each receiver's footprint box.
-void environmentVisibility(const GiSettings& settings, int shRows, const ReceiverTiles* only, GiState& st) {
+// gradientRows: the rows of the gradients that changed since the last call.
+void environmentVisibility(const GiSettings& settings, int shRows, const ReceiverTiles* only, RowSpan gradientRows,
+                           GiState& st) {
     if (st.envOperatorAzimuths != settings.visibility.azimuths || st.envOperatorInterp != settings.visibility.interp ||
         st.envOperator.shRows != shRows) {
         st.envOperator = foldFullCircle(settings.visibility.azimuths, settings.visibility.interp);
@@ -226,7 +230,8 @@ void environmentVisibility(const GiSettings& settings, int shRows, const Receive
         }
     }
     const bool footprint = settings.subsample > 1 && settings.visibility.footprintTangent;
-    if (footprint) computeFootprintBox(st.gradX.cview(), st.gradY.cview(), settings.subsample, st.footprint);
+    if (footprint)
+        computeFootprintBox(st.gradX.cview(), st.gradY.cview(), settings.subsample, st.footprint, gradientRows);
     VisibilityTarget envTarget;
     envTarget.op = &st.envOperator;
     envTarget.footprint = footprint ? &st.footprint : nullptr;
@@ -442,12 +447,18 @@ void runDirectStages(ConstGridView heights, float cellSize, const GiLighting& li
     // V newly read on unchanged geometry (the lighting now has a part that
     // goes through SH): the environment's scan reruns for every receiver.
     const bool shMissing = !change.geometry && st.envVisibility.planes < shRows;
+    RowSpan gradientRows;  // the gradients' rows this frame changes (every row unless told otherwise)
     if (change.geometry) {
         ++st.geometryVersion;
-        computeGradient(heights, cellSize, st.gradX, st.gradY);
+        // the passes that go row by row redo the changed rows alone when the
+        // buffers hold the recorded heights' results
+        const RowSpan rows = change.heightsOnly && st.geometryOfRecord ? change.heightRows : RowSpan{};
+        st.geometryOfRecord = false;  // until this frame's inputs are recorded
+        computeGradient(heights, cellSize, st.gradX, st.gradY, rows);
+        gradientRows = rows.grown(1);
         st.timings.gradient = msSince(t);
         t = Clock::now();
-        buildHeightPyramid(heights, cellSize, settings.subsample, settings.pyramid, st.pyramid);
+        buildHeightPyramid(heights, cellSize, settings.subsample, settings.pyramid, st.pyramid, rows);
         st.timings.pyramid = msSince(t);
         t = Clock::now();
     }
@@ -459,7 +470,7 @@ void runDirectStages(ConstGridView heights, float cellSize, const GiLighting& li
             forgetEnvironmentDrift(st.visibilityCache);
         only = tiled ? &st.visibilityCache.tiles : nullptr;
         keyOnly = plan.tiled ? &st.visibilityCache.keyTiles : nullptr;
-        environmentVisibility(settings, shRows, only, st);
+        environmentVisibility(settings, shRows, only, gradientRows, st);
         st.timings.visibility += msSince(t);
         st.receiversRecomputed = tiled ? st.visibilityCache.tiles.dirtyFraction() : 1.0;
     }
@@ -532,10 +543,12 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
     }
     // An indirect-only frame leaves the record at the last direct frame's
     // inputs: the next direct frame then sees every change it skipped.
-    if (!settings.incremental)
+    if (!settings.incremental) {
         st.lastInputs.valid = false;
-    else if (st.directUpdated)
+    } else if (st.directUpdated) {
         recordFrameInputs(heights, cellSize, lighting, settings, albedo, change, st.lastInputs);
+        if (change.geometry) st.geometryOfRecord = true;
+    }
     st.timings.total = msSince(t0);
 }
 

@@ -56,6 +56,7 @@ struct GiState {
     // inputs of the cached results, and whether an amortised frame left the
     // direct or the indirect light behind its inputs.
     FrameInputs lastInputs;
+    bool geometryOfRecord = false;    // the gradients, footprint boxes and height pyramid are lastInputs.heights'
     VisibilityCache visibilityCache;  // per tile, how far the cached V may have drifted
     IndirectCache indirectCache;      // per tile, how far the cached indirect light may have drifted
     bool directStale = false, indirectStale = false;
@@ -85,8 +86,10 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
                 GiState& state, const AlbedoMap* albedo = nullptr);
 
 /// Central-difference height derivatives (one-sided at the borders, 0 on a
-/// 1-wide axis), in metres per metre.
-void computeGradient(ConstGridView heights, float cellSize, Grid& gradX, Grid& gradY);
+/// 1-wide axis), in metres per metre. With `changed` (gradients of the same
+/// size already there, of heights that differ only in those rows), only the
+/// rows whose derivatives read a changed row.
+void computeGradient(ConstGridView heights, float cellSize, Grid& gradX, Grid& gradY, RowSpan changed = {});
 
 /// Throws InputError naming the first NaN/Inf height.
 void checkHeightsFinite(ConstGridView heights);

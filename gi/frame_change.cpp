@@ -6,6 +6,18 @@
 namespace terrain::gi {
 namespace {
 
+bool sameRow(const Grid& a, ConstGridView b, int y) {
+    return std::memcmp(a.data() + static_cast<std::size_t>(y) * a.nx, b.row(y), sizeof(float) * b.nx) == 0;
+}
+
+// The rows from the first to the last that differ (same sizes); empty when none does.
+RowSpan differingRows(const Grid& a, ConstGridView b) {
+    int y0 = 0, y1 = b.ny;
+    while (y0 < y1 && sameRow(a, b, y0)) ++y0;
+    while (y1 > y0 && sameRow(a, b, y1 - 1)) --y1;
+    return {y0, y1};
+}
+
 bool sameGrid(const Grid& a, ConstGridView b) {
     if (a.nx != b.nx || a.ny != b.ny) return false;
     for (int y = 0; y < b.ny; ++y)
@@ -49,8 +61,12 @@ FrameChange compareFrameInputs(const FrameInputs& last, ConstGridView heights, f
     FrameChange c;
     const bool sameFrame = cellSize == last.cellSize && settings == last.settings && last.heights.nx == heights.nx &&
                            last.heights.ny == heights.ny;
-    c.geometry = !sameFrame || !sameGrid(last.heights, heights);
+    if (sameFrame) {
+        c.heightRows = differingRows(last.heights, heights);
+        c.geometry = c.heightRows.y0 < c.heightRows.y1;
+    }
     c.heightsOnly = sameFrame && c.geometry;
+    if (!c.heightsOnly) c.heightRows = {};
     c.keyRegion.assign(nKeys, true);
     bool keyRadiance = nKeys != last.keys.size();
     for (std::size_t k = 0; k < nKeys; ++k) {
@@ -65,7 +81,7 @@ FrameChange compareFrameInputs(const FrameInputs& last, ConstGridView heights, f
 
 void recordFrameInputs(ConstGridView heights, float cellSize, const GiLighting& lighting, const GiSettings& settings,
                        const AlbedoMap* albedo, const FrameChange& change, FrameInputs& out) {
-    if (change.geometry) copyGrid(heights, out.heights);
+    if (change.geometry) copyGrid(heights, out.heights, change.heightsOnly ? change.heightRows : RowSpan{});
     out.cellSize = cellSize;
     out.settings = settings;
     out.environment = lighting.environment;

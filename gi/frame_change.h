@@ -40,6 +40,9 @@ struct FrameChange {
     // Only the heights changed (same size, cell size and settings): the
     // visibility may be recomputed tile by tile (gi/visibility_cache.h).
     bool heightsOnly = false;
+    // With heightsOnly: the rows holding every height that differs from the
+    // record (the first to the last that differ); otherwise every row.
+    RowSpan heightRows;
     std::vector<bool> keyRegion;  // per key light: its region of the sky is new (direction, size, count)
     bool radiance = true;         // environment, key radiances or albedo: shading and indirect light
     bool any() const;
@@ -54,8 +57,9 @@ FrameChange everythingChanged(std::size_t keys);
 FrameChange compareFrameInputs(const FrameInputs& last, ConstGridView heights, float cellSize,
                                const GiLighting& lighting, const GiSettings& settings, const AlbedoMap* albedo);
 
-/// Records this frame's inputs; the heights and the albedo maps are copied
-/// only when `change` says they may differ from the record (buffers reused).
+/// Records this frame's inputs; the heights (their changed rows) and the
+/// albedo maps are copied only when `change` says they may differ from the
+/// record (buffers reused).
 void recordFrameInputs(ConstGridView heights, float cellSize, const GiLighting& lighting, const GiSettings& settings,
                        const AlbedoMap* albedo, const FrameChange& change, FrameInputs& out);
 

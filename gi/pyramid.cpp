@@ -129,14 +129,18 @@ int buildSteps(HeightPyramid& p, int kv, float cellSize) {
 }
 
 // ---- raw heights, split by column phase --------------------------------
-void splitRawPhases(ConstGridView heights, HeightPyramid& p) {
+// Only the `changed` rows of the heights (and the replicated row below the
+// last when it is one of them).
+void splitRawPhases(ConstGridView heights, RowSpan changed, HeightPyramid& p) {
     const int nx = p.nx, ny = p.ny, s = p.subsample;
     const int wp = nx / s + 1;
     p.rawPhaseWidth = wp;
     p.rawPhasePlane = static_cast<std::ptrdiff_t>(wp) * (ny + 1);
     p.rawPhase.resize(static_cast<std::size_t>(s) * static_cast<std::size_t>(p.rawPhasePlane) + 2 * kFieldGuard, 0.0f);
-    parallelForRows(ny + 1, nx, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y) {
+    changed = changed.cut(ny);
+    const RowSpan rows{changed.y0, changed.y1 == ny ? ny + 1 : changed.y1};
+    parallelForRows(rows.y1 - rows.y0, nx, [&](int r0, int r1) {
+        for (int y = rows.y0 + r0; y < rows.y0 + r1; ++y) {
             const float* src = heights.row(std::min(y, ny - 1));
             for (int q = 0; q < s; ++q) {
                 float* d = p.rawPhase.data() + kFieldGuard + q * p.rawPhasePlane + static_cast<std::ptrdiff_t>(y) * wp;
@@ -187,10 +191,12 @@ void decimateOctaves(ConstGridView heights, int nOctaves, bool withMax, HeightPy
 // Section 5.2: level i is reduced by 2^(i / k_v), so f_0 = f, unfiltered),
 // taken at the receivers. (A B-spline synthesis of octave 0 would smooth it
 // by (1, 4, 1) / 6 per axis and lower the near blockers.)
-void receiverHeights(ConstGridView heights, int s, PaddedField& out) {
+void receiverHeights(ConstGridView heights, int s, RowSpan changed, PaddedField& out) {
     const int nxr = out.nx, nyr = out.ny;
-    parallelForRows(nyr, nxr, [&](int y0, int y1) {
-        for (int Y = y0; Y < y1; ++Y) {
+    changed = changed.cut(heights.ny);
+    const RowSpan receivers = RowSpan{(changed.y0 + s - 1) / s, (changed.y1 + s - 1) / s}.cut(nyr);  // s Y in changed
+    parallelForRows(receivers.y1 - receivers.y0, nxr, [&](int r0, int r1) {
+        for (int Y = receivers.y0 + r0; Y < receivers.y0 + r1; ++Y) {
             const float* src = heights.row(s * Y);
             float* d = out.row(Y);
             for (int X = 0; X < nxr; ++X) d[X] = src[s * X];
@@ -246,7 +252,8 @@ void synthesisePass(ConstGridView src, int o, int pass, float blend, HeightPyram
 // o k_v itself (q = 0), so it is synthesised straight into that level; only
 // the octaves above the last level, which the top levels blend towards, get
 // fields of their own (HeightPyramid::synth).
-void synthesiseOctaves(ConstGridView heights, int nLevels, int nOctaves, bool withMax, HeightPyramid& p) {
+void synthesiseOctaves(ConstGridView heights, RowSpan changed, int nLevels, int nOctaves, bool withMax,
+                       HeightPyramid& p) {
     const int nxr = p.nxr, nyr = p.nyr, kv = std::max(1, p.settings.levelsPerOctave);
     p.octaves = nOctaves;
     p.levels.resize(static_cast<std::size_t>(nLevels));
@@ -257,7 +264,7 @@ void synthesiseOctaves(ConstGridView heights, int nLevels, int nOctaves, bool wi
         PaddedField& out = octaveField(p, o);
         out.resize(nxr, nyr);
         if (o == 0) {
-            receiverHeights(heights, p.subsample, out);
+            receiverHeights(heights, p.subsample, changed, out);
             continue;
         }
         for (int pass = 0; pass < (withMax ? 2 : 1); ++pass) {
@@ -300,8 +307,10 @@ void blendLevels(int nLevels, int nOctaves, int kv, HeightPyramid& p) {
 }  // namespace
 
 void buildHeightPyramid(ConstGridView heights, float cellSize, int subsample, const PyramidSettings& settings,
-                        HeightPyramid& p) {
+                        HeightPyramid& p, RowSpan changed) {
     const int nx = heights.nx, ny = heights.ny, s = subsample;
+    // only on the same grid and settings are the other rows' raw phases and receiver heights there
+    if (p.nx != nx || p.ny != ny || p.subsample != s || !(p.settings == settings) || p.rawPhase.empty()) changed = {};
     const int kv = std::max(1, settings.levelsPerOctave);
     p.nx = nx;
     p.ny = ny;
@@ -312,7 +321,7 @@ void buildHeightPyramid(ConstGridView heights, float cellSize, int subsample, co
     p.settings = settings;
 
     const int maxLevel = buildSteps(p, kv, cellSize);
-    splitRawPhases(heights, p);
+    splitRawPhases(heights, changed, p);
     const int nLevels = maxLevel + 1;
     if (nLevels <= 0) {
         p.levels.resize(0);
@@ -323,7 +332,7 @@ void buildHeightPyramid(ConstGridView heights, float cellSize, int subsample, co
     const int nOctaves = octaveCount(nx, ny, nLevels, kv);
     const bool withMax = settings.peakBlend > 0.0f;
     decimateOctaves(heights, nOctaves, withMax, p);
-    synthesiseOctaves(heights, nLevels, nOctaves, withMax, p);
+    synthesiseOctaves(heights, changed, nLevels, nOctaves, withMax, p);
     blendLevels(nLevels, nOctaves, kv, p);
 }
 

@@ -131,7 +131,10 @@ int pyramidStepCount(int nx, int ny, int levelsPerOctave);
 const PaddedField& octaveSynthesis(const HeightPyramid& pyramid, int o);
 
 /// Builds (or rebuilds, reusing every buffer) the pyramid of `heights`.
+/// With `changed`, when `out` holds the pyramid of heights that differ only
+/// in those rows on the same grid and settings, the passes that copy rows
+/// (the raw phases, the receivers' heights) redo only theirs.
 void buildHeightPyramid(ConstGridView heights, float cellSize, int subsample, const PyramidSettings& settings,
-                        HeightPyramid& out);
+                        HeightPyramid& out, RowSpan changed = {});
 
 }  // namespace terrain::gi

@@ -587,9 +587,14 @@ void visibilityOfRow(const VisibilityRows& r, int Y, std::span<const ColumnSpan>
 
 }  // namespace
 
-void computeFootprintBox(ConstGridView gradX, ConstGridView gradY, int s, FootprintBox& out) {
+void computeFootprintBox(ConstGridView gradX, ConstGridView gradY, int s, FootprintBox& out, RowSpan changedGradients) {
     const int nx = gradX.nx, ny = gradX.ny, nxr = receiverCount(nx, s), nyr = receiverCount(ny, s), half = s / 2;
     const std::size_t n = static_cast<std::size_t>(nxr) * nyr;
+    if (out.nxr != nxr || out.nyr != nyr || out.subsample != s || out.loX.size() != n) changedGradients = {};
+    // receiver Y reads the rows s Y - half .. s Y + half (clamped to the
+    // field, which moves none of them out of a span that holds the edge row)
+    const RowSpan g = changedGradients.cut(ny);
+    const RowSpan receivers = RowSpan{(g.y0 - half + s - 1) / s, (g.y1 - 1 + half) / s + 1}.cut(nyr);
     out.nxr = nxr;
     out.nyr = nyr;
     out.subsample = s;
@@ -599,8 +604,8 @@ void computeFootprintBox(ConstGridView gradX, ConstGridView gradY, int s, Footpr
     out.hiY.resize(n);
     // receivers whose footprint columns need no clamping: s X - half >= 0, s X + half <= nx - 1
     const int inFirst = half > 0 ? 1 : 0, inEnd = std::max(inFirst, std::min(nxr, (nx - 1 - half) / s + 1));
-    parallelForRows(nyr, nxr, [&](int y0, int y1) {
-        for (int Y = y0; Y < y1; ++Y) {
+    parallelForRows(receivers.y1 - receivers.y0, nxr, [&](int r0, int r1) {
+        for (int Y = receivers.y0 + r0; Y < receivers.y0 + r1; ++Y) {
             // the footprint's rows (one without sub-sampling), clamped to the field
             std::array<int, 3> rows{s * Y, s * Y, s * Y};
             if (half > 0) rows = {std::max(s * Y - half, 0), s * Y, std::min(s * Y + half, ny - 1)};

@@ -125,7 +125,11 @@ struct FootprintBox {
     int nxr = 0, nyr = 0, subsample = 0;
     std::vector<float> loX, hiX, loY, hiY;
 };
-void computeFootprintBox(ConstGridView gradX, ConstGridView gradY, int subsample, FootprintBox& out);
+/// With `changedGradients` (a box of this grid already there, of gradients
+/// that differ only in those rows), only the receivers whose footprint
+/// reads a changed row.
+void computeFootprintBox(ConstGridView gradX, ConstGridView gradY, int subsample, FootprintBox& out,
+                         RowSpan changedGradients = {});
 
 /// Azimuth set and elevation window of one visibility computation.
 struct VisibilityTarget {
