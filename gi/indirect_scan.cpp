@@ -14,10 +14,18 @@ namespace {
 // The field's highest height (the raw heights; the pyramid levels are
 // filters of it and so stay below it, up to float rounding: 1e-6 relative slack).
 float fieldTopHeight(const HeightPyramid& pyr) {
-    float hMax = -std::numeric_limits<float>::infinity();
-    for (int y = 0; y < pyr.ny; ++y)
-        for (int q = 0; q < pyr.subsample; ++q)
-            for (int x = 0; x < pyr.rawPhaseWidth; ++x) hMax = std::max(hMax, pyr.rawPhaseRow(q, y)[x]);
+    constexpr float kNone = -std::numeric_limits<float>::infinity();
+    // a maximum is exact, so rows in parallel give the same value
+    float hMax = deterministicReduce(
+        0, pyr.ny, 32, kNone,
+        [&](int y0, int y1) {
+            float m = kNone;
+            for (int y = y0; y < y1; ++y)
+                for (int q = 0; q < pyr.subsample; ++q)
+                    for (int x = 0; x < pyr.rawPhaseWidth; ++x) m = std::max(m, pyr.rawPhaseRow(q, y)[x]);
+            return m;
+        },
+        [](float a, float b) { return std::max(a, b); });
     hMax += std::fabs(hMax) * 1e-6f + 1e-30f;
     return hMax;
 }
