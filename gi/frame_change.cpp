@@ -21,8 +21,7 @@ RowSpan differingRows(const Grid& a, ConstGridView b) {
 bool sameGrid(const Grid& a, ConstGridView b) {
     if (a.nx != b.nx || a.ny != b.ny) return false;
     for (int y = 0; y < b.ny; ++y)
-        if (std::memcmp(a.data() + static_cast<std::size_t>(y) * a.nx, b.row(y), sizeof(float) * b.nx) != 0)
-            return false;
+        if (!sameRow(a, b, y)) return false;
     return true;
 }
 
@@ -81,7 +80,7 @@ FrameChange compareFrameInputs(const FrameInputs& last, ConstGridView heights, f
 
 void recordFrameInputs(ConstGridView heights, float cellSize, const GiLighting& lighting, const GiSettings& settings,
                        const AlbedoMap* albedo, const FrameChange& change, FrameInputs& out) {
-    if (change.geometry) copyGrid(heights, out.heights, change.heightsOnly ? change.heightRows : RowSpan{});
+    if (change.geometry) copyGrid(heights, out.heights, change.heightRows);  // every row unless heightsOnly
     out.cellSize = cellSize;
     out.settings = settings;
     out.environment = lighting.environment;
