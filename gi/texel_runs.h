@@ -99,11 +99,12 @@ void texelTilesToRedo(std::span<const ReceiverTiles* const> recomputed, const Co
                       ConstGridView after, int subsample, int reach, ReceiverTiles& out);
 
 /// The texels to redo as rectangles, appended to `out`: per dirty tile of
-/// `recomputed`, the texels that read one of its receivers (its own and the
-/// last row and column of texels of the tiles before it: texelsReadingTiles
-/// along each axis), and, with `before`, per texel tile within `reach`
-/// cells of a height that differs bit for bit, its texels. Finer than
-/// texelTilesToRedo, which takes the whole tiles before a dirty one too.
+/// `recomputed`, the texels that read one of its receivers (its own, and
+/// those of the last receiver column and row of the tiles before it:
+/// texelsReadingTiles along each axis), and, with `before`, per texel tile
+/// within `reach` cells of a height that differs bit for bit, its texels.
+/// Finer than texelTilesToRedo, which takes the whole tiles before a dirty
+/// one too.
 /// The heights are an nx x ny field at sub-sampling s of the tiles' grid.
 void appendTexelsToRedo(const ReceiverTiles& recomputed, const ConstGridView* before, ConstGridView after,
                         int subsample, int reach, std::vector<TexelRect>& out);
