@@ -267,11 +267,14 @@ void occlusionAtReceivers(const HeightPyramid& pyr, ConstGridView gradX, ConstGr
     });
 }
 
-// The runs of the texel passes: the receivers of the dirty tiles and their
-// texels (every one without tiles).
-void planRuns(const ReceiverTiles* tiles, BlockerRadianceState& st) {
+// The runs of the texel passes: the receivers of the dirty tiles, and
+// `runs` or the tiles' texels (every one without tiles).
+void planRuns(const ReceiverTiles* tiles, const TexelRuns* runs, BlockerRadianceState& st) {
     dirtySpans(tiles, st.nxr, st.nyr, st.receiverRuns);
-    texelRunsOfTiles(tiles, st.nx, st.ny, st.subsample, st.texelRuns);
+    if (tiles && runs)
+        st.texelRuns = *runs;
+    else
+        texelRunsOfTiles(tiles, st.nx, st.ny, st.subsample, st.texelRuns);
 }
 
 }  // namespace
@@ -296,7 +299,8 @@ void prepareBlockerRadiance(const HeightPyramid& pyr, int azimuths, BlockerRadia
 }
 
 void computeTexelOcclusion(const HeightPyramid& pyr, ConstGridView gradX, ConstGridView gradY,
-                           const std::vector<double>& phi, const ReceiverTiles* tiles, BlockerRadianceState& st) {
+                           const std::vector<double>& phi, const ReceiverTiles* tiles, const TexelRuns* runs,
+                           BlockerRadianceState& st) {
     const int nx = pyr.nx, s = pyr.subsample, nxr = pyr.nxr;
     const int m = static_cast<int>(phi.size());
     const int B = s;  // border: the near samples reach s - 0.5 cells, their taps s cells
@@ -308,7 +312,7 @@ void computeTexelOcclusion(const HeightPyramid& pyr, ConstGridView gradX, ConstG
     // per full-resolution column: the receivers it interpolates
     st.cols.resize(static_cast<std::size_t>(nx));
     for (int x = 0; x < nx; ++x) st.cols[static_cast<std::size_t>(x)] = receiverLerp(x, s, nxr);
-    planRuns(st.occlusionValid ? tiles : nullptr, st);
+    planRuns(st.occlusionValid ? tiles : nullptr, runs, st);
     const OcclusionPass pass{m, 2.0f / static_cast<float>(m),
                              simd::wideEnabled() ? occlusionAzimuthAvx2 : occlusionAzimuthSse};
     occlusionAtTexels(pyr, gradX, gradY, B, stride, nTaps, pass, st);
@@ -352,7 +356,7 @@ void shadeTexelRun(const BlockerRadianceState& st, const float* const alb[3], in
 }  // namespace
 
 void shadeBlockerRadiance(BlockerRadianceState& st, const AlbedoMap* albedo, const ReceiverTiles* tiles,
-                          std::array<Grid, 3>& rgb) {
+                          const TexelRuns* runs, std::array<Grid, 3>& rgb) {
     const int nx = st.nx, ny = st.ny, s = st.subsample, nxr = st.nxr, nyr = st.nyr;
     for (Grid& g : rgb) g.ensureSize(nx, ny);
     const float* alb[3];
@@ -375,7 +379,7 @@ void shadeBlockerRadiance(BlockerRadianceState& st, const AlbedoMap* albedo, con
         });
         return;
     }
-    planRuns(tiles, st);
+    planRuns(tiles, runs, st);
     const int nBlocks = (ny + kRowsPerBlock - 1) / kRowsPerBlock;
     const std::size_t perBlock = static_cast<std::size_t>(4) * nxr;  // O, E x 3 of a row, between receiver rows
     if (st.scratch.size() < perBlock * nBlocks) st.scratch.resize(perBlock * nBlocks);

@@ -76,8 +76,8 @@ struct BlockerRadianceState {
     std::vector<NearTap> taps;                        // azimuths x near samples
     std::vector<float> cosPhi, sinPhi;
     std::vector<ReceiverLerp> cols;  // per full-resolution column: the receivers it reads
-    // The texel passes' extent (receiver tiles): the receivers to redo and
-    // the texels whose lower receiver is one of them (gi/texel_runs.h).
+    // The texel passes' extent: the receivers to redo and the texels
+    // (gi/texel_runs.h).
     DirtySpans receiverRuns;
     TexelRuns texelRuns;
 };
@@ -88,19 +88,21 @@ void prepareBlockerRadiance(const HeightPyramid& pyr, int azimuths, BlockerRadia
 /// O / pi at every texel from the receivers' horizons (farSlope, filled) and
 /// the full-resolution heights; phi: the indirect azimuths (radians). With
 /// receiver tiles (null: every texel) and a valid occlusion of this grid in
-/// the state, only the receivers of the dirty tiles and the texels whose
-/// lower receiver (receiverLerp's i0, along both axes) is one of them; the
-/// others keep their values (gi/texel_runs.h). Each value is the same
-/// whichever are computed.
+/// the state, only the receivers of the dirty tiles and the texels of
+/// `runs` (null: those whose lower receiver, receiverLerp's i0 along both
+/// axes, is one of them); the others keep their values (gi/texel_runs.h).
+/// Each value is the same whichever are computed.
 void computeTexelOcclusion(const HeightPyramid& pyr, ConstGridView gradX, ConstGridView gradY,
-                           const std::vector<double>& phi, const ReceiverTiles* tiles, BlockerRadianceState& st);
+                           const std::vector<double>& phi, const ReceiverTiles* tiles, const TexelRuns* runs,
+                           BlockerRadianceState& st);
 
 /// The bounce's exit radiance albedo E(x) / pi at every texel from the
 /// receivers' E / pi (receiverShade). With s = 1 every texel is a receiver.
-/// With receiver tiles (null: every texel), only the texels whose lower
-/// receiver lies in a dirty tile; rgb keeps the others (it must hold a
-/// result of this grid).
+/// With receiver tiles (null: every texel), only the texels of `runs` (null:
+/// those whose lower receiver lies in a dirty tile; with s = 1 the dirty
+/// tiles' receivers); rgb keeps the others (it must hold a result of this
+/// grid).
 void shadeBlockerRadiance(BlockerRadianceState& st, const AlbedoMap* albedo, const ReceiverTiles* tiles,
-                          std::array<Grid, 3>& rgb);
+                          const TexelRuns* runs, std::array<Grid, 3>& rgb);
 
 }  // namespace terrain::gi

@@ -92,6 +92,7 @@ void runIndirectStage(ConstGridView heights, const GiSettings& settings, const F
                             .shading = settings.shading,
                             .only = only,
                             .texels = texels,
+                            .texelRuns = texels ? &st.indirectCache.texelRuns : nullptr,
                             .sameGeometry = !change.geometry};
     computeIndirect(in, settings.indirect, st.indirect);
     if (cached && only == nullptr) recordIndirectSource(st.shade.rgb, st.pyramid, st.indirectCache);

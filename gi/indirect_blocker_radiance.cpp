@@ -157,8 +157,8 @@ void BlockerRadianceIndirect::receiverIrradiance(const RowBlock& rb, const Indir
 void BlockerRadianceIndirect::shade(int b, ShadeMaps& out) {
     const bool keepOcclusion = in_.sameGeometry && st_.blocker.occlusionValid;
     if (b == 1 && in_.heights.subsample > 1 && !keepOcclusion)
-        computeTexelOcclusion(in_.heights, in_.gradX, in_.gradY, in_.op.phi, in_.texels, st_.blocker);
-    shadeBlockerRadiance(st_.blocker, in_.albedo, in_.texels, out.rgb);
+        computeTexelOcclusion(in_.heights, in_.gradX, in_.gradY, in_.op.phi, in_.texels, in_.texelRuns, st_.blocker);
+    shadeBlockerRadiance(st_.blocker, in_.albedo, in_.texels, in_.texelRuns, out.rgb);
 }
 
 }  // namespace terrain::gi

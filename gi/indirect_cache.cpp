@@ -243,11 +243,11 @@ bool sameAlbedoAsLastPass(const AlbedoMap* albedo, IndirectCache& cache) {
 const ReceiverTiles* planIndirectTexels(const IndirectTexelInputs& in, IndirectCache& cache) {
     const bool albedo = sameAlbedoAsLastPass(in.albedo, cache);
     if (!in.gathered || !albedo || (!in.sameGeometry && !in.lastHeights)) return nullptr;
-    // the near samples reach s cells, the gradients one more
     const ConstGridView last = in.lastHeights ? in.lastHeights->cview() : ConstGridView{};
-    const ReceiverTiles* recomputed[] = {in.gathered};
-    texelTilesToRedo(recomputed, in.sameGeometry ? nullptr : &last, in.heights, in.pyramid.subsample,
-                     in.pyramid.subsample + 1, cache.texels);
+    cache.texelRects.clear();
+    appendTexelsToRedo(*in.gathered, in.sameGeometry ? nullptr : &last, in.heights, in.pyramid.subsample,
+                       in.pyramid.subsample + 1, cache.texelRects, &cache.texels);
+    texelRunsOfRects(cache.texelRects, in.heights.nx, in.heights.ny, cache.texelRuns);
     return &cache.texels;
 }
 

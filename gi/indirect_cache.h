@@ -75,6 +75,7 @@
 #include "gi/radiance_pyramid.h"
 #include "gi/receiver_tiles.h"
 #include "gi/shading.h"
+#include "gi/texel_runs.h"
 #include "gi/visibility_cache.h"
 
 namespace terrain::gi {
@@ -104,7 +105,9 @@ struct IndirectCache {
     std::vector<float> radianceBound;    // per tile: this frame's bound from the anchor (boundRadianceChange)
     ReceiverTiles tiles;                 // this frame's tiles to re-gather
     std::vector<std::uint8_t> geometry;  // scratch: the geometry tiles' flags on these tiles
-    ReceiverTiles texels;                // this frame's texel tiles to redo
+    ReceiverTiles texels;                // this frame's tiles whose receivers' occlusion the texel passes redo
+    TexelRuns texelRuns;                 // and the texels they redo
+    std::vector<TexelRect> texelRects;   // their scratch
     std::uint64_t geometryVersion = 0;   // GiState::geometryVersion of the last pass
     PlanSkips skips;                     // frames that re-gather everything unplanned
     bool hadAlbedo = false;              // the last pass's albedo channels (empty: 1)
@@ -155,9 +158,14 @@ struct IndirectTexelInputs {
     const HeightPyramid& pyramid;   // this pass's grid
 };
 
-/// The texel tiles to redo (cache.texels, on the layout of cache.tiles), or
-/// null for every texel: every receiver gathered, the height change not
-/// known, or a new albedo (recorded for the next pass).
+/// The texel passes' extent, or null for every texel: every receiver
+/// gathered, the height change not known, or a new albedo (recorded for the
+/// next pass). cache.texels (on the layout of cache.tiles): the gathered
+/// tiles and those within s + 1 cells of a changed height (the near
+/// samples reach s cells, the gradients one more), whose receivers' own
+/// occlusion may have changed; cache.texelRuns: the texels that read a
+/// gathered receiver and those of the tiles near a changed height
+/// (appendTexelsToRedo).
 const ReceiverTiles* planIndirectTexels(const IndirectTexelInputs& in, IndirectCache& cache);
 
 /// Forgets the cache: the next pass gathers every receiver.

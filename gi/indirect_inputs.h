@@ -7,6 +7,7 @@
 #include "gi/pyramid.h"
 #include "gi/receiver_tiles.h"
 #include "gi/shading.h"
+#include "gi/texel_runs.h"
 #include "gi/visibility.h"
 #include "gi/wedge.h"
 
@@ -37,11 +38,12 @@ struct IndirectInputs {
     // state does not keep (gathersByTiles, gi/indirect.h).
     // GlossyIndirect::VectorPyramid ignores the tiles (every receiver).
     const ReceiverTiles* only = nullptr;
-    // BlockerRadiance, one bounce: the texel tiles whose occlusion and light
-    // the texel passes redo (a texel belongs to the tile of its lower
-    // receiver; gi/blocker_radiance.h); null: every texel. The others keep
-    // the state's values: the caller's cache (gi/indirect_cache.h).
+    // BlockerRadiance, one bounce: the tiles whose receivers' occlusion the
+    // texel passes redo, and the texels whose occlusion and light they redo
+    // (gi/blocker_radiance.h); null: every texel. The others keep the
+    // state's values: the caller's cache (gi/indirect_cache.h).
     const ReceiverTiles* texels = nullptr;
+    const TexelRuns* texelRuns = nullptr;
     // The heights, gradients and settings are those of the state's last
     // call: BlockerRadiance keeps the texel occlusion it computed then
     // (a pure function of them), where it holds one of this grid.

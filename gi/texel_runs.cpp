@@ -107,35 +107,8 @@ bool cellsDiffer(ConstGridView before, ConstGridView after, CellBox box) {
     return false;
 }
 
-// Whether a texel of tile (tx, ty) reads a receiver of a dirty tile: its
-// own, or the next one along x, y or both.
-bool readsDirtyReceivers(const ReceiverTiles& tiles, int tx, int ty) {
-    for (int dy = 0; dy <= 1; ++dy)
-        for (int dx = 0; dx <= 1; ++dx)
-            if (tx + dx < tiles.tilesX && ty + dy < tiles.tilesY && tiles.isDirty(tx + dx, ty + dy)) return true;
-    return false;
-}
-
 }  // namespace
 
-void texelTilesToRedo(std::span<const ReceiverTiles* const> recomputed, const ConstGridView* before,
-                      ConstGridView after, int subsample, int reach, ReceiverTiles& out) {
-    const ReceiverTiles& layout = *recomputed.front();
-    out.reset(layout.nxr, layout.nyr, layout.tileSize, false);
-    for (int ty = 0; ty < out.tilesY; ++ty)
-        for (int tx = 0; tx < out.tilesX; ++tx) {
-            bool dirty = false;
-            for (const ReceiverTiles* t : recomputed) dirty = dirty || readsDirtyReceivers(*t, tx, ty);
-            if (!dirty && before)
-                dirty =
-                    cellsDiffer(*before, after, texelCellsOfTile(out, tx, ty, after.nx, after.ny, subsample, reach));
-            out.setDirty(tx, ty, dirty);
-        }
-}
-
-}  // namespace terrain::gi
-
-namespace terrain::gi {
 
 void texelRunsOfRects(std::span<const TexelRect> rects, int nx, int ny, TexelRuns& out) {
     out.ny = ny;
@@ -165,8 +138,9 @@ long long texelCount(const TexelRuns& runs) {
 }
 
 void appendTexelsToRedo(const ReceiverTiles& recomputed, const ConstGridView* before, ConstGridView after,
-                        int subsample, int reach, std::vector<TexelRect>& out) {
+                        int subsample, int reach, std::vector<TexelRect>& out, ReceiverTiles* flagged) {
     const ReceiverTiles& t = recomputed;
+    if (flagged) flagged->reset(t.nxr, t.nyr, t.tileSize, false);
     const int s = subsample, T = t.tileSize;
     std::vector<int> readX0, readX1, readY0, readY1;
     texelsReadingTiles(after.nx, s, t.nxr, T, readX0, readX1);
@@ -179,12 +153,15 @@ void appendTexelsToRedo(const ReceiverTiles& recomputed, const ConstGridView* be
             const auto x = static_cast<std::size_t>(tx), y = static_cast<std::size_t>(ty);
             if (t.isDirty(tx, ty)) {
                 out.push_back({readX0[x], readY0[y], readX1[x] + 1, readY1[y] + 1});
+                if (flagged) flagged->setDirty(tx, ty);
                 continue;
             }
-            if (before && cellsDiffer(*before, after, texelCellsOfTile(t, tx, ty, after.nx, after.ny, s, reach)))
-                out.push_back({ownX[static_cast<std::size_t>(tx * T)], ownY[static_cast<std::size_t>(ty * T)],
-                               ownX[static_cast<std::size_t>(std::min(t.nxr, (tx + 1) * T))],
-                               ownY[static_cast<std::size_t>(std::min(t.nyr, (ty + 1) * T))]});
+            if (!before || !cellsDiffer(*before, after, texelCellsOfTile(t, tx, ty, after.nx, after.ny, s, reach)))
+                continue;
+            if (flagged) flagged->setDirty(tx, ty);
+            out.push_back({ownX[static_cast<std::size_t>(tx * T)], ownY[static_cast<std::size_t>(ty * T)],
+                           ownX[static_cast<std::size_t>(std::min(t.nxr, (tx + 1) * T))],
+                           ownY[static_cast<std::size_t>(std::min(t.nyr, (ty + 1) * T))]});
         }
 }
 

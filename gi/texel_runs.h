@@ -88,25 +88,15 @@ ColumnSpan receiverColumnsRead(const TexelRuns* runs, int y0, int y1, int n, Low
     return {cols.x0, cols.x1 > cols.x0 ? cols.x1 : cols.x0};
 }
 
-/// The texel tiles to redo (out, on the layout of the tiles in `recomputed`,
-/// which share one): those whose texels read a receiver of a dirty tile of
-/// any of them (their own tile's, or the next one's along x, y or both), or
-/// lie within `reach` cells of a height that differs between `before` and
-/// `after` bit for bit (-0 is not 0: it can change a result's sign); null
-/// `before`: the heights are the same. The heights are a field at
-/// sub-sampling s of the tiles' receiver grid.
-void texelTilesToRedo(std::span<const ReceiverTiles* const> recomputed, const ConstGridView* before,
-                      ConstGridView after, int subsample, int reach, ReceiverTiles& out);
-
 /// The texels to redo as rectangles, appended to `out`: per dirty tile of
 /// `recomputed`, the texels that read one of its receivers (its own, and
 /// those of the last receiver column and row of the tiles before it:
 /// texelsReadingTiles along each axis), and, with `before`, per texel tile
-/// within `reach` cells of a height that differs bit for bit, its texels.
-/// Finer than texelTilesToRedo, which takes the whole tiles before a dirty
-/// one too.
-/// The heights are an nx x ny field at sub-sampling s of the tiles' grid.
+/// within `reach` cells of a height that differs bit for bit (-0 is not 0:
+/// it can change a result's sign), its texels. With `flagged` (null: not
+/// wanted), on recomputed's layout, the tiles of either kind. The heights
+/// are an nx x ny field at sub-sampling s of the tiles' grid.
 void appendTexelsToRedo(const ReceiverTiles& recomputed, const ConstGridView* before, ConstGridView after,
-                        int subsample, int reach, std::vector<TexelRect>& out);
+                        int subsample, int reach, std::vector<TexelRect>& out, ReceiverTiles* flagged = nullptr);
 
 }  // namespace terrain::gi

@@ -111,11 +111,11 @@ TEST_CASE(
                 Setup b;
                 prepare(shape == 0 ? flat : tilted, 1.5f, s, m, false, b);
                 fillFar(b, [&](int, int, int) { return far; });
-                computeTexelOcclusion(b.pyr, b.gx.cview(), b.gy.cview(), b.phi, nullptr, b.st);
+                computeTexelOcclusion(b.pyr, b.gx.cview(), b.gy.cview(), b.phi, nullptr, nullptr, b.st);
                 for (std::vector<float>& e : b.st.receiverShade) std::fill(e.begin(), e.end(), 0.75f);
                 std::array<Grid, 3> rgb;
                 const AlbedoMap a = patternAlbedo(nx, ny);
-                shadeBlockerRadiance(b.st, &a, nullptr, rgb);
+                shadeBlockerRadiance(b.st, &a, nullptr, nullptr, rgb);
                 INFO("s " << s << (shape == 0 ? " flat" : " tilted") << ", far horizon " << far);
                 CHECK(std::count(b.st.occlusion.v.begin(), b.st.occlusion.v.end(), 0.0f) ==
                       static_cast<long>(b.st.occlusion.size()));
@@ -156,7 +156,7 @@ TEST_CASE(
             fillFar(b, [&](int j, int X, int Y) {
                 return static_cast<float>(wallSlope(j, (s * X - c) * cell, (s * Y - c) * cell));
             });
-            computeTexelOcclusion(b.pyr, b.gx.cview(), b.gy.cview(), b.phi, nullptr, b.st);
+            computeTexelOcclusion(b.pyr, b.gx.cview(), b.gy.cview(), b.phi, nullptr, nullptr, b.st);
             INFO("d / r = " << d / r << ", s " << s);
             const double exact = d * d / (r * r + d * d);
             CHECK(std::fabs(b.st.occlusion(c, c) - exact) < 2e-6);
@@ -197,7 +197,7 @@ TEST_CASE("gi.blocker: shading gives O(x) sum w E_k / sum w O_k; E_k = c O_k giv
         Setup b;
         prepare(h, 1.0f, s, m, false, b);
         fillFar(b, patternSlope);
-        computeTexelOcclusion(b.pyr, b.gx.cview(), b.gy.cview(), b.phi, nullptr, b.st);
+        computeTexelOcclusion(b.pyr, b.gx.cview(), b.gy.cview(), b.phi, nullptr, nullptr, b.st);
         INFO("s " << s);
         // every receiver sees a blocker: along phi or phi + pi its own plane is not above 0.05
         for (float o : b.st.receiverOcclusion) REQUIRE(o > 0.0f);
@@ -206,7 +206,7 @@ TEST_CASE("gi.blocker: shading gives O(x) sum w E_k / sum w O_k; E_k = c O_k giv
             for (std::size_t i = 0; i < b.st.receiverOcclusion.size(); ++i)
                 b.st.receiverShade[ch][i] = k[ch] * b.st.receiverOcclusion[i];
         std::array<Grid, 3> rgb;
-        shadeBlockerRadiance(b.st, &a, nullptr, rgb);
+        shadeBlockerRadiance(b.st, &a, nullptr, nullptr, rgb);
         double worst = 0.0;
         int positive = 0;
         for (std::size_t ch = 0; ch < 3; ++ch)
@@ -224,7 +224,7 @@ TEST_CASE("gi.blocker: shading gives O(x) sum w E_k / sum w O_k; E_k = c O_k giv
                 for (int X = 0; X < b.st.nxr; ++X)
                     b.st.receiverShade[ch][static_cast<std::size_t>(Y) * b.st.nxr + X] =
                         0.1f + 0.02f * static_cast<float>((X * 5 + Y * 3 + static_cast<int>(ch)) % 9);
-        shadeBlockerRadiance(b.st, &a, nullptr, rgb);
+        shadeBlockerRadiance(b.st, &a, nullptr, nullptr, rgb);
         worst = 0.0;
         auto receivers = [&](const std::vector<float>& v) {
             return
@@ -252,7 +252,7 @@ TEST_CASE("gi.blocker: at 1x every texel is a receiver and gets albedo E / pi ex
         for (std::size_t i = 0; i < b.st.receiverShade[ch].size(); ++i)
             b.st.receiverShade[ch][i] = 0.01f * static_cast<float>(i % 37 + ch);
     std::array<Grid, 3> rgb;
-    shadeBlockerRadiance(b.st, &a, nullptr, rgb);
+    shadeBlockerRadiance(b.st, &a, nullptr, nullptr, rgb);
     long off = 0;
     for (std::size_t ch = 0; ch < 3; ++ch)
         for (int y = 0; y < ny; ++y)
@@ -278,13 +278,13 @@ TEST_CASE(
             Setup b;
             prepare(h, 1.25f, s, m, false, b);
             fillFar(b, patternSlope);
-            computeTexelOcclusion(b.pyr, b.gx.cview(), b.gy.cview(), b.phi, nullptr, b.st);
+            computeTexelOcclusion(b.pyr, b.gx.cview(), b.gy.cview(), b.phi, nullptr, nullptr, b.st);
             for (std::size_t ch = 0; ch < 3; ++ch)
                 for (std::size_t i = 0; i < b.st.receiverOcclusion.size(); ++i)
                     b.st.receiverShade[ch][i] = (0.2f + 0.1f * static_cast<float>(ch + i % 5)) *  // E_k ~ O_k
                                                 b.st.receiverOcclusion[i];
             Out o;
-            shadeBlockerRadiance(b.st, &a, nullptr, o.rgb);
+            shadeBlockerRadiance(b.st, &a, nullptr, nullptr, o.rgb);
             o.occlusion = b.st.occlusion;
             o.receiverOcclusion = b.st.receiverOcclusion;
             return o;

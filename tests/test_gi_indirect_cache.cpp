@@ -389,9 +389,10 @@ struct WholeTexelPasses {
 };
 WholeTexelPasses redoTexelPasses(const GiState& st, const AlbedoMap* albedo) {
     BlockerRadianceState copy = st.indirect.blocker;
-    computeTexelOcclusion(st.pyramid, st.gradX.cview(), st.gradY.cview(), st.indirectOperator.phi, nullptr, copy);
+    computeTexelOcclusion(st.pyramid, st.gradX.cview(), st.gradY.cview(), st.indirectOperator.phi, nullptr, nullptr,
+                          copy);
     WholeTexelPasses out;
-    shadeBlockerRadiance(copy, albedo, nullptr, out.light);
+    shadeBlockerRadiance(copy, albedo, nullptr, nullptr, out.light);
     out.occlusion = copy.occlusion;
     return out;
 }
@@ -446,8 +447,8 @@ TEST_CASE("gi.indirect_cache: the texel passes redo only the texel tiles whose i
 }
 
 TEST_CASE(
-    "gi.indirect_cache: texel tiles: a height change reaches the tiles within s + 1 cells, a re-gather the tiles "
-    "before it") {
+    "gi.indirect_cache: texel passes: a height change reaches the tiles within s + 1 cells, a re-gather the texels "
+    "that read its receivers") {
     // 200^2 at 2x: 100^2 receivers, tiles of 32 (the last one 4 wide); a
     // texel's tile is that of its lower receiver, clamped to 98
     const Grid before = bumpy(200, 200);
@@ -481,9 +482,25 @@ TEST_CASE(
     CHECK(dirtyTiles(10, 66) == std::vector<int>{0, 4});
     CHECK(dirtyTiles(199, 10) == std::vector<int>{3});  // the last column (receivers 96..99) to the grid's end
     CHECK(dirtyTiles(193, 10) == std::vector<int>{2, 3});
+    CHECK(dirtyTiles(67, 131) == std::vector<int>{9});
+    CHECK(cache.texelRuns.ofRow(127).empty());
+    for (int y : {128, 150, 191}) {  // tile (1, 2)'s own texels: columns 64..127, rows 128..191
+        REQUIRE(cache.texelRuns.ofRow(y).size() == 1);
+        CHECK((cache.texelRuns.ofRow(y)[0].x0 == 64 && cache.texelRuns.ofRow(y)[0].x1 == 128));
+    }
+    CHECK(cache.texelRuns.ofRow(192).empty());
     CHECK(dirtyTiles(-1, 0).empty());  // same geometry, nothing gathered
+    CHECK(texelCount(cache.texelRuns) == 0);
     gathered.setDirty(1, 1);
-    CHECK(dirtyTiles(-1, 0) == std::vector<int>{0, 1, 4, 5});  // the tiles whose texels read tile (1, 1)'s receivers
+    // the receivers' occlusion of tile (1, 1) alone, the texels that read its
+    // receivers 32..63: from the last texels of receiver 31 (62, 63) on
+    CHECK(dirtyTiles(-1, 0) == std::vector<int>{5});
+    CHECK(cache.texelRuns.ofRow(61).empty());
+    for (int y : {62, 100, 127}) {
+        REQUIRE(cache.texelRuns.ofRow(y).size() == 1);
+        CHECK((cache.texelRuns.ofRow(y)[0].x0 == 62 && cache.texelRuns.ofRow(y)[0].x1 == 128));
+    }
+    CHECK(cache.texelRuns.ofRow(128).empty());
     // a new albedo: every texel
     AlbedoMap albedo;
     albedo.channel[0] = Grid(200, 200, 0.5f);
