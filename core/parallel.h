@@ -15,6 +15,8 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "core/grid.h"
+
 namespace terrain {
 
 /// Calls fn(begin, end) over chunks of [begin, end), in parallel.
@@ -31,11 +33,18 @@ void parallelFor(int begin, int end, int grain, Fn&& fn) {
                       [&](const tbb::blocked_range<int>& r) { fn(r.begin(), r.end()); });
 }
 
-/// Rows [0, ny) in parallel, with a grain that keeps chunks around 16k cells.
+/// Rows [rows.y0, rows.y1) (cut to the grid already) in parallel, with a
+/// grain that keeps chunks around 16k cells; fn(y0, y1) gets row numbers.
+template <class Fn>
+void parallelForRows(RowSpan rows, int nx, Fn&& fn) {
+    const int grain = std::max(1, 16384 / std::max(nx, 1));
+    parallelFor(rows.y0, rows.y1, grain, std::forward<Fn>(fn));
+}
+
+/// Rows [0, ny) in parallel (parallelForRows above).
 template <class Fn>
 void parallelForRows(int ny, int nx, Fn&& fn) {
-    const int grain = std::max(1, 16384 / std::max(nx, 1));
-    parallelFor(0, ny, grain, std::forward<Fn>(fn));
+    parallelForRows(RowSpan{0, ny}, nx, std::forward<Fn>(fn));
 }
 
 /// How many threads may run a parallel loop's bodies at once here, and the

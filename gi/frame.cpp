@@ -137,8 +137,8 @@ void computeGradient(ConstGridView h, float cellSize, Grid& gx, Grid& gy, RowSpa
     gy.ensureSize(nx, ny);
     const float inv2 = 0.5f / cellSize, inv1 = 1.0f / cellSize;
     const RowSpan rows = changed.grown(1).cut(ny);  // the central differences read one row either side
-    parallelForRows(rows.y1 - rows.y0, nx, [&](int r0, int r1) {
-        for (int y = rows.y0 + r0; y < rows.y0 + r1; ++y)
+    parallelForRows(rows, nx, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
             for (int x = 0; x < nx; ++x) {
                 float dx = 0.0f, dy = 0.0f;
                 if (nx > 1) {

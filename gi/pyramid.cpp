@@ -139,8 +139,8 @@ void splitRawPhases(ConstGridView heights, RowSpan changed, HeightPyramid& p) {
     p.rawPhase.resize(static_cast<std::size_t>(s) * static_cast<std::size_t>(p.rawPhasePlane) + 2 * kFieldGuard, 0.0f);
     changed = changed.cut(ny);
     const RowSpan rows{changed.y0, changed.y1 == ny ? ny + 1 : changed.y1};
-    parallelForRows(rows.y1 - rows.y0, nx, [&](int r0, int r1) {
-        for (int y = rows.y0 + r0; y < rows.y0 + r1; ++y) {
+    parallelForRows(rows, nx, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y) {
             const float* src = heights.row(std::min(y, ny - 1));
             for (int q = 0; q < s; ++q) {
                 float* d = p.rawPhase.data() + kFieldGuard + q * p.rawPhasePlane + static_cast<std::ptrdiff_t>(y) * wp;
@@ -195,8 +195,8 @@ void receiverHeights(ConstGridView heights, int s, RowSpan changed, PaddedField&
     const int nxr = out.nx, nyr = out.ny;
     changed = changed.cut(heights.ny);
     const RowSpan receivers = RowSpan{(changed.y0 + s - 1) / s, (changed.y1 + s - 1) / s}.cut(nyr);  // s Y in changed
-    parallelForRows(receivers.y1 - receivers.y0, nxr, [&](int r0, int r1) {
-        for (int Y = receivers.y0 + r0; Y < receivers.y0 + r1; ++Y) {
+    parallelForRows(receivers, nxr, [&](int Y0, int Y1) {
+        for (int Y = Y0; Y < Y1; ++Y) {
             const float* src = heights.row(s * Y);
             float* d = out.row(Y);
             for (int X = 0; X < nxr; ++X) d[X] = src[s * X];

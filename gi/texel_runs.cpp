@@ -109,7 +109,6 @@ bool cellsDiffer(ConstGridView before, ConstGridView after, CellBox box) {
 
 }  // namespace
 
-
 void texelRunsOfRects(std::span<const TexelRect> rects, int nx, int ny, TexelRuns& out) {
     out.ny = ny;
     out.first.assign(static_cast<std::size_t>(ny) + 1, 0);

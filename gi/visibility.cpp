@@ -604,8 +604,8 @@ void computeFootprintBox(ConstGridView gradX, ConstGridView gradY, int s, Footpr
     out.hiY.resize(n);
     // receivers whose footprint columns need no clamping: s X - half >= 0, s X + half <= nx - 1
     const int inFirst = half > 0 ? 1 : 0, inEnd = std::max(inFirst, std::min(nxr, (nx - 1 - half) / s + 1));
-    parallelForRows(receivers.y1 - receivers.y0, nxr, [&](int r0, int r1) {
-        for (int Y = receivers.y0 + r0; Y < receivers.y0 + r1; ++Y) {
+    parallelForRows(receivers, nxr, [&](int Y0, int Y1) {
+        for (int Y = Y0; Y < Y1; ++Y) {
             // the footprint's rows (one without sub-sampling), clamped to the field
             std::array<int, 3> rows{s * Y, s * Y, s * Y};
             if (half > 0) rows = {std::max(s * Y - half, 0), s * Y, std::min(s * Y + half, ny - 1)};
