@@ -126,6 +126,25 @@ struct RowSpan {
     RowSpan grown(int d) const { return {y0 - d, y1 > std::numeric_limits<int>::max() - d ? y1 : y1 + d}; }
 };
 
+/// Cells [x0, x1) x [y0, y1) of a grid, cut to it where used; by default
+/// every cell. Empty when x0 >= x1 or y0 >= y1.
+struct CellBox {
+    static constexpr int kAll = std::numeric_limits<int>::max();
+    int x0 = 0, y0 = 0, x1 = kAll, y1 = kAll;
+    RowSpan rows() const { return {y0, y1}; }
+    bool empty() const { return x0 >= x1 || y0 >= y1; }
+    CellBox cut(int nx, int ny) const {
+        const RowSpan c = RowSpan{x0, x1}.cut(nx), r = RowSpan{y0, y1}.cut(ny);
+        return {c.y0, r.y0, c.y1, r.y1};
+    }
+    /// The smallest box holding both (an empty one adds nothing).
+    CellBox joined(const CellBox& o) const {
+        if (o.empty()) return *this;
+        if (empty()) return o;
+        return {std::min(x0, o.x0), std::min(y0, o.y0), std::max(x1, o.x1), std::max(y1, o.y1)};
+    }
+};
+
 /// Copies a view into an owning grid (its storage kept when the size is the
 /// same), only `rows` when the size is the same.
 inline void copyGrid(ConstGridView from, Grid& to, RowSpan rows = {}) {

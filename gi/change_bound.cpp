@@ -110,14 +110,14 @@ void decimateLevels(MaxChangePyramid& p) {
 }
 
 // Cells [x0, x1] x [y0, y1], inclusive.
-struct CellBox {
+struct InclusiveCells {
     int x0, y0, x1, y1;
 };
 
 // Raises m to the largest |dh| of the cells of block (bx, by) of level k that
 // lie in the box (clamped to the grid), descending into the blocks the box
 // cuts only while they could beat m.
-void maxOfBlockInBox(const MaxChangePyramid& p, const CellBox& box, int k, int bx, int by, float& m) {
+void maxOfBlockInBox(const MaxChangePyramid& p, const InclusiveCells& box, int k, int bx, int by, float& m) {
     const Grid& g = p.levels[static_cast<std::size_t>(k)];
     if (bx >= g.nx || by >= g.ny) return;
     const float v = g.v[static_cast<std::size_t>(by) * g.nx + bx];
@@ -140,7 +140,7 @@ void requireSameSize(const MaxChangePyramid& dh, const HeightPyramid& pyr, int t
 }
 
 // Cells of the receivers of tile (tx, ty).
-CellBox tileCells(const HeightPyramid& pyr, int T, int tx, int ty) {
+InclusiveCells tileCells(const HeightPyramid& pyr, int T, int tx, int ty) {
     const int s = pyr.subsample;
     const int X0 = T * tx, Y0 = T * ty;
     const int X1 = std::min(pyr.nxr - 1, X0 + T - 1), Y1 = std::min(pyr.nyr - 1, Y0 + T - 1);
@@ -198,7 +198,7 @@ int firstLevelStep(const HeightPyramid& pyr) {
 // (cells c): the tile's cells dilated by the farthest sample plus the reach.
 // The dilation never shrinks from one step to the next (t'_max, the texel
 // size and the reach grow with i), so the boxes are nested.
-float changeWithinStep(const MaxChangePyramid& dh, const HeightPyramid& pyr, const CellBox& c, int i) {
+float changeWithinStep(const MaxChangePyramid& dh, const HeightPyramid& pyr, const InclusiveCells& c, int i) {
     const StepExtent e = stepExtent(pyr, i);
     const int d = static_cast<int>(std::ceil(e.tauMax + e.reach));
     return maxChangeInBox(dh, c.x0 - d, c.y0 - d, c.x1 + d, c.y1 + d);
@@ -206,7 +206,7 @@ float changeWithinStep(const MaxChangePyramid& dh, const HeightPyramid& pyr, con
 
 // A step q such that steps 0..q see no change at all (-1: none known), by
 // bisection: a box reading 0 holds no change, nor do the boxes nested in it.
-int lastQuietStep(const MaxChangePyramid& dh, const HeightPyramid& pyr, const CellBox& c) {
+int lastQuietStep(const MaxChangePyramid& dh, const HeightPyramid& pyr, const InclusiveCells& c) {
     int quiet = -1, busy = static_cast<int>(pyr.steps.size());
     while (busy - quiet > 1) {
         const int mid = quiet + (busy - quiet) / 2;
@@ -217,14 +217,14 @@ int lastQuietStep(const MaxChangePyramid& dh, const HeightPyramid& pyr, const Ce
 
 // The first step whose samples may see a change: quiet steps' boxes hold the
 // tile's own cells, so with a change there (m0 > 0) every step counts.
-int firstBusyStep(const MaxChangePyramid& dh, const HeightPyramid& pyr, const CellBox& c, double m0) {
+int firstBusyStep(const MaxChangePyramid& dh, const HeightPyramid& pyr, const InclusiveCells& c, double m0) {
     return m0 > 0.0 ? 0 : lastQuietStep(dh, pyr, c) + 1;
 }
 
 // boundOfTile with the first level step found once per call.
 float boundOfTileFrom(const MaxChangePyramid& dh, const HeightPyramid& pyr, int T, int tx, int ty, int firstLevel,
                       double lipschitz) {
-    const CellBox c = tileCells(pyr, T, tx, ty);
+    const InclusiveCells c = tileCells(pyr, T, tx, ty);
     const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
     const double mAll = maxChangeAll(dh);
     const double cellSize = pyr.cellSize;
@@ -269,7 +269,7 @@ Directions directionsOver(double phi0, double phi1) {
 // any receiver of the tile: the tile's cells swept from t'_min to t'_max
 // along them, dilated by the reach plus one cell, and cut to the box of all
 // azimuths (changeWithinStep), which holds the samples too.
-CellBox stepBoxOver(const StepExtent& e, const CellBox& c, const Directions& dir) {
+InclusiveCells stepBoxOver(const StepExtent& e, const InclusiveCells& c, const Directions& dir) {
     const double x0 = std::min(e.tauMin * dir.cMin, e.tauMax * dir.cMin);
     const double x1 = std::max(e.tauMin * dir.cMax, e.tauMax * dir.cMax);
     const double y0 = std::min(e.tauMin * dir.sMin, e.tauMax * dir.sMin);
@@ -368,7 +368,7 @@ StepTable stepTable(const HeightPyramid& pyr) {
 }
 
 // D: the largest move of step i's level samples from the changes in box.
-double filteredChange(const MaxChangePyramid& dh, const StepTable& t, int i, const CellBox& box) {
+double filteredChange(const MaxChangePyramid& dh, const StepTable& t, int i, const InclusiveCells& box) {
     const double m = maxChangeInBox(dh, box.x0, box.y0, box.x1, box.y1);
     const int o = t.octave[static_cast<std::size_t>(i)];
     if (o == 0 || m == 0.0) return (t.meanPart + t.maxPart) * m;
@@ -380,14 +380,14 @@ double filteredChange(const MaxChangePyramid& dh, const StepTable& t, int i, con
 }
 
 // Steps before `first` see no change from any azimuth (lastQuietStep).
-double azimuthBoundFrom(const MaxChangePyramid& dh, const HeightPyramid& pyr, const StepTable& steps, const CellBox& c,
+double azimuthBoundFrom(const MaxChangePyramid& dh, const HeightPyramid& pyr, const StepTable& steps, const InclusiveCells& c,
                         double m0, int first, const Directions& dir, double lipschitz) {
     const double mAll = maxChangeAll(dh), cellSize = pyr.cellSize;
     double best = 0.0;
     for (std::size_t i = static_cast<std::size_t>(first); i < steps.extent.size(); ++i) {
         // no later step can beat best even if it sees the largest change anywhere
         if ((lipschitz * mAll + m0) / (steps.tauMinFrom[i] * cellSize) <= best) break;
-        const CellBox box = stepBoxOver(steps.extent[i], c, dir);
+        const InclusiveCells box = stepBoxOver(steps.extent[i], c, dir);
         const double d = filteredChange(dh, steps, static_cast<int>(i), box);
         best = std::max(best, (d + m0) / (steps.extent[i].tauMin * cellSize));
     }
@@ -410,7 +410,7 @@ void forEachTile(const HeightPyramid& pyr, int T, std::vector<float>& out, PerTi
 // wanted) over each distance group's steps (kDistanceGroups values, raised to
 // it); steps before `first` see no change from any azimuth, and no step's D
 // exceeds the largest change anywhere.
-double sampleBoundFrom(const MaxChangePyramid& dv, const StepTable& steps, const CellBox& c, int first, double cs,
+double sampleBoundFrom(const MaxChangePyramid& dv, const StepTable& steps, const InclusiveCells& c, int first, double cs,
                        double sn, double* groupBest = nullptr) {
     const double mAll = maxChangeAll(dv);
     double best = 0.0;
@@ -419,7 +419,7 @@ double sampleBoundFrom(const MaxChangePyramid& dv, const StepTable& steps, const
         // group's over every azimuth so far) are already the largest change
         double* group = groupBest ? groupBest + steps.group[i] : nullptr;
         if (best >= mAll && (!group || *group >= mAll)) continue;
-        const CellBox box = stepBoxOver(steps.extent[i], c, oneDirection(cs, sn));
+        const InclusiveCells box = stepBoxOver(steps.extent[i], c, oneDirection(cs, sn));
         const double d = filteredChange(dv, steps, static_cast<int>(i), box);
         best = std::max(best, d);
         if (group) *group = std::max(*group, d);
@@ -524,7 +524,7 @@ float maxChangeInBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1) 
     if (missesChange(p, x0, y0, x1, y1)) return 0.0f;
     const int k = clampBoxToLevel(p, x0, y0, x1, y1);
     if (k < 0) return 0.0f;
-    const CellBox box{x0, y0, x1, y1};
+    const InclusiveCells box{x0, y0, x1, y1};
     float m = 0.0f;
     for (int by = y0 >> k; by <= y1 >> k; ++by)
         for (int bx = x0 >> k; bx <= x1 >> k; ++bx) maxOfBlockInBox(p, box, k, bx, by, m);
@@ -577,7 +577,7 @@ void boundSlopeChange(const MaxChangePyramid& dh, const HeightPyramid& pyr, int 
 float blockingMaxLipschitz(BlockingMax rule) { return rule == BlockingMax::Samples ? 1.0f : 20.0f / 16.0f; }
 
 float gradientBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int tx, int ty) {
-    const CellBox c = tileCells(pyr, tileReceivers, tx, ty);
+    const InclusiveCells c = tileCells(pyr, tileReceivers, tx, ty);
     const int half = pyr.subsample / 2;
     const int x0 = std::max(c.x0 - half, 0), y0 = std::max(c.y0 - half, 0);
     const int x1 = std::min(c.x1 + half, pyr.nx - 1), y1 = std::min(c.y1 + half, pyr.ny - 1);
@@ -602,7 +602,7 @@ float ambientChangeBound(float slopeBound, float gradientBound, float maxSkyRadi
 
 float azimuthBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int tx, int ty,
                          double phi) {
-    const CellBox c = tileCells(pyr, tileReceivers, tx, ty);
+    const InclusiveCells c = tileCells(pyr, tileReceivers, tx, ty);
     const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
     return roundUp(azimuthBoundFrom(dh, pyr, stepTable(pyr), c, m0, firstBusyStep(dh, pyr, c, m0),
                                     oneDirection(std::cos(phi), std::sin(phi)), heightFilterLipschitz(pyr)));
@@ -614,7 +614,7 @@ void boundSlopeChangePerAzimuth(const MaxChangePyramid& dh, const HeightPyramid&
     const double lipschitz = heightFilterLipschitz(pyr);
     forEachTileAndAzimuth(
         dh, pyr, tileReceivers, azimuths, tileBound,
-        [&](const CellBox& c, const std::vector<double>& cs, const std::vector<double>& sn, float* out, std::size_t) {
+        [&](const InclusiveCells& c, const std::vector<double>& cs, const std::vector<double>& sn, float* out, std::size_t) {
             const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
             const int first = firstBusyStep(dh, pyr, c, m0);
             for (std::size_t j = 0; j < cs.size(); ++j)
@@ -627,7 +627,7 @@ void boundSampleChangePerAzimuth(const MaxChangePyramid& dv, const HeightPyramid
     const StepTable steps = stepTable(field);
     forEachTileAndAzimuth(
         dv, field, tileReceivers, azimuths, tileBound,
-        [&](const CellBox& c, const std::vector<double>& cs, const std::vector<double>& sn, float* out, std::size_t) {
+        [&](const InclusiveCells& c, const std::vector<double>& cs, const std::vector<double>& sn, float* out, std::size_t) {
             const int first = lastQuietStep(dv, field, c) + 1;
             for (std::size_t j = 0; j < cs.size(); ++j)
                 out[j] = roundUp(sampleBoundFrom(dv, steps, c, first, cs[j], sn[j]));
@@ -642,7 +642,7 @@ void boundSampleChangePerAzimuthAndGroup(const MaxChangePyramid& dv, const Heigh
     groupBound.assign(tiles * kDistanceGroups, 0.0f);
     forEachTileAndAzimuth(
         dv, field, tileReceivers, azimuths, tileBound,
-        [&](const CellBox& c, const std::vector<double>& cs, const std::vector<double>& sn, float* out, std::size_t t) {
+        [&](const InclusiveCells& c, const std::vector<double>& cs, const std::vector<double>& sn, float* out, std::size_t t) {
             const int first = lastQuietStep(dv, field, c) + 1;
             double groups[kDistanceGroups] = {};
             for (std::size_t j = 0; j < cs.size(); ++j)
@@ -669,7 +669,7 @@ float keyLightFractionBound(float slopeBound, float gradientBound, float sinLow,
 
 float rangeBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int tx, int ty,
                        double phi0, double phi1) {
-    const CellBox c = tileCells(pyr, tileReceivers, tx, ty);
+    const InclusiveCells c = tileCells(pyr, tileReceivers, tx, ty);
     const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
     return roundUp(azimuthBoundFrom(dh, pyr, stepTable(pyr), c, m0, firstBusyStep(dh, pyr, c, m0),
                                     directionsOver(phi0, phi1), heightFilterLipschitz(pyr)));
@@ -683,7 +683,7 @@ void boundSlopeChangeOverRange(const MaxChangePyramid& dh, const HeightPyramid& 
     const double lipschitz = heightFilterLipschitz(pyr);
     const Directions dir = directionsOver(phi0, phi1);
     forEachTile(pyr, tileReceivers, tileBound, [&](int tx, int ty) {
-        const CellBox c = tileCells(pyr, tileReceivers, tx, ty);
+        const InclusiveCells c = tileCells(pyr, tileReceivers, tx, ty);
         const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
         return roundUp(azimuthBoundFrom(dh, pyr, steps, c, m0, firstBusyStep(dh, pyr, c, m0), dir, lipschitz));
     });

@@ -93,8 +93,10 @@ void runIndirectStage(ConstGridView heights, const GiSettings& settings, const F
                             .only = only,
                             .texels = texels,
                             .texelRuns = texels ? &st.indirectCache.texelRuns : nullptr,
-                            .sameGeometry = !change.geometry};
+                            .sameGeometry = !change.geometry,
+                            .directChanged = settings.incremental ? st.directChanged : CellBox{}};
     computeIndirect(in, settings.indirect, st.indirect);
+    st.directChanged = {0, 0, 0, 0};  // the indirect light has read every change
     if (cached && only == nullptr) recordIndirectSource(st.shade.rgb, st.pyramid, st.indirectCache);
     st.indirectCache.geometryVersion = st.geometryVersion;
     st.indirectRecomputed = only ? only->dirtyFraction() : 1.0;
@@ -362,6 +364,7 @@ void directShading(const GiLighting& lighting, const GiSettings& settings, const
     st.shadingLights[0] = environmentShadingLight(sky.sh, st.envVisibility);
     for (std::size_t k = 0; k < (exactKeys ? 0 : nKeys); ++k)
         st.shadingLights[k + 1] = keyShadingLight(lighting.keys[k], st.keyVisibility[k]);
+    st.directChanged = st.directChanged.joined(runs ? boundingBox(*runs) : CellBox{});
     shadeTexels(st.gradX.cview(), st.gradY.cview(), settings.subsample, st.envVisibility, st.shadingLights.data(),
                 static_cast<int>(st.shadingLights.size()), albedo, settings.shading, st.shade, shAmbient, runs);
     if (sky.exactSky)
@@ -451,15 +454,17 @@ void runDirectStages(ConstGridView heights, float cellSize, const GiLighting& li
     RowSpan gradientRows;  // the gradients' rows this frame changes (every row unless told otherwise)
     if (change.geometry) {
         ++st.geometryVersion;
-        // the passes that go row by row redo the changed rows alone when the
-        // buffers hold the recorded heights' results
-        const RowSpan rows = change.heightsOnly && st.geometryOfRecord ? change.heightRows : RowSpan{};
+        // when the buffers hold the recorded heights' results, the passes
+        // that go row by row redo the changed rows alone, and the height
+        // pyramid what the box of changed cells reaches
+        const CellBox box = change.heightsOnly && st.geometryOfRecord ? change.heightBox : CellBox{};
+        const RowSpan rows = box.rows();
         st.geometryOfRecord = false;  // until this frame's inputs are recorded
         computeGradient(heights, cellSize, st.gradX, st.gradY, rows);
         gradientRows = rows.grown(1);
         st.timings.gradient = msSince(t);
         t = Clock::now();
-        buildHeightPyramid(heights, cellSize, settings.subsample, settings.pyramid, st.pyramid, rows);
+        buildHeightPyramid(heights, cellSize, settings.subsample, settings.pyramid, st.pyramid, box);
         st.timings.pyramid = msSince(t);
         t = Clock::now();
     }

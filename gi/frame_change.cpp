@@ -10,12 +10,28 @@ bool sameRow(const Grid& a, ConstGridView b, int y) {
     return std::memcmp(a.data() + static_cast<std::size_t>(y) * a.nx, b.row(y), sizeof(float) * b.nx) == 0;
 }
 
-// The rows from the first to the last that differ (same sizes); empty when none does.
-RowSpan differingRows(const Grid& a, ConstGridView b) {
+// The box from the first to the last row that differ (same sizes), and in
+// those rows from the first to the last differing column; empty when no
+// cell differs. Bits are compared (as the rows are), so -0 and 0 differ.
+CellBox differingCells(const Grid& a, ConstGridView b) {
     int y0 = 0, y1 = b.ny;
     while (y0 < y1 && sameRow(a, b, y0)) ++y0;
     while (y1 > y0 && sameRow(a, b, y1 - 1)) --y1;
-    return {y0, y1};
+    if (y0 == y1) return {0, 0, 0, 0};
+    const auto same = [&](int x, int y) {
+        return std::memcmp(a.data() + static_cast<std::size_t>(y) * a.nx + x, b.row(y) + x, sizeof(float)) == 0;
+    };
+    int x0 = b.nx, x1 = 0;
+    for (int y = y0; y < y1; ++y) {
+        int first = 0, last = b.nx;
+        while (first < std::min(x0, last) && same(first, y)) ++first;
+        while (last > std::max(x1, first) && same(last - 1, y)) --last;
+        if (first < last) {
+            x0 = std::min(x0, first);
+            x1 = std::max(x1, last);
+        }
+    }
+    return {x0, y0, x1, y1};
 }
 
 bool sameGrid(const Grid& a, ConstGridView b) {
@@ -61,11 +77,11 @@ FrameChange compareFrameInputs(const FrameInputs& last, ConstGridView heights, f
     const bool sameFrame = cellSize == last.cellSize && settings == last.settings && last.heights.nx == heights.nx &&
                            last.heights.ny == heights.ny;
     if (sameFrame) {
-        c.heightRows = differingRows(last.heights, heights);
-        c.geometry = c.heightRows.y0 < c.heightRows.y1;
+        c.heightBox = differingCells(last.heights, heights);
+        c.geometry = !c.heightBox.empty();
     }
     c.heightsOnly = sameFrame && c.geometry;
-    if (!c.heightsOnly) c.heightRows = {};
+    if (!c.heightsOnly) c.heightBox = {};
     c.keyRegion.assign(nKeys, true);
     bool keyRadiance = nKeys != last.keys.size();
     for (std::size_t k = 0; k < nKeys; ++k) {
@@ -80,7 +96,7 @@ FrameChange compareFrameInputs(const FrameInputs& last, ConstGridView heights, f
 
 void recordFrameInputs(ConstGridView heights, float cellSize, const GiLighting& lighting, const GiSettings& settings,
                        const AlbedoMap* albedo, const FrameChange& change, FrameInputs& out) {
-    if (change.geometry) copyGrid(heights, out.heights, change.heightRows);  // every row unless heightsOnly
+    if (change.geometry) copyGrid(heights, out.heights, change.heightBox.rows());  // every row unless heightsOnly
     out.cellSize = cellSize;
     out.settings = settings;
     out.environment = lighting.environment;

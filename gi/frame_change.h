@@ -40,9 +40,10 @@ struct FrameChange {
     // Only the heights changed (same size, cell size and settings): the
     // visibility may be recomputed tile by tile (gi/visibility_cache.h).
     bool heightsOnly = false;
-    // With heightsOnly: the rows holding every height that differs from the
-    // record (the first to the last that differ); otherwise every row.
-    RowSpan heightRows;
+    // With heightsOnly: the box holding every height that differs from the
+    // record bit for bit (the first to the last differing row, and in those
+    // rows the first to the last differing column); otherwise every cell.
+    CellBox heightBox;
     std::vector<bool> keyRegion;  // per key light: its region of the sky is new (direction, size, count)
     bool radiance = true;         // environment, key radiances or albedo: shading and indirect light
     bool any() const;

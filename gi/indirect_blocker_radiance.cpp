@@ -63,7 +63,7 @@ void BlockerRadianceIndirect::beginFrame() {
 }
 
 void BlockerRadianceIndirect::buildPyramid(const BounceSource& previous) {
-    scan_.buildPyramid(*previous.rgb, settings_.radiance);
+    scan_.buildPyramid(previous, settings_.radiance);
 }
 
 void BlockerRadianceIndirect::scan(int b) {

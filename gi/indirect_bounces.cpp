@@ -55,7 +55,10 @@ void runBounces(const IndirectInputs& in, const IndirectSettings& settings, Indi
     st.timings = IndirectTimings{};
     strategy.beginFrame();
     prepareIndirectSum(in.heights.nx, in.heights.ny, settings.bounces, st);
-    BounceSource source{&in.direct, in.directShade};
+    // the RGB pyramid may be redone where bounce 0 changed only when it is
+    // the last call's bounce 0 (IndirectScan::buildPyramid says so again)
+    BounceSource source{&in.direct, in.directShade, st.radianceOfDirect ? in.directChanged : CellBox{}};
+    st.radianceOfDirect = false;
     for (int b = 1; b <= settings.bounces; ++b) {
         // ---- pyramid of bounce b - 1 (Section 5.3) ------------------------------------
         auto t = Clock::now();

@@ -8,6 +8,7 @@
 // L_1 + ... + L_B. A strategy (IndirectStrategy) supplies the three steps of a
 // bounce; runBounces times them and keeps the sums.
 #include <array>
+#include <optional>
 
 #include "core/grid.h"
 #include "gi/indirect_inputs.h"
@@ -23,6 +24,10 @@ namespace terrain::gi {
 struct BounceSource {
     const std::array<Grid, 3>* rgb;
     const ShadeMaps* shade;
+    // Bounce 0 (IndirectInputs::direct) only: the texels that may differ
+    // from the radiance the state's RGB pyramid was built from (every texel
+    // unless that was the last call's bounce 0 too).
+    std::optional<CellBox> directChanged;
 };
 
 /// One way of turning casting sets into light (gi/indirect_sh_kernel.h,

@@ -48,6 +48,11 @@ struct IndirectInputs {
     // call: BlockerRadiance keeps the texel occlusion it computed then
     // (a pure function of them), where it holds one of this grid.
     bool sameGeometry = false;
+    // The texels of `direct` that may differ from the state's last call's
+    // (every texel by default): after a call whose last pyramid was bounce
+    // 0's, the RGB pyramid of bounce 0 redoes only what reads them, bit for
+    // bit a full build (buildRadiancePyramid).
+    CellBox directChanged;
 };
 
 }  // namespace terrain::gi

@@ -64,8 +64,10 @@ void IndirectScan::beginFrame() {
     dirtySpans(in_.only, in_.heights.nxr, nyr, st_.spans);
 }
 
-void IndirectScan::buildPyramid(const std::array<Grid, 3>& exit, const RadiancePyramidSettings& settings) {
-    buildRadiancePyramid(exit, in_.heights, settings, st_.radiance);
+void IndirectScan::buildPyramid(const BounceSource& source, const RadiancePyramidSettings& settings) {
+    st_.radianceOfDirect = false;  // until a build of bounce 0 is whole
+    buildRadiancePyramid(*source.rgb, in_.heights, settings, st_.radiance, source.directChanged.value_or(CellBox{}));
+    st_.radianceOfDirect = source.directChanged.has_value();
 }
 
 void IndirectScan::buildStepTable() {

@@ -22,6 +22,7 @@
 #include "core/grid.h"
 #include "core/parallel.h"
 #include "gi/casting_set_scan.h"
+#include "gi/indirect_bounces.h"
 #include "gi/indirect_inputs.h"
 #include "gi/indirect_state.h"
 #include "gi/radiance_pyramid.h"
@@ -48,7 +49,10 @@ public:
     void beginFrame();
     /// The RGB radiance pyramid of the previous bounce's exit radiance (Section 5.3;
     /// not with GlossyNlp).
-    void buildPyramid(const std::array<Grid, 3>& exit, const RadiancePyramidSettings& settings);
+    /// The RGB radiance pyramid of `source`, over the texels its
+    /// directChanged names where that is set (the state's pyramid is then the
+    /// last call's bounce 0, IndirectState::radianceOfDirect).
+    void buildPyramid(const BounceSource& source, const RadiancePyramidSettings& settings);
     /// The bounce's step table: height and radiance steps, valid prefixes
     /// (GlossyNlp: of IndirectState::glossy's pyramid).
     void buildStepTable();

@@ -104,7 +104,7 @@ void ShKernelIndirect::checkExitVectorInputs() {
 // The RGB pyramid of L_(b-1), or E of bounce b - 1 at full resolution and
 // its 48 planes' pyramid (Section 5.3)
 void ShKernelIndirect::buildPyramid(const BounceSource& previous) {
-    if (!exitVectors_) return scan_.buildPyramid(*previous.rgb, settings_.radiance);
+    if (!exitVectors_) return scan_.buildPyramid(previous, settings_.radiance);
     const HeightPyramid& pyr = in_.heights;
     GlossyIndirectState& gs = st_.glossy;
     glossyExitRadiance(in_.gradX, in_.gradY, pyr.subsample, pyr.nxr, pyr.nyr, previous.shade->incident.data(),

@@ -35,6 +35,7 @@ struct GlossyIndirectState {
 
 struct IndirectState {
     RadiancePyramid radiance;             // RGB pyramids: the previous bounce's RGB radiance pyramid
+    bool radianceOfDirect = false;        // radiance is bounce 0's (IndirectInputs::direct) of the last call
     std::vector<ScanStep> heightSteps;    // azimuths x steps
     std::vector<ScanStep> radianceSteps;  // RGB pyramids: channels x azimuths x steps
     std::vector<int> stepsPerColumn, stepsPerRow;

@@ -66,29 +66,48 @@ template <bool UseMax>
     return UseMax ? std::max(std::max(a, b), std::max(c, d)) : 0.25f * ((a + b) + (c + d));
 }
 
+// Rows [y0, y1), columns [x0, x1) of dst.
 template <bool UseMax>
-void decimateRowsOf(ConstGridView src, Grid& dst, int y0, int y1) {
+void decimateRowsOf(ConstGridView src, Grid& dst, int y0, int y1, int x0, int x1) {
     // columns whose 2x2 cells are all inside src (a loop the compiler
     // vectorises), then the last column of an odd width (its cells replicate
     // the last source column)
     const int inside = src.nx / 2;
+    const int insideEnd = std::min(x1, inside);
     for (int y = y0; y < y1; ++y) {
         const float* ra = src.row(std::min(2 * y, src.ny - 1));
         const float* rb = src.row(std::min(2 * y + 1, src.ny - 1));
         float* out = dst.data() + static_cast<std::size_t>(y) * dst.nx;
-        for (int x = 0; x < inside; ++x) out[x] = decimated<UseMax>(ra[2 * x], ra[2 * x + 1], rb[2 * x], rb[2 * x + 1]);
-        for (int x = inside; x < dst.nx; ++x) {
+        for (int x = x0; x < insideEnd; ++x)
+            out[x] = decimated<UseMax>(ra[2 * x], ra[2 * x + 1], rb[2 * x], rb[2 * x + 1]);
+        for (int x = std::max(x0, inside); x < x1; ++x) {
             const int xa = std::min(2 * x, src.nx - 1), xb = std::min(2 * x + 1, src.nx - 1);
             out[x] = decimated<UseMax>(ra[xa], ra[xb], rb[xa], rb[xb]);
         }
     }
 }
 
-void decimateRows(ConstGridView src, Grid& dst, bool useMax, int y0, int y1) {
+void decimateRows(ConstGridView src, Grid& dst, bool useMax, int y0, int y1, int x0, int x1) {
     if (useMax)
-        decimateRowsOf<true>(src, dst, y0, y1);
+        decimateRowsOf<true>(src, dst, y0, y1, x0, x1);
     else
-        decimateRowsOf<false>(src, dst, y0, y1);
+        decimateRowsOf<false>(src, dst, y0, y1, x0, x1);
+}
+
+// The cells of the next octave image (2x2 decimation of a w x h one) that
+// read a cell of `box`.
+CellBox decimatedBox(const CellBox& box, int w, int h) {
+    if (box.empty()) return {0, 0, 0, 0};
+    return CellBox{box.x0 / 2, box.y0 / 2, (box.x1 - 1) / 2 + 1, (box.y1 - 1) / 2 + 1}.cut((w + 1) / 2, (h + 1) / 2);
+}
+
+// The receivers [r0, r1) whose synthesis taps (4 per receiver, nondecreasing
+// along the axis) read a texel of [t0, t1); r0 >= r1 when none does.
+RowSpan receiversReading(const int* taps, int receivers, int t0, int t1) {
+    int r0 = 0, r1 = receivers;
+    while (r0 < r1 && taps[4 * r0 + 3] < t0) ++r0;
+    while (r1 > r0 && taps[4 * (r1 - 1)] >= t1) --r1;
+    return {r0, r1};
 }
 
 // Taps of the B-spline synthesis of octave o (spacing 2^o) at receiver
@@ -171,7 +190,10 @@ int octaveCount(int nx, int ny, int nLevels, int kv) {
 }
 
 // ---- octave images B_o (2x2 decimation) ---------------------------------
-void decimateOctaves(ConstGridView heights, int nOctaves, bool withMax, HeightPyramid& p) {
+// Only the cells that read a changed height: changed[o] is octave o's box
+// (changed[0] the heights').
+void decimateOctaves(ConstGridView heights, int nOctaves, bool withMax, const std::vector<CellBox>& changed,
+                     HeightPyramid& p) {
     p.meanOctaves.resize(static_cast<std::size_t>(nOctaves - 1));
     p.maxOctaves.resize(withMax ? static_cast<std::size_t>(nOctaves - 1) : 0u);
     for (int pass = 0; pass < (withMax ? 2 : 1); ++pass) {
@@ -181,10 +203,26 @@ void decimateOctaves(ConstGridView heights, int nOctaves, bool withMax, HeightPy
             Grid& dst = oct[static_cast<std::size_t>(o - 1)];
             const int w = (src.nx + 1) / 2, h = (src.ny + 1) / 2;
             dst.ensureSize(w, h);
-            parallelForRows(h, w, [&](int y0, int y1) { decimateRows(src, dst, pass == 1, y0, y1); });
+            const CellBox& box = changed[static_cast<std::size_t>(o)];
+            if (!box.empty())
+                parallelForRows(box.rows(), box.x1 - box.x0, [&](int y0, int y1) {
+                    decimateRows(src, dst, pass == 1, y0, y1, box.x0, box.x1);
+                });
             src = dst.cview();
         }
     }
+}
+
+// Each octave image's box of cells that read a changed height.
+std::vector<CellBox> octaveBoxes(const CellBox& heightsBox, int nx, int ny, int nOctaves) {
+    std::vector<CellBox> boxes(static_cast<std::size_t>(std::max(1, nOctaves)));
+    boxes[0] = heightsBox;
+    for (int o = 1; o < nOctaves; ++o) {
+        boxes[static_cast<std::size_t>(o)] = decimatedBox(boxes[static_cast<std::size_t>(o - 1)], nx, ny);
+        nx = (nx + 1) / 2;
+        ny = (ny + 1) / 2;
+    }
+    return boxes;
 }
 
 // S_0: level 0 is the height field itself (Nowrouzezahrai & Snyder 2009,
@@ -205,11 +243,21 @@ void receiverHeights(ConstGridView heights, int s, RowSpan changed, PaddedField&
     out.padEdges();
 }
 
+// The receivers at cells s X, s Y of a box of cells.
+CellBox receiversIn(const CellBox& cells, int s, int nxr, int nyr) {
+    if (cells.empty()) return {0, 0, 0, 0};
+    return CellBox{(cells.x0 + s - 1) / s, (cells.y0 + s - 1) / s, (cells.x1 + s - 1) / s, (cells.y1 + s - 1) / s}
+        .cut(nxr, nyr);
+}
+
 // One pass (0: the mean octave, 1: the max octave) of the B-spline synthesis
 // of octave o >= 1 at the receiver grid, weighted by `blend`: pass 0 writes
 // out, pass 1 adds to it. Separable: rows of B_o to receiver columns
-// (rowTmp), then columns to receiver rows.
-void synthesisePass(ConstGridView src, int o, int pass, float blend, HeightPyramid& p, PaddedField& out) {
+// (rowTmp), then columns to receiver rows. Only the receivers whose taps read
+// a texel of `changed` (a box of B_o), each with the same arithmetic as the
+// whole pass; returns their box.
+CellBox synthesisePass(ConstGridView src, int o, int pass, float blend, const CellBox& changed, HeightPyramid& p,
+                       PaddedField& out) {
     const int nxr = p.nxr, nyr = p.nyr, s = p.subsample;
     int* ix = p.tapIndex.data();
     int* iy = ix + 4 * nxr;
@@ -217,20 +265,27 @@ void synthesisePass(ConstGridView src, int o, int pass, float blend, HeightPyram
     float* wy = wx + 4 * nxr;
     synthesisTaps(nxr, s, o, src.nx, ix, wx);
     synthesisTaps(nyr, s, o, src.ny, iy, wy);
+    if (changed.empty()) return {0, 0, 0, 0};
+    const RowSpan cols = receiversReading(ix, nxr, changed.x0, changed.x1);
+    const RowSpan rows = receiversReading(iy, nyr, changed.y0, changed.y1);
+    if (cols.y0 >= cols.y1 || rows.y0 >= rows.y1) return {0, 0, 0, 0};
+    const int X0 = cols.y0, X1 = cols.y1;
     p.rowTmp.resize(static_cast<std::size_t>(src.ny) * nxr);
     float* tmp = p.rowTmp.data();
-    parallelForRows(src.ny, nxr, [&](int y0, int y1) {
+    // the rows of B_o those receiver rows read (taps nondecreasing)
+    const RowSpan tmpRows{iy[4 * rows.y0], iy[4 * (rows.y1 - 1) + 3] + 1};
+    parallelForRows(tmpRows, X1 - X0, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
             const float* in = src.row(y);
             float* t = tmp + static_cast<std::size_t>(y) * nxr;
-            for (int X = 0; X < nxr; ++X) {
+            for (int X = X0; X < X1; ++X) {
                 const int* k = ix + 4 * X;
                 const float* w = wx + 4 * X;
                 t[X] = (w[0] * in[k[0]] + w[1] * in[k[1]]) + (w[2] * in[k[2]] + w[3] * in[k[3]]);
             }
         }
     });
-    parallelForRows(nyr, nxr, [&](int y0, int y1) {
+    parallelForRows(rows, X1 - X0, [&](int y0, int y1) {
         for (int Y = y0; Y < y1; ++Y) {
             const int* k = iy + 4 * Y;
             const float* w = wy + 4 * Y;
@@ -239,46 +294,54 @@ void synthesisePass(ConstGridView src, int o, int pass, float blend, HeightPyram
             const float* r2 = tmp + static_cast<std::size_t>(k[2]) * nxr;
             const float* r3 = tmp + static_cast<std::size_t>(k[3]) * nxr;
             float* d = out.row(Y);
-            for (int X = 0; X < nxr; ++X) {
+            for (int X = X0; X < X1; ++X) {
                 const float v = (w[0] * r0[X] + w[1] * r1[X]) + (w[2] * r2[X] + w[3] * r3[X]);
                 d[X] = pass == 0 ? blend * v : d[X] + blend * v;
             }
         }
     });
+    return {X0, rows.y0, X1, rows.y1};
 }
 
 // ---- B-spline synthesis of each octave at the receiver grid ---------------
 // S_o; mean and (optionally) max syntheses are blended here. S_o is level
 // o k_v itself (q = 0), so it is synthesised straight into that level; only
 // the octaves above the last level, which the top levels blend towards, get
-// fields of their own (HeightPyramid::synth).
-void synthesiseOctaves(ConstGridView heights, RowSpan changed, int nLevels, int nOctaves, bool withMax,
-                       HeightPyramid& p) {
+// fields of their own (HeightPyramid::synth). Only the receivers that read a
+// changed octave texel (changed[o]); returns each octave's box of them.
+std::vector<CellBox> synthesiseOctaves(ConstGridView heights, const std::vector<CellBox>& changed, int nLevels,
+                                       int nOctaves, bool withMax, HeightPyramid& p) {
     const int nxr = p.nxr, nyr = p.nyr, kv = std::max(1, p.settings.levelsPerOctave);
     p.octaves = nOctaves;
     p.levels.resize(static_cast<std::size_t>(nLevels));
     p.synth.resize(static_cast<std::size_t>(std::max(0, nOctaves - octavesInLevels(nLevels, kv))));
     p.tapIndex.resize(static_cast<std::size_t>(4 * (nxr + nyr)));
     p.tapWeight.resize(static_cast<std::size_t>(4 * (nxr + nyr)));
+    std::vector<CellBox> receivers(static_cast<std::size_t>(nOctaves));
     for (int o = 0; o < nOctaves; ++o) {
         PaddedField& out = octaveField(p, o);
         out.resize(nxr, nyr);
+        const CellBox& box = changed[static_cast<std::size_t>(o)];
         if (o == 0) {
-            receiverHeights(heights, p.subsample, changed, out);
+            receiverHeights(heights, p.subsample, box.rows(), out);
+            receivers[0] = receiversIn(box, p.subsample, nxr, nyr);
             continue;
         }
         for (int pass = 0; pass < (withMax ? 2 : 1); ++pass) {
             ConstGridView src = (pass == 0 ? p.meanOctaves : p.maxOctaves)[static_cast<std::size_t>(o - 1)].cview();
             const float blend = withMax ? (pass == 0 ? 1.0f - p.settings.peakBlend : p.settings.peakBlend) : 1.0f;
-            synthesisePass(src, o, pass, blend, p, out);
+            receivers[static_cast<std::size_t>(o)] = synthesisePass(src, o, pass, blend, box, p, out);
         }
         out.padEdges();
     }
+    return receivers;
 }
 
 // ---- levels between octaves: f_l = (1 - q) S_o + q S_(o+1) -----------------
-// Levels past the last octave repeat it.
-void blendLevels(int nLevels, int nOctaves, int kv, HeightPyramid& p) {
+// Levels past the last octave repeat it. Only the receivers of the two
+// octaves' boxes (`receivers`); the padding then replicates the edges, as
+// the blend of the octaves' replicated edges would.
+void blendLevels(int nLevels, int nOctaves, int kv, const std::vector<CellBox>& receivers, HeightPyramid& p) {
     const int nxr = p.nxr, nyr = p.nyr;
     for (int l = 0; l < nLevels; ++l) {
         int o = l / kv;
@@ -293,24 +356,30 @@ void blendLevels(int nLevels, int nOctaves, int kv, HeightPyramid& p) {
         const PaddedField& a = octaveSynthesis(p, o);
         const PaddedField& b = octaveSynthesis(p, std::min(o + 1, nOctaves - 1));
         const float wa = 1.0f - q, wb = q;
-        parallelForRows(nyr + 1, nxr, [&](int y0, int y1) {
+        const int ob = std::min(o + 1, nOctaves - 1);
+        const CellBox box =
+            receivers[static_cast<std::size_t>(o)].joined(receivers[static_cast<std::size_t>(ob)]).cut(nxr, nyr);
+        if (box.empty()) continue;
+        parallelForRows(box.rows(), box.x1 - box.x0, [&](int y0, int y1) {
             for (int Y = y0; Y < y1; ++Y) {
                 const float* ra = a.row(Y);
                 const float* rb = b.row(Y);
                 float* d = lev.row(Y);
-                for (int X = 0; X <= nxr; ++X) d[X] = wa * ra[X] + wb * rb[X];
+                for (int X = box.x0; X < box.x1; ++X) d[X] = wa * ra[X] + wb * rb[X];
             }
         });
+        lev.padEdges();
     }
 }
 
 }  // namespace
 
 void buildHeightPyramid(ConstGridView heights, float cellSize, int subsample, const PyramidSettings& settings,
-                        HeightPyramid& p, RowSpan changed) {
+                        HeightPyramid& p, CellBox changed) {
     const int nx = heights.nx, ny = heights.ny, s = subsample;
-    // only on the same grid and settings are the other rows' raw phases and receiver heights there
+    // only on the same grid and settings are the other cells' results there
     if (p.nx != nx || p.ny != ny || p.subsample != s || !(p.settings == settings) || p.rawPhase.empty()) changed = {};
+    changed = changed.cut(nx, ny);
     const int kv = std::max(1, settings.levelsPerOctave);
     p.nx = nx;
     p.ny = ny;
@@ -321,7 +390,7 @@ void buildHeightPyramid(ConstGridView heights, float cellSize, int subsample, co
     p.settings = settings;
 
     const int maxLevel = buildSteps(p, kv, cellSize);
-    splitRawPhases(heights, changed, p);
+    splitRawPhases(heights, changed.rows(), p);
     const int nLevels = maxLevel + 1;
     if (nLevels <= 0) {
         p.levels.resize(0);
@@ -331,9 +400,10 @@ void buildHeightPyramid(ConstGridView heights, float cellSize, int subsample, co
     }
     const int nOctaves = octaveCount(nx, ny, nLevels, kv);
     const bool withMax = settings.peakBlend > 0.0f;
-    decimateOctaves(heights, nOctaves, withMax, p);
-    synthesiseOctaves(heights, changed, nLevels, nOctaves, withMax, p);
-    blendLevels(nLevels, nOctaves, kv, p);
+    const std::vector<CellBox> octaveChanges = octaveBoxes(changed, nx, ny, nOctaves);
+    decimateOctaves(heights, nOctaves, withMax, octaveChanges, p);
+    const std::vector<CellBox> receivers = synthesiseOctaves(heights, octaveChanges, nLevels, nOctaves, withMax, p);
+    blendLevels(nLevels, nOctaves, kv, receivers, p);
 }
 
 }  // namespace terrain::gi

@@ -132,9 +132,12 @@ const PaddedField& octaveSynthesis(const HeightPyramid& pyramid, int o);
 
 /// Builds (or rebuilds, reusing every buffer) the pyramid of `heights`.
 /// With `changed`, when `out` holds the pyramid of heights that differ only
-/// in those rows on the same grid and settings, the passes that copy rows
-/// (the raw phases, the receivers' heights) redo only theirs.
+/// inside that box of cells on the same grid and settings: the passes that
+/// copy rows (the raw phases, the receivers' heights) redo the box's rows,
+/// the octave images, their syntheses and the levels the cells that read a
+/// cell of the box (each with the arithmetic of the whole pass, so the
+/// pyramid is the full build's bit for bit).
 void buildHeightPyramid(ConstGridView heights, float cellSize, int subsample, const PyramidSettings& settings,
-                        HeightPyramid& out, RowSpan changed = {});
+                        HeightPyramid& out, CellBox changed = {});
 
 }  // namespace terrain::gi

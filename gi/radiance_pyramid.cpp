@@ -24,25 +24,26 @@ void matchSteps(const HeightPyramid& heights, const RadiancePyramidSettings& s, 
     }
 }
 
-void buildOne(ConstGridView field, const HeightPyramid& heights, const RadiancePyramidSettings& s, HeightPyramid& p) {
+void buildOne(ConstGridView field, const HeightPyramid& heights, const RadiancePyramidSettings& s, HeightPyramid& p,
+              CellBox changed = {}) {
     PyramidSettings ps;
     ps.levelsPerOctave = s.levelsPerOctave;
     ps.levelOffset = s.levelOffset;
     ps.peakBlend = 0.0f;  // radiance: plain mean (box + B-spline) filtering
-    buildHeightPyramid(field, heights.cellSize, heights.subsample, ps, p);
+    buildHeightPyramid(field, heights.cellSize, heights.subsample, ps, p, changed);
     matchSteps(heights, s, p);
 }
 
 }  // namespace
 
 void buildRadiancePyramid(const std::array<Grid, 3>& radiance, const HeightPyramid& heights,
-                          const RadiancePyramidSettings& settings, RadiancePyramid& out) {
+                          const RadiancePyramidSettings& settings, RadiancePyramid& out, CellBox changed) {
     out.fields.resize(3);
     // the channels side by side (each build's own row loops are parallel too)
     parallelFor(0, 3, 1, [&](int c0, int c1) {
         for (int c = c0; c < c1; ++c)
             buildOne(radiance[static_cast<std::size_t>(c)].cview(), heights, settings,
-                     out.fields[static_cast<std::size_t>(c)]);
+                     out.fields[static_cast<std::size_t>(c)], changed);
     });
 }
 

@@ -44,9 +44,12 @@ struct RadiancePyramid {
 };
 
 /// Builds the RGB radiance pyramid of `radiance` (full resolution, the height
-/// pyramid's size) at the height pyramid's receiver grid and steps.
+/// pyramid's size) at the height pyramid's receiver grid and steps. With
+/// `changed`, when `out` holds the pyramid of a radiance that differs only
+/// inside that box of texels (same grid and settings), each channel redoes
+/// the cells that read the box (buildHeightPyramid), bit for bit a full build.
 void buildRadiancePyramid(const std::array<Grid, 3>& radiance, const HeightPyramid& heights,
-                          const RadiancePyramidSettings& settings, RadiancePyramid& out);
+                          const RadiancePyramidSettings& settings, RadiancePyramid& out, CellBox changed = {});
 
 /// The pyramids of many scalar fields stored as bfloat16 (core/bfloat16.h:
 /// 2^-9 relative precision, float's range): every field's pyramid has the

@@ -76,13 +76,13 @@ void texelRunsOfTiles(const ReceiverTiles* tiles, int nx, int ny, int subsample,
 namespace {
 
 // A cell box, inclusive (it may reach outside the grid).
-struct CellBox {
+struct InclusiveCells {
     int x0, y0, x1, y1;
 };
 
 // The cells of tile (tx, ty)'s texels (on `tiles`' receiver grid, an nx x
 // ny field at sub-sampling s), dilated by `reach` cells.
-CellBox texelCellsOfTile(const ReceiverTiles& tiles, int tx, int ty, int nx, int ny, int subsample, int reach) {
+InclusiveCells texelCellsOfTile(const ReceiverTiles& tiles, int tx, int ty, int nx, int ny, int subsample, int reach) {
     const int s = subsample, T = tiles.tileSize;
     // receivers [X0, X1) take the texels [s X0, s X1), and the tile holding
     // receiver n - 2 (the largest lower receiver) the texels up to the end
@@ -97,7 +97,7 @@ CellBox texelCellsOfTile(const ReceiverTiles& tiles, int tx, int ty, int nx, int
 }
 
 // Whether any cell of the box (clamped to the grids) differs bit for bit.
-bool cellsDiffer(ConstGridView before, ConstGridView after, CellBox box) {
+bool cellsDiffer(ConstGridView before, ConstGridView after, InclusiveCells box) {
     const int x0 = std::max(0, box.x0), x1 = std::min(after.nx - 1, box.x1);
     const int y0 = std::max(0, box.y0), y1 = std::min(after.ny - 1, box.y1);
     if (x0 > x1) return false;
@@ -108,6 +108,16 @@ bool cellsDiffer(ConstGridView before, ConstGridView after, CellBox box) {
 }
 
 }  // namespace
+
+CellBox boundingBox(const TexelRuns& runs) {
+    CellBox box{0, 0, 0, 0};
+    for (int y = 0; y < runs.ny; ++y) {
+        const std::span<const ColumnSpan> row = runs.ofRow(y);
+        if (row.empty()) continue;  // runs are not empty, left to right
+        box = box.joined({row.front().x0, y, row.back().x1, y + 1});
+    }
+    return box;
+}
 
 void texelRunsOfRects(std::span<const TexelRect> rects, int nx, int ny, TexelRuns& out) {
     out.ny = ny;

@@ -41,6 +41,9 @@ struct TexelRuns {
 /// Throws InputError when the tiles are not of that receiver grid.
 void texelRunsOfTiles(const ReceiverTiles* tiles, int nx, int ny, int subsample, TexelRuns& out);
 
+/// The smallest box of texels holding every run (empty without runs).
+CellBox boundingBox(const TexelRuns& runs);
+
 /// A rectangle of texels, columns [x0, x1) of rows [y0, y1).
 struct TexelRect {
     int x0 = 0, y0 = 0, x1 = 0, y1 = 0;

@@ -338,7 +338,7 @@ TEST_CASE("gi.frame_change: the passes that redo the changed rows alone give the
             buildHeightPyramid(before.cview(), 2.0f, s, settings.pyramid, pyr);
             computeGradient(after.cview(), 2.0f, gx, gy, band);
             computeFootprintBox(gx.cview(), gy.cview(), s, box, band.grown(1));
-            buildHeightPyramid(after.cview(), 2.0f, s, settings.pyramid, pyr, band);
+            buildHeightPyramid(after.cview(), 2.0f, s, settings.pyramid, pyr, CellBox{0, band.y0, CellBox::kAll, band.y1});
             computeGradient(after.cview(), 2.0f, fullX, fullY);
             computeFootprintBox(fullX.cview(), fullY.cview(), s, fullBox);
             buildHeightPyramid(after.cview(), 2.0f, s, settings.pyramid, fullPyr);
@@ -353,4 +353,45 @@ TEST_CASE("gi.frame_change: the passes that redo the changed rows alone give the
             for (std::size_t l = 0; l < pyr.levels.size(); ++l)
                 CHECK(gi_test::sameBits(pyr.levels[l].v, fullPyr.levels[l].v));
         }
+}
+
+TEST_CASE("gi.frame_change: the changed heights' box holds exactly the cells that differ bit for bit") {
+    const Grid before = bumpy(40, 30);
+    const GiLighting light = sunSkyAndKey();
+    const GiSettings settings;
+    FrameInputs record;
+    recordFrameInputs(before.cview(), 2.0f, light, settings, nullptr, everythingChanged(light.keys.size()), record);
+    struct Edit {
+        std::vector<std::pair<int, int>> cells;
+        CellBox box;
+    };
+    const std::vector<Edit> edits = {
+        {{{0, 0}}, {0, 0, 1, 1}},
+        {{{39, 29}}, {39, 29, 40, 30}},
+        {{{5, 3}, {20, 17}}, {5, 3, 21, 18}},
+        {{{30, 2}, {4, 9}, {17, 5}}, {4, 2, 31, 10}},  // a later row's cells left of the first row's
+        {{{12, 0}, {12, 29}}, {12, 0, 13, 30}},
+    };
+    for (const Edit& e : edits) {
+        Grid after = before;
+        for (auto [x, y] : e.cells) after(x, y) += 0.25f;
+        const FrameChange c = compareFrameInputs(record, after.cview(), 2.0f, light, settings, nullptr);
+        CHECK(c.geometry);
+        CHECK(c.heightsOnly);
+        CHECK(c.heightBox.x0 == e.box.x0);
+        CHECK(c.heightBox.y0 == e.box.y0);
+        CHECK(c.heightBox.x1 == e.box.x1);
+        CHECK(c.heightBox.y1 == e.box.y1);
+    }
+    // -0 against 0 is a change of bits: the pyramid would keep the other sign
+    Grid zero = before;
+    zero(7, 8) = 0.0f;
+    recordFrameInputs(zero.cview(), 2.0f, light, settings, nullptr, everythingChanged(light.keys.size()), record);
+    Grid negative = zero;
+    negative(7, 8) = -0.0f;
+    const FrameChange signs = compareFrameInputs(record, negative.cview(), 2.0f, light, settings, nullptr);
+    CHECK(signs.geometry);
+    CHECK(signs.heightBox.x0 == 7);
+    CHECK(signs.heightBox.x1 == 8);
+    CHECK_FALSE(compareFrameInputs(record, zero.cview(), 2.0f, light, settings, nullptr).geometry);
 }

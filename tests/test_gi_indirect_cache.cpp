@@ -513,3 +513,65 @@ TEST_CASE(
     CHECK(planIndirectTexels(in, cache) == nullptr);
     CHECK(planIndirectTexels(in, cache) != nullptr);  // recorded: the next pass with it is tiled again
 }
+
+TEST_CASE("gi.indirect_cache: bounce 0's radiance pyramid redone over the changed texels is a full build's") {
+    const Grid h = bumpy(120, 96);
+    for (int s : {1, 2}) {
+        CAPTURE(s);
+        const GiSettings settings = withBounces(GiSettings{}, s, 1);
+        GiState st;
+        runGiFrame(h.cview(), kCell, sunSkyAndKey(), settings, st);
+        const FoldedWedgeOperator op = foldFullCircle(settings.indirect.azimuths, settings.visibility.interp);
+        const auto gather = [&](const std::array<Grid, 3>& source, CellBox changed, int bounces, IndirectState& out) {
+            const IndirectInputs in{.heights = st.pyramid,
+                                    .gradX = st.gradX.cview(),
+                                    .gradY = st.gradY.cview(),
+                                    .op = op,
+                                    .envVisibility = st.envVisibility,
+                                    .direct = source,
+                                    .directShade = nullptr,
+                                    .albedo = nullptr,
+                                    .shading = settings.shading,
+                                    .directChanged = changed};
+            IndirectSettings is = settings.indirect;
+            is.bounces = bounces;
+            computeIndirect(in, is, out);
+        };
+        const auto samePyramid = [](const IndirectState& a, const IndirectState& b) {
+            bool same = a.radiance.fields.size() == b.radiance.fields.size();
+            for (std::size_t c = 0; same && c < a.radiance.fields.size(); ++c) {
+                const HeightPyramid &pa = a.radiance.fields[c], &pb = b.radiance.fields[c];
+                same = pa.levels.size() == pb.levels.size() && gi_test::sameBits(pa.rawPhase, pb.rawPhase);
+                for (std::size_t l = 0; same && l < pa.levels.size(); ++l)
+                    same = gi_test::sameBits(pa.levels[l].v, pb.levels[l].v);
+            }
+            return same;
+        };
+        const std::array<Grid, 3> base = st.shade.rgb;
+        std::array<Grid, 3> after = base;
+        const CellBox patch{70, 20, 83, 29};
+        for (int y = patch.y0; y < patch.y1; ++y)
+            for (int x = patch.x0; x < patch.x1; ++x) after[static_cast<std::size_t>(x % 3)](x, y) += 0.3f;
+        IndirectState fresh;
+        gather(after, CellBox{}, 1, fresh);
+        // the last call's bounce 0 with the box of what changed
+        IndirectState redone;
+        gather(base, CellBox{}, 1, redone);
+        gather(after, patch, 1, redone);
+        CHECK(samePyramid(redone, fresh));
+        CHECK(gi_test::sameBits(redone.indirect[0].v, fresh.indirect[0].v));
+        CHECK(gi_test::sameBits(redone.total[2].v, fresh.total[2].v));
+        // a box that misses the change keeps the old cells: the box is what is redone
+        IndirectState missed;
+        gather(base, CellBox{}, 1, missed);
+        gather(after, CellBox{0, 0, 4, 4}, 1, missed);
+        CHECK_FALSE(samePyramid(missed, fresh));
+        // after two bounces the pyramid is bounce 1's: a box is not enough, it is rebuilt whole
+        IndirectState twoBounces;
+        gather(base, CellBox{}, 2, twoBounces);
+        CHECK_FALSE(twoBounces.radianceOfDirect);
+        gather(after, CellBox{0, 0, 4, 4}, 1, twoBounces);
+        CHECK(twoBounces.radianceOfDirect);
+        CHECK(samePyramid(twoBounces, fresh));
+    }
+}

@@ -112,6 +112,21 @@ TEST_CASE("gi.shading_tiles: the runs of rectangles are merged per row and cut t
     texelRunsOfRects(rects, 25, 5, r);
     CHECK(summary(r) == "0-1:5-10,20-25 1-2:5-14 2-3:0-2,8-12 3-4:0-2");
     CHECK(texelCount(r) == 5 + 5 + 9 + 2 + 4 + 2);
+    // their bounding box: the first to the last row with a run, the leftmost
+    // to the rightmost run's columns (what the radiance pyramid redoes)
+    const CellBox box = boundingBox(r);
+    CHECK(box.x0 == 0);
+    CHECK(box.y0 == 0);
+    CHECK(box.x1 == 25);
+    CHECK(box.y1 == 4);
+    texelRunsOfRects(std::vector<TexelRect>{{7, 3, 9, 4}, {2, 1, 4, 2}}, 25, 5, r);
+    const CellBox two = boundingBox(r);
+    CHECK(two.x0 == 2);
+    CHECK(two.y0 == 1);
+    CHECK(two.x1 == 9);
+    CHECK(two.y1 == 4);
+    texelRunsOfRects({}, 25, 5, r);
+    CHECK(boundingBox(r).empty());
 }
 
 namespace {
