@@ -139,7 +139,8 @@ void occlusionOfRow(ConstGridView gradX, ConstGridView gradY, const PointRow& p,
 }
 
 // Full-resolution heights with a border of B cells (kOutside there), rows of
-// `stride` floats (column x is column x / s of phase plane x % s).
+// `stride` floats (column x is column x / s of phase plane x % s). A copy of
+// the build this pyramid redid rows of takes those rows alone.
 void fillBorderedHeights(const HeightPyramid& pyr, int B, std::ptrdiff_t stride, BlockerRadianceState& st) {
     const int nx = pyr.nx, ny = pyr.ny, s = pyr.subsample;
     // the border and the padding keep kOutside from the first fill of this layout
@@ -147,8 +148,13 @@ void fillBorderedHeights(const HeightPyramid& pyr, int B, std::ptrdiff_t stride,
     if (st.heightsLayout != layout) {
         st.heights.assign(static_cast<std::size_t>(stride) * (ny + 2 * B + 1), kOutside);
         st.heightsLayout = layout;
+        st.heightsOfBuild = 0;
     }
-    parallelForRows(ny, nx, [&](int y0, int y1) {
+    RowSpan rows{0, ny};
+    if (st.heightsOfBuild != 0 && st.heightsOfBuild == pyr.buildId) rows = {0, 0};
+    if (st.heightsOfBuild != 0 && st.heightsOfBuild == pyr.basedOn) rows = pyr.rawRowsRedone.cut(ny);
+    st.heightsOfBuild = 0;  // until the copy is whole
+    parallelForRows(rows, nx, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
             float* row = st.heights.data() + (y + B) * stride + B;
             for (int q = 0; q < s; ++q) {
@@ -157,6 +163,7 @@ void fillBorderedHeights(const HeightPyramid& pyr, int B, std::ptrdiff_t stride,
             }
         }
     });
+    st.heightsOfBuild = pyr.buildId;
 }
 
 // The near samples of every azimuth (t = 0.5, 1, ..., s - 0.5 cells; nTaps

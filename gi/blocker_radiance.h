@@ -37,6 +37,7 @@
 // Deterministic: fixed blocks of rows, per texel a pure function of its
 // inputs; the 4- and 8-wide kernels use the same lane-wise IEEE operations.
 #include <array>
+#include <cstdint>
 #include <vector>
 
 #include "core/grid.h"
@@ -59,6 +60,7 @@ struct BlockerRadianceState {
     std::vector<float> farSlope;  // azimuths planes of nxr * nyr: the receivers' horizons (tan), from the scan
     std::vector<float> heights;   // full-resolution heights with a border of s cells (outside: no blocker)
     std::array<std::ptrdiff_t, 4> heightsLayout{};  // its nx, ny, border and row stride (0: not laid out yet)
+    std::uint64_t heightsOfBuild = 0;               // the pyramid build (HeightPyramid::buildId) they copy
     Grid occlusion;                                 // O / pi at every texel
     bool occlusionValid = false;                    // occlusion and receiverOcclusion hold a result of this grid
     std::vector<float> receiverOcclusion;           // O / pi at the receivers

@@ -53,6 +53,9 @@ void runBounces(const IndirectInputs& in, const IndirectSettings& settings, Indi
                 IndirectState& st) {
     const auto t0 = Clock::now();
     st.timings = IndirectTimings{};
+    // the sum is redone where this call's inputs or light may differ from the last call's
+    const bool totalOfLastCall = st.totalValid;
+    st.totalValid = false;
     strategy.beginFrame();
     prepareIndirectSum(in.heights.nx, in.heights.ny, settings.bounces, st);
     // the RGB pyramid may be redone where bounce 0 changed only when it is
@@ -86,7 +89,9 @@ void runBounces(const IndirectInputs& in, const IndirectSettings& settings, Indi
         }
         st.timings.shading += msSince(t);
     }
-    sumDirectAndIndirect(in.direct, st);
+    // one bounce over texel runs: the indirect light changed there alone
+    const bool restricted = totalOfLastCall && settings.bounces == 1 && in.texelRuns != nullptr;
+    sumDirectAndIndirect(in.direct, st, restricted ? in.directChanged.joined(boundingBox(*in.texelRuns)) : CellBox{});
     st.timings.total = msSince(t0);
 }
 
@@ -99,17 +104,24 @@ void accumulateBounce(const std::array<Grid, 3>& exit, int b, IndirectState& st)
     st.bounceMean[static_cast<std::size_t>(b - 1)] = meanOf(exit);
 }
 
-void sumDirectAndIndirect(const std::array<Grid, 3>& direct, IndirectState& st) {
+void sumDirectAndIndirect(const std::array<Grid, 3>& direct, IndirectState& st, CellBox changed) {
+    st.totalValid = false;
     for (int c = 0; c < 3; ++c) {
         Grid& tot = st.total[static_cast<std::size_t>(c)];
         const Grid& ind = st.indirect[static_cast<std::size_t>(c)];
+        if (tot.nx != ind.nx || tot.ny != ind.ny) changed = {};
         tot.ensureSize(ind.nx, ind.ny);
         const Grid& d = direct[static_cast<std::size_t>(c)];
-        parallelForRows(ind.ny, ind.nx, [&](int y0, int y1) {
-            const std::size_t a = static_cast<std::size_t>(y0) * ind.nx, b = static_cast<std::size_t>(y1) * ind.nx;
-            for (std::size_t i = a; i < b; ++i) tot.v[i] = d.v[i] + ind.v[i];
+        const CellBox box = changed.cut(ind.nx, ind.ny);
+        if (box.empty()) continue;
+        parallelForRows(box.rows(), box.x1 - box.x0, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) {
+                const std::size_t row = static_cast<std::size_t>(y) * ind.nx;
+                for (std::size_t i = row + box.x0; i < row + box.x1; ++i) tot.v[i] = d.v[i] + ind.v[i];
+            }
         });
     }
+    st.totalValid = true;
 }
 
 void setUShadingLights(IndirectState& st) {

@@ -60,8 +60,9 @@ void runBounces(const IndirectInputs& in, const IndirectSettings& settings, Indi
 /// (st.bounceMean[b - 1], RGB average).
 void accumulateBounce(const std::array<Grid, 3>& exit, int b, IndirectState& st);
 
-/// st.total = direct + st.indirect.
-void sumDirectAndIndirect(const std::array<Grid, 3>& direct, IndirectState& st);
+/// st.total = direct + st.indirect; with `changed`, only there (the caller
+/// knows st.total holds the sum everywhere else: IndirectState::totalValid).
+void sumDirectAndIndirect(const std::array<Grid, 3>& direct, IndirectState& st, CellBox changed = {});
 
 /// The shading lights of U: channel c lights channel c only (identity
 /// product matrices over st.u).

@@ -48,6 +48,7 @@ struct IndirectState {
     std::array<ShadeMaps, 2> bounceShade;  // exit radiance of the current / previous bounce (several bounces)
     std::array<Grid, 3> indirect;          // sum of bounces 1..B, full resolution
     std::array<Grid, 3> total;             // direct + indirect
+    bool totalValid = false;               // total is the sum of the last call's direct and indirect
     std::vector<double> bounceMean;        // mean exit radiance (RGB average) of each bounce
     IndirectTimings timings;
     GlossyIndirectState glossy;    // GlossyIndirect::VectorPyramid

@@ -1,6 +1,7 @@
 #include "gi/pyramid.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 #include "core/parallel.h"
@@ -149,8 +150,8 @@ int buildSteps(HeightPyramid& p, int kv, float cellSize) {
 
 // ---- raw heights, split by column phase --------------------------------
 // Only the `changed` rows of the heights (and the replicated row below the
-// last when it is one of them).
-void splitRawPhases(ConstGridView heights, RowSpan changed, HeightPyramid& p) {
+// last when it is one of them); returns the rows of the planes it wrote.
+RowSpan splitRawPhases(ConstGridView heights, RowSpan changed, HeightPyramid& p) {
     const int nx = p.nx, ny = p.ny, s = p.subsample;
     const int wp = nx / s + 1;
     p.rawPhaseWidth = wp;
@@ -174,6 +175,7 @@ void splitRawPhases(ConstGridView heights, RowSpan changed, HeightPyramid& p) {
             }
         }
     });
+    return rows;
 }
 
 // Octaves needed for nLevels levels: up to floor((nLevels - 1) / kv) + 1,
@@ -380,6 +382,11 @@ void buildHeightPyramid(ConstGridView heights, float cellSize, int subsample, co
     // only on the same grid and settings are the other cells' results there
     if (p.nx != nx || p.ny != ny || p.subsample != s || !(p.settings == settings) || p.rawPhase.empty()) changed = {};
     changed = changed.cut(nx, ny);
+    static std::atomic<std::uint64_t> builds{0};
+    const bool whole = changed.x0 == 0 && changed.y0 == 0 && changed.x1 == nx && changed.y1 == ny;
+    p.basedOn = whole ? 0 : p.buildId;
+    p.buildId = ++builds;
+    p.rawRowsRedone = {};  // every row, until the raw phases are split
     const int kv = std::max(1, settings.levelsPerOctave);
     p.nx = nx;
     p.ny = ny;
@@ -390,7 +397,7 @@ void buildHeightPyramid(ConstGridView heights, float cellSize, int subsample, co
     p.settings = settings;
 
     const int maxLevel = buildSteps(p, kv, cellSize);
-    splitRawPhases(heights, changed.rows(), p);
+    p.rawRowsRedone = splitRawPhases(heights, changed.rows(), p);
     const int nLevels = maxLevel + 1;
     if (nLevels <= 0) {
         p.levels.resize(0);

@@ -27,6 +27,7 @@
 // Optional peak keeping (PyramidSettings::peakBlend): the octave images can
 // also be max-decimated; levels then blend mean and max syntheses, which
 // counters the filtered pyramid's lowering of distant peaks.
+#include <cstdint>
 #include <vector>
 
 #include "core/grid.h"
@@ -100,6 +101,11 @@ struct HeightPyramid {
     const float* rawPhaseRow(int q, int y) const {
         return rawPhaseData() + q * rawPhasePlane + static_cast<std::ptrdiff_t>(y) * rawPhaseWidth;
     }
+    // Each build's id (unique in the process) and that of the build whose
+    // pyramid it redid in part (0: built whole), with the raw phases' rows
+    // it redid: a copy of build `basedOn`'s raw heights needs only those.
+    std::uint64_t buildId = 0, basedOn = 0;
+    RowSpan rawRowsRedone;
     std::vector<Grid> meanOctaves;    // B_1, B_2, ... (B_0 is the input)
     std::vector<Grid> maxOctaves;     // same, max-decimated (only when peakBlend > 0)
     int octaves = 0;                  // octaves synthesised, S_0 .. S_(octaves - 1)

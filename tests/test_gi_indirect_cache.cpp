@@ -40,6 +40,17 @@ double largestDifference(const std::array<Grid, 3>& a, const std::array<Grid, 3>
     return worst;
 }
 
+// Whether every texel's total is its direct plus its indirect light, bit for
+// bit (the sum is redone only where either may have changed).
+bool totalIsDirectPlusIndirect(const GiState& st) {
+    for (std::size_t c = 0; c < 3; ++c)
+        for (std::size_t i = 0; i < st.shade.rgb[c].v.size(); ++i) {
+            const float sum = st.shade.rgb[c].v[i] + st.indirect.indirect[c].v[i];
+            if (std::memcmp(&sum, &st.indirect.total[c].v[i], sizeof(float)) != 0) return false;
+        }
+    return true;
+}
+
 }  // namespace
 
 TEST_CASE("gi.indirect_cache: one-bounce incremental frames equal full recomputes, for any thread count") {
@@ -362,6 +373,7 @@ TEST_CASE("gi.indirect_cache: a crater dropped and filled again and again costs 
     for (int f = 1; f <= 20; ++f) {
         const Grid& now = f % 2 == 1 ? field.crater : field.h;
         runGiFrame(now.cview(), 10.0f, field.light, settings, inc);
+        CHECK(totalIsDirectPlusIndirect(inc));
         const GiState full = field.fullFrame(now, settings);
         worst = std::max({worst, largestDifference(inc.shade.rgb, full.shade.rgb),
                           largestDifference(inc.indirect.indirect, full.indirect.indirect)});
@@ -574,4 +586,59 @@ TEST_CASE("gi.indirect_cache: bounce 0's radiance pyramid redone over the change
         CHECK(twoBounces.radianceOfDirect);
         CHECK(samePyramid(twoBounces, fresh));
     }
+}
+
+TEST_CASE("gi.indirect_cache: the total is redone wherever the indirect light was, beyond the direct light's change") {
+    // the direct light changes in a patch; the texel passes redo a region far
+    // from it as well (the receivers there gathered the patch's light): the
+    // total must follow the indirect light there too
+    const Grid h = bumpy(128, 96);
+    const GiSettings settings = withBounces(GiSettings{}, 2, 1);
+    GiState st;
+    runGiFrame(h.cview(), kCell, sunSkyAndKey(), settings, st);
+    const FoldedWedgeOperator op = foldFullCircle(settings.indirect.azimuths, settings.visibility.interp);
+    ReceiverTiles everyTile;
+    everyTile.reset(st.pyramid.nxr, st.pyramid.nyr, kIndirectTile, true);
+    const TexelRect patch{20, 10, 30, 18}, far{90, 60, 120, 90};
+    TexelRuns runs;
+    texelRunsOfRects(std::vector<TexelRect>{patch, far}, h.nx, h.ny, runs);
+    const auto gather = [&](const std::array<Grid, 3>& source, bool restricted, CellBox changed, IndirectState& out) {
+        const IndirectInputs in{.heights = st.pyramid,
+                                .gradX = st.gradX.cview(),
+                                .gradY = st.gradY.cview(),
+                                .op = op,
+                                .envVisibility = st.envVisibility,
+                                .direct = source,
+                                .directShade = nullptr,
+                                .albedo = nullptr,
+                                .shading = settings.shading,
+                                .only = restricted ? &everyTile : nullptr,
+                                .texels = restricted ? &everyTile : nullptr,
+                                .texelRuns = restricted ? &runs : nullptr,
+                                .sameGeometry = restricted,
+                                .directChanged = changed};
+        computeIndirect(in, settings.indirect, out);
+    };
+    const auto totalIsSum = [](const std::array<Grid, 3>& direct, const IndirectState& out) {
+        for (std::size_t c = 0; c < 3; ++c)
+            for (std::size_t i = 0; i < direct[c].v.size(); ++i) {
+                const float sum = direct[c].v[i] + out.indirect[c].v[i];
+                if (std::memcmp(&sum, &out.total[c].v[i], sizeof(float)) != 0) return false;
+            }
+        return true;
+    };
+    std::array<Grid, 3> after = st.shade.rgb;
+    for (int y = patch.y0; y < patch.y1; ++y)
+        for (int x = patch.x0; x < patch.x1; ++x)
+            for (Grid& g : after) g(x, y) += 2.0f;
+    IndirectState out;
+    gather(st.shade.rgb, false, CellBox{}, out);
+    const std::array<Grid, 3> indirectBefore = out.indirect;
+    gather(after, true, CellBox{patch.x0, patch.y0, patch.x1, patch.y1}, out);
+    CHECK(totalIsSum(after, out));
+    // the far region's indirect light did change (else the test shows nothing)
+    bool farChanged = false;
+    for (int y = far.y0; y < far.y1 && !farChanged; ++y)
+        for (int x = far.x0; x < far.x1; ++x) farChanged = farChanged || out.indirect[1](x, y) != indirectBefore[1](x, y);
+    CHECK(farChanged);
 }

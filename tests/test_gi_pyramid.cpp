@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <cstring>
 #include <utility>
 #include <vector>
@@ -368,8 +369,16 @@ TEST_CASE("gi.pyramid: a rebuild over a box of changed cells gives the full buil
                             after(x, y) -= 5.0f + 0.3f * static_cast<float>((x * 3 + y) % 7);
                     HeightPyramid rebuilt, fresh;
                     buildHeightPyramid(before.cview(), 1.5f, s, ps, rebuilt);
+                    const std::uint64_t previous = rebuilt.buildId;
                     buildHeightPyramid(after.cview(), 1.5f, s, ps, rebuilt, box);
                     buildHeightPyramid(after.cview(), 1.5f, s, ps, fresh);
+                    // the build says what it redid: a copy of the raw heights follows with these rows
+                    const bool whole = box.x0 == 0 && box.y0 == 0 && box.x1 == size.nx && box.y1 == size.ny;
+                    CHECK(rebuilt.buildId != previous);
+                    CHECK(rebuilt.basedOn == (whole ? 0u : previous));
+                    CHECK(rebuilt.rawRowsRedone.y0 <= box.y0);
+                    CHECK(rebuilt.rawRowsRedone.y1 >= box.y1);
+                    CHECK(fresh.basedOn == 0u);
                     CHECK(sameLevels(rebuilt, fresh));
                     REQUIRE(rebuilt.synth.size() == fresh.synth.size());
                     for (std::size_t o = 0; o < fresh.synth.size(); ++o)
