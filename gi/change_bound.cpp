@@ -40,14 +40,15 @@ void sizeLevels(int nx, int ny, MaxChangePyramid& p) {
     }
 }
 
-// Block sums of the next level: each cell of the cut edge blocks counted once.
-void sumLevel(const Grid& src, Grid& dst) {
-    parallelForRows(dst.ny, dst.nx, [&](int y0, int y1) {
+// Block sums of the next level over the blocks of `blocks` (cut to dst):
+// each cell of the cut edge blocks counted once.
+void sumLevel(const Grid& src, Grid& dst, const CellBox& blocks) {
+    parallelForRows(blocks.rows(), blocks.x1 - blocks.x0, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
             const float* ra = src.data() + static_cast<std::size_t>(2 * y) * src.nx;
             const float* rb = 2 * y + 1 < src.ny ? ra + src.nx : nullptr;
             float* out = dst.data() + static_cast<std::size_t>(y) * dst.nx;
-            for (int x = 0; x < dst.nx; ++x) {
+            for (int x = blocks.x0; x < blocks.x1; ++x) {
                 const int xa = 2 * x;
                 const bool pair = xa + 1 < src.nx;
                 double v = static_cast<double>(ra[xa]) + (pair ? ra[xa + 1] : 0.0f);
@@ -88,23 +89,29 @@ bool missesChange(const MaxChangePyramid& p, int x0, int y0, int x1, int y1) {
     return x1 < c.x0 || y1 < c.y0 || x0 > c.x1 || y0 > c.y1;
 }
 
-// Levels 1.. from level 0: 2 x 2 maxima, the edge replicated inside its block.
-void decimateLevels(MaxChangePyramid& p) {
-    for (std::size_t k = 1; k < p.levels.size(); ++k) {
+// Levels 1.. from level 0: 2 x 2 maxima, the edge replicated inside its
+// block; only the blocks holding a cell of `redone` (level 0's cells that
+// were rewritten; every block holding none keeps its value).
+void decimateLevels(MaxChangePyramid& p, CellBox redone = {}) {
+    redone = redone.cut(p.nx, p.ny);
+    for (std::size_t k = 1; k < p.levels.size() && !redone.empty(); ++k) {
         const Grid& src = p.levels[k - 1];
         Grid& dst = p.levels[k];
-        parallelForRows(dst.ny, dst.nx, [&](int y0, int y1) {
+        redone = CellBox{redone.x0 / 2, redone.y0 / 2, (redone.x1 - 1) / 2 + 1, (redone.y1 - 1) / 2 + 1}.cut(dst.nx,
+                                                                                                         dst.ny);
+        const CellBox blocks = redone;
+        parallelForRows(blocks.rows(), blocks.x1 - blocks.x0, [&](int y0, int y1) {
             for (int y = y0; y < y1; ++y) {
                 const float* ra = src.data() + static_cast<std::size_t>(2 * y) * src.nx;
                 const float* rb = src.data() + static_cast<std::size_t>(std::min(2 * y + 1, src.ny - 1)) * src.nx;
                 float* out = dst.data() + static_cast<std::size_t>(y) * dst.nx;
-                for (int x = 0; x < dst.nx; ++x) {
+                for (int x = blocks.x0; x < blocks.x1; ++x) {
                     const int xa = 2 * x, xb = std::min(2 * x + 1, src.nx - 1);
                     out[x] = std::max(std::max(ra[xa], ra[xb]), std::max(rb[xa], rb[xb]));
                 }
             }
         });
-        sumLevel(k == 1 ? p.levels[0] : p.sums[k - 1], p.sums[k]);
+        sumLevel(k == 1 ? p.levels[0] : p.sums[k - 1], p.sums[k], blocks);
     }
     findChangedBox(p);
 }
@@ -469,37 +476,47 @@ void buildMaxChangePyramid(ConstGridView dh, MaxChangePyramid& p) {
     decimateLevels(p);
 }
 
-void buildMaxChangePyramid(ConstGridView before, ConstGridView after, MaxChangePyramid& p) {
-    buildMaxChangePyramid(std::span<const ConstGridView>(&before, 1), std::span<const ConstGridView>(&after, 1), p);
+void buildMaxChangePyramid(ConstGridView before, ConstGridView after, MaxChangePyramid& p, CellBox differing) {
+    buildMaxChangePyramid(std::span<const ConstGridView>(&before, 1), std::span<const ConstGridView>(&after, 1), p,
+                          differing);
 }
 
 void buildMaxChangePyramid(std::span<const ConstGridView> before, std::span<const ConstGridView> after,
-                           MaxChangePyramid& p) {
+                           MaxChangePyramid& p, CellBox differing) {
     if (before.empty() || before.size() != after.size())
         throw InputError("change bound: as many fields before as after, at least one");
     const int nx = before[0].nx, ny = before[0].ny;
     for (std::size_t c = 0; c < before.size(); ++c)
         if (before[c].nx != nx || before[c].ny != ny || after[c].nx != nx || after[c].ny != ny)
             throw InputError("change bound: the fields before and after differ in size");
+    // the cells to redo: those that may differ, and those the last build
+    // found changed (outside both, |dh| was 0 and still is)
+    CellBox region = differing.cut(nx, ny);
+    const auto& last = p.changed;
+    if (p.nx != nx || p.ny != ny || p.levels.empty())
+        region = CellBox{}.cut(nx, ny);
+    else if (last.x0 <= last.x1)
+        region = region.joined({last.x0, last.y0, last.x1 + 1, last.y1 + 1});
     sizeLevels(nx, ny, p);
     Grid& base = p.levels[0];
-    parallelForRows(ny, nx, [&](int y0, int y1) {
+    const int x0 = region.x0, x1 = region.x1;
+    parallelForRows(region.rows(), x1 - x0, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
             float* out = base.data() + static_cast<std::size_t>(y) * base.nx;
-            std::fill(out, out + nx, 0.0f);
+            std::fill(out + x0, out + x1, 0.0f);
             for (std::size_t c = 0; c < before.size(); ++c) {
                 const float* a = before[c].row(y);
                 const float* b = after[c].row(y);
-                int x = 0;
-                for (; x + 4 <= nx; x += 4)
+                int x = x0;
+                for (; x + 4 <= x1; x += 4)
                     simd::store(out + x,
                                 simd::vmax(simd::load<simd::F4>(out + x),
                                            absDifferenceUp(simd::load<simd::F4>(a + x), simd::load<simd::F4>(b + x))));
-                for (; x < nx; ++x) out[x] = std::max(out[x], absDifferenceUp(a[x], b[x]));
+                for (; x < x1; ++x) out[x] = std::max(out[x], absDifferenceUp(a[x], b[x]));
             }
         }
     });
-    decimateLevels(p);
+    decimateLevels(p, region);
 }
 
 namespace {

@@ -79,13 +79,17 @@ void buildMaxChangePyramid(ConstGridView dh, MaxChangePyramid& out);
 
 /// The same for dh = after - before (same sizes), each |dh| rounded up to
 /// the next float so that it bounds the real difference of the two floats.
-void buildMaxChangePyramid(ConstGridView before, ConstGridView after, MaxChangePyramid& out);
+/// `differing` holds every cell where before and after may differ (every
+/// cell by default): with a pyramid of this size in `out`, only those cells,
+/// those of its changed box and the blocks holding them are redone (the
+/// others are 0 either way), the same values as a whole build.
+void buildMaxChangePyramid(ConstGridView before, ConstGridView after, MaxChangePyramid& out, CellBox differing = {});
 
 /// The same for the largest change over several fields of one size (the
 /// channels of a radiance): max over c of |after[c] - before[c]| per cell,
 /// rounded up. Throws InputError when the counts or the sizes differ.
 void buildMaxChangePyramid(std::span<const ConstGridView> before, std::span<const ConstGridView> after,
-                           MaxChangePyramid& out);
+                           MaxChangePyramid& out, CellBox differing = {});
 
 /// max |dh| over the cells [x0, x1] x [y0, y1] (inclusive, clamped to the
 /// grid; 0 when the clamped box is empty), exact: from the at most 4 x 4

@@ -48,7 +48,8 @@ const ReceiverTiles* planIndirect(const GiSettings& settings, const FrameChange&
                                 .geometryTiles = change.geometry ? &st.visibilityCache.geometryTiles : nullptr,
                                 .azimuths = azimuths,
                                 .tolerance = settings.tolerance,
-                                .blocker = &st.indirect.blocker};
+                                .blocker = &st.indirect.blocker,
+                                .sourceChanged = st.directChanged};
     return planIndirectTiles(in, st.indirectCache);
 }
 

@@ -178,7 +178,8 @@ void boundRadianceChange(const IndirectPlanInputs& in, IndirectCache& cache) {
     const std::array<ConstGridView, 3> before{cache.anchorSource[0].cview(), cache.anchorSource[1].cview(),
                                               cache.anchorSource[2].cview()};
     const std::array<ConstGridView, 3> after{in.source[0].cview(), in.source[1].cview(), in.source[2].cview()};
-    buildMaxChangePyramid(before, after, cache.change);
+    cache.anchorChanged = cache.anchorChanged.joined(in.sourceChanged);
+    buildMaxChangePyramid(before, after, cache.change, cache.anchorChanged);
     cache.radianceBound.assign(tiles, 0.0f);
     if (maxChangeAll(cache.change) == 0.0f) return;
     boundSampleChangePerAzimuthAndGroup(cache.change, in.lastPyramid.fields[0], kVisibilityTile, in.azimuths,
@@ -207,14 +208,19 @@ const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCac
                     g.dirty[visibilityTileHolding(tx, ty, g.nxr)];
         geometry = cache.geometry;
     }
-    if (planAnchoredDrift(cache.radianceBound, geometry, in.tolerance, cache.drift, cache.tiles.dirty))
-        cache.anchorSource = in.source;
+    if (planAnchoredDrift(cache.radianceBound, geometry, in.tolerance, cache.drift, cache.tiles.dirty)) {
+        // L_0 equals the anchor's outside anchorChanged: copy its rows
+        for (std::size_t c = 0; c < 3; ++c)
+            copyGrid(in.source[c].cview(), cache.anchorSource[c], cache.anchorChanged.rows());
+        cache.anchorChanged = {0, 0, 0, 0};
+    }
     countAfterPlan(cache.tiles.dirtyCount(), static_cast<int>(cache.tiles.dirty.size()), cache.skips);
     return &cache.tiles;
 }
 
 void recordIndirectSource(const std::array<Grid, 3>& source, const HeightPyramid& heights, IndirectCache& cache) {
     cache.anchorSource = source;
+    cache.anchorChanged = {0, 0, 0, 0};
     cache.tiles.reset(heights.nxr, heights.nyr, kIndirectTile, false);
     cache.drift.reset(cache.tiles.dirty.size());
     cache.valid = true;

@@ -97,6 +97,7 @@ inline std::size_t visibilityTileHolding(int tx, int ty, int nxr) {
 struct IndirectCache {
     bool valid = false;                  // the fields below describe the cached indirect result
     std::array<Grid, 3> anchorSource;    // L_0 at the anchor (gi/anchored_drift.h)
+    CellBox anchorChanged;               // holds every texel where L_0 may differ from anchorSource (every one)
     MaxChangePyramid change;             // this frame: max over the channels of |L_0 - anchorSource|
     std::vector<float> azimuthBound;     // per tile and indirect azimuth (tile-major)
     std::vector<float> groupBound;       // per tile and distance group (gi/pyramid.h), over every azimuth
@@ -125,6 +126,9 @@ struct IndirectPlanInputs {
     // the last pass's occlusions (sub-sampling, blocker radiance: the
     // occlusion factor and the azimuths' shares); null: neither
     const BlockerRadianceState* blocker = nullptr;
+    // holds every texel of `source` that may differ from the last pass's
+    // (which planned or recorded it); every texel by default
+    CellBox sourceChanged = {};
 };
 
 /// This frame's bound per tile (cache.radianceBound, shade units; 0 where L_0

@@ -618,3 +618,45 @@ TEST_CASE("gi.change_bound: azimuth-range bounds hold for a key light's slopes a
     std::vector<float> range;
     CHECK_THROWS_AS(boundSlopeChangeOverRange(dh, st.pyramid, 8, 1.0, 0.5, range), InputError);
 }
+
+TEST_CASE("gi.change_bound: a change pyramid redone over the box of differing cells is a whole build's") {
+    // the anchor's field against fields that differ from it in a box; the
+    // pyramid of the last one is reused with the box alone (the cells the
+    // last build found changed are redone too: a change that moved away)
+    const int nx = 150, ny = 101;
+    const Grid anchor = gi_test::bumpy(nx, ny);
+    const auto withPatch = [&](CellBox box, float by) {
+        Grid g = anchor;
+        for (int y = box.y0; y < box.y1; ++y)
+            for (int x = box.x0; x < box.x1; ++x) g(x, y) += by * static_cast<float>(1 + (x * 7 + y) % 5);
+        return g;
+    };
+    const auto same = [](const MaxChangePyramid& a, const MaxChangePyramid& b) {
+        bool ok = a.levels.size() == b.levels.size() && a.changed.x0 == b.changed.x0 && a.changed.y0 == b.changed.y0 &&
+                  a.changed.x1 == b.changed.x1 && a.changed.y1 == b.changed.y1;
+        for (std::size_t k = 0; ok && k < a.levels.size(); ++k)
+            ok = gi_test::sameBits(a.levels[k].v, b.levels[k].v) && gi_test::sameBits(a.sums[k].v, b.sums[k].v);
+        return ok;
+    };
+    const std::vector<CellBox> boxes{{10, 10, 20, 15}, {140, 90, 150, 101}, {0, 0, 1, 1}, {60, 0, 61, 101},
+                                     {70, 40, 90, 60}, {0, 0, 150, 101}};
+    MaxChangePyramid reused;
+    buildMaxChangePyramid(anchor.cview(), anchor.cview(), reused);
+    CHECK(maxChangeAll(reused) == 0.0f);
+    for (std::size_t i = 0; i < boxes.size(); ++i) {
+        CAPTURE(i);
+        const Grid now = withPatch(boxes[i], 0.25f);
+        buildMaxChangePyramid(anchor.cview(), now.cview(), reused, boxes[i]);
+        MaxChangePyramid whole;
+        buildMaxChangePyramid(anchor.cview(), now.cview(), whole);
+        CHECK(same(reused, whole));
+        CHECK(maxChangeAll(whole) > 0.0f);
+    }
+    // back to the anchor's field: the last box alone, and every cell is 0 again
+    buildMaxChangePyramid(anchor.cview(), anchor.cview(), reused, CellBox{0, 0, 0, 0});
+    CHECK(maxChangeAll(reused) == 0.0f);
+    // a box that misses the change leaves it out: the box is what is redone
+    const Grid moved = withPatch(boxes[4], 0.25f);
+    buildMaxChangePyramid(anchor.cview(), moved.cview(), reused, boxes[0]);
+    CHECK(maxChangeAll(reused) == 0.0f);
+}
