@@ -40,16 +40,32 @@ double largestDifference(const std::array<Grid, 3>& a, const std::array<Grid, 3>
     return worst;
 }
 
+// What the indirect light reads of a frame run on `st`, with `source` as
+// bounce 0 (every receiver and texel; the callers narrow it).
+IndirectInputs indirectInputsOf(const GiState& st, const GiSettings& settings, const FoldedWedgeOperator& op,
+                                const std::array<Grid, 3>& source) {
+    return {.heights = st.pyramid,
+            .gradX = st.gradX.cview(),
+            .gradY = st.gradY.cview(),
+            .op = op,
+            .envVisibility = st.envVisibility,
+            .direct = source,
+            .directShade = nullptr,
+            .albedo = nullptr,
+            .shading = settings.shading};
+}
+
 // Whether every texel's total is its direct plus its indirect light, bit for
 // bit (the sum is redone only where either may have changed).
-bool totalIsDirectPlusIndirect(const GiState& st) {
+bool totalIsDirectPlusIndirect(const std::array<Grid, 3>& direct, const IndirectState& out) {
     for (std::size_t c = 0; c < 3; ++c)
-        for (std::size_t i = 0; i < st.shade.rgb[c].v.size(); ++i) {
-            const float sum = st.shade.rgb[c].v[i] + st.indirect.indirect[c].v[i];
-            if (std::memcmp(&sum, &st.indirect.total[c].v[i], sizeof(float)) != 0) return false;
+        for (std::size_t i = 0; i < direct[c].v.size(); ++i) {
+            const float sum = direct[c].v[i] + out.indirect[c].v[i];
+            if (std::memcmp(&sum, &out.total[c].v[i], sizeof(float)) != 0) return false;
         }
     return true;
 }
+bool totalIsDirectPlusIndirect(const GiState& st) { return totalIsDirectPlusIndirect(st.shade.rgb, st.indirect); }
 
 }  // namespace
 
@@ -86,16 +102,7 @@ TEST_CASE("gi.indirect_cache: the radiance bound holds for local, global and edg
         runGiFrame(h.cview(), kCell, sunSkyAndKey(), settings, st);
         const FoldedWedgeOperator op = foldFullCircle(settings.indirect.azimuths, settings.visibility.interp);
         const auto gather = [&](const std::array<Grid, 3>& source, IndirectState& out) {
-            const IndirectInputs in{.heights = st.pyramid,
-                                    .gradX = st.gradX.cview(),
-                                    .gradY = st.gradY.cview(),
-                                    .op = op,
-                                    .envVisibility = st.envVisibility,
-                                    .direct = source,
-                                    .directShade = nullptr,
-                                    .albedo = nullptr,
-                                    .shading = settings.shading};
-            computeIndirect(in, settings.indirect, out);
+            computeIndirect(indirectInputsOf(st, settings, op, source), settings.indirect, out);
         };
         const std::array<Grid, 3> base = st.shade.rgb;
         IndirectState before;
@@ -535,16 +542,8 @@ TEST_CASE("gi.indirect_cache: bounce 0's radiance pyramid redone over the change
         runGiFrame(h.cview(), kCell, sunSkyAndKey(), settings, st);
         const FoldedWedgeOperator op = foldFullCircle(settings.indirect.azimuths, settings.visibility.interp);
         const auto gather = [&](const std::array<Grid, 3>& source, CellBox changed, int bounces, IndirectState& out) {
-            const IndirectInputs in{.heights = st.pyramid,
-                                    .gradX = st.gradX.cview(),
-                                    .gradY = st.gradY.cview(),
-                                    .op = op,
-                                    .envVisibility = st.envVisibility,
-                                    .direct = source,
-                                    .directShade = nullptr,
-                                    .albedo = nullptr,
-                                    .shading = settings.shading,
-                                    .directChanged = changed};
+            IndirectInputs in = indirectInputsOf(st, settings, op, source);
+            in.directChanged = changed;
             IndirectSettings is = settings.indirect;
             is.bounces = bounces;
             computeIndirect(in, is, out);
@@ -603,29 +602,14 @@ TEST_CASE("gi.indirect_cache: the total is redone wherever the indirect light wa
     TexelRuns runs;
     texelRunsOfRects(std::vector<TexelRect>{patch, far}, h.nx, h.ny, runs);
     const auto gather = [&](const std::array<Grid, 3>& source, bool restricted, CellBox changed, IndirectState& out) {
-        const IndirectInputs in{.heights = st.pyramid,
-                                .gradX = st.gradX.cview(),
-                                .gradY = st.gradY.cview(),
-                                .op = op,
-                                .envVisibility = st.envVisibility,
-                                .direct = source,
-                                .directShade = nullptr,
-                                .albedo = nullptr,
-                                .shading = settings.shading,
-                                .only = restricted ? &everyTile : nullptr,
-                                .texels = restricted ? &everyTile : nullptr,
-                                .texelRuns = restricted ? &runs : nullptr,
-                                .sameGeometry = restricted,
-                                .directChanged = changed};
+        IndirectInputs in = indirectInputsOf(st, settings, op, source);
+        if (restricted) {
+            in.only = in.texels = &everyTile;
+            in.texelRuns = &runs;
+            in.sameGeometry = true;
+        }
+        in.directChanged = changed;
         computeIndirect(in, settings.indirect, out);
-    };
-    const auto totalIsSum = [](const std::array<Grid, 3>& direct, const IndirectState& out) {
-        for (std::size_t c = 0; c < 3; ++c)
-            for (std::size_t i = 0; i < direct[c].v.size(); ++i) {
-                const float sum = direct[c].v[i] + out.indirect[c].v[i];
-                if (std::memcmp(&sum, &out.total[c].v[i], sizeof(float)) != 0) return false;
-            }
-        return true;
     };
     std::array<Grid, 3> after = st.shade.rgb;
     for (int y = patch.y0; y < patch.y1; ++y)
@@ -635,7 +619,7 @@ TEST_CASE("gi.indirect_cache: the total is redone wherever the indirect light wa
     gather(st.shade.rgb, false, CellBox{}, out);
     const std::array<Grid, 3> indirectBefore = out.indirect;
     gather(after, true, CellBox{patch.x0, patch.y0, patch.x1, patch.y1}, out);
-    CHECK(totalIsSum(after, out));
+    CHECK(totalIsDirectPlusIndirect(after, out));
     // the far region's indirect light did change (else the test shows nothing)
     bool farChanged = false;
     for (int y = far.y0; y < far.y1 && !farChanged; ++y)
