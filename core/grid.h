@@ -131,8 +131,15 @@ struct RowSpan {
 struct CellBox {
     static constexpr int kAll = std::numeric_limits<int>::max();
     int x0 = 0, y0 = 0, x1 = kAll, y1 = kAll;
+    static constexpr CellBox none() { return {0, 0, 0, 0}; }
     RowSpan rows() const { return {y0, y1}; }
     bool empty() const { return x0 >= x1 || y0 >= y1; }
+    /// The cells of a 2 x 2 decimation (cell k of the next level holds cells
+    /// 2k and 2k + 1) that hold a cell of this box; empty stays empty.
+    CellBox halved() const {
+        if (empty()) return none();
+        return {x0 / 2, y0 / 2, (x1 - 1) / 2 + 1, (y1 - 1) / 2 + 1};
+    }
     CellBox cut(int nx, int ny) const {
         const RowSpan c = RowSpan{x0, x1}.cut(nx), r = RowSpan{y0, y1}.cut(ny);
         return {c.y0, r.y0, c.y1, r.y1};

@@ -97,8 +97,7 @@ void decimateLevels(MaxChangePyramid& p, CellBox redone = {}) {
     for (std::size_t k = 1; k < p.levels.size() && !redone.empty(); ++k) {
         const Grid& src = p.levels[k - 1];
         Grid& dst = p.levels[k];
-        redone = CellBox{redone.x0 / 2, redone.y0 / 2, (redone.x1 - 1) / 2 + 1, (redone.y1 - 1) / 2 + 1}.cut(dst.nx,
-                                                                                                         dst.ny);
+        redone = redone.halved().cut(dst.nx, dst.ny);
         const CellBox blocks = redone;
         parallelForRows(blocks.rows(), blocks.x1 - blocks.x0, [&](int y0, int y1) {
             for (int y = y0; y < y1; ++y) {

@@ -97,7 +97,7 @@ void runIndirectStage(ConstGridView heights, const GiSettings& settings, const F
                             .sameGeometry = !change.geometry,
                             .directChanged = settings.incremental ? st.directChanged : CellBox{}};
     computeIndirect(in, settings.indirect, st.indirect);
-    st.directChanged = {0, 0, 0, 0};  // the indirect light has read every change
+    st.directChanged = CellBox::none();  // the indirect light has read every change
     if (cached && only == nullptr) recordIndirectSource(st.shade.rgb, st.pyramid, st.indirectCache);
     st.indirectCache.geometryVersion = st.geometryVersion;
     st.indirectRecomputed = only ? only->dirtyFraction() : 1.0;

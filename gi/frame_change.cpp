@@ -17,7 +17,7 @@ CellBox differingCells(const Grid& a, ConstGridView b) {
     int y0 = 0, y1 = b.ny;
     while (y0 < y1 && sameRow(a, b, y0)) ++y0;
     while (y1 > y0 && sameRow(a, b, y1 - 1)) --y1;
-    if (y0 == y1) return {0, 0, 0, 0};
+    if (y0 == y1) return CellBox::none();
     const auto same = [&](int x, int y) {
         return std::memcmp(a.data() + static_cast<std::size_t>(y) * a.nx + x, b.row(y) + x, sizeof(float)) == 0;
     };

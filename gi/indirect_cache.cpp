@@ -212,7 +212,7 @@ const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCac
         // L_0 equals the anchor's outside anchorChanged: copy its rows
         for (std::size_t c = 0; c < 3; ++c)
             copyGrid(in.source[c].cview(), cache.anchorSource[c], cache.anchorChanged.rows());
-        cache.anchorChanged = {0, 0, 0, 0};
+        cache.anchorChanged = CellBox::none();
     }
     countAfterPlan(cache.tiles.dirtyCount(), static_cast<int>(cache.tiles.dirty.size()), cache.skips);
     return &cache.tiles;
@@ -220,7 +220,7 @@ const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCac
 
 void recordIndirectSource(const std::array<Grid, 3>& source, const HeightPyramid& heights, IndirectCache& cache) {
     cache.anchorSource = source;
-    cache.anchorChanged = {0, 0, 0, 0};
+    cache.anchorChanged = CellBox::none();
     cache.tiles.reset(heights.nxr, heights.nyr, kIndirectTile, false);
     cache.drift.reset(cache.tiles.dirty.size());
     cache.valid = true;

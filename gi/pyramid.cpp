@@ -95,13 +95,6 @@ void decimateRows(ConstGridView src, Grid& dst, bool useMax, int y0, int y1, int
         decimateRowsOf<false>(src, dst, y0, y1, x0, x1);
 }
 
-// The cells of the next octave image (2x2 decimation of a w x h one) that
-// read a cell of `box`.
-CellBox decimatedBox(const CellBox& box, int w, int h) {
-    if (box.empty()) return {0, 0, 0, 0};
-    return CellBox{box.x0 / 2, box.y0 / 2, (box.x1 - 1) / 2 + 1, (box.y1 - 1) / 2 + 1}.cut((w + 1) / 2, (h + 1) / 2);
-}
-
 // The receivers [r0, r1) whose synthesis taps (4 per receiver, nondecreasing
 // along the axis) read a texel of [t0, t1); r0 >= r1 when none does.
 RowSpan receiversReading(const int* taps, int receivers, int t0, int t1) {
@@ -220,9 +213,9 @@ std::vector<CellBox> octaveBoxes(const CellBox& heightsBox, int nx, int ny, int 
     std::vector<CellBox> boxes(static_cast<std::size_t>(std::max(1, nOctaves)));
     boxes[0] = heightsBox;
     for (int o = 1; o < nOctaves; ++o) {
-        boxes[static_cast<std::size_t>(o)] = decimatedBox(boxes[static_cast<std::size_t>(o - 1)], nx, ny);
         nx = (nx + 1) / 2;
         ny = (ny + 1) / 2;
+        boxes[static_cast<std::size_t>(o)] = boxes[static_cast<std::size_t>(o - 1)].halved().cut(nx, ny);
     }
     return boxes;
 }
@@ -247,7 +240,7 @@ void receiverHeights(ConstGridView heights, int s, RowSpan changed, PaddedField&
 
 // The receivers at cells s X, s Y of a box of cells.
 CellBox receiversIn(const CellBox& cells, int s, int nxr, int nyr) {
-    if (cells.empty()) return {0, 0, 0, 0};
+    if (cells.empty()) return CellBox::none();
     return CellBox{(cells.x0 + s - 1) / s, (cells.y0 + s - 1) / s, (cells.x1 + s - 1) / s, (cells.y1 + s - 1) / s}
         .cut(nxr, nyr);
 }
@@ -267,10 +260,10 @@ CellBox synthesisePass(ConstGridView src, int o, int pass, float blend, const Ce
     float* wy = wx + 4 * nxr;
     synthesisTaps(nxr, s, o, src.nx, ix, wx);
     synthesisTaps(nyr, s, o, src.ny, iy, wy);
-    if (changed.empty()) return {0, 0, 0, 0};
+    if (changed.empty()) return CellBox::none();
     const RowSpan cols = receiversReading(ix, nxr, changed.x0, changed.x1);
     const RowSpan rows = receiversReading(iy, nyr, changed.y0, changed.y1);
-    if (cols.y0 >= cols.y1 || rows.y0 >= rows.y1) return {0, 0, 0, 0};
+    if (cols.y0 >= cols.y1 || rows.y0 >= rows.y1) return CellBox::none();
     const int X0 = cols.y0, X1 = cols.y1;
     p.rowTmp.resize(static_cast<std::size_t>(src.ny) * nxr);
     float* tmp = p.rowTmp.data();

@@ -110,7 +110,7 @@ bool cellsDiffer(ConstGridView before, ConstGridView after, InclusiveCells box) 
 }  // namespace
 
 CellBox boundingBox(const TexelRuns& runs) {
-    CellBox box{0, 0, 0, 0};
+    CellBox box = CellBox::none();
     for (int y = 0; y < runs.ny; ++y) {
         const std::span<const ColumnSpan> row = runs.ofRow(y);
         if (row.empty()) continue;  // runs are not empty, left to right
