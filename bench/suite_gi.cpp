@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <optional>
@@ -23,6 +24,7 @@
 #include "bench/spread.h"
 #include "bench/suites.h"
 #include "core/error.h"
+#include "core/image_io.h"
 #include "core/parallel.h"
 #include "gi/frame.h"
 #include "gi/reference.h"
@@ -192,6 +194,7 @@ public:
     void plotFromCsv() const;
     void cpuStages() const;
     void tileTiming() const;
+    void writeDems() const;
 
 private:
     const GiOptions& o_;
@@ -383,6 +386,21 @@ void GiSuite::frameTime() const {
         }
     writeResult(ctx_.outDir, "gi_frame_time.md", md);
     writeResult(ctx_.outDir, "gi_frame_time.csv", csv);
+}
+
+// write-dems: the real DEMs of frame-time as float32 EXR heightmaps (one
+// `height` channel, the cell size in `terrain:cellSize`) and a list of their
+// names and cell sizes, dems.txt, so that another build's CLI can light the
+// same fields (bench/frame_time_against_build.sh).
+void GiSuite::writeDems() const {
+    std::string list;
+    std::filesystem::create_directories(ctx_.outDir);
+    for (const Dem& d : realDems(ctx_.dataDir)) {
+        const std::string file = d.name + ".exr";
+        writeExrChannels(ctx_.outDir + "/" + file, {"height"}, {&d.heights}, d.cell);
+        list += fmt("%s %.6f\n", file.c_str(), static_cast<double>(d.cell));
+    }
+    writeResult(ctx_.outDir, "dems.txt", list);
 }
 
 void GiSuite::runSettingsRows(const Dem& d, const Grid& ref, int border, std::vector<Row>& rows, int threads) const {
@@ -839,6 +857,10 @@ const Mode kModes[] = {
     {"cpu", "CPU time per stage, one thread, minimum over the runs (stdout)", &GiSuite::cpuStages},
     {"tiles", "computeVisibility with receiver tiles (1 %, 10 %, 50 %, all dirty) vs the whole grid (stdout)",
      &GiSuite::tileTiming},
+    {"write-dems",
+     "Write the real DEMs of frame-time as float EXR heightmaps and dems.txt (names, cell sizes) to --out, for "
+     "bench/frame_time_against_build.sh",
+     &GiSuite::writeDems},
 };
 
 int runGi(const CLI::App& sub, const GiOptions& o, const BenchContext& ctx) {
