@@ -151,11 +151,13 @@ struct IndirectBounds {
 IndirectBounds indirectBounds(const GiState& now, const GiState& last, int azimuths) {
     gi::IndirectCache cache;
     cache.anchorSource = last.shade.rgb;
+    gi::recordAnchorLevels(last.indirect.radiance, cache.levels);
+    const gi::FoldedWedgeOperator op = gi::foldFullCircle(azimuths, gi::AzimuthInterp::Linear);
     const gi::IndirectPlanInputs plan{.source = now.shade.rgb,
                                       .heights = now.pyramid,
-                                      .lastPyramid = last.indirect.radiance,
+                                      .pyramid = now.indirect.radiance,
                                       .geometryTiles = nullptr,
-                                      .azimuths = azimuths,
+                                      .phi = op.phi,
                                       .tolerance = 0.0f,
                                       .blocker = &last.indirect.blocker};
     gi::boundRadianceChange(plan, cache);

@@ -162,17 +162,7 @@ double octaveReach(int o) { return o == 0 ? 0.0 : 2.5 * std::ldexp(1.0, o) - 0.5
 
 double stepReach(const HeightPyramid& pyr, int i) {
     const int level = pyr.steps[static_cast<std::size_t>(i)].level;
-    if (level < 0) return 1.0;
-    // the octaves blendLevels reads for this level (gi/pyramid.cpp)
-    const int kv = std::max(1, pyr.settings.levelsPerOctave);
-    const int nOctaves = pyr.octaves;
-    int o = level / kv;
-    bool blended = level % kv != 0;
-    if (o >= nOctaves - 1) {
-        o = nOctaves - 1;
-        blended = false;
-    }
-    return pyr.subsample + octaveReach(blended ? o + 1 : o);
+    return level < 0 ? 1.0 : pyr.subsample + levelReachCells(pyr, level);
 }
 
 StepExtent stepExtent(const HeightPyramid& pyr, int i) {
@@ -564,6 +554,19 @@ double sumChangeInBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1)
 
 float maxChangeAll(const MaxChangePyramid& p) {
     return p.levels.empty() || p.levels.back().empty() ? 0.0f : p.levels.back().v[0];
+}
+
+double levelReachCells(const HeightPyramid& pyr, int level) {
+    // the octaves blendLevels reads for this level (gi/pyramid.cpp)
+    const int kv = std::max(1, pyr.settings.levelsPerOctave);
+    const int nOctaves = pyr.octaves;
+    int o = level / kv;
+    bool blended = level % kv != 0;
+    if (o >= nOctaves - 1) {
+        o = nOctaves - 1;
+        blended = false;
+    }
+    return octaveReach(blended ? o + 1 : o);
 }
 
 std::vector<float> stepReachCells(const HeightPyramid& pyr) {

@@ -134,6 +134,10 @@ float maxChangeAll(const MaxChangePyramid& p);
 /// r_i of every step of the pyramid, in full-resolution cells.
 std::vector<float> stepReachCells(const HeightPyramid& pyr);
 
+/// R_o of level `level` (>= 0): no change at a cell farther than this
+/// (Chebyshev, cells) from a level texel's cell can alter the texel.
+double levelReachCells(const HeightPyramid& pyr, int level);
+
 /// Factor by which a change of the heights by at most M in the max norm can
 /// move any level sample: every filter of the pyramid is 1-Lipschitz in the
 /// max norm (the 2 x 2 mean and max, the B-spline weights, which are

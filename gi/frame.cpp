@@ -36,17 +36,17 @@ const FoldedWedgeOperator& indirectScanOperator(const GiSettings& settings, GiSt
 // The receivers whose indirect light is re-gathered this frame
 // (gi/indirect_cache.h); null: every receiver. `cached`: the frame keeps an
 // indirect cache (incremental frames, a strategy that gathers by tiles).
-const ReceiverTiles* planIndirect(const GiSettings& settings, const FrameChange& change, bool cached, int azimuths,
-                                  GiState& st) {
+const ReceiverTiles* planIndirect(const GiSettings& settings, const FrameChange& change, bool cached,
+                                  std::span<const double> phi, GiState& st) {
     if (!cached || (change.geometry && !change.heightsOnly)) {
         invalidateIndirectCache(st.indirectCache);
         return nullptr;
     }
     const IndirectPlanInputs in{.source = st.shade.rgb,
                                 .heights = st.pyramid,
-                                .lastPyramid = st.indirect.radiance,
+                                .pyramid = st.indirect.radiance,
                                 .geometryTiles = change.geometry ? &st.visibilityCache.geometryTiles : nullptr,
-                                .azimuths = azimuths,
+                                .phi = phi,
                                 .tolerance = settings.tolerance,
                                 .blocker = &st.indirect.blocker,
                                 .sourceChanged = st.directChanged};
@@ -73,6 +73,17 @@ const ReceiverTiles* planTexels(ConstGridView heights, const FrameChange& change
     return planIndirectTexels(in, st.indirectCache);
 }
 
+// The RGB radiance pyramid of this frame's direct light (bounce 0), which
+// the indirect plan compares with the anchor's (gi/indirect_cache.h); the
+// bounce then finds it built (IndirectInputs::radianceCurrent). Redone over
+// the texels that read a changed one when it holds the last call's bounce 0.
+void buildDirectRadiancePyramid(const GiSettings& settings, GiState& st) {
+    IndirectState& ind = st.indirect;
+    buildRadiancePyramid(st.shade.rgb, st.pyramid, settings.indirect.radiance, ind.radiance,
+                         ind.radianceOfDirect ? st.directChanged : CellBox{});
+    ind.radianceOfDirect = true;
+}
+
 // Indirect bounces over the last computed direct shade, re-gathered where
 // its sources or the geometry within reach changed (incremental frames).
 void runIndirectStage(ConstGridView heights, const GiSettings& settings, const FrameChange& change, GiState& st,
@@ -80,7 +91,8 @@ void runIndirectStage(ConstGridView heights, const GiSettings& settings, const F
     const auto t = Clock::now();
     const FoldedWedgeOperator& op = indirectScanOperator(settings, st);
     const bool cached = settings.incremental && gathersByTiles(settings.indirect, settings.shading);
-    const ReceiverTiles* only = planIndirect(settings, change, cached, op.azimuths, st);
+    if (cached) buildDirectRadiancePyramid(settings, st);
+    const ReceiverTiles* only = planIndirect(settings, change, cached, op.phi, st);
     const ReceiverTiles* texels = cached ? planTexels(heights, change, only, albedo, st) : nullptr;
     const IndirectInputs in{.heights = st.pyramid,
                             .gradX = st.gradX.cview(),
@@ -95,10 +107,12 @@ void runIndirectStage(ConstGridView heights, const GiSettings& settings, const F
                             .texels = texels,
                             .texelRuns = texels ? &st.indirectCache.texelRuns : nullptr,
                             .sameGeometry = !change.geometry,
-                            .directChanged = settings.incremental ? st.directChanged : CellBox{}};
+                            .directChanged = settings.incremental ? st.directChanged : CellBox{},
+                            .radianceCurrent = cached};
     computeIndirect(in, settings.indirect, st.indirect);
     st.directChanged = CellBox::none();  // the indirect light has read every change
-    if (cached && only == nullptr) recordIndirectSource(st.shade.rgb, st.pyramid, st.indirectCache);
+    if (cached && only == nullptr)
+        recordIndirectSource(st.shade.rgb, st.indirect.radiance, st.pyramid, st.indirectCache);
     st.indirectCache.geometryVersion = st.geometryVersion;
     st.indirectRecomputed = only ? only->dirtyFraction() : 1.0;
     st.timings.indirect = msSince(t);

@@ -59,8 +59,10 @@ void runBounces(const IndirectInputs& in, const IndirectSettings& settings, Indi
     strategy.beginFrame();
     prepareIndirectSum(in.heights.nx, in.heights.ny, settings.bounces, st);
     // the RGB pyramid may be redone where bounce 0 changed only when it is
-    // the last call's bounce 0 (IndirectScan::buildPyramid says so again)
-    BounceSource source{&in.direct, in.directShade, st.radianceOfDirect ? in.directChanged : CellBox{}};
+    // the last call's bounce 0 (IndirectScan::buildPyramid says so again),
+    // and not at all when the caller built it for this call
+    const CellBox redo = in.radianceCurrent ? CellBox::none() : in.directChanged;
+    BounceSource source{&in.direct, in.directShade, st.radianceOfDirect ? redo : CellBox{}};
     st.radianceOfDirect = false;
     for (int b = 1; b <= settings.bounces; ++b) {
         // ---- pyramid of bounce b - 1 (Section 5.3) ------------------------------------

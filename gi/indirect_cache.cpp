@@ -17,8 +17,8 @@ namespace {
 // pyramid of the same receivers and steps.
 bool cacheFits(const IndirectPlanInputs& in, const IndirectCache& cache) {
     const HeightPyramid& h = in.heights;
-    if (!cache.valid || in.lastPyramid.fields.empty()) return false;
-    const HeightPyramid& r = in.lastPyramid.fields[0];
+    if (!cache.valid || in.pyramid.fields.empty() || !cache.levels.fits(in.pyramid)) return false;
+    const HeightPyramid& r = in.pyramid.fields[0];
     const Grid& last = cache.anchorSource[0];
     return r.nx == h.nx && r.ny == h.ny && r.nxr == h.nxr && r.nyr == h.nyr && r.steps.size() == h.steps.size() &&
            last.nx == h.nx && last.ny == h.ny && in.source[0].nx == h.nx && in.source[0].ny == h.ny &&
@@ -33,8 +33,8 @@ bool hasOcclusions(const IndirectPlanInputs& in) {
     const HeightPyramid& h = in.heights;
     const std::size_t planeR = static_cast<std::size_t>(h.nxr) * h.nyr;
     return b && b->occlusionValid && h.subsample > 1 && b->nx == h.nx && b->ny == h.ny && b->nxr == h.nxr &&
-           b->nyr == h.nyr && b->azimuths == in.azimuths && b->occlusion.nx == h.nx && b->occlusion.ny == h.ny &&
-           b->receiverOcclusionRunning.size() == static_cast<std::size_t>(in.azimuths) * planeR &&
+           b->nyr == h.nyr && b->azimuths == static_cast<int>(in.phi.size()) && b->occlusion.nx == h.nx && b->occlusion.ny == h.ny &&
+           b->receiverOcclusionRunning.size() == in.phi.size() * planeR &&
            b->receiverGroupOcclusion.size() == static_cast<std::size_t>(kDistanceGroups) * planeR;
 }
 
@@ -107,7 +107,7 @@ float rowShareBound(const BlockerRadianceState& b, int Y, int x0, int x1, const 
 void sharedBounds(const IndirectPlanInputs& in, IndirectCache& cache) {
     const HeightPyramid& h = in.heights;
     const int tilesX = tileCount(h.nxr, kIndirectTile), tilesY = tileCount(h.nyr, kIndirectTile);
-    const std::size_t m = static_cast<std::size_t>(in.azimuths);
+    const std::size_t m = in.phi.size();
     const bool shares = hasOcclusions(in);
     const auto tileBound = [&](int tx, int ty, const float* D, const float* G) {
         const float largest = *std::max_element(D, D + m);
@@ -182,8 +182,9 @@ void boundRadianceChange(const IndirectPlanInputs& in, IndirectCache& cache) {
     buildMaxChangePyramid(before, after, cache.change, cache.anchorChanged);
     cache.radianceBound.assign(tiles, 0.0f);
     if (maxChangeAll(cache.change) == 0.0f) return;
-    boundSampleChangePerAzimuthAndGroup(cache.change, in.lastPyramid.fields[0], kVisibilityTile, in.azimuths,
-                                        cache.azimuthBound, cache.groupBound);
+    buildLevelChanges(in.pyramid, cache.anchorChanged, cache.levels);
+    boundSampleChangeFromLevels(cache.change, cache.levels, in.pyramid.fields[0], kVisibilityTile, in.phi,
+                                cache.azimuthBound, cache.groupBound);
     occlusionFactors(in, cache);
     sharedBounds(in, cache);
 }
@@ -212,14 +213,17 @@ const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCac
         // L_0 equals the anchor's outside anchorChanged: copy its rows
         for (std::size_t c = 0; c < 3; ++c)
             copyGrid(in.source[c].cview(), cache.anchorSource[c], cache.anchorChanged.rows());
+        recordAnchorLevels(in.pyramid, cache.levels, cache.anchorChanged);
         cache.anchorChanged = CellBox::none();
     }
     countAfterPlan(cache.tiles.dirtyCount(), static_cast<int>(cache.tiles.dirty.size()), cache.skips);
     return &cache.tiles;
 }
 
-void recordIndirectSource(const std::array<Grid, 3>& source, const HeightPyramid& heights, IndirectCache& cache) {
+void recordIndirectSource(const std::array<Grid, 3>& source, const RadiancePyramid& pyramid,
+                          const HeightPyramid& heights, IndirectCache& cache) {
     cache.anchorSource = source;
+    recordAnchorLevels(pyramid, cache.levels);
     cache.anchorChanged = CellBox::none();
     cache.tiles.reset(heights.nxr, heights.nyr, kIndirectTile, false);
     cache.drift.reset(cache.tiles.dirty.size());

@@ -9,11 +9,12 @@
 // One bounce of LambertIndirect::BlockerRadiance gathers, at each receiver,
 // the direct light L_0 of its casting sets. Its result can move for two
 // reasons, and a tile re-gathers when either says so:
-//  - the blockers' radiance: per tile, the bound of gi/change_bound.h on
-//    how far the change of L_0 since the anchor (gi/anchored_drift.h: the
-//    L_0 of an earlier pass, kept while it pays) moves the samples the
-//    tile's scan reads (boundSampleChangePerAzimuth, the largest per
-//    indirect azimuth), weighed and scaled as below, plus how far the tile's
+//  - the blockers' radiance: per tile, how far the change of L_0 since the
+//    anchor (gi/anchored_drift.h: the L_0 of an earlier pass, kept while it
+//    pays, with its radiance pyramid's levels) moved the samples the tile's
+//    scan reads, the largest per indirect azimuth and per distance group,
+//    taken from this frame's pyramid and the anchor's
+//    (gi/radiance_sample_change.h), weighed and scaled as below, plus how far the tile's
 //    cached result was from the anchor's, bounds its drift (triangle
 //    inequality); beyond the tolerance, the tile re-gathers. A change that
 //    comes and goes (a pit dropped and filled) costs nothing once it is gone.
@@ -64,6 +65,7 @@
 //  - the albedo changed (every texel).
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "core/grid.h"
@@ -73,6 +75,7 @@
 #include "gi/plan_skips.h"
 #include "gi/pyramid.h"
 #include "gi/radiance_pyramid.h"
+#include "gi/radiance_sample_change.h"
 #include "gi/receiver_tiles.h"
 #include "gi/shading.h"
 #include "gi/texel_runs.h"
@@ -99,6 +102,7 @@ struct IndirectCache {
     std::array<Grid, 3> anchorSource;    // L_0 at the anchor (gi/anchored_drift.h)
     CellBox anchorChanged;               // holds every texel where L_0 may differ from anchorSource (every one)
     MaxChangePyramid change;             // this frame: max over the channels of |L_0 - anchorSource|
+    RadianceLevelChange levels;          // the anchor's radiance pyramid levels, this frame's change of each
     std::vector<float> azimuthBound;     // per tile and indirect azimuth (tile-major)
     std::vector<float> groupBound;       // per tile and distance group (gi/pyramid.h), over every azimuth
     AnchoredDrift drift;                 // per tile: how far its result was from the anchor's
@@ -119,9 +123,9 @@ struct IndirectCache {
 struct IndirectPlanInputs {
     const std::array<Grid, 3>& source;   // this frame's L_0 (full resolution)
     const HeightPyramid& heights;        // this frame's height pyramid
-    const RadiancePyramid& lastPyramid;  // the last indirect pass's radiance pyramid (its steps)
+    const RadiancePyramid& pyramid;      // the RGB radiance pyramid of `source` (the scan's steps)
     const ReceiverTiles* geometryTiles;  // tiles whose geometry drifted beyond the tolerance; null: none
-    int azimuths;                        // of the indirect scan
+    std::span<const double> phi;         // the indirect scan's azimuths (FoldedWedgeOperator::phi)
     float tolerance;
     // the last pass's occlusions (sub-sampling, blocker radiance: the
     // occlusion factor and the azimuths' shares); null: neither
@@ -136,7 +140,9 @@ struct IndirectPlanInputs {
 /// in.source moves the indirect light of every texel that reads one of the
 /// tile's receivers, the geometry being the last pass's: the largest sample
 /// move over the tile's azimuths weighed by each receiver's shares of its
-/// occlusion, times the occlusion factor (above).
+/// occlusion, times the occlusion factor (above). The samples' moves come
+/// from in.pyramid against cache.levels (recordAnchorLevels of the anchor's
+/// pyramid).
 void boundRadianceChange(const IndirectPlanInputs& in, IndirectCache& cache);
 
 /// The tiles to re-gather (cache.tiles), or null when every receiver must be
@@ -146,11 +152,12 @@ void boundRadianceChange(const IndirectPlanInputs& in, IndirectCache& cache);
 /// would only be added to a full pass.
 const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCache& cache);
 
-/// After an indirect pass over `source` (on the receiver grid of `heights`)
-/// that gathered every receiver: `source` is the anchor the next frames
-/// compare with, the drifts start again at 0. (A planned pass moved the
-/// anchor, if at all, in planIndirectTiles.)
-void recordIndirectSource(const std::array<Grid, 3>& source, const HeightPyramid& heights, IndirectCache& cache);
+/// After an indirect pass over `source` (its RGB radiance pyramid `pyramid`,
+/// on the receiver grid of `heights`) that gathered every receiver: `source`
+/// is the anchor the next frames compare with, the drifts start again at 0.
+/// (A planned pass moved the anchor, if at all, in planIndirectTiles.)
+void recordIndirectSource(const std::array<Grid, 3>& source, const RadiancePyramid& pyramid,
+                          const HeightPyramid& heights, IndirectCache& cache);
 
 /// What the frame knows of the texels' inputs since the last pass.
 struct IndirectTexelInputs {

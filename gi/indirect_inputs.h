@@ -53,6 +53,9 @@ struct IndirectInputs {
     // 0's, the RGB pyramid of bounce 0 redoes only what reads them, bit for
     // bit a full build (buildRadiancePyramid).
     CellBox directChanged;
+    // The state's RGB pyramid is already that of `direct` (the caller built
+    // it, IndirectState::radianceOfDirect set): bounce 1 keeps it.
+    bool radianceCurrent = false;
 };
 
 }  // namespace terrain::gi

@@ -33,6 +33,8 @@ inline int padLanes(int n) { return (n + kRowPad - 1) / kRowPad * kRowPad; }
 struct StepGeometry {
     ScanStep step;
     int xFirst = 0, xLast = -1, yFirst = 0, yLast = -1;  // valid receivers
+    int tapX = 0, tapY = 0;                              // the first tap's texel offset (ScanStepInfo)
+    bool alongX = true;                                  // the second tap is the next row (else column)
     double dx = 0.0, dy = 0.0;                           // sample offset in field texels
     int k = 1, fieldNx = 0, fieldNy = 0;                 // receiver spacing in field texels, field size
 };
@@ -91,6 +93,9 @@ StepGeometry makeStep(const HeightPyramid& pyr, int i, double c, double sn) {
     g.fieldNy = fieldNy;
     const double c0d = std::floor(dx), r0d = std::floor(dy);
     const int c0 = static_cast<int>(c0d), r0 = static_cast<int>(r0d);
+    g.tapX = c0;
+    g.tapY = r0;
+    g.alongX = alongX;
     const float f = static_cast<float>(alongX ? dy - r0d : dx - c0d);  // the other coordinate's fraction
     const float weights[3] = {1.0f - f, f, static_cast<float>(1.0 / (tau * pyr.cellSize))};
     for (int q = 0; q < 3; ++q)
@@ -646,6 +651,10 @@ ScanStepInfo scanStepInfo(const HeightPyramid& pyr, int i, double cosPhi, double
     info.xLast = g.xLast;
     info.yFirst = g.yFirst;
     info.yLast = g.yLast;
+    info.tapX = g.tapX;
+    info.tapY = g.tapY;
+    info.nextX = g.alongX ? 0 : 1;
+    info.nextY = g.alongX ? 1 : 0;
     return info;
 }
 

@@ -169,10 +169,15 @@ struct VisibilityState {
 /// gi/indirect, which walks the same steps over a radiance pyramid): step i of
 /// azimuth (cosPhi, sinPhi) read from `pyramid` (raw heights or a level), and
 /// the receivers X in [xFirst, xLast], Y in [yFirst, yLast] whose sample lies
-/// inside the domain.
+/// inside the domain. Receiver (X, Y) reads the field's texels (k X + tapX,
+/// k Y + tapY) and (k X + tapX + nextX, k Y + tapY + nextY), k the receiver
+/// spacing in the field's texels (the sub-sampling s for raw heights, in
+/// cells; 1 for a level, on the receiver grid) and (nextX, nextY) one texel
+/// across the ray's major axis: (0, 1) or (1, 0).
 struct ScanStepInfo {
     ScanStep step;
     int xFirst = 0, xLast = -1, yFirst = 0, yLast = -1;
+    int tapX = 0, tapY = 0, nextX = 0, nextY = 0;
 };
 ScanStepInfo scanStepInfo(const HeightPyramid& pyramid, int i, double cosPhi, double sinPhi);
 

@@ -148,11 +148,12 @@ TEST_CASE("gi.indirect_cache: the radiance bound holds for local, global and edg
             // (before) to this one's sources, on the same geometry
             IndirectCache cache;
             cache.anchorSource = base;
+            recordAnchorLevels(before.radiance, cache.levels);
             const IndirectPlanInputs plan{.source = after,
                                           .heights = st.pyramid,
-                                          .lastPyramid = before.radiance,
+                                          .pyramid = later.radiance,
                                           .geometryTiles = nullptr,
-                                          .azimuths = op.azimuths,
+                                          .phi = op.phi,
                                           .tolerance = 0.0f,
                                           .blocker = &before.blocker};
             boundRadianceChange(plan, cache);
@@ -185,7 +186,20 @@ TEST_CASE("gi.indirect_cache: the radiance bound holds for local, global and edg
                 const auto a = sampleBound.begin() + static_cast<std::ptrdiff_t>(t * m);
                 CHECK(*std::max_element(g, g + kDistanceGroups) == *std::max_element(a, a + m));
             }
-            for (std::size_t t = 0; t < bound.size(); ++t) CHECK(bound[t] <= largestSampleMove(t));
+            // the cache's sample moves, read from the pyramids' levels against
+            // the anchor's, are at most the filters' bound of them (up to their
+            // rounding up: both bound the same real moves), and the weighed
+            // bound is at most their largest
+            const auto largestExactMove = [&](std::size_t t) {
+                const int X = static_cast<int>(t % tilesX) * kIndirectTile / kVisibilityTile;
+                const int Y = static_cast<int>(t / tilesX) * kIndirectTile / kVisibilityTile;
+                const auto az = cache.azimuthBound.begin() + static_cast<std::ptrdiff_t>((Y * sampleTilesX + X) * m);
+                return *std::max_element(az, az + m);
+            };
+            for (std::size_t t = 0; t < bound.size(); ++t) {
+                CHECK(bound[t] <= largestExactMove(t));
+                CHECK(largestExactMove(t) <= largestSampleMove(t) * (1.0f + 1e-6f));
+            }
             const auto tileBound = [&](int X, int Y) {
                 return bound[static_cast<std::size_t>(Y / kIndirectTile) * tilesX + X / kIndirectTile];
             };

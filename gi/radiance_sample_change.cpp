@@ -1,0 +1,142 @@
+#include "gi/radiance_sample_change.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+
+#include "core/error.h"
+#include "core/parallel.h"
+#include "gi/visibility.h"
+
+namespace terrain::gi {
+
+namespace {
+
+int levelCount(const RadiancePyramid& p) {
+    return p.fields.empty() ? 0 : static_cast<int>(p.fields[0].levels.size());
+}
+
+// The level texels (receivers, half-open) that may differ where the
+// radiance changed only inside `changed`: its receivers within the level's
+// reach, one more on each side (the receiver of a cell rounds either way).
+CellBox levelBox(const HeightPyramid& f, int level, CellBox changed) {
+    changed = changed.cut(f.nx, f.ny);
+    if (changed.empty()) return CellBox::none();
+    const int s = f.subsample;
+    const int r = static_cast<int>(std::ceil(levelReachCells(f, level)));
+    const auto lo = [&](int c) { return std::max(0, (c - r) / s - 1); };
+    const auto hi = [&](int c, int n) { return std::min(n, (c - 1 + r) / s + 2); };
+    return {lo(changed.x0), lo(changed.y0), hi(changed.x1, f.nxr), hi(changed.y1, f.nyr)};
+}
+
+ConstGridView levelView(const PaddedField& f) { return {f.data(), f.nx, f.ny, f.stride}; }
+
+}  // namespace
+
+bool RadianceLevelChange::fits(const RadiancePyramid& p) const {
+    return p.fields.size() == 3 && levelCount(p) == levels && p.fields[0].nxr == nxr && p.fields[0].nyr == nyr &&
+           anchor.size() == static_cast<std::size_t>(3 * levels);
+}
+
+void recordAnchorLevels(const RadiancePyramid& p, RadianceLevelChange& out, CellBox changed) {
+    if (!out.fits(p)) {
+        changed = {};
+        out.levels = levelCount(p);
+        out.nxr = p.fields.empty() ? 0 : p.fields[0].nxr;
+        out.nyr = p.fields.empty() ? 0 : p.fields[0].nyr;
+        out.anchor.resize(static_cast<std::size_t>(3 * out.levels));
+        out.change.clear();
+    }
+    for (int c = 0; c < 3 && out.levels > 0; ++c)
+        for (int l = 0; l < out.levels; ++l) {
+            const HeightPyramid& f = p.fields[static_cast<std::size_t>(c)];
+            const CellBox box = levelBox(f, l, changed);
+            copyGrid(levelView(f.levels[static_cast<std::size_t>(l)]),
+                     out.anchor[static_cast<std::size_t>(c * out.levels + l)], box.empty() ? RowSpan{0, 0} : box.rows());
+        }
+}
+
+void buildLevelChanges(const RadiancePyramid& now, CellBox changed, RadianceLevelChange& out) {
+    if (!out.fits(now)) throw InputError("radiance sample change: the pyramid is not of the anchor's grid");
+    out.change.resize(static_cast<std::size_t>(out.levels));
+    // the levels side by side (each build's own passes are parallel too)
+    parallelFor(0, out.levels, 1, [&](int l0, int l1) {
+        for (int l = l0; l < l1; ++l) {
+            std::array<ConstGridView, 3> before, after;
+            for (std::size_t c = 0; c < 3; ++c) {
+                before[c] = out.anchor[c * static_cast<std::size_t>(out.levels) + static_cast<std::size_t>(l)].cview();
+                after[c] = levelView(now.fields[c].levels[static_cast<std::size_t>(l)]);
+            }
+            const CellBox box = levelBox(now.fields[0], l, changed);
+            // an empty box still redoes the last build's changed cells, which may now be 0
+            buildMaxChangePyramid(before, after, out.change[static_cast<std::size_t>(l)],
+                                  box.empty() ? CellBox::none() : box);
+        }
+    });
+}
+
+namespace {
+
+// The largest change the receivers [X0, X1] x [Y0, Y1] read at one step:
+// their two taps, k X + tap (+ next), cut to the field (its padding
+// replicates the last row and column).
+float tapsChange(const MaxChangePyramid& field, int k, const ScanStepInfo& si, int X0, int Y0, int X1, int Y1) {
+    float best = 0.0f;
+    for (int tap = 0; tap < 2; ++tap) {
+        const int dx = si.tapX + tap * si.nextX, dy = si.tapY + tap * si.nextY;
+        const int x0 = std::clamp(k * X0 + dx, 0, field.nx - 1), x1 = std::clamp(k * X1 + dx, 0, field.nx - 1);
+        const int y0 = std::clamp(k * Y0 + dy, 0, field.ny - 1), y1 = std::clamp(k * Y1 + dy, 0, field.ny - 1);
+        best = std::max(best, maxChangeInBox(field, x0, y0, x1, y1));
+    }
+    return best;
+}
+
+}  // namespace
+
+void boundSampleChangeFromLevels(const MaxChangePyramid& raw, const RadianceLevelChange& levels,
+                                 const HeightPyramid& field, int tileReceivers, std::span<const double> phi,
+                                 std::vector<float>& tileBound, std::vector<float>& groupBound) {
+    const int T = tileReceivers, m = static_cast<int>(phi.size()), nSteps = static_cast<int>(field.steps.size());
+    if (T < 1 || m < 1) throw InputError("radiance sample change: tiles and azimuths must be at least 1");
+    if (raw.nx != field.nx || raw.ny != field.ny || levels.nxr != field.nxr || levels.nyr != field.nyr ||
+        static_cast<int>(levels.change.size()) != levels.levels || levels.levels != static_cast<int>(field.levels.size()))
+        throw InputError("radiance sample change: the changes and the pyramid differ in size");
+    const int tilesX = tileCount(field.nxr, T), tilesY = tileCount(field.nyr, T);
+    const std::size_t tiles = static_cast<std::size_t>(tilesX) * tilesY;
+    tileBound.assign(tiles * m, 0.0f);
+    groupBound.assign(tiles * kDistanceGroups, 0.0f);
+    // each step's taps and valid receivers, per azimuth (the scan's own table entries)
+    std::vector<ScanStepInfo> info(static_cast<std::size_t>(m) * nSteps);
+    std::vector<int> group(static_cast<std::size_t>(nSteps));
+    for (int j = 0; j < m; ++j)
+        for (int i = 0; i < nSteps; ++i)
+            info[static_cast<std::size_t>(j) * nSteps + i] =
+                scanStepInfo(field, i, std::cos(phi[static_cast<std::size_t>(j)]), std::sin(phi[static_cast<std::size_t>(j)]));
+    for (int i = 0; i < nSteps; ++i) group[static_cast<std::size_t>(i)] = distanceGroup(field.steps[static_cast<std::size_t>(i)].tauCells);
+    parallelFor(0, tilesY, 1, [&](int ty0, int ty1) {
+        for (int ty = ty0; ty < ty1; ++ty)
+            for (int tx = 0; tx < tilesX; ++tx) {
+                const std::size_t t = static_cast<std::size_t>(ty) * tilesX + tx;
+                const int X0 = tx * T, Y0 = ty * T;
+                const int X1 = std::min(field.nxr, X0 + T) - 1, Y1 = std::min(field.nyr, Y0 + T) - 1;
+                for (int j = 0; j < m; ++j)
+                    for (int i = 0; i < nSteps; ++i) {
+                        const ScanStepInfo& si = info[static_cast<std::size_t>(j) * nSteps + i];
+                        const int x0 = std::max(X0, si.xFirst), x1 = std::min(X1, si.xLast);
+                        const int y0 = std::max(Y0, si.yFirst), y1 = std::min(Y1, si.yLast);
+                        if (x0 > x1 || y0 > y1) continue;
+                        const int level = field.steps[static_cast<std::size_t>(i)].level;
+                        const float d =
+                            level < 0 ? tapsChange(raw, field.subsample, si, x0, y0, x1, y1)
+                                      : tapsChange(levels.change[static_cast<std::size_t>(level)], 1, si, x0, y0, x1, y1);
+                        float& az = tileBound[t * m + static_cast<std::size_t>(j)];
+                        float& gr = groupBound[t * kDistanceGroups + static_cast<std::size_t>(group[static_cast<std::size_t>(i)])];
+                        az = std::max(az, d);
+                        gr = std::max(gr, d);
+                    }
+            }
+    });
+}
+
+}  // namespace terrain::gi

@@ -1,0 +1,70 @@
+#pragma once
+// How far the samples an indirect scan reads from an RGB radiance pyramid
+// (gi/radiance_pyramid.h) have moved since an anchor, per receiver tile:
+// taken from the pyramids themselves, not bounded through the filters.
+//
+// Step i of azimuth phi reads, for receiver (X, Y), two texels of its field
+// (scanStepInfo's taps: a level at the receiver grid, or the full-resolution
+// radiance for a raw step) and blends them linearly with weights in [0, 1]
+// that sum to 1, so the sample moves by at most the larger move of its two
+// texels. Over a tile's receivers the taps fill two shifted copies of the
+// tile, cut to the receivers whose sample lies inside the field: the
+// largest |level - anchor level| there (max over the channels; block maxima
+// of gi/change_bound.h, exact box queries) bounds every sample of the step.
+// The filters' bound (boundSampleChangePerAzimuthAndGroup) charges a sample
+// with the largest change of any cell within its reach, weighed by the
+// filter's largest tap; here a far, filtered sample of a small change counts
+// by what it really moved. The price is the anchor's pyramid levels, kept
+// beside the anchor's radiance (3 channels x levels x receivers floats).
+//
+// A level texel reads the radiance within the reach of its octaves' B-spline
+// synthesis (gi/change_bound.h, stepReachCells: R_o = 2.5 2^o - 0.5 cells
+// for octave o, the coarser octave of a blended level), so where the
+// radiance equals the anchor's outside a box of texels, each level equals
+// the anchor's level outside that box dilated by its reach.
+#include <span>
+#include <vector>
+
+#include "core/grid.h"
+#include "gi/change_bound.h"
+#include "gi/pyramid.h"
+#include "gi/radiance_pyramid.h"
+
+namespace terrain::gi {
+
+/// The anchor's pyramid levels and this frame's change of each level.
+struct RadianceLevelChange {
+    int levels = 0, nxr = 0, nyr = 0;
+    std::vector<Grid> anchor;               // channel c's level l at [c * levels + l] (nxr x nyr, no padding)
+    std::vector<MaxChangePyramid> change;   // per level: max over the channels of |level - anchor|, rounded up
+    bool fits(const RadiancePyramid& p) const;
+};
+
+/// Copies p's levels as the anchor's (whole; or, on the same grid, the rows
+/// of each level that may differ where the radiance changed only inside the
+/// box `changed` of texels).
+void recordAnchorLevels(const RadiancePyramid& p, RadianceLevelChange& out, CellBox changed = {});
+
+/// Builds each level's change from the anchor to `now` (out.change), where
+/// the radiance differs from the anchor's only inside the box `changed` of
+/// texels (every texel by default): only the level texels within each
+/// level's reach of it are compared (the others are 0). Throws InputError
+/// when `now` is not of the anchor's grid (fits).
+void buildLevelChanges(const RadiancePyramid& now, CellBox changed, RadianceLevelChange& out);
+
+/// Per tile of tileReceivers receivers and each azimuth phi[j] of the scan
+/// (radians; the scan's own values, FoldedWedgeOperator::phi, so that the
+/// taps are the ones it reads), the largest move of the samples its
+/// receivers read (tileBound[t m + j], m = phi.size(), tiles row-major as
+/// boundSlopeChange), and per tile and distance group (gi/pyramid.h) the
+/// largest over the azimuths (groupBound[t kDistanceGroups + g]): level
+/// steps from `levels.change`, raw steps from `raw`, the full-resolution
+/// change (max over the channels) of the radiance. `field` is channel 0's
+/// pyramid of this frame (its steps and level map, the same in every
+/// channel). Throws InputError when tileReceivers < 1, there is no azimuth
+/// or the sizes differ.
+void boundSampleChangeFromLevels(const MaxChangePyramid& raw, const RadianceLevelChange& levels,
+                                 const HeightPyramid& field, int tileReceivers, std::span<const double> phi,
+                                 std::vector<float>& tileBound, std::vector<float>& groupBound);
+
+}  // namespace terrain::gi
