@@ -526,12 +526,12 @@ int clampBoxToLevel(const MaxChangePyramid& p, int& x0, int& y0, int& x1, int& y
 
 }  // namespace
 
-float maxChangeInBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1) {
-    if (missesChange(p, x0, y0, x1, y1)) return 0.0f;
+float maxChangeInBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1, float above) {
+    if (missesChange(p, x0, y0, x1, y1) || maxChangeAll(p) <= above) return above;
     const int k = clampBoxToLevel(p, x0, y0, x1, y1);
-    if (k < 0) return 0.0f;
+    if (k < 0) return above;
     const InclusiveCells box{x0, y0, x1, y1};
-    float m = 0.0f;
+    float m = above;
     for (int by = y0 >> k; by <= y1 >> k; ++by)
         for (int bx = x0 >> k; bx <= x1 >> k; ++bx) maxOfBlockInBox(p, box, k, bx, by, m);
     return m;

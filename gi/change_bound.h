@@ -95,8 +95,10 @@ void buildMaxChangePyramid(std::span<const ConstGridView> before, std::span<cons
 /// grid; 0 when the clamped box is empty), exact: from the at most 4 x 4
 /// blocks of the finest level that covers the box with so few, it descends
 /// into the blocks the box's edges cut, only where they could raise the
-/// maximum found so far.
-float maxChangeInBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1);
+/// maximum found so far. With `above`: the larger of it and that maximum,
+/// without descending into blocks that cannot exceed it (a caller keeping a
+/// running maximum).
+float maxChangeInBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1, float above = 0.0f);
 
 /// Upper bound of the sum of |dh| over the same box: the sum over the at
 /// most 4 x 4 blocks that cover it (up to a block larger on each side).

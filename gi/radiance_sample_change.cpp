@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -78,18 +79,28 @@ void buildLevelChanges(const RadiancePyramid& now, CellBox changed, RadianceLeve
 
 namespace {
 
-// The largest change the receivers [X0, X1] x [Y0, Y1] read at one step:
-// their two taps, k X + tap (+ next), cut to the field (its padding
-// replicates the last row and column).
-float tapsChange(const MaxChangePyramid& field, int k, const ScanStepInfo& si, int X0, int Y0, int X1, int Y1) {
-    float best = 0.0f;
-    for (int tap = 0; tap < 2; ++tap) {
-        const int dx = si.tapX + tap * si.nextX, dy = si.tapY + tap * si.nextY;
-        const int x0 = std::clamp(k * X0 + dx, 0, field.nx - 1), x1 = std::clamp(k * X1 + dx, 0, field.nx - 1);
-        const int y0 = std::clamp(k * Y0 + dy, 0, field.ny - 1), y1 = std::clamp(k * Y1 + dy, 0, field.ny - 1);
-        best = std::max(best, maxChangeInBox(field, x0, y0, x1, y1));
-    }
-    return best;
+// The larger of `above` and a bound on how far the samples of the
+// receivers [X0, X1] x [Y0, Y1] at one step moved: each blends its tap a
+// (k X + tap) and tap b (the texel after it across the ray) with the
+// weights 1 - f and f every receiver shares at this step, so it moves by at
+// most (1 - f) A + f B, A and B the largest change over the taps a and b of
+// the tile (boxes cut to the field, whose padding replicates the last row
+// and column). One box over both taps first: when it cannot beat `above`,
+// neither can the blend.
+float tapsChange(const MaxChangePyramid& field, int k, const ScanStepInfo& si, int X0, int Y0, int X1, int Y1,
+                 float above) {
+    const auto box = [&](int dx0, int dy0, int dx1, int dy1, float floor) {
+        return maxChangeInBox(field, std::clamp(k * X0 + si.tapX + dx0, 0, field.nx - 1),
+                              std::clamp(k * Y0 + si.tapY + dy0, 0, field.ny - 1),
+                              std::clamp(k * X1 + si.tapX + dx1, 0, field.nx - 1),
+                              std::clamp(k * Y1 + si.tapY + dy1, 0, field.ny - 1), floor);
+    };
+    if (box(0, 0, si.nextX, si.nextY, above) <= above) return above;
+    const float a = box(0, 0, 0, 0, 0.0f), b = box(si.nextX, si.nextY, si.nextX, si.nextY, 0.0f);
+    const float wa = si.step.w[0][0], wb = si.step.w[1][0];
+    // rounded up, and never 0 where a read texel moved and is weighed
+    const float blend = std::nextafter(wa * a + wb * b, std::numeric_limits<float>::infinity());
+    return std::max(above, std::min(std::max(a, b), (wa > 0.0f && a > 0.0f) || (wb > 0.0f && b > 0.0f) ? blend : 0.0f));
 }
 
 }  // namespace
@@ -126,12 +137,14 @@ void boundSampleChangeFromLevels(const MaxChangePyramid& raw, const RadianceLeve
                         const int x0 = std::max(X0, si.xFirst), x1 = std::min(X1, si.xLast);
                         const int y0 = std::max(Y0, si.yFirst), y1 = std::min(Y1, si.yLast);
                         if (x0 > x1 || y0 > y1) continue;
-                        const int level = field.steps[static_cast<std::size_t>(i)].level;
-                        const float d =
-                            level < 0 ? tapsChange(raw, field.subsample, si, x0, y0, x1, y1)
-                                      : tapsChange(levels.change[static_cast<std::size_t>(level)], 1, si, x0, y0, x1, y1);
                         float& az = tileBound[t * m + static_cast<std::size_t>(j)];
                         float& gr = groupBound[t * kDistanceGroups + static_cast<std::size_t>(group[static_cast<std::size_t>(i)])];
+                        // only a move above both running maxima changes either
+                        const float above = std::min(az, gr);
+                        const int level = field.steps[static_cast<std::size_t>(i)].level;
+                        const float d = level < 0 ? tapsChange(raw, field.subsample, si, x0, y0, x1, y1, above)
+                                                  : tapsChange(levels.change[static_cast<std::size_t>(level)], 1, si,
+                                                               x0, y0, x1, y1, above);
                         az = std::max(az, d);
                         gr = std::max(gr, d);
                     }
