@@ -143,8 +143,9 @@ void oracleFrame(Track& t, const gi::GiSettings& settings, float tolerance, cons
 
 // Per tile, for the change of the direct light from the last frame to this
 // one: the largest move of the indirect scan's radiance samples (over the
-// indirect azimuths) and the radiance bound gi/indirect_cache.h adds for it
-// (those moves weighed by the last frame's receivers' occlusion shares).
+// indirect azimuths, from the two frames' radiance pyramids) and the
+// radiance bound gi/indirect_cache.h adds for it (those moves weighed by the
+// last frame's receivers' occlusion shares).
 struct IndirectBounds {
     std::vector<double> sampleMove, bound;
 };
@@ -211,8 +212,9 @@ const char* kIntro =
     "gi/visibility_cache.h adds for the frame (environment, per azimuth, V alone). True change of the cached V: "
     "the SH ambient map at the new normals shaded with the last frame's V against the one shaded with the new V "
     "(the frame's own ambient map is the exact one, which does not read V), largest over the tile's "
-    "texels. Largest radiance sample move: the largest over the indirect azimuths of boundSampleChangePerAzimuth "
-    "for the frame's change of the direct light; radiance bound of the indirect light: what gi/indirect_cache.h "
+    "texels. Largest radiance sample move: the largest over the indirect azimuths of the samples' moves "
+    "gi/indirect_cache.h reads from the frame's radiance pyramid against the last frame's "
+    "(gi/radiance_sample_change.h); radiance bound of the indirect light: what gi/indirect_cache.h "
     "adds for it (the sample moves weighed by each receiver's occlusion shares per azimuth and per distance "
     "group, times the occlusion factor; the largest over the indirect tiles of 16 x 16 receivers the tile holds); "
     "the true change of the indirect light is that of the whole frame (sources and "

@@ -33,24 +33,32 @@ const FoldedWedgeOperator& indirectScanOperator(const GiSettings& settings, GiSt
     return st.indirectOperator;
 }
 
-// The receivers whose indirect light is re-gathered this frame
-// (gi/indirect_cache.h); null: every receiver. `cached`: the frame keeps an
-// indirect cache (incremental frames, a strategy that gathers by tiles).
-const ReceiverTiles* planIndirect(const GiSettings& settings, const FrameChange& change, bool cached,
-                                  std::span<const double> phi, GiState& st) {
+// What the indirect plan reads (gi/indirect_cache.h): this frame's direct
+// light, height pyramid and geometry tiles, the state's radiance pyramid
+// (the last pass's before buildDirectRadiancePyramid, this frame's after it).
+IndirectPlanInputs indirectPlanInputs(const GiSettings& settings, const FrameChange& change,
+                                      std::span<const double> phi, GiState& st) {
+    return {.source = st.shade.rgb,
+            .heights = st.pyramid,
+            .pyramid = st.indirect.radiance,
+            .geometryTiles = change.geometry ? &st.visibilityCache.geometryTiles : nullptr,
+            .phi = phi,
+            .tolerance = settings.tolerance,
+            .blocker = &st.indirect.blocker,
+            .sourceChanged = st.directChanged};
+}
+
+// Whether the indirect light is re-gathered by tiles this frame (`cached`:
+// the frame keeps an indirect cache, incremental frames with a strategy that
+// gathers by tiles); else every receiver, the cache dropped where it no
+// longer describes the result.
+bool startIndirect(const GiSettings& settings, const FrameChange& change, bool cached, std::span<const double> phi,
+                   GiState& st) {
     if (!cached || (change.geometry && !change.heightsOnly)) {
         invalidateIndirectCache(st.indirectCache);
-        return nullptr;
+        return false;
     }
-    const IndirectPlanInputs in{.source = st.shade.rgb,
-                                .heights = st.pyramid,
-                                .pyramid = st.indirect.radiance,
-                                .geometryTiles = change.geometry ? &st.visibilityCache.geometryTiles : nullptr,
-                                .phi = phi,
-                                .tolerance = settings.tolerance,
-                                .blocker = &st.indirect.blocker,
-                                .sourceChanged = st.directChanged};
-    return planIndirectTiles(in, st.indirectCache);
+    return startIndirectPlan(indirectPlanInputs(settings, change, phi, st), st.indirectCache);
 }
 
 // The texel tiles the indirect light's texel passes redo (gi/indirect_cache.h).
@@ -91,8 +99,10 @@ void runIndirectStage(ConstGridView heights, const GiSettings& settings, const F
     const auto t = Clock::now();
     const FoldedWedgeOperator& op = indirectScanOperator(settings, st);
     const bool cached = settings.incremental && gathersByTiles(settings.indirect, settings.shading);
+    const bool plans = startIndirect(settings, change, cached, op.phi, st);
     if (cached) buildDirectRadiancePyramid(settings, st);
-    const ReceiverTiles* only = planIndirect(settings, change, cached, op.phi, st);
+    const ReceiverTiles* only =
+        plans ? planIndirectTiles(indirectPlanInputs(settings, change, op.phi, st), st.indirectCache) : nullptr;
     const ReceiverTiles* texels = cached ? planTexels(heights, change, only, albedo, st) : nullptr;
     const IndirectInputs in{.heights = st.pyramid,
                             .gradX = st.gradX.cview(),
@@ -111,8 +121,7 @@ void runIndirectStage(ConstGridView heights, const GiSettings& settings, const F
                             .radianceCurrent = cached};
     computeIndirect(in, settings.indirect, st.indirect);
     st.directChanged = CellBox::none();  // the indirect light has read every change
-    if (cached && only == nullptr)
-        recordIndirectSource(st.shade.rgb, st.indirect.radiance, st.pyramid, st.indirectCache);
+    if (cached && only == nullptr) recordIndirectSource(st.shade.rgb, st.pyramid, st.indirectCache);
     st.indirectCache.geometryVersion = st.geometryVersion;
     st.indirectRecomputed = only ? only->dirtyFraction() : 1.0;
     st.timings.indirect = msSince(t);

@@ -17,7 +17,8 @@ namespace {
 // pyramid of the same receivers and steps.
 bool cacheFits(const IndirectPlanInputs& in, const IndirectCache& cache) {
     const HeightPyramid& h = in.heights;
-    if (!cache.valid || in.pyramid.fields.empty() || !cache.levels.fits(in.pyramid)) return false;
+    if (!cache.valid || in.pyramid.fields.empty() || (cache.levelsRecorded && !cache.levels.fits(in.pyramid)))
+        return false;
     const HeightPyramid& r = in.pyramid.fields[0];
     const Grid& last = cache.anchorSource[0];
     return r.nx == h.nx && r.ny == h.ny && r.nxr == h.nxr && r.nyr == h.nyr && r.steps.size() == h.steps.size() &&
@@ -189,14 +190,26 @@ void boundRadianceChange(const IndirectPlanInputs& in, IndirectCache& cache) {
     sharedBounds(in, cache);
 }
 
-const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCache& cache) {
+bool startIndirectPlan(const IndirectPlanInputs& in, IndirectCache& cache) {
     const bool allGeometry =
         in.geometryTiles && in.geometryTiles->dirtyCount() == static_cast<int>(in.geometryTiles->dirty.size());
     if (!cacheFits(in, cache) || allGeometry) {
         cache.valid = false;
+        return false;
+    }
+    if (skipsPlan(cache.skips)) return false;
+    if (!cache.levelsRecorded) {
+        recordAnchorLevels(in.pyramid, cache.levels);
+        cache.levelsRecorded = true;
+    }
+    return true;
+}
+
+const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCache& cache) {
+    if (!cacheFits(in, cache)) {
+        cache.valid = false;
         return nullptr;
     }
-    if (skipsPlan(cache.skips)) return nullptr;
     boundRadianceChange(in, cache);
     std::span<const std::uint8_t> geometry;
     if (in.geometryTiles) {
@@ -220,10 +233,9 @@ const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCac
     return &cache.tiles;
 }
 
-void recordIndirectSource(const std::array<Grid, 3>& source, const RadiancePyramid& pyramid,
-                          const HeightPyramid& heights, IndirectCache& cache) {
+void recordIndirectSource(const std::array<Grid, 3>& source, const HeightPyramid& heights, IndirectCache& cache) {
     cache.anchorSource = source;
-    recordAnchorLevels(pyramid, cache.levels);
+    cache.levelsRecorded = false;
     cache.anchorChanged = CellBox::none();
     cache.tiles.reset(heights.nxr, heights.nyr, kIndirectTile, false);
     cache.drift.reset(cache.tiles.dirty.size());

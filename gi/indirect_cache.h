@@ -103,6 +103,7 @@ struct IndirectCache {
     CellBox anchorChanged;               // holds every texel where L_0 may differ from anchorSource (every one)
     MaxChangePyramid change;             // this frame: max over the channels of |L_0 - anchorSource|
     RadianceLevelChange levels;          // the anchor's radiance pyramid levels, this frame's change of each
+    bool levelsRecorded = false;         // `levels` hold the anchor's (else the last pass's pyramid is the anchor's)
     std::vector<float> azimuthBound;     // per tile and indirect azimuth (tile-major)
     std::vector<float> groupBound;       // per tile and distance group (gi/pyramid.h), over every azimuth
     AnchoredDrift drift;                 // per tile: how far its result was from the anchor's
@@ -145,19 +146,28 @@ struct IndirectPlanInputs {
 /// pyramid).
 void boundRadianceChange(const IndirectPlanInputs& in, IndirectCache& cache);
 
-/// The tiles to re-gather (cache.tiles), or null when every receiver must be
-/// (no valid cache of this grid: the drifts start again at 0). As for the
-/// visibility (gi/plan_skips.h): after a plan that found most tiles dirty,
-/// frames re-gather everything without computing the bound, whose cost
-/// would only be added to a full pass.
+/// Whether this frame plans its indirect tiles, asked before the frame builds
+/// its radiance pyramid (in.pyramid is still the last pass's): a valid cache
+/// of this grid, some geometry tile within the tolerance, and no frame left
+/// of a run without plans (counted down here; gi/plan_skips.h: after a plan
+/// that found most tiles dirty, frames re-gather everything without
+/// computing the bound, whose cost would only be added to a full pass).
+/// When it plans and the anchor's levels are not recorded yet, the last
+/// pass's pyramid is the anchor's: its levels are copied now (a pass that
+/// is not followed by a plan costs no copy). False: every receiver
+/// re-gathers (an unfit cache is dropped: the drifts start again at 0).
+bool startIndirectPlan(const IndirectPlanInputs& in, IndirectCache& cache);
+
+/// The tiles to re-gather (cache.tiles), after startIndirectPlan said so and
+/// with in.pyramid this frame's; null when every receiver must be.
 const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCache& cache);
 
-/// After an indirect pass over `source` (its RGB radiance pyramid `pyramid`,
-/// on the receiver grid of `heights`) that gathered every receiver: `source`
-/// is the anchor the next frames compare with, the drifts start again at 0.
-/// (A planned pass moved the anchor, if at all, in planIndirectTiles.)
-void recordIndirectSource(const std::array<Grid, 3>& source, const RadiancePyramid& pyramid,
-                          const HeightPyramid& heights, IndirectCache& cache);
+/// After an indirect pass over `source` (on the receiver grid of `heights`)
+/// that gathered every receiver: `source` is the anchor the next frames
+/// compare with (its pyramid's levels are copied by the next plan, if any),
+/// the drifts start again at 0. (A planned pass moved the anchor, if at
+/// all, in planIndirectTiles.)
+void recordIndirectSource(const std::array<Grid, 3>& source, const HeightPyramid& heights, IndirectCache& cache);
 
 /// What the frame knows of the texels' inputs since the last pass.
 struct IndirectTexelInputs {
