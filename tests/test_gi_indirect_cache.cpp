@@ -640,3 +640,44 @@ TEST_CASE("gi.indirect_cache: the total is redone wherever the indirect light wa
         for (int x = far.x0; x < far.x1; ++x) farChanged = farChanged || out.indirect[1](x, y) != indirectBefore[1](x, y);
     CHECK(farChanged);
 }
+
+// The first plan after a full pass compares this frame's radiance pyramid
+// with that pass's (the anchor's): its bound equals one computed from
+// scratch with the pass's pyramid recorded as the anchor's.
+TEST_CASE("gi.indirect_cache: the first plan after a full pass compares with that pass's pyramid") {
+    const int n = 160;
+    const Grid h = bumpy(n, n);
+    GiSettings settings = withBounces(GiSettings{}, 2, 1);
+    settings.tolerance = 0.01f;
+    const GiLighting light = sunSkyAndKey();
+    AlbedoMap plain, patched;
+    for (std::size_t c = 0; c < 3; ++c) {
+        plain.channel[c] = Grid(n, n);
+        std::fill(plain.channel[c].v.begin(), plain.channel[c].v.end(), 0.5f);
+        patched.channel[c] = plain.channel[c];
+        for (int y = 8; y < 18; ++y)
+            for (int x = 8; x < 18; ++x) patched.channel[c](x, y) = 0.9f;
+    }
+    GiState st;
+    runGiFrame(h.cview(), kCell, light, settings, st, &plain);  // a full pass: the anchor
+    const RadiancePyramid anchorPyramid = st.indirect.radiance;
+    const std::array<Grid, 3> anchorSource = st.shade.rgb;
+    const BlockerRadianceState blocker = st.indirect.blocker;
+    runGiFrame(h.cview(), kCell, light, settings, st, &patched);
+    // the frame planned, and kept some tiles
+    CHECK(st.indirectRecomputed > 0.0);
+    CHECK(st.indirectRecomputed < 1.0);
+    IndirectCache fresh;
+    fresh.anchorSource = anchorSource;
+    recordAnchorLevels(anchorPyramid, fresh.levels);
+    const FoldedWedgeOperator op = foldFullCircle(settings.indirect.azimuths, settings.visibility.interp);
+    const IndirectPlanInputs in{.source = st.shade.rgb,
+                                .heights = st.pyramid,
+                                .pyramid = st.indirect.radiance,
+                                .geometryTiles = nullptr,
+                                .phi = op.phi,
+                                .tolerance = settings.tolerance,
+                                .blocker = &blocker};
+    boundRadianceChange(in, fresh);
+    CHECK(fresh.radianceBound == st.indirectCache.radianceBound);
+}
