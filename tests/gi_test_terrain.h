@@ -1,8 +1,11 @@
 #pragma once
 // Small analytic terrains shared by the GI tests.
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstring>
+#include <functional>
 
 #include "core/grid.h"
 #include "gi/frame.h"
@@ -101,6 +104,27 @@ inline bool incrementalMatchesFull(const Grid& h, float cellSize, const gi::GiLi
     gi::GiState full;
     gi::runGiFrame(h.cview(), cellSize, light, off, full);
     return sameOutputs(inc, full);
+}
+
+// An RGB radiance with change(x, y, channel) added at every texel (clamped
+// at 0 when asked), and per texel the largest |change| over the channels.
+struct ChangedRadiance {
+    std::array<Grid, 3> after;
+    Grid dL;
+};
+inline ChangedRadiance changedRadiance(const std::array<Grid, 3>& base,
+                                       const std::function<float(int, int, int)>& change, bool clampAtZero) {
+    const int nx = base[0].nx, ny = base[0].ny;
+    ChangedRadiance out{base, Grid(nx, ny)};
+    for (int y = 0; y < ny; ++y)
+        for (int x = 0; x < nx; ++x)
+            for (std::size_t c = 0; c < 3; ++c) {
+                float& v = out.after[c](x, y);
+                v += change(x, y, static_cast<int>(c));
+                if (clampAtZero) v = std::max(0.0f, v);
+                out.dL(x, y) = std::max(out.dL(x, y), std::fabs(v - base[c](x, y)));
+            }
+    return out;
 }
 
 }  // namespace terrain::gi_test

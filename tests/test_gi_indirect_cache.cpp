@@ -133,15 +133,9 @@ TEST_CASE("gi.indirect_cache: the radiance bound holds for local, global and edg
             CAPTURE(s);
             const std::string caseName = name;
             CAPTURE(caseName);
-            std::array<Grid, 3> after = base;
-            Grid dL(nx, ny);
-            for (int y = 0; y < ny; ++y)
-                for (int x = 0; x < nx; ++x)
-                    for (int c = 0; c < 3; ++c) {
-                        Grid& g = after[static_cast<std::size_t>(c)];
-                        g(x, y) = std::max(0.0f, g(x, y) + change(x, y, c));
-                        dL(x, y) = std::max(dL(x, y), std::fabs(g(x, y) - base[static_cast<std::size_t>(c)](x, y)));
-                    }
+            const gi_test::ChangedRadiance changed = gi_test::changedRadiance(base, change, true);
+            const std::array<Grid, 3>& after = changed.after;
+            const Grid& dL = changed.dL;
             IndirectState later;
             gather(after, later);
             // the frame's bound as the cache takes it: from the cached pass

@@ -65,14 +65,9 @@ TEST_CASE("gi.radiance_sample_change: every sample the scan reads moves by at mo
                  {"patch", patch}, {"one cell", cell}, {"noise", noise}, {"corner", corner}}) {
             const std::string caseName = name;
             CAPTURE(caseName);
-            std::array<Grid, 3> after = base;
-            Grid dL(nx, ny);
-            for (int y = 0; y < ny; ++y)
-                for (int x = 0; x < nx; ++x)
-                    for (std::size_t c = 0; c < 3; ++c) {
-                        after[c](x, y) += change(x, y, static_cast<int>(c));
-                        dL(x, y) = std::max(dL(x, y), std::fabs(after[c](x, y) - base[c](x, y)));
-                    }
+            const gi_test::ChangedRadiance changed = gi_test::changedRadiance(base, change, false);
+            const std::array<Grid, 3>& after = changed.after;
+            const Grid& dL = changed.dL;
             RadiancePyramid before, now;
             buildRadiancePyramid(base, heights, RadiancePyramidSettings{}, before);
             buildRadiancePyramid(after, heights, RadiancePyramidSettings{}, now);
