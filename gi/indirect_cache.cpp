@@ -34,8 +34,8 @@ bool hasOcclusions(const IndirectPlanInputs& in) {
     const HeightPyramid& h = in.heights;
     const std::size_t planeR = static_cast<std::size_t>(h.nxr) * h.nyr;
     return b && b->occlusionValid && h.subsample > 1 && b->nx == h.nx && b->ny == h.ny && b->nxr == h.nxr &&
-           b->nyr == h.nyr && b->azimuths == static_cast<int>(in.phi.size()) && b->occlusion.nx == h.nx && b->occlusion.ny == h.ny &&
-           b->receiverOcclusionRunning.size() == in.phi.size() * planeR &&
+           b->nyr == h.nyr && b->azimuths == static_cast<int>(in.phi.size()) && b->occlusion.nx == h.nx &&
+           b->occlusion.ny == h.ny && b->receiverOcclusionRunning.size() == in.phi.size() * planeR &&
            b->receiverGroupOcclusion.size() == static_cast<std::size_t>(kDistanceGroups) * planeR;
 }
 

@@ -14,9 +14,7 @@ namespace terrain::gi {
 
 namespace {
 
-int levelCount(const RadiancePyramid& p) {
-    return p.fields.empty() ? 0 : static_cast<int>(p.fields[0].levels.size());
-}
+int levelCount(const RadiancePyramid& p) { return p.fields.empty() ? 0 : static_cast<int>(p.fields[0].levels.size()); }
 
 // The level texels (receivers, half-open) that may differ where the
 // radiance changed only inside `changed`: its receivers within the level's
@@ -54,7 +52,8 @@ void recordAnchorLevels(const RadiancePyramid& p, RadianceLevelChange& out, Cell
             const HeightPyramid& f = p.fields[static_cast<std::size_t>(c)];
             const CellBox box = levelBox(f, l, changed);
             copyGrid(levelView(f.levels[static_cast<std::size_t>(l)]),
-                     out.anchor[static_cast<std::size_t>(c * out.levels + l)], box.empty() ? RowSpan{0, 0} : box.rows());
+                     out.anchor[static_cast<std::size_t>(c * out.levels + l)],
+                     box.empty() ? RowSpan{0, 0} : box.rows());
         }
 }
 
@@ -111,7 +110,8 @@ void boundSampleChangeFromLevels(const MaxChangePyramid& raw, const RadianceLeve
     const int T = tileReceivers, m = static_cast<int>(phi.size()), nSteps = static_cast<int>(field.steps.size());
     if (T < 1 || m < 1) throw InputError("radiance sample change: tiles and azimuths must be at least 1");
     if (raw.nx != field.nx || raw.ny != field.ny || levels.nxr != field.nxr || levels.nyr != field.nyr ||
-        static_cast<int>(levels.change.size()) != levels.levels || levels.levels != static_cast<int>(field.levels.size()))
+        static_cast<int>(levels.change.size()) != levels.levels ||
+        levels.levels != static_cast<int>(field.levels.size()))
         throw InputError("radiance sample change: the changes and the pyramid differ in size");
     const int tilesX = tileCount(field.nxr, T), tilesY = tileCount(field.nyr, T);
     const std::size_t tiles = static_cast<std::size_t>(tilesX) * tilesY;
@@ -122,9 +122,10 @@ void boundSampleChangeFromLevels(const MaxChangePyramid& raw, const RadianceLeve
     std::vector<int> group(static_cast<std::size_t>(nSteps));
     for (int j = 0; j < m; ++j)
         for (int i = 0; i < nSteps; ++i)
-            info[static_cast<std::size_t>(j) * nSteps + i] =
-                scanStepInfo(field, i, std::cos(phi[static_cast<std::size_t>(j)]), std::sin(phi[static_cast<std::size_t>(j)]));
-    for (int i = 0; i < nSteps; ++i) group[static_cast<std::size_t>(i)] = distanceGroup(field.steps[static_cast<std::size_t>(i)].tauCells);
+            info[static_cast<std::size_t>(j) * nSteps + i] = scanStepInfo(
+                field, i, std::cos(phi[static_cast<std::size_t>(j)]), std::sin(phi[static_cast<std::size_t>(j)]));
+    for (int i = 0; i < nSteps; ++i)
+        group[static_cast<std::size_t>(i)] = distanceGroup(field.steps[static_cast<std::size_t>(i)].tauCells);
     parallelFor(0, tilesY, 1, [&](int ty0, int ty1) {
         for (int ty = ty0; ty < ty1; ++ty)
             for (int tx = 0; tx < tilesX; ++tx) {
@@ -138,7 +139,8 @@ void boundSampleChangeFromLevels(const MaxChangePyramid& raw, const RadianceLeve
                         const int y0 = std::max(Y0, si.yFirst), y1 = std::min(Y1, si.yLast);
                         if (x0 > x1 || y0 > y1) continue;
                         float& az = tileBound[t * m + static_cast<std::size_t>(j)];
-                        float& gr = groupBound[t * kDistanceGroups + static_cast<std::size_t>(group[static_cast<std::size_t>(i)])];
+                        float& gr = groupBound[t * kDistanceGroups +
+                                               static_cast<std::size_t>(group[static_cast<std::size_t>(i)])];
                         // only a move above both running maxima changes either
                         const float above = std::min(az, gr);
                         const int level = field.steps[static_cast<std::size_t>(i)].level;

@@ -35,8 +35,8 @@ namespace terrain::gi {
 /// The anchor's pyramid levels and this frame's change of each level.
 struct RadianceLevelChange {
     int levels = 0, nxr = 0, nyr = 0;
-    std::vector<Grid> anchor;               // channel c's level l at [c * levels + l] (nxr x nyr, no padding)
-    std::vector<MaxChangePyramid> change;   // per level: max over the channels of |level - anchor|, rounded up
+    std::vector<Grid> anchor;              // channel c's level l at [c * levels + l] (nxr x nyr, no padding)
+    std::vector<MaxChangePyramid> change;  // per level: max over the channels of |level - anchor|, rounded up
     bool fits(const RadiancePyramid& p) const;
 };
 

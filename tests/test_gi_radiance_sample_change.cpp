@@ -93,12 +93,13 @@ TEST_CASE("gi.radiance_sample_change: every sample the scan reads moves by at mo
                         for (int X = si.xFirst; X <= si.xLast; ++X) {
                             const std::size_t t = static_cast<std::size_t>(Y / T) * tilesX + X / T;
                             const float bound = tileBound[t * m + static_cast<std::size_t>(j)];
-                            const float group =
-                                groupBound[t * kDistanceGroups +
-                                           static_cast<std::size_t>(distanceGroup(heights.steps[static_cast<std::size_t>(i)].tauCells))];
+                            const float group = groupBound[t * kDistanceGroups +
+                                                           static_cast<std::size_t>(distanceGroup(
+                                                               heights.steps[static_cast<std::size_t>(i)].tauCells))];
                             for (std::size_t ch = 0; ch < 3; ++ch) {
-                                const double d = std::fabs(static_cast<double>(sampleOf(now.fields[ch], i, c, sn, X, Y)) -
-                                                           sampleOf(before.fields[ch], i, c, sn, X, Y));
+                                const double d =
+                                    std::fabs(static_cast<double>(sampleOf(now.fields[ch], i, c, sn, X, Y)) -
+                                              sampleOf(before.fields[ch], i, c, sn, X, Y));
                                 excess = std::max(excess, d - std::min(bound, group) * (1.0 + 1e-6));
                                 if (bound > 0.0f) worst = std::max(worst, d / bound);
                                 float& tt = trueTile[t * m + static_cast<std::size_t>(j)];
