@@ -339,7 +339,6 @@ struct StepTable {
     std::vector<StepExtent> extent;
     std::vector<double> tauMinFrom;
     std::vector<int> octave;
-    std::vector<int> group;  // distance group (gi/pyramid.h)
     AxisWeights wx, wy;
     double meanPart = 1.0, maxPart = 0.0;  // |1 - b|, |b|
 };
@@ -350,7 +349,6 @@ StepTable stepTable(const HeightPyramid& pyr) {
         t.extent.push_back(stepExtent(pyr, i));
         t.tauMinFrom.push_back(tauMinFrom(pyr, i, firstLevel));
         t.octave.push_back(stepOctave(pyr, i));
-        t.group.push_back(distanceGroup(pyr.steps[static_cast<std::size_t>(i)].tauCells));
     }
     const int octaves = std::max(1, pyr.octaves);
     t.wx = axisWeights(pyr.nx, octaves);
@@ -400,27 +398,6 @@ void forEachTile(const HeightPyramid& pyr, int T, std::vector<float>& out, PerTi
             for (int tx = 0; tx < tilesX; ++tx)
                 out[static_cast<std::size_t>(ty) * tilesX + static_cast<std::size_t>(tx)] = perTile(tx, ty);
     });
-}
-
-// Largest D_ij over the steps of one azimuth, and with groupBest (null: not
-// wanted) over each distance group's steps (kDistanceGroups values, raised to
-// it); steps before `first` see no change from any azimuth, and no step's D
-// exceeds the largest change anywhere.
-double sampleBoundFrom(const MaxChangePyramid& dv, const StepTable& steps, const InclusiveCells& c, int first, double cs,
-                       double sn, double* groupBest = nullptr) {
-    const double mAll = maxChangeAll(dv);
-    double best = 0.0;
-    for (std::size_t i = static_cast<std::size_t>(first); i < steps.extent.size(); ++i) {
-        // nothing to gain where this azimuth's and the group's maxima (the
-        // group's over every azimuth so far) are already the largest change
-        double* group = groupBest ? groupBest + steps.group[i] : nullptr;
-        if (best >= mAll && (!group || *group >= mAll)) continue;
-        const InclusiveCells box = stepBoxOver(steps.extent[i], c, oneDirection(cs, sn));
-        const double d = filteredChange(dv, steps, static_cast<int>(i), box);
-        best = std::max(best, d);
-        if (group) *group = std::max(*group, d);
-    }
-    return best;
 }
 
 // Fills `azimuths` values per tile (tile-major) at the m samples phi_j = 2 pi
@@ -638,35 +615,6 @@ void boundSlopeChangePerAzimuth(const MaxChangePyramid& dh, const HeightPyramid&
             const int first = firstBusyStep(dh, pyr, c, m0);
             for (std::size_t j = 0; j < cs.size(); ++j)
                 out[j] = roundUp(azimuthBoundFrom(dh, pyr, steps, c, m0, first, oneDirection(cs[j], sn[j]), lipschitz));
-        });
-}
-
-void boundSampleChangePerAzimuth(const MaxChangePyramid& dv, const HeightPyramid& field, int tileReceivers,
-                                 int azimuths, std::vector<float>& tileBound) {
-    const StepTable steps = stepTable(field);
-    forEachTileAndAzimuth(
-        dv, field, tileReceivers, azimuths, tileBound,
-        [&](const InclusiveCells& c, const std::vector<double>& cs, const std::vector<double>& sn, float* out, std::size_t) {
-            const int first = lastQuietStep(dv, field, c) + 1;
-            for (std::size_t j = 0; j < cs.size(); ++j)
-                out[j] = roundUp(sampleBoundFrom(dv, steps, c, first, cs[j], sn[j]));
-        });
-}
-
-void boundSampleChangePerAzimuthAndGroup(const MaxChangePyramid& dv, const HeightPyramid& field, int tileReceivers,
-                                         int azimuths, std::vector<float>& tileBound, std::vector<float>& groupBound) {
-    const StepTable steps = stepTable(field);
-    const std::size_t tiles =
-        static_cast<std::size_t>(tileCount(field.nxr, tileReceivers)) * tileCount(field.nyr, tileReceivers);
-    groupBound.assign(tiles * kDistanceGroups, 0.0f);
-    forEachTileAndAzimuth(
-        dv, field, tileReceivers, azimuths, tileBound,
-        [&](const InclusiveCells& c, const std::vector<double>& cs, const std::vector<double>& sn, float* out, std::size_t t) {
-            const int first = lastQuietStep(dv, field, c) + 1;
-            double groups[kDistanceGroups] = {};
-            for (std::size_t j = 0; j < cs.size(); ++j)
-                out[j] = roundUp(sampleBoundFrom(dv, steps, c, first, cs[j], sn[j], groups));
-            for (int g = 0; g < kDistanceGroups; ++g) groupBound[t * kDistanceGroups + g] = roundUp(groups[g]);
         });
 }
 

@@ -241,30 +241,6 @@ void boundSlopeChangeOverRange(const MaxChangePyramid& dh, const HeightPyramid& 
 /// bound: 1 for the sample maximum, 20 / 16 for Eq. 16's midpoints.
 float blockingMaxLipschitz(BlockingMax rule);
 
-// ---- samples of a radiance pyramid per tile and azimuth -----------------------------
-// The indirect scan reads the previous bounce's exit radiance through a
-// pyramid with the height pyramid's steps (gi/radiance_pyramid.h: plain mean
-// filtering, peakBlend 0), at the same sample points as above. A change dL
-// of that radiance moves the samples of step i along azimuth j by at most
-// D_ij (the filtered change of the swept box, as for the heights), and the
-// irradiance the casting sets gather, a sum of the samples' radiance over
-// disjoint bands of directions whose clamped-cosine measure is the
-// receiver's occlusion O / pi <= 1, by at most max_ij D_ij: its mean blocker
-// radiance E / O too (gi/blocker_radiance.h).
-
-/// max_i D_ij of every tile and each of the m = azimuths samples phi_j = 2 pi
-/// j / m of the full circle, for the change pyramid dv of one field of
-/// `field` (tileBound[t m + j], tiles row-major as boundSlopeChange; same errors).
-void boundSampleChangePerAzimuth(const MaxChangePyramid& dv, const HeightPyramid& field, int tileReceivers,
-                                 int azimuths, std::vector<float>& tileBound);
-
-/// The same, and per tile the largest D_ij over the azimuths and the steps
-/// of each distance group g (gi/pyramid.h, distanceGroup of the step's tau):
-/// groupBound[t kDistanceGroups + g]. A far change moves the samples of the
-/// far groups alone.
-void boundSampleChangePerAzimuthAndGroup(const MaxChangePyramid& dv, const HeightPyramid& field, int tileReceivers,
-                                         int azimuths, std::vector<float>& tileBound, std::vector<float>& groupBound);
-
 // ---- tangent planes and normals per tile -------------------------------------------
 // omega_min (gi/visibility.h) reads the height gradient at the receiver, or
 // with sub-sampling the box of gradients over its footprint texels (offsets

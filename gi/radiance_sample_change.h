@@ -11,10 +11,10 @@
 // tile, cut to the receivers whose sample lies inside the field: the
 // largest |level - anchor level| there (max over the channels; block maxima
 // of gi/change_bound.h, exact box queries) bounds every sample of the step.
-// The filters' bound (boundSampleChangePerAzimuthAndGroup) charges a sample
-// with the largest change of any cell within its reach, weighed by the
-// filter's largest tap; here a far, filtered sample of a small change counts
-// by what it really moved. The price is the anchor's pyramid levels, kept
+// Bounding the samples through the filters instead, as the heights' slopes
+// are (gi/change_bound.h), charges a sample with the largest change of any
+// cell within its reach, weighed by the filter's largest tap; here a far,
+// filtered sample of a small change counts by what it really moved. The price is the anchor's pyramid levels, kept
 // beside the anchor's radiance (3 channels x levels x receivers floats).
 //
 // A level texel reads the radiance within the reach of its octaves' B-spline
