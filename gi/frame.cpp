@@ -100,7 +100,9 @@ void runIndirectStage(ConstGridView heights, const GiSettings& settings, const F
     const FoldedWedgeOperator& op = indirectScanOperator(settings, st);
     const bool cached = settings.incremental && gathersByTiles(settings.indirect, settings.shading);
     const bool plans = startIndirect(settings, change, cached, op.phi, st);
+    const auto tPyramid = Clock::now();
     if (cached) buildDirectRadiancePyramid(settings, st);
+    const double pyramidMs = msSince(tPyramid);
     const ReceiverTiles* only =
         plans ? planIndirectTiles(indirectPlanInputs(settings, change, op.phi, st), st.indirectCache) : nullptr;
     const ReceiverTiles* texels = cached ? planTexels(heights, change, only, albedo, st) : nullptr;
@@ -120,6 +122,8 @@ void runIndirectStage(ConstGridView heights, const GiSettings& settings, const F
                             .directChanged = settings.incremental ? st.directChanged : CellBox{},
                             .radianceCurrent = cached};
     computeIndirect(in, settings.indirect, st.indirect);
+    st.indirect.timings.pyramid += pyramidMs;  // bounce 0's pyramid, built before the plan
+    st.indirect.timings.total += pyramidMs;
     st.directChanged = CellBox::none();  // the indirect light has read every change
     if (cached && only == nullptr) recordIndirectSource(st.shade.rgb, st.pyramid, st.indirectCache);
     st.indirectCache.geometryVersion = st.geometryVersion;
