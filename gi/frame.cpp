@@ -125,7 +125,8 @@ void runIndirectStage(ConstGridView heights, const GiSettings& settings, const F
     st.indirect.timings.pyramid += pyramidMs;  // bounce 0's pyramid, built before the plan
     st.indirect.timings.total += pyramidMs;
     st.directChanged = CellBox::none();  // the indirect light has read every change
-    if (cached && only == nullptr) recordIndirectSource(st.shade.rgb, st.pyramid, st.indirectCache);
+    if (cached && only == nullptr)
+        recordIndirectSource(st.shade.rgb, st.indirect.radiance, st.pyramid, st.indirectCache);
     st.indirectCache.geometryVersion = st.geometryVersion;
     st.indirectRecomputed = only ? only->dirtyFraction() : 1.0;
     st.timings.indirect = msSince(t);

@@ -233,9 +233,14 @@ const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCac
     return &cache.tiles;
 }
 
-void recordIndirectSource(const std::array<Grid, 3>& source, const HeightPyramid& heights, IndirectCache& cache) {
+void recordIndirectSource(const std::array<Grid, 3>& source, const RadiancePyramid& pyramid,
+                          const HeightPyramid& heights, IndirectCache& cache) {
     cache.anchorSource = source;
-    cache.levelsRecorded = false;
+    cache.levelsRecorded = !cache.levels.fits(pyramid);
+    if (cache.levelsRecorded) {
+        recordAnchorLevels(pyramid, cache.levels);
+        buildLevelChanges(pyramid, CellBox::none(), cache.levels);
+    }
     cache.anchorChanged = CellBox::none();
     cache.tiles.reset(heights.nxr, heights.nyr, kIndirectTile, false);
     cache.drift.reset(cache.tiles.dirty.size());

@@ -162,12 +162,15 @@ bool startIndirectPlan(const IndirectPlanInputs& in, IndirectCache& cache);
 /// with in.pyramid this frame's; null when every receiver must be.
 const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCache& cache);
 
-/// After an indirect pass over `source` (on the receiver grid of `heights`)
-/// that gathered every receiver: `source` is the anchor the next frames
-/// compare with (its pyramid's levels are copied by the next plan, if any),
-/// the drifts start again at 0. (A planned pass moved the anchor, if at
-/// all, in planIndirectTiles.)
-void recordIndirectSource(const std::array<Grid, 3>& source, const HeightPyramid& heights, IndirectCache& cache);
+/// After an indirect pass over `source` (its RGB radiance pyramid `pyramid`,
+/// on the receiver grid of `heights`) that gathered every receiver: `source`
+/// is the anchor the next frames compare with, the drifts start again at 0.
+/// The pyramid's levels are copied by the next plan, if any; only the first
+/// pass on a grid copies them at once, with their (zero) change, so that
+/// the cache's memory is taken then and not in the middle of a run. (A
+/// planned pass moved the anchor, if at all, in planIndirectTiles.)
+void recordIndirectSource(const std::array<Grid, 3>& source, const RadiancePyramid& pyramid,
+                          const HeightPyramid& heights, IndirectCache& cache);
 
 /// What the frame knows of the texels' inputs since the last pass.
 struct IndirectTexelInputs {

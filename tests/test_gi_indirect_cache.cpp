@@ -612,8 +612,9 @@ TEST_CASE("gi.indirect_cache: the total is redone wherever the indirect light wa
 }
 
 // The first plan after a full pass compares this frame's radiance pyramid
-// with that pass's (the anchor's): its bound equals one computed from
-// scratch with the pass's pyramid recorded as the anchor's.
+// with that pass's (the anchor's), whose levels it copies then (a pass on a
+// grid the cache already holds does not): its bound equals one computed
+// from scratch with the pass's pyramid recorded as the anchor's.
 TEST_CASE("gi.indirect_cache: the first plan after a full pass compares with that pass's pyramid") {
     const int n = 160;
     const Grid h = bumpy(n, n);
@@ -629,7 +630,11 @@ TEST_CASE("gi.indirect_cache: the first plan after a full pass compares with tha
             for (int x = 8; x < 18; ++x) patched.channel[c](x, y) = 0.9f;
     }
     GiState st;
-    runGiFrame(h.cview(), kCell, light, settings, st, &plain);  // a full pass: the anchor
+    runGiFrame(h.cview(), kCell, light, settings, st, &plain);  // the first pass on this grid
+    GiSettings full = settings;
+    full.incremental = false;
+    runGiFrame(h.cview(), kCell, light, full, st, &plain);      // forgets the recorded inputs, so
+    runGiFrame(h.cview(), kCell, light, settings, st, &plain);  // this is a full pass: the anchor
     const RadiancePyramid anchorPyramid = st.indirect.radiance;
     const std::array<Grid, 3> anchorSource = st.shade.rgb;
     const BlockerRadianceState blocker = st.indirect.blocker;
