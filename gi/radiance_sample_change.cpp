@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstring>
 #include <limits>
 
 #include "core/error.h"
@@ -52,8 +51,7 @@ void recordAnchorLevels(const RadiancePyramid& p, RadianceLevelChange& out, Cell
             const HeightPyramid& f = p.fields[static_cast<std::size_t>(c)];
             const CellBox box = levelBox(f, l, changed);
             copyGrid(levelView(f.levels[static_cast<std::size_t>(l)]),
-                     out.anchor[static_cast<std::size_t>(c * out.levels + l)],
-                     box.empty() ? RowSpan{0, 0} : box.rows());
+                     out.anchor[static_cast<std::size_t>(c * out.levels + l)], box.rows());
         }
 }
 
@@ -68,10 +66,9 @@ void buildLevelChanges(const RadiancePyramid& now, CellBox changed, RadianceLeve
                 before[c] = out.anchor[c * static_cast<std::size_t>(out.levels) + static_cast<std::size_t>(l)].cview();
                 after[c] = levelView(now.fields[c].levels[static_cast<std::size_t>(l)]);
             }
-            const CellBox box = levelBox(now.fields[0], l, changed);
             // an empty box still redoes the last build's changed cells, which may now be 0
             buildMaxChangePyramid(before, after, out.change[static_cast<std::size_t>(l)],
-                                  box.empty() ? CellBox::none() : box);
+                                  levelBox(now.fields[0], l, changed));
         }
     });
 }
