@@ -24,26 +24,43 @@ void prepareIndirectSum(int nx, int ny, int bounces, IndirectState& st) {
     st.bounceMean.resize(static_cast<std::size_t>(bounces));
 }
 
-// Mean over the texels and channels (RGB average): rows summed in
-// parallel, each into four partial sums (independent additions, so the
-// loop is not one long chain of dependent ones), folded in row order.
-double meanOf(const std::array<Grid, 3>& rgb) {
+// Mean over the texels and channels (RGB average): blocks of rows summed
+// in parallel, each into four partial sums (independent additions, so the
+// loop is not one long chain of dependent ones), folded in row order. With
+// `blocks` (the sum of each block of rows of this field) only the blocks
+// holding `redo`'s rows are summed again: the others' rows have not changed
+// since their sums were taken. The same value as summing every block.
+double meanOf(const std::array<Grid, 3>& rgb, RowSpan redo, RowBlockSums* blocks) {
+    constexpr int kRowsPerBlock = 16;
     const int nx = rgb[0].nx, ny = rgb[0].ny;
-    const double sum = deterministicReduce(
-        0, ny, 16, 0.0,
-        [&](int y0, int y1) {
+    const int nBlocks = (ny + kRowsPerBlock - 1) / kRowsPerBlock;
+    RowBlockSums own;
+    RowBlockSums& held = blocks ? *blocks : own;
+    std::vector<double>& sums = held.sums;
+    if (!blocks || held.nx != nx || sums.size() != static_cast<std::size_t>(nBlocks)) {
+        sums.assign(static_cast<std::size_t>(nBlocks), 0.0);
+        held.nx = nx;
+        redo = {};
+    }
+    redo = redo.cut(ny);
+    const int b0 = redo.y0 / kRowsPerBlock;
+    const int b1 = redo.y1 > redo.y0 ? (redo.y1 + kRowsPerBlock - 1) / kRowsPerBlock : b0;
+    parallelFor(b0, b1, 1, [&](int first, int last) {
+        for (int b = first; b < last; ++b) {
             double lanes[4] = {};
             for (const Grid& g : rgb)
-                for (int y = y0; y < y1; ++y) {
+                for (int y = b * kRowsPerBlock; y < std::min(ny, (b + 1) * kRowsPerBlock); ++y) {
                     const float* row = g.data() + static_cast<std::size_t>(y) * nx;
                     int x = 0;
                     for (; x + 4 <= nx; x += 4)
                         for (int k = 0; k < 4; ++k) lanes[k] += row[x + k];
                     for (; x < nx; ++x) lanes[0] += row[x];
                 }
-            return (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
-        },
-        [](double a, double b) { return a + b; });
+            sums[static_cast<std::size_t>(b)] = (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
+        }
+    });
+    double sum = 0.0;
+    for (const double s : sums) sum += s;
     return sum / (3.0 * static_cast<double>(std::max<std::size_t>(1, rgb[0].v.size())));
 }
 
@@ -56,6 +73,9 @@ void runBounces(const IndirectInputs& in, const IndirectSettings& settings, Indi
     // the sum is redone where this call's inputs or light may differ from the last call's
     const bool totalOfLastCall = st.totalValid;
     st.totalValid = false;
+    // one bounce over texel runs: the indirect light changed there alone
+    const bool restricted = totalOfLastCall && settings.bounces == 1 && in.texelRuns != nullptr;
+    if (settings.bounces != 1) st.meanOfRows.sums.clear();  // the row sums are of one bounce's light
     strategy.beginFrame();
     prepareIndirectSum(in.heights.nx, in.heights.ny, settings.bounces, st);
     // the RGB pyramid may be redone where bounce 0 changed only when it is
@@ -83,7 +103,9 @@ void runBounces(const IndirectInputs& in, const IndirectSettings& settings, Indi
             std::swap(out.rgb, st.indirect);
             strategy.shade(b, out);
             std::swap(out.rgb, st.indirect);
-            st.bounceMean[0] = meanOf(st.indirect);
+            // restricted to texel runs, the light changed in their rows alone
+            st.bounceMean[0] =
+                meanOf(st.indirect, restricted ? boundingBox(*in.texelRuns).rows() : RowSpan{}, &st.meanOfRows);
         } else {
             strategy.shade(b, out);
             accumulateBounce(out.rgb, b, st);
@@ -91,8 +113,6 @@ void runBounces(const IndirectInputs& in, const IndirectSettings& settings, Indi
         }
         st.timings.shading += msSince(t);
     }
-    // one bounce over texel runs: the indirect light changed there alone
-    const bool restricted = totalOfLastCall && settings.bounces == 1 && in.texelRuns != nullptr;
     sumDirectAndIndirect(in.direct, st, restricted ? in.directChanged.joined(boundingBox(*in.texelRuns)) : CellBox{});
     st.timings.total = msSince(t0);
 }
@@ -103,7 +123,7 @@ void accumulateBounce(const std::array<Grid, 3>& exit, int b, IndirectState& st)
         const Grid& add = exit[static_cast<std::size_t>(c)];
         for (std::size_t i = 0; i < acc.v.size(); ++i) acc.v[i] += add.v[i];
     }
-    st.bounceMean[static_cast<std::size_t>(b - 1)] = meanOf(exit);
+    st.bounceMean[static_cast<std::size_t>(b - 1)] = meanOf(exit, {}, nullptr);
 }
 
 void sumDirectAndIndirect(const std::array<Grid, 3>& direct, IndirectState& st, CellBox changed) {

@@ -54,29 +54,30 @@ constexpr float kNoShareBelow = 1e-6f;
 // positive float terms and a division, rounded up by 1e-5 plus one float
 // epsilon per azimuth, above their rounding for any m; a positive term w D
 // never rounds to 0 (at least the smallest float), so that tolerance 0 sees
-// every change a member may carry. Four receivers per vector (a run cut
-// by the grid's edge copied into zero-padded lanes).
-float rowShareBound(const BlockerRadianceState& b, int Y, int x0, int x1, const float* D, const float* G,
-                    float largest) {
-    using simd::F4;
-    constexpr int kLaneGroups = kIndirectTile / 4;
+// every change a member may carry. L receivers per vector (a run cut by the
+// grid's edge copied into zero-padded lanes); lane-wise IEEE arithmetic, so
+// the 4- and 8-wide builds give the same bits.
+template <class V>
+[[gnu::always_inline]] inline float rowShareBoundWith(const BlockerRadianceState& b, int Y, int x0, int x1,
+                                                      const float* D, const float* G, float largest) {
+    constexpr int L = simd::kLaneCount<V>, kLaneGroups = kIndirectTile / L;
     const std::size_t m = static_cast<std::size_t>(b.azimuths), plane = static_cast<std::size_t>(b.nxr) * b.nyr;
     const std::size_t at = static_cast<std::size_t>(Y) * b.nxr + static_cast<std::size_t>(x0);
-    const int n = x1 - x0, laneGroups = (n + 3) / 4;
-    const F4 zero = simd::splat<F4>(0.0f);
-    F4 azWeighed[kLaneGroups], azTotal[kLaneGroups], grWeighed[kLaneGroups], grTotal[kLaneGroups];
+    const int n = x1 - x0, laneGroups = (n + L - 1) / L;
+    const V zero = simd::splat<V>(0.0f);
+    V azWeighed[kLaneGroups], azTotal[kLaneGroups], grWeighed[kLaneGroups], grTotal[kLaneGroups];
     for (int q = 0; q < laneGroups; ++q) azWeighed[q] = azTotal[q] = grWeighed[q] = grTotal[q] = zero;
-    alignas(16) float lanes[kIndirectTile] = {};
-    const auto weighed = [&](const float* v, float d, F4* sum, F4* total, bool running) {
-        if (n % 4 != 0) {  // a cut run: zero-padded lanes
+    alignas(32) float lanes[kIndirectTile] = {};
+    const auto weighed = [&](const float* v, float d, V* sum, V* total, bool running) {
+        if (n % L != 0) {  // a cut run: zero-padded lanes
             std::copy(v, v + n, lanes);
             v = lanes;
         }
-        const F4 dv = simd::splat<F4>(d);
-        const F4 tiny = simd::splat<F4>(d > 0.0f ? std::numeric_limits<float>::denorm_min() : 0.0f);
+        const V dv = simd::splat<V>(d);
+        const V tiny = simd::splat<V>(d > 0.0f ? std::numeric_limits<float>::denorm_min() : 0.0f);
         for (int q = 0; q < laneGroups; ++q) {
-            const F4 x = simd::load<F4>(v + 4 * q);
-            const F4 w = running ? x - total[q] : x;  // an azimuth's share: the running sum's step
+            const V x = simd::load<V>(v + L * q);
+            const V w = running ? x - total[q] : x;  // an azimuth's share: the running sum's step
             sum[q] += w > zero ? simd::vmax(w * dv, tiny) : zero;
             total[q] = running ? x : total[q] + x;
         }
@@ -86,19 +87,27 @@ float rowShareBound(const BlockerRadianceState& b, int Y, int x0, int x1, const 
     for (std::size_t g = 0; g < kDistanceGroups; ++g)
         weighed(b.receiverGroupOcclusion.data() + g * plane + at, G[g], grWeighed, grTotal, false);
     // sum / total, positive when the sum is, or `largest` for (next to) no occlusion
-    const F4 big = simd::splat<F4>(largest), floor = simd::splat<F4>(kNoShareBelow);
-    const F4 denorm = simd::splat<F4>(std::numeric_limits<float>::denorm_min());
-    const auto mean = [&](F4 sum, F4 total) {
-        const F4 ratio = sum > zero ? simd::vmax(sum / total, denorm) : zero;
+    const V big = simd::splat<V>(largest), floor = simd::splat<V>(kNoShareBelow);
+    const V denorm = simd::splat<V>(std::numeric_limits<float>::denorm_min());
+    const auto mean = [&](V sum, V total) {
+        const V ratio = sum > zero ? simd::vmax(sum / total, denorm) : zero;
         return total > floor ? ratio : big;
     };
     float bound = 0.0f;
     for (int q = 0; q < laneGroups; ++q) {
-        const F4 rho = simd::vmin(mean(azWeighed[q], azTotal[q]), mean(grWeighed[q], grTotal[q]));
-        for (int l = 0; l < 4 && 4 * q + l < n; ++l) bound = std::max(bound, rho[l]);
+        const V rho = simd::vmin(mean(azWeighed[q], azTotal[q]), mean(grWeighed[q], grTotal[q]));
+        for (int l = 0; l < L && L * q + l < n; ++l) bound = std::max(bound, rho[l]);
     }
     const float up = 1.0f + 1e-5f + static_cast<float>(m) * std::numeric_limits<float>::epsilon();
     return std::min(largest, bound * up);
+}
+float rowShareBoundSse(const BlockerRadianceState& b, int Y, int x0, int x1, const float* D, const float* G,
+                       float largest) {
+    return rowShareBoundWith<simd::F4>(b, Y, x0, x1, D, G, largest);
+}
+[[gnu::target("avx2"), gnu::flatten]] float rowShareBoundAvx2(const BlockerRadianceState& b, int Y, int x0, int x1,
+                                                              const float* D, const float* G, float largest) {
+    return rowShareBoundWith<simd::F8>(b, Y, x0, x1, D, G, largest);
 }
 
 // Per tile: the radiance bound, the largest rho_k over its receivers (max_j
@@ -115,6 +124,7 @@ void sharedBounds(const IndirectPlanInputs& in, IndirectCache& cache) {
         if (!shares) return largest;
         float bound = 0.0f;
         const int x0 = tx * kIndirectTile, x1 = std::min(h.nxr, x0 + kIndirectTile);
+        const auto rowShareBound = simd::wideEnabled() ? rowShareBoundAvx2 : rowShareBoundSse;
         for (int Y = ty * kIndirectTile; Y < std::min(h.nyr, (ty + 1) * kIndirectTile); ++Y)
             bound = std::max(bound, rowShareBound(*in.blocker, Y, x0, x1, D, G, largest));
         return bound;

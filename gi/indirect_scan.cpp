@@ -12,20 +12,36 @@ namespace terrain::gi {
 namespace {
 
 // The field's highest height (the raw heights; the pyramid levels are
-// filters of it and so stay below it, up to float rounding: 1e-6 relative slack).
-float fieldTopHeight(const HeightPyramid& pyr) {
+// filters of it and so stay below it, up to float rounding: 1e-6 relative
+// slack). Each block of rows keeps its highest height in `blocks`, which
+// holds those of build `ofBuild`: when this pyramid redid rows of that
+// build, only the blocks holding them are redone (a maximum is exact, so
+// the value is that of a whole pass, and rows in parallel give it too).
+float fieldTopHeight(const HeightPyramid& pyr, std::vector<float>& blocks, std::uint64_t& ofBuild) {
+    constexpr int kRowsPerTopBlock = 32;
     constexpr float kNone = -std::numeric_limits<float>::infinity();
-    // a maximum is exact, so rows in parallel give the same value
-    float hMax = deterministicReduce(
-        0, pyr.ny, 32, kNone,
-        [&](int y0, int y1) {
+    const int nBlocks = (pyr.ny + kRowsPerTopBlock - 1) / kRowsPerTopBlock;
+    RowSpan redo{0, pyr.ny};
+    if (ofBuild != 0 && blocks.size() == static_cast<std::size_t>(nBlocks)) {
+        if (ofBuild == pyr.buildId) redo = {0, 0};
+        if (ofBuild == pyr.basedOn) redo = pyr.rawRowsRedone.cut(pyr.ny);
+    }
+    blocks.resize(static_cast<std::size_t>(nBlocks));
+    ofBuild = 0;  // until the blocks are redone
+    const int b0 = redo.y0 / kRowsPerTopBlock;
+    const int b1 = redo.y1 > redo.y0 ? (redo.y1 + kRowsPerTopBlock - 1) / kRowsPerTopBlock : b0;
+    parallelFor(b0, b1, 1, [&](int first, int last) {
+        for (int b = first; b < last; ++b) {
             float m = kNone;
-            for (int y = y0; y < y1; ++y)
+            for (int y = b * kRowsPerTopBlock; y < std::min(pyr.ny, (b + 1) * kRowsPerTopBlock); ++y)
                 for (int q = 0; q < pyr.subsample; ++q)
                     for (int x = 0; x < pyr.rawPhaseWidth; ++x) m = std::max(m, pyr.rawPhaseRow(q, y)[x]);
-            return m;
-        },
-        [](float a, float b) { return std::max(a, b); });
+            blocks[static_cast<std::size_t>(b)] = m;
+        }
+    });
+    ofBuild = pyr.buildId;
+    float hMax = kNone;
+    for (const float m : blocks) hMax = std::max(hMax, m);
     hMax += std::fabs(hMax) * 1e-6f + 1e-30f;
     return hMax;
 }
@@ -47,7 +63,7 @@ void IndirectScan::beginFrame() {
     st_.blocks.resize(static_cast<std::size_t>(workerSlots()));
     for (IndirectScratch& b : st_.blocks)
         sizeIndirectScratch(b, kRowsPerBlock, pad_, moments_ == CastingMoments::Irradiance);
-    hMax_ = fieldTopHeight(in_.heights);
+    hMax_ = fieldTopHeight(in_.heights, st_.topOfRows, st_.topOfBuild);
     st_.heightSteps.resize(tableSize_);
     if (moments_ == CastingMoments::GlossyNlp) {
         st_.glossy.steps.resize(tableSize_);

@@ -18,6 +18,12 @@
 
 namespace terrain::gi {
 
+/// Sums of a field's blocks of rows, and the field's width.
+struct RowBlockSums {
+    std::vector<double> sums;
+    int nx = 0;
+};
+
 struct IndirectTimings {
     double pyramid = 0.0, scan = 0.0, shading = 0.0, total = 0.0;
 };
@@ -41,6 +47,8 @@ struct IndirectState {
     std::vector<int> stepsPerColumn, stepsPerRow;
     std::vector<std::uint8_t> distanceGroups;  // per step (gi/pyramid.h, distanceGroup)
     DirtySpans spans;                          // the receiver columns to scan, per row
+    std::vector<float> topOfRows;              // per block of raw-phase rows: its highest height (fieldTopHeight)
+    std::uint64_t topOfBuild = 0;              // the height pyramid build topOfRows holds (0: none)
     std::vector<IndirectScratch> blocks;       // per worker slot (IndirectScan::scratch)
     std::array<VisibilityField, 3> u;      // U per channel (16 SH planes at the receivers; not with BlockerRadiance)
     int uZeroFrom = kShCount;              // U's planes from this one on are known to be 0
@@ -50,6 +58,7 @@ struct IndirectState {
     std::array<Grid, 3> total;             // direct + indirect
     bool totalValid = false;               // total is the sum of the last call's direct and indirect
     std::vector<double> bounceMean;        // mean exit radiance (RGB average) of each bounce
+    RowBlockSums meanOfRows;               // one bounce: per block of texel rows, its sum of bounceMean[0]
     IndirectTimings timings;
     GlossyIndirectState glossy;    // GlossyIndirect::VectorPyramid
     BlockerRadianceState blocker;  // LambertIndirect::BlockerRadiance: horizons, occlusion, receivers' E

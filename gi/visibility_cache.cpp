@@ -57,7 +57,10 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
     if (cache.tiles.nxr != pyr.nxr || cache.tiles.nyr != pyr.nyr || !cache.drift.fits(cache.tiles.dirty.size()) ||
         cache.anchorHeights.nx != after.nx || cache.anchorHeights.ny != after.ny)
         resetVisibilityCache(pyr, before, cache);
-    buildMaxChangePyramid(cache.anchorHeights.cview(), after, cache.change);
+    // outside the cells that differ from the anchor's, |dh| is 0 (and the
+    // anchor's rows the same as this frame's)
+    const CellBox differing = differingCells(cache.anchorHeights, after);
+    buildMaxChangePyramid(cache.anchorHeights.cview(), after, cache.change, differing);
     boundSlopeChange(cache.change, pyr, kVisibilityTile, cache.slopeBound);
     boundSlopeChangePerAzimuth(cache.change, pyr, kVisibilityTile, vis.azimuths, cache.azimuthBound);
     boundGradientChange(cache.change, pyr, kVisibilityTile, cache.gradBound);
@@ -88,7 +91,7 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
     advanceAnchoredDrift(cache.envBound, cache.tiles.dirty, reanchor, cache.drift);
     advanceAnchoredDrift(cache.keyBound, cache.keyTiles.dirty, reanchor, cache.keyDrift);
     advanceAnchoredDrift(cache.geometryBound, cache.geometryTiles.dirty, reanchor, cache.geometryDrift);
-    if (reanchor) copyGrid(after, cache.anchorHeights);
+    if (reanchor) copyGrid(after, cache.anchorHeights, differing.rows());
     const int all = static_cast<int>(tiles);
     // the indirect light re-gathers the geometry's dirty tiles: both count
     countAfterPlan(std::min(cache.tiles.dirtyCount(), cache.geometryTiles.dirtyCount()), all, cache.skips);

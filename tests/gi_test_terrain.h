@@ -81,7 +81,7 @@ inline gi::GiSettings withBounces(gi::GiSettings s, int subsample, int bounces) 
     return s;
 }
 
-// Every output a caller reads: ambient, direct shade, indirect and total.
+// Every output a caller reads: ambient, direct shade, indirect, total and the bounce means.
 inline bool sameOutputs(const gi::GiState& a, const gi::GiState& b) {
     bool ok = sameBits(a.shade.ambient.v, b.shade.ambient.v);
     for (int c = 0; c < 3; ++c) {
@@ -90,7 +90,8 @@ inline bool sameOutputs(const gi::GiState& a, const gi::GiState& b) {
              sameBits(a.indirect.indirect[i].v, b.indirect.indirect[i].v) &&
              sameBits(a.indirect.total[i].v, b.indirect.total[i].v);
     }
-    return ok;
+    const std::vector<double>&ma = a.indirect.bounceMean, &mb = b.indirect.bounceMean;
+    return ok && ma.size() == mb.size() && std::memcmp(ma.data(), mb.data(), ma.size() * sizeof(double)) == 0;
 }
 
 // Runs one frame of the incremental state `inc` and the same frame on a fresh

@@ -338,7 +338,8 @@ TEST_CASE("gi.frame_change: the passes that redo the changed rows alone give the
             buildHeightPyramid(before.cview(), 2.0f, s, settings.pyramid, pyr);
             computeGradient(after.cview(), 2.0f, gx, gy, band);
             computeFootprintBox(gx.cview(), gy.cview(), s, box, band.grown(1));
-            buildHeightPyramid(after.cview(), 2.0f, s, settings.pyramid, pyr, CellBox{0, band.y0, CellBox::kAll, band.y1});
+            buildHeightPyramid(after.cview(), 2.0f, s, settings.pyramid, pyr,
+                               CellBox{0, band.y0, CellBox::kAll, band.y1});
             computeGradient(after.cview(), 2.0f, fullX, fullY);
             computeFootprintBox(fullX.cview(), fullY.cview(), s, fullBox);
             buildHeightPyramid(after.cview(), 2.0f, s, settings.pyramid, fullPyr);
@@ -353,6 +354,25 @@ TEST_CASE("gi.frame_change: the passes that redo the changed rows alone give the
             for (std::size_t l = 0; l < pyr.levels.size(); ++l)
                 CHECK(gi_test::sameBits(pyr.levels[l].v, fullPyr.levels[l].v));
         }
+}
+
+TEST_CASE("gi.frame_change: a peak that rises above the field's top and falls again is lit as in full frames") {
+    // the scans stop where nothing ahead can rise above a receiver's horizon,
+    // reading the field's top height; incremental frames take it from the
+    // rows they redid, so a peak raised above every other height (and
+    // lowered again) must be seen as a full frame sees it
+    Grid h = bumpy(64, 56);
+    GiSettings settings = withBounces(GiSettings{}, 2, 1);
+    settings.tolerance = 0.0f;
+    const GiLighting light = sunSkyAndKey();
+    GiState st;
+    CHECK(incrementalMatchesFull(h, 2.0f, light, settings, st));
+    for (const float rise : {30.0f, 60.0f, -60.0f, -30.0f}) {
+        CAPTURE(rise);
+        for (int y = 40; y < 43; ++y)
+            for (int x = 21; x < 24; ++x) h(x, y) += rise;
+        CHECK(incrementalMatchesFull(h, 2.0f, light, settings, st));
+    }
 }
 
 TEST_CASE("gi.frame_change: the changed heights' box holds exactly the cells that differ bit for bit") {
