@@ -75,14 +75,16 @@ template <class V, bool Parts, int K>
     }
 }
 
-// The whole vectors of [x0, x1).
+// The whole vectors of [x0, x1): eight at a time (the more chains in
+// flight, the more of the divisions' latency is hidden), then two, then one.
 template <class V, bool Parts>
 [[gnu::always_inline]] inline void addAzimuth(const float* gx, const float* gy, const float* horizon, float c, float sn,
                                               float* const acc[3], int x0, int x1) {
-    constexpr int L = simd::kLaneCount<V>, K = 4;
+    constexpr int L = simd::kLaneCount<V>;
     const V vc = splat<V>(c), vs = splat<V>(sn);
     int x = x0;
-    for (; x + K * L <= x1; x += K * L) addAzimuthVectors<V, Parts, K>(gx, gy, horizon, vc, vs, acc, x);
+    for (; x + 8 * L <= x1; x += 8 * L) addAzimuthVectors<V, Parts, 8>(gx, gy, horizon, vc, vs, acc, x);
+    for (; x + 2 * L <= x1; x += 2 * L) addAzimuthVectors<V, Parts, 2>(gx, gy, horizon, vc, vs, acc, x);
     for (; x + L <= x1; x += L) addAzimuthVectors<V, Parts, 1>(gx, gy, horizon, vc, vs, acc, x);
 }
 
