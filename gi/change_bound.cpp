@@ -374,8 +374,8 @@ double filteredChange(const MaxChangePyramid& dh, const StepTable& t, int i, con
 }
 
 // Steps before `first` see no change from any azimuth (lastQuietStep).
-double azimuthBoundFrom(const MaxChangePyramid& dh, const HeightPyramid& pyr, const StepTable& steps, const InclusiveCells& c,
-                        double m0, int first, const Directions& dir, double lipschitz) {
+double azimuthBoundFrom(const MaxChangePyramid& dh, const HeightPyramid& pyr, const StepTable& steps,
+                        const InclusiveCells& c, double m0, int first, const Directions& dir, double lipschitz) {
     const double mAll = maxChangeAll(dh), cellSize = pyr.cellSize;
     double best = 0.0;
     for (std::size_t i = static_cast<std::size_t>(first); i < steps.extent.size(); ++i) {
@@ -427,6 +427,26 @@ void forEachTileAndAzimuth(const MaxChangePyramid& dv, const HeightPyramid& pyr,
     });
 }
 
+// out[x] = max(out[x], |b[x] - a[x]| rounded up) over [x0, x1): whole
+// vectors, then the rest one by one (the same IEEE operations, so the 4-
+// and 8-wide builds give the same bits).
+template <class V>
+[[gnu::always_inline]] inline void raiseToChange(const float* a, const float* b, float* out, int x0, int x1) {
+    constexpr int L = simd::kLaneCount<V>;
+    int x = x0;
+    for (; x + L <= x1; x += L)
+        simd::store(out + x,
+                    simd::vmax(simd::load<V>(out + x), absDifferenceUp(simd::load<V>(a + x), simd::load<V>(b + x))));
+    for (; x < x1; ++x) out[x] = std::max(out[x], absDifferenceUp(a[x], b[x]));
+}
+void raiseToChangeSse(const float* a, const float* b, float* out, int x0, int x1) {
+    raiseToChange<simd::F4>(a, b, out, x0, x1);
+}
+[[gnu::target("avx2"), gnu::flatten]] void raiseToChangeAvx2(const float* a, const float* b, float* out, int x0,
+                                                             int x1) {
+    raiseToChange<simd::F8>(a, b, out, x0, x1);
+}
+
 }  // namespace
 
 void buildMaxChangePyramid(ConstGridView dh, MaxChangePyramid& p) {
@@ -471,14 +491,8 @@ void buildMaxChangePyramid(std::span<const ConstGridView> before, std::span<cons
             float* out = base.data() + static_cast<std::size_t>(y) * base.nx;
             std::fill(out + x0, out + x1, 0.0f);
             for (std::size_t c = 0; c < before.size(); ++c) {
-                const float* a = before[c].row(y);
-                const float* b = after[c].row(y);
-                int x = x0;
-                for (; x + 4 <= x1; x += 4)
-                    simd::store(out + x,
-                                simd::vmax(simd::load<simd::F4>(out + x),
-                                           absDifferenceUp(simd::load<simd::F4>(a + x), simd::load<simd::F4>(b + x))));
-                for (; x < x1; ++x) out[x] = std::max(out[x], absDifferenceUp(a[x], b[x]));
+                (simd::wideEnabled() ? raiseToChangeAvx2 : raiseToChangeSse)(before[c].row(y), after[c].row(y), out, x0,
+                                                                             x1);
             }
         }
     });
@@ -610,7 +624,8 @@ void boundSlopeChangePerAzimuth(const MaxChangePyramid& dh, const HeightPyramid&
     const double lipschitz = heightFilterLipschitz(pyr);
     forEachTileAndAzimuth(
         dh, pyr, tileReceivers, azimuths, tileBound,
-        [&](const InclusiveCells& c, const std::vector<double>& cs, const std::vector<double>& sn, float* out, std::size_t) {
+        [&](const InclusiveCells& c, const std::vector<double>& cs, const std::vector<double>& sn, float* out,
+            std::size_t) {
             const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
             const int first = firstBusyStep(dh, pyr, c, m0);
             for (std::size_t j = 0; j < cs.size(); ++j)

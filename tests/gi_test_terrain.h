@@ -91,7 +91,8 @@ inline bool sameOutputs(const gi::GiState& a, const gi::GiState& b) {
              sameBits(a.indirect.total[i].v, b.indirect.total[i].v);
     }
     const std::vector<double>&ma = a.indirect.bounceMean, &mb = b.indirect.bounceMean;
-    return ok && ma.size() == mb.size() && std::memcmp(ma.data(), mb.data(), ma.size() * sizeof(double)) == 0;
+    return ok && ma.size() == mb.size() &&
+           (ma.empty() || std::memcmp(ma.data(), mb.data(), ma.size() * sizeof(double)) == 0);
 }
 
 // Runs one frame of the incremental state `inc` and the same frame on a fresh
