@@ -431,7 +431,7 @@ void forEachTileAndAzimuth(const MaxChangePyramid& dv, const HeightPyramid& pyr,
 // vectors, then the rest one by one (the same IEEE operations, so the 4-
 // and 8-wide builds give the same bits).
 template <class V>
-[[gnu::always_inline]] inline void raiseToChange(const float* a, const float* b, float* out, int x0, int x1) {
+[[gnu::always_inline]] inline void raiseToChangeWith(const float* a, const float* b, float* out, int x0, int x1) {
     constexpr int L = simd::kLaneCount<V>;
     int x = x0;
     for (; x + L <= x1; x += L)
@@ -440,11 +440,11 @@ template <class V>
     for (; x < x1; ++x) out[x] = std::max(out[x], absDifferenceUp(a[x], b[x]));
 }
 void raiseToChangeSse(const float* a, const float* b, float* out, int x0, int x1) {
-    raiseToChange<simd::F4>(a, b, out, x0, x1);
+    raiseToChangeWith<simd::F4>(a, b, out, x0, x1);
 }
 [[gnu::target("avx2"), gnu::flatten]] void raiseToChangeAvx2(const float* a, const float* b, float* out, int x0,
                                                              int x1) {
-    raiseToChange<simd::F8>(a, b, out, x0, x1);
+    raiseToChangeWith<simd::F8>(a, b, out, x0, x1);
 }
 
 }  // namespace
@@ -486,13 +486,13 @@ void buildMaxChangePyramid(std::span<const ConstGridView> before, std::span<cons
     sizeLevels(nx, ny, p);
     Grid& base = p.levels[0];
     const int x0 = region.x0, x1 = region.x1;
+    const auto raiseToChange = simd::wideEnabled() ? raiseToChangeAvx2 : raiseToChangeSse;
     parallelForRows(region.rows(), x1 - x0, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
             float* out = base.data() + static_cast<std::size_t>(y) * base.nx;
             std::fill(out + x0, out + x1, 0.0f);
             for (std::size_t c = 0; c < before.size(); ++c) {
-                (simd::wideEnabled() ? raiseToChangeAvx2 : raiseToChangeSse)(before[c].row(y), after[c].row(y), out, x0,
-                                                                             x1);
+                raiseToChange(before[c].row(y), after[c].row(y), out, x0, x1);
             }
         }
     });

@@ -52,13 +52,12 @@ IndirectPlanInputs indirectPlanInputs(const GiSettings& settings, const FrameCha
 // the frame keeps an indirect cache, incremental frames with a strategy that
 // gathers by tiles); else every receiver, the cache dropped where it no
 // longer describes the result.
-bool startIndirect(const GiSettings& settings, const FrameChange& change, bool cached, std::span<const double> phi,
-                   GiState& st) {
+bool startIndirect(const IndirectPlanInputs& planInputs, const FrameChange& change, bool cached, GiState& st) {
     if (!cached || (change.geometry && !change.heightsOnly)) {
         invalidateIndirectCache(st.indirectCache);
         return false;
     }
-    return startIndirectPlan(indirectPlanInputs(settings, change, phi, st), st.indirectCache);
+    return startIndirectPlan(planInputs, st.indirectCache);
 }
 
 // The texel tiles the indirect light's texel passes redo (gi/indirect_cache.h).
@@ -99,12 +98,14 @@ void runIndirectStage(ConstGridView heights, const GiSettings& settings, const F
     const auto t = Clock::now();
     const FoldedWedgeOperator& op = indirectScanOperator(settings, st);
     const bool cached = settings.incremental && gathersByTiles(settings.indirect, settings.shading);
-    const bool plans = startIndirect(settings, change, cached, op.phi, st);
+    // the plan's inputs hold the state's pyramid: the last pass's when the
+    // plan starts, this frame's once buildDirectRadiancePyramid has run
+    const IndirectPlanInputs planInputs = indirectPlanInputs(settings, change, op.phi, st);
+    const bool plans = startIndirect(planInputs, change, cached, st);
     const auto tPyramid = Clock::now();
     if (cached) buildDirectRadiancePyramid(settings, st);
     const double pyramidMs = msSince(tPyramid);
-    const ReceiverTiles* only =
-        plans ? planIndirectTiles(indirectPlanInputs(settings, change, op.phi, st), st.indirectCache) : nullptr;
+    const ReceiverTiles* only = plans ? planIndirectTiles(planInputs, st.indirectCache) : nullptr;
     const ReceiverTiles* texels = cached ? planTexels(heights, change, only, albedo, st) : nullptr;
     const IndirectInputs in{.heights = st.pyramid,
                             .gradX = st.gradX.cview(),

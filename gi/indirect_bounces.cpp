@@ -26,20 +26,19 @@ void prepareIndirectSum(int nx, int ny, int bounces, IndirectState& st) {
 
 // Mean over the texels and channels (RGB average): blocks of rows summed
 // in parallel, each into four partial sums (independent additions, so the
-// loop is not one long chain of dependent ones), folded in row order. With
-// `blocks` (the sum of each block of rows of this field) only the blocks
-// holding `redo`'s rows are summed again: the others' rows have not changed
-// since their sums were taken. The same value as summing every block.
-double meanOf(const std::array<Grid, 3>& rgb, RowSpan redo, RowBlockSums* blocks) {
+// loop is not one long chain of dependent ones), folded in row order.
+// `blocks` holds the sum of each block of rows: when they are of this
+// field's size, only the blocks holding `redo`'s rows are summed again (the
+// others' rows have not changed since their sums were taken), else every
+// block. The same value as summing every block.
+double meanOf(const std::array<Grid, 3>& rgb, RowSpan redo, RowBlockSums& blocks) {
     constexpr int kRowsPerBlock = 16;
     const int nx = rgb[0].nx, ny = rgb[0].ny;
     const int nBlocks = (ny + kRowsPerBlock - 1) / kRowsPerBlock;
-    RowBlockSums own;
-    RowBlockSums& held = blocks ? *blocks : own;
-    std::vector<double>& sums = held.sums;
-    if (!blocks || held.nx != nx || sums.size() != static_cast<std::size_t>(nBlocks)) {
+    std::vector<double>& sums = blocks.sums;
+    if (blocks.nx != nx || sums.size() != static_cast<std::size_t>(nBlocks)) {
         sums.assign(static_cast<std::size_t>(nBlocks), 0.0);
-        held.nx = nx;
+        blocks.nx = nx;
         redo = {};
     }
     redo = redo.cut(ny);
@@ -105,7 +104,7 @@ void runBounces(const IndirectInputs& in, const IndirectSettings& settings, Indi
             std::swap(out.rgb, st.indirect);
             // restricted to texel runs, the light changed in their rows alone
             st.bounceMean[0] =
-                meanOf(st.indirect, restricted ? boundingBox(*in.texelRuns).rows() : RowSpan{}, &st.meanOfRows);
+                meanOf(st.indirect, restricted ? boundingBox(*in.texelRuns).rows() : RowSpan{}, st.meanOfRows);
         } else {
             strategy.shade(b, out);
             accumulateBounce(out.rgb, b, st);
@@ -123,7 +122,8 @@ void accumulateBounce(const std::array<Grid, 3>& exit, int b, IndirectState& st)
         const Grid& add = exit[static_cast<std::size_t>(c)];
         for (std::size_t i = 0; i < acc.v.size(); ++i) acc.v[i] += add.v[i];
     }
-    st.bounceMean[static_cast<std::size_t>(b - 1)] = meanOf(exit, {}, nullptr);
+    RowBlockSums blocks;  // every block: the bounces' sums are not kept
+    st.bounceMean[static_cast<std::size_t>(b - 1)] = meanOf(exit, {}, blocks);
 }
 
 void sumDirectAndIndirect(const std::array<Grid, 3>& direct, IndirectState& st, CellBox changed) {

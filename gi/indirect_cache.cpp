@@ -119,12 +119,12 @@ void sharedBounds(const IndirectPlanInputs& in, IndirectCache& cache) {
     const int tilesX = tileCount(h.nxr, kIndirectTile), tilesY = tileCount(h.nyr, kIndirectTile);
     const std::size_t m = in.phi.size();
     const bool shares = hasOcclusions(in);
+    const auto rowShareBound = simd::wideEnabled() ? rowShareBoundAvx2 : rowShareBoundSse;
     const auto tileBound = [&](int tx, int ty, const float* D, const float* G) {
         const float largest = *std::max_element(D, D + m);
         if (!shares) return largest;
         float bound = 0.0f;
         const int x0 = tx * kIndirectTile, x1 = std::min(h.nxr, x0 + kIndirectTile);
-        const auto rowShareBound = simd::wideEnabled() ? rowShareBoundAvx2 : rowShareBoundSse;
         for (int Y = ty * kIndirectTile; Y < std::min(h.nyr, (ty + 1) * kIndirectTile); ++Y)
             bound = std::max(bound, rowShareBound(*in.blocker, Y, x0, x1, D, G, largest));
         return bound;
