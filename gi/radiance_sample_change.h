@@ -5,20 +5,21 @@
 //
 // Step i of azimuth phi reads, for receiver (X, Y), two texels of its field
 // (scanStepInfo's taps: a level at the receiver grid, or the full-resolution
-// radiance for a raw step) and blends them linearly with weights in [0, 1]
-// that sum to 1, so the sample moves by at most the larger move of its two
-// texels. Over a tile's receivers the taps fill two shifted copies of the
-// tile, cut to the receivers whose sample lies inside the field: the
-// largest |level - anchor level| there (max over the channels; block maxima
-// of gi/change_bound.h, exact box queries) bounds every sample of the step.
-// Bounding the samples through the filters instead, as the heights' slopes
-// are (gi/change_bound.h), charges a sample with the largest change of any
-// cell within its reach, weighed by the filter's largest tap; here a far,
-// filtered sample of a small change counts by what it really moved. The price is the anchor's pyramid levels, kept
-// beside the anchor's radiance (3 channels x levels x receivers floats).
+// radiance for a raw step) and blends them with weights 1 - f and f that
+// every receiver shares at that step. Over a tile's receivers the taps fill
+// two shifted copies of the tile, cut to the receivers whose sample lies
+// inside the field: with A and B the largest |level - anchor level| over
+// each copy (max over the channels; block maxima of gi/change_bound.h,
+// exact box queries), every sample of the step moved by at most
+// (1 - f) A + f B. Bounding the samples through the filters instead, as the
+// heights' slopes are (gi/change_bound.h), charges a sample with the largest
+// change of any cell within its reach, weighed by the filter's largest tap;
+// here a far, filtered sample of a small change counts by what it really
+// moved. The price is the anchor's pyramid levels, kept beside the anchor's
+// radiance (3 channels x levels x receivers floats).
 //
 // A level texel reads the radiance within the reach of its octaves' B-spline
-// synthesis (gi/change_bound.h, stepReachCells: R_o = 2.5 2^o - 0.5 cells
+// synthesis (gi/change_bound.h, levelReachCells: R_o = 2.5 2^o - 0.5 cells
 // for octave o, the coarser octave of a blended level), so where the
 // radiance equals the anchor's outside a box of texels, each level equals
 // the anchor's level outside that box dilated by its reach.
