@@ -249,14 +249,20 @@ void lambertShadeRowSse(const LambertRowJob& j, float* vert, const float* gxr, c
 
 // ---- algorithm, receivers: incident radiance I_c = sum_L T_{L,c} V_L, row Y ----
 // 16 receivers at a time from `cols.x0` (a multiple of 16) to `cols.x1`: the
-// lights' V vectors are read once, each output coefficient sums its non-zero
-// matrix entries in a fixed order (light, k), lane by lane.
+// lights' V vectors are read once; the output coefficients go
+// kIncidentBlock at a time, their sums in registers, each input V_L,k read
+// once per block and multiplied by the block's entries (buildIncidentTerms).
+// Each output sums its entries in the order (light, k), lane by lane; an
+// entry that is 0 for this output but not for another of its block adds
+// 0 x V (V finite: +-0), which leaves a sum started at +0 as it was, so every
+// output is the sum of its non-zero entries alone.
 template <class V>
 [[gnu::always_inline]] inline void incidentRowImpl(const ShadingLight* lights, int nl, int nCoef, int nxr,
                                                    ColumnSpan cols, const ShadeMaps& terms, IncidentRows to, int Y) {
-    constexpr int L = LaneTraits<V>::n, NQ = 16 / L;
+    constexpr int L = LaneTraits<V>::n, NQ = 16 / L, B = ShadeMaps::kIncidentBlock;
     const std::size_t r0 = static_cast<std::size_t>(Y) * nxr;
     const std::size_t w0 = static_cast<std::size_t>(Y - to.row0) * nxr;
+    const int outputs = 3 * nCoef, blocks = (outputs + B - 1) / B;
     for (int X = cols.x0; X < cols.x1; X += 16) {
         const int n = std::min(16, nxr - X);
         for (int g0 = 0; g0 < nl; g0 += kMaxShadingLights) {
@@ -274,26 +280,34 @@ template <class V>
                         v[(Li - g0) * kShCount + k][q] = a;
                     }
                 }
-            for (int c = 0; c < 3 * nCoef; ++c) {
-                float* o = to.base + static_cast<std::size_t>(c) * to.planeStride + w0 + X;
-                V acc[NQ];
-                for (int q = 0; q < NQ; ++q) acc[q] = splat<V>(0.0f);
+            for (int b = 0; b < blocks; ++b) {
+                const int c0 = b * B, nOut = std::min(B, outputs - c0);
+                float* o[B];
+                for (int r = 0; r < nOut; ++r)
+                    o[r] = to.base + static_cast<std::size_t>(c0 + r) * to.planeStride + w0 + X;
+                V acc[B][NQ];
+                for (int r = 0; r < B; ++r)
+                    for (int q = 0; q < NQ; ++q) acc[r][q] = splat<V>(0.0f);
                 if (g0 > 0)
-                    for (int e = 0; e < n; ++e) acc[e / L][e % L] = o[e];
-                for (int e = terms.incidentTermStart[static_cast<std::size_t>(c)];
-                     e < terms.incidentTermStart[static_cast<std::size_t>(c + 1)]; ++e) {
-                    const ShadeMaps::Term& term = terms.incidentTerms[static_cast<std::size_t>(e)];
+                    for (int r = 0; r < nOut; ++r)
+                        for (int e = 0; e < n; ++e) acc[r][e / L][e % L] = o[r][e];
+                for (int e = terms.incidentTermStart[static_cast<std::size_t>(b)];
+                     e < terms.incidentTermStart[static_cast<std::size_t>(b + 1)]; ++e) {
+                    const ShadeMaps::BlockTerm& term = terms.incidentTerms[static_cast<std::size_t>(e)];
                     const int slot = term.index - g0 * kShCount;
                     if (slot < 0 || slot >= kMaxShadingLights * kShCount) continue;
-                    const V t = splat<V>(term.value);
-                    for (int q = 0; q < NQ; ++q) acc[q] += t * v[slot][q];
+                    V t[B];
+                    for (int r = 0; r < B; ++r) t[r] = splat<V>(term.value[r]);
+                    for (int q = 0; q < NQ; ++q)
+                        for (int r = 0; r < B; ++r) acc[r][q] += t[r] * v[slot][q];
                 }
-                for (int q = 0; q < NQ; ++q) {
-                    if (L * q + L <= n)
-                        store(o + L * q, acc[q]);
-                    else
-                        for (int e = L * q; e < n; ++e) o[e] = acc[q][e - L * q];
-                }
+                for (int r = 0; r < nOut; ++r)
+                    for (int q = 0; q < NQ; ++q) {
+                        if (L * q + L <= n)
+                            store(o[r] + L * q, acc[r][q]);
+                        else
+                            for (int e = L * q; e < n; ++e) o[r][e] = acc[r][q][e - L * q];
+                    }
             }
         }
     }
@@ -320,8 +334,9 @@ void sizeShadeMaps(int nx, int ny, std::size_t incidentSize, bool ambient, std::
     out.colFrac.resize(static_cast<std::size_t>(nx));
 }
 
-// The lights' lighting matrices in float, and for each output coefficient of
-// I_c = sum_L T_{L,c} V_L its non-zero matrix entries (incidentRowImpl).
+// The lights' lighting matrices in float, and for each block of output
+// coefficients of I_c = sum_L T_{L,c} V_L the inputs that some output of the
+// block reads (a non-zero entry), with the block's entries (incidentRowImpl).
 void buildIncidentTerms(const ShadingLight* lights, int nl, int nCoef, ShadeMaps& out) {
     out.lightMatrices.resize(static_cast<std::size_t>(nl) * 3 * kShCount * kShCount);
     for (int L = 0; L < nl; ++L)
@@ -330,24 +345,29 @@ void buildIncidentTerms(const ShadingLight* lights, int nl, int nCoef, ShadeMaps
                 out.lightMatrices[(static_cast<std::size_t>(L) * 3 + ch) * kShCount * kShCount + e] =
                     static_cast<float>(lights[L].product[static_cast<std::size_t>(ch)][static_cast<std::size_t>(e)]);
 
+    // the matrix entry of output coefficient c (channel c / nCoef, row c % nCoef) for input (L, k)
+    const auto entry = [&](int c, int L, int k) {
+        const int ch = c / nCoef, i = c % nCoef;
+        return out.lightMatrices[((static_cast<std::size_t>(L) * 3 + ch) * kShCount + i) * kShCount + k];
+    };
+    constexpr int B = ShadeMaps::kIncidentBlock;
+    const int outputs = 3 * nCoef, blocks = (outputs + B - 1) / B;
     out.incidentTerms.clear();
-    out.incidentTermStart.assign(static_cast<std::size_t>(3 * nCoef + 1), 0);
-    for (int ch = 0; ch < 3; ++ch)
-        for (int i = 0; i < nCoef; ++i) {
-            for (int L = 0; L < nl; ++L)
-                for (int k = 0; k < kShCount; ++k) {
-                    const float t =
-                        out.lightMatrices[((static_cast<std::size_t>(L) * 3 + ch) * kShCount + i) * kShCount + k];
-                    if (t != 0.0f) {
-                        ShadeMaps::Term term;
-                        term.value = t;
-                        term.index = L * kShCount + k;
-                        out.incidentTerms.push_back(term);
-                    }
+    out.incidentTermStart.assign(static_cast<std::size_t>(blocks + 1), 0);
+    for (int b = 0; b < blocks; ++b) {
+        for (int L = 0; L < nl; ++L)
+            for (int k = 0; k < kShCount; ++k) {
+                ShadeMaps::BlockTerm term{};
+                term.index = L * kShCount + k;
+                bool any = false;
+                for (int r = 0; r < B && b * B + r < outputs; ++r) {
+                    term.value[r] = entry(b * B + r, L, k);
+                    any = any || term.value[r] != 0.0f;
                 }
-            out.incidentTermStart[static_cast<std::size_t>(ch * nCoef + i + 1)] =
-                static_cast<int>(out.incidentTerms.size());
-        }
+                if (any) out.incidentTerms.push_back(term);
+            }
+        out.incidentTermStart[static_cast<std::size_t>(b + 1)] = static_cast<int>(out.incidentTerms.size());
+    }
 }
 
 // ---- Phong rows (Brdf::Phong, LambertPlusPhong) --------------------------------

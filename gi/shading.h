@@ -196,12 +196,17 @@ struct ShadeMaps {
     std::vector<float> colFrac;              // and the fraction towards the right one
     std::vector<ShadingLight> activeLights;  // the call's lights that add something (lightContributes)
     std::vector<float> lightMatrices;        // lights x 3 x 16 x 16, float copies of the product matrices
-    struct Term {
-        float value;  // the matrix entry
-        int index;    // light * 16 + k
+    // The output coefficients of I_c = sum_L T_{L,c} V_L in blocks of
+    // kIncidentBlock (the last padded with zero rows): per block, each
+    // input (light, k) some output of the block reads, in the order (light,
+    // k), with the block's matrix entries for it.
+    static constexpr int kIncidentBlock = 4;
+    struct BlockTerm {
+        float value[kIncidentBlock];  // the entries of the block's outputs (0 where an output has none)
+        int index;                    // light * 16 + k
     };
-    std::vector<Term> incidentTerms;         // non-zero matrix entries per output coefficient
-    std::vector<int> incidentTermStart;      // 3 x coefficients + 1
+    std::vector<BlockTerm> incidentTerms;  // per block of output coefficients
+    std::vector<int> incidentTermStart;    // blocks + 1
     std::vector<float> rowScratch;           // per worker slot: interpolated SH planes of one row
     std::vector<std::uint8_t> receiverRows;  // per receiver row: its incident radiance is updated (restricted rows)
 };
