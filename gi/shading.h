@@ -205,8 +205,8 @@ struct ShadeMaps {
         float value[kIncidentBlock];  // the entries of the block's outputs (0 where an output has none)
         int index;                    // light * 16 + k
     };
-    std::vector<BlockTerm> incidentTerms;  // per block of output coefficients
-    std::vector<int> incidentTermStart;    // blocks + 1
+    std::vector<BlockTerm> incidentTerms;    // per block of output coefficients
+    std::vector<int> incidentTermStart;      // blocks + 1
     std::vector<float> rowScratch;           // per worker slot: interpolated SH planes of one row
     std::vector<std::uint8_t> receiverRows;  // per receiver row: its incident radiance is updated (restricted rows)
 };
