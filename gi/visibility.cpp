@@ -607,38 +607,37 @@ void computeFootprintBox(ConstGridView gradX, ConstGridView gradY, int s, Footpr
     out.hiX.resize(n);
     out.loY.resize(n);
     out.hiY.resize(n);
-    // receivers whose footprint columns need no clamping: s X - half >= 0, s X + half <= nx - 1
-    const int inFirst = half > 0 ? 1 : 0, inEnd = std::max(inFirst, std::min(nxr, (nx - 1 - half) / s + 1));
+    // Per receiver row: each column's lowest and highest gradients over the
+    // footprint's rows (whole rows, which the compiler vectorises), then per
+    // receiver those of its footprint's columns. Minima and maxima are exact,
+    // so the order of the comparisons changes no value (where +0 and -0
+    // meet, at most the sign of a zero).
     parallelForRows(receivers, nxr, [&](int Y0, int Y1) {
+        std::vector<float> columns(4 * static_cast<std::size_t>(nx));
+        float* colLoX = columns.data();
+        float* colHiX = colLoX + nx;
+        float* colLoY = colHiX + nx;
+        float* colHiY = colLoY + nx;
         for (int Y = Y0; Y < Y1; ++Y) {
             // the footprint's rows (one without sub-sampling), clamped to the field
-            std::array<int, 3> rows{s * Y, s * Y, s * Y};
-            if (half > 0) rows = {std::max(s * Y - half, 0), s * Y, std::min(s * Y + half, ny - 1)};
+            const int r0 = std::max(s * Y - half, 0), r1 = s * Y, r2 = std::min(s * Y + half, ny - 1);
+            const float *ax = gradX.row(r0), *bx = gradX.row(r1), *cx = gradX.row(r2);
+            const float *ay = gradY.row(r0), *by = gradY.row(r1), *cy = gradY.row(r2);
+            for (int x = 0; x < nx; ++x) {
+                colLoX[x] = std::min(std::min(ax[x], bx[x]), cx[x]);
+                colHiX[x] = std::max(std::max(ax[x], bx[x]), cx[x]);
+                colLoY[x] = std::min(std::min(ay[x], by[x]), cy[x]);
+                colHiY[x] = std::max(std::max(ay[x], by[x]), cy[x]);
+            }
+            // the footprint's columns, clamped to the field
             const std::size_t at = static_cast<std::size_t>(Y) * nxr;
-            float* loX = out.loX.data() + at;
-            float* hiX = out.hiX.data() + at;
-            float* loY = out.loY.data() + at;
-            float* hiY = out.hiY.data() + at;
-            const auto boxAt = [&](int X, auto column) {
-                float ax = gradX(s * X, s * Y), bx = ax, ay = gradY(s * X, s * Y), by = ay;
-                for (int yy : rows)
-                    for (int ox = -half; ox <= half; ox += std::max(half, 1)) {
-                        const int xx = column(s * X + ox);
-                        ax = std::min(ax, gradX(xx, yy));
-                        bx = std::max(bx, gradX(xx, yy));
-                        ay = std::min(ay, gradY(xx, yy));
-                        by = std::max(by, gradY(xx, yy));
-                    }
-                loX[X] = ax;
-                hiX[X] = bx;
-                loY[X] = ay;
-                hiY[X] = by;
-            };
-            const auto clamped = [&](int x) { return std::clamp(x, 0, nx - 1); };
-            const auto inside = [](int x) { return x; };
-            for (int X = 0; X < inFirst; ++X) boxAt(X, clamped);
-            for (int X = inFirst; X < inEnd; ++X) boxAt(X, inside);  // the same samples, no clamps
-            for (int X = inEnd; X < nxr; ++X) boxAt(X, clamped);
+            for (int X = 0; X < nxr; ++X) {
+                const int c0 = std::max(s * X - half, 0), c1 = s * X, c2 = std::min(s * X + half, nx - 1);
+                out.loX[at + X] = std::min(std::min(colLoX[c0], colLoX[c1]), colLoX[c2]);
+                out.hiX[at + X] = std::max(std::max(colHiX[c0], colHiX[c1]), colHiX[c2]);
+                out.loY[at + X] = std::min(std::min(colLoY[c0], colLoY[c1]), colLoY[c2]);
+                out.hiY[at + X] = std::max(std::max(colHiY[c0], colHiY[c1]), colHiY[c2]);
+            }
         }
     });
 }
