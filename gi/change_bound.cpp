@@ -11,7 +11,8 @@ namespace terrain::gi {
 
 namespace {
 
-constexpr int kBlocksPerAxis = 4;  // blocks a box query reads per axis at most
+constexpr int kBlocksPerAxis = 4;          // blocks a box query reads per axis at most
+constexpr int kCoveringBlocksPerAxis = 8;  // the same for maxChangeCoveringBox (no descent)
 // Rounded up: a sample moves by at most half a texel / |major| <= texel / sqrt2
 // (|major| >= 1 / sqrt2), and one texel / |major| <= sqrt2 texels.
 constexpr double kHalfDiagonal = 0.70710679;  // 1 / sqrt2
@@ -502,8 +503,8 @@ void buildMaxChangePyramid(std::span<const ConstGridView> before, std::span<cons
 namespace {
 
 // Clamps the box to the grid and returns the finest level whose blocks cover
-// it with at most kBlocksPerAxis per axis; -1 for an empty box.
-int clampBoxToLevel(const MaxChangePyramid& p, int& x0, int& y0, int& x1, int& y1) {
+// it with at most `blocks` per axis; -1 for an empty box.
+int clampBoxToLevel(const MaxChangePyramid& p, int& x0, int& y0, int& x1, int& y1, int blocks = kBlocksPerAxis) {
     x0 = std::max(x0, 0);
     y0 = std::max(y0, 0);
     x1 = std::min(x1, p.nx - 1);
@@ -511,7 +512,7 @@ int clampBoxToLevel(const MaxChangePyramid& p, int& x0, int& y0, int& x1, int& y
     if (x0 > x1 || y0 > y1 || p.levels.empty()) return -1;
     int k = 0;
     const int top = static_cast<int>(p.levels.size()) - 1;
-    while (k < top && ((x1 >> k) - (x0 >> k) >= kBlocksPerAxis || (y1 >> k) - (y0 >> k) >= kBlocksPerAxis)) ++k;
+    while (k < top && ((x1 >> k) - (x0 >> k) >= blocks || (y1 >> k) - (y0 >> k) >= blocks)) ++k;
     return k;
 }
 
@@ -525,6 +526,19 @@ float maxChangeInBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1, 
     float m = above;
     for (int by = y0 >> k; by <= y1 >> k; ++by)
         for (int bx = x0 >> k; bx <= x1 >> k; ++bx) maxOfBlockInBox(p, box, k, bx, by, m);
+    return m;
+}
+
+float maxChangeCoveringBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1, float above) {
+    if (missesChange(p, x0, y0, x1, y1) || maxChangeAll(p) <= above) return above;
+    const int k = clampBoxToLevel(p, x0, y0, x1, y1, kCoveringBlocksPerAxis);
+    if (k < 0) return above;
+    const Grid& g = p.levels[static_cast<std::size_t>(k)];
+    float m = above;
+    for (int by = y0 >> k; by <= y1 >> k; ++by) {
+        const float* row = g.data() + static_cast<std::size_t>(by) * g.nx;
+        for (int bx = x0 >> k; bx <= x1 >> k; ++bx) m = std::max(m, row[bx]);
+    }
     return m;
 }
 

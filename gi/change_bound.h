@@ -100,6 +100,15 @@ void buildMaxChangePyramid(std::span<const ConstGridView> before, std::span<cons
 /// running maximum).
 float maxChangeInBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1, float above = 0.0f);
 
+/// An upper bound on maxChangeInBox's answer for the same box, without its
+/// descent along the box's edges: the largest of the at most 8 x 8 blocks
+/// of the finest level that covers the box with so few (the box rounded
+/// out to those blocks: at most 2^k - 1 cells more on each side at level
+/// k, less than a third of the box's longer side). For callers that query many
+/// boxes per frame, where the exact walk costs more than a few cells
+/// more in the bound (gi/radiance_sample_change.cpp).
+float maxChangeCoveringBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1, float above = 0.0f);
+
 /// Upper bound of the sum of |dh| over the same box: the sum over the at
 /// most 4 x 4 blocks that cover it (up to a block larger on each side).
 double sumChangeInBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1);

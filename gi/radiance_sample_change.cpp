@@ -79,17 +79,18 @@ namespace {
 // receivers [X0, X1] x [Y0, Y1] at one step moved: each blends its tap a
 // (k X + tap) and tap b (the texel after it across the ray) with the
 // weights 1 - f and f every receiver shares at this step, so it moves by at
-// most (1 - f) A + f B, A and B the largest change over the taps a and b of
-// the tile (boxes cut to the field, whose padding replicates the last row
-// and column). One box over both taps first: when it cannot beat `above`,
-// neither can the blend.
+// most (1 - f) A + f B, A and B bounds on the largest change over the taps
+// a and b of the tile (boxes cut to the field, whose padding replicates the
+// last row and column; each rounded out to the change pyramid's covering
+// blocks, maxChangeCoveringBox). One box over both taps first: when it
+// cannot beat `above`, neither can the blend.
 float tapsChange(const MaxChangePyramid& field, int k, const ScanStepInfo& si, int X0, int Y0, int X1, int Y1,
                  float above) {
     const auto box = [&](int dx0, int dy0, int dx1, int dy1, float floor) {
-        return maxChangeInBox(field, std::clamp(k * X0 + si.tapX + dx0, 0, field.nx - 1),
-                              std::clamp(k * Y0 + si.tapY + dy0, 0, field.ny - 1),
-                              std::clamp(k * X1 + si.tapX + dx1, 0, field.nx - 1),
-                              std::clamp(k * Y1 + si.tapY + dy1, 0, field.ny - 1), floor);
+        return maxChangeCoveringBox(field, std::clamp(k * X0 + si.tapX + dx0, 0, field.nx - 1),
+                                    std::clamp(k * Y0 + si.tapY + dy0, 0, field.ny - 1),
+                                    std::clamp(k * X1 + si.tapX + dx1, 0, field.nx - 1),
+                                    std::clamp(k * Y1 + si.tapY + dy1, 0, field.ny - 1), floor);
     };
     if (box(0, 0, si.nextX, si.nextY, above) <= above) return above;
     const float a = box(0, 0, 0, 0, 0.0f), b = box(si.nextX, si.nextY, si.nextX, si.nextY, 0.0f);

@@ -10,8 +10,8 @@
 // two shifted copies of the tile, cut to the receivers whose sample lies
 // inside the field: with A and B the largest |level - anchor level| over
 // each copy (max over the channels; block maxima of gi/change_bound.h,
-// exact box queries), every sample of the step moved by at most
-// (1 - f) A + f B. Bounding the samples through the filters instead, as the
+// each copy rounded out to the blocks that cover it, maxChangeCoveringBox),
+// every sample of the step moved by at most (1 - f) A + f B. Bounding the samples through the filters instead, as the
 // heights' slopes are (gi/change_bound.h), charges a sample with the largest
 // change of any cell within its reach, weighed by the filter's largest tap;
 // here a far, filtered sample of a small change counts by what it really

@@ -246,7 +246,10 @@ TEST_CASE("gi.change_bound: |b - a| rounded up in float arithmetic is the exact 
     CHECK(absDifferenceUp(tiny, big) > big);
 }
 
-TEST_CASE("gi.change_bound: box maxima equal the brute-force maximum, box sums bound the brute-force sum") {
+TEST_CASE(
+    "gi.change_bound: box maxima equal the brute-force maximum, the covering blocks bound it from a slightly larger "
+    "box, "
+    "box sums bound the brute-force sum") {
     std::mt19937 rng(7);
     MaxChangePyramid p;
     for (int trial = 0; trial < 30; ++trial) {
@@ -260,7 +263,16 @@ TEST_CASE("gi.change_bound: box maxima equal the brute-force maximum, box sums b
             const int x0 = static_cast<int>(rng() % (nx + 10)) - 5, y0 = static_cast<int>(rng() % (ny + 10)) - 5;
             const int x1 = x0 + static_cast<int>(rng() % (q % 2 ? 6 : nx + 5));
             const int y1 = y0 + static_cast<int>(rng() % (q % 2 ? 6 : ny + 5));
-            CHECK(maxChangeInBox(p, x0, y0, x1, y1) == bruteMax(dh, x0, y0, x1, y1));
+            const float exact = bruteMax(dh, x0, y0, x1, y1);
+            CHECK(maxChangeInBox(p, x0, y0, x1, y1) == exact);
+            // the covering blocks: at least the box's maximum, at most that of
+            // the box grown by a third of its longer side (clamped to the grid)
+            const int grow =
+                (std::max(std::min(x1, nx - 1) - std::max(x0, 0), std::min(y1, ny - 1) - std::max(y0, 0)) + 1) / 3 + 1;
+            const float covering = maxChangeCoveringBox(p, x0, y0, x1, y1);
+            CHECK(covering >= exact);
+            CHECK(covering <= bruteMax(dh, x0 - grow, y0 - grow, x1 + grow, y1 + grow));
+            CHECK(maxChangeCoveringBox(p, x0, y0, x1, y1, 2.0f) == 2.0f);  // |dh| <= 1 here
             double sum = 0.0;
             for (int y = std::max(y0, 0); y <= std::min(y1, ny - 1); ++y)
                 for (int x = std::max(x0, 0); x <= std::min(x1, nx - 1); ++x) sum += std::fabs(dh(x, y));
@@ -638,8 +650,8 @@ TEST_CASE("gi.change_bound: a change pyramid redone over the box of differing ce
             ok = gi_test::sameBits(a.levels[k].v, b.levels[k].v) && gi_test::sameBits(a.sums[k].v, b.sums[k].v);
         return ok;
     };
-    const std::vector<CellBox> boxes{{10, 10, 20, 15}, {140, 90, 150, 101}, {0, 0, 1, 1}, {60, 0, 61, 101},
-                                     {70, 40, 90, 60}, {0, 0, 150, 101}};
+    const std::vector<CellBox> boxes{{10, 10, 20, 15}, {140, 90, 150, 101}, {0, 0, 1, 1},
+                                     {60, 0, 61, 101}, {70, 40, 90, 60},    {0, 0, 150, 101}};
     MaxChangePyramid reused;
     buildMaxChangePyramid(anchor.cview(), anchor.cview(), reused);
     CHECK(maxChangeAll(reused) == 0.0f);
