@@ -51,6 +51,12 @@ struct MaxChangePyramid {
     } changed;
 };
 
+/// p.changed as a half-open box of cells (CellBox::none() when nothing changed).
+inline CellBox changedCells(const MaxChangePyramid& p) {
+    const auto& c = p.changed;
+    return c.x0 > c.x1 ? CellBox::none() : CellBox{c.x0, c.y0, c.x1 + 1, c.y1 + 1};
+}
+
 /// The smallest float not below the real |b - a| (a, b finite), in float
 /// arithmetic, per lane (V = float or a simd lane type): the rounded
 /// difference s and its rounding error e (Knuth's TwoSum, exact in

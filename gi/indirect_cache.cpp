@@ -193,7 +193,10 @@ void boundRadianceChange(const IndirectPlanInputs& in, IndirectCache& cache) {
     buildMaxChangePyramid(before, after, cache.change, cache.anchorChanged);
     cache.radianceBound.assign(tiles, 0.0f);
     if (maxChangeAll(cache.change) == 0.0f) return;
-    buildLevelChanges(in.pyramid, cache.anchorChanged, cache.levels);
+    // the levels differ from the anchor's within their reach of the texels
+    // whose light differs (a box of the change pyramid's blocks, inside the
+    // box of the texels reshaded since the anchor)
+    buildLevelChanges(in.pyramid, changedCells(cache.change), cache.levels);
     boundSampleChangeFromLevels(cache.change, cache.levels, in.pyramid.fields[0], kVisibilityTile, in.phi,
                                 cache.azimuthBound, cache.groupBound);
     occlusionFactors(in, cache);
