@@ -123,6 +123,7 @@ void runIndirectStage(ConstGridView heights, const GiSettings& settings, const F
                             .directChanged = settings.incremental ? st.directChanged : CellBox{},
                             .radianceCurrent = cached};
     computeIndirect(in, settings.indirect, st.indirect);
+    noteOcclusionsRedone(cached ? texels : nullptr, st.indirectCache);
     st.indirect.timings.pyramid += pyramidMs;  // bounce 0's pyramid, built before the plan
     st.indirect.timings.total += pyramidMs;
     st.directChanged = CellBox::none();  // the indirect light has read every change

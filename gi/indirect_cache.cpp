@@ -1,6 +1,7 @@
 #include "gi/indirect_cache.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <limits>
 
@@ -110,19 +111,88 @@ float rowShareBoundSse(const BlockerRadianceState& b, int Y, int x0, int x1, con
     return rowShareBoundWith<simd::F8>(b, Y, x0, x1, D, G, largest);
 }
 
+// Tile (tx, ty)'s share envelope (IndirectCache::shareEnvelope) from the
+// last pass's occlusions: per azimuth and per distance group the largest
+// share of a receiver's occlusion, each rounded up a float.
+void takeShareEnvelope(const BlockerRadianceState& b, int tx, int ty, float* envelope) {
+    const std::size_t m = static_cast<std::size_t>(b.azimuths), plane = static_cast<std::size_t>(b.nxr) * b.nyr;
+    const int x0 = tx * kIndirectTile, x1 = std::min(b.nxr, x0 + kIndirectTile);
+    std::fill(envelope, envelope + m + kDistanceGroups, 0.0f);
+    const auto raise = [](float& e, float part, float total) {
+        e = std::max(e, std::nextafter(part / total, std::numeric_limits<float>::infinity()));
+    };
+    for (int Y = ty * kIndirectTile; Y < std::min(b.nyr, (ty + 1) * kIndirectTile); ++Y)
+        for (int X = x0; X < x1; ++X) {
+            const std::size_t at = static_cast<std::size_t>(Y) * b.nxr + static_cast<std::size_t>(X);
+            const float total = b.receiverOcclusionRunning[(m - 1) * plane + at];
+            float groups = 0.0f;
+            for (std::size_t g = 0; g < kDistanceGroups; ++g) groups += b.receiverGroupOcclusion[g * plane + at];
+            if (!(total > kNoShareBelow) || !(groups > kNoShareBelow)) {
+                std::fill(envelope, envelope + m + kDistanceGroups, -1.0f);  // the receiver's bound is `largest`
+                return;
+            }
+            float before = 0.0f;
+            for (std::size_t j = 0; j < m; ++j) {
+                const float running = b.receiverOcclusionRunning[j * plane + at];
+                raise(envelope[j], std::max(running - before, 0.0f), total);
+                before = running;
+            }
+            for (std::size_t g = 0; g < kDistanceGroups; ++g)
+                raise(envelope[m + g], b.receiverGroupOcclusion[g * plane + at], groups);
+        }
+}
+
+// A bound on every receiver's rho_k in a tile from its share envelope: a
+// receiver's weighed sums are at most the envelope's (each share at most
+// the envelope's, the moves D_j and G_g the tile's), so the smaller of the
+// two envelope sums, rounded up as rowShareBound's, bounds the smaller of
+// its two; at most `largest`.
+float envelopeBound(const float* envelope, std::size_t m, const float* D, const float* G, float largest) {
+    if (envelope[0] < 0.0f) return largest;
+    const auto weighed = [](const float* share, const float* move, std::size_t n) {
+        float sum = 0.0f;
+        for (std::size_t i = 0; i < n; ++i)
+            if (share[i] > 0.0f && move[i] > 0.0f)
+                sum += std::max(share[i] * move[i], std::numeric_limits<float>::denorm_min());
+        return sum;
+    };
+    const float up = 1.0f + 1e-5f + static_cast<float>(m + kDistanceGroups) * std::numeric_limits<float>::epsilon();
+    return std::min(largest, std::min(weighed(envelope, D, m), weighed(envelope + m, G, kDistanceGroups)) * up);
+}
+
+// A tile whose bound from its share envelope is at most this fraction of the
+// tolerance takes that bound, a little looser than weighing each receiver
+// (sharedBounds): it keeps its light unless its drift from the anchor was
+// already past the rest of the tolerance.
+constexpr float kEnvelopeShareOfTolerance = 0.5f;
+
 // Per tile: the radiance bound, the largest rho_k over its receivers (max_j
 // D_tj without the last pass's occlusions, D and G those of the sample
-// bounds' larger tile that holds it) times its occlusion factor. Tile rows
-// in parallel (each tile's value alone).
+// bounds' larger tile that holds it) times its occlusion factor; from the
+// tile's share envelope where that is small enough. Tile rows in parallel
+// (each tile's value alone).
 void sharedBounds(const IndirectPlanInputs& in, IndirectCache& cache) {
     const HeightPyramid& h = in.heights;
     const int tilesX = tileCount(h.nxr, kIndirectTile), tilesY = tileCount(h.nyr, kIndirectTile);
-    const std::size_t m = in.phi.size();
+    const std::size_t m = in.phi.size(), tiles = static_cast<std::size_t>(tilesX) * tilesY;
+    const std::size_t perTile = m + kDistanceGroups;
     const bool shares = hasOcclusions(in);
+    if (cache.shareEnvelope.size() != tiles * perTile || cache.shareEnvelopeStale.size() != tiles) {
+        cache.shareEnvelope.assign(tiles * perTile, 0.0f);
+        cache.shareEnvelopeStale.assign(tiles, 1);
+    }
     const auto rowShareBound = simd::wideEnabled() ? rowShareBoundAvx2 : rowShareBoundSse;
     const auto tileBound = [&](int tx, int ty, const float* D, const float* G) {
         const float largest = *std::max_element(D, D + m);
         if (!shares) return largest;
+        const std::size_t t = static_cast<std::size_t>(ty) * tilesX + tx;
+        float* envelope = cache.shareEnvelope.data() + t * perTile;
+        if (cache.shareEnvelopeStale[t]) {
+            takeShareEnvelope(*in.blocker, tx, ty, envelope);
+            cache.shareEnvelopeStale[t] = 0;
+        }
+        const float coarse = envelopeBound(envelope, m, D, G, largest);
+        if (cache.occlusionFactor[t] * coarse <= in.tolerance * kEnvelopeShareOfTolerance) return coarse;
         float bound = 0.0f;
         const int x0 = tx * kIndirectTile, x1 = std::min(h.nxr, x0 + kIndirectTile);
         for (int Y = ty * kIndirectTile; Y < std::min(h.nyr, (ty + 1) * kIndirectTile); ++Y)
@@ -258,6 +328,15 @@ void recordIndirectSource(const std::array<Grid, 3>& source, const RadiancePyram
     cache.tiles.reset(heights.nxr, heights.nyr, kIndirectTile, false);
     cache.drift.reset(cache.tiles.dirty.size());
     cache.valid = true;
+}
+
+void noteOcclusionsRedone(const ReceiverTiles* redone, IndirectCache& cache) {
+    std::vector<std::uint8_t>& stale = cache.shareEnvelopeStale;
+    if (!redone || redone->dirty.size() != stale.size()) {
+        std::fill(stale.begin(), stale.end(), 1);
+        return;
+    }
+    for (std::size_t t = 0; t < stale.size(); ++t) stale[t] = stale[t] || redone->dirty[t] ? 1 : 0;
 }
 
 namespace {

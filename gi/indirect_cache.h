@@ -109,6 +109,13 @@ struct IndirectCache {
     AnchoredDrift drift;                 // per tile: how far its result was from the anchor's
     std::vector<float> occlusionFactor;  // per tile: this frame's factor of the radiance bound
     std::vector<float> radianceBound;    // per tile: this frame's bound from the anchor (boundRadianceChange)
+    // per tile: the largest share of a receiver's occlusion along each
+    // azimuth, then in each distance group (azimuths + kDistanceGroups
+    // floats, rounded up), or all -1 when some receiver has (next to) no
+    // occlusion; of the occlusions of the last pass that redid the tile's
+    // (shareEnvelopeStale: not yet taken since)
+    std::vector<float> shareEnvelope;
+    std::vector<std::uint8_t> shareEnvelopeStale;
     ReceiverTiles tiles;                 // this frame's tiles to re-gather
     std::vector<std::uint8_t> geometry;  // scratch: the geometry tiles' flags on these tiles
     ReceiverTiles texels;                // this frame's tiles whose receivers' occlusion the texel passes redo
@@ -171,6 +178,11 @@ const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCac
 /// planned pass moved the anchor, if at all, in planIndirectTiles.)
 void recordIndirectSource(const std::array<Grid, 3>& source, const RadiancePyramid& pyramid,
                           const HeightPyramid& heights, IndirectCache& cache);
+
+/// After an indirect pass whose texel passes redid the receivers'
+/// occlusions in the tiles `redone` (cache.texels; null: every tile): their
+/// share envelopes are taken again by the next plan.
+void noteOcclusionsRedone(const ReceiverTiles* redone, IndirectCache& cache);
 
 /// What the frame knows of the texels' inputs since the last pass.
 struct IndirectTexelInputs {

@@ -201,6 +201,28 @@ TEST_CASE("gi.indirect_cache: the radiance bound holds for local, global and edg
                       << " (the sample bound alone: " << meanSample << ")");
             // with sub-sampling the occlusions lower the bound
             if (s > 1) CHECK(meanBound < meanSample);
+            // with a tolerance, tiles whose share envelope bounds them within
+            // half of it take that bound instead: never lower, the receivers'
+            // weighing above half the tolerance, and so still above every
+            // change (the occlusion factor holds the tolerance too)
+            IndirectCache tolerant;
+            tolerant.anchorSource = base;
+            recordAnchorLevels(before.radiance, tolerant.levels);
+            IndirectPlanInputs withTolerance = plan;
+            withTolerance.tolerance = 0.1f;
+            boundRadianceChange(withTolerance, tolerant);
+            int coarser = 0;
+            for (std::size_t t = 0; t < bound.size(); ++t) {
+                // the tile's bound before its occlusion factor, at tolerance 0
+                const double weighed = static_cast<double>(bound[t]) / cache.occlusionFactor[t];
+                const double expected = weighed * tolerant.occlusionFactor[t];
+                CHECK(tolerant.radianceBound[t] >= expected * (1.0 - 1e-6));
+                if (tolerant.radianceBound[t] > 0.05f)
+                    CHECK(tolerant.radianceBound[t] == doctest::Approx(expected).epsilon(1e-6));
+                coarser += tolerant.radianceBound[t] > expected * (1.0 + 1e-6) ? 1 : 0;
+            }
+            // small changes everywhere: some tile took its envelope's bound
+            if (s > 1 && caseName == "noise") CHECK(coarser > 0);
             // a local patch: tiles far from it are charged less than its full change
             if (caseName == "patch" || caseName == "corner patch") CHECK(smallest < maxChangeAll(cache.change));
         }
@@ -607,7 +629,8 @@ TEST_CASE("gi.indirect_cache: the total is redone wherever the indirect light wa
     // the far region's indirect light did change (else the test shows nothing)
     bool farChanged = false;
     for (int y = far.y0; y < far.y1 && !farChanged; ++y)
-        for (int x = far.x0; x < far.x1; ++x) farChanged = farChanged || out.indirect[1](x, y) != indirectBefore[1](x, y);
+        for (int x = far.x0; x < far.x1; ++x)
+            farChanged = farChanged || out.indirect[1](x, y) != indirectBefore[1](x, y);
     CHECK(farChanged);
 }
 
