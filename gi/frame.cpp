@@ -76,7 +76,8 @@ const ReceiverTiles* planTexels(ConstGridView heights, const FrameChange& change
                                  .lastHeights = replacedLast ? &st.lastInputs.heights : nullptr,
                                  .heights = heights,
                                  .albedo = albedo,
-                                 .pyramid = st.pyramid};
+                                 .pyramid = st.pyramid,
+                                 .heightsDiffer = change.heightBox};
     return planIndirectTexels(in, st.indirectCache);
 }
 
@@ -465,7 +466,7 @@ DirectRuns directRuns(ConstGridView heights, const FrameChange& change, const Ge
         return {};
     const VisibilityCache& cache = st.visibilityCache;
     changedDirectTexels(st.lastInputs.heights.cview(), heights, cache.tiles, cache.keyTiles, st.pyramid.subsample,
-                        st.texelRects, st.ambientRuns, st.shadingRuns);
+                        st.texelRects, st.ambientRuns, st.shadingRuns, change.heightBox);
     return {&st.shadingRuns, &st.ambientRuns};
 }
 

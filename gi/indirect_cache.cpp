@@ -113,14 +113,12 @@ float rowShareBoundSse(const BlockerRadianceState& b, int Y, int x0, int x1, con
 
 // Tile (tx, ty)'s share envelope (IndirectCache::shareEnvelope) from the
 // last pass's occlusions: per azimuth and per distance group the largest
-// share of a receiver's occlusion, each rounded up a float.
+// share of a receiver's occlusion, rounded up a float.
 void takeShareEnvelope(const BlockerRadianceState& b, int tx, int ty, float* envelope) {
     const std::size_t m = static_cast<std::size_t>(b.azimuths), plane = static_cast<std::size_t>(b.nxr) * b.nyr;
     const int x0 = tx * kIndirectTile, x1 = std::min(b.nxr, x0 + kIndirectTile);
     std::fill(envelope, envelope + m + kDistanceGroups, 0.0f);
-    const auto raise = [](float& e, float part, float total) {
-        e = std::max(e, std::nextafter(part / total, std::numeric_limits<float>::infinity()));
-    };
+    const auto raise = [](float& e, float part, float total) { e = std::max(e, part / total); };
     for (int Y = ty * kIndirectTile; Y < std::min(b.nyr, (ty + 1) * kIndirectTile); ++Y)
         for (int X = x0; X < x1; ++X) {
             const std::size_t at = static_cast<std::size_t>(Y) * b.nxr + static_cast<std::size_t>(X);
@@ -140,6 +138,9 @@ void takeShareEnvelope(const BlockerRadianceState& b, int tx, int ty, float* env
             for (std::size_t g = 0; g < kDistanceGroups; ++g)
                 raise(envelope[m + g], b.receiverGroupOcclusion[g * plane + at], groups);
         }
+    // each largest share rounded up (the largest of the rounded-up shares)
+    for (std::size_t i = 0; i < m + kDistanceGroups; ++i)
+        envelope[i] = std::nextafter(envelope[i], std::numeric_limits<float>::infinity());
 }
 
 // A bound on every receiver's rho_k in a tile from its share envelope: a
@@ -365,7 +366,7 @@ const ReceiverTiles* planIndirectTexels(const IndirectTexelInputs& in, IndirectC
     const ConstGridView last = in.lastHeights ? in.lastHeights->cview() : ConstGridView{};
     cache.texelRects.clear();
     appendTexelsToRedo(*in.gathered, in.sameGeometry ? nullptr : &last, in.heights, in.pyramid.subsample,
-                       in.pyramid.subsample + 1, cache.texelRects, &cache.texels);
+                       in.pyramid.subsample + 1, cache.texelRects, &cache.texels, in.heightsDiffer);
     texelRunsOfRects(cache.texelRects, in.heights.nx, in.heights.ny, cache.texelRuns);
     return &cache.texels;
 }

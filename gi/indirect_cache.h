@@ -192,6 +192,7 @@ struct IndirectTexelInputs {
     ConstGridView heights;          // and this pass's
     const AlbedoMap* albedo;        // this pass's (null: 1)
     const HeightPyramid& pyramid;   // this pass's grid
+    CellBox heightsDiffer = {};     // holds every height where lastHeights and heights may differ
 };
 
 /// The texel passes' extent, or null for every texel: every receiver

@@ -16,10 +16,11 @@ void checkSizes(ConstGridView before, ConstGridView after, const ReceiverTiles& 
 }  // namespace
 
 void changedDirectTexels(ConstGridView before, ConstGridView after, const ReceiverTiles& env, const ReceiverTiles& keys,
-                         int subsample, std::vector<TexelRect>& rects, TexelRuns& ambient, TexelRuns& shading) {
+                         int subsample, std::vector<TexelRect>& rects, TexelRuns& ambient, TexelRuns& shading,
+                         CellBox differing) {
     checkSizes(before, after, env, keys);
     rects.clear();
-    appendTexelsToRedo(env, &before, after, subsample, shadingReach(subsample), rects);
+    appendTexelsToRedo(env, &before, after, subsample, shadingReach(subsample), rects, nullptr, differing);
     texelRunsOfRects(rects, after.nx, after.ny, ambient);
     if (keys.dirtyCount() == 0) {
         shading = ambient;

@@ -40,9 +40,11 @@ inline int shadingReach(int subsample) { return subsample + subsample / 2 + 1; }
 /// `keys` (on the receiver grid of `subsample`, one layout) was recomputed:
 /// the texels that read a receiver of a dirty tile (the ambient: of `env`
 /// alone) and those of the texel tiles within shadingReach of a changed
-/// height (appendTexelsToRedo). `rects` is scratch. Throws InputError when
-/// the sizes differ.
+/// height (appendTexelsToRedo; `differing` holds every height that may
+/// differ, every cell by default). `rects` is scratch. Throws InputError
+/// when the sizes differ.
 void changedDirectTexels(ConstGridView before, ConstGridView after, const ReceiverTiles& env, const ReceiverTiles& keys,
-                         int subsample, std::vector<TexelRect>& rects, TexelRuns& ambient, TexelRuns& shading);
+                         int subsample, std::vector<TexelRect>& rects, TexelRuns& ambient, TexelRuns& shading,
+                         CellBox differing = {});
 
 }  // namespace terrain::gi

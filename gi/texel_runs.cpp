@@ -147,7 +147,9 @@ long long texelCount(const TexelRuns& runs) {
 }
 
 void appendTexelsToRedo(const ReceiverTiles& recomputed, const ConstGridView* before, ConstGridView after,
-                        int subsample, int reach, std::vector<TexelRect>& out, ReceiverTiles* flagged) {
+                        int subsample, int reach, std::vector<TexelRect>& out, ReceiverTiles* flagged,
+                        CellBox differing) {
+    differing = differing.cut(after.nx, after.ny);
     const ReceiverTiles& t = recomputed;
     if (flagged) flagged->reset(t.nxr, t.nyr, t.tileSize, false);
     const int s = subsample, T = t.tileSize;
@@ -165,8 +167,11 @@ void appendTexelsToRedo(const ReceiverTiles& recomputed, const ConstGridView* be
                 if (flagged) flagged->setDirty(tx, ty);
                 continue;
             }
-            if (!before || !cellsDiffer(*before, after, texelCellsOfTile(t, tx, ty, after.nx, after.ny, s, reach)))
-                continue;
+            if (!before) continue;
+            const InclusiveCells cells = texelCellsOfTile(t, tx, ty, after.nx, after.ny, s, reach);
+            const bool outside = cells.x1 < differing.x0 || cells.x0 >= differing.x1 || cells.y1 < differing.y0 ||
+                                 cells.y0 >= differing.y1;
+            if (outside || !cellsDiffer(*before, after, cells)) continue;
             if (flagged) flagged->setDirty(tx, ty);
             out.push_back({ownX[static_cast<std::size_t>(tx * T)], ownY[static_cast<std::size_t>(ty * T)],
                            ownX[static_cast<std::size_t>(std::min(t.nxr, (tx + 1) * T))],

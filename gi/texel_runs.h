@@ -98,8 +98,11 @@ ColumnSpan receiverColumnsRead(const TexelRuns* runs, int y0, int y1, int n, Low
 /// within `reach` cells of a height that differs bit for bit (-0 is not 0:
 /// it can change a result's sign), its texels. With `flagged` (null: not
 /// wanted), on recomputed's layout, the tiles of either kind. The heights
-/// are an nx x ny field at sub-sampling s of the tiles' grid.
+/// are an nx x ny field at sub-sampling s of the tiles' grid. `differing`
+/// holds every cell where before and after may differ (every cell by
+/// default): tiles whose cells lie outside it are not compared.
 void appendTexelsToRedo(const ReceiverTiles& recomputed, const ConstGridView* before, ConstGridView after,
-                        int subsample, int reach, std::vector<TexelRect>& out, ReceiverTiles* flagged = nullptr);
+                        int subsample, int reach, std::vector<TexelRect>& out, ReceiverTiles* flagged = nullptr,
+                        CellBox differing = {});
 
 }  // namespace terrain::gi
