@@ -31,11 +31,11 @@ void sizeLevels(int nx, int ny, MaxChangePyramid& p) {
     int count = 1;
     for (int w = nx, h = ny; w > 1 || h > 1; w = (w + 1) / 2, h = (h + 1) / 2) ++count;
     p.levels.resize(static_cast<std::size_t>(count));
-    p.sums.resize(p.levels.size());
+    p.sums.resize(p.withSums ? p.levels.size() : 0);
     int w = nx, h = ny;
     for (std::size_t k = 0; k < p.levels.size(); ++k) {
         if (p.levels[k].nx != w || p.levels[k].ny != h) p.levels[k].resize(w, h);
-        if (k > 0 && (p.sums[k].nx != w || p.sums[k].ny != h)) p.sums[k].resize(w, h);
+        if (p.withSums && k > 0 && (p.sums[k].nx != w || p.sums[k].ny != h)) p.sums[k].resize(w, h);
         w = (w + 1) / 2;
         h = (h + 1) / 2;
     }
@@ -111,7 +111,7 @@ void decimateLevels(MaxChangePyramid& p, CellBox redone = {}) {
                 }
             }
         });
-        sumLevel(k == 1 ? p.levels[0] : p.sums[k - 1], p.sums[k], blocks);
+        if (p.withSums) sumLevel(k == 1 ? p.levels[0] : p.sums[k - 1], p.sums[k], blocks);
     }
     findChangedBox(p);
 }
@@ -480,7 +480,9 @@ void buildMaxChangePyramid(std::span<const ConstGridView> before, std::span<cons
     // found changed (outside both, |dh| was 0 and still is)
     CellBox region = differing.cut(nx, ny);
     const auto& last = p.changed;
-    if (p.nx != nx || p.ny != ny || p.levels.empty())
+    // sums switched on since the last build: every block's sum is missing
+    const bool noSums = p.withSums && p.sums.size() != p.levels.size();
+    if (p.nx != nx || p.ny != ny || p.levels.empty() || noSums)
         region = CellBox{}.cut(nx, ny);
     else if (last.x0 <= last.x1)
         region = region.joined({last.x0, last.y0, last.x1 + 1, last.y1 + 1});
@@ -543,6 +545,7 @@ float maxChangeCoveringBox(const MaxChangePyramid& p, int x0, int y0, int x1, in
 }
 
 double sumChangeInBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1) {
+    if (!p.withSums) throw InputError("change bound: this change pyramid was built without its sums");
     const int k = clampBoxToLevel(p, x0, y0, x1, y1);
     if (k < 0) return 0.0;
     // the blocks read cover the box, rounded out to level k's blocks

@@ -38,7 +38,8 @@ namespace terrain::gi {
 /// |dh| over 2^k x 2^k cells (blocks aligned to multiples of 2^k, the last
 /// ones cut by the grid's edge); level 0 is |dh| itself, the last level 1 x 1.
 /// `sums` holds the sums of |dh| over the same blocks (sums[0] is empty:
-/// level 0 is its own sum; each sum rounded up to the next float).
+/// level 0 is its own sum; each sum rounded up to the next float), unless
+/// withSums is false.
 /// `changed` is a box of cells (inclusive; empty when x0 > x1) that holds
 /// every cell with |dh| > 0, from a coarse level's blocks: queries of boxes
 /// outside it answer 0 at once, as they would after their walk.
@@ -46,6 +47,7 @@ struct MaxChangePyramid {
     int nx = 0, ny = 0;
     std::vector<Grid> levels;
     std::vector<Grid> sums;
+    bool withSums = true;  // false: `sums` are not built (the owner never asks sumChangeInBox)
     struct {
         int x0 = 0, y0 = 0, x1 = -1, y1 = -1;
     } changed;
@@ -117,6 +119,7 @@ float maxChangeCoveringBox(const MaxChangePyramid& p, int x0, int y0, int x1, in
 
 /// Upper bound of the sum of |dh| over the same box: the sum over the at
 /// most 4 x 4 blocks that cover it (up to a block larger on each side).
+/// Throws InputError for a pyramid built without its sums.
 double sumChangeInBox(const MaxChangePyramid& p, int x0, int y0, int x1, int y1);
 
 /// max |dh| over the whole grid (the top level).
