@@ -15,9 +15,12 @@ void PaddedField::resize(int w, int h) {
     v.resize(static_cast<std::size_t>(w + 1) * static_cast<std::size_t>(h + 1) + 2 * kFieldGuard, 0.0f);
 }
 
-void PaddedField::padEdges() {
-    for (int y = 0; y < ny; ++y) row(y)[nx] = row(y)[nx - 1];
-    std::copy(row(ny - 1), row(ny - 1) + stride, row(ny));
+void PaddedField::padEdges(CellBox changed) {
+    changed = changed.cut(nx, ny);
+    if (changed.empty()) return;
+    if (changed.x1 == nx)  // the last column changed in these rows
+        for (int y = changed.y0; y < changed.y1; ++y) row(y)[nx] = row(y)[nx - 1];
+    if (changed.y1 == ny) std::copy(row(ny - 1), row(ny - 1) + stride, row(ny));
 }
 
 namespace {
@@ -200,9 +203,8 @@ void decimateOctaves(ConstGridView heights, int nOctaves, bool withMax, const st
             dst.ensureSize(w, h);
             const CellBox& box = changed[static_cast<std::size_t>(o)];
             if (!box.empty())
-                parallelForRows(box.rows(), box.x1 - box.x0, [&](int y0, int y1) {
-                    decimateRows(src, dst, pass == 1, y0, y1, box.x0, box.x1);
-                });
+                parallelForRows(box.rows(), box.x1 - box.x0,
+                                [&](int y0, int y1) { decimateRows(src, dst, pass == 1, y0, y1, box.x0, box.x1); });
             src = dst.cview();
         }
     }
@@ -235,14 +237,14 @@ void receiverHeights(ConstGridView heights, int s, RowSpan changed, PaddedField&
             for (int X = 0; X < nxr; ++X) d[X] = src[s * X];
         }
     });
-    out.padEdges();
+    out.padEdges({0, receivers.y0, nxr, receivers.y1});
 }
 
 // The receivers at cells s X, s Y of a box of cells.
 CellBox receiversIn(const CellBox& cells, int s, int nxr, int nyr) {
     if (cells.empty()) return CellBox::none();
-    return CellBox{(cells.x0 + s - 1) / s, (cells.y0 + s - 1) / s, (cells.x1 + s - 1) / s, (cells.y1 + s - 1) / s}
-        .cut(nxr, nyr);
+    return CellBox{(cells.x0 + s - 1) / s, (cells.y0 + s - 1) / s, (cells.x1 + s - 1) / s, (cells.y1 + s - 1) / s}.cut(
+        nxr, nyr);
 }
 
 // One pass (0: the mean octave, 1: the max octave) of the B-spline synthesis
@@ -327,7 +329,7 @@ std::vector<CellBox> synthesiseOctaves(ConstGridView heights, const std::vector<
             const float blend = withMax ? (pass == 0 ? 1.0f - p.settings.peakBlend : p.settings.peakBlend) : 1.0f;
             receivers[static_cast<std::size_t>(o)] = synthesisePass(src, o, pass, blend, box, p, out);
         }
-        out.padEdges();
+        out.padEdges(receivers[static_cast<std::size_t>(o)]);
     }
     return receivers;
 }
@@ -363,7 +365,7 @@ void blendLevels(int nLevels, int nOctaves, int kv, const std::vector<CellBox>& 
                 for (int X = box.x0; X < box.x1; ++X) d[X] = wa * ra[X] + wb * rb[X];
             }
         });
-        lev.padEdges();
+        lev.padEdges(box);
     }
 }
 

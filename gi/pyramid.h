@@ -69,7 +69,9 @@ struct PaddedField {
     const float* data() const { return v.data() + kFieldGuard; }
     float* row(int y) { return data() + y * stride; }
     const float* row(int y) const { return data() + y * stride; }
-    void padEdges();  // copies the last column / row into the padding
+    // Copies the last column / row into the padding, after the cells of
+    // `changed` were written (every cell by default): only what they reach.
+    void padEdges(CellBox changed = {});
 };
 
 struct PyramidStep {
