@@ -445,29 +445,29 @@ void rowBatchSse(const RowBatch& r) { rowBatchImpl<simd::F4>(r); }
 // ---- per frame: the step table and the valid-prefix lengths -----------------
 // Step table of azimuth j (cos c, sin sn) and the valid-prefix length of each
 // receiver column and row.
-void buildAzimuthSteps(const HeightPyramid& pyr, int j, double c, double sn, int nxrPad, VisibilityState& state) {
+void buildAzimuthSteps(const HeightPyramid& pyr, int j, double c, double sn, int nxrPad, StepTables& t) {
     const int nxr = pyr.nxr, nyr = pyr.nyr;
     const int nSteps = static_cast<int>(pyr.steps.size());
     const std::size_t base = static_cast<std::size_t>(j) * nSteps;
-    int* vc = state.validColumns.data() + 2 * base;
-    int* vr = state.validRows.data() + 2 * base;
+    int* vc = t.validColumns.data() + 2 * base;
+    int* vr = t.validRows.data() + 2 * base;
     for (int i = 0; i < nSteps; ++i) {
         const StepGeometry g = makeStep(pyr, i, c, sn);
-        state.steps[base + static_cast<std::size_t>(i)] = g.step;
+        t.steps[base + static_cast<std::size_t>(i)] = g.step;
         vc[2 * i] = g.xFirst;
         vc[2 * i + 1] = g.xLast;
         vr[2 * i] = g.yFirst;
         vr[2 * i + 1] = g.yLast;
     }
     // a receiver's sequence is the prefix of steps before its first invalid one
-    int* colSteps = state.stepsPerColumn.data() + static_cast<std::size_t>(j) * nxrPad;
+    int* colSteps = t.stepsPerColumn.data() + static_cast<std::size_t>(j) * nxrPad;
     for (int X = 0; X < nxrPad; ++X) {
         int n = 0;
         if (X < nxr)
             while (n < nSteps && vc[2 * n] <= X && X <= vc[2 * n + 1]) ++n;
         colSteps[X] = n;
     }
-    int* rowSteps = state.stepsPerRow.data() + static_cast<std::size_t>(j) * nyr;
+    int* rowSteps = t.stepsPerRow.data() + static_cast<std::size_t>(j) * nyr;
     for (int Y = 0; Y < nyr; ++Y) {
         int n = 0;
         while (n < nSteps && vr[2 * n] <= Y && Y <= vr[2 * n + 1]) ++n;
@@ -475,30 +475,71 @@ void buildAzimuthSteps(const HeightPyramid& pyr, int j, double c, double sn, int
     }
 }
 
-// The step tables of every azimuth of op, and each azimuth's cos and sin in float.
+StepTableKey stepTableKey(const HeightPyramid& pyr, const FoldedWedgeOperator& op, int nxrPad) {
+    StepTableKey k;
+    k.phi = op.phi;
+    k.nxrPad = nxrPad;
+    k.nx = pyr.nx;
+    k.ny = pyr.ny;
+    k.nxr = pyr.nxr;
+    k.nyr = pyr.nyr;
+    k.subsample = pyr.subsample;
+    k.cellSize = pyr.cellSize;
+    k.raw = pyr.rawPhaseData();
+    k.rawWidth = pyr.rawPhaseWidth;
+    k.rawPlane = pyr.rawPhasePlane;
+    for (const PyramidStep& ps : pyr.steps) {
+        k.tauCells.push_back(ps.tauCells);
+        k.stepLevels.push_back(ps.level);
+    }
+    for (const PaddedField& f : pyr.levels) {
+        k.levelData.push_back(f.data());
+        k.levelStrides.push_back(f.stride);
+    }
+    return k;
+}
+
+// The step tables of every azimuth of op, and each azimuth's cos and sin in
+// float, into state.tables.front(): the kept tables of the same key when
+// there are (they are a function of it alone), else built anew in place of
+// the least recently used.
 void buildStepTables(const HeightPyramid& pyr, const FoldedWedgeOperator& op, int nxrPad, VisibilityState& state) {
+    StepTableKey key = stepTableKey(pyr, op, nxrPad);
+    std::vector<StepTables>& kept = state.tables;
+    // the front is the most recently used
+    auto found = std::find_if(kept.begin(), kept.end(), [&](const StepTables& t) { return t.key == key; });
+    if (found == kept.end()) {
+        if (kept.size() < VisibilityState::kKeptTables) kept.emplace_back();
+        found = kept.end() - 1;
+        found->key = StepTableKey{};  // not valid until built
+    }
+    std::rotate(kept.begin(), found, found + 1);
+    StepTables& t = kept.front();
+    if (t.key == key) return;
+
     const int m = op.azimuths, nyr = pyr.nyr;
     const int nSteps = static_cast<int>(pyr.steps.size());
     const std::size_t tableSize = static_cast<std::size_t>(m) * nSteps;
-    state.steps.resize(tableSize);
-    state.validColumns.resize(2 * tableSize);
-    state.validRows.resize(2 * tableSize);
-    state.stepsPerColumn.resize(static_cast<std::size_t>(m) * nxrPad);
-    state.stepsPerRow.resize(static_cast<std::size_t>(m) * nyr);
+    t.steps.resize(tableSize);
+    t.validColumns.resize(2 * tableSize);
+    t.validRows.resize(2 * tableSize);
+    t.stepsPerColumn.resize(static_cast<std::size_t>(m) * nxrPad);
+    t.stepsPerRow.resize(static_cast<std::size_t>(m) * nyr);
     parallelFor(0, m, 1, [&](int j0, int j1) {
         for (int j = j0; j < j1; ++j) {
             const double c = std::cos(op.phi[static_cast<std::size_t>(j)]);
             const double sn = std::sin(op.phi[static_cast<std::size_t>(j)]);
-            buildAzimuthSteps(pyr, j, c, sn, nxrPad, state);
+            buildAzimuthSteps(pyr, j, c, sn, nxrPad, t);
         }
     });
 
-    state.cosSin.resize(2 * static_cast<std::size_t>(m));
+    t.cosSin.resize(2 * static_cast<std::size_t>(m));
     for (int j = 0; j < m; ++j) {
         const double phi = op.phi[static_cast<std::size_t>(j)];
-        state.cosSin[2 * static_cast<std::size_t>(j)] = static_cast<float>(std::cos(phi));
-        state.cosSin[2 * static_cast<std::size_t>(j) + 1] = static_cast<float>(std::sin(phi));
+        t.cosSin[2 * static_cast<std::size_t>(j)] = static_cast<float>(std::cos(phi));
+        t.cosSin[2 * static_cast<std::size_t>(j) + 1] = static_cast<float>(std::sin(phi));
     }
+    t.key = std::move(key);
 }
 
 void resizeBlockScratch(int nBlocks, int nxrPad, int nSteps, VisibilityState& state) {
@@ -562,7 +603,8 @@ void visibilityOfRow(const VisibilityRows& r, int Y, std::span<const ColumnSpan>
         for (const ColumnSpan& span : spans) std::fill(vRows[i] + span.x0, vRows[i] + span.x1, 0.0f);
     }
     for (int j0 = 0; j0 < m; j0 += 2) {
-        const RowBatch rb{state.steps.data(),
+        const StepTables& t = state.tables.front();
+        const RowBatch rb{t.steps.data(),
                           r.nSteps,
                           nxr,
                           nyr,
@@ -571,9 +613,9 @@ void visibilityOfRow(const VisibilityRows& r, int Y, std::span<const ColumnSpan>
                           j0,
                           std::min(2, m - j0),
                           spans,
-                          state.stepsPerColumn.data(),
-                          state.stepsPerRow.data(),
-                          state.cosSin.data(),
+                          t.stepsPerColumn.data(),
+                          t.stepsPerRow.data(),
+                          t.cosSin.data(),
                           sc.h0.data(),
                           sc.gradX.data(),
                           sc.gradY.data(),

@@ -153,16 +153,42 @@ struct VisibilityField {
     const float* plane(int i) const { return sh.data() + static_cast<std::size_t>(i) * nxr * nyr; }
 };
 
-/// Reusable buffers of the visibility stage.
-struct VisibilityState {
-    std::vector<VisibilityScratch> blocks;
+/// What a scan's step tables are a function of: the azimuths and the
+/// pyramid's layout (its step distances and levels, its grids, where its
+/// fields lie in memory and their strides), not the heights the fields hold.
+struct StepTableKey {
+    std::vector<double> phi;
+    int nxrPad = 0, nx = 0, ny = 0, nxr = 0, nyr = 0, subsample = 0;
+    float cellSize = 0.0f;
+    const float* raw = nullptr;  // the raw phases
+    std::ptrdiff_t rawWidth = 0, rawPlane = 0;
+    std::vector<double> tauCells;
+    std::vector<int> stepLevels;
+    std::vector<const float*> levelData;  // each level's first texel
+    std::vector<std::ptrdiff_t> levelStrides;
+    bool operator==(const StepTableKey&) const = default;
+};
+
+/// One scan's step tables (computeVisibility).
+struct StepTables {
+    StepTableKey key;
     std::vector<ScanStep> steps;      // azimuths x steps
     std::vector<int> validColumns;    // azimuths x steps: receivers X in [first, last] sample inside (x)
     std::vector<int> validRows;       // azimuths x steps: same for receiver rows Y (pairs)
     std::vector<int> stepsPerColumn;  // azimuths x padded nxr: valid-prefix length from x alone
     std::vector<int> stepsPerRow;     // azimuths x nyr: valid-prefix length from y alone
     std::vector<float> cosSin;        // azimuths x 2: cos, sin of each azimuth (float)
-    DirtySpans spans;                 // the receiver columns to compute, per row
+};
+
+/// Reusable buffers of the visibility stage.
+struct VisibilityState {
+    std::vector<VisibilityScratch> blocks;
+    // the tables of the last scans (the environment's and each key light's,
+    // which take turns), the running scan's first: a scan whose key one of
+    // them holds reuses it
+    static constexpr std::size_t kKeptTables = 4;
+    std::vector<StepTables> tables;
+    DirtySpans spans;  // the receiver columns to compute, per row
 };
 
 /// One step of the scan table as computeVisibility builds it (exposed for

@@ -293,6 +293,42 @@ TEST_CASE("gi.visibility: a second frame on a changed field reuses every buffer"
     CHECK(hashState(st) != before);
 }
 
+TEST_CASE("gi.visibility: kept step tables give a fresh state's bits as the layout, cell size and lights change") {
+    // one state through frames whose step tables differ in one input each
+    // (the environment's and the key lights' tables take turns in it)
+    struct Frame {
+        int nx, ny;
+        float cell;
+        int keys;
+        int subsample;
+    };
+    const Frame frames[] = {{64, 48, 1.0f, 1, 2}, {64, 48, 1.5f, 1, 2}, {64, 48, 1.5f, 3, 2}, {70, 48, 1.5f, 3, 2},
+                            {70, 48, 1.5f, 3, 1}, {64, 48, 1.0f, 1, 2}, {64, 48, 1.0f, 2, 2}};
+    GiState kept;
+    for (const Frame& f : frames) {
+        CAPTURE(f.nx);
+        CAPTURE(f.cell);
+        CAPTURE(f.keys);
+        CAPTURE(f.subsample);
+        const Grid g = hills(f.nx, f.ny, 20.0f);
+        GiLighting light;
+        for (int k = 0; k < f.keys; ++k) {
+            KeyLight key;
+            key.azimuthDeg = 40.0f + 70.0f * static_cast<float>(k);
+            key.elevationDeg = 20.0f + 5.0f * static_cast<float>(k);
+            light.keys.push_back(key);
+        }
+        GiSettings settings;
+        settings.subsample = f.subsample;
+        settings.incremental = false;
+        GiState fresh;
+        runGiFrame(g.cview(), f.cell, light, settings, kept);
+        runGiFrame(g.cview(), f.cell, light, settings, fresh);
+        CHECK(hashState(kept) == hashState(fresh));
+        CHECK(kept.visibilityState.tables.size() <= VisibilityState::kKeptTables);
+    }
+}
+
 TEST_CASE(
     "gi.visibility: the SIMD scan matches its scalar twin bit for bit (every receiver, azimuth, rule, 1x/2x/4x)") {
     const Grid g = hills(61, 47, 30.0f);
