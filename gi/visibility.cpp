@@ -476,18 +476,17 @@ void buildAzimuthSteps(const HeightPyramid& pyr, int j, double c, double sn, int
 }
 
 StepTableKey stepTableKey(const HeightPyramid& pyr, const FoldedWedgeOperator& op, int nxrPad) {
-    StepTableKey k;
-    k.phi = op.phi;
-    k.nxrPad = nxrPad;
-    k.nx = pyr.nx;
-    k.ny = pyr.ny;
-    k.nxr = pyr.nxr;
-    k.nyr = pyr.nyr;
-    k.subsample = pyr.subsample;
-    k.cellSize = pyr.cellSize;
-    k.raw = pyr.rawPhaseData();
-    k.rawWidth = pyr.rawPhaseWidth;
-    k.rawPlane = pyr.rawPhasePlane;
+    StepTableKey k{.phi = op.phi,
+                   .nxrPad = nxrPad,
+                   .nx = pyr.nx,
+                   .ny = pyr.ny,
+                   .nxr = pyr.nxr,
+                   .nyr = pyr.nyr,
+                   .subsample = pyr.subsample,
+                   .cellSize = pyr.cellSize,
+                   .raw = pyr.rawPhaseData(),
+                   .rawWidth = pyr.rawPhaseWidth,
+                   .rawPlane = pyr.rawPhasePlane};
     for (const PyramidStep& ps : pyr.steps) {
         k.tauCells.push_back(ps.tauCells);
         k.stepLevels.push_back(ps.level);
