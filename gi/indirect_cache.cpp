@@ -261,7 +261,6 @@ void boundRadianceChange(const IndirectPlanInputs& in, IndirectCache& cache) {
                                               cache.anchorSource[2].cview()};
     const std::array<ConstGridView, 3> after{in.source[0].cview(), in.source[1].cview(), in.source[2].cview()};
     cache.anchorChanged = cache.anchorChanged.joined(in.sourceChanged);
-    cache.change.withSums = false;  // the sample bounds read maxima alone
     buildMaxChangePyramid(before, after, cache.change, cache.anchorChanged);
     cache.radianceBound.assign(tiles, 0.0f);
     if (maxChangeAll(cache.change) == 0.0f) return;

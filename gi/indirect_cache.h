@@ -98,10 +98,12 @@ inline std::size_t visibilityTileHolding(int tx, int ty, int nxr) {
 }
 
 struct IndirectCache {
-    bool valid = false;                  // the fields below describe the cached indirect result
-    std::array<Grid, 3> anchorSource;    // L_0 at the anchor (gi/anchored_drift.h)
-    CellBox anchorChanged;               // holds every texel where L_0 may differ from anchorSource (every one)
-    MaxChangePyramid change;             // this frame: max over the channels of |L_0 - anchorSource|
+    bool valid = false;                // the fields below describe the cached indirect result
+    std::array<Grid, 3> anchorSource;  // L_0 at the anchor (gi/anchored_drift.h)
+    CellBox anchorChanged;             // holds every texel where L_0 may differ from anchorSource (every one)
+    // this frame: max over the channels of |L_0 - anchorSource| (no block
+    // sums: the sample bounds read maxima alone)
+    MaxChangePyramid change{.withSums = false};
     RadianceLevelChange levels;          // the anchor's radiance pyramid levels, this frame's change of each
     bool levelsRecorded = false;         // `levels` hold the anchor's (else the last pass's pyramid is the anchor's)
     std::vector<float> azimuthBound;     // per tile and indirect azimuth (tile-major)

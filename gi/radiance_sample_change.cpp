@@ -57,8 +57,8 @@ void recordAnchorLevels(const RadiancePyramid& p, RadianceLevelChange& out, Cell
 
 void buildLevelChanges(const RadiancePyramid& now, CellBox changed, RadianceLevelChange& out) {
     if (!out.fits(now)) throw InputError("radiance sample change: the pyramid is not of the anchor's grid");
-    out.change.resize(static_cast<std::size_t>(out.levels));
-    for (MaxChangePyramid& c : out.change) c.withSums = false;  // the sample bounds read maxima alone
+    // no block sums: the sample bounds read maxima alone
+    out.change.resize(static_cast<std::size_t>(out.levels), MaxChangePyramid{.withSums = false});
     // the levels side by side (each build's own passes are parallel too)
     parallelFor(0, out.levels, 1, [&](int l0, int l1) {
         for (int l = l0; l < l1; ++l) {

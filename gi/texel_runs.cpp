@@ -167,11 +167,11 @@ void appendTexelsToRedo(const ReceiverTiles& recomputed, const ConstGridView* be
                 if (flagged) flagged->setDirty(tx, ty);
                 continue;
             }
-            if (!before) continue;
-            const InclusiveCells cells = texelCellsOfTile(t, tx, ty, after.nx, after.ny, s, reach);
-            const bool outside = cells.x1 < differing.x0 || cells.x0 >= differing.x1 || cells.y1 < differing.y0 ||
-                                 cells.y0 >= differing.y1;
-            if (outside || !cellsDiffer(*before, after, cells)) continue;
+            // only the cells of `differing` can differ
+            const InclusiveCells c = texelCellsOfTile(t, tx, ty, after.nx, after.ny, s, reach);
+            const InclusiveCells maybe{std::max(c.x0, differing.x0), std::max(c.y0, differing.y0),
+                                       std::min(c.x1, differing.x1 - 1), std::min(c.y1, differing.y1 - 1)};
+            if (!before || !cellsDiffer(*before, after, maybe)) continue;
             if (flagged) flagged->setDirty(tx, ty);
             out.push_back({ownX[static_cast<std::size_t>(tx * T)], ownY[static_cast<std::size_t>(ty * T)],
                            ownX[static_cast<std::size_t>(std::min(t.nxr, (tx + 1) * T))],

@@ -601,8 +601,8 @@ void visibilityOfRow(const VisibilityRows& r, int Y, std::span<const ColumnSpan>
         vRows[i] = r.out.plane(i) + static_cast<std::size_t>(Y) * nxr;
         for (const ColumnSpan& span : spans) std::fill(vRows[i] + span.x0, vRows[i] + span.x1, 0.0f);
     }
+    const StepTables& t = state.tables.front();  // this scan's (buildStepTables)
     for (int j0 = 0; j0 < m; j0 += 2) {
-        const StepTables& t = state.tables.front();
         const RowBatch rb{t.steps.data(),
                           r.nSteps,
                           nxr,
