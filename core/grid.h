@@ -162,22 +162,26 @@ inline void copyGrid(ConstGridView from, Grid& to, RowSpan rows = {}) {
         std::memcpy(to.data() + static_cast<std::size_t>(y) * from.nx, from.row(y), sizeof(float) * from.nx);
 }
 
+/// The cells of `box` (inside the view) as a view of their own: its cell
+/// (0, 0) is the view's (box.x0, box.y0).
+inline ConstGridView subView(ConstGridView v, CellBox box) {
+    return {v.row(box.y0) + box.x0, box.x1 - box.x0, box.y1 - box.y0, v.stride};
+}
+
 /// Whether row y of `a` and `b` (the same width) holds the same bits.
-inline bool sameRow(const Grid& a, ConstGridView b, int y) {
-    return std::memcmp(a.data() + static_cast<std::size_t>(y) * a.nx, b.row(y), sizeof(float) * b.nx) == 0;
+inline bool sameRow(ConstGridView a, ConstGridView b, int y) {
+    return std::memcmp(a.row(y), b.row(y), sizeof(float) * b.nx) == 0;
 }
 
 /// The box from the first to the last row of `a` and `b` (the same size)
 /// that differ, and in those rows from the first to the last differing
 /// column; empty when no cell differs. Bits are compared, so -0 and 0 differ.
-inline CellBox differingCells(const Grid& a, ConstGridView b) {
+inline CellBox differingCells(ConstGridView a, ConstGridView b) {
     int y0 = 0, y1 = b.ny;
     while (y0 < y1 && sameRow(a, b, y0)) ++y0;
     while (y1 > y0 && sameRow(a, b, y1 - 1)) --y1;
     if (y0 == y1) return CellBox::none();
-    const auto same = [&](int x, int y) {
-        return std::memcmp(a.data() + static_cast<std::size_t>(y) * a.nx + x, b.row(y) + x, sizeof(float)) == 0;
-    };
+    const auto same = [&](int x, int y) { return std::memcmp(a.row(y) + x, b.row(y) + x, sizeof(float)) == 0; };
     int x0 = b.nx, x1 = 0;
     for (int y = y0; y < y1; ++y) {
         int first = 0, last = b.nx;

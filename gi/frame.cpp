@@ -124,7 +124,7 @@ void runIndirectStage(ConstGridView heights, const GiSettings& settings, const F
                             .directChanged = settings.incremental ? st.directChanged : CellBox{},
                             .radianceCurrent = cached};
     computeIndirect(in, settings.indirect, st.indirect);
-    noteOcclusionsRedone(cached ? texels : nullptr, st.indirectCache);
+    noteOcclusionsRedone(cached ? texels : nullptr, cached ? in.texelRuns : nullptr, st.indirectCache);
     st.indirect.timings.pyramid += pyramidMs;  // bounce 0's pyramid, built before the plan
     st.indirect.timings.total += pyramidMs;
     st.directChanged = CellBox::none();  // the indirect light has read every change
@@ -381,6 +381,17 @@ void exactAmbient(ConstGridView heights, float cellSize, const GiSettings& setti
     sh.skyParts = withSkyParts;
 }
 
+// The box of the texels of `box` whose light differs from `before` (copies
+// of that box's light, taken before the shading redid it); empty when none.
+CellBox changedLight(const std::array<Grid, 3>& before, const std::array<Grid, 3>& now, CellBox box) {
+    CellBox out = CellBox::none();
+    for (int c = 0; c < 3; ++c) {
+        const CellBox d = differingCells(before[c].cview(), subView(now[c].cview(), box));
+        if (!d.empty()) out = out.joined({d.x0 + box.x0, d.y0 + box.y0, d.x1 + box.x0, d.y1 + box.y0});
+    }
+    return out;
+}
+
 // Direct light at every texel: the lighting's SH product matrices once per
 // frame, then the shading (Section 7); key lights through the SH clamped
 // cosine, or with the exact cosine (GiSettings::keyLightExactCosine). With
@@ -397,7 +408,12 @@ void directShading(const GiLighting& lighting, const GiSettings& settings, const
     st.shadingLights[0] = environmentShadingLight(sky.sh, st.envVisibility);
     for (std::size_t k = 0; k < (exactKeys ? 0 : nKeys); ++k)
         st.shadingLights[k + 1] = keyShadingLight(lighting.keys[k], st.keyVisibility[k]);
-    st.directChanged = st.directChanged.joined(runs ? boundingBox(*runs) : CellBox{});
+    // The indirect light re-reads the texels whose light changed, which can
+    // be far fewer than those redone (a key light's tile recomputed to the
+    // same visible fractions): its pyramids and bounds cost by their box.
+    const CellBox redone = runs ? boundingBox(*runs) : CellBox{};
+    if (runs)
+        for (int c = 0; c < 3; ++c) copyGrid(subView(st.shade.rgb[c].cview(), redone), st.shadeBefore[c]);
     shadeTexels(st.gradX.cview(), st.gradY.cview(), settings.subsample, st.envVisibility, st.shadingLights.data(),
                 static_cast<int>(st.shadingLights.size()), albedo, settings.shading, st.shade, shAmbient, runs);
     if (sky.exactSky)
@@ -409,6 +425,7 @@ void directShading(const GiLighting& lighting, const GiSettings& settings, const
         for (std::size_t k = 0; k < nKeys; ++k)
             addKeyLightExactCosine(lighting.keys[k], st.keyVisibility[k], settings.subsample, st.gradX.cview(),
                                    st.gradY.cview(), albedo, st.shade.rgb, runs);
+    st.directChanged = st.directChanged.joined(runs ? changedLight(st.shadeBefore, st.shade.rgb, redone) : CellBox{});
 }
 
 // Which receivers' visibility the frame recomputes, planned before any stage

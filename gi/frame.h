@@ -60,8 +60,9 @@ struct GiState {
     VisibilityCache visibilityCache;  // per tile, how far the cached V may have drifted
     IndirectCache indirectCache;      // per tile, how far the cached indirect light may have drifted
     bool directStale = false, indirectStale = false;
-    TexelRuns shadingRuns;              // this frame's texels whose direct light was redone (gi/shading_tiles.h)
-    CellBox directChanged;              // texels of shade.rgb redone since the indirect light last read it (all)
+    TexelRuns shadingRuns;  // this frame's texels whose direct light was redone (gi/shading_tiles.h)
+    CellBox directChanged;  // texels of shade.rgb that may differ from what the indirect light last read (all)
+    std::array<Grid, 3> shadeBefore;    // scratch: the light of the texels a restricted shading redoes, before it
     TexelRuns ambientRuns;              // of those, the texels whose exact ambient was redone
     std::vector<TexelRect> texelRects;  // their scratch
     double receiversRecomputed = 0.0;   // fraction of the receivers whose environment V the last frame recomputed

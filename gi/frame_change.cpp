@@ -9,7 +9,7 @@ namespace {
 bool sameGrid(const Grid& a, ConstGridView b) {
     if (a.nx != b.nx || a.ny != b.ny) return false;
     for (int y = 0; y < b.ny; ++y)
-        if (!sameRow(a, b, y)) return false;
+        if (!sameRow(a.cview(), b, y)) return false;
     return true;
 }
 
@@ -49,7 +49,7 @@ FrameChange compareFrameInputs(const FrameInputs& last, ConstGridView heights, f
     const bool sameFrame = cellSize == last.cellSize && settings == last.settings && last.heights.nx == heights.nx &&
                            last.heights.ny == heights.ny;
     if (sameFrame) {
-        c.heightBox = differingCells(last.heights, heights);
+        c.heightBox = differingCells(last.heights.cview(), heights);
         c.geometry = !c.heightBox.empty();
     }
     c.heightsOnly = sameFrame && c.geometry;

@@ -226,12 +226,20 @@ float largestOf(const float* v, int n) {
 
 // Per tile: min(1, the largest O / pi of the texels that read its
 // receivers + the tolerance), or 1 without a texel occlusion (the
-// occlusion factor of gi/indirect_cache.h).
+// occlusion factor of gi/indirect_cache.h). The largest O is kept per tile
+// and taken again where the texels it reads meet the box of those whose
+// occlusion was redone since.
 void occlusionFactors(const IndirectPlanInputs& in, IndirectCache& cache) {
     const HeightPyramid& h = in.heights;
     const int tilesX = tileCount(h.nxr, kIndirectTile), tilesY = tileCount(h.nyr, kIndirectTile);
-    cache.occlusionFactor.assign(static_cast<std::size_t>(tilesX) * tilesY, 1.0f);
+    const std::size_t tiles = static_cast<std::size_t>(tilesX) * tilesY;
+    cache.occlusionFactor.assign(tiles, 1.0f);
     if (!hasOcclusions(in)) return;
+    if (cache.largestOcclusion.size() != tiles) {
+        cache.largestOcclusion.assign(tiles, 0.0f);
+        cache.occlusionsRedone = CellBox{};
+    }
+    const CellBox redone = cache.occlusionsRedone.cut(h.nx, h.ny);
     const Grid* occ = &in.blocker->occlusion;
     std::vector<int> x0, x1, y0, y1;
     texelsReadingTiles(h.nx, h.subsample, h.nxr, kIndirectTile, x0, x1);
@@ -239,16 +247,20 @@ void occlusionFactors(const IndirectPlanInputs& in, IndirectCache& cache) {
     parallelFor(0, tilesY, 1, [&](int ty0, int ty1) {
         for (int ty = ty0; ty < ty1; ++ty)
             for (int tx = 0; tx < tilesX; ++tx) {
-                float largest = 0.0f;
-                for (int y = y0[static_cast<std::size_t>(ty)]; y <= y1[static_cast<std::size_t>(ty)]; ++y) {
-                    const int a = x0[static_cast<std::size_t>(tx)], b = x1[static_cast<std::size_t>(tx)];
-                    largest =
-                        std::max(largest, largestOf(occ->data() + static_cast<std::size_t>(y) * h.nx + a, b - a + 1));
+                const int a = x0[static_cast<std::size_t>(tx)], b = x1[static_cast<std::size_t>(tx)];
+                const int c = y0[static_cast<std::size_t>(ty)], d = y1[static_cast<std::size_t>(ty)];
+                float& largest = cache.largestOcclusion[static_cast<std::size_t>(ty) * tilesX + tx];
+                if (a < redone.x1 && b >= redone.x0 && c < redone.y1 && d >= redone.y0) {
+                    largest = 0.0f;
+                    for (int y = c; y <= d; ++y)
+                        largest = std::max(largest,
+                                           largestOf(occ->data() + static_cast<std::size_t>(y) * h.nx + a, b - a + 1));
                 }
                 cache.occlusionFactor[static_cast<std::size_t>(ty) * tilesX + tx] =
                     std::min(1.0f, largest + in.tolerance);
             }
     });
+    cache.occlusionsRedone = CellBox::none();
 }
 
 }  // namespace
@@ -331,7 +343,8 @@ void recordIndirectSource(const std::array<Grid, 3>& source, const RadiancePyram
     cache.valid = true;
 }
 
-void noteOcclusionsRedone(const ReceiverTiles* redone, IndirectCache& cache) {
+void noteOcclusionsRedone(const ReceiverTiles* redone, const TexelRuns* runs, IndirectCache& cache) {
+    cache.occlusionsRedone = redone && runs ? cache.occlusionsRedone.joined(boundingBox(*runs)) : CellBox{};
     std::vector<std::uint8_t>& stale = cache.shareEnvelopeStale;
     if (!redone || redone->dirty.size() != stale.size()) {
         std::fill(stale.begin(), stale.end(), 1);

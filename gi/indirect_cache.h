@@ -110,7 +110,12 @@ struct IndirectCache {
     std::vector<float> groupBound;       // per tile and distance group (gi/pyramid.h), over every azimuth
     AnchoredDrift drift;                 // per tile: how far its result was from the anchor's
     std::vector<float> occlusionFactor;  // per tile: this frame's factor of the radiance bound
-    std::vector<float> radianceBound;    // per tile: this frame's bound from the anchor (boundRadianceChange)
+    // per tile: the largest O / pi of the texels that read its receivers,
+    // taken again only where the texel passes redid an occlusion since
+    // (occlusionsRedone: a box of texels, every one by default)
+    std::vector<float> largestOcclusion;
+    CellBox occlusionsRedone;
+    std::vector<float> radianceBound;  // per tile: this frame's bound from the anchor (boundRadianceChange)
     // per tile: the largest share of a receiver's occlusion along each
     // azimuth, then in each distance group (azimuths + kDistanceGroups
     // floats, rounded up), or all -1 when some receiver has (next to) no
@@ -182,9 +187,10 @@ void recordIndirectSource(const std::array<Grid, 3>& source, const RadiancePyram
                           const HeightPyramid& heights, IndirectCache& cache);
 
 /// After an indirect pass whose texel passes redid the receivers'
-/// occlusions in the tiles `redone` (cache.texels; null: every tile): their
-/// share envelopes are taken again by the next plan.
-void noteOcclusionsRedone(const ReceiverTiles* redone, IndirectCache& cache);
+/// occlusions in the tiles `redone` (cache.texels) and the texels'
+/// occlusions at `runs` (cache.texelRuns; both null: every one): their share
+/// envelopes and largest occlusions are taken again by the next plan.
+void noteOcclusionsRedone(const ReceiverTiles* redone, const TexelRuns* runs, IndirectCache& cache);
 
 /// What the frame knows of the texels' inputs since the last pass.
 struct IndirectTexelInputs {

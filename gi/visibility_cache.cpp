@@ -59,7 +59,7 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
         resetVisibilityCache(pyr, before, cache);
     // outside the cells that differ from the anchor's, |dh| is 0 (and the
     // anchor's rows the same as this frame's)
-    const CellBox differing = differingCells(cache.anchorHeights, after);
+    const CellBox differing = differingCells(cache.anchorHeights.cview(), after);
     buildMaxChangePyramid(cache.anchorHeights.cview(), after, cache.change, differing);
     boundSlopeChange(cache.change, pyr, kVisibilityTile, cache.slopeBound);
     boundSlopeChangePerAzimuth(cache.change, pyr, kVisibilityTile, vis.azimuths, cache.azimuthBound);

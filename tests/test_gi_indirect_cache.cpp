@@ -2,6 +2,7 @@
 // sources or geometry drifted beyond the tolerance, bit for bit a full
 // recompute at tolerance 0, and the radiance bound it adds up holds.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <functional>
@@ -402,6 +403,41 @@ TEST_CASE("gi.indirect_cache: a crater dropped and filled again and again costs 
     CHECK(v[19] == v[3]);
     CHECK(indirect[18] == indirect[2]);
     CHECK(indirect[19] == indirect[3]);
+}
+
+TEST_CASE("gi.indirect_cache: the tiles' kept largest occlusions equal ones taken afresh") {
+    // Each tile's largest texel occlusion is kept between plans and taken
+    // again only where the texel passes redid an occlusion: through drops
+    // and fills of a crater, a plan's occlusion factors from the kept values
+    // are those of a cache that takes every tile again.
+    const CraterField field;
+    const GiSettings settings = CraterField::settings(0.05f);
+    GiState inc;
+    runGiFrame(field.h.cview(), 10.0f, field.light, settings, inc);
+    for (int f = 1; f <= 6; ++f) {
+        runGiFrame((f % 2 == 1 ? field.crater : field.h).cview(), 10.0f, field.light, settings, inc);
+        const CellBox redone = inc.indirectCache.occlusionsRedone;
+        CHECK(!redone.empty());
+        CHECK((redone.x1 - redone.x0) * static_cast<long>(redone.y1 - redone.y0) < 256L * 256 / 2);  // most tiles kept
+        // a source that differs from the anchor, so that the plan weighs it
+        std::array<Grid, 3> source = inc.shade.rgb;
+        for (Grid& c : source) c(128, 128) += 0.5f;
+        const IndirectPlanInputs in{.source = source,
+                                    .heights = inc.pyramid,
+                                    .pyramid = inc.indirect.radiance,
+                                    .geometryTiles = nullptr,
+                                    .phi = inc.indirectOperator.phi,
+                                    .tolerance = settings.tolerance,
+                                    .blocker = &inc.indirect.blocker};
+        IndirectCache kept = inc.indirectCache, fresh = inc.indirectCache;
+        fresh.largestOcclusion.clear();
+        boundRadianceChange(in, kept);
+        boundRadianceChange(in, fresh);
+        REQUIRE(kept.occlusionFactor.size() == fresh.occlusionFactor.size());
+        CHECK(kept.occlusionFactor == fresh.occlusionFactor);
+        // the factors are the texels' occlusions, not the bound's default of 1
+        CHECK(*std::min_element(kept.occlusionFactor.begin(), kept.occlusionFactor.end()) < 1.0f);
+    }
 }
 
 namespace {
