@@ -482,7 +482,7 @@ DirectRuns directRuns(ConstGridView heights, const FrameChange& change, const Ge
         st.lastInputs.heights.ny != heights.ny)
         return {};
     const VisibilityCache& cache = st.visibilityCache;
-    changedDirectTexels(st.lastInputs.heights.cview(), heights, cache.tiles, cache.keyTiles, st.pyramid.subsample,
+    changedDirectTexels(st.lastInputs.heights.cview(), heights, cache.tiles, st.keyTilesChanged, st.pyramid.subsample,
                         st.texelRects, st.ambientRuns, st.shadingRuns, change.heightBox);
     return {&st.shadingRuns, &st.ambientRuns};
 }
@@ -536,7 +536,9 @@ void runDirectStages(ConstGridView heights, float cellSize, const GiLighting& li
         !change.geometry && change.radiance && !lighting.keys.empty() &&
         planKeyBrightness(keyLightRegions(lighting, settings), settings.tolerance, st.visibilityCache);
     if (brighter) keyOnly = &st.visibilityCache.keyTiles;
+    if (keyOnly) keepKeyVisibility(st.keyVisibility, *keyOnly, st.keyBefore);
     keyLightVisibility(lighting, settings, change, keyOnly, brighter, st);
+    if (keyOnly) keyTilesChanged(st.keyVisibility, *keyOnly, st.keyBefore, st.keyTilesChanged);
     st.timings.keyVisibility = msSince(t);
     t = Clock::now();
     const DirectRuns runs = directRuns(heights, change, plan, st);

@@ -15,6 +15,7 @@
 #include "gi/pyramid.h"
 #include "gi/settings.h"
 #include "gi/shading.h"
+#include "gi/shading_tiles.h"
 #include "gi/visibility.h"
 #include "gi/visibility_cache.h"
 #include "gi/wedge.h"
@@ -64,6 +65,8 @@ struct GiState {
     CellBox directChanged;  // texels of shade.rgb that may differ from what the indirect light last read (all)
     std::array<Grid, 3> shadeBefore;    // scratch: the light of the texels a restricted shading redoes, before it
     TexelRuns ambientRuns;              // of those, the texels whose exact ambient was redone
+    KeyVisibilityBefore keyBefore;      // scratch: the key tiles' visibility before this frame's scan
+    ReceiverTiles keyTilesChanged;      // the key tiles whose visibility this frame's scan changed
     std::vector<TexelRect> texelRects;  // their scratch
     double receiversRecomputed = 0.0;   // fraction of the receivers whose environment V the last frame recomputed
     int keyVisibilitiesRecomputed = 0;  // key lights whose V the last frame recomputed

@@ -15,19 +15,21 @@
 //  - the lights and the albedo.
 // When only the heights changed and the visibility was recomputed by tiles
 // (gi/visibility_cache.h), a texel has the last frame's inputs bit for bit
-// unless it reads a receiver of a tile whose environment or key-light
-// visibility was recomputed, or a height within s + s / 2 + 1 cells of the
+// unless it reads a receiver of a tile whose environment visibility was
+// recomputed or whose key-light visibility changed (below), or a height within s + s / 2 + 1 cells of the
 // texels of its tile (gi/texel_runs.h) changed; the others keep their light,
 // identical to recomputing it. The exact ambient (and the analytic sky's
 // parts) reads the environment's horizons, not the key lights': its texels
 // are those of the environment's dirty tiles and the changed heights alone,
 // so a local change that a low key light looks across redoes the shade of a
 // strip of tiles but the ambient of a few.
+#include <array>
 #include <vector>
 
 #include "core/grid.h"
 #include "gi/receiver_tiles.h"
 #include "gi/texel_runs.h"
+#include "gi/visibility.h"
 
 namespace terrain::gi {
 
@@ -46,5 +48,27 @@ inline int shadingReach(int subsample) { return subsample + subsample / 2 + 1; }
 void changedDirectTexels(ConstGridView before, ConstGridView after, const ReceiverTiles& env, const ReceiverTiles& keys,
                          int subsample, std::vector<TexelRect>& rects, TexelRuns& ambient, TexelRuns& shading,
                          CellBox differing = {});
+
+// A key light's tile is recomputed when its bound allows a change, which
+// is often none at all (a local change beside a light's region of the sky
+// moves its far, filtered samples, not whether the window is visible):
+// the key tiles whose visibility the scan left bit for bit as it was need
+// no shading, and a texel that reads only their receivers keeps its light.
+
+/// The key lights' visibility (every light's planes) of the receivers of
+/// the dirty tiles of `tiles`, kept before a scan recomputes them.
+struct KeyVisibilityBefore {
+    std::vector<float> values;
+    std::vector<std::array<int, 3>> layout;  // per light: nxr, nyr, planes
+};
+
+/// Keeps the key lights' visibility of the dirty tiles of `tiles` (in `out`).
+void keepKeyVisibility(const std::vector<VisibilityField>& keys, const ReceiverTiles& tiles, KeyVisibilityBefore& out);
+
+/// `changed`: the dirty tiles of `tiles` where some light's visibility
+/// differs (bits) from `before`, kept of the same tiles; every dirty tile
+/// when the lights or their fields' layout differ from the kept ones.
+void keyTilesChanged(const std::vector<VisibilityField>& keys, const ReceiverTiles& tiles,
+                     const KeyVisibilityBefore& before, ReceiverTiles& changed);
 
 }  // namespace terrain::gi
