@@ -157,9 +157,10 @@ ShadingLight keyShadingLight(const KeyLight& light, const VisibilityField& v) {
 
 }  // namespace
 
-void checkHeightsFinite(ConstGridView h) {
-    for (int y = 0; y < h.ny; ++y)
-        for (int x = 0; x < h.nx; ++x)
+void checkHeightsFinite(ConstGridView h, CellBox box) {
+    box = box.cut(h.nx, h.ny);
+    for (int y = box.y0; y < box.y1; ++y)
+        for (int x = box.x0; x < box.x1; ++x)
             if (!std::isfinite(h(x, y)))
                 throw InputError("heights: NaN or Inf at column " + std::to_string(x) + ", row " + std::to_string(y));
 }
@@ -200,7 +201,8 @@ void computeGradient(ConstGridView h, float cellSize, Grid& gx, Grid& gy, RowSpa
 
 namespace {
 
-// The stage's boundary: every input and setting checked before any work.
+// The stage's boundary: every input and setting checked before any work,
+// but for the heights' values (runGiFrame checks those that are new).
 void validateFrameInputs(ConstGridView heights, float cellSize, const GiLighting& lighting, const GiSettings& settings,
                          const AlbedoMap* albedo) {
     if (heights.nx < 1 || heights.ny < 1 || !heights.data) throw InputError("heights: empty grid");
@@ -215,7 +217,6 @@ void validateFrameInputs(ConstGridView heights, float cellSize, const GiLighting
     for (const ShVector& c : lighting.environment.c)
         for (double v : c)
             if (!std::isfinite(v)) throw InputError("environment light: NaN or Inf coefficient");
-    checkHeightsFinite(heights);
     if (!albedo) return;
     for (const Grid& g : albedo->channel)
         if (!g.empty() && (g.nx != heights.nx || g.ny != heights.ny))
@@ -562,11 +563,13 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
     const auto t0 = Clock::now();  // the whole frame: input checks and the comparison included
     validateFrameInputs(heights, cellSize, lighting, settings, albedo);
     const bool refresh =
-        settings.incremental && settings.refreshEvery > 0 && ++st.framesSinceRefresh >= settings.refreshEvery;
-    if (refresh || !settings.incremental) st.framesSinceRefresh = 0;
+        settings.incremental && settings.refreshEvery > 0 && st.framesSinceRefresh + 1 >= settings.refreshEvery;
     const FrameChange change = settings.incremental && !refresh
                                    ? compareFrameInputs(st.lastInputs, heights, cellSize, lighting, settings, albedo)
                                    : everythingChanged(lighting.keys.size());
+    // heights equal to the recorded ones bit for bit were checked when recorded
+    checkHeightsFinite(heights, change.newHeights);
+    st.framesSinceRefresh = refresh || !settings.incremental ? 0 : st.framesSinceRefresh + 1;
     st.timings = GiTimings{};
     st.receiversRecomputed = 0.0;
     st.indirectRecomputed = 0.0;

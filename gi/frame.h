@@ -96,8 +96,9 @@ void runGiFrame(ConstGridView heights, float cellSize, const GiLighting& lightin
 /// rows whose derivatives read a changed row.
 void computeGradient(ConstGridView heights, float cellSize, Grid& gradX, Grid& gradY, RowSpan changed = {});
 
-/// Throws InputError naming the first NaN/Inf height.
-void checkHeightsFinite(ConstGridView heights);
+/// Throws InputError naming the first NaN/Inf height of the cells `box`
+/// (every cell by default).
+void checkHeightsFinite(ConstGridView heights, CellBox box = {});
 
 /// Redoes the direct light of every texel (and the ambient map) from the
 /// visibility `st` holds, as the last frame's shading stage would with every

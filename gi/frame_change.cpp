@@ -46,10 +46,11 @@ FrameChange compareFrameInputs(const FrameInputs& last, ConstGridView heights, f
     const std::size_t nKeys = lighting.keys.size();
     if (!last.valid) return everythingChanged(nKeys);
     FrameChange c;
-    const bool sameFrame = cellSize == last.cellSize && settings == last.settings && last.heights.nx == heights.nx &&
-                           last.heights.ny == heights.ny;
+    const bool sameSize = last.heights.nx == heights.nx && last.heights.ny == heights.ny;
+    if (sameSize) c.newHeights = differingCells(last.heights.cview(), heights);
+    const bool sameFrame = sameSize && cellSize == last.cellSize && settings == last.settings;
     if (sameFrame) {
-        c.heightBox = differingCells(last.heights.cview(), heights);
+        c.heightBox = c.newHeights;
         c.geometry = !c.heightBox.empty();
     }
     c.heightsOnly = sameFrame && c.geometry;

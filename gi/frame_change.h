@@ -44,6 +44,10 @@ struct FrameChange {
     // record bit for bit (the first to the last differing row, and in those
     // rows the first to the last differing column); otherwise every cell.
     CellBox heightBox;
+    // The box holding every height that differs from the recorded heights
+    // bit for bit, whatever else changed (every cell without a record of
+    // this size): the others are the record's, checked when recorded.
+    CellBox newHeights;
     std::vector<bool> keyRegion;  // per key light: its region of the sky is new (direction, size, count)
     bool radiance = true;         // environment, key radiances or albedo: shading and indirect light
     bool any() const;

@@ -247,6 +247,21 @@ CellBox receiversIn(const CellBox& cells, int s, int nxr, int nyr) {
         nxr, nyr);
 }
 
+// Octave o's synthesis taps for a B_o of srcNx x srcNy texels, computed
+// when the grids differ from the last build's.
+const HeightPyramid::OctaveTaps& octaveTaps(HeightPyramid& p, int o, int srcNx, int srcNy) {
+    HeightPyramid::OctaveTaps& t = p.taps[static_cast<std::size_t>(o)];
+    const std::array<int, 5> grid{p.nxr, p.nyr, p.subsample, srcNx, srcNy};
+    if (t.grid != grid || t.index.empty()) {
+        t.index.resize(static_cast<std::size_t>(4 * (p.nxr + p.nyr)));
+        t.weight.resize(t.index.size());
+        synthesisTaps(p.nxr, p.subsample, o, srcNx, t.index.data(), t.weight.data());
+        synthesisTaps(p.nyr, p.subsample, o, srcNy, t.index.data() + 4 * p.nxr, t.weight.data() + 4 * p.nxr);
+        t.grid = grid;
+    }
+    return t;
+}
+
 // One pass (0: the mean octave, 1: the max octave) of the B-spline synthesis
 // of octave o >= 1 at the receiver grid, weighted by `blend`: pass 0 writes
 // out, pass 1 adds to it. Separable: rows of B_o to receiver columns
@@ -255,14 +270,13 @@ CellBox receiversIn(const CellBox& cells, int s, int nxr, int nyr) {
 // whole pass; returns their box.
 CellBox synthesisePass(ConstGridView src, int o, int pass, float blend, const CellBox& changed, HeightPyramid& p,
                        PaddedField& out) {
-    const int nxr = p.nxr, nyr = p.nyr, s = p.subsample;
-    int* ix = p.tapIndex.data();
-    int* iy = ix + 4 * nxr;
-    float* wx = p.tapWeight.data();
-    float* wy = wx + 4 * nxr;
-    synthesisTaps(nxr, s, o, src.nx, ix, wx);
-    synthesisTaps(nyr, s, o, src.ny, iy, wy);
     if (changed.empty()) return CellBox::none();
+    const int nxr = p.nxr, nyr = p.nyr;
+    const HeightPyramid::OctaveTaps& taps = octaveTaps(p, o, src.nx, src.ny);
+    const int* ix = taps.index.data();
+    const int* iy = ix + 4 * nxr;
+    const float* wx = taps.weight.data();
+    const float* wy = wx + 4 * nxr;
     const RowSpan cols = receiversReading(ix, nxr, changed.x0, changed.x1);
     const RowSpan rows = receiversReading(iy, nyr, changed.y0, changed.y1);
     if (cols.y0 >= cols.y1 || rows.y0 >= rows.y1) return CellBox::none();
@@ -312,8 +326,7 @@ std::vector<CellBox> synthesiseOctaves(ConstGridView heights, const std::vector<
     p.octaves = nOctaves;
     p.levels.resize(static_cast<std::size_t>(nLevels));
     p.synth.resize(static_cast<std::size_t>(std::max(0, nOctaves - octavesInLevels(nLevels, kv))));
-    p.tapIndex.resize(static_cast<std::size_t>(4 * (nxr + nyr)));
-    p.tapWeight.resize(static_cast<std::size_t>(4 * (nxr + nyr)));
+    p.taps.resize(static_cast<std::size_t>(nOctaves));
     std::vector<CellBox> receivers(static_cast<std::size_t>(nOctaves));
     for (int o = 0; o < nOctaves; ++o) {
         PaddedField& out = octaveField(p, o);

@@ -27,6 +27,7 @@
 // Optional peak keeping (PyramidSettings::peakBlend): the octave images can
 // also be max-decimated; levels then blend mean and max syntheses, which
 // counters the filtered pyramid's lowering of distant peaks.
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -114,8 +115,15 @@ struct HeightPyramid {
     std::vector<PaddedField> levels;  // f_l at the receiver grid, spacing s; level o k_v is S_o
     std::vector<PaddedField> synth;   // S_o of the octaves above the last level (octaveSynthesis)
     std::vector<float> rowTmp;        // scratch of the separable synthesis
-    std::vector<int> tapIndex;        // scratch: 4 taps per receiver column / row
-    std::vector<float> tapWeight;
+    // Each octave's synthesis taps (4 indices into B_o and 4 weights per
+    // receiver column, then per receiver row), a function of the grids
+    // alone: kept while they are the same.
+    struct OctaveTaps {
+        std::array<int, 5> grid{};  // nxr, nyr, subsample, B_o's nx and ny
+        std::vector<int> index;
+        std::vector<float> weight;
+    };
+    std::vector<OctaveTaps> taps;  // per octave (o >= 1)
 };
 
 /// The steps grouped by distance, in doubling bands of tau (cells): [0, 4),

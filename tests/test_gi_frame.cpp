@@ -108,6 +108,19 @@ TEST_CASE("gi.frame: NaN/Inf heights, a bad cell size or sub-sampling throw Inpu
     GiState fresh;
     runGiFrame(h.cview(), 1.0f, sunSkyAndKey(), ok, fresh);
     CHECK(sameOutputs(st, fresh));
+    // incremental frames check the heights that differ from the recorded
+    // ones: a bad height is caught alone, beside other changes and with a
+    // new cell size, and the state is still usable after it
+    for (float bad : {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+        Grid g = h;
+        g(3, 2) = bad;
+        CHECK_THROWS_AS(runGiFrame(g.cview(), 1.0f, sunSkyAndKey(), ok, st), InputError);
+        g(20, 17) += 1.0f;
+        CHECK_THROWS_AS(runGiFrame(g.cview(), 1.0f, sunSkyAndKey(), ok, st), InputError);
+        CHECK_THROWS_AS(runGiFrame(g.cview(), 2.0f, sunSkyAndKey(), ok, st), InputError);
+    }
+    runGiFrame(h.cview(), 1.0f, sunSkyAndKey(), ok, st);
+    CHECK(sameOutputs(st, fresh));
 }
 
 TEST_CASE(
