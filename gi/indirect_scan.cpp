@@ -88,6 +88,12 @@ void IndirectScan::buildPyramid(const BounceSource& source, const RadiancePyrami
 
 void IndirectScan::buildStepTable() {
     if (moments_ == CastingMoments::GlossyNlp) return buildGlossyStepTable();
+    // the tables are a function of the pyramids' layout and the azimuths
+    // (StepTableKey): kept while those are the same, across frames
+    std::vector<StepTableKey> key{stepTableKey(in_.heights, in_.op.phi, pad_)};
+    for (const HeightPyramid& f : st_.radiance.fields) key.push_back(stepTableKey(f, in_.op.phi, pad_));
+    if (key == st_.radianceTableKey) return;
+    st_.radianceTableKey.clear();  // not valid until built
     const auto channelSteps = [&](int i, double c, double sn, std::size_t at, ValidPrefix& prefix) {
         for (int ch = 0; ch < 3; ++ch) {
             const ScanStepInfo r = scanStepInfo(st_.radiance.fields[static_cast<std::size_t>(ch)], i, c, sn);
@@ -97,10 +103,12 @@ void IndirectScan::buildStepTable() {
     };
     buildIndirectStepTable(in_.heights, in_.op.phi, pad_, st_.heightSteps, st_.stepsPerColumn, st_.stepsPerRow,
                            channelSteps);
+    st_.radianceTableKey = std::move(key);
 }
 
 // The exit-radiance planes' steps (IndirectState::glossy's pyramid).
 void IndirectScan::buildGlossyStepTable() {
+    st_.radianceTableKey.clear();  // the height tables are the glossy planes' now
     GlossyIndirectState& gs = st_.glossy;
     gi::buildGlossyStepTable(in_.heights, gs.pyramid, in_.op.phi, pad_, st_.heightSteps, st_.stepsPerColumn,
                              st_.stepsPerRow, gs.steps, gs.fields);

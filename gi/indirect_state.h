@@ -45,6 +45,9 @@ struct IndirectState {
     std::vector<ScanStep> heightSteps;    // azimuths x steps
     std::vector<ScanStep> radianceSteps;  // RGB pyramids: channels x azimuths x steps
     std::vector<int> stepsPerColumn, stepsPerRow;
+    // what the RGB pyramids' tables above were built for (the height
+    // pyramid's key, then each channel's); empty: not those tables
+    std::vector<StepTableKey> radianceTableKey;
     std::vector<std::uint8_t> distanceGroups;  // per step (gi/pyramid.h, distanceGroup)
     DirtySpans spans;                          // the receiver columns to scan, per row
     std::vector<float> topOfRows;              // per block of raw-phase rows: its highest height (fieldTopHeight)

@@ -475,35 +475,12 @@ void buildAzimuthSteps(const HeightPyramid& pyr, int j, double c, double sn, int
     }
 }
 
-StepTableKey stepTableKey(const HeightPyramid& pyr, const FoldedWedgeOperator& op, int nxrPad) {
-    StepTableKey k{.phi = op.phi,
-                   .nxrPad = nxrPad,
-                   .nx = pyr.nx,
-                   .ny = pyr.ny,
-                   .nxr = pyr.nxr,
-                   .nyr = pyr.nyr,
-                   .subsample = pyr.subsample,
-                   .cellSize = pyr.cellSize,
-                   .raw = pyr.rawPhaseData(),
-                   .rawWidth = pyr.rawPhaseWidth,
-                   .rawPlane = pyr.rawPhasePlane};
-    for (const PyramidStep& ps : pyr.steps) {
-        k.tauCells.push_back(ps.tauCells);
-        k.stepLevels.push_back(ps.level);
-    }
-    for (const PaddedField& f : pyr.levels) {
-        k.levelData.push_back(f.data());
-        k.levelStrides.push_back(f.stride);
-    }
-    return k;
-}
-
 // The step tables of every azimuth of op, and each azimuth's cos and sin in
 // float, into state.tables.front(): the kept tables of the same key when
 // there are (they are a function of it alone), else built anew in place of
 // the least recently used.
 void buildStepTables(const HeightPyramid& pyr, const FoldedWedgeOperator& op, int nxrPad, VisibilityState& state) {
-    StepTableKey key = stepTableKey(pyr, op, nxrPad);
+    StepTableKey key = stepTableKey(pyr, op.phi, nxrPad);
     std::vector<StepTables>& kept = state.tables;
     // the front is the most recently used
     auto found = std::find_if(kept.begin(), kept.end(), [&](const StepTables& t) { return t.key == key; });
@@ -681,6 +658,29 @@ void computeFootprintBox(ConstGridView gradX, ConstGridView gradY, int s, Footpr
             }
         }
     });
+}
+
+StepTableKey stepTableKey(const HeightPyramid& pyr, const std::vector<double>& phi, int nxrPad) {
+    StepTableKey k{.phi = phi,
+                   .nxrPad = nxrPad,
+                   .nx = pyr.nx,
+                   .ny = pyr.ny,
+                   .nxr = pyr.nxr,
+                   .nyr = pyr.nyr,
+                   .subsample = pyr.subsample,
+                   .cellSize = pyr.cellSize,
+                   .raw = pyr.rawPhaseData(),
+                   .rawWidth = pyr.rawPhaseWidth,
+                   .rawPlane = pyr.rawPhasePlane};
+    for (const PyramidStep& ps : pyr.steps) {
+        k.tauCells.push_back(ps.tauCells);
+        k.stepLevels.push_back(ps.level);
+    }
+    for (const PaddedField& f : pyr.levels) {
+        k.levelData.push_back(f.data());
+        k.levelStrides.push_back(f.stride);
+    }
+    return k;
 }
 
 ScanStepInfo scanStepInfo(const HeightPyramid& pyr, int i, double cosPhi, double sinPhi) {

@@ -169,6 +169,10 @@ struct StepTableKey {
     bool operator==(const StepTableKey&) const = default;
 };
 
+/// The key of a scan over `pyr` along the azimuths `phi` (radians) with
+/// receiver rows padded to nxrPad.
+StepTableKey stepTableKey(const HeightPyramid& pyr, const std::vector<double>& phi, int nxrPad);
+
 /// One scan's step tables (computeVisibility).
 struct StepTables {
     StepTableKey key;
