@@ -459,7 +459,7 @@ GeometryPlan planGeometry(ConstGridView heights, const GiLighting& lighting, con
     if (plan.tiled) {
         VisibilityCache& cache = st.visibilityCache;
         planVisibilityTiles(st.lastInputs.heights.cview(), heights, st.pyramid, settings.visibility,
-                            keyLightRegions(lighting, settings), settings.tolerance, cache);
+                            keyLightRegions(lighting, settings), settings.tolerance, cache, change.heightBox);
         plan.withinTolerance =
             cache.tiles.dirtyCount() == 0 && cache.keyTiles.dirtyCount() == 0 && cache.geometryTiles.dirtyCount() == 0;
     }

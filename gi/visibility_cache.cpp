@@ -13,6 +13,7 @@ void resetVisibilityCache(const HeightPyramid& pyr, ConstGridView heights, Visib
     cache.keyDrift.reset(cache.tiles.dirty.size());
     cache.geometryDrift.reset(cache.tiles.dirty.size());
     copyGrid(heights, cache.anchorHeights);
+    cache.anchorDiffers = CellBox{};  // the next plan compares every cell once
 }
 
 void forgetEnvironmentDrift(VisibilityCache& cache) { cache.drift.recomputedAll(); }
@@ -53,13 +54,18 @@ bool planKeyBrightness(const std::vector<KeyLightRegion>& keys, float tolerance,
 
 void planVisibilityTiles(ConstGridView before, ConstGridView after, const HeightPyramid& pyr,
                          const VisibilitySettings& vis, const std::vector<KeyLightRegion>& keys, float tolerance,
-                         VisibilityCache& cache) {
+                         VisibilityCache& cache, CellBox sinceBefore) {
     if (cache.tiles.nxr != pyr.nxr || cache.tiles.nyr != pyr.nyr || !cache.drift.fits(cache.tiles.dirty.size()) ||
         cache.anchorHeights.nx != after.nx || cache.anchorHeights.ny != after.ny)
         resetVisibilityCache(pyr, before, cache);
     // outside the cells that differ from the anchor's, |dh| is 0 (and the
-    // anchor's rows the same as this frame's)
-    const CellBox differing = differingCells(cache.anchorHeights.cview(), after);
+    // anchor's rows the same as this frame's); they lie where the anchor
+    // differs from `before` or `before` from `after`
+    const CellBox mayDiffer = cache.anchorDiffers.joined(sinceBefore).cut(after.nx, after.ny);
+    CellBox differing = differingCells(subView(cache.anchorHeights.cview(), mayDiffer), subView(after, mayDiffer));
+    if (!differing.empty())
+        differing = {differing.x0 + mayDiffer.x0, differing.y0 + mayDiffer.y0, differing.x1 + mayDiffer.x0,
+                     differing.y1 + mayDiffer.y0};
     buildMaxChangePyramid(cache.anchorHeights.cview(), after, cache.change, differing);
     boundSlopeChange(cache.change, pyr, kVisibilityTile, cache.slopeBound);
     boundSlopeChangePerAzimuth(cache.change, pyr, kVisibilityTile, vis.azimuths, cache.azimuthBound);
@@ -91,7 +97,11 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
     advanceAnchoredDrift(cache.envBound, cache.tiles.dirty, reanchor, cache.drift);
     advanceAnchoredDrift(cache.keyBound, cache.keyTiles.dirty, reanchor, cache.keyDrift);
     advanceAnchoredDrift(cache.geometryBound, cache.geometryTiles.dirty, reanchor, cache.geometryDrift);
+    // the anchor becomes `after`, which differs from `before` within
+    // sinceBefore; else it differs from `before` and from `after` (the
+    // next plan's `before`, if this frame is recorded) within mayDiffer
     if (reanchor) copyGrid(after, cache.anchorHeights, differing.rows());
+    cache.anchorDiffers = reanchor ? sinceBefore : mayDiffer;
     const int all = static_cast<int>(tiles);
     // the indirect light re-gathers the geometry's dirty tiles: both count
     countAfterPlan(std::min(cache.tiles.dirtyCount(), cache.geometryTiles.dirtyCount()), all, cache.skips);

@@ -58,6 +58,7 @@ struct KeyLightRegion {
 
 struct VisibilityCache {
     Grid anchorHeights;                        // the heights the drifts are measured from
+    CellBox anchorDiffers;                     // holds every cell where they may differ from the last plan's (all)
     MaxChangePyramid change;                   // |dh| from the anchor to this frame
     std::vector<float> slopeBound, gradBound;  // this frame's bounds per tile (all azimuths)
     std::vector<float> azimuthBound;           // per tile and environment azimuth (tile-major)
@@ -99,9 +100,11 @@ void forgetEnvironmentDrift(VisibilityCache& cache);
 /// (`vis`: its azimuths and maximum rule), cache.keyTiles for the key lights'
 /// (one region per light; none: no key tile), cache.geometryTiles over every
 /// azimuth. `before`: the last frame's heights, the anchor when the cache
-/// starts afresh (no drift of this grid). `pyr` is the pyramid of `after`.
+/// starts afresh (no drift of this grid); `sinceBefore` holds every cell
+/// where `after` differs from them (every cell by default). `pyr` is the
+/// pyramid of `after`.
 void planVisibilityTiles(ConstGridView before, ConstGridView after, const HeightPyramid& pyr,
                          const VisibilitySettings& vis, const std::vector<KeyLightRegion>& keys, float tolerance,
-                         VisibilityCache& cache);
+                         VisibilityCache& cache, CellBox sinceBefore = {});
 
 }  // namespace terrain::gi
