@@ -565,16 +565,9 @@ float maxChangeAll(const MaxChangePyramid& p) {
 }
 
 double levelReachCells(const HeightPyramid& pyr, int level) {
-    // the octaves blendLevels reads for this level (gi/pyramid.cpp)
-    const int kv = std::max(1, pyr.settings.levelsPerOctave);
-    const int nOctaves = pyr.octaves;
-    int o = level / kv;
-    bool blended = level % kv != 0;
-    if (o >= nOctaves - 1) {
-        o = nOctaves - 1;
-        blended = false;
-    }
-    return octaveReach(blended ? o + 1 : o);
+    // the coarser of the octaves blendLevels reads for this level (gi/pyramid.cpp)
+    const LevelOctaves lo = levelOctaves(pyr, level);
+    return octaveReach(lo.q > 0.0f ? lo.octave + 1 : lo.octave);
 }
 
 std::vector<float> stepReachCells(const HeightPyramid& pyr) {

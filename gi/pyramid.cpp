@@ -40,6 +40,13 @@ auto& octaveField(Pyramid& p, int o) {
 
 const PaddedField& octaveSynthesis(const HeightPyramid& p, int o) { return octaveField(p, o); }
 
+LevelOctaves levelOctaves(const HeightPyramid& p, int level) {
+    const int kv = std::max(1, p.settings.levelsPerOctave);
+    LevelOctaves out{level / kv, static_cast<float>(level % kv) / static_cast<float>(kv)};
+    if (out.octave >= p.octaves - 1) out = {p.octaves - 1, 0.0f};
+    return out;
+}
+
 int distanceGroup(double tauCells) {
     int g = 0;
     for (double edge = 4.0; g + 1 < kDistanceGroups && tauCells >= edge; edge *= 2.0) ++g;
@@ -107,13 +114,18 @@ RowSpan receiversReading(const int* taps, int receivers, int t0, int t1) {
     return {r0, r1};
 }
 
-// Taps of the B-spline synthesis of octave o (spacing 2^o) at receiver
-// positions s * X (full-resolution cell centres at integers; octave texel k
-// is centred at (k + 0.5) 2^o - 0.5).
+// Receiver X's position in octave o's texels (spacing 2^o): receivers sit
+// at cells s * X (full-resolution cell centres at integers), octave texel k
+// is centred at (k + 0.5) 2^o - 0.5. Its B-spline taps are floor(u) - 1 ..
+// floor(u) + 2.
+double synthesisCoordinate(int X, int subsample, int octave) {
+    return (subsample * X + 0.5) / std::ldexp(1.0, octave) - 0.5;
+}
+
+// Taps of the B-spline synthesis of octave o at the receivers.
 void synthesisTaps(int receivers, int subsample, int octave, int octaveSize, int* index, float* weight) {
-    const double scale = std::ldexp(1.0, octave);
     for (int X = 0; X < receivers; ++X) {
-        const double u = (subsample * X + 0.5) / scale - 0.5;
+        const double u = synthesisCoordinate(X, subsample, octave);
         const double k0 = std::floor(u);
         bsplineWeights(static_cast<float>(u - k0), weight + 4 * X);
         for (int k = 0; k < 4; ++k) index[4 * X + k] = std::clamp(static_cast<int>(k0) - 1 + k, 0, octaveSize - 1);
@@ -419,6 +431,11 @@ void buildHeightPyramid(ConstGridView heights, float cellSize, int subsample, co
     decimateOctaves(heights, nOctaves, withMax, octaveChanges, p);
     const std::vector<CellBox> receivers = synthesiseOctaves(heights, octaveChanges, nLevels, nOctaves, withMax, p);
     blendLevels(nLevels, nOctaves, kv, receivers, p);
+}
+
+RowSpan synthesisTexels(const HeightPyramid& p, int octave, int size, int r0, int r1) {
+    const auto first = [&](int X) { return static_cast<int>(std::floor(synthesisCoordinate(X, p.subsample, octave))); };
+    return {std::clamp(first(r0) - 1, 0, size - 1), std::clamp(first(r1) + 2, 0, size - 1) + 1};
 }
 
 }  // namespace terrain::gi

@@ -146,6 +146,20 @@ int pyramidStepCount(int nx, int ny, int levelsPerOctave);
 /// field of its own.
 const PaddedField& octaveSynthesis(const HeightPyramid& pyramid, int o);
 
+/// The octaves a level blends (gi/pyramid.cpp, blendLevels): f_l = (1 - q)
+/// S_o + q S_(o+1), q = 0 where it is S_o alone (levels past the last octave
+/// repeat it).
+struct LevelOctaves {
+    int octave = 0;
+    float q = 0.0f;
+};
+LevelOctaves levelOctaves(const HeightPyramid& pyramid, int level);
+
+/// The texels [y0, y1) of octave o's image B_o (o >= 1; `size` texels along
+/// the axis) that the B-spline synthesis at the receivers [r0, r1] of that
+/// axis reads: each receiver's four taps, clamped to the image.
+RowSpan synthesisTexels(const HeightPyramid& pyramid, int octave, int size, int r0, int r1);
+
 /// Builds (or rebuilds, reusing every buffer) the pyramid of `heights`.
 /// With `changed`, when `out` holds the pyramid of heights that differ only
 /// inside that box of cells on the same grid and settings: the passes that

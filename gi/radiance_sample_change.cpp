@@ -15,6 +15,12 @@ namespace {
 
 int levelCount(const RadiancePyramid& p) { return p.fields.empty() ? 0 : static_cast<int>(p.fields[0].levels.size()); }
 
+// The levels compared texel by texel: those below octave `from`.
+int exactLevelCount(const HeightPyramid& f, int from) {
+    const int kv = std::max(1, f.settings.levelsPerOctave);
+    return std::clamp(kv * from, 0, static_cast<int>(f.levels.size()));
+}
+
 // The level texels (receivers, half-open) that may differ where the
 // radiance changed only inside `changed`: its receivers within the level's
 // reach, one more on each side (the receiver of a cell rounds either way).
@@ -33,38 +39,55 @@ ConstGridView levelView(const PaddedField& f) { return {f.data(), f.nx, f.ny, f.
 }  // namespace
 
 bool RadianceLevelChange::fits(const RadiancePyramid& p) const {
-    return p.fields.size() == 3 && levelCount(p) == levels && p.fields[0].nxr == nxr && p.fields[0].nyr == nyr &&
-           anchor.size() == static_cast<std::size_t>(3 * levels);
+    if (p.fields.size() != 3 || levelCount(p) != levels) return false;
+    const HeightPyramid& f = p.fields[0];
+    return f.nxr == nxr && f.nyr == nyr && exactLevels == exactLevelCount(f, octaveBoundFrom) &&
+           anchor.size() == static_cast<std::size_t>(3 * exactLevels) && f.octaves == octaves &&
+           anchorOctaves.size() == static_cast<std::size_t>(3 * (octaves - firstOctave));
 }
 
 void recordAnchorLevels(const RadiancePyramid& p, RadianceLevelChange& out, CellBox changed) {
     if (!out.fits(p)) {
         changed = {};
         out.levels = levelCount(p);
-        out.nxr = p.fields.empty() ? 0 : p.fields[0].nxr;
-        out.nyr = p.fields.empty() ? 0 : p.fields[0].nyr;
-        out.anchor.resize(static_cast<std::size_t>(3 * out.levels));
+        const HeightPyramid* f = p.fields.empty() ? nullptr : &p.fields[0];
+        out.nxr = f ? f->nxr : 0;
+        out.nyr = f ? f->nyr : 0;
+        out.exactLevels = f ? exactLevelCount(*f, out.octaveBoundFrom) : 0;
+        out.anchor.resize(static_cast<std::size_t>(3 * out.exactLevels));
         out.change.clear();
+        out.octaves = f ? f->octaves : 0;
+        out.firstOctave = f && out.exactLevels < out.levels ? levelOctaves(*f, out.exactLevels).octave : out.octaves;
+        out.anchorOctaves.resize(static_cast<std::size_t>(3 * (out.octaves - out.firstOctave)));
+        out.octaveChange.clear();
     }
-    for (int c = 0; c < 3 && out.levels > 0; ++c)
-        for (int l = 0; l < out.levels; ++l) {
-            const HeightPyramid& f = p.fields[static_cast<std::size_t>(c)];
+    const int kept = out.octaves - out.firstOctave;
+    for (int c = 0; c < 3 && out.levels > 0; ++c) {
+        const HeightPyramid& f = p.fields[static_cast<std::size_t>(c)];
+        for (int l = 0; l < out.exactLevels; ++l) {
             const CellBox box = levelBox(f, l, changed);
             copyGrid(levelView(f.levels[static_cast<std::size_t>(l)]),
-                     out.anchor[static_cast<std::size_t>(c * out.levels + l)], box.rows());
+                     out.anchor[static_cast<std::size_t>(c * out.exactLevels + l)], box.rows());
         }
+        for (int o = out.firstOctave; o < out.octaves; ++o)  // a few texels: whole
+            copyGrid(f.meanOctaves[static_cast<std::size_t>(o - 1)].cview(),
+                     out.anchorOctaves[static_cast<std::size_t>(c * kept + o - out.firstOctave)]);
+    }
 }
 
 void buildLevelChanges(const RadiancePyramid& now, CellBox changed, RadianceLevelChange& out) {
     if (!out.fits(now)) throw InputError("radiance sample change: the pyramid is not of the anchor's grid");
     // no block sums: the sample bounds read maxima alone
-    out.change.resize(static_cast<std::size_t>(out.levels), MaxChangePyramid{.withSums = false});
+    out.change.resize(static_cast<std::size_t>(out.exactLevels), MaxChangePyramid{.withSums = false});
+    const int kept = out.octaves - out.firstOctave;
+    out.octaveChange.resize(static_cast<std::size_t>(kept), MaxChangePyramid{.withSums = false});
     // the levels side by side (each build's own passes are parallel too)
-    parallelFor(0, out.levels, 1, [&](int l0, int l1) {
+    parallelFor(0, out.exactLevels, 1, [&](int l0, int l1) {
         for (int l = l0; l < l1; ++l) {
             std::array<ConstGridView, 3> before, after;
             for (std::size_t c = 0; c < 3; ++c) {
-                before[c] = out.anchor[c * static_cast<std::size_t>(out.levels) + static_cast<std::size_t>(l)].cview();
+                before[c] =
+                    out.anchor[c * static_cast<std::size_t>(out.exactLevels) + static_cast<std::size_t>(l)].cview();
                 after[c] = levelView(now.fields[c].levels[static_cast<std::size_t>(l)]);
             }
             // an empty box still redoes the last build's changed cells, which may now be 0
@@ -72,6 +95,20 @@ void buildLevelChanges(const RadiancePyramid& now, CellBox changed, RadianceLeve
                                   levelBox(now.fields[0], l, changed));
         }
     });
+    // B_o differs from the anchor's only in the texels that decimate a changed cell
+    CellBox box = changed.cut(now.fields[0].nx, now.fields[0].ny);
+    for (int o = 1; o < out.octaves; ++o) {
+        box = box.halved();
+        if (o < out.firstOctave) continue;
+        std::array<ConstGridView, 3> before, after;
+        for (std::size_t c = 0; c < 3; ++c) {
+            before[c] =
+                out.anchorOctaves[c * static_cast<std::size_t>(kept) + static_cast<std::size_t>(o - out.firstOctave)]
+                    .cview();
+            after[c] = now.fields[c].meanOctaves[static_cast<std::size_t>(o - 1)].cview();
+        }
+        buildMaxChangePyramid(before, after, out.octaveChange[static_cast<std::size_t>(o - out.firstOctave)], box);
+    }
 }
 
 namespace {
@@ -101,6 +138,33 @@ float tapsChange(const MaxChangePyramid& field, int k, const ScanStepInfo& si, i
     return std::max(above, std::min(std::max(a, b), (wa > 0.0f && a > 0.0f) || (wb > 0.0f && b > 0.0f) ? blend : 0.0f));
 }
 
+// The same for a level bounded through its octaves (RadianceLevelChange::
+// exactLevels): every texel the receivers' two taps read lies in the box of
+// level texels from tap a's to tap b's, where the level is (1 - q) S_o + q
+// S_(o+1); a texel of S_o is a combination of the octave image's texels its
+// B-spline taps read, with non-negative weights summing to 1, so it moved
+// by at most the largest move A_o of those texels, and the sample by at
+// most (1 - q) A_o + q A_(o+1).
+float octaveTapsChange(const RadianceLevelChange& lc, const HeightPyramid& field, int level, const ScanStepInfo& si,
+                       int X0, int Y0, int X1, int Y1, float above) {
+    const int xa = std::clamp(X0 + si.tapX + std::min(0, si.nextX), 0, field.nxr - 1);
+    const int xb = std::clamp(X1 + si.tapX + std::max(0, si.nextX), 0, field.nxr - 1);
+    const int ya = std::clamp(Y0 + si.tapY + std::min(0, si.nextY), 0, field.nyr - 1);
+    const int yb = std::clamp(Y1 + si.tapY + std::max(0, si.nextY), 0, field.nyr - 1);
+    const LevelOctaves lo = levelOctaves(field, level);
+    const auto octaveMove = [&](int o) {
+        const MaxChangePyramid& c = lc.octaveChange[static_cast<std::size_t>(o - lc.firstOctave)];
+        const RowSpan tx = synthesisTexels(field, o, c.nx, xa, xb), ty = synthesisTexels(field, o, c.ny, ya, yb);
+        return maxChangeCoveringBox(c, tx.y0, ty.y0, tx.y1 - 1, ty.y1 - 1);
+    };
+    const float a = octaveMove(lo.octave), b = lo.q > 0.0f ? octaveMove(lo.octave + 1) : 0.0f;
+    if (std::max(a, b) <= above) return above;
+    // rounded up, and never 0 where a read texel moved
+    const float blend =
+        lo.q > 0.0f ? std::nextafter((1.0f - lo.q) * a + lo.q * b, std::numeric_limits<float>::infinity()) : a;
+    return std::max(above, std::min(std::max(a, b), blend));
+}
+
 }  // namespace
 
 void boundSampleChangeFromLevels(const MaxChangePyramid& raw, const RadianceLevelChange& levels,
@@ -109,7 +173,8 @@ void boundSampleChangeFromLevels(const MaxChangePyramid& raw, const RadianceLeve
     const int T = tileReceivers, m = static_cast<int>(phi.size()), nSteps = static_cast<int>(field.steps.size());
     if (T < 1 || m < 1) throw InputError("radiance sample change: tiles and azimuths must be at least 1");
     if (raw.nx != field.nx || raw.ny != field.ny || levels.nxr != field.nxr || levels.nyr != field.nyr ||
-        static_cast<int>(levels.change.size()) != levels.levels ||
+        static_cast<int>(levels.change.size()) != levels.exactLevels ||
+        static_cast<int>(levels.octaveChange.size()) != levels.octaves - levels.firstOctave ||
         levels.levels != static_cast<int>(field.levels.size()))
         throw InputError("radiance sample change: the changes and the pyramid differ in size");
     const int tilesX = tileCount(field.nxr, T), tilesY = tileCount(field.nyr, T);
@@ -144,8 +209,10 @@ void boundSampleChangeFromLevels(const MaxChangePyramid& raw, const RadianceLeve
                         const float above = std::min(az, gr);
                         const int level = field.steps[static_cast<std::size_t>(i)].level;
                         const float d = level < 0 ? tapsChange(raw, field.subsample, si, x0, y0, x1, y1, above)
-                                                  : tapsChange(levels.change[static_cast<std::size_t>(level)], 1, si,
-                                                               x0, y0, x1, y1, above);
+                                        : level < levels.exactLevels
+                                            ? tapsChange(levels.change[static_cast<std::size_t>(level)], 1, si, x0, y0,
+                                                         x1, y1, above)
+                                            : octaveTapsChange(levels, field, level, si, x0, y0, x1, y1, above);
                         az = std::max(az, d);
                         gr = std::max(gr, d);
                     }

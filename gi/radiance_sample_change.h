@@ -18,6 +18,10 @@
 // moved. The price is the anchor's pyramid levels, kept beside the anchor's
 // radiance (3 channels x levels x receivers floats).
 //
+// The coarse levels (from kOctaveBoundFrom on) are the exception: their
+// change is bounded through the octave images B_o they synthesise, kept
+// beside the anchor's radiance in place of those levels (below).
+//
 // A level texel reads the radiance within the reach of its octaves' B-spline
 // synthesis (gi/change_bound.h, levelReachCells: R_o = 2.5 2^o - 0.5 cells
 // for octave o, the coarser octave of a blended level), so where the
@@ -33,11 +37,30 @@
 
 namespace terrain::gi {
 
-/// The anchor's pyramid levels and this frame's change of each level.
+/// The levels from this octave on are bounded through their octave images
+/// (below): their reach spans most of the field (2.5 2^o cells), so any
+/// change makes the whole level differ from the anchor's and comparing them
+/// texel by texel was most of a local change's plan, where B_o holds 4^-o
+/// as many texels as the field. The finer levels, whose samples near
+/// receivers read, are compared texel by texel. Chosen by the re-gathered
+/// shares of the incremental suite's cases (README).
+inline constexpr int kOctaveBoundFrom = 4;
+
+/// The anchor's pyramid levels and this frame's change of each level: the
+/// finer levels texel by texel, the levels from exactLevels on through the
+/// octave images they synthesise: a level texel is (1 - q) S_o + q S_(o+1),
+/// and a texel of S_o a combination of B_o's texels under its B-spline taps
+/// with non-negative weights summing to 1, so it moves by at most the
+/// largest move of those texels.
 struct RadianceLevelChange {
+    int octaveBoundFrom = kOctaveBoundFrom;  // set before the first recordAnchorLevels
     int levels = 0, nxr = 0, nyr = 0;
-    std::vector<Grid> anchor;              // channel c's level l at [c * levels + l] (nxr x nyr, no padding)
-    std::vector<MaxChangePyramid> change;  // per level: max over the channels of |level - anchor|, rounded up
+    int exactLevels = 0;                   // levels [0, exactLevels) compared texel by texel
+    std::vector<Grid> anchor;              // channel c's level l at [c * exactLevels + l] (nxr x nyr, no padding)
+    std::vector<MaxChangePyramid> change;  // per exact level: max over the channels of |level - anchor|, rounded up
+    int firstOctave = 0, octaves = 0;      // the octave images [firstOctave, octaves) the other levels read
+    std::vector<Grid> anchorOctaves;       // channel c's B_o at [c * (octaves - firstOctave) + o - firstOctave]
+    std::vector<MaxChangePyramid> octaveChange;  // per such octave: max over the channels of |B_o - anchor's|
     bool fits(const RadiancePyramid& p) const;
 };
 

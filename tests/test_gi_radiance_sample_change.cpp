@@ -71,55 +71,63 @@ TEST_CASE("gi.radiance_sample_change: every sample the scan reads moves by at mo
             RadiancePyramid before, now;
             buildRadiancePyramid(base, heights, RadiancePyramidSettings{}, before);
             buildRadiancePyramid(after, heights, RadiancePyramidSettings{}, now);
-            RadianceLevelChange levels;
-            recordAnchorLevels(before, levels);
-            buildLevelChanges(now, CellBox{}, levels);
-            MaxChangePyramid raw;
-            buildMaxChangePyramid(dL.cview(), raw);
-            const FoldedWedgeOperator op = foldFullCircle(8, AzimuthInterp::Linear);
-            constexpr int T = 16;
-            std::vector<float> tileBound, groupBound;
-            boundSampleChangeFromLevels(raw, levels, now.fields[0], T, op.phi, tileBound, groupBound);
-            const int tilesX = tileCount(heights.nxr, T), m = op.azimuths;
-            // every receiver's every sample, every channel: the true move
-            double worst = 0.0, excess = 0.0;
-            std::vector<float> trueTile(tileBound.size(), 0.0f);
-            for (int j = 0; j < m; ++j) {
-                const double c = std::cos(op.phi[static_cast<std::size_t>(j)]);
-                const double sn = std::sin(op.phi[static_cast<std::size_t>(j)]);
-                for (int i = 0; i < static_cast<int>(heights.steps.size()); ++i) {
-                    const ScanStepInfo si = scanStepInfo(now.fields[0], i, c, sn);
-                    for (int Y = si.yFirst; Y <= si.yLast; ++Y)
-                        for (int X = si.xFirst; X <= si.xLast; ++X) {
-                            const std::size_t t = static_cast<std::size_t>(Y / T) * tilesX + X / T;
-                            const float bound = tileBound[t * m + static_cast<std::size_t>(j)];
-                            const float group = groupBound[t * kDistanceGroups +
-                                                           static_cast<std::size_t>(distanceGroup(
-                                                               heights.steps[static_cast<std::size_t>(i)].tauCells))];
-                            for (std::size_t ch = 0; ch < 3; ++ch) {
-                                const double d =
-                                    std::fabs(static_cast<double>(sampleOf(now.fields[ch], i, c, sn, X, Y)) -
-                                              sampleOf(before.fields[ch], i, c, sn, X, Y));
-                                excess = std::max(excess, d - std::min(bound, group) * (1.0 + 1e-6));
-                                if (bound > 0.0f) worst = std::max(worst, d / bound);
-                                float& tt = trueTile[t * m + static_cast<std::size_t>(j)];
-                                tt = std::max(tt, static_cast<float>(d));
+            // the engine's split, and every level bounded through its octave images
+            for (int from : {kOctaveBoundFrom, 1}) {
+                CAPTURE(from);
+                RadianceLevelChange levels;
+                levels.octaveBoundFrom = from;
+                recordAnchorLevels(before, levels);
+                buildLevelChanges(now, CellBox{}, levels);
+                if (from == 1) REQUIRE(levels.firstOctave == 1);  // all but octave 0
+                MaxChangePyramid raw;
+                buildMaxChangePyramid(dL.cview(), raw);
+                const FoldedWedgeOperator op = foldFullCircle(8, AzimuthInterp::Linear);
+                constexpr int T = 16;
+                std::vector<float> tileBound, groupBound;
+                boundSampleChangeFromLevels(raw, levels, now.fields[0], T, op.phi, tileBound, groupBound);
+                const int tilesX = tileCount(heights.nxr, T), m = op.azimuths;
+                // every receiver's every sample, every channel: the true move
+                double worst = 0.0, excess = 0.0;
+                std::vector<float> trueTile(tileBound.size(), 0.0f);
+                for (int j = 0; j < m; ++j) {
+                    const double c = std::cos(op.phi[static_cast<std::size_t>(j)]);
+                    const double sn = std::sin(op.phi[static_cast<std::size_t>(j)]);
+                    for (int i = 0; i < static_cast<int>(heights.steps.size()); ++i) {
+                        const ScanStepInfo si = scanStepInfo(now.fields[0], i, c, sn);
+                        for (int Y = si.yFirst; Y <= si.yLast; ++Y)
+                            for (int X = si.xFirst; X <= si.xLast; ++X) {
+                                const std::size_t t = static_cast<std::size_t>(Y / T) * tilesX + X / T;
+                                const float bound = tileBound[t * m + static_cast<std::size_t>(j)];
+                                const float group =
+                                    groupBound[t * kDistanceGroups +
+                                               static_cast<std::size_t>(
+                                                   distanceGroup(heights.steps[static_cast<std::size_t>(i)].tauCells))];
+                                for (std::size_t ch = 0; ch < 3; ++ch) {
+                                    const double d =
+                                        std::fabs(static_cast<double>(sampleOf(now.fields[ch], i, c, sn, X, Y)) -
+                                                  sampleOf(before.fields[ch], i, c, sn, X, Y));
+                                    excess = std::max(excess, d - std::min(bound, group) * (1.0 + 1e-6));
+                                    if (bound > 0.0f) worst = std::max(worst, d / bound);
+                                    float& tt = trueTile[t * m + static_cast<std::size_t>(j)];
+                                    tt = std::max(tt, static_cast<float>(d));
+                                }
                             }
-                        }
+                    }
                 }
+                CHECK(excess <= 0.0);
+                // the bound is the largest texel move the tile's samples read:
+                // never far above the largest true sample move (the two taps'
+                // blend can only lower it)
+                double loosest = 1.0;
+                for (std::size_t k = 0; k < tileBound.size(); ++k)
+                    if (trueTile[k] > 0.0f)
+                        loosest = std::max(loosest, static_cast<double>(tileBound[k] / trueTile[k]));
+                MESSAGE(s << "x, " << caseName << ", octaves from " << from << ": largest sample move / bound " << worst
+                          << ", loosest tile " << loosest);
+                // a local change: some tiles read nothing that moved, and say so
+                if (caseName == "one cell" || caseName == "corner")
+                    CHECK(*std::min_element(tileBound.begin(), tileBound.end()) == 0.0f);
             }
-            CHECK(excess <= 0.0);
-            // the bound is the largest texel move the tile's samples read:
-            // never far above the largest true sample move (the two taps'
-            // blend can only lower it)
-            double loosest = 1.0;
-            for (std::size_t k = 0; k < tileBound.size(); ++k)
-                if (trueTile[k] > 0.0f) loosest = std::max(loosest, static_cast<double>(tileBound[k] / trueTile[k]));
-            MESSAGE(s << "x, " << caseName << ": largest sample move / bound " << worst << ", loosest tile "
-                      << loosest);
-            // a local change: some tiles read nothing that moved, and say so
-            if (caseName == "one cell" || caseName == "corner")
-                CHECK(*std::min_element(tileBound.begin(), tileBound.end()) == 0.0f);
         }
     }
 }
@@ -135,8 +143,12 @@ TEST_CASE("gi.radiance_sample_change: levels compared over a box of changed texe
         RadiancePyramid anchor;
         buildRadiancePyramid(base, heights, RadiancePyramidSettings{}, anchor);
         RadianceLevelChange boxed, whole;
+        // half the levels texel by texel, the others through their octave images
+        boxed.octaveBoundFrom = whole.octaveBoundFrom = 2;
         recordAnchorLevels(anchor, boxed);
         recordAnchorLevels(anchor, whole);
+        REQUIRE(boxed.exactLevels > 0);
+        REQUIRE(boxed.exactLevels < boxed.levels);
         // changes that come and go: each frame's radiance differs from the
         // anchor's only inside the box it names (joined over the frames, as
         // the cache keeps anchorChanged)
@@ -159,6 +171,13 @@ TEST_CASE("gi.radiance_sample_change: levels compared over a box of changed texe
                 CHECK(boxed.change[l].levels[0].v == whole.change[l].levels[0].v);
                 CHECK(maxChangeAll(boxed.change[l]) == maxChangeAll(whole.change[l]));
             }
+            REQUIRE(boxed.octaveChange.size() == whole.octaveChange.size());
+            REQUIRE(!boxed.octaveChange.empty());
+            for (std::size_t o = 0; o < boxed.octaveChange.size(); ++o) {
+                CAPTURE(o);
+                CHECK(boxed.octaveChange[o].levels[0].v == whole.octaveChange[o].levels[0].v);
+                CHECK(maxChangeAll(boxed.octaveChange[o]) > 0.0f);
+            }
         }
         // moving the anchor over a box: the rows that may differ are copied
         std::array<Grid, 3> moved = base;
@@ -166,9 +185,12 @@ TEST_CASE("gi.radiance_sample_change: levels compared over a box of changed texe
         RadiancePyramid movedPyramid;
         buildRadiancePyramid(moved, heights, RadiancePyramidSettings{}, movedPyramid);
         RadianceLevelChange partial = boxed, fresh;
+        fresh.octaveBoundFrom = boxed.octaveBoundFrom;
         recordAnchorLevels(movedPyramid, partial, CellBox{100, 50, 101, 51});
         recordAnchorLevels(movedPyramid, fresh);
         for (std::size_t k = 0; k < fresh.anchor.size(); ++k) CHECK(partial.anchor[k].v == fresh.anchor[k].v);
+        for (std::size_t k = 0; k < fresh.anchorOctaves.size(); ++k)
+            CHECK(partial.anchorOctaves[k].v == fresh.anchorOctaves[k].v);
         // a box that misses the change leaves the old rows: the box is what is copied
         RadianceLevelChange missed = boxed;
         recordAnchorLevels(movedPyramid, missed, CellBox{0, 0, 2, 2});
