@@ -15,10 +15,11 @@ namespace {
 
 int levelCount(const RadiancePyramid& p) { return p.fields.empty() ? 0 : static_cast<int>(p.fields[0].levels.size()); }
 
-// The levels compared texel by texel: those below octave `from`.
+// The levels compared texel by texel: those below octave `from`, and
+// always octave 0's (S_0 is the radiance itself, no octave image).
 int exactLevelCount(const HeightPyramid& f, int from) {
     const int kv = std::max(1, f.settings.levelsPerOctave);
-    return std::clamp(kv * from, 0, static_cast<int>(f.levels.size()));
+    return std::clamp(kv * std::max(1, from), 0, static_cast<int>(f.levels.size()));
 }
 
 // The level texels (receivers, half-open) that may differ where the

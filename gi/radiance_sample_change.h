@@ -53,7 +53,7 @@ inline constexpr int kOctaveBoundFrom = 4;
 /// with non-negative weights summing to 1, so it moves by at most the
 /// largest move of those texels.
 struct RadianceLevelChange {
-    int octaveBoundFrom = kOctaveBoundFrom;  // set before the first recordAnchorLevels
+    int octaveBoundFrom = kOctaveBoundFrom;  // set before the first recordAnchorLevels (1 or more)
     int levels = 0, nxr = 0, nyr = 0;
     int exactLevels = 0;                   // levels [0, exactLevels) compared texel by texel
     std::vector<Grid> anchor;              // channel c's level l at [c * exactLevels + l] (nxr x nyr, no padding)
