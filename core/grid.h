@@ -144,6 +144,11 @@ struct CellBox {
         const RowSpan c = RowSpan{x0, x1}.cut(nx), r = RowSpan{y0, y1}.cut(ny);
         return {c.y0, r.y0, c.y1, r.y1};
     }
+    /// The box moved by (dx, dy) cells (empty stays empty).
+    CellBox shifted(int dx, int dy) const {
+        if (empty()) return none();
+        return {x0 + dx, y0 + dy, x1 + dx, y1 + dy};
+    }
     /// The smallest box holding both (an empty one adds nothing).
     CellBox joined(const CellBox& o) const {
         if (o.empty()) return *this;
@@ -193,6 +198,13 @@ inline CellBox differingCells(ConstGridView a, ConstGridView b) {
         }
     }
     return {x0, y0, x1, y1};
+}
+
+/// differingCells over the cells of `box` alone (the views of one size), in
+/// the views' coordinates: the cells outside it are known to be equal.
+inline CellBox differingCellsIn(ConstGridView a, ConstGridView b, CellBox box) {
+    box = box.cut(b.nx, b.ny);
+    return differingCells(subView(a, box), subView(b, box)).shifted(box.x0, box.y0);
 }
 
 }  // namespace terrain

@@ -386,10 +386,8 @@ void exactAmbient(ConstGridView heights, float cellSize, const GiSettings& setti
 // of that box's light, taken before the shading redid it); empty when none.
 CellBox changedLight(const std::array<Grid, 3>& before, const std::array<Grid, 3>& now, CellBox box) {
     CellBox out = CellBox::none();
-    for (int c = 0; c < 3; ++c) {
-        const CellBox d = differingCells(before[c].cview(), subView(now[c].cview(), box));
-        if (!d.empty()) out = out.joined({d.x0 + box.x0, d.y0 + box.y0, d.x1 + box.x0, d.y1 + box.y0});
-    }
+    for (int c = 0; c < 3; ++c)
+        out = out.joined(differingCells(before[c].cview(), subView(now[c].cview(), box)).shifted(box.x0, box.y0));
     return out;
 }
 

@@ -366,13 +366,10 @@ std::vector<CellBox> synthesiseOctaves(ConstGridView heights, const std::vector<
 void blendLevels(int nLevels, int nOctaves, int kv, const std::vector<CellBox>& receivers, HeightPyramid& p) {
     const int nxr = p.nxr, nyr = p.nyr;
     for (int l = 0; l < nLevels; ++l) {
-        int o = l / kv;
-        float q = static_cast<float>(l % kv) / static_cast<float>(kv);
-        if (q == 0.0f && o < nOctaves) continue;  // the octave itself, synthesised in place
-        if (o >= nOctaves - 1) {
-            o = nOctaves - 1;
-            q = 0.0f;
-        }
+        const LevelOctaves lo = levelOctaves(p, l);
+        const int o = lo.octave;
+        const float q = lo.q;
+        if (l == o * kv) continue;  // the octave itself, synthesised in place
         PaddedField& lev = p.levels[static_cast<std::size_t>(l)];
         lev.resize(nxr, nyr);
         const PaddedField& a = octaveSynthesis(p, o);

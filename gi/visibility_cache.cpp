@@ -62,10 +62,7 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
     // anchor's rows the same as this frame's); they lie where the anchor
     // differs from `before` or `before` from `after`
     const CellBox mayDiffer = cache.anchorDiffers.joined(sinceBefore).cut(after.nx, after.ny);
-    CellBox differing = differingCells(subView(cache.anchorHeights.cview(), mayDiffer), subView(after, mayDiffer));
-    if (!differing.empty())
-        differing = {differing.x0 + mayDiffer.x0, differing.y0 + mayDiffer.y0, differing.x1 + mayDiffer.x0,
-                     differing.y1 + mayDiffer.y0};
+    const CellBox differing = differingCellsIn(cache.anchorHeights.cview(), after, mayDiffer);
     buildMaxChangePyramid(cache.anchorHeights.cview(), after, cache.change, differing);
     boundSlopeChange(cache.change, pyr, kVisibilityTile, cache.slopeBound);
     boundSlopeChangePerAzimuth(cache.change, pyr, kVisibilityTile, vis.azimuths, cache.azimuthBound);
