@@ -109,19 +109,39 @@ void sortRays(int M, GlossyLobeScratch& sc) {
     for (std::size_t k = 0; k < keys.size(); ++k) sc.sorted[k] = sc.rays[static_cast<std::size_t>(keys[k].index)];
 }
 
-// A met member's exit radiance E (48 planes), read once for all the rays it meets.
+// The exit radiance E (48 planes) where a ray meets the surface.
 struct MemberSamples {
     float e[kPlanes];
 };
 
-// The member at table entry `at` (azimuth j, step i) of receiver (X, Y)'s walk.
-void readMember(const GlossyLobeState& st, std::size_t at, int X, int Y, MemberSamples& m) {
-    const ScanStep& ps = st.planeSteps[at];
-    const std::ptrdiff_t o = Y * ps.rowStep + X, dB = ps.offB - ps.offA;
-    const std::uint16_t* a = st.memberOrigins[at] + o * kPlanes;
-    const std::uint16_t* b = a + dB * kPlanes;
-    const float wa = ps.w[0][0], wb = ps.w[1][0];
-    for (int f = 0; f < kPlanes; ++f) m.e[f] = wa * fromBfloat16(a[f]) + wb * fromBfloat16(b[f]);
+// E at full-resolution position (px, py) in cells, bilinear between the four
+// texels around it (clamped to the field).
+void readExit(const GlossyLobeState& st, int nx, int ny, double px, double py, MemberSamples& m) {
+    const int ix = std::clamp(static_cast<int>(std::floor(px)), 0, std::max(nx - 2, 0));
+    const int iy = std::clamp(static_cast<int>(std::floor(py)), 0, std::max(ny - 2, 0));
+    const float fx = std::clamp(static_cast<float>(px - ix), 0.0f, 1.0f);
+    const float fy = std::clamp(static_cast<float>(py - iy), 0.0f, 1.0f);
+    const std::ptrdiff_t dx = nx > 1 ? kPlanes : 0, dy = ny > 1 ? static_cast<std::ptrdiff_t>(nx) * kPlanes : 0;
+    const std::uint16_t* a = st.exitTexels.data() + (static_cast<std::ptrdiff_t>(iy) * nx + ix) * kPlanes;
+    const float w00 = (1.0f - fx) * (1.0f - fy), w10 = fx * (1.0f - fy), w01 = (1.0f - fx) * fy, w11 = fx * fy;
+    for (int f = 0; f < kPlanes; ++f)
+        m.e[f] = w00 * fromBfloat16(a[f]) + w10 * fromBfloat16(a[f + dx]) + w01 * fromBfloat16(a[f + dy]) +
+                 w11 * fromBfloat16(a[f + dx + dy]);
+}
+
+// Where along its azimuth a ray of slope `slope` meets the surface, in cells
+// from the receiver: between the last step below it (blocking slope tBefore
+// at tauBefore cells) and the first that reaches it (tAfter, tauAfter), where
+// the ray's height above the linearly interpolated samples crosses zero; the
+// sample heights above the ray are (t - slope) tau. Before the first step
+// (tauBefore 0: the ray leaves the surface at the receiver, and nothing says
+// where it rises again) halfway to it.
+double crossingDistance(float tBefore, double tauBefore, float tAfter, double tauAfter, float slope) {
+    if (tauBefore <= 0.0) return 0.5 * tauAfter;
+    const double below = (static_cast<double>(slope) - tBefore) * tauBefore;  // > 0
+    const double above = (static_cast<double>(tAfter) - slope) * tauAfter;    // >= 0
+    const double alpha = below + above > 0.0 ? below / (below + above) : 1.0;
+    return tauBefore + alpha * (tauAfter - tauBefore);
 }
 
 // What the member sends back along `ray`, E . Y(back) (max(0, .) with the
@@ -138,29 +158,39 @@ void addSent(const MemberSamples& m, const GlossyLobeScratch::Ray& ray, bool cla
 }
 
 // Receiver (X, Y)'s rays [begin, end) of one azimuth (sorted by slope):
-// the walk over the steps, each ray brought what its first reaching step
-// sends into its texel's acc (3 per texel).
+// the walk over the steps, each ray brought what the surface sends back
+// where it crosses it, between its first reaching step and the step before,
+// into its texel's acc (3 per texel).
 void walkAzimuth(const GlossyLobeInputs& in, const GlossyLobeState& st, const GlossyLobeScratch::Ray* begin,
                  const GlossyLobeScratch::Ray* end, int X, int Y, float h0, float margin, double* acc) {
-    const int j = begin->azimuth, nSteps = static_cast<int>(in.heights.steps.size());
+    const HeightPyramid& pyr = in.heights;
+    const int j = begin->azimuth, nSteps = static_cast<int>(pyr.steps.size());
     const int pad = static_cast<int>(st.stepsPerColumn.size() / st.phi.size());
-    const int prefix =
-        std::min(st.stepsPerColumn[static_cast<std::size_t>(j) * pad + static_cast<std::size_t>(X)],
-                 st.stepsPerRow[static_cast<std::size_t>(j) * in.heights.nyr + static_cast<std::size_t>(Y)]);
+    const int prefix = std::min(st.stepsPerColumn[static_cast<std::size_t>(j) * pad + static_cast<std::size_t>(X)],
+                                st.stepsPerRow[static_cast<std::size_t>(j) * pyr.nyr + static_cast<std::size_t>(Y)]);
     const std::size_t base = static_cast<std::size_t>(j) * nSteps;
     const float reach = (in.topHeight - h0) - margin;  // the highest rise any sample can have
     const bool clamp = in.shading.positivity == GlossyPositivity::Clamp;
+    const double x0 = static_cast<double>(pyr.subsample) * X, y0 = static_cast<double>(pyr.subsample) * Y;
+    const double c = st.cosPhi[static_cast<std::size_t>(j)], sn = st.sinPhi[static_cast<std::size_t>(j)];
     const GlossyLobeScratch::Ray* next = begin;
     MemberSamples m;
+    float tBefore = 0.0f;    // the last step below every ray left: its blocking slope
+    double tauBefore = 0.0;  // and its distance (cells); 0: none yet
     for (int i = 0; i < prefix && next != end; ++i) {
         const ScanStep& hs = st.heightSteps[base + static_cast<std::size_t>(i)];
         if (reach * hs.w[2][0] < next->slope) break;  // no sample from here on reaches the lowest ray left
         const std::ptrdiff_t o = Y * hs.rowStep + X;
         const float t =
             ((hs.w[0][0] * hs.field[o + hs.offA] + hs.w[1][0] * hs.field[o + hs.offB] - h0) - margin) * hs.w[2][0];
-        if (t < next->slope) continue;
-        readMember(st, base + static_cast<std::size_t>(i), X, Y, m);
-        for (; next != end && next->slope <= t; ++next) addSent(m, *next, clamp, acc);
+        const double tau = st.stepCells[base + static_cast<std::size_t>(i)];
+        for (; next != end && next->slope <= t; ++next) {
+            const double d = crossingDistance(tBefore, tauBefore, t, tau, next->slope);
+            readExit(st, pyr.nx, pyr.ny, x0 + d * c, y0 + d * sn, m);
+            addSent(m, *next, clamp, acc);
+        }
+        tBefore = t;
+        tauBefore = tau;
     }
 }
 
@@ -217,29 +247,23 @@ void gatherRow(const GlossyLobeInputs& in, GlossyLobeState& st, int Y, GlossyLob
     }
 }
 
-// st.members and st.memberOrigins from the exit pyramid: its fields are laid
-// out one after the other with the same regions, so interleaving them is a
-// transpose of a 48 x (one field's length) matrix.
-void interleaveMembers(const PackedPyramids& exit, GlossyLobeState& st) {
-    const std::size_t regions = exit.geometry.levels.size() + 1;
-    const std::size_t length = exit.regionAt[regions] - exit.regionAt[0];
-    st.members.resize(length * kPlanes);
-    const std::uint16_t* block = exit.block.data() + exit.regionAt[0];
+// st.exitTexels from the 48 planes of E: a transpose of a 48 x (nx ny)
+// matrix, rounded to bfloat16 (a ray's E is then 4 runs of 96 bytes).
+void interleaveExit(const float* exit, std::size_t texels, GlossyLobeState& st) {
+    st.exitTexels.resize(texels * kPlanes);
     constexpr int kChunk = 64;
-    const int chunks = static_cast<int>((length + kChunk - 1) / kChunk);
+    const int chunks = static_cast<int>((texels + kChunk - 1) / kChunk);
     parallelFor(0, chunks, 64, [&](int c0, int c1) {
         for (int c = c0; c < c1; ++c) {
             const std::size_t k0 = static_cast<std::size_t>(c) * kChunk;
-            const std::size_t k1 = std::min(length, k0 + kChunk);
+            const std::size_t k1 = std::min(texels, k0 + kChunk);
             for (int f = 0; f < kPlanes; ++f) {
-                const std::uint16_t* src = block + static_cast<std::size_t>(f) * length;
-                for (std::size_t k = k0; k < k1; ++k) st.members[k * kPlanes + static_cast<std::size_t>(f)] = src[k];
+                const float* src = exit + static_cast<std::size_t>(f) * texels;
+                for (std::size_t k = k0; k < k1; ++k)
+                    st.exitTexels[k * kPlanes + static_cast<std::size_t>(f)] = toBfloat16(src[k]);
             }
         }
     });
-    st.memberOrigins.resize(st.planeSteps.size());
-    for (std::size_t at = 0; at < st.memberOrigins.size(); ++at)
-        st.memberOrigins[at] = st.members.data() + (st.planeOrigins[at * kPlanes] - block) * kPlanes;
 }
 
 }  // namespace
@@ -258,13 +282,14 @@ void gatherGlossyLobes(const GlossyLobeInputs& in, GlossyLobeState& st) {
         st.sinPhi[u] = static_cast<float>(std::sin(st.phi[u]));
     }
     st.heightSteps.resize(table);
-    st.planeSteps.resize(table);
-    st.planeOrigins.resize(table * kPlanes);
     st.stepsPerColumn.resize(static_cast<std::size_t>(M) * pad);
     st.stepsPerRow.resize(static_cast<std::size_t>(M) * pyr.nyr);
-    buildGlossyStepTable(pyr, in.exit, st.phi, pad, st.heightSteps, st.stepsPerColumn, st.stepsPerRow, st.planeSteps,
-                         st.planeOrigins);
-    interleaveMembers(in.exit, st);
+    buildIndirectStepTable(pyr, st.phi, pad, st.heightSteps, st.stepsPerColumn, st.stepsPerRow,
+                           [](int, double, double, std::size_t, ValidPrefix&) {});
+    st.stepCells.resize(table);
+    for (std::size_t k = 0; k < table; ++k)
+        st.stepCells[k] = 1.0 / (static_cast<double>(st.heightSteps[k].w[2][0]) * pyr.cellSize);
+    interleaveExit(in.exit, static_cast<std::size_t>(pyr.nx) * pyr.ny, st);
     st.gathered.resize(static_cast<std::size_t>(3) * pyr.nx * pyr.ny);
     st.scratch.resize(static_cast<std::size_t>(workerSlots()));
     for (GlossyLobeScratch& sc : st.scratch) {

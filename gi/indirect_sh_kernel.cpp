@@ -65,6 +65,7 @@ ShKernelIndirect::ShKernelIndirect(const IndirectInputs& in, const IndirectSetti
 void ShKernelIndirect::beginFrame() {
     const int nxr = in_.heights.nxr, nyr = in_.heights.nyr;
     const std::size_t planeR = static_cast<std::size_t>(nxr) * nyr;
+    bounce_ = 0;
     if (exitVectors_) checkExitVectorInputs();
     // receiver tiles: the clean receivers keep the U of a previous scan
     if (in_.only)
@@ -102,14 +103,16 @@ void ShKernelIndirect::checkExitVectorInputs() {
 }
 
 // The RGB pyramid of L_(b-1), or E of bounce b - 1 at full resolution and
-// its 48 planes' pyramid (Section 5.3)
+// its 48 planes' pyramid (Section 5.3). The lobe gather reads E at full
+// resolution, so with LobeScan the pyramid is built only for a scan of U.
 void ShKernelIndirect::buildPyramid(const BounceSource& previous) {
+    const int b = ++bounce_;
     if (!exitVectors_) return scan_.buildPyramid(previous, settings_.radiance);
     const HeightPyramid& pyr = in_.heights;
     GlossyIndirectState& gs = st_.glossy;
     glossyExitRadiance(in_.gradX, in_.gradY, pyr.subsample, pyr.nxr, pyr.nyr, previous.shade->incident.data(),
                        previous.shade->rgb, in_.albedo, in_.shading, gs.exitScratch, gs.exitSh.data());
-    buildPackedPyramids(gs.exitSh.data(), kGlossyFields, pyr, settings_.radiance, gs.pyramid);
+    if (!lobes_ || needsU(b)) buildPackedPyramids(gs.exitSh.data(), kGlossyFields, pyr, settings_.radiance, gs.pyramid);
 }
 
 bool ShKernelIndirect::needsU(int b) const {
@@ -118,7 +121,7 @@ bool ShKernelIndirect::needsU(int b) const {
 
 void ShKernelIndirect::scan(int b) {
     if (lobes_) {
-        const GlossyLobeInputs lobeIn{in_.heights,        in_.gradX,   in_.gradY,         st_.glossy.pyramid,
+        const GlossyLobeInputs lobeIn{in_.heights,        in_.gradX,   in_.gradY,         st_.glossy.exitSh.data(),
                                       in_.albedo,         in_.shading, scan_.topHeight(), settings_.lobeAzimuths,
                                       settings_.lobeRings};
         gatherGlossyLobes(lobeIn, st_.glossy.lobes);

@@ -26,11 +26,11 @@
 //   member t_i sends Ebar(t_i) . Y(-d_i) back to its receiver. Accuracy and
 //   cost against the scalar pyramid and the glossy reference
 //   (gi/reference_gi.h): bench/results/gi_glossy.md.
-// GlossyIndirect::LobeScan reads the same exit-radiance pyramid, but the
-// Phong part of each bounce's shade is each receiver's own lobe gathered
-// along the directions it covers (gi/glossy_lobe_gather.h), not the order-4
-// lobe applied to U; U is scanned only where something still reads it: the
-// diffuse part of a mixture and the next bounce's incident SH.
+// GlossyIndirect::LobeScan: the Phong part of each bounce's shade is each
+// receiver's own lobe gathered along the directions it covers, reading E at
+// full resolution (gi/glossy_lobe_gather.h), not the order-4 lobe applied to
+// U; U (and the pyramid it reads) is scanned only where something still
+// reads it: the diffuse part of a mixture and the next bounce's incident SH.
 #include "gi/indirect_bounces.h"
 #include "gi/indirect_scan.h"
 
@@ -59,7 +59,8 @@ private:
     bool exitVectors_;  // the members send E . Y(-d) (GlossyIndirect::VectorPyramid, LobeScan)
     bool lobes_;        // the receivers gather their own lobes (GlossyIndirect::LobeScan)
     IndirectScan scan_;
-    int nRows_;  // SH rows of U that shading reads
+    int nRows_;       // SH rows of U that shading reads
+    int bounce_ = 0;  // the bounce whose pyramid buildPyramid built last (this frame)
 };
 
 }  // namespace terrain::gi

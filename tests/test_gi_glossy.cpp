@@ -339,7 +339,11 @@ TEST_CASE("gi.glossy: V valley with Phong walls: the lobe gather against the exa
     // diagnostic isolates. With the gather's quadrature (3 rings, 32
     // azimuths) and order-4 members, the reference is the gather's
     // idealisation: the gather must follow it closely, and the exact
-    // reference up to the members' order-4 floor.
+    // reference up to the members' order-4 floor (and a little more: reading
+    // the wall's E where each ray crosses it puts the wall at 1.177 / 1.208
+    // for S = 64 / 256, against 1.151 / 1.178 with the members' pyramid
+    // samples, where the idealisation has 1.127 / 1.149; on real terrain the
+    // crossing is the more accurate, README "The lobe gather").
     const int n = 41;
     const Grid h = valley(n, n, 1.0f);
     const AlbedoMap a = uniformAlbedo(n, n, 1.0f);
@@ -365,7 +369,7 @@ TEST_CASE("gi.glossy: V valley with Phong walls: the lobe gather against the exa
                        << ", exact reference " << wallR << " (members SH " << wallM << ")");
         CHECK(wallR > 0.01);
         CHECK(wallL == doctest::Approx(wallI).epsilon(0.05));
-        CHECK(std::fabs(wallL - wallR) < std::fabs(wallM - wallR) + 0.05 * wallR);
+        CHECK(std::fabs(wallL - wallR) < std::fabs(wallM - wallR) + 0.07 * wallR);
     }
 }
 
