@@ -91,6 +91,8 @@ void checkGiFlags(const gi::GiSettings& s) {
     checkRange(r::kIndirectAzimuths, s.indirect.azimuths, "--indirect-azimuths");
     checkRange(r::kLobeRings, s.indirect.lobeRings, "--glossy-lobe-rings");
     checkRange(r::kLobeAzimuths, s.indirect.lobeAzimuths, "--glossy-lobe-azimuths");
+    checkRange(r::kLobeNearStepsPerOctave, s.indirect.lobeNearStepsPerOctave, "--glossy-lobe-near-steps");
+    checkRange(r::kLobeNearOctaves, s.indirect.lobeNearOctaves, "--glossy-lobe-near-octaves");
 }
 
 // The output files, before any work: each must be a file in a folder we can write to.
@@ -198,6 +200,12 @@ void addLightTransportFlags(CLI::App* sub, GiOptions& o) {
         ->capture_default_str();
     sub->add_option("--glossy-lobe-azimuths", gs.indirect.lobeAzimuths,
                     gi::describe(r::kLobeAzimuths) + " (--glossy lobe)")
+        ->capture_default_str();
+    sub->add_option("--glossy-lobe-near-steps", gs.indirect.lobeNearStepsPerOctave,
+                    gi::describe(r::kLobeNearStepsPerOctave) + " (--glossy lobe)")
+        ->capture_default_str();
+    sub->add_option("--glossy-lobe-near-octaves", gs.indirect.lobeNearOctaves,
+                    gi::describe(r::kLobeNearOctaves) + " (--glossy lobe)")
         ->capture_default_str();
     sub->add_option(
         "--indirect-kernel", o.indirectKernel,

@@ -128,8 +128,14 @@ RowReferences rowReferences(const Grid& h, float cell, const GiLighting& light, 
 // lobe gather at kLobeQuadratures. Each also a CSV line.
 struct LobeQuadrature {
     int rings, azimuths;
+    bool pyramidSteps = false;  // the walks on the height pyramid's own steps (no denser near steps)
 };
-constexpr LobeQuadrature kLobeQuadratures[] = {{2, 16}, {2, 32}, {3, 16}, {3, 32}, {3, 64}, {4, 32}, {4, 64}};
+constexpr LobeQuadrature kLobeQuadratures[] = {{2, 16},       {2, 32}, {3, 16}, {3, 32},
+                                               {3, 32, true}, {3, 64}, {4, 32}, {4, 64}};
+
+std::string quadratureName(const LobeQuadrature& q) {
+    return strprintf("%d rings, %d az%s", q.rings, q.azimuths, q.pyramidSteps ? ", pyramid steps" : "");
+}
 constexpr int kLobeQuadratureCount = sizeof kLobeQuadratures / sizeof kLobeQuadratures[0];
 
 struct RowErrors {
@@ -169,9 +175,12 @@ RowErrors rowErrors(const Grid& h, float cell, const GiLighting& light, const Al
         GiSettings g = settingsFor(row.brdf, row.S, s, 1, GlossyIndirect::LobeScan);
         g.indirect.lobeRings = kLobeQuadratures[q].rings;
         g.indirect.lobeAzimuths = kLobeQuadratures[q].azimuths;
+        if (kLobeQuadratures[q].pyramidSteps) {
+            g.indirect.lobeNearStepsPerOctave = g.pyramid.levelsPerOctave;
+            g.indirect.lobeNearOctaves = g.pyramid.levelOffset;
+        }
         r.quad[q] = engineError(h, cell, light, a, g, GlossyPositivity::Clamp, ref.exact);
-        csvLine(strprintf("lobe %d rings %d azimuths", kLobeQuadratures[q].rings, kLobeQuadratures[q].azimuths),
-                "clamp", r.quad[q]);
+        csvLine("lobe " + quadratureName(kLobeQuadratures[q]), "clamp", r.quad[q]);
     }
     return r;
 }
@@ -239,13 +248,18 @@ std::string accuracySection(const GlossyOptions& o, const BenchContext& ctx, std
           "): relative RMSE of the vector pyramid (clamp) against the exact reference.\n\n";
     md += "| BRDF | S | sub-sampling | default | 16 azimuths | 32 azimuths |\n|---|---|---|---|---|---|\n";
     md += azim;
-    md += "\nLobe quadrature (`--glossy lobe`, engine default " + std::to_string(IndirectSettings{}.lobeRings) +
-          " rings, " + std::to_string(IndirectSettings{}.lobeAzimuths) +
+    const IndirectSettings defaults;
+    md += "\nLobe quadrature (`--glossy lobe`, engine default " + std::to_string(defaults.lobeRings) + " rings, " +
+          std::to_string(defaults.lobeAzimuths) +
           " azimuths): relative RMSE of the lobe gather against the exact reference with n rings (n x 2n rays per "
-          "lobe) and M global azimuths.\n\n| BRDF | S | sub-sampling |";
+          "lobe) and M global azimuths; the walks' raw steps out to " +
+          std::to_string(1 << defaults.lobeNearOctaves) + " cells at " +
+          std::to_string(defaults.lobeNearStepsPerOctave) +
+          " per octave, or on the height pyramid's own steps (`--glossy-lobe-near-steps` and "
+          "`--glossy-lobe-near-octaves` set to its levels per octave and level offset).\n\n| BRDF | S | sub-sampling |";
     std::string rule = "|---|---|---|";
     for (const LobeQuadrature& q : kLobeQuadratures) {
-        md += strprintf(" %d rings, %d az |", q.rings, q.azimuths);
+        md += " " + quadratureName(q) + " |";
         rule += "---|";
     }
     md += "\n" + rule + "\n" + quad;

@@ -164,7 +164,7 @@ void addSent(const MemberSamples& m, const GlossyLobeScratch::Ray& ray, bool cla
 void walkAzimuth(const GlossyLobeInputs& in, const GlossyLobeState& st, const GlossyLobeScratch::Ray* begin,
                  const GlossyLobeScratch::Ray* end, int X, int Y, float h0, float margin, double* acc) {
     const HeightPyramid& pyr = in.heights;
-    const int j = begin->azimuth, nSteps = static_cast<int>(pyr.steps.size());
+    const int j = begin->azimuth, nSteps = st.stepStride;
     const int pad = static_cast<int>(st.stepsPerColumn.size() / st.phi.size());
     const int prefix = std::min(st.stepsPerColumn[static_cast<std::size_t>(j) * pad + static_cast<std::size_t>(X)],
                                 st.stepsPerRow[static_cast<std::size_t>(j) * pyr.nyr + static_cast<std::size_t>(Y)]);
@@ -266,12 +266,68 @@ void interleaveExit(const float* exit, std::size_t texels, GlossyLobeState& st) 
     });
 }
 
+// The walks' steps: raw steps (the full-resolution heights, exact between
+// grid lines) from the pyramid's first step out to 2^nearOctaves cells at
+// perOctave steps per octave, then the pyramid's steps beyond. Where a ray
+// meets the surface and what it reads there follow the steps' spacing, so
+// near, where most rays meet it, they are denser than the pyramid's.
+std::vector<PyramidStep> walkSteps(const HeightPyramid& pyr, int perOctave, int nearOctaves) {
+    std::vector<PyramidStep> steps;
+    if (pyr.steps.empty()) return steps;
+    const double first = pyr.steps.front().tauCells, limit = std::ldexp(1.0, nearOctaves);
+    for (int k = 0;; ++k) {
+        const double tau = first * std::exp2(static_cast<double>(k) / perOctave);
+        if (tau >= limit) break;
+        steps.push_back({tau, static_cast<float>(1.0 / (tau * pyr.cellSize)), -1});
+    }
+    for (const PyramidStep& ps : pyr.steps)
+        if (ps.tauCells >= limit) steps.push_back(ps);
+    return steps;
+}
+
+bool sameSample(const ScanStep& a, const ScanStep& b) {
+    return a.field == b.field && a.offA == b.offA && a.offB == b.offB && a.w[0][0] == b.w[0][0] &&
+           a.w[2][0] == b.w[2][0];
+}
+
+// st's step table (azimuth j's steps from j * stepStride, a step whose moved
+// sample is the one before's left out: near the receiver several distances
+// round to the same grid line), the valid prefixes and the steps' distances.
+void buildWalkTable(const HeightPyramid& pyr, int perOctave, int nearOctaves, int pad, GlossyLobeState& st) {
+    const std::vector<PyramidStep> steps = walkSteps(pyr, perOctave, nearOctaves);
+    const int M = static_cast<int>(st.phi.size());
+    st.stepStride = static_cast<int>(steps.size());
+    const std::size_t table = static_cast<std::size_t>(M) * steps.size();
+    st.heightSteps.resize(table);
+    st.stepCells.resize(table);
+    st.stepsPerColumn.resize(static_cast<std::size_t>(M) * pad);
+    st.stepsPerRow.resize(static_cast<std::size_t>(M) * pyr.nyr);
+    parallelFor(0, M, 1, [&](int j0, int j1) {
+        for (int j = j0; j < j1; ++j) {
+            const auto ju = static_cast<std::size_t>(j);
+            const std::size_t base = ju * steps.size();
+            ValidPrefix prefix(pyr.nxr, pyr.nyr, pad, st.stepsPerColumn.data() + ju * pad,
+                               st.stepsPerRow.data() + ju * pyr.nyr);
+            int n = 0;
+            for (const PyramidStep& ps : steps) {
+                const ScanStepInfo info = scanStepInfoAt(pyr, ps, std::cos(st.phi[ju]), std::sin(st.phi[ju]));
+                if (n > 0 && sameSample(info.step, st.heightSteps[base + static_cast<std::size_t>(n - 1)])) continue;
+                st.heightSteps[base + static_cast<std::size_t>(n)] = info.step;
+                st.stepCells[base + static_cast<std::size_t>(n)] =
+                    1.0 / (static_cast<double>(info.step.w[2][0]) * pyr.cellSize);
+                prefix.narrow(info);
+                prefix.commit(n);
+                ++n;
+            }
+        }
+    });
+}
+
 }  // namespace
 
 void gatherGlossyLobes(const GlossyLobeInputs& in, GlossyLobeState& st) {
     const HeightPyramid& pyr = in.heights;
-    const int M = in.azimuths, pad = indirectRowPad(pyr.nxr), nSteps = static_cast<int>(pyr.steps.size());
-    const std::size_t table = static_cast<std::size_t>(M) * nSteps;
+    const int M = in.azimuths, pad = indirectRowPad(pyr.nxr);
     st.phi.resize(static_cast<std::size_t>(M));
     st.cosPhi.resize(static_cast<std::size_t>(M));
     st.sinPhi.resize(static_cast<std::size_t>(M));
@@ -281,14 +337,7 @@ void gatherGlossyLobes(const GlossyLobeInputs& in, GlossyLobeState& st) {
         st.cosPhi[u] = static_cast<float>(std::cos(st.phi[u]));
         st.sinPhi[u] = static_cast<float>(std::sin(st.phi[u]));
     }
-    st.heightSteps.resize(table);
-    st.stepsPerColumn.resize(static_cast<std::size_t>(M) * pad);
-    st.stepsPerRow.resize(static_cast<std::size_t>(M) * pyr.nyr);
-    buildIndirectStepTable(pyr, st.phi, pad, st.heightSteps, st.stepsPerColumn, st.stepsPerRow,
-                           [](int, double, double, std::size_t, ValidPrefix&) {});
-    st.stepCells.resize(table);
-    for (std::size_t k = 0; k < table; ++k)
-        st.stepCells[k] = 1.0 / (static_cast<double>(st.heightSteps[k].w[2][0]) * pyr.cellSize);
+    buildWalkTable(pyr, in.nearStepsPerOctave, in.nearOctaves, pad, st);
     interleaveExit(in.exit, static_cast<std::size_t>(pyr.nx) * pyr.ny, st);
     st.gathered.resize(static_cast<std::size_t>(3) * pyr.nx * pyr.ny);
     st.scratch.resize(static_cast<std::size_t>(workerSlots()));

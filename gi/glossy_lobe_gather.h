@@ -88,8 +88,12 @@ struct GlossyLobeScratch {
 struct GlossyLobeState {
     std::vector<double> phi;            // the M global azimuths 2 pi j / M
     std::vector<float> cosPhi, sinPhi;  // their directions
-    std::vector<ScanStep> heightSteps;  // M x steps (gi/indirect_scan_tables.h)
-    std::vector<double> stepCells;      // M x steps: each step's sample distance from its receiver, in cells
+    // The walks' steps (GlossyLobeInputs::nearStepsPerOctave): azimuth j's
+    // from j * stepStride; each step's sample distance from its receiver, in
+    // cells; per receiver column and row the steps inside the domain.
+    int stepStride = 0;
+    std::vector<ScanStep> heightSteps;
+    std::vector<double> stepCells;
     std::vector<int> stepsPerColumn, stepsPerRow;
     // E at full resolution with the 48 planes interleaved (value f of texel
     // k at k * 48 + f), bfloat16: a ray's E is four runs of 96 bytes.
@@ -108,6 +112,10 @@ struct GlossyLobeInputs {
     float topHeight;  // the field's highest height (no sample rises above it)
     int azimuths;     // M, the global azimuths
     int rings;        // n: n rings x 2n directions per lobe
+    // The walks' raw steps: out to 2^nearOctaves cells, nearStepsPerOctave per
+    // octave (then the pyramid's steps).
+    int nearStepsPerOctave;
+    int nearOctaves;
 };
 
 /// GlossyLobeState::gathered at every texel (see above).

@@ -48,9 +48,13 @@ struct IndirectSettings {
     // Azimuths of the indirect scan (0: the visibility's m; paper: 0).
     int azimuths = 8;
     // GlossyIndirect::LobeScan: the global azimuths the lobes are gathered
-    // along, and the lobe quadrature's rings (rings x 2 rings directions).
+    // along, the lobe quadrature's rings (rings x 2 rings directions), and
+    // the walks' raw steps, out to 2^lobeNearOctaves cells at
+    // lobeNearStepsPerOctave per octave (gi/glossy_lobe_gather.h).
     int lobeAzimuths = 32;
     int lobeRings = 3;
+    int lobeNearStepsPerOctave = 16;
+    int lobeNearOctaves = 7;
     bool operator==(const IndirectSettings&) const = default;
 };
 

@@ -121,9 +121,17 @@ bool ShKernelIndirect::needsU(int b) const {
 
 void ShKernelIndirect::scan(int b) {
     if (lobes_) {
-        const GlossyLobeInputs lobeIn{in_.heights,        in_.gradX,   in_.gradY,         st_.glossy.exitSh.data(),
-                                      in_.albedo,         in_.shading, scan_.topHeight(), settings_.lobeAzimuths,
-                                      settings_.lobeRings};
+        const GlossyLobeInputs lobeIn{in_.heights,
+                                      in_.gradX,
+                                      in_.gradY,
+                                      st_.glossy.exitSh.data(),
+                                      in_.albedo,
+                                      in_.shading,
+                                      scan_.topHeight(),
+                                      settings_.lobeAzimuths,
+                                      settings_.lobeRings,
+                                      settings_.lobeNearStepsPerOctave,
+                                      settings_.lobeNearOctaves};
         gatherGlossyLobes(lobeIn, st_.glossy.lobes);
         if (!needsU(b)) return;
     }

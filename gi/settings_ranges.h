@@ -40,6 +40,10 @@ inline constexpr SettingRange<int> kLobeAzimuths{"glossy lobe azimuths", 4, 4096
                                                  "Global azimuths of the glossy lobe gather"};
 inline constexpr SettingRange<int> kLobeRings{"glossy lobe rings", 1, 64,
                                               "Rings of the glossy lobe quadrature (rings x 2 rings directions)"};
+inline constexpr SettingRange<int> kLobeNearStepsPerOctave{
+    "glossy lobe near steps per octave", 1, 64, "Raw height steps per octave of the glossy lobe gather's walks"};
+inline constexpr SettingRange<int> kLobeNearOctaves{"glossy lobe near octaves", 0, 16,
+                                                    "The glossy lobe gather's raw height steps reach 2^this cells"};
 inline constexpr SettingRange<int> kIndirectAzimuths{"indirect azimuths", 3, 4096,
                                                      "Azimuths of the indirect scan (0: the visibility's)", true};
 

@@ -51,8 +51,7 @@ void validRange(double d, int k, int fieldN, int receivers, int& first, int& las
     }
 }
 
-StepGeometry makeStep(const HeightPyramid& pyr, int i, double c, double sn) {
-    const PyramidStep& ps = pyr.steps[static_cast<std::size_t>(i)];
+StepGeometry makeStepAt(const HeightPyramid& pyr, const PyramidStep& ps, double c, double sn) {
     const int s = pyr.subsample;
     const bool raw = ps.level < 0;
     StepGeometry g;
@@ -117,6 +116,10 @@ StepGeometry makeStep(const HeightPyramid& pyr, int i, double c, double sn) {
         st.offB = st.offA + (alongX ? fl.stride : 1);
     }
     return g;
+}
+
+StepGeometry makeStep(const HeightPyramid& pyr, int i, double c, double sn) {
+    return makeStepAt(pyr, pyr.steps[static_cast<std::size_t>(i)], c, sn);
 }
 
 // The blocking slope of one receiver at one step (the scalar form of the
@@ -684,7 +687,11 @@ StepTableKey stepTableKey(const HeightPyramid& pyr, const std::vector<double>& p
 }
 
 ScanStepInfo scanStepInfo(const HeightPyramid& pyr, int i, double cosPhi, double sinPhi) {
-    const StepGeometry g = makeStep(pyr, i, cosPhi, sinPhi);
+    return scanStepInfoAt(pyr, pyr.steps[static_cast<std::size_t>(i)], cosPhi, sinPhi);
+}
+
+ScanStepInfo scanStepInfoAt(const HeightPyramid& pyr, const PyramidStep& step, double cosPhi, double sinPhi) {
+    const StepGeometry g = makeStepAt(pyr, step, cosPhi, sinPhi);
     ScanStepInfo info;
     info.step = g.step;
     info.xFirst = g.xFirst;

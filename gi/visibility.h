@@ -210,6 +210,9 @@ struct ScanStepInfo {
     int tapX = 0, tapY = 0, nextX = 0, nextY = 0;
 };
 ScanStepInfo scanStepInfo(const HeightPyramid& pyramid, int i, double cosPhi, double sinPhi);
+/// The same for a step of one's own: a raw step (level -1) at any distance,
+/// or one of the pyramid's level steps.
+ScanStepInfo scanStepInfoAt(const HeightPyramid& pyramid, const PyramidStep& step, double cosPhi, double sinPhi);
 
 /// Valid prefixes of one azimuth's step table when several fields are read
 /// at each step (gi/indirect: heights and radiance): a receiver's sequence
