@@ -81,23 +81,27 @@ void appendLobeRays(const ReceiverLobe& L, const GlossyLobeState& st, float gx, 
         }
 }
 
-// sc.rays in walk order into sc.sorted: by azimuth (a counting sort, M
-// buckets), then by slope within an azimuth (insertion sort, stable: equal
+// sc.rays in walk order into sc.sorted: by azimuth, then by texel (a counting
+// sort, M x texels buckets), then by slope (insertion sort, stable: equal
 // slopes keep the order they were appended in, so the sums are fixed). The
 // sorts move 8-byte keys; each ray is copied once, at the end.
-void sortRays(int M, GlossyLobeScratch& sc) {
+void sortRays(int M, int texels, GlossyLobeScratch& sc) {
     std::vector<int>& start = sc.bucketStart;
-    start.assign(static_cast<std::size_t>(M + 1), 0);
-    for (const GlossyLobeScratch::Ray& r : sc.rays) ++start[static_cast<std::size_t>(r.azimuth + 1)];
-    for (int j = 0; j < M; ++j) start[static_cast<std::size_t>(j + 1)] += start[static_cast<std::size_t>(j)];
+    const int buckets = M * texels;
+    start.assign(static_cast<std::size_t>(buckets + 1), 0);
+    const auto bucketOf = [texels](const GlossyLobeScratch::Ray& r) {
+        return static_cast<std::size_t>(r.azimuth * texels + r.texel);
+    };
+    for (const GlossyLobeScratch::Ray& r : sc.rays) ++start[bucketOf(r) + 1];
+    for (int j = 0; j < buckets; ++j) start[static_cast<std::size_t>(j + 1)] += start[static_cast<std::size_t>(j)];
     std::vector<GlossyLobeScratch::RayKey>& keys = sc.keys;
     keys.resize(sc.rays.size());
     for (std::size_t i = 0; i < sc.rays.size(); ++i) {
         const GlossyLobeScratch::Ray& r = sc.rays[i];
-        keys[static_cast<std::size_t>(start[static_cast<std::size_t>(r.azimuth)]++)] = {r.slope, static_cast<int>(i)};
+        keys[static_cast<std::size_t>(start[bucketOf(r)]++)] = {r.slope, static_cast<int>(i)};
     }
     // start[j] is now the end of bucket j
-    for (int j = 0, begin = 0; j < M; begin = start[static_cast<std::size_t>(j)], ++j)
+    for (int j = 0, begin = 0; j < buckets; begin = start[static_cast<std::size_t>(j)], ++j)
         for (int a = begin + 1; a < start[static_cast<std::size_t>(j)]; ++a) {
             const GlossyLobeScratch::RayKey x = keys[static_cast<std::size_t>(a)];
             int b = a;
@@ -129,19 +133,19 @@ void readExit(const GlossyLobeState& st, int nx, int ny, double px, double py, M
                  w11 * fromBfloat16(a[f + dx + dy]);
 }
 
-// Where along its azimuth a ray of slope `slope` meets the surface, in cells
-// from the receiver: between the last step below it (blocking slope tBefore
-// at tauBefore cells) and the first that reaches it (tAfter, tauAfter), where
-// the ray's height above the linearly interpolated samples crosses zero; the
-// sample heights above the ray are (t - slope) tau. Before the first step
-// (tauBefore 0: the ray leaves the surface at the receiver, and nothing says
-// where it rises again) halfway to it.
-double crossingDistance(float tBefore, double tauBefore, float tAfter, double tauAfter, float slope) {
-    if (tauBefore <= 0.0) return 0.5 * tauAfter;
-    const double below = (static_cast<double>(slope) - tBefore) * tauBefore;  // > 0
-    const double above = (static_cast<double>(tAfter) - slope) * tauAfter;    // >= 0
+// Where along its azimuth a ray of slope `slope` meets the surface, as a
+// horizontal distance from where it leaves: between the last step below it
+// (a sample riseBefore over the ray's start, runBefore away) and the first
+// that reaches it (rise, run), where the ray's height above the linearly
+// interpolated samples crosses zero. Before the first step (runBefore 0: the
+// ray leaves the surface there, and nothing says where it rises again)
+// halfway to it.
+double crossingDistance(double riseBefore, double runBefore, double rise, double run, float slope) {
+    if (runBefore <= 0.0) return 0.5 * run;
+    const double below = slope * runBefore - riseBefore;  // > 0
+    const double above = rise - slope * run;              // >= 0
     const double alpha = below + above > 0.0 ? below / (below + above) : 1.0;
-    return tauBefore + alpha * (tauAfter - tauBefore);
+    return runBefore + alpha * (run - runBefore);
 }
 
 // What the member sends back along `ray`, E . Y(back) (max(0, .) with the
@@ -157,40 +161,61 @@ void addSent(const MemberSamples& m, const GlossyLobeScratch::Ray& ray, bool cla
     }
 }
 
-// Receiver (X, Y)'s rays [begin, end) of one azimuth (sorted by slope):
-// the walk over the steps, each ray brought what the surface sends back
-// where it crosses it, between its first reaching step and the step before,
-// into its texel's acc (3 per texel).
+// Receiver (X, Y)'s rays [begin, end) of one azimuth (by texel, then by
+// slope): the walk over the receiver's steps. Each texel sees the samples
+// from where it stands, its own height and its distance along the azimuth
+// (the samples lie on the receiver's ray, at most s / 2 cells beside its
+// own), and each of its rays brings what the surface sends back where it
+// crosses it, between its first reaching step and the step before, into the
+// texel's acc (3 per texel).
 void walkAzimuth(const GlossyLobeInputs& in, const GlossyLobeState& st, const GlossyLobeScratch::Ray* begin,
-                 const GlossyLobeScratch::Ray* end, int X, int Y, float h0, float margin, double* acc) {
+                 const GlossyLobeScratch::Ray* end, int X, int Y, GlossyLobeScratch& sc, double* acc) {
     const HeightPyramid& pyr = in.heights;
     const int j = begin->azimuth, nSteps = st.stepStride;
     const int pad = static_cast<int>(st.stepsPerColumn.size() / st.phi.size());
     const int prefix = std::min(st.stepsPerColumn[static_cast<std::size_t>(j) * pad + static_cast<std::size_t>(X)],
                                 st.stepsPerRow[static_cast<std::size_t>(j) * pyr.nyr + static_cast<std::size_t>(Y)]);
     const std::size_t base = static_cast<std::size_t>(j) * nSteps;
-    const float reach = (in.topHeight - h0) - margin;  // the highest rise any sample can have
     const bool clamp = in.shading.positivity == GlossyPositivity::Clamp;
     const double x0 = static_cast<double>(pyr.subsample) * X, y0 = static_cast<double>(pyr.subsample) * Y;
     const double c = st.cosPhi[static_cast<std::size_t>(j)], sn = st.sinPhi[static_cast<std::size_t>(j)];
-    const GlossyLobeScratch::Ray* next = begin;
+    const double cell = pyr.cellSize;
+    std::vector<GlossyLobeScratch::TexelWalk>& walks = sc.walks;
+    walks.clear();
+    for (const GlossyLobeScratch::Ray* r = begin; r != end;) {
+        const GlossyLobeScratch::Ray* e = r;
+        while (e != end && e->texel == r->texel) ++e;
+        const GlossyLobeScratch::TexelFrame& f = sc.texelFrames[static_cast<std::size_t>(r->texel)];
+        walks.push_back({r, e, f.h, f.margin, (in.topHeight - f.h) - f.margin, f.ox, f.oy, f.ox * c + f.oy * sn});
+        r = e;
+    }
     MemberSamples m;
-    float tBefore = 0.0f;    // the last step below every ray left: its blocking slope
-    double tauBefore = 0.0;  // and its distance (cells); 0: none yet
-    for (int i = 0; i < prefix && next != end; ++i) {
+    int active = static_cast<int>(walks.size());
+    for (int i = 0; i < prefix && active > 0; ++i) {
         const ScanStep& hs = st.heightSteps[base + static_cast<std::size_t>(i)];
-        if (reach * hs.w[2][0] < next->slope) break;  // no sample from here on reaches the lowest ray left
         const std::ptrdiff_t o = Y * hs.rowStep + X;
-        const float t =
-            ((hs.w[0][0] * hs.field[o + hs.offA] + hs.w[1][0] * hs.field[o + hs.offB] - h0) - margin) * hs.w[2][0];
+        const float v = hs.w[0][0] * hs.field[o + hs.offA] + hs.w[1][0] * hs.field[o + hs.offB];
         const double tau = st.stepCells[base + static_cast<std::size_t>(i)];
-        for (; next != end && next->slope <= t; ++next) {
-            const double d = crossingDistance(tBefore, tauBefore, t, tau, next->slope);
-            readExit(st, pyr.nx, pyr.ny, x0 + d * c, y0 + d * sn, m);
-            addSent(m, *next, clamp, acc);
+        for (GlossyLobeScratch::TexelWalk& w : walks) {
+            if (w.next == w.end) continue;
+            const double dist = tau - w.along;    // from the texel, along the azimuth (cells)
+            if (dist < 0.5) continue;             // beside or behind the texel
+            const double run = dist * cell;       // metres
+            if (w.reach < w.next->slope * run) {  // no sample from here on rises to its lowest ray left
+                w.next = w.end;
+                --active;
+                continue;
+            }
+            const double rise = (static_cast<double>(v) - w.h) - w.margin;  // the sample over the texel, metres
+            for (; w.next != w.end && w.next->slope * run <= rise; ++w.next) {
+                const double d = crossingDistance(w.riseBefore, w.runBefore, rise, run, w.next->slope) / cell;
+                readExit(st, pyr.nx, pyr.ny, x0 + w.ox + d * c, y0 + w.oy + d * sn, m);
+                addSent(m, *w.next, clamp, acc);
+            }
+            if (w.next == w.end) --active;
+            w.riseBefore = rise;
+            w.runBefore = run;
         }
-        tBefore = t;
-        tauBefore = tau;
     }
 }
 
@@ -221,21 +246,25 @@ void gatherRow(const GlossyLobeInputs& in, GlossyLobeState& st, int Y, GlossyLob
         const int width = cols.last - cols.first + 1;
         const int texels = width * (rows.last - rows.first + 1);
         sc.rays.clear();
+        sc.texelFrames.clear();
         for (int y = rows.first; y <= rows.last; ++y)
             for (int x = cols.first; x <= cols.last; ++x) {
+                const float h = pyr.rawPhaseRow(x % s, y)[x / s];
+                sc.texelFrames.push_back({h, std::fabs(h) * kHeightMarginRel, static_cast<double>(x - s * X),
+                                          static_cast<double>(y - s * Y)});
                 const double S = expMap ? in.surface->phongExponent(x, y) : in.shading.phongExponent;
                 const float gx = in.gradX(x, y), gy = in.gradY(x, y);
                 const ReceiverLobe L = receiverLobe(gx, gy, in.shading.viewDir, S);
                 appendLobeRays(L, st, gx, gy, (y - rows.first) * width + (x - cols.first), sc);
             }
-        sortRays(static_cast<int>(st.phi.size()), sc);
+        sortRays(static_cast<int>(st.phi.size()), texels, sc);
         sc.acc.assign(static_cast<std::size_t>(3 * texels), 0.0);
         const GlossyLobeScratch::Ray* rays = sc.sorted.data();
         const std::size_t n = sc.sorted.size();
         for (std::size_t a = 0; a < n;) {
             std::size_t b = a + 1;
             while (b < n && rays[b].azimuth == rays[a].azimuth) ++b;
-            walkAzimuth(in, st, rays + a, rays + b, X, Y, sc.h0[X], sc.margin[X], sc.acc.data());
+            walkAzimuth(in, st, rays + a, rays + b, X, Y, sc, sc.acc.data());
             a = b;
         }
         for (int t = 0; t < texels; ++t) {

@@ -377,8 +377,10 @@ TEST_CASE("gi.glossy: the lobe gather against the reference's own idealisation o
     // The reference with the gather's quadrature (3 rings, 32 azimuths) and
     // order-4 members (membersSh) is what the gather would give without the
     // pyramids' steps and filtering: the difference is the scan's own error.
-    // With 2x sub-sampling every texel still gathers its own lobe (walked
-    // from its receiver), so the error stays near the 1x one, where the
+    // With 2x sub-sampling every texel still gathers its own lobe, seeing its
+    // receiver's samples from where it stands (its height and distance), so
+    // the error stays near the 1x one (walked as if from the receiver, the
+    // 2x error was 0.064 / 0.066 above the 1x one for S = 8 / 64), where the
     // vector pyramid, shading interpolated U, loses more.
     const Grid h = hills(48, 8.0f);
     const AlbedoMap a = uniformAlbedo(48, 48, 0.8f);
@@ -412,7 +414,7 @@ TEST_CASE("gi.glossy: the lobe gather against the reference's own idealisation o
             const double vector = relative(vs.indirect.indirect[1], exact.indirect[1]);
             MESSAGE("S = " << S << ", " << s << "x: relative RMS difference gather vs its idealisation " << toIdeal
                            << ", vs the exact reference " << err[s - 1] << " (vector pyramid " << vector << ")");
-            CHECK(toIdeal < (s == 1 ? 0.2 : 0.25));
+            CHECK(toIdeal < (s == 1 ? 0.2 : 0.15));
             CHECK(err[s - 1] < (s == 1 ? 0.25 : 0.3));
             if (S > 10.0f) CHECK(err[s - 1] < vector);
             // the walks' dense raw steps against the pyramid's own steps
@@ -425,7 +427,7 @@ TEST_CASE("gi.glossy: the lobe gather against the reference's own idealisation o
             MESSAGE("  with the pyramid's steps alone: " << coarseErr);
             CHECK(err[s - 1] < coarseErr);
         }
-        CHECK(err[1] < err[0] + 0.08);
+        CHECK(err[1] < err[0] + 0.03);
     }
 }
 
