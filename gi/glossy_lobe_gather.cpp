@@ -186,7 +186,7 @@ void walkAzimuth(const GlossyLobeInputs& in, const GlossyLobeState& st, const Gl
         const GlossyLobeScratch::Ray* e = r;
         while (e != end && e->texel == r->texel) ++e;
         const GlossyLobeScratch::TexelFrame& f = sc.texelFrames[static_cast<std::size_t>(r->texel)];
-        walks.push_back({r, e, f.h, f.margin, (in.topHeight - f.h) - f.margin, f.ox, f.oy, f.ox * c + f.oy * sn});
+        walks.push_back({r, e, &f, f.ox * c + f.oy * sn});
         r = e;
     }
     MemberSamples m;
@@ -198,18 +198,19 @@ void walkAzimuth(const GlossyLobeInputs& in, const GlossyLobeState& st, const Gl
         const double tau = st.stepCells[base + static_cast<std::size_t>(i)];
         for (GlossyLobeScratch::TexelWalk& w : walks) {
             if (w.next == w.end) continue;
+            const GlossyLobeScratch::TexelFrame& f = *w.frame;
             const double dist = tau - w.along;    // from the texel, along the azimuth (cells)
             if (dist < 0.5) continue;             // beside or behind the texel
             const double run = dist * cell;       // metres
-            if (w.reach < w.next->slope * run) {  // no sample from here on rises to its lowest ray left
+            if (f.reach < w.next->slope * run) {  // no sample from here on rises to its lowest ray left
                 w.next = w.end;
                 --active;
                 continue;
             }
-            const double rise = (static_cast<double>(v) - w.h) - w.margin;  // the sample over the texel, metres
+            const double rise = (static_cast<double>(v) - f.h) - f.margin;  // the sample over the texel, metres
             for (; w.next != w.end && w.next->slope * run <= rise; ++w.next) {
                 const double d = crossingDistance(w.riseBefore, w.runBefore, rise, run, w.next->slope) / cell;
-                readExit(st, pyr.nx, pyr.ny, x0 + w.ox + d * c, y0 + w.oy + d * sn, m);
+                readExit(st, pyr.nx, pyr.ny, x0 + f.ox + d * c, y0 + f.oy + d * sn, m);
                 addSent(m, *w.next, clamp, acc);
             }
             if (w.next == w.end) --active;
@@ -231,14 +232,12 @@ OwnedSpan ownedTexels(int i, int s, int nr, int n) {
     return {first, last};
 }
 
-// Receiver row Y: the lobes of the texels every receiver of it owns, walked
-// from the receiver, into st.gathered.
+// Receiver row Y: the lobes of the texels every receiver of it owns, along
+// the receiver's walks, into st.gathered.
 void gatherRow(const GlossyLobeInputs& in, GlossyLobeState& st, int Y, GlossyLobeScratch& sc) {
     const HeightPyramid& pyr = in.heights;
     const int nxr = pyr.nxr, nx = pyr.nx, s = pyr.subsample;
     const std::size_t plane = static_cast<std::size_t>(nx) * pyr.ny;
-    const int pad = static_cast<int>(sc.gx.size());
-    loadReceiverRow(pyr, in.gradX, in.gradY, Y, pad, sc.gx.data(), sc.gy.data(), sc.h0.data(), sc.margin.data());
     const bool expMap = in.surface && !in.surface->phongExponent.empty();
     const OwnedSpan rows = ownedTexels(Y, s, pyr.nyr, pyr.ny);
     for (int X = 0; X < nxr; ++X) {
@@ -250,7 +249,8 @@ void gatherRow(const GlossyLobeInputs& in, GlossyLobeState& st, int Y, GlossyLob
         for (int y = rows.first; y <= rows.last; ++y)
             for (int x = cols.first; x <= cols.last; ++x) {
                 const float h = pyr.rawPhaseRow(x % s, y)[x / s];
-                sc.texelFrames.push_back({h, std::fabs(h) * kHeightMarginRel, static_cast<double>(x - s * X),
+                const float margin = std::fabs(h) * kHeightMarginRel;
+                sc.texelFrames.push_back({h, margin, (in.topHeight - h) - margin, static_cast<double>(x - s * X),
                                           static_cast<double>(y - s * Y)});
                 const double S = expMap ? in.surface->phongExponent(x, y) : in.shading.phongExponent;
                 const float gx = in.gradX(x, y), gy = in.gradY(x, y);
@@ -371,7 +371,6 @@ void gatherGlossyLobes(const GlossyLobeInputs& in, GlossyLobeState& st) {
     st.gathered.resize(static_cast<std::size_t>(3) * pyr.nx * pyr.ny);
     st.scratch.resize(static_cast<std::size_t>(workerSlots()));
     for (GlossyLobeScratch& sc : st.scratch) {
-        for (std::vector<float>* v : {&sc.gx, &sc.gy, &sc.h0, &sc.margin}) v->resize(static_cast<std::size_t>(pad));
         sc.quadrature.set(in.shading.phongExponent, in.rings);
     }
     parallelFor(0, pyr.nyr, 1, [&](int y0, int y1) {

@@ -68,7 +68,6 @@ namespace terrain::gi {
 
 /// Per worker slot: one receiver row's inputs and the rays of one receiver's texels.
 struct GlossyLobeScratch {
-    std::vector<float> gx, gy, h0, margin;  // loadReceiverRow, padded row
     struct Ray {
         int azimuth;    // global azimuth j of the walk that reads the ray
         int texel;      // which of the receiver's texels it serves
@@ -84,10 +83,11 @@ struct GlossyLobeScratch {
     std::vector<RayKey> keys;       // sortRays' keys
     std::vector<int> bucketStart;   // the counting sort's buckets (one per azimuth)
     std::vector<double> acc;        // 3 per texel of the receiver
-    // Per texel of the receiver: its height, float margin and offset from
-    // the receiver (cells).
+    // Per texel of the receiver: its height, float margin, the highest rise
+    // any sample can have over it (metres), and its offset from the receiver
+    // (cells).
     struct TexelFrame {
-        float h, margin;
+        float h, margin, reach;
         double ox, oy;
     };
     std::vector<TexelFrame> texelFrames;
@@ -95,8 +95,8 @@ struct GlossyLobeScratch {
     // where it stands against the receiver and what it last saw.
     struct TexelWalk {
         const Ray *next, *end;
-        float h, margin, reach;  // its height, float margin, the highest rise any sample can have over it
-        double ox, oy, along;    // its offset from the receiver (cells), and that offset along the azimuth
+        const TexelFrame* frame;
+        double along;  // its offset from the receiver along the azimuth (cells)
         // the last step below every ray left: its sample's rise over the
         // texel and its distance from it (metres; 0: none yet)
         double riseBefore = 0.0, runBefore = 0.0;

@@ -62,7 +62,7 @@ void BlockerRadianceIndirect::beginFrame() {
     scan_.beginFrame();
 }
 
-void BlockerRadianceIndirect::buildPyramid(const BounceSource& previous) {
+void BlockerRadianceIndirect::buildPyramid(int, const BounceSource& previous) {
     scan_.buildPyramid(previous, settings_.radiance);
 }
 

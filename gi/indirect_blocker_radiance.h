@@ -19,7 +19,7 @@ class BlockerRadianceIndirect final : public IndirectStrategy {
 public:
     BlockerRadianceIndirect(const IndirectInputs& in, const IndirectSettings& settings, IndirectState& st);
     void beginFrame() override;
-    void buildPyramid(const BounceSource& previous) override;
+    void buildPyramid(int b, const BounceSource& previous) override;
     void scan(int b) override;
     void shade(int b, ShadeMaps& out) override;
 

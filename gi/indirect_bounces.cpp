@@ -86,7 +86,7 @@ void runBounces(const IndirectInputs& in, const IndirectSettings& settings, Indi
     for (int b = 1; b <= settings.bounces; ++b) {
         // ---- pyramid of bounce b - 1 (Section 5.3) ------------------------------------
         auto t = Clock::now();
-        strategy.buildPyramid(source);
+        strategy.buildPyramid(b, source);
         st.timings.pyramid += msSince(t);
 
         // ---- step table and casting-set scan --------------------------------------------

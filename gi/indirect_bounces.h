@@ -39,8 +39,8 @@ public:
     /// Sizes the strategy's buffers for this frame (throws InputError on
     /// inputs it cannot use).
     virtual void beginFrame() = 0;
-    /// The pyramid of the previous bounce's exit radiance (Section 5.3).
-    virtual void buildPyramid(const BounceSource& previous) = 0;
+    /// Bounce b's pyramid of the previous bounce's exit radiance (Section 5.3).
+    virtual void buildPyramid(int b, const BounceSource& previous) = 0;
     /// Bounce b's step table and casting-set scan (with receiver tiles,
     /// IndirectInputs::only, the receivers of the dirty tiles only, where
     /// the strategy supports them).

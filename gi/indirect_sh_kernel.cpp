@@ -65,7 +65,6 @@ ShKernelIndirect::ShKernelIndirect(const IndirectInputs& in, const IndirectSetti
 void ShKernelIndirect::beginFrame() {
     const int nxr = in_.heights.nxr, nyr = in_.heights.nyr;
     const std::size_t planeR = static_cast<std::size_t>(nxr) * nyr;
-    bounce_ = 0;
     if (exitVectors_) checkExitVectorInputs();
     // receiver tiles: the clean receivers keep the U of a previous scan
     if (in_.only)
@@ -105,8 +104,7 @@ void ShKernelIndirect::checkExitVectorInputs() {
 // The RGB pyramid of L_(b-1), or E of bounce b - 1 at full resolution and
 // its 48 planes' pyramid (Section 5.3). The lobe gather reads E at full
 // resolution, so with LobeScan the pyramid is built only for a scan of U.
-void ShKernelIndirect::buildPyramid(const BounceSource& previous) {
-    const int b = ++bounce_;
+void ShKernelIndirect::buildPyramid(int b, const BounceSource& previous) {
     if (!exitVectors_) return scan_.buildPyramid(previous, settings_.radiance);
     const HeightPyramid& pyr = in_.heights;
     GlossyIndirectState& gs = st_.glossy;

@@ -42,7 +42,7 @@ public:
     /// With the exit-radiance vectors, throws InputError without
     /// IndirectInputs::directShade or when it is not a Phong shading of this field.
     void beginFrame() override;
-    void buildPyramid(const BounceSource& previous) override;
+    void buildPyramid(int b, const BounceSource& previous) override;
     void scan(int b) override;
     void shade(int b, ShadeMaps& out) override;
 
@@ -59,8 +59,7 @@ private:
     bool exitVectors_;  // the members send E . Y(-d) (GlossyIndirect::VectorPyramid, LobeScan)
     bool lobes_;        // the receivers gather their own lobes (GlossyIndirect::LobeScan)
     IndirectScan scan_;
-    int nRows_;       // SH rows of U that shading reads
-    int bounce_ = 0;  // the bounce whose pyramid buildPyramid built last (this frame)
+    int nRows_;  // SH rows of U that shading reads
 };
 
 }  // namespace terrain::gi

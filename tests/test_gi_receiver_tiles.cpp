@@ -168,14 +168,14 @@ std::vector<float> scanOutputs(const Field& f, LambertIndirect kind, IndirectSta
     if (kind == LambertIndirect::BlockerRadiance) {
         BlockerRadianceIndirect strategy(in, gs.indirect, st);
         strategy.beginFrame();
-        strategy.buildPyramid({&direct, nullptr});
+        strategy.buildPyramid(1, {&direct, nullptr});
         strategy.scan(1);
         for (const std::vector<float>& e : st.blocker.receiverShade) out.insert(out.end(), e.begin(), e.end());
         out.insert(out.end(), st.blocker.farSlope.begin(), st.blocker.farSlope.end());
     } else {
         ShKernelIndirect strategy(in, gs.indirect, st);
         strategy.beginFrame();
-        strategy.buildPyramid({&direct, nullptr});
+        strategy.buildPyramid(1, {&direct, nullptr});
         strategy.scan(1);
         for (const VisibilityField& u : st.u) out.insert(out.end(), u.sh.begin(), u.sh.end());
     }
