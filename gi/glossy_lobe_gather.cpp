@@ -6,6 +6,7 @@
 
 #include "core/bfloat16.h"
 #include "core/parallel.h"
+#include "core/simd.h"
 #include "gi/indirect_scan_tables.h"
 #include "gi/phong_lobe_quadrature.h"
 #include "gi/sh.h"
@@ -118,15 +119,34 @@ struct MemberSamples {
     float e[kPlanes];
 };
 
-// E at full-resolution position (px, py) in cells, bilinear between the four
-// texels around it (clamped to the field).
-void readExit(const GlossyLobeState& st, int nx, int ny, double px, double py, MemberSamples& m) {
+// E's texels around full-resolution position (px, py) in cells: the first
+// of the four (clamped to the field) and the bilinear fractions.
+GlossyLobeScratch::ExitTap exitTap(int nx, int ny, double px, double py) {
     const int ix = std::clamp(static_cast<int>(std::floor(px)), 0, std::max(nx - 2, 0));
     const int iy = std::clamp(static_cast<int>(std::floor(py)), 0, std::max(ny - 2, 0));
     const float fx = std::clamp(static_cast<float>(px - ix), 0.0f, 1.0f);
     const float fy = std::clamp(static_cast<float>(py - iy), 0.0f, 1.0f);
+    return {static_cast<std::ptrdiff_t>(iy) * nx + ix, fx, fy};
+}
+
+// Asks for the cache lines of a tap's texels (two runs of two texels, 2 x 96
+// bytes) well before readExit reads them: the rays meet the surface anywhere,
+// and E at 512^2 is 25 MB, so the receiver's hits are read after its walks.
+void prefetchExit(const GlossyLobeState& st, int nx, int ny, const GlossyLobeScratch::ExitTap& t) {
+    constexpr int kTexelBytes = kPlanes * static_cast<int>(sizeof(std::uint16_t));
+    const auto* a = reinterpret_cast<const char*>(st.exitTexels.data() + t.first * kPlanes);
+    const std::ptrdiff_t row = ny > 1 ? static_cast<std::ptrdiff_t>(nx) * kTexelBytes : 0;
+    for (int k = 0; k < 2 * kTexelBytes; k += 64) {
+        __builtin_prefetch(a + k);
+        __builtin_prefetch(a + row + k);
+    }
+}
+
+// E bilinear between a tap's four texels.
+void readExit(const GlossyLobeState& st, int nx, int ny, const GlossyLobeScratch::ExitTap& t, MemberSamples& m) {
     const std::ptrdiff_t dx = nx > 1 ? kPlanes : 0, dy = ny > 1 ? static_cast<std::ptrdiff_t>(nx) * kPlanes : 0;
-    const std::uint16_t* a = st.exitTexels.data() + (static_cast<std::ptrdiff_t>(iy) * nx + ix) * kPlanes;
+    const std::uint16_t* a = st.exitTexels.data() + t.first * kPlanes;
+    const float fx = t.fx, fy = t.fy;
     const float w00 = (1.0f - fx) * (1.0f - fy), w10 = fx * (1.0f - fy), w01 = (1.0f - fx) * fy, w11 = fx * fy;
     for (int f = 0; f < kPlanes; ++f)
         m.e[f] = w00 * fromBfloat16(a[f]) + w10 * fromBfloat16(a[f + dx]) + w01 * fromBfloat16(a[f + dy]) +
@@ -161,22 +181,44 @@ void addSent(const MemberSamples& m, const GlossyLobeScratch::Ray& ray, bool cla
     }
 }
 
+// Whether any lane of a comparison's mask is set.
+template <class Mask>
+inline bool anyLane(Mask m) {
+    std::int64_t any = 0;
+    for (std::size_t l = 0; l < sizeof(Mask) / sizeof(std::int64_t); ++l) any |= m[l];
+    return any != 0;
+}
+
+// The scratch's lane blocks of width N.
+template <int N>
+std::vector<TexelLanes<N>>& laneBlocks(GlossyLobeScratch& sc) {
+    if constexpr (N == 4)
+        return sc.wideLanes;
+    else
+        return sc.narrowLanes;
+}
+
 // Receiver (X, Y)'s rays [begin, end) of one azimuth (by texel, then by
 // slope): the walk over the receiver's steps. Each texel sees the samples
 // from where it stands, its own height and its distance along the azimuth
 // (the samples lie on the receiver's ray, at most s / 2 cells beside its
 // own), and each of its rays brings what the surface sends back where it
 // crosses it, between its first reaching step and the step before, into the
-// texel's acc (3 per texel).
-void walkAzimuth(const GlossyLobeInputs& in, const GlossyLobeState& st, const GlossyLobeScratch::Ray* begin,
-                 const GlossyLobeScratch::Ray* end, int X, int Y, GlossyLobeScratch& sc, double* acc) {
+// texel's acc (3 per texel; through sc.hits, read after the walks). The
+// texels go N to a block of lanes (TexelLanes): a step tests every lane of a
+// block at once, in the same double arithmetic as one texel at a time, and
+// only a lane whose texel stops or whose lowest ray left meets the step
+// there goes on alone.
+template <int N>
+[[gnu::always_inline]] inline void walkAzimuth(const GlossyLobeInputs& in, const GlossyLobeState& st,
+                                               const GlossyLobeScratch::Ray* begin, const GlossyLobeScratch::Ray* end,
+                                               int X, int Y, GlossyLobeScratch& sc) {
     const HeightPyramid& pyr = in.heights;
     const int j = begin->azimuth, nSteps = st.stepStride;
     const int pad = static_cast<int>(st.stepsPerColumn.size() / st.phi.size());
     const int prefix = std::min(st.stepsPerColumn[static_cast<std::size_t>(j) * pad + static_cast<std::size_t>(X)],
                                 st.stepsPerRow[static_cast<std::size_t>(j) * pyr.nyr + static_cast<std::size_t>(Y)]);
     const std::size_t base = static_cast<std::size_t>(j) * nSteps;
-    const bool clamp = in.shading.positivity == GlossyPositivity::Clamp;
     const double x0 = static_cast<double>(pyr.subsample) * X, y0 = static_cast<double>(pyr.subsample) * Y;
     const double c = st.cosPhi[static_cast<std::size_t>(j)], sn = st.sinPhi[static_cast<std::size_t>(j)];
     const double cell = pyr.cellSize;
@@ -185,38 +227,84 @@ void walkAzimuth(const GlossyLobeInputs& in, const GlossyLobeState& st, const Gl
     for (const GlossyLobeScratch::Ray* r = begin; r != end;) {
         const GlossyLobeScratch::Ray* e = r;
         while (e != end && e->texel == r->texel) ++e;
-        const GlossyLobeScratch::TexelFrame& f = sc.texelFrames[static_cast<std::size_t>(r->texel)];
-        walks.push_back({r, e, &f, f.ox * c + f.oy * sn});
+        walks.push_back({r, e, &sc.texelFrames[static_cast<std::size_t>(r->texel)]});
         r = e;
     }
-    MemberSamples m;
+    // the lanes: a lane past the last texel, or whose texel is done, stands
+    // infinitely far back (every step lies behind it)
+    using Block = TexelLanes<N>;
+    std::vector<Block>& blocks = laneBlocks<N>(sc);
+    const int nBlocks = (static_cast<int>(walks.size()) + N - 1) / N;
+    blocks.resize(static_cast<std::size_t>(nBlocks));
+    constexpr double kDone = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < nBlocks * N; ++k) {
+        Block& L = blocks[static_cast<std::size_t>(k / N)];
+        const int l = k % N;
+        L.riseBefore[l] = L.runBefore[l] = 0.0;
+        if (k >= static_cast<int>(walks.size())) {
+            L.along[l] = kDone;
+            L.h[l] = L.margin[l] = L.reach[l] = L.slope[l] = 0.0;
+            continue;
+        }
+        const GlossyLobeScratch::TexelWalk& w = walks[static_cast<std::size_t>(k)];
+        L.along[l] = w.frame->ox * c + w.frame->oy * sn;
+        L.h[l] = w.frame->h;
+        L.margin[l] = w.frame->margin;
+        L.reach[l] = w.frame->reach;
+        L.slope[l] = w.next->slope;
+    }
     int active = static_cast<int>(walks.size());
-    for (int i = 0; i < prefix && active > 0; ++i) {
+    // block b's lanes L at a step: sample v, tau cells from the receiver
+    const auto step = [&](Block& L, int b, float v, double tau) {
+        const typename Block::Lanes dist = tau - L.along;  // from the texel, along the azimuth (cells)
+        const typename Block::Mask valid = dist >= 0.5;    // not beside or behind the texel
+        const typename Block::Lanes run = dist * cell;     // metres
+        const typename Block::Lanes reached = L.slope * run;
+        // no sample from here on rises to its lowest ray left
+        const typename Block::Mask stop = valid & (L.reach < reached);
+        const typename Block::Lanes rise = (static_cast<double>(v) - L.h) - L.margin;  // over the texel, metres
+        const typename Block::Mask meets = valid & ~stop & (reached <= rise);
+        if (anyLane(stop | meets)) {
+            for (int l = 0; l < N; ++l) {
+                if (!(stop[l] | meets[l])) continue;
+                GlossyLobeScratch::TexelWalk& w = walks[static_cast<std::size_t>(b * N + l)];
+                if (meets[l]) {
+                    const GlossyLobeScratch::TexelFrame& f = *w.frame;
+                    for (; w.next != w.end && w.next->slope * run[l] <= rise[l]; ++w.next) {
+                        const double d =
+                            crossingDistance(L.riseBefore[l], L.runBefore[l], rise[l], run[l], w.next->slope) / cell;
+                        const GlossyLobeScratch::ExitTap tap =
+                            exitTap(pyr.nx, pyr.ny, x0 + f.ox + d * c, y0 + f.oy + d * sn);
+                        prefetchExit(st, pyr.nx, pyr.ny, tap);
+                        sc.hits.push_back({tap, w.next});
+                    }
+                }
+                if (stop[l] || w.next == w.end) {
+                    L.along[l] = kDone;
+                    --active;
+                } else {
+                    L.slope[l] = w.next->slope;
+                }
+            }
+        }
+        L.riseBefore = valid ? rise : L.riseBefore;
+        L.runBefore = valid ? run : L.runBefore;
+    };
+    const auto sample = [&](int i) {
         const ScanStep& hs = st.heightSteps[base + static_cast<std::size_t>(i)];
         const std::ptrdiff_t o = Y * hs.rowStep + X;
-        const float v = hs.w[0][0] * hs.field[o + hs.offA] + hs.w[1][0] * hs.field[o + hs.offB];
-        const double tau = st.stepCells[base + static_cast<std::size_t>(i)];
-        for (GlossyLobeScratch::TexelWalk& w : walks) {
-            if (w.next == w.end) continue;
-            const GlossyLobeScratch::TexelFrame& f = *w.frame;
-            const double dist = tau - w.along;    // from the texel, along the azimuth (cells)
-            if (dist < 0.5) continue;             // beside or behind the texel
-            const double run = dist * cell;       // metres
-            if (f.reach < w.next->slope * run) {  // no sample from here on rises to its lowest ray left
-                w.next = w.end;
-                --active;
-                continue;
-            }
-            const double rise = (static_cast<double>(v) - f.h) - f.margin;  // the sample over the texel, metres
-            for (; w.next != w.end && w.next->slope * run <= rise; ++w.next) {
-                const double d = crossingDistance(w.riseBefore, w.runBefore, rise, run, w.next->slope) / cell;
-                readExit(st, pyr.nx, pyr.ny, x0 + f.ox + d * c, y0 + f.oy + d * sn, m);
-                addSent(m, *w.next, clamp, acc);
-            }
-            if (w.next == w.end) --active;
-            w.riseBefore = rise;
-            w.runBefore = run;
-        }
+        return hs.w[0][0] * hs.field[o + hs.offA] + hs.w[1][0] * hs.field[o + hs.offB];
+    };
+    if (nBlocks == 1) {  // one block (1x, 2x): its lanes held in registers
+        Block L = blocks[0];
+        for (int i = 0; i < prefix && active > 0; ++i)
+            step(L, 0, sample(i), st.stepCells[base + static_cast<std::size_t>(i)]);
+        return;
+    }
+    for (int i = 0; i < prefix && active > 0; ++i) {
+        const float v = sample(i);
+        for (int b = 0; b < nBlocks; ++b)
+            step(blocks[static_cast<std::size_t>(b)], b, v, st.stepCells[base + static_cast<std::size_t>(i)]);
     }
 }
 
@@ -234,11 +322,14 @@ OwnedSpan ownedTexels(int i, int s, int nr, int n) {
 
 // Receiver row Y: the lobes of the texels every receiver of it owns, along
 // the receiver's walks, into st.gathered.
-void gatherRow(const GlossyLobeInputs& in, GlossyLobeState& st, int Y, GlossyLobeScratch& sc) {
+template <int N>
+[[gnu::always_inline]] inline void gatherRowImpl(const GlossyLobeInputs& in, GlossyLobeState& st, int Y,
+                                                 GlossyLobeScratch& sc) {
     const HeightPyramid& pyr = in.heights;
     const int nxr = pyr.nxr, nx = pyr.nx, s = pyr.subsample;
     const std::size_t plane = static_cast<std::size_t>(nx) * pyr.ny;
     const bool expMap = in.surface && !in.surface->phongExponent.empty();
+    const bool clamp = in.shading.positivity == GlossyPositivity::Clamp;
     const OwnedSpan rows = ownedTexels(Y, s, pyr.nyr, pyr.ny);
     for (int X = 0; X < nxr; ++X) {
         const OwnedSpan cols = ownedTexels(X, s, nxr, nx);
@@ -258,14 +349,22 @@ void gatherRow(const GlossyLobeInputs& in, GlossyLobeState& st, int Y, GlossyLob
                 appendLobeRays(L, st, gx, gy, (y - rows.first) * width + (x - cols.first), sc);
             }
         sortRays(static_cast<int>(st.phi.size()), texels, sc);
-        sc.acc.assign(static_cast<std::size_t>(3 * texels), 0.0);
+        sc.hits.clear();
         const GlossyLobeScratch::Ray* rays = sc.sorted.data();
         const std::size_t n = sc.sorted.size();
         for (std::size_t a = 0; a < n;) {
             std::size_t b = a + 1;
             while (b < n && rays[b].azimuth == rays[a].azimuth) ++b;
-            walkAzimuth(in, st, rays + a, rays + b, X, Y, sc, sc.acc.data());
+            walkAzimuth<N>(in, st, rays + a, rays + b, X, Y, sc);
             a = b;
+        }
+        // what the surface sends back where each ray met it, in the walks'
+        // order (so the sums are fixed)
+        sc.acc.assign(static_cast<std::size_t>(3 * texels), 0.0);
+        MemberSamples m;
+        for (const GlossyLobeScratch::Hit& hit : sc.hits) {
+            readExit(st, nx, pyr.ny, hit.tap, m);
+            addSent(m, *hit.ray, clamp, sc.acc.data());
         }
         for (int t = 0; t < texels; ++t) {
             const std::size_t i = static_cast<std::size_t>(rows.first + t / width) * nx + cols.first + t % width;
@@ -274,6 +373,14 @@ void gatherRow(const GlossyLobeInputs& in, GlossyLobeState& st, int Y, GlossyLob
                     static_cast<float>(sc.acc[static_cast<std::size_t>(3 * t + c)]);
         }
     }
+}
+
+void gatherRowSse(const GlossyLobeInputs& in, GlossyLobeState& st, int Y, GlossyLobeScratch& sc) {
+    gatherRowImpl<2>(in, st, Y, sc);
+}
+[[gnu::target("avx2"), gnu::flatten]] void gatherRowAvx2(const GlossyLobeInputs& in, GlossyLobeState& st, int Y,
+                                                         GlossyLobeScratch& sc) {
+    gatherRowImpl<4>(in, st, Y, sc);
 }
 
 // st.exitTexels from the 48 planes of E: a transpose of a 48 x (nx ny)
@@ -375,7 +482,7 @@ void gatherGlossyLobes(const GlossyLobeInputs& in, GlossyLobeState& st) {
     }
     parallelFor(0, pyr.nyr, 1, [&](int y0, int y1) {
         GlossyLobeScratch& sc = st.scratch[static_cast<std::size_t>(workerSlot())];
-        for (int Y = y0; Y < y1; ++Y) gatherRow(in, st, Y, sc);
+        for (int Y = y0; Y < y1; ++Y) (simd::wideEnabled() ? gatherRowAvx2 : gatherRowSse)(in, st, Y, sc);
     });
 }
 

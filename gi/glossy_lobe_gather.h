@@ -66,6 +66,32 @@
 
 namespace terrain::gi {
 
+/// GCC vectors of N doubles and their comparison masks (GCC does not size a
+/// vector by a template argument).
+template <int N>
+struct TexelLaneTypes;
+template <>
+struct TexelLaneTypes<2> {
+    using Lanes = double __attribute__((vector_size(16)));
+    using Mask = std::int64_t __attribute__((vector_size(16)));
+};
+template <>
+struct TexelLaneTypes<4> {
+    using Lanes = double __attribute__((vector_size(32)));
+    using Mask = std::int64_t __attribute__((vector_size(32)));
+};
+/// N texels of a walk side by side (2 with SSE2, 4 with AVX2; in double, as
+/// one texel alone would compute): each one's offset from the receiver along
+/// the azimuth (cells), height, float margin and reach (metres), the slope of
+/// its lowest ray left, and the last step below every ray left: its sample's
+/// rise over the texel and its distance from it (metres; 0: none yet).
+template <int N>
+struct alignas(8 * N) TexelLanes {
+    using Lanes = typename TexelLaneTypes<N>::Lanes;
+    using Mask = typename TexelLaneTypes<N>::Mask;
+    Lanes along, h, margin, reach, slope, riseBefore, runBefore;
+};
+
 /// Per worker slot: one receiver row's inputs and the rays of one receiver's texels.
 struct GlossyLobeScratch {
     struct Ray {
@@ -81,7 +107,7 @@ struct GlossyLobeScratch {
     };
     std::vector<Ray> rays, sorted;  // as appended, and in walk order
     std::vector<RayKey> keys;       // sortRays' keys
-    std::vector<int> bucketStart;   // the counting sort's buckets (one per azimuth)
+    std::vector<int> bucketStart;   // the counting sort's buckets (one per azimuth and texel)
     std::vector<double> acc;        // 3 per texel of the receiver
     // Per texel of the receiver: its height, float margin, the highest rise
     // any sample can have over it (metres), and its offset from the receiver
@@ -91,17 +117,27 @@ struct GlossyLobeScratch {
         double ox, oy;
     };
     std::vector<TexelFrame> texelFrames;
-    // One texel's part of a walk: its rays along the azimuth (by slope),
-    // where it stands against the receiver and what it last saw.
+    // One texel's part of a walk: its rays along the azimuth (by slope) and
+    // where it stands; the rest of its state is in its lane.
     struct TexelWalk {
         const Ray *next, *end;
         const TexelFrame* frame;
-        double along;  // its offset from the receiver along the azimuth (cells)
-        // the last step below every ray left: its sample's rise over the
-        // texel and its distance from it (metres; 0: none yet)
-        double riseBefore = 0.0, runBefore = 0.0;
     };
     std::vector<TexelWalk> walks;
+    // walk k in lane k % N of block k / N (the SSE2 and the AVX2 variant)
+    std::vector<TexelLanes<2>> narrowLanes;
+    std::vector<TexelLanes<4>> wideLanes;
+    // Where a ray meets the surface: E's first texel of the four around it
+    // and the bilinear fractions; the receiver's hits in the walks' order.
+    struct ExitTap {
+        std::ptrdiff_t first;
+        float fx, fy;
+    };
+    struct Hit {
+        ExitTap tap;
+        const Ray* ray;
+    };
+    std::vector<Hit> hits;
     LobeQuadrature quadrature;  // the lobe directions of the last exponent
 };
 

@@ -1,5 +1,6 @@
 // The 8-wide AVX2 kernels (chosen at run time where the processor has AVX2)
-// against the 4-wide SSE2 baseline: every GI output must be bit-identical,
+// against the 4-wide SSE2 baseline (the lobe gather's walks: 4 double lanes
+// against 2): every GI output must be bit-identical,
 // so results do not depend on which path a machine takes.
 #include <vector>
 
@@ -58,4 +59,19 @@ TEST_CASE("simd: the AVX2 and SSE2 kernels give bit-identical GI frames") {
             REQUIRE(narrow.size() == wide.size());
             CHECK(narrow == wide);
         }
+    // the glossy lobe gather: its walks test 2 (SSE2) or 4 (AVX2) texels per
+    // block of lanes; at 4x a receiver's 16 texels fill several blocks
+    for (int sub : {1, 2, 4}) {
+        GiSettings s = GiSettings{};
+        s.subsample = sub;
+        s.indirect.bounces = 1;
+        s.shading.brdf = Brdf::Phong;
+        s.shading.phongExponent = 24.0f;
+        s.indirect.glossy = GlossyIndirect::LobeScan;
+        CAPTURE(sub);
+        const std::vector<float> narrow = frameOutputs(false, s, h, a);
+        const std::vector<float> wide = frameOutputs(true, s, h, a);
+        REQUIRE(narrow.size() == wide.size());
+        CHECK(narrow == wide);
+    }
 }
