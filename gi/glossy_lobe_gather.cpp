@@ -82,36 +82,24 @@ void appendLobeRays(const ReceiverLobe& L, const GlossyLobeState& st, float gx, 
         }
 }
 
-// sc.rays in walk order into sc.sorted: by azimuth, then by texel (a counting
-// sort, M x texels buckets), then by slope (insertion sort, stable: equal
-// slopes keep the order they were appended in, so the sums are fixed). The
-// sorts move 8-byte keys; each ray is copied once, at the end.
-void sortRays(int M, int texels, GlossyLobeScratch& sc) {
+// sc.rays by azimuth into sc.byAzimuth (a stable counting sort: each azimuth's
+// rays stay texel by texel, in the order they were appended).
+void bucketRays(int M, GlossyLobeScratch& sc) {
     std::vector<int>& start = sc.bucketStart;
-    const int buckets = M * texels;
-    start.assign(static_cast<std::size_t>(buckets + 1), 0);
-    const auto bucketOf = [texels](const GlossyLobeScratch::Ray& r) {
-        return static_cast<std::size_t>(r.azimuth * texels + r.texel);
-    };
-    for (const GlossyLobeScratch::Ray& r : sc.rays) ++start[bucketOf(r) + 1];
-    for (int j = 0; j < buckets; ++j) start[static_cast<std::size_t>(j + 1)] += start[static_cast<std::size_t>(j)];
-    std::vector<GlossyLobeScratch::RayKey>& keys = sc.keys;
-    keys.resize(sc.rays.size());
-    for (std::size_t i = 0; i < sc.rays.size(); ++i) {
-        const GlossyLobeScratch::Ray& r = sc.rays[i];
-        keys[static_cast<std::size_t>(start[bucketOf(r)]++)] = {r.slope, static_cast<int>(i)};
-    }
-    // start[j] is now the end of bucket j
-    for (int j = 0, begin = 0; j < buckets; begin = start[static_cast<std::size_t>(j)], ++j)
-        for (int a = begin + 1; a < start[static_cast<std::size_t>(j)]; ++a) {
-            const GlossyLobeScratch::RayKey x = keys[static_cast<std::size_t>(a)];
-            int b = a;
-            for (; b > begin && keys[static_cast<std::size_t>(b - 1)].slope > x.slope; --b)
-                keys[static_cast<std::size_t>(b)] = keys[static_cast<std::size_t>(b - 1)];
-            keys[static_cast<std::size_t>(b)] = x;
-        }
-    sc.sorted.resize(sc.rays.size());
-    for (std::size_t k = 0; k < keys.size(); ++k) sc.sorted[k] = sc.rays[static_cast<std::size_t>(keys[k].index)];
+    start.assign(static_cast<std::size_t>(M + 1), 0);
+    for (const GlossyLobeScratch::Ray& r : sc.rays) ++start[static_cast<std::size_t>(r.azimuth) + 1];
+    for (int j = 0; j < M; ++j) start[static_cast<std::size_t>(j + 1)] += start[static_cast<std::size_t>(j)];
+    sc.byAzimuth.resize(sc.rays.size());
+    for (const GlossyLobeScratch::Ray& r : sc.rays)
+        sc.byAzimuth[static_cast<std::size_t>(start[static_cast<std::size_t>(r.azimuth)]++)] = r;
+}
+
+// The lowest slope of the rays [first, end) not yet met (+inf when none is
+// left: a met ray's slope is set to +inf).
+double lowestSlope(const GlossyLobeScratch::Ray* first, const GlossyLobeScratch::Ray* end) {
+    float lowest = std::numeric_limits<float>::infinity();
+    for (const GlossyLobeScratch::Ray* r = first; r != end; ++r) lowest = std::min(lowest, r->slope);
+    return lowest;
 }
 
 // The exit radiance E (48 planes) where a ray meets the surface.
@@ -211,8 +199,8 @@ std::vector<TexelLanes<N>>& laneBlocks(GlossyLobeScratch& sc) {
 // there goes on alone.
 template <int N>
 [[gnu::always_inline]] inline void walkAzimuth(const GlossyLobeInputs& in, const GlossyLobeState& st,
-                                               const GlossyLobeScratch::Ray* begin, const GlossyLobeScratch::Ray* end,
-                                               int X, int Y, GlossyLobeScratch& sc) {
+                                               GlossyLobeScratch::Ray* begin, GlossyLobeScratch::Ray* end, int X, int Y,
+                                               GlossyLobeScratch& sc) {
     const HeightPyramid& pyr = in.heights;
     const int j = begin->azimuth, nSteps = st.stepStride;
     const int pad = static_cast<int>(st.stepsPerColumn.size() / st.phi.size());
@@ -224,8 +212,8 @@ template <int N>
     const double cell = pyr.cellSize;
     std::vector<GlossyLobeScratch::TexelWalk>& walks = sc.walks;
     walks.clear();
-    for (const GlossyLobeScratch::Ray* r = begin; r != end;) {
-        const GlossyLobeScratch::Ray* e = r;
+    for (GlossyLobeScratch::Ray* r = begin; r != end;) {
+        GlossyLobeScratch::Ray* e = r;
         while (e != end && e->texel == r->texel) ++e;
         walks.push_back({r, e, &sc.texelFrames[static_cast<std::size_t>(r->texel)]});
         r = e;
@@ -251,7 +239,7 @@ template <int N>
         L.h[l] = w.frame->h;
         L.margin[l] = w.frame->margin;
         L.reach[l] = w.frame->reach;
-        L.slope[l] = w.next->slope;
+        L.slope[l] = lowestSlope(w.first, w.end);
     }
     int active = static_cast<int>(walks.size());
     // block b's lanes L at a step: sample v, tau cells from the receiver
@@ -268,22 +256,36 @@ template <int N>
             for (int l = 0; l < N; ++l) {
                 if (!(stop[l] | meets[l])) continue;
                 GlossyLobeScratch::TexelWalk& w = walks[static_cast<std::size_t>(b * N + l)];
+                double lowest = stop[l] ? kDone : L.slope[l];
                 if (meets[l]) {
+                    // the rays met here, in the order of their slopes (equal
+                    // slopes in the order appended, so the sums are fixed)
+                    std::vector<GlossyLobeScratch::Ray*>& met = sc.met;
+                    met.clear();
+                    for (GlossyLobeScratch::Ray* r = w.first; r != w.end; ++r) {
+                        if (!(r->slope * run[l] <= rise[l])) continue;
+                        std::size_t k = met.size();
+                        met.push_back(r);
+                        for (; k > 0 && met[k - 1]->slope > r->slope; --k) met[k] = met[k - 1];
+                        met[k] = r;
+                    }
                     const GlossyLobeScratch::TexelFrame& f = *w.frame;
-                    for (; w.next != w.end && w.next->slope * run[l] <= rise[l]; ++w.next) {
+                    for (GlossyLobeScratch::Ray* r : met) {
                         const double d =
-                            crossingDistance(L.riseBefore[l], L.runBefore[l], rise[l], run[l], w.next->slope) / cell;
+                            crossingDistance(L.riseBefore[l], L.runBefore[l], rise[l], run[l], r->slope) / cell;
                         const GlossyLobeScratch::ExitTap tap =
                             exitTap(pyr.nx, pyr.ny, x0 + f.ox + d * c, y0 + f.oy + d * sn);
                         prefetchExit(st, pyr.nx, pyr.ny, tap);
-                        sc.hits.push_back({tap, w.next});
+                        sc.hits.push_back({tap, r});
+                        r->slope = std::numeric_limits<float>::infinity();
                     }
+                    lowest = lowestSlope(w.first, w.end);
                 }
-                if (stop[l] || w.next == w.end) {
+                if (lowest == kDone) {
                     L.along[l] = kDone;
                     --active;
                 } else {
-                    L.slope[l] = w.next->slope;
+                    L.slope[l] = lowest;
                 }
             }
         }
@@ -348,10 +350,10 @@ template <int N>
                 const ReceiverLobe L = receiverLobe(gx, gy, in.shading.viewDir, S);
                 appendLobeRays(L, st, gx, gy, (y - rows.first) * width + (x - cols.first), sc);
             }
-        sortRays(static_cast<int>(st.phi.size()), texels, sc);
+        bucketRays(static_cast<int>(st.phi.size()), sc);
         sc.hits.clear();
-        const GlossyLobeScratch::Ray* rays = sc.sorted.data();
-        const std::size_t n = sc.sorted.size();
+        GlossyLobeScratch::Ray* rays = sc.byAzimuth.data();
+        const std::size_t n = sc.byAzimuth.size();
         for (std::size_t a = 0; a < n;) {
             std::size_t b = a + 1;
             while (b < n && rays[b].azimuth == rays[a].azimuth) ++b;

@@ -52,8 +52,9 @@
 // diffuse part of a mixture and the bounces after the first keep the SH
 // kernel (U); their incident SH comes from U as in the vector mode.
 //
-// Deterministic: per receiver a pure function of its inputs (the rays sorted
-// by a total order), receiver rows in parallel.
+// Deterministic: per receiver a pure function of its inputs (the rays a step
+// meets taken by slope, then in the order appended), receiver rows in
+// parallel.
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -97,18 +98,13 @@ struct GlossyLobeScratch {
     struct Ray {
         int azimuth;    // global azimuth j of the walk that reads the ray
         int texel;      // which of the receiver's texels it serves
-        float slope;    // tan of the ray's elevation
+        float slope;    // tan of the ray's elevation (+inf once the walk met it)
         float weight;   // quadrature weight x the linear azimuth weight
         float back[3];  // unit direction from the member back to the receiver
     };
-    struct RayKey {
-        float slope;
-        int index;  // into rays
-    };
-    std::vector<Ray> rays, sorted;  // as appended, and in walk order
-    std::vector<RayKey> keys;       // sortRays' keys
-    std::vector<int> bucketStart;   // the counting sort's buckets (one per azimuth and texel)
-    std::vector<double> acc;        // 3 per texel of the receiver
+    std::vector<Ray> rays, byAzimuth;  // as appended, and by azimuth (then texel)
+    std::vector<int> bucketStart;      // the counting sort's buckets (one per azimuth)
+    std::vector<double> acc;           // 3 per texel of the receiver
     // Per texel of the receiver: its height, float margin, the highest rise
     // any sample can have over it (metres), and its offset from the receiver
     // (cells).
@@ -120,9 +116,10 @@ struct GlossyLobeScratch {
     // One texel's part of a walk: its rays along the azimuth (by slope) and
     // where it stands; the rest of its state is in its lane.
     struct TexelWalk {
-        const Ray *next, *end;
+        Ray *first, *end;  // a met ray's slope becomes +inf
         const TexelFrame* frame;
     };
+    std::vector<Ray*> met;  // one texel's rays met at one step
     std::vector<TexelWalk> walks;
     // walk k in lane k % N of block k / N (the SSE2 and the AVX2 variant)
     std::vector<TexelLanes<2>> narrowLanes;
