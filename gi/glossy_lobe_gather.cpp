@@ -45,41 +45,52 @@ double azimuthOf(double x, double y) {
     const double lo = std::min(ax, ay), hi = std::max(ax, ay);
     const double q = hi > 0.0 ? lo / hi : 0.0, q2 = q * q;
     double a = q * (0.9998660 + q2 * (-0.3302995 + q2 * (0.1801410 + q2 * (-0.0851330 + q2 * 0.0208351))));
-    if (ay > ax) a = 0.5 * kPi - a;
-    if (x < 0.0) a = kPi - a;
-    if (y < 0.0) a = 2.0 * kPi - a;
+    a = ay > ax ? 0.5 * kPi - a : a;
+    a = x < 0.0 ? kPi - a : a;
+    a = y < 0.0 ? 2.0 * kPi - a : a;
     return a >= 2.0 * kPi ? 0.0 : a;
 }
 
 // A texel's rays as the walks read them, appended to sc.rays: each lobe
 // direction split between the two global azimuths on either side of it
 // (linear weights), those above the texel's tangent plane along their azimuth
-// only.
+// only. The directions go through each stage together (loops the compiler
+// vectorises), the rays are appended one by one.
 void appendLobeRays(const ReceiverLobe& L, const GlossyLobeState& st, float gx, float gy, int texel,
                     GlossyLobeScratch& sc) {
     sc.quadrature.set(L.S, sc.quadrature.rings());
     const int rings = sc.quadrature.rings(), M = static_cast<int>(st.phi.size());
+    const int count = 2 * rings * rings;
     const double dphi = 2.0 * kPi / M;
     const float w0 = 1.0f / static_cast<float>(2 * rings * rings);
-    for (int i = 0; i < rings; ++i)
-        for (int k = 0; k < 2 * rings; ++k) {
+    GlossyLobeScratch::Directions& dir = sc.directions;
+    dir.resize(count);
+    for (int i = 0, d = 0; i < rings; ++i)
+        for (int k = 0; k < 2 * rings; ++k, ++d) {
             double w[3];
             sc.quadrature.direction(L.r, L.t, L.b, i, k, w);
-            const double horizontal = std::sqrt(w[0] * w[0] + w[1] * w[1]);
-            if (horizontal < 1e-9) continue;  // straight up: meets nothing
-            const double u = azimuthOf(w[0], w[1]) / dphi;
-            const int j0 = std::min(static_cast<int>(u), M - 1);
-            const double f = u - j0;
-            const float slope = static_cast<float>(w[2] / horizontal);
-            const float cosE = static_cast<float>(horizontal), sinE = static_cast<float>(w[2]);
-            for (int side = 0; side < 2; ++side) {
-                const int j = (j0 + side) % M;
-                const float weight = w0 * static_cast<float>(side == 0 ? 1.0 - f : f);
-                const float c = st.cosPhi[static_cast<std::size_t>(j)], s = st.sinPhi[static_cast<std::size_t>(j)];
-                if (weight <= 0.0f || slope <= gx * c + gy * s) continue;  // below the tangent plane
-                sc.rays.push_back({j, texel, slope, weight, {-c * cosE, -s * cosE, -sinE}});
-            }
+            dir.x[d] = w[0];
+            dir.y[d] = w[1];
+            dir.z[d] = w[2];
         }
+    for (int d = 0; d < count; ++d) dir.horizontal[d] = std::sqrt(dir.x[d] * dir.x[d] + dir.y[d] * dir.y[d]);
+    for (int d = 0; d < count; ++d) dir.u[d] = azimuthOf(dir.x[d], dir.y[d]) / dphi;
+    for (int d = 0; d < count; ++d) dir.slope[d] = dir.z[d] / dir.horizontal[d];
+    for (int d = 0; d < count; ++d) {
+        if (dir.horizontal[d] < 1e-9) continue;  // straight up: meets nothing
+        const double u = dir.u[d];
+        const int j0 = std::min(static_cast<int>(u), M - 1);
+        const double f = u - j0;
+        const float slope = static_cast<float>(dir.slope[d]);
+        const float cosE = static_cast<float>(dir.horizontal[d]), sinE = static_cast<float>(dir.z[d]);
+        for (int side = 0; side < 2; ++side) {
+            const int j = (j0 + side) % M;
+            const float weight = w0 * static_cast<float>(side == 0 ? 1.0 - f : f);
+            const float c = st.cosPhi[static_cast<std::size_t>(j)], s = st.sinPhi[static_cast<std::size_t>(j)];
+            if (weight <= 0.0f || slope <= gx * c + gy * s) continue;  // below the tangent plane
+            sc.rays.push_back({j, texel, slope, weight, {-c * cosE, -s * cosE, -sinE}});
+        }
+    }
 }
 
 // sc.rays by azimuth into sc.byAzimuth (a stable counting sort: each azimuth's

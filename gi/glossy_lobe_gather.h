@@ -136,6 +136,15 @@ struct GlossyLobeScratch {
     };
     std::vector<Hit> hits;
     LobeQuadrature quadrature;  // the lobe directions of the last exponent
+    // One texel's lobe directions, stage by stage: the unit direction, its
+    // horizontal length, its azimuth in units of the global azimuths and its
+    // slope.
+    struct Directions {
+        std::vector<double> x, y, z, horizontal, u, slope;
+        void resize(int n) {
+            for (std::vector<double>* v : {&x, &y, &z, &horizontal, &u, &slope}) v->resize(static_cast<std::size_t>(n));
+        }
+    } directions;
 };
 
 /// The gather's step tables and its result (reused: no allocation after the

@@ -35,17 +35,12 @@ double ringSine(double c) { return std::sqrt(std::max(0.0, 1.0 - c * c)); }
 // Azimuth j of the 2n about R.
 double azimuthAngle(int n, int j) { return kPi * (j + 0.5) / n; }
 
-void combine(const double r[3], const double t[3], const double b[3], double c, double s, double cp, double sp,
-             double w[3]) {
-    for (int k = 0; k < 3; ++k) w[k] = c * r[k] + s * (cp * t[k] + sp * b[k]);
-}
-
 }  // namespace
 
 void lobeDirection(const double r[3], const double t[3], const double b[3], double S, int n, int i, int j,
                    double w[3]) {
     const double c = ringCosine(S, n, i), psi = azimuthAngle(n, j);
-    combine(r, t, b, c, ringSine(c), std::cos(psi), std::sin(psi), w);
+    lobeCombine(r, t, b, c, ringSine(c), std::cos(psi), std::sin(psi), w);
 }
 
 void LobeQuadrature::set(double S, int n) {
@@ -67,12 +62,6 @@ void LobeQuadrature::set(double S, int n) {
         ringCos_[static_cast<std::size_t>(i)] = ringCosine(S, n, i);
         ringSin_[static_cast<std::size_t>(i)] = ringSine(ringCos_[static_cast<std::size_t>(i)]);
     }
-}
-
-void LobeQuadrature::direction(const double r[3], const double t[3], const double b[3], int i, int j,
-                               double w[3]) const {
-    const auto ii = static_cast<std::size_t>(i), jj = static_cast<std::size_t>(j);
-    combine(r, t, b, ringCos_[ii], ringSin_[ii], psiCos_[jj], psiSin_[jj], w);
 }
 
 }  // namespace terrain::gi

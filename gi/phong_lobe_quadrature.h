@@ -12,12 +12,20 @@
 // therefore integrates every exponent alike (the lobe's peak is absorbed by
 // the substitution); each direction carries the weight 1 / (2 n^2).
 
+#include <cstddef>
 #include <vector>
 
 namespace terrain::gi {
 
 /// Orthonormal frame (t, b) about the unit vector r.
 void lobeFrame(const double r[3], double t[3], double b[3]);
+
+/// c r + s (cp t + sp b): the direction at cosine c (sine s) from r and
+/// azimuth (cp, sp) about it in the frame (t, b).
+inline void lobeCombine(const double r[3], const double t[3], const double b[3], double c, double s, double cp,
+                        double sp, double w[3]) {
+    for (int k = 0; k < 3; ++k) w[k] = c * r[k] + s * (cp * t[k] + sp * b[k]);
+}
 
 /// Quadrature direction (ring i of n, azimuth j of 2n) of the Phong lobe of
 /// exponent S about r (frame t, b from lobeFrame); each carries the weight
@@ -32,7 +40,10 @@ class LobeQuadrature {
 public:
     void set(double S, int n);
     int rings() const { return n_; }
-    void direction(const double r[3], const double t[3], const double b[3], int i, int j, double w[3]) const;
+    void direction(const double r[3], const double t[3], const double b[3], int i, int j, double w[3]) const {
+        const auto ii = static_cast<std::size_t>(i), jj = static_cast<std::size_t>(j);
+        lobeCombine(r, t, b, ringCos_[ii], ringSin_[ii], psiCos_[jj], psiSin_[jj], w);
+    }
 
 private:
     double S_ = -1.0;
