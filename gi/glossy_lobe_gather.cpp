@@ -242,25 +242,30 @@ template <int N>
         L.riseBefore[l] = L.runBefore[l] = 0.0;
         if (k >= static_cast<int>(walks.size())) {
             L.along[l] = kDone;
-            L.h[l] = L.margin[l] = L.reach[l] = L.slope[l] = 0.0;
+            L.h[l] = L.margin[l] = L.slope[l] = 0.0;
             continue;
         }
         const GlossyLobeScratch::TexelWalk& w = walks[static_cast<std::size_t>(k)];
         L.along[l] = w.frame->ox * c + w.frame->oy * sn;
         L.h[l] = w.frame->h;
         L.margin[l] = w.frame->margin;
-        L.reach[l] = w.frame->reach;
         L.slope[l] = lowestSlope(w.first, w.end);
     }
     int active = static_cast<int>(walks.size());
-    // block b's lanes L at a step: sample v, tau cells from the receiver
-    const auto step = [&](Block& L, int b, float v, double tau) {
+    // the highest sample of each band on, of this receiver's walk
+    const float* tops = sc.bandTops.data() + static_cast<std::size_t>(j * st.bands) * pad + static_cast<std::size_t>(X);
+    // block b's lanes L at a step: sample v, tau cells from the receiver, in
+    // band `band`
+    const auto step = [&](Block& L, int b, float v, double tau, int band) {
         const typename Block::Lanes dist = tau - L.along;  // from the texel, along the azimuth (cells)
         const typename Block::Mask valid = dist >= 0.5;    // not beside or behind the texel
         const typename Block::Lanes run = dist * cell;     // metres
         const typename Block::Lanes reached = L.slope * run;
-        // no sample from here on rises to its lowest ray left
-        const typename Block::Mask stop = valid & (L.reach < reached);
+        // no sample from here on rises to its lowest ray left: the highest
+        // of this band on is below it here, and farther on a rising ray is
+        // higher still (a falling one may yet meet one)
+        const double top = tops[static_cast<std::size_t>(band * pad)];
+        const typename Block::Mask stop = valid & (L.slope >= 0.0) & (reached > (top - L.h) - L.margin);
         const typename Block::Lanes rise = (static_cast<double>(v) - L.h) - L.margin;  // over the texel, metres
         const typename Block::Mask meets = valid & ~stop & (reached <= rise);
         if (anyLane(stop | meets)) {
@@ -311,13 +316,43 @@ template <int N>
     if (nBlocks == 1) {  // one block (1x, 2x): its lanes held in registers
         Block L = blocks[0];
         for (int i = 0; i < prefix && active > 0; ++i)
-            step(L, 0, sample(i), st.stepCells[base + static_cast<std::size_t>(i)]);
+            step(L, 0, sample(i), st.stepCells[base + static_cast<std::size_t>(i)],
+                 st.stepBand[base + static_cast<std::size_t>(i)]);
         return;
     }
     for (int i = 0; i < prefix && active > 0; ++i) {
         const float v = sample(i);
         for (int b = 0; b < nBlocks; ++b)
-            step(blocks[static_cast<std::size_t>(b)], b, v, st.stepCells[base + static_cast<std::size_t>(i)]);
+            step(blocks[static_cast<std::size_t>(b)], b, v, st.stepCells[base + static_cast<std::size_t>(i)],
+                 st.stepBand[base + static_cast<std::size_t>(i)]);
+    }
+}
+
+// sc.bandTops of receiver row Y: per azimuth, band and receiver the highest
+// height sample of its walk from that band on, each sample as the walk reads
+// it (the same floats), the receivers of the row side by side.
+void rowBandTops(const GlossyLobeState& st, int Y, GlossyLobeScratch& sc) {
+    const int M = static_cast<int>(st.phi.size()), bands = st.bands;
+    const std::size_t nxr = st.stepsPerColumn.size() / st.phi.size();  // padded row
+    sc.bandTops.assign(static_cast<std::size_t>(M * bands) * nxr, -std::numeric_limits<float>::infinity());
+    for (int j = 0; j < M; ++j) {
+        float* tops = sc.bandTops.data() + static_cast<std::size_t>(j * bands) * nxr;
+        const std::size_t base = static_cast<std::size_t>(j) * st.stepStride;
+        for (int i = 0; i < st.stepCounts[static_cast<std::size_t>(j)]; ++i) {
+            const GlossyLobeState::StepReceivers& r = st.stepReceivers[base + static_cast<std::size_t>(i)];
+            if (Y < r.y0 || Y > r.y1 || r.x0 > r.x1) break;  // the boxes only narrow
+            const ScanStep& hs = st.heightSteps[base + static_cast<std::size_t>(i)];
+            const float wA = hs.w[0][0], wB = hs.w[1][0];
+            const float* a = hs.field + Y * hs.rowStep + hs.offA;
+            const float* b = hs.field + Y * hs.rowStep + hs.offB;
+            float* top = tops + static_cast<std::size_t>(st.stepBand[base + static_cast<std::size_t>(i)]) * nxr;
+            for (int X = r.x0; X <= r.x1; ++X) top[X] = std::max(top[X], wA * a[X] + wB * b[X]);
+        }
+        for (int k = bands - 2; k >= 0; --k) {
+            float* top = tops + static_cast<std::size_t>(k) * nxr;
+            const float* next = top + nxr;
+            for (std::size_t X = 0; X < nxr; ++X) top[X] = std::max(top[X], next[X]);
+        }
     }
 }
 
@@ -344,6 +379,7 @@ template <int N>
     const bool expMap = in.surface && !in.surface->phongExponent.empty();
     const bool clamp = in.shading.positivity == GlossyPositivity::Clamp;
     const OwnedSpan rows = ownedTexels(Y, s, pyr.nyr, pyr.ny);
+    rowBandTops(st, Y, sc);
     for (int X = 0; X < nxr; ++X) {
         const OwnedSpan cols = ownedTexels(X, s, nxr, nx);
         const int width = cols.last - cols.first + 1;
@@ -354,8 +390,7 @@ template <int N>
             for (int x = cols.first; x <= cols.last; ++x) {
                 const float h = pyr.rawPhaseRow(x % s, y)[x / s];
                 const float margin = std::fabs(h) * kHeightMarginRel;
-                sc.texelFrames.push_back({h, margin, (in.topHeight - h) - margin, static_cast<double>(x - s * X),
-                                          static_cast<double>(y - s * Y)});
+                sc.texelFrames.push_back({h, margin, static_cast<double>(x - s * X), static_cast<double>(y - s * Y)});
                 const double S = expMap ? in.surface->phongExponent(x, y) : in.shading.phongExponent;
                 const float gx = in.gradX(x, y), gy = in.gradY(x, y);
                 const ReceiverLobe L = receiverLobe(gx, gy, in.shading.viewDir, S);
@@ -449,6 +484,9 @@ void buildWalkTable(const HeightPyramid& pyr, int perOctave, int nearOctaves, in
     const std::size_t table = static_cast<std::size_t>(M) * steps.size();
     st.heightSteps.resize(table);
     st.stepCells.resize(table);
+    st.stepBand.resize(table);
+    st.stepReceivers.resize(table);
+    st.stepCounts.resize(static_cast<std::size_t>(M));
     st.stepsPerColumn.resize(static_cast<std::size_t>(M) * pad);
     st.stepsPerRow.resize(static_cast<std::size_t>(M) * pyr.nyr);
     parallelFor(0, M, 1, [&](int j0, int j1) {
@@ -458,18 +496,30 @@ void buildWalkTable(const HeightPyramid& pyr, int perOctave, int nearOctaves, in
             ValidPrefix prefix(pyr.nxr, pyr.nyr, pad, st.stepsPerColumn.data() + ju * pad,
                                st.stepsPerRow.data() + ju * pyr.nyr);
             int n = 0;
+            GlossyLobeState::StepReceivers reach{0, pyr.nxr - 1, 0, pyr.nyr - 1};
             for (const PyramidStep& ps : steps) {
                 const ScanStepInfo info = scanStepInfoAt(pyr, ps, std::cos(st.phi[ju]), std::sin(st.phi[ju]));
                 if (n > 0 && sameSample(info.step, st.heightSteps[base + static_cast<std::size_t>(n - 1)])) continue;
-                st.heightSteps[base + static_cast<std::size_t>(n)] = info.step;
-                st.stepCells[base + static_cast<std::size_t>(n)] =
-                    1.0 / (static_cast<double>(info.step.w[2][0]) * pyr.cellSize);
+                const std::size_t at = base + static_cast<std::size_t>(n);
+                const double tau = 1.0 / (static_cast<double>(info.step.w[2][0]) * pyr.cellSize);
+                st.heightSteps[at] = info.step;
+                st.stepCells[at] = tau;
+                st.stepBand[at] = static_cast<std::uint8_t>(tau <= 1.0 ? 0 : std::ceil(std::log2(tau)));
                 prefix.narrow(info);
                 prefix.commit(n);
+                reach = {std::max(reach.x0, info.xFirst), std::min(reach.x1, info.xLast),
+                         std::max(reach.y0, info.yFirst), std::min(reach.y1, info.yLast)};
+                st.stepReceivers[at] = reach;
                 ++n;
             }
+            st.stepCounts[ju] = n;
         }
     });
+    st.bands = 0;
+    for (int j = 0; j < M; ++j) {
+        const int n = st.stepCounts[static_cast<std::size_t>(j)];
+        if (n > 0) st.bands = std::max(st.bands, st.stepBand[static_cast<std::size_t>(j) * steps.size() + n - 1] + 1);
+    }
 }
 
 }  // namespace

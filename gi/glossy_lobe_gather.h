@@ -83,14 +83,14 @@ struct TexelLaneTypes<4> {
 };
 /// N texels of a walk side by side (2 with SSE2, 4 with AVX2; in double, as
 /// one texel alone would compute): each one's offset from the receiver along
-/// the azimuth (cells), height, float margin and reach (metres), the slope of
-/// its lowest ray left, and the last step below every ray left: its sample's
+/// the azimuth (cells), height and float margin (metres), the slope of its
+/// lowest ray left, and the last step below every ray left: its sample's
 /// rise over the texel and its distance from it (metres; 0: none yet).
 template <int N>
 struct alignas(8 * N) TexelLanes {
     using Lanes = typename TexelLaneTypes<N>::Lanes;
     using Mask = typename TexelLaneTypes<N>::Mask;
-    Lanes along, h, margin, reach, slope, riseBefore, runBefore;
+    Lanes along, h, margin, slope, riseBefore, runBefore;
 };
 
 /// Per worker slot: one receiver row's inputs and the rays of one receiver's texels.
@@ -105,14 +105,17 @@ struct GlossyLobeScratch {
     std::vector<Ray> rays, byAzimuth;  // as appended, and by azimuth (then texel)
     std::vector<int> bucketStart;      // the counting sort's buckets (one per azimuth)
     std::vector<double> acc;           // 3 per texel of the receiver
-    // Per texel of the receiver: its height, float margin, the highest rise
-    // any sample can have over it (metres), and its offset from the receiver
-    // (cells).
+    // Per texel of the receiver: its height and float margin (metres), and
+    // its offset from the receiver (cells).
     struct TexelFrame {
-        float h, margin, reach;
+        float h, margin;
         double ox, oy;
     };
     std::vector<TexelFrame> texelFrames;
+    // The receiver row's highest samples (GlossyLobeState::stepBand): of
+    // azimuth j, band k and receiver X at (j bands + k) nxr + X, the highest
+    // height sample of its walk from band k on (-inf: none).
+    std::vector<float> bandTops;
     // One texel's part of a walk: its rays along the azimuth (by slope) and
     // where it stands; the rest of its state is in its lane.
     struct TexelWalk {
@@ -159,6 +162,17 @@ struct GlossyLobeState {
     std::vector<ScanStep> heightSteps;
     std::vector<double> stepCells;
     std::vector<int> stepsPerColumn, stepsPerRow;
+    // Per step (as heightSteps) its distance band (0 out to 1 cell, k from
+    // 2^(k-1) to 2^k cells) and the receivers whose walks reach it (a box:
+    // the valid prefixes narrow step by step); per azimuth its steps; the
+    // bands of the longest walk.
+    struct StepReceivers {
+        int x0, x1, y0, y1;  // inclusive
+    };
+    std::vector<std::uint8_t> stepBand;
+    std::vector<StepReceivers> stepReceivers;
+    std::vector<int> stepCounts;
+    int bands = 0;
     // E at full resolution with the 48 planes interleaved (value f of texel
     // k at k * 48 + f), bfloat16: a ray's E is four runs of 96 bytes.
     std::vector<std::uint16_t> exitTexels;
@@ -173,9 +187,8 @@ struct GlossyLobeInputs {
     const float* exit;             // E at full resolution: 48 planes of nx * ny (gi/glossy_exit_radiance.h)
     const AlbedoMap* surface;      // per-texel exponent (null or empty: the settings')
     const ShadingSettings& shading;
-    float topHeight;  // the field's highest height (no sample rises above it)
-    int azimuths;     // M, the global azimuths
-    int rings;        // n: n rings x 2n directions per lobe
+    int azimuths;  // M, the global azimuths
+    int rings;     // n: n rings x 2n directions per lobe
     // The walks' raw steps: out to 2^nearOctaves cells, nearStepsPerOctave per
     // octave (then the pyramid's steps).
     int nearStepsPerOctave;

@@ -125,7 +125,6 @@ void ShKernelIndirect::scan(int b) {
                                       st_.glossy.exitSh.data(),
                                       in_.albedo,
                                       in_.shading,
-                                      scan_.topHeight(),
                                       settings_.lobeAzimuths,
                                       settings_.lobeRings,
                                       settings_.lobeNearStepsPerOctave,
