@@ -83,6 +83,7 @@ TEST_CASE("frame layers: EXR channels round trip bit for bit, with the cell size
     CHECK(sameBits(one.grids[0], f.find("discharge")->grid));
     CHECK(one.available.size() == f.layers.size());
     CHECK_THROWS_AS(writeExrChannels(file, {"a", "a"}, {f.grids()[0], f.grids()[1]}), IoError);
+    std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("frame layers: GeoTIFF bands round trip bit for bit, named by their descriptions") {
@@ -107,6 +108,7 @@ TEST_CASE("frame layers: GeoTIFF bands round trip bit for bit, named by their de
     }
     GDALClose(ds);
     CHECK_THROWS_AS(writeGeoTiff(file, bands, GeoReference{}, std::vector<std::string>{"one"}), IoError);
+    std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("frame layers: an OpenVDB frame holds every layer as a grid, and still reads as a terrain") {
@@ -135,6 +137,7 @@ TEST_CASE("frame layers: an OpenVDB frame holds every layer as a grid, and still
     readVdb(file, s, LayerSet{.water = true});
     CHECK(sameBits(s.bedrock, f.find("bedrock")->grid));
     CHECK(sameBits(s.water, f.find("water")->grid));
+    std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("frame layers: a float EXR is a heightmap: its height channel, or its only channel") {
@@ -159,6 +162,7 @@ TEST_CASE("frame layers: a float EXR is a heightmap: its height channel, or its 
     const std::string two = (dir / "two.exr").string();
     writeExrChannels(two, {"R", "G"}, {&h, &other});
     CHECK(readErrorOf(two).find("no 'height' channel and more than one other (G, R)") != std::string::npos);
+    std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("frame layers: a truncated or damaged EXR heightmap gets one line naming the file") {
@@ -177,6 +181,7 @@ TEST_CASE("frame layers: a truncated or damaged EXR heightmap gets one line nami
     const std::string empty = (dir / "empty.exr").string();
     test::writeBytes(empty, "");
     CHECK(readErrorOf(empty).find("empty.exr") != std::string::npos);
+    std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("frame layers: an EXR declaring more pixels than its bytes can hold is refused before they are allocated") {
@@ -197,4 +202,5 @@ TEST_CASE("frame layers: an EXR declaring more pixels than its bytes can hold is
     const std::string error = readErrorOf(big);
     CHECK(error.find("big.exr: 1 EXR channels of 16384 x 16384 pixels in") != std::string::npos);
     CHECK(error.find("more than the file can hold") != std::string::npos);
+    std::filesystem::remove_all(dir);
 }

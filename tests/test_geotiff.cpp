@@ -139,6 +139,7 @@ TEST_CASE("geotiff: every integer and float type reads as its heights, cell size
         CHECK(geo.georeferenced());
         for (std::size_t i = 0; i < typed.size(); ++i) REQUIRE(g.v[i] == static_cast<float>(typed[i]));
     }
+    std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("geotiff: tiled and compressed layouts read the same heights") {
@@ -163,6 +164,7 @@ TEST_CASE("geotiff: tiled and compressed layouts read the same heights") {
         makeTiff(path, nx, ny, v, spec);
         CHECK(sameBits(readHeightmap(path, 1.0f, 0.0f), reference));
     }
+    std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("geotiff: a written map reads back bit-exactly with its geotransform and CRS") {
@@ -188,6 +190,7 @@ TEST_CASE("geotiff: a written map reads back bit-exactly with its geotransform a
     const std::string again = (dir / "again.tiff").string();
     writeGeoTiff(again, std::span<const Grid>(&g, 1), geo);
     CHECK(test::readBytes(out) == test::readBytes(again));
+    std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("geotiff: three bands keep their order and values") {
@@ -210,6 +213,7 @@ TEST_CASE("geotiff: three bands keep their order and values") {
         CHECK(std::memcmp(band.data(), rgb[c].v.data(), band.size() * sizeof(float)) == 0);
     }
     GDALClose(ds);
+    std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("geotiff: a failed write leaves the previous file as it was") {
@@ -227,6 +231,7 @@ TEST_CASE("geotiff: a failed write leaves the previous file as it was") {
     std::size_t files = 0;
     for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++files;
     CHECK(files == 1);  // no temporary left behind
+    std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("geotiff: the same heights light the same as the PNG given the GeoTIFF's cell size") {
@@ -246,6 +251,7 @@ TEST_CASE("geotiff: the same heights light the same as the PNG given the GeoTIFF
     const std::string tif = (dir / "dem.tif").string();
     makeTiff(tif, nx, ny, heights, spec);
     requireLitAlike(tif, fromPng, cell);
+    std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("geotiff: the Mont Blanc DEM as a GeoTIFF lights the same as its PNG (when the data are here)") {
@@ -264,6 +270,7 @@ TEST_CASE("geotiff: the Mont Blanc DEM as a GeoTIFF lights the same as its PNG (
     const std::string tif = (dir / "montblanc.tif").string();
     writeGeoTiff(tif, std::span<const Grid>(&fromPng, 1), geo);
     requireLitAlike(tif, fromPng, cell);
+    std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("geotiff: a scene's DEM takes the file's cell size, and its frames its place") {
@@ -285,6 +292,7 @@ TEST_CASE("geotiff: a scene's DEM takes the file's cell size, and its frames its
     CHECK(set.geoReference().transform == expected);
     // a generated terrain has no place
     CHECK_FALSE(Simulation(builtinScene("erosion", 16, 1)).geoReference().georeferenced());
+    std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("geotiff: nodata cells take the nearest valid height and are counted") {
@@ -311,6 +319,7 @@ TEST_CASE("geotiff: nodata cells take the nearest valid height and are counted")
     CHECK(t.heights.v[23] == 117.0f);
     for (std::size_t i = 0; i < v.size(); ++i)
         if (v[i] != -9999.0) CHECK(t.heights.v[i] == static_cast<float>(v[i]));
+    std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("geotiff: a float32 NaN nodata is filled; a NaN that is not nodata is an error") {
@@ -334,6 +343,7 @@ TEST_CASE("geotiff: a float32 NaN nodata is filled; a NaN that is not nodata is 
     holes.nodata = -32768.0;
     makeTiff((dir / "all.tif").string(), 5, 5, all, holes);
     CHECK(errorOf((dir / "all.tif").string()).find("every cell is nodata") != std::string::npos);
+    std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("fillNodata: nearest in steps, the same on every run, an error with nothing to fill from") {
@@ -366,6 +376,7 @@ TEST_CASE("geotiff: a CRS that is not projected in metres gets one line saying w
     noCrs.epsg = 0;
     makeTiff((dir / "nocrs.tif").string(), 8, 8, v, noCrs);
     CHECK(errorOf((dir / "nocrs.tif").string()).find("no coordinate reference system") != std::string::npos);
+    std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("geotiff: rotated or non-square pixels are refused") {
@@ -379,6 +390,7 @@ TEST_CASE("geotiff: rotated or non-square pixels are refused") {
     oblong.transform = {500000.0, 30.0, 0.0, 5000000.0, 0.0, -20.0};
     makeTiff((dir / "oblong.tif").string(), 8, 8, v, oblong);
     CHECK(errorOf((dir / "oblong.tif").string()).find("not square") != std::string::npos);
+    std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("geotiff: a declared size over the limit is refused before any pixel is read") {
@@ -398,6 +410,7 @@ TEST_CASE("geotiff: a declared size over the limit is refused before any pixel i
     const std::string e = errorOf(path);
     CHECK(e.find("20000") != std::string::npos);
     CHECK(e.find("16384") != std::string::npos);
+    std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("geotiff: a block (tile or strip) of gigabytes is refused before GDAL allocates it") {
@@ -413,6 +426,7 @@ TEST_CASE("geotiff: a block (tile or strip) of gigabytes is refused before GDAL 
     spec.options = {"TILED=YES", "BLOCKXSIZE=256", "BLOCKYSIZE=256"};
     makeTiff((dir / "small_block.tif").string(), 32, 32, ridge(32, 32), spec);
     CHECK(errorOf((dir / "small_block.tif").string()).empty());
+    std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("geotiff: truncated and corrupted files give one bounded line or a successful read") {
@@ -450,4 +464,5 @@ TEST_CASE("geotiff: truncated and corrupted files give one bounded line or a suc
     }
     CHECK(errors > 0);
     CHECK(reads > 0);
+    std::filesystem::remove_all(dir);
 }
