@@ -44,9 +44,10 @@
 // its own), its rays leaving from it. Seen from the receiver instead, 2x lost
 // 6-9 points of accuracy against 1x (README). A receiver's texels share its
 // walks: one per azimuth some ray of theirs reads, each step's sample read
-// once for all of them; a texel's part of a walk stops once the field's
-// highest height cannot reach its lowest unmet ray: narrow lobes walk 2-4
-// azimuths, and rays high above the horizon stop after a few steps.
+// once for all of them; a texel's part of a walk stops once its lowest unmet
+// ray rises above the highest sample the walk has left (taken per distance
+// band for the whole receiver row, GlossyLobeScratch::bandTops): narrow
+// lobes walk 2-4 azimuths, and rays above the horizon stop after a few steps.
 // Interpolating receivers' gathered radiance instead (Fig. 7) would lose
 // what makes a glossy texel glossy: its lobe follows its own normal. The
 // diffuse part of a mixture and the bounces after the first keep the SH
