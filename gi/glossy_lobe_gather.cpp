@@ -16,6 +16,7 @@ namespace terrain::gi {
 namespace {
 
 constexpr int kPlanes = 3 * kShCount;  // RGB x 16 SH planes of the exit radiance
+constexpr int kBandTopsChunk = 64;     // receivers whose walks' band maxima are taken together
 
 // One receiver's lobe: its reflection R (unit), frame and exponent.
 struct ReceiverLobe {
@@ -253,7 +254,8 @@ template <int N>
     }
     int active = static_cast<int>(walks.size());
     // the highest sample of each band on, of this receiver's walk
-    const float* tops = sc.bandTops.data() + static_cast<std::size_t>(j * st.bands) * pad + static_cast<std::size_t>(X);
+    const float* tops = sc.bandTops.data() + static_cast<std::size_t>(j * st.bands) * kBandTopsChunk +
+                        static_cast<std::size_t>(X % kBandTopsChunk);
     // block b's lanes L at a step: sample v, tau cells from the receiver, in
     // band `band`
     const auto step = [&](Block& L, int b, float v, double tau, int band) {
@@ -264,7 +266,7 @@ template <int N>
         // no sample from here on rises to its lowest ray left: the highest
         // of this band on is below it here, and farther on a rising ray is
         // higher still (a falling one may yet meet one)
-        const double top = tops[static_cast<std::size_t>(band * pad)];
+        const double top = tops[static_cast<std::size_t>(band * kBandTopsChunk)];
         const typename Block::Mask stop = valid & (L.slope >= 0.0) & (reached > (top - L.h) - L.margin);
         const typename Block::Lanes rise = (static_cast<double>(v) - L.h) - L.margin;  // over the texel, metres
         const typename Block::Mask meets = valid & ~stop & (reached <= rise);
@@ -328,30 +330,33 @@ template <int N>
     }
 }
 
-// sc.bandTops of receiver row Y: per azimuth, band and receiver the highest
-// height sample of its walk from that band on, each sample as the walk reads
-// it (the same floats), the receivers of the row side by side.
-void rowBandTops(const GlossyLobeState& st, int Y, GlossyLobeScratch& sc) {
+// sc.bandTops of the receivers [X0, X0 + kBandTopsChunk) of row Y (those
+// inside the field): per azimuth, band and receiver the highest height
+// sample of its walk from that band on, each sample as the walk reads it
+// (the same floats), the receivers side by side. A chunk at a time, so the
+// memory does not grow with the row times the azimuths.
+void chunkBandTops(const GlossyLobeState& st, int Y, int X0, GlossyLobeScratch& sc) {
     const int M = static_cast<int>(st.phi.size()), bands = st.bands;
-    const std::size_t nxr = st.stepsPerColumn.size() / st.phi.size();  // padded row
-    sc.bandTops.assign(static_cast<std::size_t>(M * bands) * nxr, -std::numeric_limits<float>::infinity());
+    constexpr std::size_t kStride = kBandTopsChunk;
+    sc.bandTops.assign(static_cast<std::size_t>(M * bands) * kStride, -std::numeric_limits<float>::infinity());
     for (int j = 0; j < M; ++j) {
-        float* tops = sc.bandTops.data() + static_cast<std::size_t>(j * bands) * nxr;
+        float* tops = sc.bandTops.data() + static_cast<std::size_t>(j * bands) * kStride;
         const std::size_t base = static_cast<std::size_t>(j) * st.stepStride;
         for (int i = 0; i < st.stepCounts[static_cast<std::size_t>(j)]; ++i) {
             const GlossyLobeState::StepReceivers& r = st.stepReceivers[base + static_cast<std::size_t>(i)];
-            if (Y < r.y0 || Y > r.y1 || r.x0 > r.x1) break;  // the boxes only narrow
+            const int x0 = std::max(r.x0, X0), x1 = std::min(r.x1, X0 + kBandTopsChunk - 1);
+            if (Y < r.y0 || Y > r.y1 || x0 > x1) break;  // the boxes only narrow
             const ScanStep& hs = st.heightSteps[base + static_cast<std::size_t>(i)];
             const float wA = hs.w[0][0], wB = hs.w[1][0];
-            const float* a = hs.field + Y * hs.rowStep + hs.offA;
-            const float* b = hs.field + Y * hs.rowStep + hs.offB;
-            float* top = tops + static_cast<std::size_t>(st.stepBand[base + static_cast<std::size_t>(i)]) * nxr;
-            for (int X = r.x0; X <= r.x1; ++X) top[X] = std::max(top[X], wA * a[X] + wB * b[X]);
+            const float* a = hs.field + Y * hs.rowStep + hs.offA + X0;
+            const float* b = hs.field + Y * hs.rowStep + hs.offB + X0;
+            float* top = tops + static_cast<std::size_t>(st.stepBand[base + static_cast<std::size_t>(i)]) * kStride;
+            for (int x = x0 - X0; x <= x1 - X0; ++x) top[x] = std::max(top[x], wA * a[x] + wB * b[x]);
         }
         for (int k = bands - 2; k >= 0; --k) {
-            float* top = tops + static_cast<std::size_t>(k) * nxr;
-            const float* next = top + nxr;
-            for (std::size_t X = 0; X < nxr; ++X) top[X] = std::max(top[X], next[X]);
+            float* top = tops + static_cast<std::size_t>(k) * kStride;
+            const float* next = top + kStride;
+            for (std::size_t x = 0; x < kStride; ++x) top[x] = std::max(top[x], next[x]);
         }
     }
 }
@@ -379,8 +384,8 @@ template <int N>
     const bool expMap = in.surface && !in.surface->phongExponent.empty();
     const bool clamp = in.shading.positivity == GlossyPositivity::Clamp;
     const OwnedSpan rows = ownedTexels(Y, s, pyr.nyr, pyr.ny);
-    rowBandTops(st, Y, sc);
     for (int X = 0; X < nxr; ++X) {
+        if (X % kBandTopsChunk == 0) chunkBandTops(st, Y, X, sc);
         const OwnedSpan cols = ownedTexels(X, s, nxr, nx);
         const int width = cols.last - cols.first + 1;
         const int texels = width * (rows.last - rows.first + 1);

@@ -46,7 +46,7 @@
 // walks: one per azimuth some ray of theirs reads, each step's sample read
 // once for all of them; a texel's part of a walk stops once its lowest unmet
 // ray rises above the highest sample the walk has left (taken per distance
-// band for the whole receiver row, GlossyLobeScratch::bandTops): narrow
+// band for 64 receivers of a row at once, GlossyLobeScratch::bandTops): narrow
 // lobes walk 2-4 azimuths, and rays above the horizon stop after a few steps.
 // Interpolating receivers' gathered radiance instead (Fig. 7) would lose
 // what makes a glossy texel glossy: its lobe follows its own normal. The
@@ -113,9 +113,10 @@ struct GlossyLobeScratch {
         double ox, oy;
     };
     std::vector<TexelFrame> texelFrames;
-    // The receiver row's highest samples (GlossyLobeState::stepBand): of
-    // azimuth j, band k and receiver X at (j bands + k) nxr + X, the highest
-    // height sample of its walk from band k on (-inf: none).
+    // A chunk of the receiver row's highest samples (GlossyLobeState::
+    // stepBand): of azimuth j, band k and the chunk's receiver x at
+    // (j bands + k) 64 + x, the highest height sample of its walk from band k
+    // on (-inf: none).
     std::vector<float> bandTops;
     // One texel's part of a walk: its rays along the azimuth (by slope) and
     // where it stands; the rest of its state is in its lane.
