@@ -198,8 +198,8 @@ std::vector<TexelLanes<N>>& laneBlocks(GlossyLobeScratch& sc) {
         return sc.narrowLanes;
 }
 
-// Receiver (X, Y)'s rays [begin, end) of one azimuth (by texel, then by
-// slope): the walk over the receiver's steps. Each texel sees the samples
+// Receiver (X, Y)'s rays [begin, end) of one azimuth (texel by texel, as
+// appended): the walk over the receiver's steps. Each texel sees the samples
 // from where it stands, its own height and its distance along the azimuth
 // (the samples lie on the receiver's ray, at most s / 2 cells beside its
 // own), and each of its rays brings what the surface sends back where it

@@ -118,7 +118,7 @@ struct GlossyLobeScratch {
     // (j bands + k) 64 + x, the highest height sample of its walk from band k
     // on (-inf: none).
     std::vector<float> bandTops;
-    // One texel's part of a walk: its rays along the azimuth (by slope) and
+    // One texel's part of a walk: its rays along the azimuth (as appended) and
     // where it stands; the rest of its state is in its lane.
     struct TexelWalk {
         Ray *first, *end;  // a met ray's slope becomes +inf

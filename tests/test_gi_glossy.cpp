@@ -431,6 +431,38 @@ TEST_CASE("gi.glossy: the lobe gather against the reference's own idealisation o
     }
 }
 
+TEST_CASE("gi.glossy: the lobe gather's walks reach a ridge past flat ground (a texel stops on every band ahead)") {
+    // Flat ground with a ridge 100-130 cells east of the texels checked,
+    // seen by lobes about a reflection 10 degrees above the eastern horizon:
+    // the walks cross bands whose samples are all at ground level before the
+    // ridge's, so a texel stopped on the band at hand (or on a wrong band's
+    // highest sample) would lose the ridge's light. Flat ground alone sends
+    // none (the test above).
+    const int nx = 160, ny = 24;
+    const Grid flat(nx, ny, 0.0f);
+    Grid ridge = flat;
+    for (int y = 0; y < ny; ++y)
+        for (int x = 130; x < 140; ++x) ridge(x, y) = 60.0f;
+    const AlbedoMap a = uniformAlbedo(nx, ny, 0.8f);
+    GiLighting light;
+    light.environment = sunSkyLight();
+    const double e = 10.0 * kPi / 180.0;
+    for (int s : {1, 2}) {
+        GiSettings g = glossySettings(Brdf::Phong, 32.0f, 1, GlossyIndirect::LobeScan, s);
+        g.shading.viewDir[0] = static_cast<float>(-std::cos(e));
+        g.shading.viewDir[1] = 0.0f;
+        g.shading.viewDir[2] = static_cast<float>(std::sin(e));
+        GiState withRidge, without;
+        runGiFrame(ridge.view(), 1.0f, light, g, withRidge, &a);
+        runGiFrame(flat.view(), 1.0f, light, g, without, &a);
+        const double lit = meanOver(withRidge.indirect.indirect[1], 10, 31, 8, 16);
+        const double none = meanOver(without.indirect.indirect[1], 10, 31, 8, 16);
+        MESSAGE(s << "x: glossy indirect light 100-130 cells before the ridge " << lit << ", without it " << none);
+        CHECK(none == 0.0);
+        CHECK(lit > 0.01);
+    }
+}
+
 TEST_CASE("gi.glossy: as the lobe widens (S -> 0) the vector pyramid becomes the scalar (isotropic) one") {
     // For S -> 0 the lobe factors e^{-l^2/(2S)} vanish for l >= 1: the exit
     // radiance is isotropic, E = sqrt(4 pi) shade e_00, and u = E . Y = the
