@@ -77,8 +77,6 @@ public:
     void castRows(const AzimuthSteps& az, int j, const RowBlock& rb, IndirectScratch& sc) const;
 
     int pad() const { return pad_; }
-    /// The field's highest height, found by beginFrame.
-    float topHeight() const { return hMax_; }
 
 private:
     void buildGlossyStepTable();
