@@ -312,8 +312,7 @@ template <int N>
     };
     const auto sample = [&](int i) {
         const ScanStep& hs = st.heightSteps[base + static_cast<std::size_t>(i)];
-        const std::ptrdiff_t o = Y * hs.rowStep + X;
-        return hs.w[0][0] * hs.field[o + hs.offA] + hs.w[1][0] * hs.field[o + hs.offB];
+        return stepSample(hs, Y * hs.rowStep + X);
     };
     if (nBlocks == 1) {  // one block (1x, 2x): its lanes held in registers
         Block L = blocks[0];
@@ -343,15 +342,15 @@ void chunkBandTops(const GlossyLobeState& st, int Y, int X0, GlossyLobeScratch& 
         float* tops = sc.bandTops.data() + static_cast<std::size_t>(j * bands) * kStride;
         const std::size_t base = static_cast<std::size_t>(j) * st.stepStride;
         for (int i = 0; i < st.stepCounts[static_cast<std::size_t>(j)]; ++i) {
-            const GlossyLobeState::StepReceivers& r = st.stepReceivers[base + static_cast<std::size_t>(i)];
+            const ValidPrefix::Receivers& r = st.stepReceivers[base + static_cast<std::size_t>(i)];
             const int x0 = std::max(r.x0, X0), x1 = std::min(r.x1, X0 + kBandTopsChunk - 1);
             if (Y < r.y0 || Y > r.y1 || x0 > x1) break;  // the boxes only narrow
-            const ScanStep& hs = st.heightSteps[base + static_cast<std::size_t>(i)];
-            const float wA = hs.w[0][0], wB = hs.w[1][0];
-            const float* a = hs.field + Y * hs.rowStep + hs.offA + X0;
-            const float* b = hs.field + Y * hs.rowStep + hs.offB + X0;
+            // a copy: the stores to top cannot then alias the step's weights
+            // and pointer, and the loop vectorises
+            const ScanStep hs = st.heightSteps[base + static_cast<std::size_t>(i)];
+            const std::ptrdiff_t row = Y * hs.rowStep;
             float* top = tops + static_cast<std::size_t>(st.stepBand[base + static_cast<std::size_t>(i)]) * kStride;
-            for (int x = x0 - X0; x <= x1 - X0; ++x) top[x] = std::max(top[x], wA * a[x] + wB * b[x]);
+            for (int X = x0; X <= x1; ++X) top[X - X0] = std::max(top[X - X0], stepSample(hs, row + X));
         }
         for (int k = bands - 2; k >= 0; --k) {
             float* top = tops + static_cast<std::size_t>(k) * kStride;
@@ -501,7 +500,6 @@ void buildWalkTable(const HeightPyramid& pyr, int perOctave, int nearOctaves, in
             ValidPrefix prefix(pyr.nxr, pyr.nyr, pad, st.stepsPerColumn.data() + ju * pad,
                                st.stepsPerRow.data() + ju * pyr.nyr);
             int n = 0;
-            GlossyLobeState::StepReceivers reach{0, pyr.nxr - 1, 0, pyr.nyr - 1};
             for (const PyramidStep& ps : steps) {
                 const ScanStepInfo info = scanStepInfoAt(pyr, ps, std::cos(st.phi[ju]), std::sin(st.phi[ju]));
                 if (n > 0 && sameSample(info.step, st.heightSteps[base + static_cast<std::size_t>(n - 1)])) continue;
@@ -512,9 +510,7 @@ void buildWalkTable(const HeightPyramid& pyr, int perOctave, int nearOctaves, in
                 st.stepBand[at] = static_cast<std::uint8_t>(tau <= 1.0 ? 0 : std::ceil(std::log2(tau)));
                 prefix.narrow(info);
                 prefix.commit(n);
-                reach = {std::max(reach.x0, info.xFirst), std::min(reach.x1, info.xLast),
-                         std::max(reach.y0, info.yFirst), std::min(reach.y1, info.yLast)};
-                st.stepReceivers[at] = reach;
+                st.stepReceivers[at] = prefix.receivers();
                 ++n;
             }
             st.stepCounts[ju] = n;

@@ -168,11 +168,8 @@ struct GlossyLobeState {
     // 2^(k-1) to 2^k cells) and the receivers whose walks reach it (a box:
     // the valid prefixes narrow step by step); per azimuth its steps; the
     // bands of the longest walk.
-    struct StepReceivers {
-        int x0, x1, y0, y1;  // inclusive
-    };
     std::vector<std::uint8_t> stepBand;
-    std::vector<StepReceivers> stepReceivers;
+    std::vector<ValidPrefix::Receivers> stepReceivers;
     std::vector<int> stepCounts;
     int bands = 0;
     // E at full resolution with the 48 planes interleaved (value f of texel

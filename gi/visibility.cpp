@@ -125,8 +125,7 @@ StepGeometry makeStep(const HeightPyramid& pyr, int i, double c, double sn) {
 // The blocking slope of one receiver at one step (the scalar form of the
 // kernel's lanes: the same operations in the same order).
 inline float sampleSlope(const ScanStep& st, std::ptrdiff_t index, float h0) {
-    const float v = st.w[0][0] * st.field[index + st.offA] + st.w[1][0] * st.field[index + st.offB];
-    return (v - h0) * st.w[2][0];
+    return (stepSample(st, index) - h0) * st.w[2][0];
 }
 
 // ---- algorithm: per-step visitors over the slope sequence ---------------------

@@ -115,6 +115,13 @@ struct ScanStep {
     std::ptrdiff_t rowStep = 0, offA = 0, offB = 0;
 };
 
+/// The height a step samples for the receiver at `index` = Y rowStep + X (the
+/// scalar form of the scan kernels' lanes; every reader of a step's sample
+/// computes it so, to the bit).
+inline float stepSample(const ScanStep& st, std::ptrdiff_t index) {
+    return st.w[0][0] * st.field[index + st.offA] + st.w[1][0] * st.field[index + st.offB];
+}
+
 /// The box [lo, hi] of the height gradients over each receiver's shading
 /// footprint: the texels at offsets {-s/2, 0, s/2}^2 cells (clamped to the
 /// field), which interpolate the receiver's SH vectors (Fig. 7). Along an
@@ -225,6 +232,12 @@ public:
     ValidPrefix(int nxr, int nyr, int pad, int* colSteps, int* rowSteps);
     void narrow(const ScanStepInfo& s);
     void commit(int step);
+    /// The receivers inside the domain at every step narrowed so far, columns
+    /// [x0, x1] and rows [y0, y1] (empty where first > last).
+    struct Receivers {
+        int x0, x1, y0, y1;
+    };
+    Receivers receivers() const { return {xLo_, xHi_, yLo_, yHi_}; }
 
 private:
     int xLo_, xHi_, yLo_, yHi_;
