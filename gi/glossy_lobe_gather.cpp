@@ -52,13 +52,46 @@ double azimuthOf(double x, double y) {
     return a >= 2.0 * kPi ? 0.0 : a;
 }
 
+// The slope above which a ray leaving texel f along azimuth j meets no
+// sample of receiver X's walk: every band's samples lie at most its
+// GlossyLobeScratch::bandTops high and at least the band's nearest step ahead
+// of the texel (and the walk reads none nearer than half a cell), so a ray of
+// slope t >= 0 passes above them where t run > (top - h) - margin, in the
+// walk's own double arithmetic. The highest such ratio over the bands, raised
+// by 1e-9 of itself (far more than the division's and the walk's product's
+// rounding). Taken once per texel and azimuth.
+double escapeSlope(const GlossyLobeState& st, GlossyLobeScratch& sc, const GlossyLobeScratch::TexelFrame& f, int X,
+                   int j, double cell) {
+    const auto ju = static_cast<std::size_t>(j);
+    if (sc.escapeStamp[ju] == sc.texelSerial) return sc.escape[ju];
+    const double c = st.cosPhi[ju], sn = st.sinPhi[ju];
+    const double along = f.ox * c + f.oy * sn;  // as walkAzimuth's lanes
+    const float* tops = sc.bandTops.data() + static_cast<std::size_t>(j * st.bands) * kBandTopsChunk +
+                        static_cast<std::size_t>(X % kBandTopsChunk);
+    const double* start = st.bandStart.data() + static_cast<std::size_t>(j * st.bands);
+    double escape = -std::numeric_limits<double>::infinity();
+    for (int k = 0; k < st.bands; ++k) {
+        const double run = std::max(0.5, start[k] - along) * cell;
+        const double rise = (static_cast<double>(tops[static_cast<std::size_t>(k * kBandTopsChunk)]) - f.h) - f.margin;
+        escape = std::max(escape, rise / run);
+    }
+    if (!std::isinf(escape)) escape += std::fabs(escape) * 1e-9;
+    sc.escape[ju] = escape;
+    sc.escapeStamp[ju] = sc.texelSerial;
+    return escape;
+}
+
 // A texel's rays as the walks read them, appended to sc.rays: each lobe
 // direction split between the two global azimuths on either side of it
 // (linear weights), those above the texel's tangent plane along their azimuth
-// only. The directions go through each stage together (loops the compiler
-// vectorises), the rays are appended one by one.
-void appendLobeRays(const ReceiverLobe& L, const GlossyLobeState& st, float gx, float gy, int texel,
+// and below its escape slope there only (a ray above it meets nothing, and
+// the rays a walk meets come in the same order without it). The directions
+// go through each stage together (loops the compiler vectorises), the rays
+// are appended one by one.
+void appendLobeRays(const ReceiverLobe& L, const GlossyLobeState& st, float gx, float gy, int X, double cell, int texel,
                     GlossyLobeScratch& sc) {
+    const GlossyLobeScratch::TexelFrame& frame = sc.texelFrames[static_cast<std::size_t>(texel)];
+    ++sc.texelSerial;
     sc.quadrature.set(L.S, sc.quadrature.rings());
     const int rings = sc.quadrature.rings(), M = static_cast<int>(st.phi.size());
     const int count = 2 * rings * rings;
@@ -89,6 +122,7 @@ void appendLobeRays(const ReceiverLobe& L, const GlossyLobeState& st, float gx, 
             const float weight = w0 * static_cast<float>(side == 0 ? 1.0 - f : f);
             const float c = st.cosPhi[static_cast<std::size_t>(j)], s = st.sinPhi[static_cast<std::size_t>(j)];
             if (weight <= 0.0f || slope <= gx * c + gy * s) continue;  // below the tangent plane
+            if (slope >= 0.0f && static_cast<double>(slope) > escapeSlope(st, sc, frame, X, j, cell)) continue;
             sc.rays.push_back({j, texel, slope, weight, {-c * cosE, -s * cosE, -sinE}});
         }
     }
@@ -254,7 +288,7 @@ template <int N>
     }
     int active = static_cast<int>(walks.size());
     // the highest sample of each band on, of this receiver's walk
-    const float* tops = sc.bandTops.data() + static_cast<std::size_t>(j * st.bands) * kBandTopsChunk +
+    const float* tops = sc.bandTopsAhead.data() + static_cast<std::size_t>(j * st.bands) * kBandTopsChunk +
                         static_cast<std::size_t>(X % kBandTopsChunk);
     // block b's lanes L at a step: sample v, tau cells from the receiver, in
     // band `band`
@@ -329,15 +363,17 @@ template <int N>
     }
 }
 
-// sc.bandTops of the receivers [X0, X0 + kBandTopsChunk) of row Y (those
-// inside the field): per azimuth, band and receiver the highest height
-// sample of its walk from that band on, each sample as the walk reads it
-// (the same floats), the receivers side by side. A chunk at a time, so the
-// memory does not grow with the row times the azimuths.
+// sc.bandTops and bandTopsAhead of the receivers [X0, X0 + kBandTopsChunk)
+// of row Y (those inside the field): per azimuth, band and receiver the
+// highest height sample of its walk in that band and from that band on, each
+// sample as the walk reads it (the same floats), the receivers side by side.
+// A chunk at a time, so the memory does not grow with the row times the
+// azimuths.
 void chunkBandTops(const GlossyLobeState& st, int Y, int X0, GlossyLobeScratch& sc) {
     const int M = static_cast<int>(st.phi.size()), bands = st.bands;
     constexpr std::size_t kStride = kBandTopsChunk;
     sc.bandTops.assign(static_cast<std::size_t>(M * bands) * kStride, -std::numeric_limits<float>::infinity());
+    sc.bandTopsAhead.resize(sc.bandTops.size());
     for (int j = 0; j < M; ++j) {
         float* tops = sc.bandTops.data() + static_cast<std::size_t>(j * bands) * kStride;
         const std::size_t base = static_cast<std::size_t>(j) * st.stepStride;
@@ -352,10 +388,14 @@ void chunkBandTops(const GlossyLobeState& st, int Y, int X0, GlossyLobeScratch& 
             float* top = tops + static_cast<std::size_t>(st.stepBand[base + static_cast<std::size_t>(i)]) * kStride;
             for (int X = x0; X <= x1; ++X) top[X - X0] = std::max(top[X - X0], stepSample(hs, row + X));
         }
-        for (int k = bands - 2; k >= 0; --k) {
-            float* top = tops + static_cast<std::size_t>(k) * kStride;
-            const float* next = top + kStride;
-            for (std::size_t x = 0; x < kStride; ++x) top[x] = std::max(top[x], next[x]);
+        float* ahead = sc.bandTopsAhead.data() + static_cast<std::size_t>(j * bands) * kStride;
+        for (int k = bands - 1; k >= 0; --k) {
+            const float* top = tops + static_cast<std::size_t>(k) * kStride;
+            float* from = ahead + static_cast<std::size_t>(k) * kStride;
+            if (k == bands - 1)
+                std::copy(top, top + kStride, from);
+            else
+                for (std::size_t x = 0; x < kStride; ++x) from[x] = std::max(top[x], from[x + kStride]);
         }
     }
 }
@@ -398,7 +438,7 @@ template <int N>
                 const double S = expMap ? in.surface->phongExponent(x, y) : in.shading.phongExponent;
                 const float gx = in.gradX(x, y), gy = in.gradY(x, y);
                 const ReceiverLobe L = receiverLobe(gx, gy, in.shading.viewDir, S);
-                appendLobeRays(L, st, gx, gy, (y - rows.first) * width + (x - cols.first), sc);
+                appendLobeRays(L, st, gx, gy, X, pyr.cellSize, (y - rows.first) * width + (x - cols.first), sc);
             }
         bucketRays(static_cast<int>(st.phi.size()), sc);
         sc.hits.clear();
@@ -521,6 +561,13 @@ void buildWalkTable(const HeightPyramid& pyr, int perOctave, int nearOctaves, in
         const int n = st.stepCounts[static_cast<std::size_t>(j)];
         if (n > 0) st.bands = std::max(st.bands, st.stepBand[static_cast<std::size_t>(j) * steps.size() + n - 1] + 1);
     }
+    st.bandStart.assign(static_cast<std::size_t>(M * st.bands), std::numeric_limits<double>::infinity());
+    for (int j = 0; j < M; ++j)
+        for (int i = 0; i < st.stepCounts[static_cast<std::size_t>(j)]; ++i) {
+            const std::size_t at = static_cast<std::size_t>(j) * steps.size() + static_cast<std::size_t>(i);
+            double& start = st.bandStart[static_cast<std::size_t>(j * st.bands + st.stepBand[at])];
+            start = std::min(start, st.stepCells[at]);
+        }
 }
 
 }  // namespace
@@ -543,6 +590,9 @@ void gatherGlossyLobes(const GlossyLobeInputs& in, GlossyLobeState& st) {
     st.scratch.resize(static_cast<std::size_t>(workerSlots()));
     for (GlossyLobeScratch& sc : st.scratch) {
         sc.quadrature.set(in.shading.phongExponent, in.rings);
+        sc.escape.resize(static_cast<std::size_t>(M));
+        sc.escapeStamp.assign(static_cast<std::size_t>(M), 0);
+        sc.texelSerial = 0;
     }
     parallelFor(0, pyr.nyr, 1, [&](int y0, int y1) {
         GlossyLobeScratch& sc = st.scratch[static_cast<std::size_t>(workerSlot())];
