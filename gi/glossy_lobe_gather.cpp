@@ -52,33 +52,88 @@ double azimuthOf(double x, double y) {
     return a >= 2.0 * kPi ? 0.0 : a;
 }
 
+// Receiver X's walk along azimuth j seen from texel f, band by band: each
+// band's samples lie at most GlossyLobeScratch::bandTops high (rise, over the
+// texel less its margin) and at least the band's nearest step ahead of the
+// texel (run; the walk reads none nearer than half a cell), so a ray of slope
+// t >= 0 passes above them where t run > rise, in the walk's own double
+// arithmetic (its steps' runs and rises are no shorter and no higher).
+struct BandClearance {
+    const float* tops;    // band k's at tops[k * kBandTopsChunk]
+    const double* start;  // band k's nearest step (cells)
+    double along, h, margin, cell;
+    int bands;
+    double run(int k) const { return std::max(0.5, start[k] - along) * cell; }
+    double rise(int k) const {
+        return (static_cast<double>(tops[static_cast<std::size_t>(k * kBandTopsChunk)]) - h) - margin;
+    }
+};
+
+BandClearance bandClearance(const GlossyLobeState& st, const GlossyLobeScratch& sc,
+                            const GlossyLobeScratch::TexelFrame& f, int X, int j, double cell) {
+    const auto ju = static_cast<std::size_t>(j);
+    const double c = st.cosPhi[ju], sn = st.sinPhi[ju];
+    return {sc.bandTops.data() + static_cast<std::size_t>(j * st.bands) * kBandTopsChunk +
+                static_cast<std::size_t>(X % kBandTopsChunk),
+            st.bandStart.data() + static_cast<std::size_t>(j * st.bands),
+            f.ox * c + f.oy * sn,  // as walkAzimuth's lanes
+            f.h,
+            f.margin,
+            cell,
+            st.bands};
+}
+
 // The slope above which a ray leaving texel f along azimuth j meets no
-// sample of receiver X's walk: every band's samples lie at most its
-// GlossyLobeScratch::bandTops high and at least the band's nearest step ahead
-// of the texel (and the walk reads none nearer than half a cell), so a ray of
-// slope t >= 0 passes above them where t run > (top - h) - margin, in the
-// walk's own double arithmetic. The highest such ratio over the bands, raised
-// by 1e-9 of itself (far more than the division's and the walk's product's
-// rounding). Taken once per texel and azimuth.
+// sample of receiver X's walk: the highest rise / run over the bands
+// (BandClearance), raised by 1e-9 of itself (far more than the division's
+// and the walk's product's rounding). Taken once per texel and azimuth.
 double escapeSlope(const GlossyLobeState& st, GlossyLobeScratch& sc, const GlossyLobeScratch::TexelFrame& f, int X,
                    int j, double cell) {
     const auto ju = static_cast<std::size_t>(j);
     if (sc.escapeStamp[ju] == sc.texelSerial) return sc.escape[ju];
-    const double c = st.cosPhi[ju], sn = st.sinPhi[ju];
-    const double along = f.ox * c + f.oy * sn;  // as walkAzimuth's lanes
-    const float* tops = sc.bandTops.data() + static_cast<std::size_t>(j * st.bands) * kBandTopsChunk +
-                        static_cast<std::size_t>(X % kBandTopsChunk);
-    const double* start = st.bandStart.data() + static_cast<std::size_t>(j * st.bands);
+    const BandClearance bc = bandClearance(st, sc, f, X, j, cell);
     double escape = -std::numeric_limits<double>::infinity();
-    for (int k = 0; k < st.bands; ++k) {
-        const double run = std::max(0.5, start[k] - along) * cell;
-        const double rise = (static_cast<double>(tops[static_cast<std::size_t>(k * kBandTopsChunk)]) - f.h) - f.margin;
-        escape = std::max(escape, rise / run);
-    }
+    for (int k = 0; k < bc.bands; ++k) escape = std::max(escape, bc.rise(k) / bc.run(k));
     if (!std::isinf(escape)) escape += std::fabs(escape) * 1e-9;
     sc.escape[ju] = escape;
     sc.escapeStamp[ju] = sc.texelSerial;
     return escape;
+}
+
+// Whether every ray of the lobe L of a texel clears its walks
+// (BandClearance) along every azimuth its directions reach, so that it has
+// none: the
+// directions lie within the widest ring's angle theta of R, so none is lower
+// than elevation(R) - theta (its slope is lowered by 1e-6 of itself, beyond
+// the directions' rounding and the rays' float slopes), and their azimuths
+// within asin(sin theta / cos elevation(R)) of R's (every azimuth where the
+// lobe holds the zenith). asin(x) <= x + (pi / 2 - 1) x^3 on [0, 1]; the
+// span is widened by 0.05 azimuths for azimuthOf's error (1e-5 radians, 0.013
+// azimuths at the most azimuths allowed), and by the azimuth after it, which
+// takes the linear weight of the rays between the two.
+bool lobeEscapes(const ReceiverLobe& L, const GlossyLobeState& st, const GlossyLobeScratch::TexelFrame& frame, int X,
+                 double cell, const GlossyLobeScratch& sc) {
+    const double cosT = sc.quadrature.widestCos(), sinT = std::sqrt(std::max(0.0, 1.0 - cosT * cosT));
+    const double rz = L.r[2], rh = std::sqrt(L.r[0] * L.r[0] + L.r[1] * L.r[1]);
+    const double lowZ = rz * cosT - rh * sinT;  // sin(elevation(R) - theta)
+    if (!(lowZ > 1e-6)) return false;           // the lobe reaches the horizon
+    const double lowH = rh * cosT + rz * sinT;  // its cosine
+    const double lowest = lowZ / lowH * (1.0 - 1e-6);
+    const int M = static_cast<int>(st.phi.size());
+    int first = 0, last = M - 1;
+    if (rh > sinT) {
+        const double dphi = 2.0 * kPi / M, x = sinT / rh;
+        const double half = (x + (0.5 * kPi - 1.0) * x * x * x) / dphi + 0.05;
+        const double u = azimuthOf(L.r[0], L.r[1]) / dphi;
+        first = static_cast<int>(std::floor(u - half));
+        last = std::min(static_cast<int>(std::floor(u + half)) + 1, first + M - 1);
+    }
+    for (int j = first; j <= last; ++j) {
+        const BandClearance bc = bandClearance(st, sc, frame, X, (j % M + M) % M, cell);
+        for (int k = 0; k < bc.bands; ++k)
+            if (!(lowest * bc.run(k) > bc.rise(k))) return false;
+    }
+    return true;
 }
 
 // A texel's rays as the walks read them, appended to sc.rays: each lobe
@@ -93,6 +148,7 @@ void appendLobeRays(const ReceiverLobe& L, const GlossyLobeState& st, float gx, 
     const GlossyLobeScratch::TexelFrame& frame = sc.texelFrames[static_cast<std::size_t>(texel)];
     ++sc.texelSerial;
     sc.quadrature.set(L.S, sc.quadrature.rings());
+    if (lobeEscapes(L, st, frame, X, cell, sc)) return;
     const int rings = sc.quadrature.rings(), M = static_cast<int>(st.phi.size());
     const int count = 2 * rings * rings;
     const double dphi = 2.0 * kPi / M;

@@ -40,6 +40,9 @@ class LobeQuadrature {
 public:
     void set(double S, int n);
     int rings() const { return n_; }
+    /// The cosine of the angle from R of the ring farthest from it: every
+    /// direction lies within that angle.
+    double widestCos() const { return ringCos_.front(); }
     void direction(const double r[3], const double t[3], const double b[3], int i, int j, double w[3]) const {
         const auto ii = static_cast<std::size_t>(i), jj = static_cast<std::size_t>(j);
         lobeCombine(r, t, b, ringCos_[ii], ringSin_[ii], psiCos_[jj], psiSin_[jj], w);

@@ -500,6 +500,37 @@ TEST_CASE("gi.glossy: the lobe gather's light before a wall is smooth across a d
     }
 }
 
+TEST_CASE("gi.glossy: the lobe gather sees a block at the edge of a lobe's azimuths") {
+    // Flat ground and a block 10 high, 8-12 cells east of the texels
+    // checked and 3 cells wide: lobes of exponent 32 about a reflection 30
+    // degrees up at azimuth 25 degrees (north of east) reach azimuths from
+    // about 3 to 47 degrees, and only those near east see the block. A texel
+    // whose lobe clears its walks along every azimuth it reaches has no rays;
+    // taking that span too narrow (the azimuths around the reflection's
+    // alone) leaves these texels dark.
+    const int nx = 48, ny = 32, y0 = 16;
+    Grid h(nx, ny, 0.0f);
+    for (int y = y0 - 1; y <= y0 + 1; ++y)
+        for (int x = 22; x <= 26; ++x) h(x, y) = 10.0f;
+    const AlbedoMap a = uniformAlbedo(nx, ny, 0.8f);
+    GiLighting light;
+    light.environment = sunSkyLight();
+    const double e = 30.0 * kPi / 180.0, az = 25.0 * kPi / 180.0;
+    for (int s : {1, 2}) {
+        GiSettings g = glossySettings(Brdf::Phong, 32.0f, 1, GlossyIndirect::LobeScan, s);
+        g.shading.viewDir[0] = static_cast<float>(-std::cos(e) * std::cos(az));
+        g.shading.viewDir[1] = static_cast<float>(-std::cos(e) * std::sin(az));
+        g.shading.viewDir[2] = static_cast<float>(std::sin(e));
+        GiState st;
+        runGiFrame(h.view(), 1.0f, light, g, st, &a);
+        for (int x = 10; x <= 14; ++x) {
+            CAPTURE(s);
+            CAPTURE(x);
+            CHECK(st.indirect.indirect[1](x, y0) > 0.01f);
+        }
+    }
+}
+
 TEST_CASE("gi.glossy: as the lobe widens (S -> 0) the vector pyramid becomes the scalar (isotropic) one") {
     // For S -> 0 the lobe factors e^{-l^2/(2S)} vanish for l >= 1: the exit
     // radiance is isotropic, E = sqrt(4 pi) shade e_00, and u = E . Y = the
