@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/bfloat16.h"
 #include "core/parallel.h"
 #include "core/simd.h"
 
@@ -117,8 +118,9 @@ struct ExitRow {
     const float* lobe[kShOrder - 1];  // per-texel lobe factors of bands 1..3 (null: uniform)
     const float* uniformLobe;         // phongLobeFactors of the settings
     float ws, view[3];
-    float* out;  // E plane 0 at the row's first texel
-    std::size_t plane;
+    float* planes;          // E plane 0 at the row's first texel (null: none)
+    std::size_t plane;      // the planes' stride
+    std::uint16_t* texels;  // E of the row's first texel, texel by texel (null: none)
 };
 
 // E of the texels [x, x + lanes of V) of a row: the normal, the lobe, the
@@ -149,11 +151,20 @@ template <class V>
     }
     V E[3][kShCount];
     exitVectors<V>(mt, I, nx, ny, nz, ph, r.ws, diffuse, E);
+    constexpr int L = simd::kLaneCount<V>;
+    alignas(32) float lanes[kGlossyFields][L];  // E of the lanes' texels, field by field
     for (int c = 0; c < 3; ++c)
         for (int i = 0; i < kShCount; ++i) {
             const V e = E[c][i];
-            simd::store(r.out + static_cast<std::size_t>(c * kShCount + i) * r.plane + x, (e - e) == zero ? e : zero);
+            simd::store(lanes[c * kShCount + i], (e - e) == zero ? e : zero);
         }
+    if (r.planes)
+        for (int f = 0; f < kGlossyFields; ++f)
+            for (int l = 0; l < L; ++l) r.planes[static_cast<std::size_t>(f) * r.plane + x + l] = lanes[f][l];
+    if (r.texels)
+        for (int l = 0; l < L; ++l)
+            for (int f = 0; f < kGlossyFields; ++f)
+                r.texels[static_cast<std::size_t>(x + l) * kGlossyFields + f] = toBfloat16(lanes[f][l]);
 }
 
 // A row's texels: whole lane groups, then the rest one by one (the same
@@ -183,7 +194,7 @@ void glossyExitVector(const float incident[kShCount], float nx, float ny, float 
 
 void glossyExitRadiance(ConstGridView gradX, ConstGridView gradY, int s, int nxr, int nyr, const float* incident,
                         const std::array<Grid, 3>& shade, const AlbedoMap* surface, const ShadingSettings& shading,
-                        GlossyExitScratch& scratch, float* out) {
+                        GlossyExitScratch& scratch, float* planes, std::uint16_t* texels) {
     const int nx = gradX.nx, ny = gradX.ny;
     const std::size_t planeR = static_cast<std::size_t>(nxr) * nyr, plane = static_cast<std::size_t>(nx) * ny;
     const MirrorTables& mt = mirrorTables();
@@ -200,7 +211,7 @@ void glossyExitRadiance(ConstGridView gradX, ConstGridView gradY, int s, int nxr
     void (*const exitRow)(const MirrorTables&, const ExitRow&, int) = simd::wideEnabled() ? exitRowAvx2 : exitRowSse;
     parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
         float* vert = scratch.rows.data() + static_cast<std::size_t>(workerSlot()) * slot;
-        float* texels = vert + kGlossyFields * static_cast<std::size_t>(nxr);
+        float* rowIncident = vert + kGlossyFields * static_cast<std::size_t>(nxr);
         for (int block = b0; block < b1; ++block) {
             const int yBegin = static_cast<int>(static_cast<long long>(ny) * block / nBlocks);
             const int yEnd = static_cast<int>(static_cast<long long>(ny) * (block + 1) / nBlocks);
@@ -212,10 +223,10 @@ void glossyExitRadiance(ConstGridView gradX, ConstGridView gradY, int s, int nxr
                     const float* rb = incident + p * planeR + static_cast<std::size_t>(ry.i1) * nxr;
                     float* v = vert + static_cast<std::size_t>(p) * nxr;
                     for (int X = 0; X < nxr; ++X) v[X] = ra[X] + ry.f * (rb[X] - ra[X]);
-                    lerpReceiverRow(v, nxr, s, columns.data(), nx, texels + p * nxPad);
+                    lerpReceiverRow(v, nxr, s, columns.data(), nx, rowIncident + p * nxPad);
                 }
                 const std::size_t row = static_cast<std::size_t>(y) * nx;
-                ExitRow r{texels,
+                ExitRow r{rowIncident,
                           nxPad,
                           gradX.row(y),
                           gradY.row(y),
@@ -224,8 +235,9 @@ void glossyExitRadiance(ConstGridView gradX, ConstGridView gradY, int s, int nxr
                           phUniform,
                           specularWeightOf(shading),
                           {shading.viewDir[0], shading.viewDir[1], shading.viewDir[2]},
-                          out + row,
-                          plane};
+                          planes ? planes + row : nullptr,
+                          plane,
+                          texels ? texels + row * kGlossyFields : nullptr};
                 for (std::size_t c = 0; c < 3; ++c) r.shade[c] = shade[c].v.data() + row;
                 for (int l = 1; l < kShOrder; ++l)
                     r.lobe[l - 1] =

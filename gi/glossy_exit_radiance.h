@@ -34,6 +34,7 @@
 //
 // Deterministic: fixed blocks of rows, per texel a pure function of its inputs.
 #include <array>
+#include <cstdint>
 #include <vector>
 
 #include "core/grid.h"
@@ -44,18 +45,23 @@ namespace terrain::gi {
 
 inline constexpr int kGlossyFields = 3 * kShCount;  // RGB x 16 SH planes of E
 
-/// Exit-radiance SH vectors E (kGlossyFields planes of nx * ny, see above)
-/// from the previous bounce's incident radiance at the receivers
-/// (`incident`: 3 x 16 planes of nxr * nyr, as ShadeMaps::incident with a
-/// Phong BRDF) and its shade towards the viewer (full resolution).
-/// scratch: reused (no allocation after the first call of a size).
+/// Exit-radiance SH vectors E (see above) from the previous bounce's
+/// incident radiance at the receivers (`incident`: 3 x 16 planes of
+/// nxr * nyr, as ShadeMaps::incident with a Phong BRDF) and its shade towards
+/// the viewer (full resolution), into `planes` (kGlossyFields planes of
+/// nx * ny, plane c * 16 + k; what the vector pyramid filters) and into
+/// `texels` (texel by texel, value f of texel k at k * kGlossyFields + f,
+/// rounded to bfloat16: what the lobe gather reads where its rays meet the
+/// surface); either may be null. scratch: reused (no allocation after the
+/// first call of a size).
 struct GlossyExitScratch {
     std::vector<float> rows;            // per worker slot: the incident SH of one row, at receivers and texels
     std::vector<ReceiverLerp> columns;  // per texel column: the receivers it lies between
 };
 void glossyExitRadiance(ConstGridView gradX, ConstGridView gradY, int subsample, int nxr, int nyr,
                         const float* incident, const std::array<Grid, 3>& shade, const AlbedoMap* surface,
-                        const ShadingSettings& shading, GlossyExitScratch& scratch, float* out);
+                        const ShadingSettings& shading, GlossyExitScratch& scratch, float* planes,
+                        std::uint16_t* texels);
 
 /// Exit-radiance SH vector of one texel (the scalar twin for tests and the
 /// reference): E = Rot_N(pi)(w_s g (.) I) + sqrt(4 pi) D e_00 for unit normal

@@ -222,9 +222,9 @@ GlossyLobeScratch::ExitTap exitTap(int nx, int ny, double px, double py) {
 // Asks for the cache lines of a tap's texels (two runs of two texels, 2 x 96
 // bytes) well before readExit reads them: the rays meet the surface anywhere,
 // and E at 512^2 is 25 MB, so the receiver's hits are read after its walks.
-void prefetchExit(const GlossyLobeState& st, int nx, int ny, const GlossyLobeScratch::ExitTap& t) {
+void prefetchExit(const std::uint16_t* exit, int nx, int ny, const GlossyLobeScratch::ExitTap& t) {
     constexpr int kTexelBytes = kPlanes * static_cast<int>(sizeof(std::uint16_t));
-    const auto* a = reinterpret_cast<const char*>(st.exitTexels.data() + t.first * kPlanes);
+    const auto* a = reinterpret_cast<const char*>(exit + t.first * kPlanes);
     const std::ptrdiff_t row = ny > 1 ? static_cast<std::ptrdiff_t>(nx) * kTexelBytes : 0;
     for (int k = 0; k < 2 * kTexelBytes; k += 64) {
         __builtin_prefetch(a + k);
@@ -233,9 +233,9 @@ void prefetchExit(const GlossyLobeState& st, int nx, int ny, const GlossyLobeScr
 }
 
 // E bilinear between a tap's four texels.
-void readExit(const GlossyLobeState& st, int nx, int ny, const GlossyLobeScratch::ExitTap& t, MemberSamples& m) {
+void readExit(const std::uint16_t* exit, int nx, int ny, const GlossyLobeScratch::ExitTap& t, MemberSamples& m) {
     const std::ptrdiff_t dx = nx > 1 ? kPlanes : 0, dy = ny > 1 ? static_cast<std::ptrdiff_t>(nx) * kPlanes : 0;
-    const std::uint16_t* a = st.exitTexels.data() + t.first * kPlanes;
+    const std::uint16_t* a = exit + t.first * kPlanes;
     const float fx = t.fx, fy = t.fy;
     const float w00 = (1.0f - fx) * (1.0f - fy), w10 = fx * (1.0f - fy), w01 = (1.0f - fx) * fy, w11 = fx * fy;
     for (int f = 0; f < kPlanes; ++f)
@@ -383,7 +383,7 @@ template <int N>
                             crossingDistance(L.riseBefore[l], L.runBefore[l], rise[l], run[l], r->slope) / cell;
                         const GlossyLobeScratch::ExitTap tap =
                             exitTap(pyr.nx, pyr.ny, x0 + f.ox + d * c, y0 + f.oy + d * sn);
-                        prefetchExit(st, pyr.nx, pyr.ny, tap);
+                        prefetchExit(in.exit, pyr.nx, pyr.ny, tap);
                         sc.hits.push_back({tap, r});
                         r->slope = std::numeric_limits<float>::infinity();
                     }
@@ -511,7 +511,7 @@ template <int N>
         sc.acc.assign(static_cast<std::size_t>(3 * texels), 0.0);
         MemberSamples m;
         for (const GlossyLobeScratch::Hit& hit : sc.hits) {
-            readExit(st, nx, pyr.ny, hit.tap, m);
+            readExit(in.exit, nx, pyr.ny, hit.tap, m);
             addSent(m, *hit.ray, clamp, sc.acc.data());
         }
         for (int t = 0; t < texels; ++t) {
@@ -529,25 +529,6 @@ void gatherRowSse(const GlossyLobeInputs& in, GlossyLobeState& st, int Y, Glossy
 [[gnu::target("avx2"), gnu::flatten]] void gatherRowAvx2(const GlossyLobeInputs& in, GlossyLobeState& st, int Y,
                                                          GlossyLobeScratch& sc) {
     gatherRowImpl<4>(in, st, Y, sc);
-}
-
-// st.exitTexels from the 48 planes of E: a transpose of a 48 x (nx ny)
-// matrix, rounded to bfloat16 (a ray's E is then 4 runs of 96 bytes).
-void interleaveExit(const float* exit, std::size_t texels, GlossyLobeState& st) {
-    st.exitTexels.resize(texels * kPlanes);
-    constexpr int kChunk = 64;
-    const int chunks = static_cast<int>((texels + kChunk - 1) / kChunk);
-    parallelFor(0, chunks, 64, [&](int c0, int c1) {
-        for (int c = c0; c < c1; ++c) {
-            const std::size_t k0 = static_cast<std::size_t>(c) * kChunk;
-            const std::size_t k1 = std::min(texels, k0 + kChunk);
-            for (int f = 0; f < kPlanes; ++f) {
-                const float* src = exit + static_cast<std::size_t>(f) * texels;
-                for (std::size_t k = k0; k < k1; ++k)
-                    st.exitTexels[k * kPlanes + static_cast<std::size_t>(f)] = toBfloat16(src[k]);
-            }
-        }
-    });
 }
 
 // The walks' steps: raw steps (the full-resolution heights, exact between
@@ -641,7 +622,6 @@ void gatherGlossyLobes(const GlossyLobeInputs& in, GlossyLobeState& st) {
         st.sinPhi[u] = static_cast<float>(std::sin(st.phi[u]));
     }
     buildWalkTable(pyr, in.nearStepsPerOctave, in.nearOctaves, pad, st);
-    interleaveExit(in.exit, static_cast<std::size_t>(pyr.nx) * pyr.ny, st);
     st.gathered.resize(static_cast<std::size_t>(3) * pyr.nx * pyr.ny);
     st.scratch.resize(static_cast<std::size_t>(workerSlots()));
     for (GlossyLobeScratch& sc : st.scratch) {

@@ -181,9 +181,6 @@ struct GlossyLobeState {
     std::vector<ValidPrefix::Receivers> stepReceivers;
     std::vector<int> stepCounts;
     int bands = 0;
-    // E at full resolution with the 48 planes interleaved (value f of texel
-    // k at k * 48 + f), bfloat16: a ray's E is four runs of 96 bytes.
-    std::vector<std::uint16_t> exitTexels;
     std::vector<float> gathered;  // 3 planes of nx * ny: int I f dw per texel (RGB)
     std::vector<GlossyLobeScratch> scratch;
 };
@@ -192,8 +189,10 @@ struct GlossyLobeState {
 struct GlossyLobeInputs {
     const HeightPyramid& heights;  // the frame's height pyramid (receivers, steps)
     ConstGridView gradX, gradY;    // full-resolution height gradients
-    const float* exit;             // E at full resolution: 48 planes of nx * ny (gi/glossy_exit_radiance.h)
-    const AlbedoMap* surface;      // per-texel exponent (null or empty: the settings')
+    // E at full resolution texel by texel (value f of texel k at k * 48 + f),
+    // bfloat16 (glossyExitRadiance's texels): a ray's E is four runs of 96 bytes
+    const std::uint16_t* exit;
+    const AlbedoMap* surface;  // per-texel exponent (null or empty: the settings')
     const ShadingSettings& shading;
     int azimuths;  // M, the global azimuths
     int rings;     // n: n rings x 2n directions per lobe

@@ -98,19 +98,24 @@ void ShKernelIndirect::checkExitVectorInputs() {
     const std::size_t planeR = static_cast<std::size_t>(pyr.nxr) * pyr.nyr;
     if (direct.incident.size() != planeR * kGlossyFields || direct.nx != pyr.nx || direct.ny != pyr.ny)
         throw InputError("glossy vector pyramid: the direct shading is not a Phong shading of this field");
-    st_.glossy.exitSh.resize(static_cast<std::size_t>(pyr.nx) * pyr.ny * kGlossyFields);
 }
 
 // The RGB pyramid of L_(b-1), or E of bounce b - 1 at full resolution and
 // its 48 planes' pyramid (Section 5.3). The lobe gather reads E at full
-// resolution, so with LobeScan the pyramid is built only for a scan of U.
+// resolution texel by texel, so with LobeScan the planes and their pyramid
+// are made only for a scan of U.
 void ShKernelIndirect::buildPyramid(int b, const BounceSource& previous) {
     if (!exitVectors_) return scan_.buildPyramid(previous, settings_.radiance);
     const HeightPyramid& pyr = in_.heights;
     GlossyIndirectState& gs = st_.glossy;
+    const std::size_t values = static_cast<std::size_t>(pyr.nx) * pyr.ny * kGlossyFields;
+    const bool planes = !lobes_ || needsU(b);
+    if (planes) gs.exitSh.resize(values);
+    if (lobes_) gs.exitTexels.resize(values);
     glossyExitRadiance(in_.gradX, in_.gradY, pyr.subsample, pyr.nxr, pyr.nyr, previous.shade->incident.data(),
-                       previous.shade->rgb, in_.albedo, in_.shading, gs.exitScratch, gs.exitSh.data());
-    if (!lobes_ || needsU(b)) buildPackedPyramids(gs.exitSh.data(), kGlossyFields, pyr, settings_.radiance, gs.pyramid);
+                       previous.shade->rgb, in_.albedo, in_.shading, gs.exitScratch,
+                       planes ? gs.exitSh.data() : nullptr, lobes_ ? gs.exitTexels.data() : nullptr);
+    if (planes) buildPackedPyramids(gs.exitSh.data(), kGlossyFields, pyr, settings_.radiance, gs.pyramid);
 }
 
 bool ShKernelIndirect::needsU(int b) const {
@@ -122,7 +127,7 @@ void ShKernelIndirect::scan(int b) {
         const GlossyLobeInputs lobeIn{in_.heights,
                                       in_.gradX,
                                       in_.gradY,
-                                      st_.glossy.exitSh.data(),
+                                      st_.glossy.exitTexels.data(),
                                       in_.albedo,
                                       in_.shading,
                                       settings_.lobeAzimuths,

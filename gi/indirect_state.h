@@ -32,6 +32,7 @@ struct IndirectTimings {
 /// LobeScan, gi/indirect_sh_kernel.h).
 struct GlossyIndirectState {
     std::vector<float> exitSh;                 // 3 x 16 planes of nx * ny: E at full resolution (plane c * 16 + k)
+    std::vector<std::uint16_t> exitTexels;     // LobeScan: E texel by texel, bfloat16 (glossyExitRadiance)
     PackedPyramids pyramid;                    // one field per plane of exitSh, bfloat16
     std::vector<ScanStep> steps;               // azimuths x steps: geometry and weights (field 0)
     std::vector<const std::uint16_t*> fields;  // azimuths x steps x 48: field + offA of each plane
