@@ -211,7 +211,7 @@ struct MemberSamples {
 
 // E's texels around full-resolution position (px, py) in cells: the first
 // of the four (clamped to the field) and the bilinear fractions.
-GlossyLobeScratch::ExitTap exitTap(int nx, int ny, double px, double py) {
+[[gnu::always_inline]] inline GlossyLobeScratch::ExitTap exitTap(int nx, int ny, double px, double py) {
     const int ix = std::clamp(static_cast<int>(std::floor(px)), 0, std::max(nx - 2, 0));
     const int iy = std::clamp(static_cast<int>(std::floor(py)), 0, std::max(ny - 2, 0));
     const float fx = std::clamp(static_cast<float>(px - ix), 0.0f, 1.0f);
@@ -233,7 +233,8 @@ void prefetchExit(const std::uint16_t* exit, int nx, int ny, const GlossyLobeScr
 }
 
 // E bilinear between a tap's four texels.
-void readExit(const std::uint16_t* exit, int nx, int ny, const GlossyLobeScratch::ExitTap& t, MemberSamples& m) {
+[[gnu::always_inline]] inline void readExit(const std::uint16_t* exit, int nx, int ny,
+                                            const GlossyLobeScratch::ExitTap& t, MemberSamples& m) {
     const std::ptrdiff_t dx = nx > 1 ? kPlanes : 0, dy = ny > 1 ? static_cast<std::ptrdiff_t>(nx) * kPlanes : 0;
     const std::uint16_t* a = exit + t.first * kPlanes;
     const float fx = t.fx, fy = t.fy;
