@@ -38,6 +38,17 @@ GiSettings glossySettings(Brdf brdf, float exponent, int bounces, GlossyIndirect
     return s;
 }
 
+// One lobe-gather bounce (Phong 32, sub-sampling s) seen by a viewer whose
+// reflection in flat ground rises `elevation` above the horizon towards
+// `azimuth` (radians, from +x towards +y).
+GiSettings lobeGatherReflectingTowards(double elevation, double azimuth, int s) {
+    GiSettings g = glossySettings(Brdf::Phong, 32.0f, 1, GlossyIndirect::LobeScan, s);
+    g.shading.viewDir[0] = static_cast<float>(-std::cos(elevation) * std::cos(azimuth));
+    g.shading.viewDir[1] = static_cast<float>(-std::cos(elevation) * std::sin(azimuth));
+    g.shading.viewDir[2] = static_cast<float>(std::sin(elevation));
+    return g;
+}
+
 // One-bounce glossy reference settings (Phong of exponent S) with the given
 // quadrature: fixed directions, horizon azimuths and lobe rings.
 ReferenceGiSettings glossyReference(float S, int directions, int azimuths, int lobeRings) {
@@ -446,12 +457,8 @@ TEST_CASE("gi.glossy: the lobe gather's walks reach a ridge past flat ground (a 
     const AlbedoMap a = uniformAlbedo(nx, ny, 0.8f);
     GiLighting light;
     light.environment = sunSkyLight();
-    const double e = 10.0 * kPi / 180.0;
     for (int s : {1, 2}) {
-        GiSettings g = glossySettings(Brdf::Phong, 32.0f, 1, GlossyIndirect::LobeScan, s);
-        g.shading.viewDir[0] = static_cast<float>(-std::cos(e));
-        g.shading.viewDir[1] = 0.0f;
-        g.shading.viewDir[2] = static_cast<float>(std::sin(e));
+        const GiSettings g = lobeGatherReflectingTowards(10.0 * kPi / 180.0, 0.0, s);
         GiState withRidge, without;
         runGiFrame(ridge.view(), 1.0f, light, g, withRidge, &a);
         runGiFrame(flat.view(), 1.0f, light, g, without, &a);
@@ -479,14 +486,9 @@ TEST_CASE("gi.glossy: the lobe gather's light before a wall is smooth across a d
     const AlbedoMap a = uniformAlbedo(nx, ny, 0.8f);
     GiLighting light;
     light.environment = sunSkyLight();
-    const double e = 25.0 * kPi / 180.0;
     for (int s : {1, 2}) {
-        GiSettings g = glossySettings(Brdf::Phong, 32.0f, 1, GlossyIndirect::LobeScan, s);
-        g.shading.viewDir[0] = static_cast<float>(-std::cos(e));
-        g.shading.viewDir[1] = 0.0f;
-        g.shading.viewDir[2] = static_cast<float>(std::sin(e));
         GiState st;
-        runGiFrame(h.view(), 1.0f, light, g, st, &a);
+        runGiFrame(h.view(), 1.0f, light, lobeGatherReflectingTowards(25.0 * kPi / 180.0, 0.0, s), st, &a);
         const Grid& green = st.indirect.indirect[1];
         for (int d = 10; d < 24; ++d) {
             const double nearer = meanOver(green, wall - d, wall - d + 1, 4, 12);
@@ -515,14 +517,10 @@ TEST_CASE("gi.glossy: the lobe gather sees a block at the edge of a lobe's azimu
     const AlbedoMap a = uniformAlbedo(nx, ny, 0.8f);
     GiLighting light;
     light.environment = sunSkyLight();
-    const double e = 30.0 * kPi / 180.0, az = 25.0 * kPi / 180.0;
     for (int s : {1, 2}) {
-        GiSettings g = glossySettings(Brdf::Phong, 32.0f, 1, GlossyIndirect::LobeScan, s);
-        g.shading.viewDir[0] = static_cast<float>(-std::cos(e) * std::cos(az));
-        g.shading.viewDir[1] = static_cast<float>(-std::cos(e) * std::sin(az));
-        g.shading.viewDir[2] = static_cast<float>(std::sin(e));
         GiState st;
-        runGiFrame(h.view(), 1.0f, light, g, st, &a);
+        runGiFrame(h.view(), 1.0f, light, lobeGatherReflectingTowards(30.0 * kPi / 180.0, 25.0 * kPi / 180.0, s), st,
+                   &a);
         for (int x = 10; x <= 14; ++x) {
             CAPTURE(s);
             CAPTURE(x);
