@@ -84,16 +84,19 @@ BandClearance bandClearance(const GlossyLobeState& st, const GlossyLobeScratch& 
 }
 
 // The slope above which a ray leaving texel f along azimuth j meets no
-// sample of receiver X's walk: the highest rise / run over the bands
-// (BandClearance), raised by 1e-9 of itself (far more than the division's
-// and the walk's product's rounding). Taken once per texel and azimuth.
+// sample of receiver X's walk: the highest rise / run over the bands that
+// hold one (BandClearance), raised by 1e-9 of itself (far more than the
+// division's and the walk's product's rounding); -inf where none does.
+// Taken once per texel and azimuth.
 double escapeSlope(const GlossyLobeState& st, GlossyLobeScratch& sc, const GlossyLobeScratch::TexelFrame& f, int X,
                    int j, double cell) {
     const auto ju = static_cast<std::size_t>(j);
     if (sc.escapeStamp[ju] == sc.texelSerial) return sc.escape[ju];
     const BandClearance bc = bandClearance(st, sc, f, X, j, cell);
     double escape = -std::numeric_limits<double>::infinity();
-    for (int k = 0; k < bc.bands; ++k) escape = std::max(escape, bc.rise(k) / bc.run(k));
+    for (int k = 0; k < bc.bands; ++k)
+        if (bc.rise(k) > -std::numeric_limits<double>::infinity())  // a band with no sample bounds nothing
+            escape = std::max(escape, bc.rise(k) / bc.run(k));
     if (!std::isinf(escape)) escape += std::fabs(escape) * 1e-9;
     sc.escape[ju] = escape;
     sc.escapeStamp[ju] = sc.texelSerial;
@@ -102,15 +105,15 @@ double escapeSlope(const GlossyLobeState& st, GlossyLobeScratch& sc, const Gloss
 
 // Whether every ray of the lobe L of a texel clears its walks
 // (BandClearance) along every azimuth its directions reach, so that it has
-// none: the
-// directions lie within the widest ring's angle theta of R, so none is lower
-// than elevation(R) - theta (its slope is lowered by 1e-6 of itself, beyond
-// the directions' rounding and the rays' float slopes), and their azimuths
-// within asin(sin theta / cos elevation(R)) of R's (every azimuth where the
-// lobe holds the zenith). asin(x) <= x + (pi / 2 - 1) x^3 on [0, 1]; the
-// span is widened by 0.05 azimuths for azimuthOf's error (1e-5 radians, 0.013
-// azimuths at the most azimuths allowed), and by the azimuth after it, which
-// takes the linear weight of the rays between the two.
+// none: the directions lie within the widest ring's angle theta of R, so
+// none is lower than elevation(R) - theta (its slope is lowered by 1e-6 of
+// itself, beyond the directions' rounding and the rays' float slopes), and
+// their azimuths within asin(sin theta / cos elevation(R)) of R's (every
+// azimuth where the lobe holds the zenith). asin(x) <= x + (pi / 2 - 1) x^3
+// on [0, 1]; the span is widened by 0.05 azimuths for azimuthOf's error
+// (1e-5 radians, 0.013 azimuths at the most azimuths allowed), and by the
+// azimuth after it, which takes the linear weight of the rays between the
+// two.
 bool lobeEscapes(const ReceiverLobe& L, const GlossyLobeState& st, const GlossyLobeScratch::TexelFrame& frame, int X,
                  double cell, const GlossyLobeScratch& sc) {
     const double cosT = sc.quadrature.widestCos(), sinT = std::sqrt(std::max(0.0, 1.0 - cosT * cosT));

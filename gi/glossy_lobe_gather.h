@@ -49,7 +49,8 @@
 // band for 64 receivers of a row at once, GlossyLobeScratch::bandTops): narrow
 // lobes walk 2-4 azimuths, and rays above the horizon stop after a few steps.
 // A ray that passes above every band's highest sample, each seen from the
-// band's nearest step, is never appended (82 % of the rays at 512^2 2x).
+// band's nearest step, is never appended, and a texel whose whole lobe does
+// makes no rays at all.
 // Interpolating receivers' gathered radiance instead (Fig. 7) would lose
 // what makes a glossy texel glossy: its lobe follows its own normal. The
 // diffuse part of a mixture and the bounces after the first keep the SH
