@@ -348,8 +348,14 @@ template <int N>
     }
     int active = static_cast<int>(walks.size());
     // the highest sample of each band on, of this receiver's walk
-    const float* tops = sc.bandTopsAhead.data() + static_cast<std::size_t>(j * st.bands) * kBandTopsChunk +
-                        static_cast<std::size_t>(X % kBandTopsChunk);
+    const float* own = sc.bandTops.data() + static_cast<std::size_t>(j * st.bands) * kBandTopsChunk +
+                       static_cast<std::size_t>(X % kBandTopsChunk);
+    std::vector<float>& ahead = sc.topsAhead;
+    ahead.resize(static_cast<std::size_t>(st.bands));
+    float highest = -std::numeric_limits<float>::infinity();
+    for (int k = st.bands - 1; k >= 0; --k)
+        ahead[static_cast<std::size_t>(k)] = highest =
+            std::max(highest, own[static_cast<std::size_t>(k * kBandTopsChunk)]);
     // block b's lanes L at a step: sample v, tau cells from the receiver, in
     // band `band`
     const auto step = [&](Block& L, int b, float v, double tau, int band) {
@@ -360,7 +366,7 @@ template <int N>
         // no sample from here on rises to its lowest ray left: the highest
         // of this band on is below it here, and farther on a rising ray is
         // higher still (a falling one may yet meet one)
-        const double top = tops[static_cast<std::size_t>(band * kBandTopsChunk)];
+        const double top = ahead[static_cast<std::size_t>(band)];
         const typename Block::Mask stop = valid & (L.slope >= 0.0) & (reached > (top - L.h) - L.margin);
         const typename Block::Lanes rise = (static_cast<double>(v) - L.h) - L.margin;  // over the texel, metres
         const typename Block::Mask meets = valid & ~stop & (reached <= rise);
@@ -423,17 +429,15 @@ template <int N>
     }
 }
 
-// sc.bandTops and bandTopsAhead of the receivers [X0, X0 + kBandTopsChunk)
-// of row Y (those inside the field): per azimuth, band and receiver the
-// highest height sample of its walk in that band and from that band on, each
-// sample as the walk reads it (the same floats), the receivers side by side.
-// A chunk at a time, so the memory does not grow with the row times the
-// azimuths.
+// sc.bandTops of the receivers [X0, X0 + kBandTopsChunk) of row Y (those
+// inside the field): per azimuth, band and receiver the highest height
+// sample of its walk in that band, each sample as the walk reads it (the
+// same floats), the receivers side by side. A chunk at a time, so the memory
+// does not grow with the row times the azimuths.
 void chunkBandTops(const GlossyLobeState& st, int Y, int X0, GlossyLobeScratch& sc) {
     const int M = static_cast<int>(st.phi.size()), bands = st.bands;
     constexpr std::size_t kStride = kBandTopsChunk;
     sc.bandTops.assign(static_cast<std::size_t>(M * bands) * kStride, -std::numeric_limits<float>::infinity());
-    sc.bandTopsAhead.resize(sc.bandTops.size());
     for (int j = 0; j < M; ++j) {
         float* tops = sc.bandTops.data() + static_cast<std::size_t>(j * bands) * kStride;
         const std::size_t base = static_cast<std::size_t>(j) * st.stepStride;
@@ -447,15 +451,6 @@ void chunkBandTops(const GlossyLobeState& st, int Y, int X0, GlossyLobeScratch& 
             const std::ptrdiff_t row = Y * hs.rowStep;
             float* top = tops + static_cast<std::size_t>(st.stepBand[base + static_cast<std::size_t>(i)]) * kStride;
             for (int X = x0; X <= x1; ++X) top[X - X0] = std::max(top[X - X0], stepSample(hs, row + X));
-        }
-        float* ahead = sc.bandTopsAhead.data() + static_cast<std::size_t>(j * bands) * kStride;
-        for (int k = bands - 1; k >= 0; --k) {
-            const float* top = tops + static_cast<std::size_t>(k) * kStride;
-            float* from = ahead + static_cast<std::size_t>(k) * kStride;
-            if (k == bands - 1)
-                std::copy(top, top + kStride, from);
-            else
-                for (std::size_t x = 0; x < kStride; ++x) from[x] = std::max(top[x], from[x + kStride]);
         }
     }
 }

@@ -119,8 +119,9 @@ struct GlossyLobeScratch {
     // A chunk of the receiver row's highest samples (GlossyLobeState::
     // stepBand): of azimuth j, band k and the chunk's receiver x at
     // (j bands + k) 64 + x, the highest height sample of band k of its walk
-    // (bandTops) and of bands k and after (bandTopsAhead; -inf: none).
-    std::vector<float> bandTops, bandTopsAhead;
+    // (-inf: none); and of one walk, per band the highest of that band and
+    // the bands after it.
+    std::vector<float> bandTops, topsAhead;
     // Per global azimuth, the slope above which the current texel's rays
     // meet nothing along it (escapeSlope), valid where its stamp is the
     // texel's serial.
