@@ -11,6 +11,7 @@
 
 #include <doctest/doctest.h>
 
+#include "core/bfloat16.h"
 #include "core/error.h"
 #include "core/parallel.h"
 #include "gi/frame.h"
@@ -129,6 +130,51 @@ TEST_CASE("gi.glossy: the exit-radiance vector E . Y(w) is the Phong lobe about 
     }
     MESSAGE("max |E . Y(w) - lobe(R_N(w))| = " << worst);
     CHECK(worst < 2e-5);
+}
+
+TEST_CASE(
+    "gi.glossy: the exit radiance texel by texel is its planes' values in bfloat16 (either alone, both lane widths)") {
+    // The lobe gather reads E texel by texel, the vector pyramid its planes:
+    // written by the same kernel, 8 or 4 texels at a time and the rest one
+    // by one (a width of 37 leaves a remainder), each value once.
+    const int nx = 37, ny = 11, s = 2, nxr = receiverCount(nx, s), nyr = receiverCount(ny, s);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    Grid gx(nx, ny, 0.0f), gy(nx, ny, 0.0f);
+    for (float& v : gx.v) v = 0.5f * u(rng);
+    for (float& v : gy.v) v = 0.5f * u(rng);
+    std::vector<float> incident(static_cast<std::size_t>(nxr) * nyr * kGlossyFields);
+    for (float& v : incident) v = u(rng);
+    std::array<Grid, 3> shade;
+    for (Grid& g : shade) {
+        g = Grid(nx, ny, 0.0f);
+        for (float& v : g.v) v = 0.5f + 0.5f * u(rng);
+    }
+    const ShadingSettings shading = glossySettings(Brdf::Phong, 24.0f, 1, GlossyIndirect::LobeScan).shading;
+    const std::size_t values = static_cast<std::size_t>(nx) * ny * kGlossyFields, plane = values / kGlossyFields;
+    const bool wide = simd::wideEnabled();
+    for (bool w : {wide, !wide}) {
+        if (simd::setWideEnabled(w) != w) continue;  // this machine has one width only
+        GlossyExitScratch scratch;
+        std::vector<float> planes(values), planesAlone(values);
+        std::vector<std::uint16_t> texels(values), texelsAlone(values);
+        glossyExitRadiance(gx.cview(), gy.cview(), s, nxr, nyr, incident.data(), shade, nullptr, shading, scratch,
+                           planes.data(), texels.data());
+        glossyExitRadiance(gx.cview(), gy.cview(), s, nxr, nyr, incident.data(), shade, nullptr, shading, scratch,
+                           planesAlone.data(), nullptr);
+        glossyExitRadiance(gx.cview(), gy.cview(), s, nxr, nyr, incident.data(), shade, nullptr, shading, scratch,
+                           nullptr, texelsAlone.data());
+        long mismatches = 0;
+        for (std::size_t k = 0; k < plane; ++k)
+            for (int f = 0; f < kGlossyFields; ++f)
+                mismatches += texels[k * kGlossyFields + static_cast<std::size_t>(f)] !=
+                              toBfloat16(planes[static_cast<std::size_t>(f) * plane + k]);
+        CAPTURE(w);
+        CHECK(mismatches == 0);
+        CHECK(planes == planesAlone);
+        CHECK(texels == texelsAlone);
+    }
+    simd::setWideEnabled(wide);
 }
 
 TEST_CASE("gi.glossy: a flat plane gets exactly no glossy indirect light (fast path and reference)") {
