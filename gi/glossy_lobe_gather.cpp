@@ -52,6 +52,11 @@ double azimuthOf(double x, double y) {
     return a >= 2.0 * kPi ? 0.0 : a;
 }
 
+// How far texel f stands ahead of its receiver along the azimuth (c, sn),
+// in cells: the walk's distances from it and the bands' clearance from it
+// (BandClearance) take the same value.
+double texelAlong(const GlossyLobeScratch::TexelFrame& f, double c, double sn) { return f.ox * c + f.oy * sn; }
+
 // Receiver X's walk along azimuth j seen from texel f, band by band: each
 // band's samples lie at most GlossyLobeScratch::bandTops high (rise, over the
 // texel less its margin) and at least the band's nearest step ahead of the
@@ -76,7 +81,7 @@ BandClearance bandClearance(const GlossyLobeState& st, const GlossyLobeScratch& 
     return {sc.bandTops.data() + static_cast<std::size_t>(j * st.bands) * kBandTopsChunk +
                 static_cast<std::size_t>(X % kBandTopsChunk),
             st.bandStart.data() + static_cast<std::size_t>(j * st.bands),
-            f.ox * c + f.oy * sn,  // as walkAzimuth's lanes
+            texelAlong(f, c, sn),
             f.h,
             f.margin,
             cell,
@@ -341,7 +346,7 @@ template <int N>
             continue;
         }
         const GlossyLobeScratch::TexelWalk& w = walks[static_cast<std::size_t>(k)];
-        L.along[l] = w.frame->ox * c + w.frame->oy * sn;
+        L.along[l] = texelAlong(*w.frame, c, sn);
         L.h[l] = w.frame->h;
         L.margin[l] = w.frame->margin;
         L.slope[l] = lowestSlope(w.first, w.end);
