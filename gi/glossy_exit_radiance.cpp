@@ -155,12 +155,11 @@ template <class V>
     alignas(32) float lanes[kGlossyFields][L];  // E of the lanes' texels, field by field
     for (int c = 0; c < 3; ++c)
         for (int i = 0; i < kShCount; ++i) {
-            const V e = E[c][i];
-            simd::store(lanes[c * kShCount + i], (e - e) == zero ? e : zero);
+            const int f = c * kShCount + i;
+            const V e = E[c][i], finite = (e - e) == zero ? e : zero;
+            if (r.planes) simd::store(r.planes + static_cast<std::size_t>(f) * r.plane + x, finite);
+            if (r.texels) simd::store(lanes[f], finite);
         }
-    if (r.planes)
-        for (int f = 0; f < kGlossyFields; ++f)
-            for (int l = 0; l < L; ++l) r.planes[static_cast<std::size_t>(f) * r.plane + x + l] = lanes[f][l];
     if (r.texels)
         for (int l = 0; l < L; ++l)
             for (int f = 0; f < kGlossyFields; ++f)

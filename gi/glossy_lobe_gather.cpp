@@ -57,6 +57,13 @@ double azimuthOf(double x, double y) {
 // (BandClearance) take the same value.
 double texelAlong(const GlossyLobeScratch::TexelFrame& f, double c, double sn) { return f.ox * c + f.oy * sn; }
 
+// Receiver X's highest samples of azimuth j (GlossyLobeScratch::bandTops):
+// band k's at [k * kBandTopsChunk].
+const float* bandTopsOf(const GlossyLobeState& st, const GlossyLobeScratch& sc, int X, int j) {
+    return sc.bandTops.data() + static_cast<std::size_t>(j * st.bands) * kBandTopsChunk +
+           static_cast<std::size_t>(X % kBandTopsChunk);
+}
+
 // Receiver X's walk along azimuth j seen from texel f, band by band: each
 // band's samples lie at most GlossyLobeScratch::bandTops high (rise, over the
 // texel less its margin) and at least the band's nearest step ahead of the
@@ -78,8 +85,7 @@ BandClearance bandClearance(const GlossyLobeState& st, const GlossyLobeScratch& 
                             const GlossyLobeScratch::TexelFrame& f, int X, int j, double cell) {
     const auto ju = static_cast<std::size_t>(j);
     const double c = st.cosPhi[ju], sn = st.sinPhi[ju];
-    return {sc.bandTops.data() + static_cast<std::size_t>(j * st.bands) * kBandTopsChunk +
-                static_cast<std::size_t>(X % kBandTopsChunk),
+    return {bandTopsOf(st, sc, X, j),
             st.bandStart.data() + static_cast<std::size_t>(j * st.bands),
             texelAlong(f, c, sn),
             f.h,
@@ -99,9 +105,11 @@ double escapeSlope(const GlossyLobeState& st, GlossyLobeScratch& sc, const Gloss
     if (sc.escapeStamp[ju] == sc.texelSerial) return sc.escape[ju];
     const BandClearance bc = bandClearance(st, sc, f, X, j, cell);
     double escape = -std::numeric_limits<double>::infinity();
-    for (int k = 0; k < bc.bands; ++k)
-        if (bc.rise(k) > -std::numeric_limits<double>::infinity())  // a band with no sample bounds nothing
-            escape = std::max(escape, bc.rise(k) / bc.run(k));
+    for (int k = 0; k < bc.bands; ++k) {
+        const double rise = bc.rise(k);
+        if (rise > -std::numeric_limits<double>::infinity())  // a band with no sample bounds nothing
+            escape = std::max(escape, rise / bc.run(k));
+    }
     if (!std::isinf(escape)) escape += std::fabs(escape) * 1e-9;
     sc.escape[ju] = escape;
     sc.escapeStamp[ju] = sc.texelSerial;
@@ -109,8 +117,9 @@ double escapeSlope(const GlossyLobeState& st, GlossyLobeScratch& sc, const Gloss
 }
 
 // Whether every ray of the lobe L of a texel clears its walks
-// (BandClearance) along every azimuth its directions reach, so that it has
-// none: the directions lie within the widest ring's angle theta of R, so
+// (BandClearance; the escape slope's bound without its divisions, which
+// across every azimuth of a lobe about the zenith cost more than the test
+// saves) along every azimuth its directions reach, so that it has none: the directions lie within the widest ring's angle theta of R, so
 // none is lower than elevation(R) - theta (its slope is lowered by 1e-6 of
 // itself, beyond the directions' rounding and the rays' float slopes), and
 // their azimuths within asin(sin theta / cos elevation(R)) of R's (every
@@ -353,8 +362,7 @@ template <int N>
     }
     int active = static_cast<int>(walks.size());
     // the highest sample of each band on, of this receiver's walk
-    const float* own = sc.bandTops.data() + static_cast<std::size_t>(j * st.bands) * kBandTopsChunk +
-                       static_cast<std::size_t>(X % kBandTopsChunk);
+    const float* own = bandTopsOf(st, sc, X, j);
     std::vector<float>& ahead = sc.topsAhead;
     ahead.resize(static_cast<std::size_t>(st.bands));
     float highest = -std::numeric_limits<float>::infinity();
