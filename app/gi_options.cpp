@@ -201,6 +201,10 @@ void addLightTransportFlags(CLI::App* sub, GiOptions& o) {
     sub->add_option("--glossy-lobe-azimuths", gs.indirect.lobeAzimuths,
                     gi::describe(r::kLobeAzimuths) + " (--glossy lobe)")
         ->capture_default_str();
+    sub->add_option("--glossy-lobe-members", o.glossyLobeMembers,
+                    "What the first bounce's surface sends back to the lobe gather (--glossy lobe): windowed (its "
+                    "lobe-filtered light times the part of its lobe above its horizon, default) | sh (its order-4 SH "
+                    "exit radiance)");
     sub->add_option("--glossy-lobe-near-steps", gs.indirect.lobeNearStepsPerOctave,
                     gi::describe(r::kLobeNearStepsPerOctave) + " (--glossy lobe)")
         ->capture_default_str();
@@ -277,6 +281,10 @@ gi::GiSettings giSettingsFrom(const GiOptions& o, ExponentSource& exponent) {
                                                                    {{"vector", gi::GlossyIndirect::VectorPyramid},
                                                                     {"scalar", gi::GlossyIndirect::ScalarPyramid},
                                                                     {"lobe", gi::GlossyIndirect::LobeScan}});
+    if (!o.glossyLobeMembers.empty())
+        settings.indirect.lobeMembers = namedChoice<gi::GlossyLobeMembers>(
+            "--glossy-lobe-members", o.glossyLobeMembers,
+            {{"windowed", gi::GlossyLobeMembers::Windowed}, {"sh", gi::GlossyLobeMembers::Sh}});
     if (!o.glossyPositivity.empty())
         settings.shading.positivity = namedChoice<gi::GlossyPositivity>(
             "--glossy-positivity", o.glossyPositivity,

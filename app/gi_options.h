@@ -40,10 +40,11 @@ struct GiOptions {
     std::string svfKind = "plain";  // which one --out-svf writes: plain | normal
     std::string outHorizons;        // horizon elevation angles per azimuth (gi/horizon_angles.h)
     int referenceDirections = 2048;
-    int referenceLobeRings = 12;   // glossy reference: lobe quadrature rings (ReferenceGiSettings::lobeRings)
-    std::string glossy;            // vector | scalar | lobe (glossy indirect light)
-    std::string glossyPositivity;  // clamp | off (negative Phong radiance clamped, or the paper's linear values)
-    std::string phongExponent;     // VALUE or a 16-bit PNG
+    int referenceLobeRings = 12;    // glossy reference: lobe quadrature rings (ReferenceGiSettings::lobeRings)
+    std::string glossy;             // vector | scalar | lobe (glossy indirect light)
+    std::string glossyLobeMembers;  // windowed | sh (what the lobe gather's first-bounce members send)
+    std::string glossyPositivity;   // clamp | off (negative Phong radiance clamped, or the paper's linear values)
+    std::string phongExponent;      // VALUE or a 16-bit PNG
     std::string phongExponentRange = "1,1000";
 };
 

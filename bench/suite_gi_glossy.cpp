@@ -139,7 +139,7 @@ std::string quadratureName(const LobeQuadrature& q) {
 constexpr int kLobeQuadratureCount = sizeof kLobeQuadratures / sizeof kLobeQuadratures[0];
 
 struct RowErrors {
-    EngineError e[2][2], d[2], az[2], lobe, quad[kLobeQuadratureCount];
+    EngineError e[2][2], d[2], az[2], lobe, lobeSh, quad[kLobeQuadratureCount];
 };
 
 RowErrors rowErrors(const Grid& h, float cell, const GiLighting& light, const AlbedoMap& a, const AccuracyRow& row,
@@ -171,6 +171,10 @@ RowErrors rowErrors(const Grid& h, float cell, const GiLighting& light, const Al
     r.lobe = engineError(h, cell, light, a, settingsFor(row.brdf, row.S, s, 1, GlossyIndirect::LobeScan),
                          GlossyPositivity::Clamp, ref.exact);
     csvLine("lobe", "clamp", r.lobe);
+    GiSettings gsh = settingsFor(row.brdf, row.S, s, 1, GlossyIndirect::LobeScan);
+    gsh.indirect.lobeMembers = GlossyLobeMembers::Sh;
+    r.lobeSh = engineError(h, cell, light, a, gsh, GlossyPositivity::Clamp, ref.exact);
+    csvLine("lobe, SH members", "clamp", r.lobeSh);
     for (int q = 0; q < kLobeQuadratureCount; ++q) {
         GiSettings g = settingsFor(row.brdf, row.S, s, 1, GlossyIndirect::LobeScan);
         g.indirect.lobeRings = kLobeQuadratures[q].rings;
@@ -203,13 +207,16 @@ std::string accuracySection(const GlossyOptions& o, const BenchContext& ctx, std
         " fixed directions for the Lambert part. Relative RMSE and bias of the indirect light (bounce 1, RGB, 10 % "
         "border left out); clamp: `--glossy-positivity clamp` (engine default), off: the paper's linear SH "
         "values; neg: share of negative indirect values without the clamp (with it: none); lobe: `--glossy lobe` "
-        "(the lobe gather, never negative).\n\n";
+        "(the lobe gather, never negative; its first bounce's surface sends its lobe-filtered light times the "
+        "part of its lobe above its horizon, `--glossy-lobe-members windowed`); lobe SH: the same gather with the "
+        "surface sending its order-4 SH exit radiance (`--glossy-lobe-members sh`).\n\n";
     md +=
         "| BRDF | S | sub-sampling | vector clamp RMSE | bias | vector off RMSE | bias | vector off neg | scalar clamp "
-        "RMSE | bias | scalar off RMSE | bias | scalar off neg | lobe RMSE | bias | reference mean indirect | "
+        "RMSE | bias | scalar off RMSE | bias | scalar off neg | lobe RMSE | bias | lobe SH RMSE | bias | reference "
+        "mean indirect | "
         "reference "
         "time (s) |\n";
-    md += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    md += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     csv += "brdf,S,subsample,mode,positivity,rel_rmse,bias,negative_share,reference_mean,reference_seconds\n";
     for (const AccuracyRow& row :
          {AccuracyRow{Brdf::Phong, 8.0f}, AccuracyRow{Brdf::Phong, 16.0f}, AccuracyRow{Brdf::Phong, 32.0f},
@@ -226,10 +233,11 @@ std::string accuracySection(const GlossyOptions& o, const BenchContext& ctx, std
                               r.d[0].rmse, r.d[0].bias, r.d[1].rmse, r.d[1].bias);
             const std::string line = strprintf(
                 "| %s | %g | %dx | %.4f | %+.4f | %.4f | %+.4f | %.1f %% | %.4f | %+.4f | %.4f | %+.4f | %.1f "
-                "%% | %.4f | %+.4f | %.4f | %.1f |\n",
+                "%% | %.4f | %+.4f | %.4f | %+.4f | %.4f | %.1f |\n",
                 brdfName(row.brdf), row.S, s, r.e[0][0].rmse, r.e[0][0].bias, r.e[0][1].rmse, r.e[0][1].bias,
                 100.0 * r.e[0][1].negative, r.e[1][0].rmse, r.e[1][0].bias, r.e[1][1].rmse, r.e[1][1].bias,
-                100.0 * r.e[1][1].negative, r.lobe.rmse, r.lobe.bias, ref.mean, ref.seconds);
+                100.0 * r.e[1][1].negative, r.lobe.rmse, r.lobe.bias, r.lobeSh.rmse, r.lobeSh.bias, ref.mean,
+                ref.seconds);
             std::fprintf(stderr, "%s", line.c_str());
             md += line;
         }
@@ -282,12 +290,16 @@ std::string frameTimeSection(const GlossyOptions& o, const BenchContext& ctx) {
             const char* name;
             Brdf brdf;
             GlossyIndirect mode;
+            GlossyLobeMembers members = GlossyLobeMembers::Windowed;
         };
         for (const Case& cs : {Case{"lambert", Brdf::Lambert, GlossyIndirect::ScalarPyramid},
                                Case{"phong:32, scalar pyramid", Brdf::Phong, GlossyIndirect::ScalarPyramid},
                                Case{"phong:32, vector pyramid", Brdf::Phong, GlossyIndirect::VectorPyramid},
-                               Case{"phong:32, lobe gather", Brdf::Phong, GlossyIndirect::LobeScan}}) {
-            const GiSettings g = settingsFor(cs.brdf, 32.0f, 2, 1, cs.mode);
+                               Case{"phong:32, lobe gather", Brdf::Phong, GlossyIndirect::LobeScan},
+                               Case{"phong:32, lobe gather, SH members", Brdf::Phong, GlossyIndirect::LobeScan,
+                                    GlossyLobeMembers::Sh}}) {
+            GiSettings g = settingsFor(cs.brdf, 32.0f, 2, 1, cs.mode);
+            g.indirect.lobeMembers = cs.members;
             GiState st;
             std::vector<double> frame, ind, pyr, scan, shade;
             withThreads(2, [&] {

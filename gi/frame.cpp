@@ -122,7 +122,8 @@ void runIndirectStage(ConstGridView heights, const GiSettings& settings, const F
                             .texelRuns = texels ? &st.indirectCache.texelRuns : nullptr,
                             .sameGeometry = !change.geometry,
                             .directChanged = settings.incremental ? st.directChanged : CellBox{},
-                            .radianceCurrent = cached};
+                            .radianceCurrent = cached,
+                            .memberLight = &st.shadedLight};
     computeIndirect(in, settings.indirect, st.indirect);
     noteOcclusionsRedone(cached ? texels : nullptr, cached ? in.texelRuns : nullptr, st.indirectCache);
     st.indirect.timings.pyramid += pyramidMs;  // bounce 0's pyramid, built before the plan
@@ -405,8 +406,14 @@ void directShading(const GiLighting& lighting, const GiSettings& settings, const
     st.shadingLights.resize(1 + (exactKeys ? 0 : nKeys));
     // the shading leaves the environment out when nothing of it goes through SH
     st.shadingLights[0] = environmentShadingLight(sky.sh, st.envVisibility);
-    for (std::size_t k = 0; k < (exactKeys ? 0 : nKeys); ++k)
+    st.shadedLight = sky.sh;
+    for (std::size_t k = 0; k < (exactKeys ? 0 : nKeys); ++k) {
         st.shadingLights[k + 1] = keyShadingLight(lighting.keys[k], st.keyVisibility[k]);
+        const ShRgb cap = keyLightSh(lighting.keys[k]);
+        for (std::size_t ch = 0; ch < 3; ++ch)
+            for (std::size_t i = 0; i < static_cast<std::size_t>(kShCount); ++i)
+                st.shadedLight.c[ch][i] += cap.c[ch][i];
+    }
     // The indirect light re-reads the texels whose light changed, which can
     // be far fewer than those redone (a key light's tile recomputed to the
     // same visible fractions): its pyramids and bounds cost by their box.

@@ -46,6 +46,10 @@ struct GiState {
     std::vector<KeyLight> keyOperatorLights;  // the lights the key operators were built for
     std::vector<VisibilityField> keyVisibility;
     std::vector<ShadingLight> shadingLights;
+    // The lights' SH radiance those shading lights filter, unoccluded (the
+    // environment's SH part and the SH key lights as caps): what the lobe
+    // gather's first-bounce members reflect (IndirectInputs::memberLight).
+    ShRgb shadedLight;
     ShadeMaps shade;
     std::vector<float> envCosSin;  // cos, sin of each envOperator azimuth (the exact ambient's), built with it
     AmbientScratch ambientScratch;

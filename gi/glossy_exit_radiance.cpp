@@ -121,6 +121,8 @@ struct ExitRow {
     float* planes;          // E plane 0 at the row's first texel (null: none)
     std::size_t plane;      // the planes' stride
     std::uint16_t* texels;  // E of the row's first texel, texel by texel (null: none)
+    float* diffuse;         // D of the row's first texel, RGB texel by texel (null: none)
+    std::size_t diffuseStride;
 };
 
 // E of the texels [x, x + lanes of V) of a row: the normal, the lobe, the
@@ -149,9 +151,18 @@ template <class V>
         for (int i = 0; i < kShCount; ++i) sp += ph[shBand(i)] * yv[i] * I[c][i];
         diffuse[c] = load<V>(r.shade[c] + x) - r.ws * sp;
     }
+    constexpr int L = simd::kLaneCount<V>;
+    if (r.diffuse) {
+        alignas(32) float lanes[3][L];
+        for (int c = 0; c < 3; ++c) simd::store(lanes[c], (diffuse[c] - diffuse[c]) == zero ? diffuse[c] : zero);
+        for (int l = 0; l < L; ++l)
+            for (int c = 0; c < 3; ++c)
+                r.diffuse[static_cast<std::size_t>(x + l) * r.diffuseStride + static_cast<std::size_t>(c)] =
+                    lanes[c][l];
+    }
+    if (!r.planes && !r.texels) return;
     V E[3][kShCount];
     exitVectors<V>(mt, I, nx, ny, nz, ph, r.ws, diffuse, E);
-    constexpr int L = simd::kLaneCount<V>;
     alignas(32) float lanes[kGlossyFields][L];  // E of the lanes' texels, field by field
     for (int c = 0; c < 3; ++c)
         for (int i = 0; i < kShCount; ++i) {
@@ -193,7 +204,7 @@ void glossyExitVector(const float incident[kShCount], float nx, float ny, float 
 
 void glossyExitRadiance(ConstGridView gradX, ConstGridView gradY, int s, int nxr, int nyr, const float* incident,
                         const std::array<Grid, 3>& shade, const AlbedoMap* surface, const ShadingSettings& shading,
-                        GlossyExitScratch& scratch, float* planes, std::uint16_t* texels) {
+                        GlossyExitScratch& scratch, const GlossyExitOutputs& out) {
     const int nx = gradX.nx, ny = gradX.ny;
     const std::size_t planeR = static_cast<std::size_t>(nxr) * nyr, plane = static_cast<std::size_t>(nx) * ny;
     const MirrorTables& mt = mirrorTables();
@@ -234,9 +245,11 @@ void glossyExitRadiance(ConstGridView gradX, ConstGridView gradY, int s, int nxr
                           phUniform,
                           specularWeightOf(shading),
                           {shading.viewDir[0], shading.viewDir[1], shading.viewDir[2]},
-                          planes ? planes + row : nullptr,
+                          out.planes ? out.planes + row : nullptr,
                           plane,
-                          texels ? texels + row * kGlossyFields : nullptr};
+                          out.texels ? out.texels + row * kGlossyFields : nullptr,
+                          out.diffuse ? out.diffuse + row * static_cast<std::size_t>(out.diffuseStride) : nullptr,
+                          static_cast<std::size_t>(out.diffuseStride)};
                 for (std::size_t c = 0; c < 3; ++c) r.shade[c] = shade[c].v.data() + row;
                 for (int l = 1; l < kShOrder; ++l)
                     r.lobe[l - 1] =

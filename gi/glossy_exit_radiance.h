@@ -52,16 +52,23 @@ inline constexpr int kGlossyFields = 3 * kShCount;  // RGB x 16 SH planes of E
 /// nx * ny, plane c * 16 + k; what the vector pyramid filters) and into
 /// `texels` (texel by texel, value f of texel k at k * kGlossyFields + f,
 /// rounded to bfloat16: what the lobe gather reads where its rays meet the
-/// surface); either may be null. scratch: reused (no allocation after the
+/// surface) and the diffuse parts D_q alone into `diffuse` (what the lobe
+/// gather's first-bounce members add to their lobe); any may be null. scratch: reused (no allocation after the
 /// first call of a size).
 struct GlossyExitScratch {
     std::vector<float> rows;            // per worker slot: the incident SH of one row, at receivers and texels
     std::vector<ReceiverLerp> columns;  // per texel column: the receivers it lies between
 };
+/// What glossyExitRadiance writes; any may be null.
+struct GlossyExitOutputs {
+    float* planes = nullptr;          // E's kGlossyFields planes of nx * ny
+    std::uint16_t* texels = nullptr;  // E texel by texel, bfloat16
+    float* diffuse = nullptr;         // D_q RGB texel by texel (texel k at diffuseStride k; gi/glossy_lobe_members.h)
+    int diffuseStride = 3;
+};
 void glossyExitRadiance(ConstGridView gradX, ConstGridView gradY, int subsample, int nxr, int nyr,
                         const float* incident, const std::array<Grid, 3>& shade, const AlbedoMap* surface,
-                        const ShadingSettings& shading, GlossyExitScratch& scratch, float* planes,
-                        std::uint16_t* texels);
+                        const ShadingSettings& shading, GlossyExitScratch& scratch, const GlossyExitOutputs& out);
 
 /// Exit-radiance SH vector of one texel (the scalar twin for tests and the
 /// reference): E = Rot_N(pi)(w_s g (.) I) + sqrt(4 pi) D e_00 for unit normal

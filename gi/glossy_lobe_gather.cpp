@@ -7,6 +7,7 @@
 #include "core/bfloat16.h"
 #include "core/parallel.h"
 #include "core/simd.h"
+#include "gi/azimuth.h"
 #include "gi/indirect_scan_tables.h"
 #include "gi/phong_lobe_quadrature.h"
 #include "gi/sh.h"
@@ -35,21 +36,6 @@ ReceiverLobe receiverLobe(float gx, float gy, const float view[3], double S) {
     lobeFrame(L.r, L.t, L.b);
     L.S = S;
     return L;
-}
-
-// The azimuth of (x, y) in [0, 2 pi), within 1e-5 radians: the rays' split
-// between two global azimuths needs no more (a weight moves by 1e-5 / the
-// azimuths' spacing), and libm's atan2 was a tenth of the gather's time.
-// atan on [0, 1] by Abramowitz & Stegun (1964), Eq. 4.4.49, then the octant.
-double azimuthOf(double x, double y) {
-    const double ax = std::fabs(x), ay = std::fabs(y);
-    const double lo = std::min(ax, ay), hi = std::max(ax, ay);
-    const double q = hi > 0.0 ? lo / hi : 0.0, q2 = q * q;
-    double a = q * (0.9998660 + q2 * (-0.3302995 + q2 * (0.1801410 + q2 * (-0.0851330 + q2 * 0.0208351))));
-    a = ay > ax ? 0.5 * kPi - a : a;
-    a = x < 0.0 ? kPi - a : a;
-    a = y < 0.0 ? 2.0 * kPi - a : a;
-    return a >= 2.0 * kPi ? 0.0 : a;
 }
 
 // How far texel f stands ahead of its receiver along the azimuth (c, sn),
@@ -261,6 +247,16 @@ void prefetchExit(const std::uint16_t* exit, int nx, int ny, const GlossyLobeScr
                  w11 * fromBfloat16(a[f + dx + dy]);
 }
 
+// What a first-bounce member sends back along the hit's ray
+// (gi/glossy_lobe_members.h), weighted into its texel's accumulator.
+[[gnu::always_inline]] inline void addMemberSent(const LobeMembers& members, const GlossyLobeScratch::Hit& hit,
+                                                 bool clamp, double* acc) {
+    float u[3];
+    lobeMemberSends(members, hit.px, hit.py, hit.ray->back, u);
+    for (int c = 0; c < 3; ++c)
+        acc[3 * hit.ray->texel + c] += static_cast<double>(hit.ray->weight) * (clamp ? std::max(u[c], 0.0f) : u[c]);
+}
+
 // Where along its azimuth a ray of slope `slope` meets the surface, as a
 // horizontal distance from where it leaves: between the last step below it
 // (a sample riseBefore over the ray's start, runBefore away) and the first
@@ -404,10 +400,12 @@ template <int N>
                     for (GlossyLobeScratch::Ray* r : met) {
                         const double d =
                             crossingDistance(L.riseBefore[l], L.runBefore[l], rise[l], run[l], r->slope) / cell;
-                        const GlossyLobeScratch::ExitTap tap =
-                            exitTap(pyr.nx, pyr.ny, x0 + f.ox + d * c, y0 + f.oy + d * sn);
-                        prefetchExit(in.exit, pyr.nx, pyr.ny, tap);
-                        sc.hits.push_back({tap, r});
+                        const double px = x0 + f.ox + d * c, py = y0 + f.oy + d * sn;
+                        if (in.members)
+                            prefetchLobeMember(*in.members, px, py);
+                        else
+                            prefetchExit(in.exit, pyr.nx, pyr.ny, exitTap(pyr.nx, pyr.ny, px, py));
+                        sc.hits.push_back({px, py, r});
                         r->slope = std::numeric_limits<float>::infinity();
                     }
                     lowest = lowestSlope(w.first, w.end);
@@ -521,11 +519,14 @@ template <int N>
         // what the surface sends back where each ray met it, in the walks'
         // order (so the sums are fixed)
         sc.acc.assign(static_cast<std::size_t>(3 * texels), 0.0);
-        MemberSamples m;
-        for (const GlossyLobeScratch::Hit& hit : sc.hits) {
-            readExit(in.exit, nx, pyr.ny, hit.tap, m);
-            addSent(m, *hit.ray, clamp, sc.acc.data());
-        }
+        if (in.members)
+            for (const GlossyLobeScratch::Hit& hit : sc.hits) addMemberSent(*in.members, hit, clamp, sc.acc.data());
+        else
+            for (const GlossyLobeScratch::Hit& hit : sc.hits) {
+                MemberSamples m;
+                readExit(in.exit, nx, pyr.ny, exitTap(nx, pyr.ny, hit.px, hit.py), m);
+                addSent(m, *hit.ray, clamp, sc.acc.data());
+            }
         for (int t = 0; t < texels; ++t) {
             const std::size_t i = static_cast<std::size_t>(rows.first + t / width) * nx + cols.first + t % width;
             for (int c = 0; c < 3; ++c)

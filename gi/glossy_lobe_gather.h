@@ -64,6 +64,7 @@
 #include <vector>
 
 #include "core/grid.h"
+#include "gi/glossy_lobe_members.h"
 #include "gi/phong_lobe_quadrature.h"
 #include "gi/pyramid.h"
 #include "gi/shading.h"
@@ -139,14 +140,15 @@ struct GlossyLobeScratch {
     // walk k in lane k % N of block k / N (the SSE2 and the AVX2 variant)
     std::vector<TexelLanes<2>> narrowLanes;
     std::vector<TexelLanes<4>> wideLanes;
-    // Where a ray meets the surface: E's first texel of the four around it
-    // and the bilinear fractions; the receiver's hits in the walks' order.
+    // E's first texel of the four around a position and the bilinear fractions.
     struct ExitTap {
         std::ptrdiff_t first;
         float fx, fy;
     };
+    // Where a ray meets the surface (full-resolution cells); the receiver's
+    // hits in the walks' order.
     struct Hit {
-        ExitTap tap;
+        double px, py;
         const Ray* ray;
     };
     std::vector<Hit> hits;
@@ -194,6 +196,9 @@ struct GlossyLobeInputs {
     // E at full resolution texel by texel (value f of texel k at k * 48 + f),
     // bfloat16 (glossyExitRadiance's texels): a ray's E is four runs of 96 bytes
     const std::uint16_t* exit;
+    // Bounce 1's members (gi/glossy_lobe_members.h): when given, what they
+    // send instead of E (exit may then be null).
+    const LobeMembers* members;
     const AlbedoMap* surface;  // per-texel exponent (null or empty: the settings')
     const ShadingSettings& shading;
     int azimuths;  // M, the global azimuths

@@ -4,6 +4,7 @@
 #include <array>
 
 #include "core/grid.h"
+#include "gi/lights.h"
 #include "gi/pyramid.h"
 #include "gi/receiver_tiles.h"
 #include "gi/shading.h"
@@ -56,6 +57,10 @@ struct IndirectInputs {
     // The state's RGB pyramid is already that of `direct` (the caller built
     // it, IndirectState::radianceOfDirect set): bounce 1 keeps it.
     bool radianceCurrent = false;
+    // The lights' SH radiance the direct shading filtered, unoccluded: what
+    // the lobe gather's first-bounce members reflect above their horizons
+    // (GlossyLobeMembers::Windowed; null: they send E).
+    const ShRgb* memberLight = nullptr;
 };
 
 }  // namespace terrain::gi

@@ -20,6 +20,17 @@ enum class GlossyIndirect {
     LobeScan,
 };
 
+// What the lobe gather's first-bounce members send (GlossyIndirect::LobeScan).
+enum class GlossyLobeMembers {
+    // The lobe-filtered light times the part of the lobe above the member's
+    // horizon (gi/glossy_lobe_members.h): no order-4 projection of the
+    // horizon's edge.
+    Windowed,
+    // The vector pyramid's exit-radiance SH vectors E, order 4
+    // (gi/glossy_exit_radiance.h).
+    Sh,
+};
+
 // How Lambert receivers turn their casting sets into irradiance.
 enum class LambertIndirect {
     // Eq. 12 + the folded wedge operator + the order-4 SH clamped cosine (the
@@ -55,6 +66,9 @@ struct IndirectSettings {
     int lobeRings = 3;
     int lobeNearStepsPerOctave = 16;
     int lobeNearOctaves = 7;
+    // What the first bounce's members send to the lobe gather; the bounces
+    // after it send E.
+    GlossyLobeMembers lobeMembers = GlossyLobeMembers::Windowed;
     bool operator==(const IndirectSettings&) const = default;
 };
 

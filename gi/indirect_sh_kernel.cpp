@@ -109,13 +109,23 @@ void ShKernelIndirect::buildPyramid(int b, const BounceSource& previous) {
     const HeightPyramid& pyr = in_.heights;
     GlossyIndirectState& gs = st_.glossy;
     const std::size_t values = static_cast<std::size_t>(pyr.nx) * pyr.ny * kGlossyFields;
-    const bool planes = !lobes_ || needsU(b);
+    const bool planes = !lobes_ || needsU(b), windowed = windowedMembers(b);
     if (planes) gs.exitSh.resize(values);
-    if (lobes_) gs.exitTexels.resize(values);
+    if (lobes_ && !windowed) gs.exitTexels.resize(values);
+    if (windowed)
+        prepareLobeMembers(in_.gradX, in_.gradY, in_.envVisibility, pyr.subsample, *in_.memberLight, in_.albedo,
+                           in_.shading, gs.members);
     glossyExitRadiance(in_.gradX, in_.gradY, pyr.subsample, pyr.nxr, pyr.nyr, previous.shade->incident.data(),
                        previous.shade->rgb, in_.albedo, in_.shading, gs.exitScratch,
-                       planes ? gs.exitSh.data() : nullptr, lobes_ ? gs.exitTexels.data() : nullptr);
+                       {planes ? gs.exitSh.data() : nullptr, lobes_ && !windowed ? gs.exitTexels.data() : nullptr,
+                        windowed ? gs.members.texels.data() + LobeMembers::kDiffuse : nullptr, LobeMembers::kRecord});
     if (planes) buildPackedPyramids(gs.exitSh.data(), kGlossyFields, pyr, settings_.radiance, gs.pyramid);
+}
+
+// The first bounce's members of the lobe gather send their windowed lobe
+// (gi/glossy_lobe_members.h) when the lights they reflect are known.
+bool ShKernelIndirect::windowedMembers(int b) const {
+    return lobes_ && b == 1 && settings_.lobeMembers == GlossyLobeMembers::Windowed && in_.memberLight;
 }
 
 bool ShKernelIndirect::needsU(int b) const {
@@ -127,7 +137,8 @@ void ShKernelIndirect::scan(int b) {
         const GlossyLobeInputs lobeIn{in_.heights,
                                       in_.gradX,
                                       in_.gradY,
-                                      st_.glossy.exitTexels.data(),
+                                      windowedMembers(b) ? nullptr : st_.glossy.exitTexels.data(),
+                                      windowedMembers(b) ? &st_.glossy.members : nullptr,
                                       in_.albedo,
                                       in_.shading,
                                       settings_.lobeAzimuths,

@@ -55,6 +55,7 @@ private:
     IndirectState& st_;
     /// LobeScan: bounce b reads U (its diffuse part, or a bounce after it).
     bool needsU(int b) const;
+    bool windowedMembers(int b) const;
 
     bool exitVectors_;  // the members send E . Y(-d) (GlossyIndirect::VectorPyramid, LobeScan)
     bool lobes_;        // the receivers gather their own lobes (GlossyIndirect::LobeScan)

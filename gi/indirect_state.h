@@ -33,6 +33,7 @@ struct IndirectTimings {
 struct GlossyIndirectState {
     std::vector<float> exitSh;                 // 3 x 16 planes of nx * ny: E at full resolution (plane c * 16 + k)
     std::vector<std::uint16_t> exitTexels;     // LobeScan: E texel by texel, bfloat16 (glossyExitRadiance)
+    LobeMembers members;                       // LobeScan, bounce 1: what the members send (windowed)
     PackedPyramids pyramid;                    // one field per plane of exitSh, bfloat16
     std::vector<ScanStep> steps;               // azimuths x steps: geometry and weights (field 0)
     std::vector<const std::uint16_t*> fields;  // azimuths x steps x 48: field + offA of each plane

@@ -58,6 +58,12 @@ struct ReferenceGiSettings {
     // instead of integrating their lobe exactly; the receivers stay exact
     // unless receiverSh is set too. The floor of what order-4 members send.
     bool membersSh = false;
+    // Glossy reference diagnostic: the first bounce's hits send the lobe-
+    // filtered light times the lobe's open fraction above their exact horizon
+    // along R's azimuth, erfc((e_h - e_R) sqrt((S + 1) / 2)) / 2 (what the
+    // lobe gather's windowed members send, gi/glossy_lobe_members.h, with
+    // exact horizons), instead of integrating their lobe exactly.
+    bool membersWindowed = false;
     // Glossy reference diagnostic: the first bounce's receivers see their
     // incident radiance only along m = receiverAzimuths evenly spaced
     // azimuths phi_j = 2 pi j / m (the fast path's scan azimuths), exactly

@@ -249,6 +249,21 @@ void radianceFromHit(const GlossyGather& g, float qx, float qy, const double dir
     reflect(nq, back, r);
     for (int c = 0; c < 3; ++c) L[c] = bl(prevD[c].data());
     if (g.ws == 0.0) return;
+    if (!prevI && g.s.membersWindowed) {
+        double yR[kShCount], ph[kShOrder];
+        basis(r[0], r[1], r[2], yR);
+        g.surf.lobeAt(bl, ph);
+        const double eR = std::asin(std::clamp(r[2], -1.0, 1.0));
+        const double eH = std::atan(g.horizons.at(qx, qy, std::atan2(r[1], r[0])));
+        const double open = 0.5 * std::erfc((eH - eR) * std::sqrt(0.5 * (g.surf.exponentAt(bl) + 1.0)));
+        for (std::size_t c = 0; c < 3; ++c) {
+            double sp = 0.0;
+            for (int j = 0; j < kShCount; ++j)
+                sp += ph[shBand(j)] * yR[j] * g.lighting.c[c][static_cast<std::size_t>(j)];
+            L[c] += g.ws * open * sp;
+        }
+        return;
+    }
     if (!prevI) {
         double e[3];
         exactLobeRadiance(g.horizons, g.lighting, qx, qy, nq, r, g.surf.exponentAt(bl), g.s.lobeRings, e);
