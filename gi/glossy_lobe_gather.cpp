@@ -247,16 +247,6 @@ void prefetchExit(const std::uint16_t* exit, int nx, int ny, const GlossyLobeScr
                  w11 * fromBfloat16(a[f + dx + dy]);
 }
 
-// What a first-bounce member sends back along the hit's ray
-// (gi/glossy_lobe_members.h), weighted into its texel's accumulator.
-[[gnu::always_inline]] inline void addMemberSent(const LobeMembers& members, const GlossyLobeScratch::Hit& hit,
-                                                 bool clamp, double* acc) {
-    float u[3];
-    lobeMemberSends(members, hit.px, hit.py, hit.ray->back, u);
-    for (int c = 0; c < 3; ++c)
-        acc[3 * hit.ray->texel + c] += static_cast<double>(hit.ray->weight) * (clamp ? std::max(u[c], 0.0f) : u[c]);
-}
-
 // Where along its azimuth a ray of slope `slope` meets the surface, as a
 // horizontal distance from where it leaves: between the last step below it
 // (a sample riseBefore over the ray's start, runBefore away) and the first
@@ -519,9 +509,20 @@ template <int N>
         // what the surface sends back where each ray met it, in the walks'
         // order (so the sums are fixed)
         sc.acc.assign(static_cast<std::size_t>(3 * texels), 0.0);
-        if (in.members)
-            for (const GlossyLobeScratch::Hit& hit : sc.hits) addMemberSent(*in.members, hit, clamp, sc.acc.data());
-        else
+        if (in.members) {
+            LobeMemberHits& mh = sc.memberHits;
+            mh.clear();
+            for (const GlossyLobeScratch::Hit& hit : sc.hits) mh.push(hit.px, hit.py, hit.ray->back);
+            lobeMembersSend<std::conditional_t<N == 4, simd::F8, simd::F4>>(*in.members, mh);
+            for (std::size_t k = 0; k < sc.hits.size(); ++k) {
+                const GlossyLobeScratch::Ray& ray = *sc.hits[k].ray;
+                for (int c = 0; c < 3; ++c) {
+                    const float u = mh.sent[c][k];
+                    sc.acc[static_cast<std::size_t>(3 * ray.texel + c)] +=
+                        static_cast<double>(ray.weight) * (clamp ? std::max(u, 0.0f) : u);
+                }
+            }
+        } else
             for (const GlossyLobeScratch::Hit& hit : sc.hits) {
                 MemberSamples m;
                 readExit(in.exit, nx, pyr.ny, exitTap(nx, pyr.ny, hit.px, hit.py), m);

@@ -152,6 +152,7 @@ struct GlossyLobeScratch {
         const Ray* ray;
     };
     std::vector<Hit> hits;
+    LobeMemberHits memberHits;  // the hits again, for the first bounce's members
     LobeQuadrature quadrature;  // the lobe directions of the last exponent
     // One texel's lobe directions, stage by stage: the unit direction, its
     // horizontal length, its azimuth in units of the global azimuths and its

@@ -18,7 +18,8 @@ void prepareLobeMembers(ConstGridView gradX, ConstGridView gradY, const Visibili
     m.nxr = env.nxr;
     m.nyr = env.nyr;
     m.azimuths = static_cast<int>(env.maxSlope.size() / receivers);
-    m.subsample = subsample;
+    m.perReceiver = 1.0 / subsample;
+    m.azimuthsPerRadian = m.azimuths / (2.0 * kPi);
     m.exponentMap = surface && !surface->phongExponent.empty();
     constexpr std::size_t R = LobeMembers::kRecord;
     m.texels.resize(static_cast<std::size_t>(nx) * ny * R);

@@ -54,6 +54,7 @@
 #include <vector>
 
 #include "core/grid.h"
+#include "core/simd.h"
 #include "gi/azimuth.h"
 #include "gi/lights.h"
 #include "gi/shading.h"
@@ -67,10 +68,14 @@ struct LobeMembers {
     static constexpr int kRecord = 8;   // floats per texel: gx, gy, D (RGB), S, two unused
     static constexpr int kDiffuse = 2;  // where D starts in a record
     static constexpr int kErfcSteps = 64, kErfcRange = 4;
-    int nx = 0, ny = 0, nxr = 0, nyr = 0, azimuths = 0, subsample = 1;
-    std::vector<float> texels;    // kRecord per texel
-    std::vector<float> horizons;  // per receiver its horizon slope at each azimuth 2 pi j / azimuths
-    bool exponentMap = false;     // S varies by texel (else the lobe factors are the settings')
+    int nx = 0, ny = 0, nxr = 0, nyr = 0, azimuths = 0;
+    double perReceiver = 1.0;        // 1 / the sub-sampling: receiver cells per texel cell
+    double azimuthsPerRadian = 0.0;  // azimuths / (2 pi)
+    // (64-byte aligned: a receiver's 16 horizons are one cache line, two
+    // texels' records share one)
+    FloatVector texels;        // kRecord per texel
+    FloatVector horizons;      // per receiver its horizon slope at each azimuth 2 pi j / azimuths
+    bool exponentMap = false;  // S varies by texel (else the lobe factors are the settings')
     // w_s L_lm of the lights (RGB x 16), and w_s g_l L_lm with the settings' lobe
     std::array<std::array<float, kShCount>, 3> light{}, filtered{};
     // erfc(x) / 2 at x = -range + k / steps
@@ -111,24 +116,6 @@ struct Tap {
             fx * fy};
 }
 
-// Vbar: the part of a lobe of exponent S about r (unit) above horizon slope
-// h along r's azimuth (see above).
-[[gnu::always_inline]] inline float openFraction(const LobeMembers& m, const float r[3], float h, float S) {
-    const float horizontal = std::sqrt(r[0] * r[0] + r[1] * r[1]);
-    const float inv = 1.0f / std::sqrt(1.0f + h * h);
-    const float sinD = (h * horizontal - r[2]) * inv;  // sin(e_h - e_R)
-    const float cosD = (horizontal + h * r[2]) * inv;
-    if (cosD <= 0.0f) return sinD > 0.0f ? 0.0f : 1.0f;
-    const float u = (std::clamp(sinD * std::sqrt(0.5f * (S + 1.0f)), -1.0f * LobeMembers::kErfcRange,
-                                1.0f * LobeMembers::kErfcRange) +
-                     LobeMembers::kErfcRange) *
-                    LobeMembers::kErfcSteps;
-    const int k = std::min(static_cast<int>(u), 2 * LobeMembers::kErfcRange * LobeMembers::kErfcSteps);
-    const float f = u - static_cast<float>(k);
-    const auto kk = static_cast<std::size_t>(k);
-    return m.halfErfc[kk] + f * (m.halfErfc[kk + 1] - m.halfErfc[kk]);
-}
-
 }  // namespace lobe_members_detail
 
 /// Asks for the cache lines the member at (px, py) will be read from.
@@ -140,57 +127,150 @@ struct Tap {
     __builtin_prefetch(a + LobeMembers::kRecord);
     __builtin_prefetch(a + t.dy * LobeMembers::kRecord);
     __builtin_prefetch(a + (t.dy + 1) * LobeMembers::kRecord);
-    const double s = m.subsample;
-    const auto r = tapAt(m.nxr, m.nyr, px / s, py / s);
+    const auto r = tapAt(m.nxr, m.nyr, px * m.perReceiver, py * m.perReceiver);
     const std::size_t line = static_cast<std::size_t>(m.azimuths);
     const float* h = m.horizons.data() + r.i00 * line;
     for (std::size_t k : {std::size_t{0}, r.dx, r.dy, r.dx + r.dy}) __builtin_prefetch(h + k * line);
 }
 
-/// The radiance (RGB) the member at full-resolution position (px, py) sends
-/// towards `back` (unit): D + w_s filtered light x Vbar (see above).
-[[gnu::always_inline]] inline void lobeMemberSends(const LobeMembers& m, double px, double py, const float back[3],
-                                                   float out[3]) {
-    using namespace lobe_members_detail;
-    constexpr std::size_t R = LobeMembers::kRecord;
-    const Tap t = tapAt(m.nx, m.ny, px, py);
-    const float* rec = m.texels.data();
-    // the member's normal and the reflection of `back` about it
-    const float gx = t.at(rec, R), gy = t.at(rec + 1, R);
-    const float inv = 1.0f / std::sqrt(1.0f + gx * gx + gy * gy);
-    const float n[3] = {-gx * inv, -gy * inv, inv};
-    const float nb = 2.0f * (n[0] * back[0] + n[1] * back[1] + n[2] * back[2]);
-    const float r[3] = {nb * n[0] - back[0], nb * n[1] - back[1], nb * n[2] - back[2]};
-    float y[kShCount];
-    shBasisLanes<float>(r[0], r[1], r[2], y);
-    const float S = t.at(rec + 5, R);
-    float spec[3];
-    if (m.exponentMap) {
-        // g_l = q^(l^2), q = e^{-1 / (2 S)}
-        const float q = std::exp(-0.5f / S), q4 = (q * q) * (q * q);
-        const float ph[kShOrder] = {1.0f, q, q4, q4 * q4 * q};
-        for (std::size_t c = 0; c < 3; ++c) {
-            spec[c] = 0.0f;
-            for (int i = 0; i < kShCount; ++i)
-                spec[c] += ph[shBand(i)] * m.light[c][static_cast<std::size_t>(i)] * y[i];
-        }
-    } else {
-        for (std::size_t c = 0; c < 3; ++c) {
-            spec[c] = 0.0f;
-            for (int i = 0; i < kShCount; ++i) spec[c] += m.filtered[c][static_cast<std::size_t>(i)] * y[i];
-        }
+/// Where rays met the surface, one per hit (structure of arrays): the
+/// full-resolution position and the unit direction back to the receiver.
+struct LobeMemberHits {
+    std::vector<double> px, py;
+    std::vector<float> bx, by, bz;
+    std::vector<float> sent[3];  // what lobeMembersSend writes: RGB per hit
+    void clear() {
+        for (auto* v : {&px, &py}) v->clear();
+        for (auto* v : {&bx, &by, &bz}) v->clear();
     }
+    void push(double x, double y, const float back[3]) {
+        px.push_back(x);
+        py.push_back(y);
+        bx.push_back(back[0]);
+        by.push_back(back[1]);
+        bz.push_back(back[2]);
+    }
+    std::size_t size() const { return px.size(); }
+};
+
+namespace lobe_members_detail {
+
+// The azimuth of (x, y) in [0, 2 pi) per lane: atan of the smaller over the
+// larger component (simd::atanv), then the octant.
+template <class V>
+[[gnu::always_inline]] inline V azimuthLanes(V x, V y) {
+    const V zero = simd::splat<V>(0.0f);
+    const V ax = x < zero ? -x : x, ay = y < zero ? -y : y;
+    const V lo = simd::vmin(ax, ay), hi = simd::vmax(ax, ay);
+    V a = simd::atanv(hi > zero ? lo / hi : zero);
+    const V halfPi = simd::splat<V>(static_cast<float>(0.5 * kPi)), pi = simd::splat<V>(static_cast<float>(kPi));
+    a = ay > ax ? halfPi - a : a;
+    a = x < zero ? pi - a : a;
+    a = y < zero ? 2.0f * pi - a : a;
+    return a >= 2.0f * pi ? zero : a;
+}
+
+// What the members of hits [k, k + lanes of V) send (see the header's
+// formula): each lane the arithmetic of one hit alone, so both lane widths
+// give the same values.
+template <class V>
+[[gnu::always_inline]] inline void sendLanes(const LobeMembers& m, LobeMemberHits& hits, std::size_t k) {
+    using simd::load;
+    using simd::splat;
+    constexpr int L = simd::kLaneCount<V>;
+    constexpr std::size_t R = LobeMembers::kRecord;
+    // the texels' records about each hit: gx, gy, D (RGB), S bilinear
+    alignas(32) float w[4][L];
+    alignas(32) float corner[4][6][L];
+    for (int l = 0; l < L; ++l) {
+        const Tap t = tapAt(m.nx, m.ny, hits.px[k + l], hits.py[k + l]);
+        const float* rec = m.texels.data() + t.i00 * R;
+        const std::size_t offs[4] = {0, t.dx * R, t.dy * R, (t.dx + t.dy) * R};
+        for (int c = 0; c < 4; ++c)
+            for (int f = 0; f < 6; ++f) corner[c][f][l] = rec[offs[c] + static_cast<std::size_t>(f)];
+        w[0][l] = t.w00;
+        w[1][l] = t.w10;
+        w[2][l] = t.w01;
+        w[3][l] = t.w11;
+    }
+    const V w00 = load<V>(w[0]), w10 = load<V>(w[1]), w01 = load<V>(w[2]), w11 = load<V>(w[3]);
+    V f6[6];
+    for (int f = 0; f < 6; ++f)
+        f6[f] = w00 * load<V>(corner[0][f]) + w10 * load<V>(corner[1][f]) + w01 * load<V>(corner[2][f]) +
+                w11 * load<V>(corner[3][f]);
+    const V one = splat<V>(1.0f), zero = splat<V>(0.0f);
+    // the member's normal and the reflection of the way back about it
+    const V gx = f6[0], gy = f6[1], S = f6[5];
+    const V inv = one / simd::sqrtv(one + gx * gx + gy * gy);
+    const V nx = -gx * inv, ny = -gy * inv, nz = inv;
+    const V bx = load<V>(hits.bx.data() + k), by = load<V>(hits.by.data() + k), bz = load<V>(hits.bz.data() + k);
+    const V nb = 2.0f * (nx * bx + ny * by + nz * bz);
+    const V rx = nb * nx - bx, ry = nb * ny - by, rz = nb * nz - bz;
     // the horizon along R's azimuth: linear between the scan's azimuths,
     // bilinear between the receivers
-    const double s = m.subsample;
-    const Tap rt = tapAt(m.nxr, m.nyr, px / s, py / s);
-    const double u = azimuthOf(r[0], r[1]) / (2.0 * kPi) * m.azimuths;
-    const int a0 = std::min(static_cast<int>(u), m.azimuths - 1), a1 = (a0 + 1) % m.azimuths;
-    const float fa = static_cast<float>(u - a0);
+    alignas(32) float u[L], hz[L];
+    simd::store(u, azimuthLanes(rx, ry) * static_cast<float>(m.azimuthsPerRadian));
     const std::size_t line = static_cast<std::size_t>(m.azimuths);
-    const float h0 = rt.at(m.horizons.data() + a0, line), h1 = rt.at(m.horizons.data() + a1, line);
-    const float open = openFraction(m, r, h0 + fa * (h1 - h0), S);
-    for (std::size_t c = 0; c < 3; ++c) out[c] = t.at(rec + LobeMembers::kDiffuse + c, R) + open * spec[c];
+    for (int l = 0; l < L; ++l) {
+        const Tap rt = tapAt(m.nxr, m.nyr, hits.px[k + l] * m.perReceiver, hits.py[k + l] * m.perReceiver);
+        const int a0 = std::min(static_cast<int>(u[l]), m.azimuths - 1), a1 = a0 + 1 < m.azimuths ? a0 + 1 : 0;
+        const float fa = u[l] - static_cast<float>(a0);
+        const float h0 = rt.at(m.horizons.data() + a0, line), h1 = rt.at(m.horizons.data() + a1, line);
+        hz[l] = h0 + fa * (h1 - h0);
+    }
+    // Vbar: sin and cos of e_h - e_R, then erfc from the table
+    const V h = load<V>(hz);
+    const V horizontal = simd::sqrtv(rx * rx + ry * ry), invH = one / simd::sqrtv(one + h * h);
+    const V sinD = (h * horizontal - rz) * invH, cosD = (horizontal + h * rz) * invH;
+    const V range = splat<V>(static_cast<float>(LobeMembers::kErfcRange));
+    const V x = simd::vmin(simd::vmax(sinD * simd::sqrtv(0.5f * (S + one)), -range), range);
+    alignas(32) float tableAt[L], open[L];
+    simd::store(tableAt, (x + range) * static_cast<float>(LobeMembers::kErfcSteps));
+    for (int l = 0; l < L; ++l) {
+        const int i = std::min(static_cast<int>(tableAt[l]), 2 * LobeMembers::kErfcRange * LobeMembers::kErfcSteps);
+        const auto ii = static_cast<std::size_t>(i);
+        open[l] = m.halfErfc[ii] + (tableAt[l] - static_cast<float>(i)) * (m.halfErfc[ii + 1] - m.halfErfc[ii]);
+    }
+    // beyond a quarter turn the sine turns back: 0 or 1 by the angle's sign
+    const V Vbar = cosD <= zero ? (sinD > zero ? zero : one) : load<V>(open);
+    // the lobe-filtered light at R
+    V y[kShCount];
+    shBasisLanes<V>(rx, ry, rz, y);
+    V ph[kShOrder] = {one, one, one, one};
+    if (m.exponentMap) {
+        // g_l = q^(l^2), q = e^{-1 / (2 S)}
+        alignas(32) float Ss[L], q[L];
+        simd::store(Ss, S);
+        for (int l = 0; l < L; ++l) q[l] = std::exp(-0.5f / Ss[l]);
+        const V qv = load<V>(q), q4 = (qv * qv) * (qv * qv);
+        ph[1] = qv;
+        ph[2] = q4;
+        ph[3] = q4 * q4 * qv;
+    }
+    for (std::size_t c = 0; c < 3; ++c) {
+        V spec = zero;
+        if (m.exponentMap)
+            for (int i = 0; i < kShCount; ++i) spec += ph[shBand(i)] * m.light[c][static_cast<std::size_t>(i)] * y[i];
+        else
+            for (int i = 0; i < kShCount; ++i) spec += m.filtered[c][static_cast<std::size_t>(i)] * y[i];
+        simd::store(hits.sent[c].data() + k, f6[2 + c] + Vbar * spec);
+    }
+}
+
+}  // namespace lobe_members_detail
+
+/// hits.sent: what the member of every hit sends back along its ray (RGB,
+/// see above), lanes of V at a time (the last group filled up with copies of
+/// the last hit, whose results are dropped).
+template <class V>
+[[gnu::always_inline]] inline void lobeMembersSend(const LobeMembers& m, LobeMemberHits& hits) {
+    constexpr std::size_t L = simd::kLaneCount<V>;
+    const std::size_t n = hits.size();
+    if (n == 0) return;
+    const float back[3] = {hits.bx.back(), hits.by.back(), hits.bz.back()};
+    while (hits.size() % L != 0) hits.push(hits.px.back(), hits.py.back(), back);
+    for (auto& s : hits.sent) s.resize(hits.size());
+    for (std::size_t k = 0; k < hits.size(); k += L) lobe_members_detail::sendLanes<V>(m, hits, k);
 }
 
 }  // namespace terrain::gi

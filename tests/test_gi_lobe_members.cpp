@@ -33,9 +33,10 @@ struct FlatMembers {
     // about the flat ground's normal lies at elevation e (radians), azimuth 0
     float sendsWithReflectionAt(double e) const {
         const float back[3] = {static_cast<float>(-std::cos(e)), 0.0f, static_cast<float>(std::sin(e))};
-        float out[3];
-        lobeMemberSends(m, 8.3, 8.6, back, out);
-        return out[0];
+        LobeMemberHits hits;
+        hits.push(8.3, 8.6, back);
+        lobeMembersSend<simd::F4>(m, hits);
+        return hits.sent[0][0];
     }
 };
 
