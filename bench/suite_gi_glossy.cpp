@@ -340,7 +340,9 @@ std::string floorsIntro(const GlossyOptions& o) {
           "quadrature with N directions (2 or 3 rings); M azimuths: each of the receivers' lobe rays takes the "
           "first hits at its elevation along the two nearest of M evenly spaced azimuths (the fast path's scan "
           "azimuths, 8 by default), linearly weighted (`receiverAzimuths`): what a receiver that integrates its "
-          "own lobe over the scan's incident radiance could reach.\n\n";
+          "own lobe over the scan's incident radiance could reach; members windowed: the first hits send the "
+          "lobe-filtered light times the part of their lobe above their exact horizon along R's azimuth "
+          "(`membersWindowed`, what the lobe gather's first-bounce members send, gi/glossy_lobe_members.h).\n\n";
     return md;
 }
 
@@ -351,7 +353,8 @@ std::string floorsIntro(const GlossyOptions& o) {
 // receivers' lobe sampled by a few rays (2 or 3 rings of the lobe quadrature:
 // 8 or 18 rays) with exact or order-4 members, and the receivers' lobe seeing
 // its incident radiance along the scan's azimuths only (receiverAzimuths: 8,
-// the engine's, 16 or 32). Phong, 1x, on the accuracy crop.
+// the engine's, 16 or 32), and windowed members (membersWindowed) alone and
+// as the lobe gather has them. Phong, 1x, on the accuracy crop.
 void floorsSection(const GlossyOptions& o, const BenchContext& ctx) {
     float cell = 1.0f;
     const Grid h = alpsCentreCrop(ctx.dataDir, o.size, cell);
@@ -360,20 +363,23 @@ void floorsSection(const GlossyOptions& o, const BenchContext& ctx) {
     struct Variant {
         const char* name;
         bool membersSh, receiverSh;
+        bool membersWindowed;
         int rings;     // 0: the reference's
         int azimuths;  // ReferenceGiSettings::receiverAzimuths (0: every ray its own)
     };
-    const Variant variants[] = {{"members SH", true, false, 0, 0},
-                                {"receivers SH", false, true, 0, 0},
-                                {"both SH", true, true, 0, 0},
-                                {"receivers 8 rays", false, false, 2, 0},
-                                {"receivers 18 rays", false, false, 3, 0},
-                                {"8 rays, members SH", true, false, 2, 0},
-                                {"18 rays, members SH", true, false, 3, 0},
-                                {"members SH, 8 azimuths", true, false, 0, 8},
-                                {"18 rays, members SH, 8 azimuths", true, false, 3, 8},
-                                {"18 rays, members SH, 16 azimuths", true, false, 3, 16},
-                                {"18 rays, members SH, 32 azimuths", true, false, 3, 32}};
+    const Variant variants[] = {{"members SH", true, false, false, 0, 0},
+                                {"receivers SH", false, true, false, 0, 0},
+                                {"both SH", true, true, false, 0, 0},
+                                {"receivers 8 rays", false, false, false, 2, 0},
+                                {"receivers 18 rays", false, false, false, 3, 0},
+                                {"8 rays, members SH", true, false, false, 2, 0},
+                                {"18 rays, members SH", true, false, false, 3, 0},
+                                {"members SH, 8 azimuths", true, false, false, 0, 8},
+                                {"18 rays, members SH, 8 azimuths", true, false, false, 3, 8},
+                                {"18 rays, members SH, 16 azimuths", true, false, false, 3, 16},
+                                {"18 rays, members SH, 32 azimuths", true, false, false, 3, 32},
+                                {"members windowed", false, false, true, 0, 0},
+                                {"18 rays, members windowed, 32 azimuths", false, false, true, 3, 32}};
     std::string md = floorsIntro(o);
     std::string head = "| S |", rule = "|---|";
     for (const Variant& v : variants) {
@@ -394,6 +400,7 @@ void floorsSection(const GlossyOptions& o, const BenchContext& ctx) {
         for (const Variant& v : variants) {
             ReferenceGiSettings d = rs;
             d.membersSh = v.membersSh;
+            d.membersWindowed = v.membersWindowed;
             d.receiverSh = v.receiverSh;
             if (v.rings > 0) d.lobeRings = v.rings;
             d.receiverAzimuths = v.azimuths;
