@@ -26,12 +26,14 @@
 // casting set: that step is the member whose segment holds te, Eq. 8). It
 // meets the surface between that step and the one before, where the ray's
 // height above the two samples, linearly interpolated, crosses zero, and
-// brings back what the surface sends towards the receiver from there,
-// E . Y(-w_j) (the ray's direction, not the member's own elevation) with E
-// the full-resolution exit radiance, bilinear, max(0, .) with
-// GlossyPositivity::Clamp. Reading E there rather than the member's pyramid
-// sample, which stands for the whole step and a footprint as wide, took the
-// error against the exact reference from 16-24 % to 14-20 % (1x, README).
+// brings back what the surface sends towards the receiver from there along
+// the ray (not the member's own elevation), max(0, .) with
+// GlossyPositivity::Clamp: in the first bounce its windowed lobe
+// (gi/glossy_lobe_members.h, GlossyLobeMembers::Windowed), else E . Y(-w_j)
+// with E the full-resolution exit radiance, bilinear. Reading what the
+// surface sends there rather than at the member's pyramid sample, which
+// stands for the whole step and a footprint as wide, made the gather
+// markedly more accurate (README).
 // A ray below the tangent plane along phi_j carries nothing; one that meets
 // no step sees the sky (direct light, bounce 0).
 //

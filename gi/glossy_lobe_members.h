@@ -6,11 +6,10 @@
 //
 // Why. E (gi/glossy_exit_radiance.h) carries the member's incident radiance
 // T_L V projected to order-4 SH, so the horizon's edge, which a sharp lobe
-// resolves, is blurred to band 3. Measured with the glossy reference's
-// diagnostics (README, "The lobe gather"), members sending order-4 SH are
-// 3.4 / 6.4 / 10.0 / 13.4 % from the truth at S = 8 / 16 / 32 / 64, the
-// floor under the gather at sharp lobes; the product below is 5.6 / 3.5 /
-// 2.2 / 1.5 %.
+// resolves, is blurred to band 3: measured with the glossy reference's
+// diagnostics (membersSh, membersWindowed; README, "The lobe gather"), that
+// was the floor under the gather at sharp lobes, and the product below lies
+// far lower there.
 //
 // What is sent. Member q (normal N, exponent S) towards w, R = R_N(w) =
 // 2 (N . w) N - w: its first-bounce incident radiance is the lights' SH
@@ -36,14 +35,14 @@
 // sine turns back, Vbar is 0 or 1 by the angle's sign). The horizon is the
 // environment scan's (VisibilityField::maxSlope at its m azimuths 2 pi j / m,
 // Section 6): linear between azimuths, bilinear between receivers (Fig. 7).
-// Against the reference with exact horizons (lobe fraction by quadrature)
-// the closed form costs nothing measurable (README).
+// The README compares the closed form with the lobe's open fraction taken
+// by quadrature over the reference's exact horizons.
 //
 // Cost. A hit reads one record of 8 floats for each of the four texels
 // about it (gradients, D, exponent) and one line of horizons for each of the
 // four receivers about it, asked for when the hit is found (the hits fall
-// anywhere); erfc comes from a table (x in [-4, 4], steps of 1 / 64, linear:
-// within 1e-4 of it).
+// anywhere); erfc / 2 comes from a table (x in [-4, 4], steps of 1 / 64,
+// linear: within 2e-5, the step squared / 8 times its largest curvature).
 //
 // Positions are full-resolution cells; the gradients, D and the exponent
 // are read bilinear there, as E was.
