@@ -212,23 +212,13 @@ struct MemberSamples {
     float e[kPlanes];
 };
 
-// E's texels around full-resolution position (px, py) in cells: the first
-// of the four (clamped to the field) and the bilinear fractions.
-[[gnu::always_inline]] inline GlossyLobeScratch::ExitTap exitTap(int nx, int ny, double px, double py) {
-    const int ix = std::clamp(static_cast<int>(std::floor(px)), 0, std::max(nx - 2, 0));
-    const int iy = std::clamp(static_cast<int>(std::floor(py)), 0, std::max(ny - 2, 0));
-    const float fx = std::clamp(static_cast<float>(px - ix), 0.0f, 1.0f);
-    const float fy = std::clamp(static_cast<float>(py - iy), 0.0f, 1.0f);
-    return {static_cast<std::ptrdiff_t>(iy) * nx + ix, fx, fy};
-}
-
 // Asks for the cache lines of a tap's texels (two runs of two texels, 2 x 96
 // bytes) well before readExit reads them: the rays meet the surface anywhere,
 // and E at 512^2 is 25 MB, so the receiver's hits are read after its walks.
-void prefetchExit(const std::uint16_t* exit, int nx, int ny, const GlossyLobeScratch::ExitTap& t) {
+void prefetchExit(const std::uint16_t* exit, const BilinearTap& t) {
     constexpr int kTexelBytes = kPlanes * static_cast<int>(sizeof(std::uint16_t));
-    const auto* a = reinterpret_cast<const char*>(exit + t.first * kPlanes);
-    const std::ptrdiff_t row = ny > 1 ? static_cast<std::ptrdiff_t>(nx) * kTexelBytes : 0;
+    const auto* a = reinterpret_cast<const char*>(exit + t.i00 * kPlanes);
+    const std::size_t row = t.dy * kTexelBytes;
     for (int k = 0; k < 2 * kTexelBytes; k += 64) {
         __builtin_prefetch(a + k);
         __builtin_prefetch(a + row + k);
@@ -236,15 +226,12 @@ void prefetchExit(const std::uint16_t* exit, int nx, int ny, const GlossyLobeScr
 }
 
 // E bilinear between a tap's four texels.
-[[gnu::always_inline]] inline void readExit(const std::uint16_t* exit, int nx, int ny,
-                                            const GlossyLobeScratch::ExitTap& t, MemberSamples& m) {
-    const std::ptrdiff_t dx = nx > 1 ? kPlanes : 0, dy = ny > 1 ? static_cast<std::ptrdiff_t>(nx) * kPlanes : 0;
-    const std::uint16_t* a = exit + t.first * kPlanes;
-    const float fx = t.fx, fy = t.fy;
-    const float w00 = (1.0f - fx) * (1.0f - fy), w10 = fx * (1.0f - fy), w01 = (1.0f - fx) * fy, w11 = fx * fy;
+[[gnu::always_inline]] inline void readExit(const std::uint16_t* exit, const BilinearTap& t, MemberSamples& m) {
+    const std::size_t dx = t.dx * kPlanes, dy = t.dy * kPlanes;
+    const std::uint16_t* a = exit + t.i00 * kPlanes;
     for (int f = 0; f < kPlanes; ++f)
-        m.e[f] = w00 * fromBfloat16(a[f]) + w10 * fromBfloat16(a[f + dx]) + w01 * fromBfloat16(a[f + dy]) +
-                 w11 * fromBfloat16(a[f + dx + dy]);
+        m.e[f] = t.w00 * fromBfloat16(a[f]) + t.w10 * fromBfloat16(a[f + dx]) + t.w01 * fromBfloat16(a[f + dy]) +
+                 t.w11 * fromBfloat16(a[f + dx + dy]);
 }
 
 // Where along its azimuth a ray of slope `slope` meets the surface, as a
@@ -391,10 +378,12 @@ template <int N>
                         const double d =
                             crossingDistance(L.riseBefore[l], L.runBefore[l], rise[l], run[l], r->slope) / cell;
                         const double px = x0 + f.ox + d * c, py = y0 + f.oy + d * sn;
-                        if (in.members)
+                        if (in.members) {
                             prefetchLobeMember(*in.members, px, py);
-                        else
-                            prefetchExit(in.exit, pyr.nx, pyr.ny, exitTap(pyr.nx, pyr.ny, px, py));
+                            sc.memberHits.push(px, py, r->back);
+                        } else {
+                            prefetchExit(in.exit, bilinearTap(pyr.nx, pyr.ny, px, py));
+                        }
                         sc.hits.push_back({px, py, r});
                         r->slope = std::numeric_limits<float>::infinity();
                     }
@@ -498,6 +487,7 @@ template <int N>
             }
         bucketRays(static_cast<int>(st.phi.size()), sc);
         sc.hits.clear();
+        sc.memberHits.clear();
         GlossyLobeScratch::Ray* rays = sc.byAzimuth.data();
         const std::size_t n = sc.byAzimuth.size();
         for (std::size_t a = 0; a < n;) {
@@ -511,8 +501,6 @@ template <int N>
         sc.acc.assign(static_cast<std::size_t>(3 * texels), 0.0);
         if (in.members) {
             LobeMemberHits& mh = sc.memberHits;
-            mh.clear();
-            for (const GlossyLobeScratch::Hit& hit : sc.hits) mh.push(hit.px, hit.py, hit.ray->back);
             lobeMembersSend<std::conditional_t<N == 4, simd::F8, simd::F4>>(*in.members, mh);
             for (std::size_t k = 0; k < sc.hits.size(); ++k) {
                 const GlossyLobeScratch::Ray& ray = *sc.hits[k].ray;
@@ -525,7 +513,7 @@ template <int N>
         } else
             for (const GlossyLobeScratch::Hit& hit : sc.hits) {
                 MemberSamples m;
-                readExit(in.exit, nx, pyr.ny, exitTap(nx, pyr.ny, hit.px, hit.py), m);
+                readExit(in.exit, bilinearTap(nx, pyr.ny, hit.px, hit.py), m);
                 addSent(m, *hit.ray, clamp, sc.acc.data());
             }
         for (int t = 0; t < texels; ++t) {

@@ -142,11 +142,6 @@ struct GlossyLobeScratch {
     // walk k in lane k % N of block k / N (the SSE2 and the AVX2 variant)
     std::vector<TexelLanes<2>> narrowLanes;
     std::vector<TexelLanes<4>> wideLanes;
-    // E's first texel of the four around a position and the bilinear fractions.
-    struct ExitTap {
-        std::ptrdiff_t first;
-        float fx, fy;
-    };
     // Where a ray meets the surface (full-resolution cells); the receiver's
     // hits in the walks' order.
     struct Hit {
@@ -154,7 +149,7 @@ struct GlossyLobeScratch {
         const Ray* ray;
     };
     std::vector<Hit> hits;
-    LobeMemberHits memberHits;  // the hits again, for the first bounce's members
+    LobeMemberHits memberHits;  // with windowed members: the hits' positions and ways back, as hits
     LobeQuadrature quadrature;  // the lobe directions of the last exponent
     // One texel's lobe directions, stage by stage: the unit direction, its
     // horizontal length, its azimuth in units of the global azimuths and its

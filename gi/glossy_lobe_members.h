@@ -55,6 +55,7 @@
 #include "core/grid.h"
 #include "core/simd.h"
 #include "gi/azimuth.h"
+#include "gi/bilinear_tap.h"
 #include "gi/lights.h"
 #include "gi/shading.h"
 #include "gi/visibility.h"
@@ -89,44 +90,15 @@ struct LobeMembers {
 void prepareLobeMembers(ConstGridView gradX, ConstGridView gradY, const VisibilityField& env, int subsample,
                         const ShRgb& light, const AlbedoMap* surface, const ShadingSettings& shading, LobeMembers& m);
 
-namespace lobe_members_detail {
-
-// Bilinear taps of an n x ny grid at (p, q) in its own cells.
-struct Tap {
-    std::size_t i00, dx, dy;
-    float w00, w10, w01, w11;
-    [[gnu::always_inline]] float at(const float* v, std::size_t stride) const {
-        return w00 * v[i00 * stride] + w10 * v[(i00 + dx) * stride] + w01 * v[(i00 + dy) * stride] +
-               w11 * v[(i00 + dx + dy) * stride];
-    }
-};
-
-[[gnu::always_inline]] inline Tap tapAt(int n, int ny, double p, double q) {
-    const int ix = std::clamp(static_cast<int>(std::floor(p)), 0, std::max(n - 2, 0));
-    const int iy = std::clamp(static_cast<int>(std::floor(q)), 0, std::max(ny - 2, 0));
-    const float fx = std::clamp(static_cast<float>(p - ix), 0.0f, 1.0f);
-    const float fy = std::clamp(static_cast<float>(q - iy), 0.0f, 1.0f);
-    return {static_cast<std::size_t>(iy) * static_cast<std::size_t>(n) + static_cast<std::size_t>(ix),
-            n > 1 ? std::size_t{1} : std::size_t{0},
-            ny > 1 ? static_cast<std::size_t>(n) : std::size_t{0},
-            (1.0f - fx) * (1.0f - fy),
-            fx * (1.0f - fy),
-            (1.0f - fx) * fy,
-            fx * fy};
-}
-
-}  // namespace lobe_members_detail
-
 /// Asks for the cache lines the member at (px, py) will be read from.
 [[gnu::always_inline]] inline void prefetchLobeMember(const LobeMembers& m, double px, double py) {
-    using lobe_members_detail::tapAt;
-    const auto t = tapAt(m.nx, m.ny, px, py);
+    const auto t = bilinearTap(m.nx, m.ny, px, py);
     const float* a = m.texels.data() + t.i00 * LobeMembers::kRecord;
     __builtin_prefetch(a);
     __builtin_prefetch(a + LobeMembers::kRecord);
     __builtin_prefetch(a + t.dy * LobeMembers::kRecord);
     __builtin_prefetch(a + (t.dy + 1) * LobeMembers::kRecord);
-    const auto r = tapAt(m.nxr, m.nyr, px * m.perReceiver, py * m.perReceiver);
+    const auto r = bilinearTap(m.nxr, m.nyr, px * m.perReceiver, py * m.perReceiver);
     const std::size_t line = static_cast<std::size_t>(m.azimuths);
     const float* h = m.horizons.data() + r.i00 * line;
     for (std::size_t k : {std::size_t{0}, r.dx, r.dy, r.dx + r.dy}) __builtin_prefetch(h + k * line);
@@ -182,7 +154,7 @@ template <class V>
     alignas(32) float w[4][L];
     alignas(32) float corner[4][6][L];
     for (int l = 0; l < L; ++l) {
-        const Tap t = tapAt(m.nx, m.ny, hits.px[k + l], hits.py[k + l]);
+        const BilinearTap t = bilinearTap(m.nx, m.ny, hits.px[k + l], hits.py[k + l]);
         const float* rec = m.texels.data() + t.i00 * R;
         const std::size_t offs[4] = {0, t.dx * R, t.dy * R, (t.dx + t.dy) * R};
         for (int c = 0; c < 4; ++c)
@@ -211,7 +183,8 @@ template <class V>
     simd::store(u, azimuthLanes(rx, ry) * static_cast<float>(m.azimuthsPerRadian));
     const std::size_t line = static_cast<std::size_t>(m.azimuths);
     for (int l = 0; l < L; ++l) {
-        const Tap rt = tapAt(m.nxr, m.nyr, hits.px[k + l] * m.perReceiver, hits.py[k + l] * m.perReceiver);
+        const BilinearTap rt =
+            bilinearTap(m.nxr, m.nyr, hits.px[k + l] * m.perReceiver, hits.py[k + l] * m.perReceiver);
         const int a0 = std::min(static_cast<int>(u[l]), m.azimuths - 1), a1 = a0 + 1 < m.azimuths ? a0 + 1 : 0;
         const float fa = u[l] - static_cast<float>(a0);
         const float h0 = rt.at(m.horizons.data() + a0, line), h1 = rt.at(m.horizons.data() + a1, line);
