@@ -379,8 +379,7 @@ template <int N>
                             crossingDistance(L.riseBefore[l], L.runBefore[l], rise[l], run[l], r->slope) / cell;
                         const double px = x0 + f.ox + d * c, py = y0 + f.oy + d * sn;
                         if (in.members) {
-                            prefetchLobeMember(*in.members, px, py);
-                            sc.memberHits.push(px, py, r->back);
+                            sc.memberHits.push(*in.members, px, py, r->back);
                         } else {
                             prefetchExit(in.exit, bilinearTap(pyr.nx, pyr.ny, px, py));
                         }

@@ -149,7 +149,7 @@ struct GlossyLobeScratch {
         const Ray* ray;
     };
     std::vector<Hit> hits;
-    LobeMemberHits memberHits;  // with windowed members: the hits' positions and ways back, as hits
+    LobeMemberHits memberHits;  // with windowed members: the hits' taps and ways back, as hits
     LobeQuadrature quadrature;  // the lobe directions of the last exponent
     // One texel's lobe directions, stage by stage: the unit direction, its
     // horizontal length, its azimuth in units of the global azimuths and its

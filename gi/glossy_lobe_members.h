@@ -90,38 +90,48 @@ struct LobeMembers {
 void prepareLobeMembers(ConstGridView gradX, ConstGridView gradY, const VisibilityField& env, int subsample,
                         const ShRgb& light, const AlbedoMap* surface, const ShadingSettings& shading, LobeMembers& m);
 
-/// Asks for the cache lines the member at (px, py) will be read from.
-[[gnu::always_inline]] inline void prefetchLobeMember(const LobeMembers& m, double px, double py) {
-    const auto t = bilinearTap(m.nx, m.ny, px, py);
-    const float* a = m.texels.data() + t.i00 * LobeMembers::kRecord;
-    __builtin_prefetch(a);
-    __builtin_prefetch(a + LobeMembers::kRecord);
-    __builtin_prefetch(a + t.dy * LobeMembers::kRecord);
-    __builtin_prefetch(a + (t.dy + 1) * LobeMembers::kRecord);
-    const auto r = bilinearTap(m.nxr, m.nyr, px * m.perReceiver, py * m.perReceiver);
-    const std::size_t line = static_cast<std::size_t>(m.azimuths);
-    const float* h = m.horizons.data() + r.i00 * line;
-    for (std::size_t k : {std::size_t{0}, r.dx, r.dy, r.dx + r.dy}) __builtin_prefetch(h + k * line);
-}
-
-/// Where rays met the surface, one per hit (structure of arrays): the
-/// full-resolution position and the unit direction back to the receiver.
+/// Where rays met the surface, one per hit (structure of arrays): the taps
+/// of the texels' records and of the receivers' horizons about where it met
+/// it, and the unit direction back to the receiver.
 struct LobeMemberHits {
-    std::vector<double> px, py;
+    struct Taps {
+        BilinearTap record, horizon;
+    };
+    std::vector<Taps> taps;
     std::vector<float> bx, by, bz;
     std::vector<float> sent[3];  // what lobeMembersSend writes: RGB per hit
     void clear() {
-        for (auto* v : {&px, &py}) v->clear();
+        taps.clear();
         for (auto* v : {&bx, &by, &bz}) v->clear();
     }
-    void push(double x, double y, const float back[3]) {
-        px.push_back(x);
-        py.push_back(y);
+    /// A hit at (px, py) (full-resolution cells) whose way back is `back`;
+    /// asks for the cache lines its member will be read from (the rays meet
+    /// the surface anywhere, and the hits are read after the walks).
+    [[gnu::always_inline]] void push(const LobeMembers& m, double px, double py, const float back[3]) {
+        const Taps t{bilinearTap(m.nx, m.ny, px, py),
+                     bilinearTap(m.nxr, m.nyr, px * m.perReceiver, py * m.perReceiver)};
+        const float* a = m.texels.data() + t.record.i00 * LobeMembers::kRecord;
+        __builtin_prefetch(a);
+        __builtin_prefetch(a + LobeMembers::kRecord);
+        __builtin_prefetch(a + t.record.dy * LobeMembers::kRecord);
+        __builtin_prefetch(a + (t.record.dy + 1) * LobeMembers::kRecord);
+        const std::size_t line = static_cast<std::size_t>(m.azimuths);
+        const float* h = m.horizons.data() + t.horizon.i00 * line;
+        for (std::size_t k : {std::size_t{0}, t.horizon.dx, t.horizon.dy, t.horizon.dx + t.horizon.dy})
+            __builtin_prefetch(h + k * line);
+        taps.push_back(t);
         bx.push_back(back[0]);
         by.push_back(back[1]);
         bz.push_back(back[2]);
     }
-    std::size_t size() const { return px.size(); }
+    /// A copy of the last hit (to fill up a group of lanes).
+    void pushLast() {
+        taps.push_back(taps.back());
+        bx.push_back(bx.back());
+        by.push_back(by.back());
+        bz.push_back(bz.back());
+    }
+    std::size_t size() const { return taps.size(); }
 };
 
 namespace lobe_members_detail {
@@ -150,25 +160,26 @@ template <class V>
     using simd::splat;
     constexpr int L = simd::kLaneCount<V>;
     constexpr std::size_t R = LobeMembers::kRecord;
-    // the texels' records about each hit: gx, gy, D (RGB), S bilinear
-    alignas(32) float w[4][L];
-    alignas(32) float corner[4][6][L];
+    // the texels' records about each hit, bilinear: a whole record per lane
+    // (two runs of 4 floats), then the lanes field by field: gx, gy, D (RGB), S
+    alignas(32) float bilinear[L][R];
     for (int l = 0; l < L; ++l) {
-        const BilinearTap t = bilinearTap(m.nx, m.ny, hits.px[k + l], hits.py[k + l]);
+        const BilinearTap& t = hits.taps[k + l].record;
         const float* rec = m.texels.data() + t.i00 * R;
-        const std::size_t offs[4] = {0, t.dx * R, t.dy * R, (t.dx + t.dy) * R};
-        for (int c = 0; c < 4; ++c)
-            for (int f = 0; f < 6; ++f) corner[c][f][l] = rec[offs[c] + static_cast<std::size_t>(f)];
-        w[0][l] = t.w00;
-        w[1][l] = t.w10;
-        w[2][l] = t.w01;
-        w[3][l] = t.w11;
+        const std::size_t dx = t.dx * R, dy = t.dy * R;
+        const simd::F4 w00 = splat<simd::F4>(t.w00), w10 = splat<simd::F4>(t.w10), w01 = splat<simd::F4>(t.w01),
+                       w11 = splat<simd::F4>(t.w11);
+        for (std::size_t h = 0; h < R; h += 4)
+            simd::store(bilinear[l] + h, w00 * load<simd::F4>(rec + h) + w10 * load<simd::F4>(rec + dx + h) +
+                                             w01 * load<simd::F4>(rec + dy + h) +
+                                             w11 * load<simd::F4>(rec + dx + dy + h));
     }
-    const V w00 = load<V>(w[0]), w10 = load<V>(w[1]), w01 = load<V>(w[2]), w11 = load<V>(w[3]);
     V f6[6];
-    for (int f = 0; f < 6; ++f)
-        f6[f] = w00 * load<V>(corner[0][f]) + w10 * load<V>(corner[1][f]) + w01 * load<V>(corner[2][f]) +
-                w11 * load<V>(corner[3][f]);
+    for (int f = 0; f < 6; ++f) {
+        alignas(32) float lanes[L];
+        for (int l = 0; l < L; ++l) lanes[l] = bilinear[l][f];
+        f6[f] = load<V>(lanes);
+    }
     const V one = splat<V>(1.0f), zero = splat<V>(0.0f);
     // the member's normal and the reflection of the way back about it
     const V gx = f6[0], gy = f6[1], S = f6[5];
@@ -183,8 +194,7 @@ template <class V>
     simd::store(u, azimuthLanes(rx, ry) * static_cast<float>(m.azimuthsPerRadian));
     const std::size_t line = static_cast<std::size_t>(m.azimuths);
     for (int l = 0; l < L; ++l) {
-        const BilinearTap rt =
-            bilinearTap(m.nxr, m.nyr, hits.px[k + l] * m.perReceiver, hits.py[k + l] * m.perReceiver);
+        const BilinearTap& rt = hits.taps[k + l].horizon;
         const int a0 = std::min(static_cast<int>(u[l]), m.azimuths - 1), a1 = a0 + 1 < m.azimuths ? a0 + 1 : 0;
         const float fa = u[l] - static_cast<float>(a0);
         const float h0 = rt.at(m.horizons.data() + a0, line), h1 = rt.at(m.horizons.data() + a1, line);
@@ -239,8 +249,7 @@ template <class V>
     constexpr std::size_t L = simd::kLaneCount<V>;
     const std::size_t n = hits.size();
     if (n == 0) return;
-    const float back[3] = {hits.bx.back(), hits.by.back(), hits.bz.back()};
-    while (hits.size() % L != 0) hits.push(hits.px.back(), hits.py.back(), back);
+    while (hits.size() % L != 0) hits.pushLast();
     for (auto& s : hits.sent) s.resize(hits.size());
     for (std::size_t k = 0; k < hits.size(); k += L) lobe_members_detail::sendLanes<V>(m, hits, k);
 }

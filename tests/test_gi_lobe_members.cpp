@@ -34,7 +34,7 @@ struct FlatMembers {
     float sendsWithReflectionAt(double e) const {
         const float back[3] = {static_cast<float>(-std::cos(e)), 0.0f, static_cast<float>(std::sin(e))};
         LobeMemberHits hits;
-        hits.push(8.3, 8.6, back);
+        hits.push(m, 8.3, 8.6, back);
         lobeMembersSend<simd::F4>(m, hits);
         return hits.sent[0][0];
     }
