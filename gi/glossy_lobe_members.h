@@ -90,9 +90,9 @@ struct LobeMembers {
 void prepareLobeMembers(ConstGridView gradX, ConstGridView gradY, const VisibilityField& env, int subsample,
                         const ShRgb& light, const AlbedoMap* surface, const ShadingSettings& shading, LobeMembers& m);
 
-/// Where rays met the surface, one per hit (structure of arrays): the taps
-/// of the texels' records and of the receivers' horizons about where it met
-/// it, and the unit direction back to the receiver.
+/// Where rays met the surface, one per hit: the taps of the texels' records
+/// and of the receivers' horizons about where it met it, and the unit
+/// direction back to the receiver (one array per component, read as lanes).
 struct LobeMemberHits {
     struct Taps {
         BilinearTap record, horizon;
