@@ -129,12 +129,14 @@ RowReferences rowReferences(const Grid& h, float cell, const GiLighting& light, 
 struct LobeQuadrature {
     int rings, azimuths;
     bool pyramidSteps = false;  // the walks on the height pyramid's own steps (no denser near steps)
+    int nearSteps = 0;          // raw steps per octave (0: the engine's default)
 };
-constexpr LobeQuadrature kLobeQuadratures[] = {{2, 16},       {2, 32}, {3, 16}, {3, 32},
-                                               {3, 32, true}, {3, 64}, {4, 32}, {4, 64}};
+constexpr LobeQuadrature kLobeQuadratures[] = {
+    {2, 16}, {2, 28}, {3, 16}, {3, 28}, {3, 28, true}, {3, 32}, {3, 32, false, 16}, {3, 64}, {4, 28}, {4, 64}};
 
 std::string quadratureName(const LobeQuadrature& q) {
-    return strprintf("%d rings, %d az%s", q.rings, q.azimuths, q.pyramidSteps ? ", pyramid steps" : "");
+    return strprintf("%d rings, %d az%s%s", q.rings, q.azimuths, q.pyramidSteps ? ", pyramid steps" : "",
+                     q.nearSteps > 0 ? strprintf(", %d near steps", q.nearSteps).c_str() : "");
 }
 constexpr int kLobeQuadratureCount = sizeof kLobeQuadratures / sizeof kLobeQuadratures[0];
 
@@ -183,6 +185,7 @@ RowErrors rowErrors(const Grid& h, float cell, const GiLighting& light, const Al
             g.indirect.lobeNearStepsPerOctave = g.pyramid.levelsPerOctave;
             g.indirect.lobeNearOctaves = g.pyramid.levelOffset;
         }
+        if (kLobeQuadratures[q].nearSteps > 0) g.indirect.lobeNearStepsPerOctave = kLobeQuadratures[q].nearSteps;
         r.quad[q] = engineError(h, cell, light, a, g, GlossyPositivity::Clamp, ref.exact);
         csvLine("lobe " + quadratureName(kLobeQuadratures[q]), "clamp", r.quad[q]);
     }

@@ -61,10 +61,14 @@ struct IndirectSettings {
     // GlossyIndirect::LobeScan: the global azimuths the lobes are gathered
     // along, the lobe quadrature's rings (rings x 2 rings directions), and
     // the walks' raw steps, out to 2^lobeNearOctaves cells at
-    // lobeNearStepsPerOctave per octave (gi/glossy_lobe_gather.h).
-    int lobeAzimuths = 32;
+    // lobeNearStepsPerOctave per octave (gi/glossy_lobe_gather.h). 28
+    // azimuths and 12 steps per octave rather than 32 and 16: with the
+    // quadrature's staggered rings (gi/phong_lobe_quadrature.h) about the
+    // accuracy the denser walks had with aligned ones, for less work
+    // (bench/results/gi_glossy.md, the lobe quadrature table).
+    int lobeAzimuths = 28;
     int lobeRings = 3;
-    int lobeNearStepsPerOctave = 16;
+    int lobeNearStepsPerOctave = 12;
     int lobeNearOctaves = 7;
     // What the first bounce's members send to the lobe gather; the bounces
     // after it send E.

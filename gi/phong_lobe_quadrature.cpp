@@ -32,14 +32,14 @@ double ringCosine(double S, int n, int i) {
 
 double ringSine(double c) { return std::sqrt(std::max(0.0, 1.0 - c * c)); }
 
-// Azimuth j of the 2n about R.
-double azimuthAngle(int n, int j) { return kPi * (j + 0.5) / n; }
+// Azimuth j of the 2n about R on ring i (odd rings turned by half a step).
+double azimuthAngle(int n, int i, int j) { return kPi * (j + 0.5 + 0.5 * (i % 2)) / n; }
 
 }  // namespace
 
 void lobeDirection(const double r[3], const double t[3], const double b[3], double S, int n, int i, int j,
                    double w[3]) {
-    const double c = ringCosine(S, n, i), psi = azimuthAngle(n, j);
+    const double c = ringCosine(S, n, i), psi = azimuthAngle(n, i, j);
     lobeCombine(r, t, b, c, ringSine(c), std::cos(psi), std::sin(psi), w);
 }
 
@@ -47,12 +47,14 @@ void LobeQuadrature::set(double S, int n) {
     if (n != n_) {
         n_ = n;
         S_ = -1.0;
-        psiCos_.resize(static_cast<std::size_t>(2 * n));
-        psiSin_.resize(static_cast<std::size_t>(2 * n));
-        for (int j = 0; j < 2 * n; ++j) {
-            psiCos_[static_cast<std::size_t>(j)] = std::cos(azimuthAngle(n, j));
-            psiSin_[static_cast<std::size_t>(j)] = std::sin(azimuthAngle(n, j));
-        }
+        psiCos_.resize(static_cast<std::size_t>(4 * n));
+        psiSin_.resize(static_cast<std::size_t>(4 * n));
+        for (int parity = 0; parity < 2; ++parity)
+            for (int j = 0; j < 2 * n; ++j) {
+                const auto at = static_cast<std::size_t>(parity * 2 * n + j);
+                psiCos_[at] = std::cos(azimuthAngle(n, parity, j));
+                psiSin_[at] = std::sin(azimuthAngle(n, parity, j));
+            }
     }
     if (S == S_) return;
     S_ = S;

@@ -11,6 +11,12 @@
 // azimuth about R. A midpoint rule with n rings in t and 2n azimuths in psi
 // therefore integrates every exponent alike (the lobe's peak is absorbed by
 // the substitution); each direction carries the weight 1 / (2 n^2).
+//
+// Every other ring is turned by half an azimuth step, so that the directions
+// of neighbouring rings interleave instead of lining up on 2n spokes from R:
+// the same rule in each variable, the directions spread more evenly about
+// R; the lobe gather's error against the exact reference falls at every
+// exponent (measured in README, "The lobe gather").
 
 #include <cstddef>
 #include <vector>
@@ -27,7 +33,8 @@ inline void lobeCombine(const double r[3], const double t[3], const double b[3],
     for (int k = 0; k < 3; ++k) w[k] = c * r[k] + s * (cp * t[k] + sp * b[k]);
 }
 
-/// Quadrature direction (ring i of n, azimuth j of 2n) of the Phong lobe of
+/// Quadrature direction (ring i of n, azimuth j of 2n about R, odd rings
+/// turned by half a step) of the Phong lobe of
 /// exponent S about r (frame t, b from lobeFrame); each carries the weight
 /// 1 / (2 n^2) of the lobe's unit mass.
 void lobeDirection(const double r[3], const double t[3], const double b[3], double S, int n, int i, int j, double w[3]);
@@ -44,14 +51,16 @@ public:
     /// direction lies within that angle.
     double widestCos() const { return ringCos_.front(); }
     void direction(const double r[3], const double t[3], const double b[3], int i, int j, double w[3]) const {
-        const auto ii = static_cast<std::size_t>(i), jj = static_cast<std::size_t>(j);
+        const auto ii = static_cast<std::size_t>(i);
+        const auto jj = static_cast<std::size_t>((i % 2) * 2 * n_ + j);
         lobeCombine(r, t, b, ringCos_[ii], ringSin_[ii], psiCos_[jj], psiSin_[jj], w);
     }
 
 private:
     double S_ = -1.0;
     int n_ = 0;
-    std::vector<double> ringCos_, ringSin_, psiCos_, psiSin_;  // n rings, 2n azimuths
+    std::vector<double> ringCos_, ringSin_;  // n rings
+    std::vector<double> psiCos_, psiSin_;    // 2n azimuths of the even rings, then 2n of the odd
 };
 
 }  // namespace terrain::gi

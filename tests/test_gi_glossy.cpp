@@ -393,8 +393,8 @@ TEST_CASE("gi.glossy: V valley with Phong walls: the lobe gather against the exa
     // along the viewer's reflection. The lobe gather integrates each
     // receiver's own lobe; what the opposite wall sends it is its windowed
     // lobe (gi/glossy_lobe_members.h), the lobe-filtered sky times the part of
-    // the lobe above the wall's horizon. With the gather's quadrature (3
-    // rings, 32 azimuths) and windowed members, the reference is the gather's
+    // the lobe above the wall's horizon. With the gather's quadrature (its
+    // rings and azimuths) and windowed members, the reference is the gather's
     // idealisation: the gather must follow it closely, and come closer to the
     // exact reference than members sending their order-4 exit radiance E . Y
     // do (the reference's membersSh diagnostic: 1.126 / 1.149 for S = 64 /
@@ -432,7 +432,7 @@ TEST_CASE("gi.glossy: V valley with Phong walls: the lobe gather against the exa
 }
 
 TEST_CASE("gi.glossy: the lobe gather against the reference's own idealisation of it on hills at 1x and 2x") {
-    // The reference with the gather's quadrature (3 rings, 32 azimuths) and
+    // The reference with the gather's quadrature (its rings and azimuths) and
     // windowed members (membersWindowed) is what the gather would give
     // without the pyramids' steps and filtering and with exact horizons: the
     // difference is the scan's own error.
@@ -455,9 +455,10 @@ TEST_CASE("gi.glossy: the lobe gather against the reference's own idealisation o
         return std::sqrt(d2 / r2);
     };
     for (float S : {8.0f, 64.0f}) {
-        ReferenceGiSettings rs = glossyReference(S, 512, 64, 3);
+        const IndirectSettings gather;
+        ReferenceGiSettings rs = glossyReference(S, 512, 64, gather.lobeRings);
         rs.membersWindowed = true;
-        rs.receiverAzimuths = 32;
+        rs.receiverAzimuths = gather.lobeAzimuths;
         ReferenceGiResult ideal, exact;
         renderReferenceGi(h.view(), 1.0f, light.environment, &a, rs, ideal);
         rs = glossyReference(S, 512, 64, 8);
