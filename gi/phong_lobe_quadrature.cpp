@@ -47,13 +47,13 @@ void LobeQuadrature::set(double S, int n) {
     if (n != n_) {
         n_ = n;
         S_ = -1.0;
-        psiCos_.resize(static_cast<std::size_t>(4 * n));
-        psiSin_.resize(static_cast<std::size_t>(4 * n));
-        for (int parity = 0; parity < 2; ++parity)
+        psiCos_.resize(static_cast<std::size_t>(2 * n * n));
+        psiSin_.resize(static_cast<std::size_t>(2 * n * n));
+        for (int i = 0; i < n; ++i)
             for (int j = 0; j < 2 * n; ++j) {
-                const auto at = static_cast<std::size_t>(parity * 2 * n + j);
-                psiCos_[at] = std::cos(azimuthAngle(n, parity, j));
-                psiSin_[at] = std::sin(azimuthAngle(n, parity, j));
+                const auto at = static_cast<std::size_t>(i * 2 * n + j);
+                psiCos_[at] = std::cos(azimuthAngle(n, i, j));
+                psiSin_[at] = std::sin(azimuthAngle(n, i, j));
             }
     }
     if (S == S_) return;

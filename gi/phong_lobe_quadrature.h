@@ -52,7 +52,7 @@ public:
     double widestCos() const { return ringCos_.front(); }
     void direction(const double r[3], const double t[3], const double b[3], int i, int j, double w[3]) const {
         const auto ii = static_cast<std::size_t>(i);
-        const auto jj = static_cast<std::size_t>((i % 2) * 2 * n_ + j);
+        const auto jj = static_cast<std::size_t>(i * 2 * n_ + j);
         lobeCombine(r, t, b, ringCos_[ii], ringSin_[ii], psiCos_[jj], psiSin_[jj], w);
     }
 
@@ -60,7 +60,7 @@ private:
     double S_ = -1.0;
     int n_ = 0;
     std::vector<double> ringCos_, ringSin_;  // n rings
-    std::vector<double> psiCos_, psiSin_;    // 2n azimuths of the even rings, then 2n of the odd
+    std::vector<double> psiCos_, psiSin_;    // ring by ring, its 2n azimuths
 };
 
 }  // namespace terrain::gi

@@ -454,8 +454,8 @@ TEST_CASE("gi.glossy: the lobe gather against the reference's own idealisation o
             }
         return std::sqrt(d2 / r2);
     };
+    const IndirectSettings gather;
     for (float S : {8.0f, 64.0f}) {
-        const IndirectSettings gather;
         ReferenceGiSettings rs = glossyReference(S, 512, 64, gather.lobeRings);
         rs.membersWindowed = true;
         rs.receiverAzimuths = gather.lobeAzimuths;
