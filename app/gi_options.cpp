@@ -90,6 +90,7 @@ void checkGiFlags(const gi::GiSettings& s) {
     checkRange(r::kRadianceLevelOffset, s.indirect.radiance.levelOffset, "--radiance-level-offset");
     checkRange(r::kIndirectAzimuths, s.indirect.azimuths, "--indirect-azimuths");
     checkRange(r::kLobeRings, s.indirect.lobeRings, "--glossy-lobe-rings");
+    checkRange(r::kLobeInnerDirections, s.indirect.lobeInnerDirections, "--glossy-lobe-inner-directions");
     checkRange(r::kLobeAzimuths, s.indirect.lobeAzimuths, "--glossy-lobe-azimuths");
     checkRange(r::kLobeNearStepsPerOctave, s.indirect.lobeNearStepsPerOctave, "--glossy-lobe-near-steps");
     checkRange(r::kLobeNearOctaves, s.indirect.lobeNearOctaves, "--glossy-lobe-near-octaves");
@@ -197,6 +198,9 @@ void addLightTransportFlags(CLI::App* sub, GiOptions& o) {
     sub->add_option("--indirect-azimuths", gs.indirect.azimuths, gi::describe(r::kIndirectAzimuths))
         ->capture_default_str();
     sub->add_option("--glossy-lobe-rings", gs.indirect.lobeRings, gi::describe(r::kLobeRings) + " (--glossy lobe)")
+        ->capture_default_str();
+    sub->add_option("--glossy-lobe-inner-directions", gs.indirect.lobeInnerDirections,
+                    gi::describe(r::kLobeInnerDirections) + " (--glossy lobe)")
         ->capture_default_str();
     sub->add_option("--glossy-lobe-azimuths", gs.indirect.lobeAzimuths,
                     gi::describe(r::kLobeAzimuths) + " (--glossy lobe)")

@@ -35,7 +35,7 @@ GiMaps runReference(const GiOptions& o, const gi::GiSettings& settings, const Gi
         gi::ReferenceGiSettings gs;
         gs.bounces = bounces;
         gs.directions = o.referenceDirections;
-        gs.lobeRings = o.referenceLobeRings;
+        gs.lobe = gi::LobeLayout::uniform(o.referenceLobeRings);
         gs.progress = o.progress;
         gs.keys = in.lighting.keys;  // key lights enter the ground truth as exact caps, not as SH
         gs.shading = settings.shading;

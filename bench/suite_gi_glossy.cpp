@@ -106,7 +106,7 @@ RowReferences rowReferences(const Grid& h, float cell, const GiLighting& light, 
     RowReferences r;
     ReferenceGiSettings rs;
     rs.directions = o.directions;
-    rs.lobeRings = o.lobeRings;
+    rs.lobe = LobeLayout::uniform(o.lobeRings);
     rs.bounces = 1;
     rs.shading = settingsFor(row.brdf, row.S, 1, 1, GlossyIndirect::VectorPyramid).shading;
     const auto t0 = Clock::now();
@@ -125,23 +125,28 @@ RowReferences rowReferences(const Grid& h, float cell, const GiLighting& light, 
 // off] against the exact reference; d, the vector mode [clamp, off] against
 // the diagnostic reference; az, the vector mode (clamp) with 16 and 32 scan
 // azimuths; lobe, the lobe gather (engine default quadrature) and quad, the
-// lobe gather at kLobeQuadratures. Each also a CSV line.
-struct LobeQuadrature {
-    int rings, azimuths;
+// lobe gather at kLobeColumns. Each also a CSV line.
+struct LobeColumn {
+    int rings, innerDirections, azimuths;
     bool pyramidSteps = false;  // the walks on the height pyramid's own steps (no denser near steps)
     int nearSteps = 0;          // raw steps per octave (0: the engine's default)
 };
-constexpr LobeQuadrature kLobeQuadratures[] = {
-    {2, 16}, {2, 28}, {3, 16}, {3, 28}, {3, 28, true}, {3, 32}, {3, 32, false, 16}, {3, 64}, {4, 28}, {4, 64}};
+constexpr LobeColumn kLobeColumns[] = {{2, 4, 28}, {2, 5, 16}, {2, 5, 28}, {2, 5, 28, true},
+                                       {2, 6, 28}, {3, 3, 28}, {3, 4, 28}, {2, 5, 32, false, 16},
+                                       {2, 5, 64}, {4, 4, 64}};
 
-std::string quadratureName(const LobeQuadrature& q) {
-    return strprintf("%d rings, %d az%s%s", q.rings, q.azimuths, q.pyramidSteps ? ", pyramid steps" : "",
+// "2 rings (5, 10), 28 az": the rings' directions from the lobe's axis out.
+std::string quadratureName(const LobeColumn& q) {
+    std::string rings;
+    for (int i = 1; i <= q.rings; ++i) rings += (i > 1 ? ", " : "") + std::to_string(i * q.innerDirections);
+    return strprintf("%d rings (%s), %d az%s%s", q.rings, rings.c_str(), q.azimuths,
+                     q.pyramidSteps ? ", pyramid steps" : "",
                      q.nearSteps > 0 ? strprintf(", %d near steps", q.nearSteps).c_str() : "");
 }
-constexpr int kLobeQuadratureCount = sizeof kLobeQuadratures / sizeof kLobeQuadratures[0];
+constexpr int kLobeColumnCount = sizeof kLobeColumns / sizeof kLobeColumns[0];
 
 struct RowErrors {
-    EngineError e[2][2], d[2], az[2], lobe, lobeSh, quad[kLobeQuadratureCount];
+    EngineError e[2][2], d[2], az[2], lobe, lobeSh, quad[kLobeColumnCount];
 };
 
 RowErrors rowErrors(const Grid& h, float cell, const GiLighting& light, const AlbedoMap& a, const AccuracyRow& row,
@@ -177,17 +182,18 @@ RowErrors rowErrors(const Grid& h, float cell, const GiLighting& light, const Al
     gsh.indirect.lobeMembers = GlossyLobeMembers::Sh;
     r.lobeSh = engineError(h, cell, light, a, gsh, GlossyPositivity::Clamp, ref.exact);
     csvLine("lobe, SH members", "clamp", r.lobeSh);
-    for (int q = 0; q < kLobeQuadratureCount; ++q) {
+    for (int q = 0; q < kLobeColumnCount; ++q) {
         GiSettings g = settingsFor(row.brdf, row.S, s, 1, GlossyIndirect::LobeScan);
-        g.indirect.lobeRings = kLobeQuadratures[q].rings;
-        g.indirect.lobeAzimuths = kLobeQuadratures[q].azimuths;
-        if (kLobeQuadratures[q].pyramidSteps) {
+        g.indirect.lobeRings = kLobeColumns[q].rings;
+        g.indirect.lobeInnerDirections = kLobeColumns[q].innerDirections;
+        g.indirect.lobeAzimuths = kLobeColumns[q].azimuths;
+        if (kLobeColumns[q].pyramidSteps) {
             g.indirect.lobeNearStepsPerOctave = g.pyramid.levelsPerOctave;
             g.indirect.lobeNearOctaves = g.pyramid.levelOffset;
         }
-        if (kLobeQuadratures[q].nearSteps > 0) g.indirect.lobeNearStepsPerOctave = kLobeQuadratures[q].nearSteps;
+        if (kLobeColumns[q].nearSteps > 0) g.indirect.lobeNearStepsPerOctave = kLobeColumns[q].nearSteps;
         r.quad[q] = engineError(h, cell, light, a, g, GlossyPositivity::Clamp, ref.exact);
-        csvLine("lobe " + quadratureName(kLobeQuadratures[q]), "clamp", r.quad[q]);
+        csvLine("lobe " + quadratureName(kLobeColumns[q]), "clamp", r.quad[q]);
     }
     return r;
 }
@@ -260,16 +266,18 @@ std::string accuracySection(const GlossyOptions& o, const BenchContext& ctx, std
     md += "| BRDF | S | sub-sampling | default | 16 azimuths | 32 azimuths |\n|---|---|---|---|---|---|\n";
     md += azim;
     const IndirectSettings defaults;
-    md += "\nLobe quadrature (`--glossy lobe`, engine default " + std::to_string(defaults.lobeRings) + " rings, " +
+    md += "\nLobe quadrature (`--glossy lobe`, engine default " + std::to_string(defaults.lobeRings) +
+          " rings, the innermost of " + std::to_string(defaults.lobeInnerDirections) + " directions, " +
           std::to_string(defaults.lobeAzimuths) +
-          " azimuths): relative RMSE of the lobe gather against the exact reference with n rings (n x 2n rays per "
-          "lobe) and M global azimuths; the walks' raw steps out to " +
+          " azimuths): relative RMSE of the lobe gather against the exact reference with n rings, ring i from the "
+          "lobe's axis holding i k directions (k: `--glossy-lobe-inner-directions`), and M global azimuths; the "
+          "walks' raw steps out to " +
           std::to_string(1 << defaults.lobeNearOctaves) + " cells at " +
           std::to_string(defaults.lobeNearStepsPerOctave) +
           " per octave, or on the height pyramid's own steps (`--glossy-lobe-near-steps` and "
           "`--glossy-lobe-near-octaves` set to its levels per octave and level offset).\n\n| BRDF | S | sub-sampling |";
     std::string rule = "|---|---|---|";
-    for (const LobeQuadrature& q : kLobeQuadratures) {
+    for (const LobeColumn& q : kLobeColumns) {
         md += " " + quadratureName(q) + " |";
         rule += "---|";
     }
@@ -394,7 +402,7 @@ void floorsSection(const GlossyOptions& o, const BenchContext& ctx) {
     for (float S : {8.0f, 16.0f, 32.0f, 64.0f}) {
         ReferenceGiSettings rs;
         rs.directions = o.directions;
-        rs.lobeRings = o.lobeRings;
+        rs.lobe = LobeLayout::uniform(o.lobeRings);
         rs.bounces = 1;
         rs.shading = settingsFor(Brdf::Phong, S, 1, 1, GlossyIndirect::VectorPyramid).shading;
         ReferenceGiResult exact;
@@ -405,7 +413,7 @@ void floorsSection(const GlossyOptions& o, const BenchContext& ctx) {
             d.membersSh = v.membersSh;
             d.membersWindowed = v.membersWindowed;
             d.receiverSh = v.receiverSh;
-            if (v.rings > 0) d.lobeRings = v.rings;
+            if (v.rings > 0) d.lobe = LobeLayout::uniform(v.rings);
             d.receiverAzimuths = v.azimuths;
             ReferenceGiResult r;
             withThreads(2, [&] { renderReferenceGi(h.cview(), cell, light.environment, &a, d, r); });

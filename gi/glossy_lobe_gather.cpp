@@ -150,22 +150,20 @@ void appendLobeRays(const ReceiverLobe& L, const GlossyLobeState& st, float gx, 
                     GlossyLobeScratch& sc) {
     const GlossyLobeScratch::TexelFrame& frame = sc.texelFrames[static_cast<std::size_t>(texel)];
     ++sc.texelSerial;
-    sc.quadrature.set(L.S, sc.quadrature.rings());
+    sc.quadrature.set(L.S, sc.quadrature.layout());
     if (lobeEscapes(L, st, frame, X, cell, sc)) return;
-    const int rings = sc.quadrature.rings(), M = static_cast<int>(st.phi.size());
-    const int count = 2 * rings * rings;
+    const int count = sc.quadrature.directions(), M = static_cast<int>(st.phi.size());
     const double dphi = 2.0 * kPi / M;
-    const float w0 = 1.0f / static_cast<float>(2 * rings * rings);
+    const float w0 = 1.0f / static_cast<float>(count);
     GlossyLobeScratch::Directions& dir = sc.directions;
     dir.resize(count);
-    for (int i = 0, d = 0; i < rings; ++i)
-        for (int k = 0; k < 2 * rings; ++k, ++d) {
-            double w[3];
-            sc.quadrature.direction(L.r, L.t, L.b, i, k, w);
-            dir.x[d] = w[0];
-            dir.y[d] = w[1];
-            dir.z[d] = w[2];
-        }
+    for (int d = 0; d < count; ++d) {
+        double w[3];
+        sc.quadrature.direction(L.r, L.t, L.b, d, w);
+        dir.x[d] = w[0];
+        dir.y[d] = w[1];
+        dir.z[d] = w[2];
+    }
     for (int d = 0; d < count; ++d) dir.horizontal[d] = std::sqrt(dir.x[d] * dir.x[d] + dir.y[d] * dir.y[d]);
     for (int d = 0; d < count; ++d) dir.u[d] = azimuthOf(dir.x[d], dir.y[d]) / dphi;
     for (int d = 0; d < count; ++d) dir.slope[d] = dir.z[d] / dir.horizontal[d];
@@ -626,7 +624,7 @@ void gatherGlossyLobes(const GlossyLobeInputs& in, GlossyLobeState& st) {
     st.gathered.resize(static_cast<std::size_t>(3) * pyr.nx * pyr.ny);
     st.scratch.resize(static_cast<std::size_t>(workerSlots()));
     for (GlossyLobeScratch& sc : st.scratch) {
-        sc.quadrature.set(in.shading.phongExponent, in.rings);
+        sc.quadrature.set(in.shading.phongExponent, in.lobe);
         sc.escape.resize(static_cast<std::size_t>(M));
         sc.escapeStamp.assign(static_cast<std::size_t>(M), 0);
         sc.texelSerial = 0;

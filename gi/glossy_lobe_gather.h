@@ -15,7 +15,8 @@
 // What is gathered. The Phong part of a receiver's first-bounce exit
 // radiance towards the viewer, int I(w) f(w) dw with f the normalised Phong
 // lobe about the viewer's reflection R (gi/phong_lobe_quadrature.h), by the
-// lobe quadrature's n rings x 2n directions (IndirectSettings::lobeRings).
+// lobe quadrature's directions (gi/phong_lobe_quadrature.h; its growing rule,
+// IndirectSettings::lobeRings and lobeInnerDirections).
 // Each direction w is seen along the scan's global azimuths phi_j = 2 pi j /
 // M (IndirectSettings::lobeAzimuths): at w's own elevation along the two
 // azimuths on either side of w's, weighted linearly (the reference's
@@ -199,8 +200,8 @@ struct GlossyLobeInputs {
     const LobeMembers* members;
     const AlbedoMap* surface;  // per-texel exponent (null or empty: the settings')
     const ShadingSettings& shading;
-    int azimuths;  // M, the global azimuths
-    int rings;     // n: n rings x 2n directions per lobe
+    int azimuths;     // M, the global azimuths
+    LobeLayout lobe;  // the lobe quadrature's directions
     // The walks' raw steps: out to 2^nearOctaves cells, nearStepsPerOctave per
     // octave (then the pyramid's steps).
     int nearStepsPerOctave;

@@ -11,6 +11,7 @@ void validateIndirectSettings(const IndirectSettings& s) {
     checkRange(ranges::kIndirectAzimuths, s.azimuths);
     checkRange(ranges::kLobeAzimuths, s.lobeAzimuths);
     checkRange(ranges::kLobeRings, s.lobeRings);
+    checkRange(ranges::kLobeInnerDirections, s.lobeInnerDirections);
     checkRange(ranges::kLobeNearStepsPerOctave, s.lobeNearStepsPerOctave);
     checkRange(ranges::kLobeNearOctaves, s.lobeNearOctaves);
 }

@@ -59,15 +59,19 @@ struct IndirectSettings {
     // Azimuths of the indirect scan (0: the visibility's m; paper: 0).
     int azimuths = 8;
     // GlossyIndirect::LobeScan: the global azimuths the lobes are gathered
-    // along, the lobe quadrature's rings (rings x 2 rings directions), and
-    // the walks' raw steps, out to 2^lobeNearOctaves cells at
+    // along, the lobe quadrature (LobeLayout::growing(lobeRings,
+    // lobeInnerDirections), gi/phong_lobe_quadrature.h: ring i from the
+    // lobe's axis holds (i + 1) lobeInnerDirections directions), and the
+    // walks' raw steps, out to 2^lobeNearOctaves cells at
     // lobeNearStepsPerOctave per octave (gi/glossy_lobe_gather.h). 28
     // azimuths and 12 steps per octave rather than 32 and 16: with the
-    // quadrature's staggered rings (gi/phong_lobe_quadrature.h) about the
-    // accuracy the denser walks had with aligned ones, for less work
-    // (bench/results/gi_glossy.md, the lobe quadrature table).
+    // quadrature's staggered rings about the accuracy the denser walks had
+    // with aligned ones, for less work. 2 rings of 5 and 10 directions rather
+    // than the 18 of 3 rings of 6: fewer rays, and fewer of them low enough to
+    // walk far (bench/results/gi_glossy.md, the lobe quadrature table).
     int lobeAzimuths = 28;
-    int lobeRings = 3;
+    int lobeRings = 2;
+    int lobeInnerDirections = 5;
     int lobeNearStepsPerOctave = 12;
     int lobeNearOctaves = 7;
     // What the first bounce's members send to the lobe gather; the bounces

@@ -142,7 +142,7 @@ void ShKernelIndirect::scan(int b) {
                                       in_.albedo,
                                       in_.shading,
                                       settings_.lobeAzimuths,
-                                      settings_.lobeRings,
+                                      LobeLayout::growing(settings_.lobeRings, settings_.lobeInnerDirections),
                                       settings_.lobeNearStepsPerOctave,
                                       settings_.lobeNearOctaves};
         gatherGlossyLobes(lobeIn, st_.glossy.lobes);

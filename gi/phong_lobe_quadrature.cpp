@@ -24,44 +24,50 @@ void lobeFrame(const double r[3], double t[3], double b[3]) {
 
 namespace {
 
-// Ring i of n: the midpoint of [i / n, (i + 1) / n] in t = cos^(S + 1).
-double ringCosine(double S, int n, int i) {
-    const double tm = (i + 0.5) / n;
+// Ring i's slab of t is its share of the directions (ring 0 from t = 0, the
+// farthest from R); its directions lie at the slab's midpoint.
+double ringCosine(double S, const LobeLayout& layout, int i) {
+    const double tm =
+        static_cast<double>(layout.directionsBefore(i) + layout.directionsBefore(i + 1)) / (2.0 * layout.directions());
     return std::exp(std::log(tm) / (S + 1.0));
 }
 
 double ringSine(double c) { return std::sqrt(std::max(0.0, 1.0 - c * c)); }
 
-// Azimuth j of the 2n about R on ring i (odd rings turned by half a step).
-double azimuthAngle(int n, int i, int j) { return kPi * (j + 0.5 + 0.5 * (i % 2)) / n; }
+// Azimuth j about R of the c directions of ring i: half a step from psi = 0,
+// odd rings turned by another half step.
+double azimuthAngle(const LobeLayout& layout, int i, int j) {
+    return kPi * (2 * j + 1 + i % 2) / layout.ringDirections(i);
+}
 
 }  // namespace
 
-void lobeDirection(const double r[3], const double t[3], const double b[3], double S, int n, int i, int j,
-                   double w[3]) {
-    const double c = ringCosine(S, n, i), psi = azimuthAngle(n, i, j);
+void lobeDirection(const double r[3], const double t[3], const double b[3], double S, const LobeLayout& layout, int i,
+                   int j, double w[3]) {
+    const double c = ringCosine(S, layout, i), psi = azimuthAngle(layout, i, j);
     lobeCombine(r, t, b, c, ringSine(c), std::cos(psi), std::sin(psi), w);
 }
 
-void LobeQuadrature::set(double S, int n) {
-    if (n != n_) {
-        n_ = n;
+void LobeQuadrature::set(double S, const LobeLayout& layout) {
+    if (!(layout == layout_)) {
+        layout_ = layout;
         S_ = -1.0;
-        psiCos_.resize(static_cast<std::size_t>(2 * n * n));
-        psiSin_.resize(static_cast<std::size_t>(2 * n * n));
-        for (int i = 0; i < n; ++i)
-            for (int j = 0; j < 2 * n; ++j) {
-                const auto at = static_cast<std::size_t>(i * 2 * n + j);
-                psiCos_[at] = std::cos(azimuthAngle(n, i, j));
-                psiSin_[at] = std::sin(azimuthAngle(n, i, j));
+        psiCos_.clear();
+        psiSin_.clear();
+        ringOf_.clear();
+        for (int i = 0; i < layout.rings; ++i)
+            for (int j = 0; j < layout.ringDirections(i); ++j) {
+                psiCos_.push_back(std::cos(azimuthAngle(layout, i, j)));
+                psiSin_.push_back(std::sin(azimuthAngle(layout, i, j)));
+                ringOf_.push_back(i);
             }
     }
     if (S == S_) return;
     S_ = S;
-    ringCos_.resize(static_cast<std::size_t>(n));
-    ringSin_.resize(static_cast<std::size_t>(n));
-    for (int i = 0; i < n; ++i) {
-        ringCos_[static_cast<std::size_t>(i)] = ringCosine(S, n, i);
+    ringCos_.resize(static_cast<std::size_t>(layout.rings));
+    ringSin_.resize(static_cast<std::size_t>(layout.rings));
+    for (int i = 0; i < layout.rings; ++i) {
+        ringCos_[static_cast<std::size_t>(i)] = ringCosine(S, layout, i);
         ringSin_[static_cast<std::size_t>(i)] = ringSine(ringCos_[static_cast<std::size_t>(i)]);
     }
 }

@@ -18,6 +18,7 @@
 
 #include "core/grid.h"
 #include "gi/lights.h"
+#include "gi/phong_lobe_quadrature.h"
 #include "gi/reference.h"
 #include "gi/shading.h"
 
@@ -43,9 +44,9 @@ struct ReferenceGiSettings {
     bool shLambert = false;
     int keyAzimuths = 48;  // midpoint azimuths across each cap's extent
     // Glossy reference: quadrature of every Phong lobe it integrates exactly
-    // (n rings x 2n azimuths, gi/reference_glossy_lobe.h), at the receivers
-    // and at each of their rays' first hits.
-    int lobeRings = 12;
+    // (gi/phong_lobe_quadrature.h; n rings x 2n azimuths, n = 12), at the
+    // receivers and at each of their rays' first hits.
+    LobeLayout lobe = LobeLayout::uniform(12);
     // Glossy reference diagnostic: the first bounce's receivers shade their
     // incident radiance projected to order-4 SH with the lobe factors g_l
     // (as the fast path's receivers do) instead of integrating their lobe
@@ -108,7 +109,7 @@ void renderReferenceGi(ConstGridView heights, float cellSize, const ShRgb& light
 /// Bounce 1: I(p, w) = L_0(q, -w) at the first hit q of the ray from p in
 /// direction w (D_0 and the normal bilinear at q, q's Phong part integrated
 /// exactly against q's own sky); the Phong part samples p's lobe with
-/// lobeRings quadrature rays, the Lambert part D_1 = w_d albedo(p) / pi
+/// the lobe quadrature's rays, the Lambert part D_1 = w_d albedo(p) / pi
 /// 4 pi / K sum_k L_0(q_k, -w_k) (N . w_k) the fixed direction set.
 /// With receiverSh (a diagnostic) the first bounce's receivers shade as in
 /// the bounces after it, from I_1 projected to SH; with membersSh (another)

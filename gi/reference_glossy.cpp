@@ -198,7 +198,7 @@ void towardsViewer(const GlossySurface& surf, const double view[3], double ws, c
 // Bounce 0 towards the viewer, exact: D_0 + w_s (the Phong lobe about the
 // viewer's reflection against the exact sky, gi/reference_glossy_lobe.h).
 void directTowardsViewer(const GlossySurface& surf, const SkyHorizons& hz, const ShRgb& lighting, const double view[3],
-                         double ws, int rings, const std::array<Grid, 3>& D, std::array<Grid, 3>& dst) {
+                         double ws, const LobeLayout& lobe, const std::array<Grid, 3>& D, std::array<Grid, 3>& dst) {
     const int nx = surf.gx.nx, ny = surf.gx.ny;
     parallelFor(0, ny, 1, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y)
@@ -209,7 +209,7 @@ void directTowardsViewer(const GlossySurface& surf, const SkyHorizons& hz, const
                 reflect(n, view, r);
                 if (ws != 0.0)
                     exactLobeRadiance(hz, lighting, static_cast<float>(x), static_cast<float>(y), n, r,
-                                      surf.exponentAt(i), rings, e);
+                                      surf.exponentAt(i), lobe, e);
                 for (int c = 0; c < 3; ++c) dst[c].v[i] = static_cast<float>(D[c].v[i] + ws * e[c]);
             }
     });
@@ -266,7 +266,7 @@ void radianceFromHit(const GlossyGather& g, float qx, float qy, const double dir
     }
     if (!prevI) {
         double e[3];
-        exactLobeRadiance(g.horizons, g.lighting, qx, qy, nq, r, g.surf.exponentAt(bl), g.s.lobeRings, e);
+        exactLobeRadiance(g.horizons, g.lighting, qx, qy, nq, r, g.surf.exponentAt(bl), g.s.lobe, e);
         for (int c = 0; c < 3; ++c) L[c] += g.ws * e[c];
         return;
     }
@@ -361,23 +361,24 @@ void addAzimuthSnappedRadiance(const GlossyGather& g, const std::array<Grid, 3>&
 // scan's azimuths see it (addAzimuthSnappedRadiance).
 void firstBouncePhong(const GlossyGather& g, const std::array<Grid, 3>& prevD, const std::vector<float>* prevI,
                       const double view[3], int x, int y, double out[3]) {
-    const int nx = g.heights.nx, n = g.s.lobeRings;
+    const int nx = g.heights.nx;
+    const LobeLayout& layout = g.s.lobe;
     const std::size_t i = static_cast<std::size_t>(y) * nx + x;
     double nrm[3], r[3], t[3], b[3], acc[3] = {0.0, 0.0, 0.0};
     g.surf.normalAt(i, nrm);
     reflect(nrm, view, r);
     lobeFrame(r, t, b);
     const double S = g.surf.exponentAt(i);
-    for (int a = 0; a < n; ++a)
-        for (int j = 0; j < 2 * n; ++j) {
+    for (int a = 0; a < layout.rings; ++a)
+        for (int j = 0; j < layout.ringDirections(a); ++j) {
             double w[3];
-            lobeDirection(r, t, b, S, n, a, j, w);
+            lobeDirection(r, t, b, S, layout, a, j, w);
             if (g.s.receiverAzimuths > 0)
                 addAzimuthSnappedRadiance(g, prevD, prevI, nrm, w, x, y, acc);
             else
                 addRayRadiance(g, prevD, prevI, nrm, w, x, y, 1.0, acc);
         }
-    for (int c = 0; c < 3; ++c) out[c] = g.ws * acc[c] / (2.0 * n * n);
+    for (int c = 0; c < 3; ++c) out[c] = g.ws * acc[c] / layout.directions();
 }
 
 }  // namespace
@@ -454,7 +455,8 @@ void renderReferenceGlossy(ConstGridView heights, float cellSize, const ShRgb& l
     const double ws = specularWeightOf(sh);
     const double wd = sh.brdf == Brdf::Phong ? 0.0 : 1.0;
     const double view[3] = {sh.viewDir[0], sh.viewDir[1], sh.viewDir[2]};
-    if (s.lobeRings < 1) throw InputError("glossy reference: lobeRings must be at least 1");
+    if (s.lobe.rings < 1 || s.lobe.innermost < 1 || s.lobe.growth < 0)
+        throw InputError("glossy reference: the lobe quadrature needs a ring and a direction on each");
     if (s.receiverAzimuths < 0) throw InputError("glossy reference: receiverAzimuths must not be negative");
     Grid gx, gy;
     computeGradient(heights, cellSize, gx, gy);
@@ -469,7 +471,7 @@ void renderReferenceGlossy(ConstGridView heights, float cellSize, const ShRgb& l
     std::array<Grid, 3> prevD, nextD;
     directBounce(heights, cellSize, lighting, surface, s, wd, s.bounces >= 2 || s.membersSh, out, prevD, prevI);
     for (int c = 0; c < 3; ++c) nextD[c].resize(nx, ny, 0.0f);
-    directTowardsViewer(surf, horizons, lighting, view, ws, s.lobeRings, prevD, out.direct);
+    directTowardsViewer(surf, horizons, lighting, view, ws, s.lobe, prevD, out.direct);
 
     // ---- bounce 1 exact; bounces 2..B gather (D, I) of the previous bounce in SH
     if (nx >= 2 && ny >= 2 && s.bounces > 0) {

@@ -65,20 +65,20 @@ bool skyVisible(const SkyHorizons& hz, float px, float py, const double n[3], co
 }
 
 void exactLobeRadiance(const SkyHorizons& hz, const ShRgb& lighting, float px, float py, const double n[3],
-                       const double r[3], double S, int rings, double out[3]) {
+                       const double r[3], double S, const LobeLayout& layout, double out[3]) {
     double t[3], b[3];
     lobeFrame(r, t, b);
     double acc[3] = {0.0, 0.0, 0.0};
-    for (int i = 0; i < rings; ++i)
-        for (int j = 0; j < 2 * rings; ++j) {
+    for (int i = 0; i < layout.rings; ++i)
+        for (int j = 0; j < layout.ringDirections(i); ++j) {
             double w[3];
-            lobeDirection(r, t, b, S, rings, i, j, w);
+            lobeDirection(r, t, b, S, layout, i, j, w);
             if (!skyVisible(hz, px, py, n, w)) continue;
             double L[3];
             evaluateShRgb(lighting, w[0], w[1], w[2], L);
             for (int c = 0; c < 3; ++c) acc[c] += L[c];
         }
-    const double weight = 1.0 / (2.0 * rings * rings);
+    const double weight = 1.0 / layout.directions();
     for (int c = 0; c < 3; ++c) out[c] = acc[c] * weight;
 }
 

@@ -19,9 +19,10 @@
 // M azimuths phi_a = 2 pi (a + 0.5) / M; between azimuths linear, at a first
 // hit between grid points bilinear.
 //
-// Quadrature: gi/phong_lobe_quadrature.h (n rings in t = (w . R)^(S + 1) x
-// 2n azimuths about R); the error comes from the horizon edge and the sky's
-// variation only. The convergence in n is tested by doubling it.
+// Quadrature: gi/phong_lobe_quadrature.h (rings in t = (w . R)^(S + 1),
+// directions evenly spaced in the azimuth about R on each); the error comes
+// from the horizon edge and the sky's variation only. The convergence is
+// tested by doubling the rings.
 #include <vector>
 
 #include "core/grid.h"
@@ -48,8 +49,8 @@ bool skyVisible(const SkyHorizons& hz, float px, float py, const double n[3], co
 
 /// Phong part of the exit radiance (RGB) at (px, py) with unit normal n
 /// towards the direction whose reflection about n is r: int I f dw over the
-/// sky `lighting` through the exact visibility, n rings of quadrature.
+/// sky `lighting` through the exact visibility, by the quadrature `layout`.
 void exactLobeRadiance(const SkyHorizons& hz, const ShRgb& lighting, float px, float py, const double n[3],
-                       const double r[3], double S, int rings, double out[3]);
+                       const double r[3], double S, const LobeLayout& layout, double out[3]);
 
 }  // namespace terrain::gi

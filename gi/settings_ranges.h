@@ -38,8 +38,10 @@ inline constexpr SettingRange<int> kRadianceLevelOffset{"radiance level offset",
                                                         "Radiance pyramid level offset o_u, octaves"};
 inline constexpr SettingRange<int> kLobeAzimuths{"glossy lobe azimuths", 4, 4096,
                                                  "Global azimuths of the glossy lobe gather"};
-inline constexpr SettingRange<int> kLobeRings{"glossy lobe rings", 1, 64,
-                                              "Rings of the glossy lobe quadrature (rings x 2 rings directions)"};
+inline constexpr SettingRange<int> kLobeRings{"glossy lobe rings", 1, 32, "Rings of the glossy lobe quadrature"};
+inline constexpr SettingRange<int> kLobeInnerDirections{
+    "glossy lobe inner directions", 3, 64,
+    "Directions of the glossy lobe quadrature's ring nearest the lobe's axis (each ring outwards has as many more)"};
 inline constexpr SettingRange<int> kLobeNearStepsPerOctave{
     "glossy lobe near steps per octave", 1, 64, "Raw height steps per octave of the glossy lobe gather's walks"};
 inline constexpr SettingRange<int> kLobeNearOctaves{"glossy lobe near octaves", 0, 16,

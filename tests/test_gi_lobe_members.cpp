@@ -47,11 +47,12 @@ double lobeAboveHorizontal(double e, double S) {
     double t[3], b[3];
     lobeFrame(r, t, b);
     const int n = 200;
+    const LobeLayout layout = LobeLayout::uniform(n);
     double above = 0.0;
     for (int i = 0; i < n; ++i)
         for (int j = 0; j < 2 * n; ++j) {
             double w[3];
-            lobeDirection(r, t, b, S, n, i, j, w);
+            lobeDirection(r, t, b, S, layout, i, j, w);
             above += w[2] > 0.0;
         }
     return above / (2.0 * n * n);
