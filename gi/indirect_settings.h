@@ -60,8 +60,8 @@ struct IndirectSettings {
     int azimuths = 8;
     // GlossyIndirect::LobeScan: the global azimuths the lobes are gathered
     // along, the lobe quadrature (LobeLayout::growing(lobeRings,
-    // lobeInnerDirections), gi/phong_lobe_quadrature.h: ring i from the
-    // lobe's axis holds (i + 1) lobeInnerDirections directions), and the
+    // lobeInnerDirections), gi/phong_lobe_quadrature.h: the i-th ring from
+    // the lobe's axis holds i lobeInnerDirections directions), and the
     // walks' raw steps, out to 2^lobeNearOctaves cells at
     // lobeNearStepsPerOctave per octave (gi/glossy_lobe_gather.h). 28
     // azimuths and 12 steps per octave rather than 32 and 16: with the

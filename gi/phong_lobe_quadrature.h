@@ -20,13 +20,14 @@
 // lining up on spokes from R.
 // - LobeLayout::uniform(n): n rings of 2n directions each, equal slabs (the
 //   glossy reference's, n = 12 by default).
-// - LobeLayout::growing(n, k): ring i counted from R holds (i + 1) k
+// - LobeLayout::growing(n, k): the i-th ring from R (i = 1..n) holds i k
 //   directions, as many as its circumference on the disk asks for: cells
 //   about as wide as they are deep, where the uniform rule's outer cells are
-//   several times wider than deep. At equal count the two are about as
-//   accurate; the growing rule's outer ring lies nearer R (t = 1/3 at n = 2
-//   against 1 / (2n) for the uniform one), so fewer of its rays walk far
-//   along the ground (the gather's default; README, "Fewer rays").
+//   several times wider than deep. At equal count the gather is a little
+//   less accurate with it (README, "Fewer rays") but faster: the growing
+//   rule's outer ring lies nearer R (t = 1/3 at n = 2 against 1 / (2n) for
+//   the uniform one), so fewer of its rays walk far along the ground. The
+//   gather's default is growing(2, 5).
 
 #include <cstddef>
 #include <vector>

@@ -2,7 +2,7 @@
 // gather and the glossy reference: rings in t = cos^(S + 1), each ring's slab
 // its share of the equally weighted directions, every other ring turned by
 // half of its own azimuth step; the reference's uniform layout (n rings of
-// 2n) and the gather's growing one (ring i from the axis holds (i + 1) k).
+// 2n) and the gather's growing one (the i-th ring from the axis holds i k).
 #include <cmath>
 #include <vector>
 
