@@ -150,7 +150,6 @@ void appendLobeRays(const ReceiverLobe& L, const GlossyLobeState& st, float gx, 
                     GlossyLobeScratch& sc) {
     const GlossyLobeScratch::TexelFrame& frame = sc.texelFrames[static_cast<std::size_t>(texel)];
     ++sc.texelSerial;
-    sc.quadrature.set(L.S, sc.quadrature.layout());
     if (lobeEscapes(L, st, frame, X, cell, sc)) return;
     const int count = sc.quadrature.directions(), M = static_cast<int>(st.phi.size());
     const double dphi = 2.0 * kPi / M;
@@ -480,6 +479,7 @@ template <int N>
                 const double S = expMap ? in.surface->phongExponent(x, y) : in.shading.phongExponent;
                 const float gx = in.gradX(x, y), gy = in.gradY(x, y);
                 const ReceiverLobe L = receiverLobe(gx, gy, in.shading.viewDir, S);
+                sc.quadrature.set(S, gatherLobeLayout(S, in.rings, in.innerDirections));
                 appendLobeRays(L, st, gx, gy, X, pyr.cellSize, (y - rows.first) * width + (x - cols.first), sc);
             }
         bucketRays(static_cast<int>(st.phi.size()), sc);
@@ -608,6 +608,10 @@ void buildWalkTable(const HeightPyramid& pyr, int perOctave, int nearOctaves, in
 
 }  // namespace
 
+LobeLayout gatherLobeLayout(double S, int rings, int innerDirections) {
+    return LobeLayout::growing(rings > 0 ? rings : (S < kWideLobeExponent ? 3 : 2), innerDirections);
+}
+
 void gatherGlossyLobes(const GlossyLobeInputs& in, GlossyLobeState& st) {
     const HeightPyramid& pyr = in.heights;
     const int M = in.azimuths, pad = indirectRowPad(pyr.nxr);
@@ -624,7 +628,6 @@ void gatherGlossyLobes(const GlossyLobeInputs& in, GlossyLobeState& st) {
     st.gathered.resize(static_cast<std::size_t>(3) * pyr.nx * pyr.ny);
     st.scratch.resize(static_cast<std::size_t>(workerSlots()));
     for (GlossyLobeScratch& sc : st.scratch) {
-        sc.quadrature.set(in.shading.phongExponent, in.lobe);
         sc.escape.resize(static_cast<std::size_t>(M));
         sc.escapeStamp.assign(static_cast<std::size_t>(M), 0);
         sc.texelSerial = 0;

@@ -59,18 +59,19 @@ struct IndirectSettings {
     // Azimuths of the indirect scan (0: the visibility's m; paper: 0).
     int azimuths = 8;
     // GlossyIndirect::LobeScan: the global azimuths the lobes are gathered
-    // along, the lobe quadrature (LobeLayout::growing(lobeRings,
-    // lobeInnerDirections), gi/phong_lobe_quadrature.h: the i-th ring from
-    // the lobe's axis holds i lobeInnerDirections directions), and the
-    // walks' raw steps, out to 2^lobeNearOctaves cells at
-    // lobeNearStepsPerOctave per octave (gi/glossy_lobe_gather.h). 28
-    // azimuths and 12 steps per octave rather than 32 and 16: with the
-    // quadrature's staggered rings about the accuracy the denser walks had
-    // with aligned ones, for less work. 2 rings of 5 and 10 directions rather
-    // than the 18 of 3 rings of 6: fewer rays, and fewer of them low enough to
-    // walk far (bench/results/gi_glossy.md, the lobe quadrature table).
+    // along, the lobe quadrature (gatherLobeLayout: the i-th ring from the
+    // lobe's axis holds i lobeInnerDirections directions, gi/
+    // phong_lobe_quadrature.h; lobeRings 0 takes 3 rings for lobes of
+    // exponent below 16 and 2 from 16 up), and the walks' raw steps, out to
+    // 2^lobeNearOctaves cells at lobeNearStepsPerOctave per octave
+    // (gi/glossy_lobe_gather.h). 28 azimuths and 12 steps per octave rather
+    // than 32 and 16: with the quadrature's staggered rings about the
+    // accuracy the denser walks had with aligned ones, for less work. 2
+    // rings of 5 and 10 directions for the narrower lobes rather than the 18
+    // of 3 rings of 6: fewer rays, and fewer of them low enough to walk far
+    // (bench/results/gi_glossy.md, the lobe quadrature table).
     int lobeAzimuths = 28;
-    int lobeRings = 2;
+    int lobeRings = 0;
     int lobeInnerDirections = 5;
     int lobeNearStepsPerOctave = 12;
     int lobeNearOctaves = 7;

@@ -142,7 +142,8 @@ void ShKernelIndirect::scan(int b) {
                                       in_.albedo,
                                       in_.shading,
                                       settings_.lobeAzimuths,
-                                      LobeLayout::growing(settings_.lobeRings, settings_.lobeInnerDirections),
+                                      settings_.lobeRings,
+                                      settings_.lobeInnerDirections,
                                       settings_.lobeNearStepsPerOctave,
                                       settings_.lobeNearOctaves};
         gatherGlossyLobes(lobeIn, st_.glossy.lobes);

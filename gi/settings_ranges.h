@@ -39,7 +39,8 @@ inline constexpr SettingRange<int> kRadianceLevelOffset{"radiance level offset",
 inline constexpr SettingRange<int> kLobeAzimuths{"glossy lobe azimuths", 4, 4096,
                                                  "Global azimuths of the glossy lobe gather"};
 // At most 16 rings of up to 16 x 64 directions: 8704 directions per lobe.
-inline constexpr SettingRange<int> kLobeRings{"glossy lobe rings", 1, 16, "Rings of the glossy lobe quadrature"};
+inline constexpr SettingRange<int> kLobeRings{
+    "glossy lobe rings", 0, 16, "Rings of the glossy lobe quadrature (0: 3 below exponent 16, 2 from it up)"};
 inline constexpr SettingRange<int> kLobeInnerDirections{
     "glossy lobe inner directions", 3, 64,
     "Directions of the glossy lobe quadrature's ring nearest the lobe's axis (each ring outwards has as many more)"};

@@ -167,8 +167,8 @@ TEST_CASE("gi.lobe_quadrature: integrates the normalised lobe's moments") {
         }
 }
 
-TEST_CASE("gi.lobe_quadrature: the gather's default layout and the lobe's spread") {
-    // 2 rings of 5 and 10: the midpoint rule in t with two slabs (1/3 and
+TEST_CASE("gi.lobe_quadrature: the gather's layout for narrow lobes and the lobe's spread") {
+    // 2 rings of 5 and 10 (the gather's from S = 16 up): the midpoint rule in t with two slabs (1/3 and
     // 2/3 of the mass) places the outer ring at t = 1/3, the inner at 5/6, so
     // E[w . R] = (2/3) (1/3)^(1/(S+1)) + (1/3) (5/6)^(1/(S+1)). The rule
     // narrows the lobe: its spread 1 - E[w . R] is 17-20 % short of the
