@@ -80,7 +80,9 @@ hm16="$tmp/g16/frame_000000.png"
   --glossy-lobe-azimuths 16 --phong-exponent "$hm24" --out-indirect "$tmp/globe.npy" >/dev/null 2>&1 &&
   [ -s "$tmp/globe.npy" ] && ok || bad "gi --glossy lobe"
 expect_error "glossy lobe rings out of range" "glossy-lobe-rings" "$T" gi --heightmap "$hm24" --cell-size 10 \
-  --brdf phong:20 --glossy lobe --glossy-lobe-rings 0
+  --brdf phong:20 --glossy lobe --glossy-lobe-rings 17
+expect_error "glossy lobe inner directions out of range" "glossy-lobe-inner-directions" "$T" gi --heightmap "$hm24" \
+  --cell-size 10 --brdf phong:20 --glossy lobe --glossy-lobe-inner-directions 2
 expect_error "glossy lobe azimuths out of range" "glossy-lobe-azimuths" "$T" gi --heightmap "$hm24" --cell-size 10 \
   --brdf phong:20 --glossy lobe --glossy-lobe-azimuths 100000
 expect_error "lobe rings out of range" "reference-lobe-rings" "$T" gi --heightmap "$hm24" --cell-size 10 \
