@@ -135,10 +135,13 @@ constexpr LobeColumn kLobeColumns[] = {{2, 4, 28}, {2, 5, 16}, {2, 5, 28}, {2, 5
                                        {2, 6, 28}, {3, 3, 28}, {3, 4, 28}, {2, 5, 32, false, 16},
                                        {2, 5, 64}, {4, 4, 64}};
 
-// "2 rings (5, 10), 28 az": the rings' directions from the lobe's axis out.
+// "2 rings (5, 10), 28 az": the rings' directions from the lobe's axis out
+// (LobeLayout numbers its rings from the outermost).
 std::string quadratureName(const LobeColumn& q) {
+    const LobeLayout layout = LobeLayout::growing(q.rings, q.innerDirections);
     std::string rings;
-    for (int i = 1; i <= q.rings; ++i) rings += (i > 1 ? ", " : "") + std::to_string(i * q.innerDirections);
+    for (int i = layout.rings - 1; i >= 0; --i)
+        rings += (i < layout.rings - 1 ? ", " : "") + std::to_string(layout.ringDirections(i));
     return strprintf("%d rings (%s), %d az%s%s", q.rings, rings.c_str(), q.azimuths,
                      q.pyramidSteps ? ", pyramid steps" : "",
                      q.nearSteps > 0 ? strprintf(", %d near steps", q.nearSteps).c_str() : "");

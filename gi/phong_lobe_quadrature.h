@@ -73,7 +73,6 @@ void lobeDirection(const double r[3], const double t[3], const double b[3], doub
 class LobeQuadrature {
 public:
     void set(double S, const LobeLayout& layout);
-    const LobeLayout& layout() const { return layout_; }
     int directions() const { return static_cast<int>(psiCos_.size()); }
     /// The cosine of the angle from R of the ring farthest from it: every
     /// direction lies within that angle.
