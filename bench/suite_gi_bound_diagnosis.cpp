@@ -7,7 +7,10 @@
 // V against the new V, largest over the tile's texels), and the radiance
 // bound of gi/indirect_cache.h against the true change of the one-bounce
 // indirect light. An animated scene (the lit surface, ground + water, and the
-// ground alone) and the Mont Blanc DEM with pits dropped and filled.
+// ground alone) and the Mont Blanc DEM with pits dropped and filled. Then
+// the same at finer granularities (tiles of 16, 8 and 1 receivers): the
+// share of the receivers whose one-frame V bound passes the tolerance, and
+// the shares an oracle recomputes, which is what finer tiles could save.
 // Writes gi_bound_diagnosis.md.
 #include <algorithm>
 #include <array>
@@ -20,8 +23,10 @@
 
 #include "bench/suites.h"
 #include "core/parallel.h"
+#include "gi/change_bound.h"
 #include "gi/frame.h"
 #include "gi/indirect_cache.h"
+#include "gi/visibility_cache.h"
 #include "sim/scene.h"
 
 namespace terrain::bench {
@@ -51,16 +56,20 @@ double share(const std::vector<double>& v, double above) {
 
 using GiState = gi::GiState;
 
-// Largest |a - b| per visibility tile over the texels of its receivers (any channel).
+// Receivers per tile side of the granularities compared: the visibility
+// tiles' first (the engine's), then finer ones.
+constexpr std::array<int, 4> kGranularities = {gi::kVisibilityTile, 16, 8, 1};
+
+// Largest |a - b| per tile of T x T receivers over the texels of its receivers (any channel).
 std::vector<double> perTile(const std::vector<const Grid*>& a, const std::vector<const Grid*>& b, const GiState& st,
-                            int s) {
-    const int tilesX = gi::tileCount(st.pyramid.nxr, gi::kVisibilityTile);
-    std::vector<double> out(static_cast<std::size_t>(tilesX) * gi::tileCount(st.pyramid.nyr, gi::kVisibilityTile), 0.0);
+                            int s, int T = gi::kVisibilityTile) {
+    const int tilesX = gi::tileCount(st.pyramid.nxr, T);
+    std::vector<double> out(static_cast<std::size_t>(tilesX) * gi::tileCount(st.pyramid.nyr, T), 0.0);
     for (std::size_t c = 0; c < a.size(); ++c)
         for (int y = 0; y < a[c]->ny; ++y)
             for (int x = 0; x < a[c]->nx; ++x) {
-                const int tx = std::min(x / s, st.pyramid.nxr - 1) / gi::kVisibilityTile;
-                const int ty = std::min(y / s, st.pyramid.nyr - 1) / gi::kVisibilityTile;
+                const int tx = std::min(x / s, st.pyramid.nxr - 1) / T;
+                const int ty = std::min(y / s, st.pyramid.nyr - 1) / T;
                 double& t = out[static_cast<std::size_t>(ty) * tilesX + tx];
                 t = std::max(t, std::fabs(static_cast<double>((*b[c])(x, y)) - (*a[c])(x, y)));
             }
@@ -73,27 +82,38 @@ struct Track {
     GiState now, last;
     Grid heights, lastHeights;
     std::vector<double> bound, vChange, indirectSampleBound, indirectBound, indirectChange, dh;
-    // An oracle that knows the true results: per tile it keeps its cached V
-    // and indirect light until they are more than the tolerance from the
-    // truth. The share of tiles it recomputes per frame is what any
-    // conservative bound recomputes at least.
-    gi::VisibilityField oracleV;
-    std::array<Grid, 3> oracleIndirect;
-    std::vector<double> oracleVShare, oracleIndirectShare;
+    // An oracle that knows the true results, per granularity
+    // (kGranularities): per tile it keeps its cached V and indirect light
+    // until they are more than the tolerance from the truth. The share of
+    // receivers it recomputes per frame is what any conservative bound on
+    // tiles of that size recomputes at least.
+    struct Oracle {
+        gi::VisibilityField v;
+        std::array<Grid, 3> indirect;
+        std::vector<double> vShare, indirectShare;
+    };
+    std::array<Oracle, kGranularities.size()> oracles;
+    // per granularity, per frame: the share of the receivers whose tile's
+    // one-frame V bound passes the tolerance
+    std::array<std::vector<double>, kGranularities.size()> boundShare;
+    // the same for receivers alone, counted in the scans' runs of 16 along a row
+    std::vector<double> laneRunShare;
+    // the same with one slope bound for every azimuth (the geometry tiles' form)
+    std::vector<double> isotropicShare;
 };
 
-// Copies the receivers (V) or texels (indirect light) of the tiles whose
-// deviation exceeds the tolerance from the truth into the oracle's cache;
-// returns the share of such tiles.
-double refreshTiles(const std::vector<double>& deviation, float tolerance, const GiState& now, int s,
+// Copies the receivers (V) or texels (indirect light) of the tiles of T x T
+// receivers whose deviation exceeds the tolerance from the truth into the
+// oracle's cache; returns the share of the receivers they hold.
+double refreshTiles(const std::vector<double>& deviation, float tolerance, const GiState& now, int s, int T,
                     gi::VisibilityField* v, std::array<Grid, 3>* indirect) {
-    const int tilesX = gi::tileCount(now.pyramid.nxr, gi::kVisibilityTile), T = gi::kVisibilityTile;
+    const int tilesX = gi::tileCount(now.pyramid.nxr, T);
     double dirty = 0.0;
     for (std::size_t t = 0; t < deviation.size(); ++t) {
         if (!(deviation[t] > tolerance)) continue;
-        dirty += 1.0;
         const int tx = static_cast<int>(t) % tilesX, ty = static_cast<int>(t) / tilesX;
         const int X1 = std::min(now.pyramid.nxr, T * tx + T), Y1 = std::min(now.pyramid.nyr, T * ty + T);
+        dirty += static_cast<double>(X1 - T * tx) * (Y1 - T * ty);
         for (int Y = T * ty; Y < Y1; ++Y)
             for (int X = T * tx; X < X1; ++X) {
                 if (v)
@@ -109,7 +129,7 @@ double refreshTiles(const std::vector<double>& deviation, float tolerance, const
                         for (int x = s * X; x < xEnd; ++x) (*indirect)[c](x, y) = now.indirect.indirect[c](x, y);
             }
     }
-    return deviation.empty() ? 0.0 : dirty / static_cast<double>(deviation.size());
+    return dirty / (static_cast<double>(now.pyramid.nxr) * now.pyramid.nyr);
 }
 
 // The SH ambient map of the environment V `v` at the frame's normals: what
@@ -125,20 +145,65 @@ void ambientOfV(const GiState& now, const gi::VisibilityField& v, const gi::GiSe
 // One frame of the oracle (the first frame fills its caches).
 // `fresh`: the SH ambient map of this frame's V (ambientOfV).
 void oracleFrame(Track& t, const gi::GiSettings& settings, float tolerance, const gi::ShadeMaps& fresh) {
-    if (t.oracleV.sh.empty()) {
-        t.oracleV = t.now.envVisibility;
-        t.oracleIndirect = t.now.indirect.indirect;
-        return;
-    }
     const int s = settings.subsample;
-    gi::ShadeMaps cached;
-    ambientOfV(t.now, t.oracleV, settings, cached);
-    const std::vector<double> v = perTile({&cached.ambient}, {&fresh.ambient}, t.now, s);
-    t.oracleVShare.push_back(refreshTiles(v, tolerance, t.now, s, &t.oracleV, nullptr));
-    const std::vector<double> ind =
-        perTile({&t.oracleIndirect[0], &t.oracleIndirect[1], &t.oracleIndirect[2]},
-                {&t.now.indirect.indirect[0], &t.now.indirect.indirect[1], &t.now.indirect.indirect[2]}, t.now, s);
-    t.oracleIndirectShare.push_back(refreshTiles(ind, tolerance, t.now, s, nullptr, &t.oracleIndirect));
+    for (std::size_t g = 0; g < kGranularities.size(); ++g) {
+        Track::Oracle& o = t.oracles[g];
+        const int T = kGranularities[g];
+        if (o.v.sh.empty()) {
+            o.v = t.now.envVisibility;
+            o.indirect = t.now.indirect.indirect;
+            continue;
+        }
+        gi::ShadeMaps cached;
+        ambientOfV(t.now, o.v, settings, cached);
+        const std::vector<double> v = perTile({&cached.ambient}, {&fresh.ambient}, t.now, s, T);
+        o.vShare.push_back(refreshTiles(v, tolerance, t.now, s, T, &o.v, nullptr));
+        const std::vector<double> ind = perTile(
+            {&o.indirect[0], &o.indirect[1], &o.indirect[2]},
+            {&t.now.indirect.indirect[0], &t.now.indirect.indirect[1], &t.now.indirect.indirect[2]}, t.now, s, T);
+        o.indirectShare.push_back(refreshTiles(ind, tolerance, t.now, s, T, nullptr, &o.indirect));
+    }
+}
+
+// One frame's environment V bound per tile of T x T receivers (what
+// gi/visibility_cache.h adds to a tile's drift), from the height change `dh`.
+std::vector<float> environmentBounds(const gi::MaxChangePyramid& dh, const gi::HeightPyramid& pyr,
+                                     const gi::VisibilitySettings& vis, int T) {
+    std::vector<float> azimuths, gradients, scratch, bound;
+    gi::boundSlopeChangePerAzimuth(dh, pyr, T, vis.azimuths, azimuths);
+    gi::boundGradientChange(dh, pyr, T, gradients);
+    gi::environmentBoundPerTile(azimuths, gradients, vis.azimuths, gi::blockingMaxLipschitz(vis.blockingMax), scratch,
+                                bound);
+    return bound;
+}
+
+// The same per receiver with the slope bound over every azimuth instead of
+// one per azimuth (gi/visibility_cache.h's geometry bound).
+std::vector<float> isotropicBounds(const gi::MaxChangePyramid& dh, const gi::HeightPyramid& pyr,
+                                   const gi::VisibilitySettings& vis) {
+    std::vector<float> slopes, gradients, bound;
+    gi::boundSlopeChange(dh, pyr, 1, slopes);
+    gi::boundGradientChange(dh, pyr, 1, gradients);
+    gi::geometryBoundPerTile(slopes, gradients, gi::blockingMaxLipschitz(vis.blockingMax), bound);
+    return bound;
+}
+
+// The share of the receivers that lie in a tile of T x T receivers whose
+// bound is above the tolerance; with T = 1 and `run` > 1, in a run of `run`
+// receivers of a row (from a multiple of `run`) holding one such receiver.
+double shareAbove(const std::vector<float>& bound, int T, int run, int nxr, int nyr, float tolerance) {
+    const int tilesX = gi::tileCount(nxr, T);
+    double above = 0.0;
+    for (int ty = 0; ty < gi::tileCount(nyr, T); ++ty)
+        for (int tx0 = 0; tx0 < tilesX; tx0 += run) {
+            const int tx1 = std::min(tilesX, tx0 + run);
+            bool any = false;
+            for (int tx = tx0; tx < tx1; ++tx)
+                any = any || bound[static_cast<std::size_t>(ty) * tilesX + tx] > tolerance;
+            if (any)
+                above += static_cast<double>(std::min(nxr, T * tx1) - T * tx0) * (std::min(nyr, T * ty + T) - T * ty);
+        }
+    return above / (static_cast<double>(nxr) * nyr);
 }
 
 // Per tile, for the change of the direct light from the last frame to this
@@ -191,6 +256,16 @@ void measureFrame(Track& t, const gi::GiSettings& settings, float cell, float to
     gi::VisibilityCache cache;  // fresh, anchored at the last heights: one plan's excursion is the frame's bound
     gi::planVisibilityTiles(t.lastHeights.cview(), t.heights.cview(), t.now.pyramid, settings.visibility, {}, 1e30f,
                             cache);
+    const int nxr = t.now.pyramid.nxr, nyr = t.now.pyramid.nyr;
+    for (std::size_t g = 0; g < kGranularities.size(); ++g) {
+        const int T = kGranularities[g];
+        const std::vector<float> bound = environmentBounds(cache.change, t.now.pyramid, settings.visibility, T);
+        t.boundShare[g].push_back(shareAbove(bound, T, 1, nxr, nyr, tolerance));
+        if (T != 1) continue;
+        t.laneRunShare.push_back(shareAbove(bound, 1, gi::ReceiverTiles::kTileAlign, nxr, nyr, tolerance));
+        t.isotropicShare.push_back(
+            shareAbove(isotropicBounds(cache.change, t.now.pyramid, settings.visibility), 1, 1, nxr, nyr, tolerance));
+    }
     gi::ShadeMaps cached;
     ambientOfV(t.now, t.last.envVisibility, settings, cached);
     const int s = settings.subsample;
@@ -222,7 +297,11 @@ const char* kIntro =
     "channels. Quantiles over every tile of every frame after the first. The oracle knows the true results: per "
     "tile it keeps its cached V (or indirect light) until the tile's texels are more than the tolerance from the "
     "truth, then takes the truth; the share of tiles it recomputes per frame is about the least any conservative "
-    "bound can recompute.\n";
+    "bound can recompute. The second table of each case compares granularities: per frame, the share of the "
+    "receivers whose tile's one-frame V bound passes the tolerance (the same bound taken over tiles of that many "
+    "receivers a side, 1: each receiver alone; and, as the scans take receivers in runs of 16 along a row, the share "
+    "of the receivers in a run that holds one above) and the shares of the receivers an oracle with tiles of that "
+    "size recomputes, mean over the frames after the first.\n";
 
 // One row per quantity: its quantiles and the share of tiles (or cells) above the tolerance.
 std::string row(const std::string& what, const std::vector<double>& v, double above) {
@@ -230,6 +309,34 @@ std::string row(const std::string& what, const std::vector<double>& v, double ab
     std::snprintf(buf, sizeof buf, "| %s | %.3g | %.3g | %.3g | %.3g | %.1f %% |\n", what.c_str(), quantile(v, 0.1),
                   quantile(v, 0.5), quantile(v, 0.9), quantile(v, 1.0), 100.0 * share(v, above));
     return buf;
+}
+
+double mean(const std::vector<double>& v) {
+    double sum = 0.0;
+    for (double x : v) sum += x;
+    return v.empty() ? 0.0 : sum / static_cast<double>(v.size());
+}
+
+// Per granularity, the mean share per frame of the receivers the one-frame
+// V bound marks and of those the oracle recomputes.
+std::string granularityTable(const Track& t) {
+    std::string out =
+        "\n| tiles (receivers) | one-frame V bound above the tolerance | oracle: V recomputed | oracle: indirect light "
+        "recomputed |\n|---|---|---|---|\n";
+    for (std::size_t g = 0; g < kGranularities.size(); ++g) {
+        char buf[200];
+        std::snprintf(buf, sizeof buf, "| %d x %d | %.2f %% | %.2f %% | %.2f %% |\n", kGranularities[g],
+                      kGranularities[g], 100.0 * mean(t.boundShare[g]), 100.0 * mean(t.oracles[g].vShare),
+                      100.0 * mean(t.oracles[g].indirectShare));
+        out += buf;
+    }
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "| 1 x 1, in the scans' runs of %d along a row | %.2f %% | | |\n",
+                  gi::ReceiverTiles::kTileAlign, 100.0 * mean(t.laneRunShare));
+    out += buf;
+    std::snprintf(buf, sizeof buf, "| 1 x 1, one slope bound for every azimuth | %.2f %% | | |\n",
+                  100.0 * mean(t.isotropicShare));
+    return out + buf;
 }
 
 std::string report(const Track& t, float tolerance) {
@@ -245,9 +352,11 @@ std::string report(const Track& t, float tolerance) {
            row("per tile: largest radiance sample move of the indirect scan", t.indirectSampleBound, tolerance) +
            row("per tile: one-frame radiance bound of the indirect light", t.indirectBound, tolerance) +
            row("per tile: true change of the indirect light", t.indirectChange, tolerance) +
-           row("oracle: share of the tiles whose V it recomputes, per frame (share above 0)", t.oracleVShare, 0.0) +
+           row("oracle: share of the tiles whose V it recomputes, per frame (share above 0)", t.oracles[0].vShare,
+               0.0) +
            row("oracle: share of the tiles whose indirect light it recomputes, per frame (share above 0)",
-               t.oracleIndirectShare, 0.0);
+               t.oracles[0].indirectShare, 0.0) +
+           granularityTable(t);
 }
 
 gi::GiSettings diagnosisSettings() {

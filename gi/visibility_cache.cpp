@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <limits>
 
+#include "core/error.h"
+
 namespace terrain::gi {
 
 void resetVisibilityCache(const HeightPyramid& pyr, ConstGridView heights, VisibilityCache& cache) {
@@ -52,6 +54,28 @@ bool planKeyBrightness(const std::vector<KeyLightRegion>& keys, float tolerance,
     return markDriftAgain(keyShadePerFraction(keys), tolerance, cache.keyDrift, cache.keyTiles.dirty);
 }
 
+void environmentBoundPerTile(std::span<const float> azimuthBound, std::span<const float> gradBound, int azimuths,
+                             float lipschitz, std::vector<float>& scratch, std::vector<float>& out) {
+    const std::size_t m = static_cast<std::size_t>(azimuths), tiles = gradBound.size();
+    if (azimuths < 1 || azimuthBound.size() != tiles * m)
+        throw InputError("environmentBoundPerTile: one slope bound per tile and azimuth, at least one azimuth");
+    scratch.resize(m);  // no allocation after the first frame of these settings
+    out.resize(tiles);
+    for (std::size_t t = 0; t < tiles; ++t) {
+        for (std::size_t j = 0; j < m; ++j) scratch[j] = lipschitz * azimuthBound[t * m + j];
+        out[t] = ambientChangeBoundPerAzimuth(scratch.data(), azimuths, gradBound[t], 1.0f, false);
+    }
+}
+
+void geometryBoundPerTile(std::span<const float> slopeBound, std::span<const float> gradBound, float lipschitz,
+                          std::vector<float>& out) {
+    if (slopeBound.size() != gradBound.size())
+        throw InputError("geometryBoundPerTile: one slope bound and one gradient bound per tile");
+    out.resize(slopeBound.size());
+    for (std::size_t t = 0; t < out.size(); ++t)
+        out[t] = ambientChangeBound(lipschitz * slopeBound[t], gradBound[t], 1.0f, false);
+}
+
 void planVisibilityTiles(ConstGridView before, ConstGridView after, const HeightPyramid& pyr,
                          const VisibilitySettings& vis, const std::vector<KeyLightRegion>& keys, float tolerance,
                          VisibilityCache& cache, CellBox sinceBefore) {
@@ -73,17 +97,9 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
     // normals every frame, so only V's own change counts.
     const float lipschitz = blockingMaxLipschitz(vis.blockingMax);
     boundKeyFractions(pyr, keys, lipschitz, cache);
-    const std::size_t m = static_cast<std::size_t>(vis.azimuths), tiles = cache.slopeBound.size();
-    std::vector<float>& perAzimuth = cache.tileAzimuths;
-    perAzimuth.resize(m);  // no allocation after the first frame of these settings
-    cache.envBound.resize(tiles);
-    cache.geometryBound.resize(tiles);
-    for (std::size_t t = 0; t < tiles; ++t) {
-        for (std::size_t j = 0; j < m; ++j) perAzimuth[j] = lipschitz * cache.azimuthBound[t * m + j];
-        cache.envBound[t] =
-            ambientChangeBoundPerAzimuth(perAzimuth.data(), vis.azimuths, cache.gradBound[t], 1.0f, false);
-        cache.geometryBound[t] = ambientChangeBound(lipschitz * cache.slopeBound[t], cache.gradBound[t], 1.0f, false);
-    }
+    environmentBoundPerTile(cache.azimuthBound, cache.gradBound, vis.azimuths, lipschitz, cache.tileAzimuths,
+                            cache.envBound);
+    geometryBoundPerTile(cache.slopeBound, cache.gradBound, lipschitz, cache.geometryBound);
     // one anchor for the three drifts: they vote together on moving it
     AnchorVotes votes;
     markAnchoredDrift(cache.envBound, {}, 1.0f, tolerance, cache.drift, cache.tiles.dirty, votes);
@@ -99,7 +115,7 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
     // next plan's `before`, if this frame is recorded) within mayDiffer
     if (reanchor) copyGrid(after, cache.anchorHeights, differing.rows());
     cache.anchorDiffers = reanchor ? sinceBefore : mayDiffer;
-    const int all = static_cast<int>(tiles);
+    const int all = static_cast<int>(cache.slopeBound.size());
     // the indirect light re-gathers the geometry's dirty tiles: both count
     countAfterPlan(std::min(cache.tiles.dirtyCount(), cache.geometryTiles.dirtyCount()), all, cache.skips);
 }

@@ -30,6 +30,7 @@
 // is not 0, where its order-4 product has no such bound. The geometry
 // tiles (geometryTiles) do the same with the bound over every azimuth: what
 // the indirect light's casting sets may have moved (gi/indirect_cache.h).
+#include <span>
 #include <vector>
 
 #include "core/grid.h"
@@ -93,6 +94,19 @@ void resetVisibilityCache(const HeightPyramid& pyr, ConstGridView heights, Visib
 /// planned heights: its drift is theirs (the key lights' and the geometry's
 /// are kept, their results were not recomputed).
 void forgetEnvironmentDrift(VisibilityCache& cache);
+
+/// Per tile, the bound on the change of the environment's ambient map (unit
+/// sky) that its per-azimuth slope bounds (`azimuthBound`, tile-major, before
+/// the maximum rule's Lipschitz factor) and its gradient bound allow: what
+/// planVisibilityTiles adds to an environment tile's drift. `scratch` holds
+/// one tile's azimuths.
+void environmentBoundPerTile(std::span<const float> azimuthBound, std::span<const float> gradBound, int azimuths,
+                             float lipschitz, std::vector<float>& scratch, std::vector<float>& out);
+
+/// The same from one slope bound per tile over every azimuth (`slopeBound`):
+/// what planVisibilityTiles adds to a geometry tile's drift.
+void geometryBoundPerTile(std::span<const float> slopeBound, std::span<const float> gradBound, float lipschitz,
+                          std::vector<float>& out);
 
 /// Bounds the change from the anchor's heights to the pyramid's heights
 /// `after`, adds every tile's drift from the anchor, and marks the tiles
