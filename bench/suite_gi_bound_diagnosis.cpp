@@ -26,6 +26,7 @@
 #include "gi/change_bound.h"
 #include "gi/frame.h"
 #include "gi/indirect_cache.h"
+#include "gi/receiver_change_bound.h"
 #include "gi/visibility_cache.h"
 #include "sim/scene.h"
 
@@ -177,12 +178,13 @@ std::vector<float> environmentBounds(const gi::MaxChangePyramid& dh, const gi::H
     return bound;
 }
 
-// The same per receiver with the slope bound over every azimuth instead of
-// one per azimuth (gi/visibility_cache.h's geometry bound).
+// The same per receiver with one slope bound for every azimuth (the form of
+// gi/visibility_cache.h's geometry bound), from the max filters of
+// gi/receiver_change_bound.h.
 std::vector<float> isotropicBounds(const gi::MaxChangePyramid& dh, const gi::HeightPyramid& pyr,
                                    const gi::VisibilitySettings& vis) {
     std::vector<float> slopes, gradients, bound;
-    gi::boundSlopeChange(dh, pyr, 1, slopes);
+    gi::boundSlopeChangePerReceiver(dh, pyr, slopes);
     gi::boundGradientChange(dh, pyr, 1, gradients);
     gi::geometryBoundPerTile(slopes, gradients, gi::blockingMaxLipschitz(vis.blockingMax), bound);
     return bound;
@@ -300,8 +302,9 @@ const char* kIntro =
     "bound can recompute. The second table of each case compares granularities: per frame, the share of the "
     "receivers whose tile's one-frame V bound passes the tolerance (the same bound taken over tiles of that many "
     "receivers a side, 1: each receiver alone; and, as the scans take receivers in runs of 16 along a row, the share "
-    "of the receivers in a run that holds one above) and the shares of the receivers an oracle with tiles of that "
-    "size recomputes, mean over the frames after the first.\n";
+    "of the receivers in a run that holds one above; and per receiver with one slope bound for every azimuth, from "
+    "max filters of the change pyramid, gi/receiver_change_bound.h) and the shares of the receivers an oracle with "
+    "tiles of that size recomputes, mean over the frames after the first.\n";
 
 // One row per quantity: its quantiles and the share of tiles (or cells) above the tolerance.
 std::string row(const std::string& what, const std::vector<double>& v, double above) {
@@ -334,7 +337,7 @@ std::string granularityTable(const Track& t) {
     std::snprintf(buf, sizeof buf, "| 1 x 1, in the scans' runs of %d along a row | %.2f %% | | |\n",
                   gi::ReceiverTiles::kTileAlign, 100.0 * mean(t.laneRunShare));
     out += buf;
-    std::snprintf(buf, sizeof buf, "| 1 x 1, one slope bound for every azimuth | %.2f %% | | |\n",
+    std::snprintf(buf, sizeof buf, "| 1 x 1, one slope bound for every azimuth (max filters) | %.2f %% | | |\n",
                   100.0 * mean(t.isotropicShare));
     return out + buf;
 }

@@ -18,13 +18,6 @@ constexpr int kCoveringBlocksPerAxis = 8;  // the same for maxChangeCoveringBox 
 constexpr double kHalfDiagonal = 0.70710679;  // 1 / sqrt2
 constexpr double kSqrt2Up = 1.41421357;       // sqrt2
 
-// A float not below the non-negative double v.
-float roundUp(double v) {
-    float f = static_cast<float>(v);
-    if (static_cast<double>(f) < v) f = std::nextafter(f, std::numeric_limits<float>::infinity());
-    return f;
-}
-
 void sizeLevels(int nx, int ny, MaxChangePyramid& p) {
     p.nx = nx;
     p.ny = ny;
@@ -54,7 +47,7 @@ void sumLevel(const Grid& src, Grid& dst, const CellBox& blocks) {
                 const bool pair = xa + 1 < src.nx;
                 double v = static_cast<double>(ra[xa]) + (pair ? ra[xa + 1] : 0.0f);
                 if (rb) v += static_cast<double>(rb[xa]) + (pair ? rb[xa + 1] : 0.0f);
-                out[x] = roundUp(v);
+                out[x] = floatNotBelow(v);
             }
         }
     });
@@ -176,6 +169,11 @@ StepExtent stepExtent(const HeightPyramid& pyr, int i) {
     return e;
 }
 
+// Half-size (cells) of the square around a cell that holds every cell step
+// i's samples read from it along any azimuth: the farthest sample plus the
+// reach.
+int stepHalfSize(const StepExtent& e) { return static_cast<int>(std::ceil(e.tauMax + e.reach)); }
+
 // The smallest tauMin of steps i.. : tauMin grows with i within the raw steps
 // and within the level steps, and may drop once where the texel size changes.
 double tauMinFrom(const HeightPyramid& pyr, int i, int firstLevelStep) {
@@ -196,8 +194,7 @@ int firstLevelStep(const HeightPyramid& pyr) {
 // The dilation never shrinks from one step to the next (t'_max, the texel
 // size and the reach grow with i), so the boxes are nested.
 float changeWithinStep(const MaxChangePyramid& dh, const HeightPyramid& pyr, const InclusiveCells& c, int i) {
-    const StepExtent e = stepExtent(pyr, i);
-    const int d = static_cast<int>(std::ceil(e.tauMax + e.reach));
+    const int d = stepHalfSize(stepExtent(pyr, i));
     return maxChangeInBox(dh, c.x0 - d, c.y0 - d, c.x1 + d, c.y1 + d);
 }
 
@@ -234,7 +231,7 @@ float boundOfTileFrom(const MaxChangePyramid& dh, const HeightPyramid& pyr, int 
         const double m = changeWithinStep(dh, pyr, c, i);
         best = std::max(best, (lipschitz * m + m0) / (stepExtent(pyr, i).tauMin * cellSize));
     }
-    return roundUp(best);
+    return floatNotBelow(best);
 }
 
 // The directions a bound covers: cos and sin of the azimuths range over
@@ -272,7 +269,7 @@ InclusiveCells stepBoxOver(const StepExtent& e, const InclusiveCells& c, const D
     const double y0 = std::min(e.tauMin * dir.sMin, e.tauMax * dir.sMin);
     const double y1 = std::max(e.tauMin * dir.sMax, e.tauMax * dir.sMax);
     const double r = e.reach + 1.0;
-    const int d = static_cast<int>(std::ceil(e.tauMax + e.reach));
+    const int d = stepHalfSize(e);
     return {c.x0 + std::max(-d, static_cast<int>(std::floor(x0 - r))),
             c.y0 + std::max(-d, static_cast<int>(std::floor(y0 - r))),
             c.x1 + std::min(d, static_cast<int>(std::ceil(x1 + r))),
@@ -450,6 +447,12 @@ void raiseToChangeSse(const float* a, const float* b, float* out, int x0, int x1
 
 }  // namespace
 
+float floatNotBelow(double v) {
+    float f = static_cast<float>(v);
+    if (static_cast<double>(f) < v) f = std::nextafter(f, std::numeric_limits<float>::infinity());
+    return f;
+}
+
 void buildMaxChangePyramid(ConstGridView dh, MaxChangePyramid& p) {
     sizeLevels(dh.nx, dh.ny, p);
     Grid& base = p.levels[0];
@@ -594,6 +597,15 @@ void boundSlopeChange(const MaxChangePyramid& dh, const HeightPyramid& pyr, int 
                 [&](int tx, int ty) { return boundOfTileFrom(dh, pyr, tileReceivers, tx, ty, firstLevel, lipschitz); });
 }
 
+std::vector<StepSquare> stepSquares(const HeightPyramid& pyr) {
+    std::vector<StepSquare> out;
+    for (int i = 0; i < static_cast<int>(pyr.steps.size()); ++i) {
+        const StepExtent e = stepExtent(pyr, i);
+        out.push_back({e.tauMin, stepHalfSize(e)});
+    }
+    return out;
+}
+
 float blockingMaxLipschitz(BlockingMax rule) { return rule == BlockingMax::Samples ? 1.0f : 20.0f / 16.0f; }
 
 float gradientBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int tx, int ty) {
@@ -603,7 +615,7 @@ float gradientBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, 
     const int x1 = std::min(c.x1 + half, pyr.nx - 1), y1 = std::min(c.y1 + half, pyr.ny - 1);
     const bool border = x0 == 0 || y0 == 0 || x1 == pyr.nx - 1 || y1 == pyr.ny - 1;  // one-sided differences
     const double m = maxChangeInBox(dh, x0 - 1, y0 - 1, x1 + 1, y1 + 1);
-    return roundUp((border ? 2.0 : 1.0) * m / pyr.cellSize);
+    return floatNotBelow((border ? 2.0 : 1.0) * m / pyr.cellSize);
 }
 
 void boundGradientChange(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers,
@@ -617,30 +629,30 @@ float ambientChangeBound(float slopeBound, float gradientBound, float maxSkyRadi
     const double g = kSqrt2Up * gradientBound;  // bounds both the tangent slope's and the normal's move
     const double v =
         maxSkyRadiance * (kShadePerSlope * std::max<double>(slopeBound, g) + (withNormals ? kShadePerNormal * g : 0.0));
-    return roundUp(v);
+    return floatNotBelow(v);
 }
 
 float azimuthBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int tx, int ty,
                          double phi) {
     const InclusiveCells c = tileCells(pyr, tileReceivers, tx, ty);
     const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
-    return roundUp(azimuthBoundFrom(dh, pyr, stepTable(pyr), c, m0, firstBusyStep(dh, pyr, c, m0),
-                                    oneDirection(std::cos(phi), std::sin(phi)), heightFilterLipschitz(pyr)));
+    return floatNotBelow(azimuthBoundFrom(dh, pyr, stepTable(pyr), c, m0, firstBusyStep(dh, pyr, c, m0),
+                                          oneDirection(std::cos(phi), std::sin(phi)), heightFilterLipschitz(pyr)));
 }
 
 void boundSlopeChangePerAzimuth(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int azimuths,
                                 std::vector<float>& tileBound) {
     const StepTable steps = stepTable(pyr);
     const double lipschitz = heightFilterLipschitz(pyr);
-    forEachTileAndAzimuth(
-        dh, pyr, tileReceivers, azimuths, tileBound,
-        [&](const InclusiveCells& c, const std::vector<double>& cs, const std::vector<double>& sn, float* out,
-            std::size_t) {
-            const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
-            const int first = firstBusyStep(dh, pyr, c, m0);
-            for (std::size_t j = 0; j < cs.size(); ++j)
-                out[j] = roundUp(azimuthBoundFrom(dh, pyr, steps, c, m0, first, oneDirection(cs[j], sn[j]), lipschitz));
-        });
+    forEachTileAndAzimuth(dh, pyr, tileReceivers, azimuths, tileBound,
+                          [&](const InclusiveCells& c, const std::vector<double>& cs, const std::vector<double>& sn,
+                              float* out, std::size_t) {
+                              const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
+                              const int first = firstBusyStep(dh, pyr, c, m0);
+                              for (std::size_t j = 0; j < cs.size(); ++j)
+                                  out[j] = floatNotBelow(azimuthBoundFrom(dh, pyr, steps, c, m0, first,
+                                                                          oneDirection(cs[j], sn[j]), lipschitz));
+                          });
 }
 
 float ambientChangeBoundPerAzimuth(const float* slopeBound, int azimuths, float gradientBound, float maxSkyRadiance,
@@ -649,22 +661,22 @@ float ambientChangeBoundPerAzimuth(const float* slopeBound, int azimuths, float 
     double sum = 0.0;
     for (int j = 0; j < azimuths; ++j) sum += std::max<double>(slopeBound[j], g);
     const double v = maxSkyRadiance * (kShadePerSlope * sum / azimuths + (withNormals ? kShadePerNormal * g : 0.0));
-    return roundUp(v);
+    return floatNotBelow(v);
 }
 
 float keyLightFractionBound(float slopeBound, float gradientBound, float sinLow, float sinHigh) {
     const double dt = std::max<double>(slopeBound, kSqrt2Up * gradientBound);
     if (dt == 0.0) return 0.0f;
     const double window = static_cast<double>(sinHigh) - sinLow;
-    return window > 0.0 ? roundUp(std::min(1.0, dt / window)) : 1.0f;
+    return window > 0.0 ? floatNotBelow(std::min(1.0, dt / window)) : 1.0f;
 }
 
 float rangeBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int tx, int ty,
                        double phi0, double phi1) {
     const InclusiveCells c = tileCells(pyr, tileReceivers, tx, ty);
     const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
-    return roundUp(azimuthBoundFrom(dh, pyr, stepTable(pyr), c, m0, firstBusyStep(dh, pyr, c, m0),
-                                    directionsOver(phi0, phi1), heightFilterLipschitz(pyr)));
+    return floatNotBelow(azimuthBoundFrom(dh, pyr, stepTable(pyr), c, m0, firstBusyStep(dh, pyr, c, m0),
+                                          directionsOver(phi0, phi1), heightFilterLipschitz(pyr)));
 }
 
 void boundSlopeChangeOverRange(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, double phi0,
@@ -677,7 +689,7 @@ void boundSlopeChangeOverRange(const MaxChangePyramid& dh, const HeightPyramid& 
     forEachTile(pyr, tileReceivers, tileBound, [&](int tx, int ty) {
         const InclusiveCells c = tileCells(pyr, tileReceivers, tx, ty);
         const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
-        return roundUp(azimuthBoundFrom(dh, pyr, steps, c, m0, firstBusyStep(dh, pyr, c, m0), dir, lipschitz));
+        return floatNotBelow(azimuthBoundFrom(dh, pyr, steps, c, m0, firstBusyStep(dh, pyr, c, m0), dir, lipschitz));
     });
 }
 

@@ -190,6 +190,19 @@ float heightFilterLipschitz(const HeightPyramid& pyr);
 /// metre). `dh` must cover the pyramid's full-resolution grid.
 float boundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int tx, int ty);
 
+/// Per step of the pyramid, what boundOfTile reads for a tile of one
+/// receiver: t'_min (cells) and the half-size (cells) of the square around
+/// the receiver's cell that holds every cell the step's samples read from it
+/// along any azimuth.
+struct StepSquare {
+    double tauMin = 0.0;
+    int halfSize = 0;
+};
+std::vector<StepSquare> stepSquares(const HeightPyramid& pyr);
+
+/// A float not below the non-negative double v (the bounds are rounded up).
+float floatNotBelow(double v);
+
 /// boundOfTile of every tile, row-major (tileCount(nxr, T) x tileCount(nyr, T)),
 /// in parallel. Throws InputError when tileReceivers < 1 or the sizes of dh
 /// and the pyramid differ.

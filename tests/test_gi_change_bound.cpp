@@ -440,8 +440,11 @@ TEST_CASE("gi.change_bound: SH constants cover the engine's horizon kernel") {
 }
 
 TEST_CASE("gi.change_bound: tile bounds hold for the engine's slopes and ambient light") {
-    const Config configs[] = {
-        {97, 70, 1, 8, false}, {120, 83, 2, 8, false}, {150, 118, 4, 4, false}, {80, 96, 1, 6, true}};
+    const Config configs[] = {{97, 70, 1, 8, false},
+                              {120, 83, 2, 8, false},
+                              {150, 118, 4, 4, false},
+                              {80, 96, 1, 6, true},
+                              {61, 47, 2, 1, false}};
     double worstSlope = 0.0, worstAmbient = 0.0, worstAzimuth = 0.0, worstAzimuthAmbient = 0.0;
     for (const Config& cfg : configs) {
         GiSettings settings = cfg.paper ? paperGiSettings() : GiSettings{};
