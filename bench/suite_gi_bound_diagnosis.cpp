@@ -261,7 +261,10 @@ void measureFrame(Track& t, const gi::GiSettings& settings, float cell, float to
     const int nxr = t.now.pyramid.nxr, nyr = t.now.pyramid.nyr;
     for (std::size_t g = 0; g < kGranularities.size(); ++g) {
         const int T = kGranularities[g];
-        const std::vector<float> bound = environmentBounds(cache.change, t.now.pyramid, settings.visibility, T);
+        // the engine's tiles: the plan above has this frame's bound already
+        const std::vector<float> bound = T == gi::kVisibilityTile
+                                             ? cache.envBound
+                                             : environmentBounds(cache.change, t.now.pyramid, settings.visibility, T);
         t.boundShare[g].push_back(shareAbove(bound, T, 1, nxr, nyr, tolerance));
         if (T != 1) continue;
         t.laneRunShare.push_back(shareAbove(bound, 1, gi::ReceiverTiles::kTileAlign, nxr, nyr, tolerance));
