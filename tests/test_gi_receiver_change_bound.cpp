@@ -1,8 +1,12 @@
-// gi/receiver_change_bound: the blocking-slope bound per receiver from max
-// filters of the change pyramid, against boundSlopeChange with tiles of one
-// receiver (which test_gi_change_bound checks against the engine's slopes):
-// never below it, equal to it where every cell changed alike.
+// Blocking-slope bounds per receiver. gi/receiver_change_bound (one bound
+// for every azimuth, from max filters of the change pyramid) against
+// boundSlopeChange with tiles of one receiver (which test_gi_change_bound
+// checks against the engine's slopes): never below it, equal to it where
+// every cell changed alike. gi/receiver_azimuth_bound (per azimuth, from the
+// samples' own change) against the engine's slopes before and after each
+// change.
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -11,7 +15,9 @@
 
 #include "core/error.h"
 #include "gi/change_bound.h"
+#include "gi/frame.h"
 #include "gi/pyramid.h"
+#include "gi/receiver_azimuth_bound.h"
 #include "gi/receiver_change_bound.h"
 #include "tests/gi_test_terrain.h"
 
@@ -130,4 +136,133 @@ TEST_CASE(
     buildMaxChangePyramid(terrainOf(30, 30).cview(), other);
     std::vector<float> out;
     CHECK_THROWS_AS(boundSlopeChangePerReceiver(other, pyr, out), InputError);
+}
+
+namespace {
+
+// The receivers' maximum blocking slopes of a frame on `h` (every azimuth of
+// the environment's scan, out[(j nyr + Y) nxr + X]), with its state.
+const std::vector<float>& slopesOf(const Grid& h, const GiSettings& settings, GiState& st) {
+    runGiFrame(h.cview(), kCell, GiLighting{}, settings, st);
+    return st.envVisibility.maxSlope;
+}
+
+float largestAbs(const Grid& g) {
+    float m = 0.0f;
+    for (float v : g.v) m = std::max(m, std::fabs(v));
+    return m;
+}
+
+}  // namespace
+
+TEST_CASE("gi.receiver_azimuth_bound: bounds every receiver's slope change along every azimuth of the engine's scan") {
+    struct Case {
+        int nx, ny, subsample;
+        bool paper;  // paperGiSettings (Eq. 16's maximum, mean pyramid) instead of GiSettings{}
+    };
+    for (const Case c : {Case{97, 70, 1, false}, Case{120, 83, 2, false}, Case{150, 118, 4, false},
+                         Case{80, 96, 1, true}, Case{300, 260, 2, false}}) {
+        GiSettings settings = c.paper ? paperGiSettings() : GiSettings{};
+        settings.subsample = c.subsample;
+        settings.indirect.bounces = 0;
+        const float lipschitz = blockingMaxLipschitz(settings.visibility.blockingMax);
+        const Grid base = terrainOf(c.nx, c.ny);
+        GiState before, after;
+        const std::vector<float> s0 = slopesOf(base, settings, before);
+        ChangeLevels levels;  // reused across the changes: each build redoes the last one's box and its own
+        for (int kind = 0; kind < 4; ++kind) {
+            CAPTURE(c.nx);
+            CAPTURE(c.subsample);
+            CAPTURE(kind);
+            const Grid h = changed(base, kind);
+            const std::vector<float>& s1 = slopesOf(h, settings, after);
+            const HeightPyramid& pyr = after.pyramid;
+            MaxChangePyramid dh;
+            buildMaxChangePyramid(base.cview(), h.cview(), dh);
+            buildChangeLevels(dh, pyr, levels);
+            const std::vector<double>& phi = after.envOperator.phi;
+            std::vector<float> bound, tiles;
+            boundSlopeChangePerReceiverAzimuth(levels, pyr, phi, nullptr, bound);
+            const std::size_t planeR = static_cast<std::size_t>(pyr.nxr) * pyr.nyr, m = phi.size();
+            REQUIRE(s1.size() == m * planeR);
+            REQUIRE(bound.size() == m * planeR);
+            boundSlopeChangePerAzimuth(dh, pyr, 1, static_cast<int>(m), tiles);
+            // float rounding: a sample is some dozen operations deep, each off
+            // by half an ulp of a height, over a step of at least one cell
+            const double heightUlps = 64.0 * FLT_EPSILON * std::max(largestAbs(base), largestAbs(h)) / kCell;
+            int over = 0;
+            std::vector<double> toTiles;
+            for (std::size_t j = 0; j < m; ++j)
+                for (std::size_t r = 0; r < planeR; ++r) {
+                    const std::size_t i = j * planeR + r;
+                    const double change = std::fabs(static_cast<double>(s1[i]) - s0[i]);
+                    const double allowance =
+                        heightUlps + 4.0 * FLT_EPSILON * std::max(std::fabs(s0[i]), std::fabs(s1[i]));
+                    over += change > lipschitz * bound[i] + allowance ? 1 : 0;
+                    const float tile = tiles[r * m + j];
+                    if (tile > 0.0f) toTiles.push_back(bound[i] / tile);
+                }
+            CHECK(over == 0);
+            std::sort(toTiles.begin(), toTiles.end());
+            if (!toTiles.empty())
+                MESSAGE(c.nx << " x " << c.ny << " s=" << c.subsample << " change " << kind
+                             << ": per receiver and azimuth / one-receiver tiles' bound, median "
+                             << toTiles[toTiles.size() / 2] << ", p90 " << toTiles[toTiles.size() * 9 / 10]
+                             << ", largest " << toTiles.back());
+        }
+    }
+}
+
+TEST_CASE(
+    "gi.receiver_azimuth_bound: zero without a change; restricted to tiles, the same values there; a redone build is "
+    "a whole one's") {
+    const Grid base = terrainOf(120, 90);
+    HeightPyramid pyr;
+    buildHeightPyramid(base.cview(), kCell, 2, PyramidSettings{}, pyr);
+    const FoldedWedgeOperator op = foldFullCircle(16, AzimuthInterp::Linear);
+    MaxChangePyramid dh;
+    ChangeLevels levels, whole;
+    std::vector<float> bound, wholeBound;
+    buildMaxChangePyramid(base.cview(), base.cview(), dh);
+    buildChangeLevels(dh, pyr, levels);
+    boundSlopeChangePerReceiverAzimuth(levels, pyr, op.phi, nullptr, bound);
+    CHECK(std::all_of(bound.begin(), bound.end(), [](float v) { return v == 0.0f; }));
+    // a bump, then a spike elsewhere: the second build redoes both boxes
+    for (int kind : {0, 2}) {
+        CAPTURE(kind);
+        const Grid h = changed(base, kind);
+        buildMaxChangePyramid(base.cview(), h.cview(), dh);
+        buildChangeLevels(dh, pyr, levels);
+        whole = {};
+        buildChangeLevels(dh, pyr, whole);
+        REQUIRE(levels.bound.levels.size() == whole.bound.levels.size());
+        for (std::size_t l = 0; l < whole.bound.levels.size(); ++l)
+            CHECK(levels.bound.levels[l].v == whole.bound.levels[l].v);
+        CHECK(levels.bound.rawPhase == whole.bound.rawPhase);
+        boundSlopeChangePerReceiverAzimuth(levels, pyr, op.phi, nullptr, bound);
+        boundSlopeChangePerReceiverAzimuth(whole, pyr, op.phi, nullptr, wholeBound);
+        CHECK(bound == wholeBound);
+        CHECK(*std::max_element(bound.begin(), bound.end()) > 0.0f);
+    }
+    // tiles of 16 receivers, every other one dirty
+    ReceiverTiles only;
+    only.reset(pyr.nxr, pyr.nyr, 16, false);
+    for (int t = 0; t < only.tilesX * only.tilesY; t += 2) only.dirty[static_cast<std::size_t>(t)] = 1;
+    std::vector<float> restricted;
+    boundSlopeChangePerReceiverAzimuth(levels, pyr, op.phi, &only, restricted);
+    REQUIRE(restricted.size() == bound.size());
+    int mismatched = 0;
+    for (std::size_t i = 0; i < bound.size(); ++i) {
+        const std::size_t r = i % (static_cast<std::size_t>(pyr.nxr) * pyr.nyr);
+        const int X = static_cast<int>(r) % pyr.nxr, Y = static_cast<int>(r) / pyr.nxr;
+        const float expected = only.isDirty(X / 16, Y / 16) ? bound[i] : 0.0f;
+        mismatched += restricted[i] != expected ? 1 : 0;
+    }
+    CHECK(mismatched == 0);
+    HeightPyramid other;
+    buildHeightPyramid(terrainOf(60, 40).cview(), kCell, 2, PyramidSettings{}, other);
+    CHECK_THROWS_AS(boundSlopeChangePerReceiverAzimuth(levels, other, op.phi, nullptr, bound), InputError);
+    MaxChangePyramid small;
+    buildMaxChangePyramid(terrainOf(30, 30).cview(), small);
+    CHECK_THROWS_AS(buildChangeLevels(small, pyr, levels), InputError);
 }

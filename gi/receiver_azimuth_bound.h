@@ -1,0 +1,66 @@
+#pragma once
+// The per-azimuth blocking-slope bound of gi/change_bound.h for each
+// receiver on its own, from the samples its scan reads rather than from the
+// boxes that hold them.
+//
+// A scan sample is w_a f_l[a] + w_b f_l[b] (gi/visibility.h, stepSample):
+// two texels of level l (or of the raw heights) with non-negative weights
+// summing to 1. Every level blends, with non-negative weights, the B-spline
+// syntheses (non-negative weights) of two octave images, each the blend of a
+// mean and a maximum octave (gi/pyramid.cpp), and the octaves are 2 x 2
+// means and maxima of the next finer one: |mean(a) - mean(b)| <= mean|a - b|
+// and |max(a) - max(b)| <= max|a - b|. So the pyramid of the field |dh| built
+// with the heights' own settings (the same levels, steps, layout and blends)
+// holds at each texel a bound on |change| of the same texel of the height
+// pyramid, and
+//     |change of the slope of step i| <= (w_a D_l[a] + w_b D_l[b] + |dh_0|) / tau_i
+// (dh_0: the receiver's own height's change). Its largest over a receiver's
+// valid steps along azimuth j bounds the change of its maximum blocking slope
+// along j, the counterpart of azimuthBoundOfTile for a tile of one receiver,
+// in one vector read per step instead of a box query: a small change far away
+// counts by what the filters let through to the very texels read, and a
+// change beside the tile by its distance to this receiver, not to the tile's
+// nearest one. The bound holds in real arithmetic, as gi/change_bound.h's,
+// and is 0 where no height the receiver's samples read changed.
+#include <span>
+#include <vector>
+
+#include "core/grid.h"
+#include "gi/change_bound.h"
+#include "gi/pyramid.h"
+#include "gi/receiver_tiles.h"
+
+namespace terrain::gi {
+
+/// The |dh| pyramid (above) and the box of non-zero |dh| it was built from.
+struct ChangeLevels {
+    HeightPyramid bound;
+    CellBox built = CellBox::none();
+    bool valid = false;  // `bound` was built for the grid and settings of the last call
+};
+
+/// Builds (or redoes, over the cells whose |dh| may differ from the last
+/// build's: the old and the new box of non-zero |dh|) the |dh| pyramid of
+/// `dh` (its level 0, |dh| per cell rounded up) for the heights' pyramid
+/// `pyr`. Throws InputError when the sizes of dh and pyr differ.
+void buildChangeLevels(const MaxChangePyramid& dh, const HeightPyramid& pyr, ChangeLevels& out);
+
+/// Per receiver and azimuth phi_j (radians), a bound on |change| of its
+/// maximum blocking slope's samples along phi_j (metres per metre; the
+/// maximum's own rule multiplies it by blockingMaxLipschitz), azimuth-major:
+/// out[(j nyr + Y) nxr + X]. With `only`, the receivers of its dirty tiles
+/// alone; the others get 0. Throws InputError when `levels` was not built
+/// for `pyr`.
+void boundSlopeChangePerReceiverAzimuth(const ChangeLevels& levels, const HeightPyramid& pyr,
+                                        std::span<const double> phi, const ReceiverTiles* only,
+                                        std::vector<float>& out);
+
+/// Per receiver (row-major), the bound on the change of its environment V's
+/// ambient light (ambientChangeBoundPerAzimuth) from the per-azimuth slope
+/// bounds above (m = azimuths, the full circle's samples 2 pi j / m), the
+/// gradient bound of each receiver (`gradientBound`, row-major, or one value
+/// for every receiver) and the maximum's Lipschitz factor.
+void environmentBoundPerReceiver(std::span<const float> slopeBound, int azimuths, std::span<const float> gradientBound,
+                                 float lipschitz, std::vector<float>& out);
+
+}  // namespace terrain::gi
