@@ -14,8 +14,10 @@
 // Writes gi_bound_diagnosis.md.
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <memory>
 #include <string>
@@ -26,6 +28,7 @@
 #include "gi/change_bound.h"
 #include "gi/frame.h"
 #include "gi/indirect_cache.h"
+#include "gi/receiver_azimuth_bound.h"
 #include "gi/receiver_change_bound.h"
 #include "gi/visibility_cache.h"
 #include "sim/scene.h"
@@ -101,6 +104,10 @@ struct Track {
     std::vector<double> laneRunShare;
     // the same with one slope bound for every azimuth (the geometry tiles' form)
     std::vector<double> isotropicShare;
+    // per receiver and azimuth from the samples' own change
+    // (gi/receiver_azimuth_bound.h): alone, in runs of 16, and its cost (ms)
+    std::vector<double> sampleShare, sampleRunShare, sampleMs;
+    gi::ChangeLevels changeLevels;  // its |dh| pyramid, redone from frame to frame as a plan would
 };
 
 // Copies the receivers (V) or texels (indirect light) of the tiles of T x T
@@ -190,6 +197,21 @@ std::vector<float> isotropicBounds(const gi::MaxChangePyramid& dh, const gi::Hei
     return bound;
 }
 
+// The same per receiver and azimuth from the samples' own change
+// (gi/receiver_azimuth_bound.h), every receiver; `ms` gets what it cost
+// (the |dh| pyramid redone, the scan, the gradients and the V bound).
+std::vector<float> sampleBounds(const gi::MaxChangePyramid& dh, const gi::HeightPyramid& pyr,
+                                const gi::VisibilitySettings& vis, gi::ChangeLevels& levels, double& ms) {
+    std::vector<float> bound;
+    const gi::FoldedWedgeOperator op = gi::foldFullCircle(vis.azimuths, vis.interp);
+    const auto t0 = std::chrono::steady_clock::now();
+    gi::buildChangeLevels(dh, pyr, levels);
+    gi::boundEnvironmentPerReceiver(levels, dh, pyr, op.phi, gi::blockingMaxLipschitz(vis.blockingMax), nullptr, 0.0f,
+                                    bound);
+    ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    return bound;
+}
+
 // The share of the receivers that lie in a tile of T x T receivers whose
 // bound is above the tolerance; with T = 1 and `run` > 1, in a run of `run`
 // receivers of a row (from a multiple of `run`) holding one such receiver.
@@ -270,6 +292,12 @@ void measureFrame(Track& t, const gi::GiSettings& settings, float cell, float to
         t.laneRunShare.push_back(shareAbove(bound, 1, gi::ReceiverTiles::kTileAlign, nxr, nyr, tolerance));
         t.isotropicShare.push_back(
             shareAbove(isotropicBounds(cache.change, t.now.pyramid, settings.visibility), 1, 1, nxr, nyr, tolerance));
+        double ms = 0.0;
+        const std::vector<float> samples =
+            sampleBounds(cache.change, t.now.pyramid, settings.visibility, t.changeLevels, ms);
+        t.sampleShare.push_back(shareAbove(samples, 1, 1, nxr, nyr, tolerance));
+        t.sampleRunShare.push_back(shareAbove(samples, 1, gi::ReceiverTiles::kTileAlign, nxr, nyr, tolerance));
+        t.sampleMs.push_back(ms);
     }
     gi::ShadeMaps cached;
     ambientOfV(t.now, t.last.envVisibility, settings, cached);
@@ -306,7 +334,11 @@ const char* kIntro =
     "receivers whose tile's one-frame V bound passes the tolerance (the same bound taken over tiles of that many "
     "receivers a side, 1: each receiver alone; and, as the scans take receivers in runs of 16 along a row, the share "
     "of the receivers in a run that holds one above; and per receiver with one slope bound for every azimuth, from "
-    "max filters of the change pyramid, gi/receiver_change_bound.h) and the shares of the receivers an oracle with "
+    "max filters of the change pyramid, gi/receiver_change_bound.h; and per receiver and azimuth from the change of "
+    "the "
+    "very samples its scan reads, gi/receiver_azimuth_bound.h, with what it costs on 2 threads: the |dh| pyramid "
+    "redone over the change since the last frame, the scan over every receiver and the V bound) and the shares of the "
+    "receivers an oracle with "
     "tiles of that size recomputes, mean over the frames after the first.\n";
 
 // One row per quantity: its quantiles and the share of tiles (or cells) above the tolerance.
@@ -342,6 +374,13 @@ std::string granularityTable(const Track& t) {
     out += buf;
     std::snprintf(buf, sizeof buf, "| 1 x 1, one slope bound for every azimuth (max filters) | %.2f %% | | |\n",
                   100.0 * mean(t.isotropicShare));
+    out += buf;
+    std::snprintf(buf, sizeof buf,
+                  "| 1 x 1, per azimuth from the samples' own change (%.1f ms per frame, median) | %.2f %% | | |\n",
+                  quantile(t.sampleMs, 0.5), 100.0 * mean(t.sampleShare));
+    out += buf;
+    std::snprintf(buf, sizeof buf, "| the same, in the scans' runs of %d along a row | %.2f %% | | |\n",
+                  gi::ReceiverTiles::kTileAlign, 100.0 * mean(t.sampleRunShare));
     return out + buf;
 }
 

@@ -5,6 +5,7 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "core/simd.h"
 #include "gi/visibility.h"
 
 namespace terrain::gi {
@@ -21,24 +22,25 @@ void buildChangeLevels(const MaxChangePyramid& dh, const HeightPyramid& pyr, Cha
     if (!same || !redo.empty())
         buildHeightPyramid(dh.levels[0].cview(), pyr.cellSize, pyr.subsample, pyr.settings, out.bound, redo);
     out.built = nonZero;
+    out.largest = maxChangeAll(dh);
     out.valid = true;
 }
 
 namespace {
 
-// One step of one azimuth as the bound reads it: the step's taps into the
-// |dh| pyramid and the receivers whose samples lie inside the domain at this
-// step and every earlier one (a receiver's valid prefix).
-struct BoundStep {
-    ScanStep step;
-    int x0 = 0, x1 = -1, y0 = 0, y1 = -1;
-};
-
-std::vector<BoundStep> boundSteps(const HeightPyramid& b, std::span<const double> phi) {
+// Each azimuth's walk (ChangeWalk) into `walks`: its steps stop at the first
+// from which on no step's slope can move by more than the floor (each sample
+// and the receiver's own height moved by at most the largest |dh|, M: 2 M
+// over the step's length).
+void buildWalks(const HeightPyramid& b, std::span<const double> phi, float largest, float floor,
+                std::vector<ChangeWalk>& walks, std::vector<float>& tail) {
     const std::size_t nSteps = b.steps.size();
-    std::vector<BoundStep> out(phi.size() * nSteps);
+    walks.resize(phi.size());
+    tail.resize(nSteps + 1);
     for (std::size_t j = 0; j < phi.size(); ++j) {
         const double c = std::cos(phi[j]), sn = std::sin(phi[j]);
+        std::vector<ChangeWalk::Step>& steps = walks[j].steps;
+        steps.resize(nSteps);
         int x0 = 0, x1 = b.nxr - 1, y0 = 0, y1 = b.nyr - 1;
         for (std::size_t i = 0; i < nSteps; ++i) {
             const ScanStepInfo info = scanStepInfo(b, static_cast<int>(i), c, sn);
@@ -46,67 +48,122 @@ std::vector<BoundStep> boundSteps(const HeightPyramid& b, std::span<const double
             x1 = std::min(x1, info.xLast);
             y0 = std::max(y0, info.yFirst);
             y1 = std::min(y1, info.yLast);
-            out[j * nSteps + i] = {info.step, x0, x1, y0, y1};
+            steps[i] = {info.step, x0, x1, y0, y1};
         }
+        tail[nSteps] = 0.0f;  // tail[i]: the bound of steps i and on
+        for (std::size_t i = nSteps; i-- > 0;)
+            tail[i] = std::max(tail[i + 1], floatNotBelow(2.0 * largest * steps[i].step.w[2][0]));
+        std::size_t walked = 0;
+        while (walked < nSteps && tail[walked] > floor) ++walked;
+        steps.resize(walked);
+        walks[j].tail = tail[walked];
     }
-    return out;
 }
 
-}  // namespace
+// One receiver row's span [x0, x1) along one azimuth into o (the row of
+// out): the largest bound of its walked steps, at least the tail's.
+template <class V>
+[[gnu::always_inline]] inline void walkSpan(const ChangeWalk& walk, const float* dh0, int Y, int x0, int x1, float* o) {
+    for (int X = x0; X < x1; ++X) o[X] = walk.tail;
+    for (const ChangeWalk::Step& bs : walk.steps) {
+        const int a = std::max(x0, bs.x0), e = std::min(x1 - 1, bs.x1);
+        // the valid ranges only shrink: once empty, for good
+        if (Y < bs.y0 || Y > bs.y1 || a > e) break;
+        const ScanStep& st = bs.step;
+        const float* fa = st.field + st.offA + static_cast<std::ptrdiff_t>(Y) * st.rowStep;
+        const float* fb = st.field + st.offB + static_cast<std::ptrdiff_t>(Y) * st.rowStep;
+        const V wa = simd::splat<V>(st.w[0][0]), wb = simd::splat<V>(st.w[1][0]), inv = simd::splat<V>(st.w[2][0]);
+        constexpr int L = simd::kLaneCount<V>;
+        int X = a;
+        for (; X + L <= e + 1; X += L) {
+            const V v = (wa * simd::load<V>(fa + X) + wb * simd::load<V>(fb + X) + simd::load<V>(dh0 + X)) * inv;
+            simd::store(o + X, simd::vmax(simd::load<V>(o + X), v));
+        }
+        for (; X <= e; ++X) o[X] = std::max(o[X], (st.w[0][0] * fa[X] + st.w[1][0] * fb[X] + dh0[X]) * st.w[2][0]);
+    }
+}
 
-void boundSlopeChangePerReceiverAzimuth(const ChangeLevels& levels, const HeightPyramid& pyr,
-                                        std::span<const double> phi, const ReceiverTiles* only,
-                                        std::vector<float>& out) {
+// Every azimuth's walk over the row's spans; azimuth j's bounds go to the
+// row rows + j * stride (indexed by the receiver's column).
+using WalkRow = void (*)(const std::vector<ChangeWalk>&, std::span<const ColumnSpan>, const float*, int, float*,
+                         std::size_t);
+
+template <class V>
+[[gnu::always_inline]] inline void walkRowWith(const std::vector<ChangeWalk>& walks, std::span<const ColumnSpan> spans,
+                                               const float* dh0, int Y, float* rows, std::size_t stride) {
+    for (std::size_t j = 0; j < walks.size(); ++j)
+        for (const ColumnSpan& span : spans) walkSpan<V>(walks[j], dh0, Y, span.x0, span.x1, rows + j * stride);
+}
+void walkRowSse(const std::vector<ChangeWalk>& walks, std::span<const ColumnSpan> spans, const float* dh0, int Y,
+                float* rows, std::size_t stride) {
+    walkRowWith<simd::F4>(walks, spans, dh0, Y, rows, stride);
+}
+[[gnu::target("avx2"), gnu::flatten]] void walkRowAvx2(const std::vector<ChangeWalk>& walks,
+                                                       std::span<const ColumnSpan> spans, const float* dh0, int Y,
+                                                       float* rows, std::size_t stride) {
+    walkRowWith<simd::F8>(walks, spans, dh0, Y, rows, stride);
+}
+
+// The walks of `levels` over the receivers of `only`'s dirty tiles: calls
+// row(Y, spans, walk) for each receiver row with a span, in parallel, where
+// walk(rows, stride) writes the row's bounds per azimuth.
+template <class Row>
+void forEachWalkedRow(ChangeLevels& levels, const HeightPyramid& pyr, std::span<const double> phi,
+                      const ReceiverTiles* only, float floor, Row&& row) {
     const HeightPyramid& b = levels.bound;
     if (!levels.valid || b.nx != pyr.nx || b.ny != pyr.ny || b.nxr != pyr.nxr || b.nyr != pyr.nyr ||
         b.steps.size() != pyr.steps.size())
         throw InputError("receiver azimuth bound: the change levels were not built for this pyramid");
-    const int nxr = b.nxr, nyr = b.nyr, s = b.subsample;
-    const std::size_t m = phi.size(), nSteps = b.steps.size(), planeR = static_cast<std::size_t>(nxr) * nyr;
-    out.assign(m * planeR, 0.0f);
-    const std::vector<BoundStep> steps = boundSteps(b, phi);
-    DirtySpans spans;
-    dirtySpans(only, nxr, nyr, spans);
-    parallelForRows(RowSpan{0, nyr}, nxr * static_cast<int>(m), [&](int Y0, int Y1) {
+    buildWalks(b, phi, levels.largest, std::max(floor, 0.0f), levels.walks, levels.tails);
+    const std::vector<ChangeWalk>& walks = levels.walks;
+    const DirtySpans& spans = levels.spans;
+    dirtySpans(only, b.nxr, b.nyr, levels.spans);
+    const WalkRow walkRow = simd::wideEnabled() ? walkRowAvx2 : walkRowSse;
+    parallelForRows(RowSpan{0, b.nyr}, b.nxr * static_cast<int>(phi.size()), [&](int Y0, int Y1) {
         for (int Y = Y0; Y < Y1; ++Y) {
-            const float* dh0 = b.rawPhaseRow(0, s * Y);  // |dh| at the receivers' own cells
-            for (const ColumnSpan& span : spans.ofRow(Y))
-                for (std::size_t j = 0; j < m; ++j) {
-                    float* o = out.data() + (j * static_cast<std::size_t>(nyr) + static_cast<std::size_t>(Y)) * nxr;
-                    for (std::size_t i = 0; i < nSteps; ++i) {
-                        const BoundStep& bs = steps[j * nSteps + i];
-                        const int x0 = std::max(span.x0, bs.x0), x1 = std::min(span.x1 - 1, bs.x1);
-                        // the valid ranges only shrink: once empty, for good
-                        if (Y < bs.y0 || Y > bs.y1 || x0 > x1) break;
-                        const ScanStep& st = bs.step;
-                        const float wa = st.w[0][0], wb = st.w[1][0], inv = st.w[2][0];
-                        const float* fa = st.field + st.offA + static_cast<std::ptrdiff_t>(Y) * st.rowStep;
-                        const float* fb = st.field + st.offB + static_cast<std::ptrdiff_t>(Y) * st.rowStep;
-                        for (int X = x0; X <= x1; ++X) o[X] = std::max(o[X], (wa * fa[X] + wb * fb[X] + dh0[X]) * inv);
-                    }
-                }
+            const std::span<const ColumnSpan> rowSpans = spans.ofRow(Y);
+            if (rowSpans.empty()) continue;
+            // |dh| at the receivers' own cells: raw phase 0 of row s Y
+            const float* dh0 = b.rawPhaseRow(0, b.subsample * Y);
+            row(Y, rowSpans, [&](float* rows, std::size_t stride) { walkRow(walks, rowSpans, dh0, Y, rows, stride); });
         }
     });
 }
 
-void environmentBoundPerReceiver(std::span<const float> slopeBound, int azimuths, std::span<const float> gradientBound,
-                                 float lipschitz, std::vector<float>& out) {
-    const std::size_t m = static_cast<std::size_t>(azimuths);
-    if (azimuths < 1 || slopeBound.size() % m != 0)
-        throw InputError("environmentBoundPerReceiver: one slope bound per receiver and azimuth, at least one azimuth");
-    const std::size_t n = slopeBound.size() / m;
-    if (gradientBound.size() != n && gradientBound.size() != 1)
-        throw InputError("environmentBoundPerReceiver: one gradient bound per receiver, or one for all");
-    out.resize(n);
-    parallelFor(0, static_cast<int>(n), 4096, [&](int r0, int r1) {
-        std::vector<float> perAzimuth(m);
-        for (int r = r0; r < r1; ++r) {
-            for (std::size_t j = 0; j < m; ++j)
-                perAzimuth[j] = lipschitz * slopeBound[j * n + static_cast<std::size_t>(r)];
-            const float g = gradientBound.size() == 1 ? gradientBound[0] : gradientBound[static_cast<std::size_t>(r)];
-            out[static_cast<std::size_t>(r)] =
-                ambientChangeBoundPerAzimuth(perAzimuth.data(), azimuths, g, 1.0f, false);
-        }
+}  // namespace
+
+void boundSlopeChangePerReceiverAzimuth(ChangeLevels& levels, const HeightPyramid& pyr, std::span<const double> phi,
+                                        const ReceiverTiles* only, float floor, std::vector<float>& out) {
+    const std::size_t planeR = static_cast<std::size_t>(pyr.nxr) * pyr.nyr;
+    out.assign(phi.size() * planeR, 0.0f);
+    if (levels.largest == 0.0f && levels.valid) return;  // no height changed
+    forEachWalkedRow(levels, pyr, phi, only, floor, [&](int Y, std::span<const ColumnSpan>, auto&& walk) {
+        walk(out.data() + static_cast<std::size_t>(Y) * pyr.nxr, planeR);
+    });
+}
+
+void boundEnvironmentPerReceiver(ChangeLevels& levels, const MaxChangePyramid& dh, const HeightPyramid& pyr,
+                                 std::span<const double> phi, float lipschitz, const ReceiverTiles* only, float floor,
+                                 std::vector<float>& out) {
+    const int nxr = pyr.nxr, m = static_cast<int>(phi.size());
+    out.assign(static_cast<std::size_t>(nxr) * pyr.nyr, 0.0f);
+    if (m < 1) throw InputError("boundEnvironmentPerReceiver: at least one azimuth");
+    if (levels.largest == 0.0f && levels.valid) return;  // no height changed
+    // per worker slot: a row's slope bounds per azimuth, then one receiver's
+    levels.rows.resize(static_cast<std::size_t>(workerSlots()));
+    for (std::vector<float>& r : levels.rows) r.resize(static_cast<std::size_t>(m) * (nxr + 1));
+    forEachWalkedRow(levels, pyr, phi, only, floor, [&](int Y, std::span<const ColumnSpan> spans, auto&& walk) {
+        float* slopes = levels.rows[static_cast<std::size_t>(workerSlot())].data();
+        float* perAzimuth = slopes + static_cast<std::size_t>(m) * nxr;
+        walk(slopes, static_cast<std::size_t>(nxr));
+        for (const ColumnSpan& span : spans)
+            for (int X = span.x0; X < span.x1; ++X) {
+                for (int j = 0; j < m; ++j)
+                    perAzimuth[static_cast<std::size_t>(j)] =
+                        lipschitz * slopes[static_cast<std::size_t>(j) * nxr + static_cast<std::size_t>(X)];
+                out[static_cast<std::size_t>(Y) * nxr + X] =
+                    ambientChangeBoundPerAzimuth(perAzimuth, m, gradientBoundOfTile(dh, pyr, 1, X, Y), 1.0f, false);
+            }
     });
 }
 

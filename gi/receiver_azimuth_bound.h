@@ -29,14 +29,34 @@
 #include "gi/change_bound.h"
 #include "gi/pyramid.h"
 #include "gi/receiver_tiles.h"
+#include "gi/visibility.h"
 
 namespace terrain::gi {
 
-/// The |dh| pyramid (above) and the box of non-zero |dh| it was built from.
+/// One azimuth's walk over the |dh| pyramid: its steps' taps and the
+/// receivers inside the domain at each (a receiver's valid prefix), up to
+/// the first step from which on no step can move a slope by more than the
+/// floor (below), and what those steps not walked can move one by.
+struct ChangeWalk {
+    struct Step {
+        ScanStep step;
+        int x0 = 0, x1 = -1, y0 = 0, y1 = -1;
+    };
+    std::vector<Step> steps;
+    float tail = 0.0f;
+};
+
+/// The |dh| pyramid (above), the box of non-zero |dh| it was built from,
+/// and the bounds' scratch (reused: no allocation once sized).
 struct ChangeLevels {
     HeightPyramid bound;
     CellBox built = CellBox::none();
-    bool valid = false;  // `bound` was built for the grid and settings of the last call
+    float largest = 0.0f;  // max |dh|
+    bool valid = false;    // `bound` was built for the grid and settings of the last call
+    std::vector<ChangeWalk> walks;
+    std::vector<float> tails;
+    DirtySpans spans;
+    std::vector<std::vector<float>> rows;  // per worker slot: one receiver row's bounds per azimuth
 };
 
 /// Builds (or redoes, over the cells whose |dh| may differ from the last
@@ -49,18 +69,25 @@ void buildChangeLevels(const MaxChangePyramid& dh, const HeightPyramid& pyr, Cha
 /// maximum blocking slope's samples along phi_j (metres per metre; the
 /// maximum's own rule multiplies it by blockingMaxLipschitz), azimuth-major:
 /// out[(j nyr + Y) nxr + X]. With `only`, the receivers of its dirty tiles
-/// alone; the others get 0. Throws InputError when `levels` was not built
-/// for `pyr`.
-void boundSlopeChangePerReceiverAzimuth(const ChangeLevels& levels, const HeightPyramid& pyr,
-                                        std::span<const double> phi, const ReceiverTiles* only,
-                                        std::vector<float>& out);
+/// alone; the others get 0. `floor`: precision not needed below it; a walk
+/// stops at the first step from which on no step can change a slope by more
+/// (at most twice the largest |dh| over the step's length) and every
+/// receiver is charged that much instead, so the bound stays one (0: walk
+/// every step that can see a change). Throws InputError when `levels` was
+/// not built for `pyr`.
+void boundSlopeChangePerReceiverAzimuth(ChangeLevels& levels, const HeightPyramid& pyr, std::span<const double> phi,
+                                        const ReceiverTiles* only, float floor, std::vector<float>& out);
 
-/// Per receiver (row-major), the bound on the change of its environment V's
-/// ambient light (ambientChangeBoundPerAzimuth) from the per-azimuth slope
-/// bounds above (m = azimuths, the full circle's samples 2 pi j / m), the
-/// gradient bound of each receiver (`gradientBound`, row-major, or one value
-/// for every receiver) and the maximum's Lipschitz factor.
-void environmentBoundPerReceiver(std::span<const float> slopeBound, int azimuths, std::span<const float> gradientBound,
-                                 float lipschitz, std::vector<float>& out);
+/// Per receiver (row-major), the bound on the change of its environment
+/// V's ambient light (ambientChangeBoundPerAzimuth, what gi/visibility_cache.h
+/// adds to a tile's drift, for the receiver alone): from the slope bounds
+/// above along phi (the full circle's samples 2 pi j / m) times the
+/// maximum's Lipschitz factor, and the gradient bound of the receiver's own
+/// footprint (gradientBoundOfTile with tiles of one receiver, from dh: the
+/// |dh| the levels were built from). With `only`, the receivers of its
+/// dirty tiles alone; the others get 0. `floor` as above.
+void boundEnvironmentPerReceiver(ChangeLevels& levels, const MaxChangePyramid& dh, const HeightPyramid& pyr,
+                                 std::span<const double> phi, float lipschitz, const ReceiverTiles* only, float floor,
+                                 std::vector<float>& out);
 
 }  // namespace terrain::gi

@@ -182,7 +182,7 @@ TEST_CASE("gi.receiver_azimuth_bound: bounds every receiver's slope change along
             buildChangeLevels(dh, pyr, levels);
             const std::vector<double>& phi = after.envOperator.phi;
             std::vector<float> bound, tiles;
-            boundSlopeChangePerReceiverAzimuth(levels, pyr, phi, nullptr, bound);
+            boundSlopeChangePerReceiverAzimuth(levels, pyr, phi, nullptr, 0.0f, bound);
             const std::size_t planeR = static_cast<std::size_t>(pyr.nxr) * pyr.nyr, m = phi.size();
             REQUIRE(s1.size() == m * planeR);
             REQUIRE(bound.size() == m * planeR);
@@ -203,6 +203,19 @@ TEST_CASE("gi.receiver_azimuth_bound: bounds every receiver's slope change along
                     if (tile > 0.0f) toTiles.push_back(bound[i] / tile);
                 }
             CHECK(over == 0);
+            // the fused per-receiver V bound is the per-azimuth slopes' with the receiver's own gradients
+            std::vector<float> env, perAzimuth(m);
+            boundEnvironmentPerReceiver(levels, dh, pyr, phi, lipschitz, nullptr, 0.0f, env);
+            REQUIRE(env.size() == planeR);
+            int differing = 0;
+            for (std::size_t r = 0; r < planeR; ++r) {
+                for (std::size_t j = 0; j < m; ++j) perAzimuth[j] = lipschitz * bound[j * planeR + r];
+                const int X = static_cast<int>(r % static_cast<std::size_t>(pyr.nxr));
+                const int Y = static_cast<int>(r / static_cast<std::size_t>(pyr.nxr));
+                differing += env[r] != ambientChangeBoundPerAzimuth(perAzimuth.data(), static_cast<int>(m),
+                                                                    gradientBoundOfTile(dh, pyr, 1, X, Y), 1.0f, false);
+            }
+            CHECK(differing == 0);
             std::sort(toTiles.begin(), toTiles.end());
             if (!toTiles.empty())
                 MESSAGE(c.nx << " x " << c.ny << " s=" << c.subsample << " change " << kind
@@ -214,8 +227,8 @@ TEST_CASE("gi.receiver_azimuth_bound: bounds every receiver's slope change along
 }
 
 TEST_CASE(
-    "gi.receiver_azimuth_bound: zero without a change; restricted to tiles, the same values there; a redone build is "
-    "a whole one's") {
+    "gi.receiver_azimuth_bound: zero without a change; a redone build is a whole one's; a floor only raises it, to at "
+    "most the floor; restricted to tiles, the same values there") {
     const Grid base = terrainOf(120, 90);
     HeightPyramid pyr;
     buildHeightPyramid(base.cview(), kCell, 2, PyramidSettings{}, pyr);
@@ -225,7 +238,7 @@ TEST_CASE(
     std::vector<float> bound, wholeBound;
     buildMaxChangePyramid(base.cview(), base.cview(), dh);
     buildChangeLevels(dh, pyr, levels);
-    boundSlopeChangePerReceiverAzimuth(levels, pyr, op.phi, nullptr, bound);
+    boundSlopeChangePerReceiverAzimuth(levels, pyr, op.phi, nullptr, 0.0f, bound);
     CHECK(std::all_of(bound.begin(), bound.end(), [](float v) { return v == 0.0f; }));
     // a bump, then a spike elsewhere: the second build redoes both boxes
     for (int kind : {0, 2}) {
@@ -239,17 +252,31 @@ TEST_CASE(
         for (std::size_t l = 0; l < whole.bound.levels.size(); ++l)
             CHECK(levels.bound.levels[l].v == whole.bound.levels[l].v);
         CHECK(levels.bound.rawPhase == whole.bound.rawPhase);
-        boundSlopeChangePerReceiverAzimuth(levels, pyr, op.phi, nullptr, bound);
-        boundSlopeChangePerReceiverAzimuth(whole, pyr, op.phi, nullptr, wholeBound);
+        boundSlopeChangePerReceiverAzimuth(levels, pyr, op.phi, nullptr, 0.0f, bound);
+        boundSlopeChangePerReceiverAzimuth(whole, pyr, op.phi, nullptr, 0.0f, wholeBound);
         CHECK(bound == wholeBound);
         CHECK(*std::max_element(bound.begin(), bound.end()) > 0.0f);
+    }
+    // a floor: the walks stop early and charge their tails, never below the whole walk nor above the floor more
+    for (float floor : {1e-3f, 1e-2f, 1e-1f}) {
+        CAPTURE(floor);
+        std::vector<float> floored;
+        boundSlopeChangePerReceiverAzimuth(levels, pyr, op.phi, nullptr, floor, floored);
+        REQUIRE(floored.size() == bound.size());
+        int outside = 0, raised = 0;
+        for (std::size_t i = 0; i < bound.size(); ++i) {
+            outside += floored[i] < bound[i] || floored[i] > std::max(bound[i], floor) ? 1 : 0;
+            raised += floored[i] > bound[i] ? 1 : 0;
+        }
+        CHECK(outside == 0);
+        if (floor >= 0.1f) CHECK(raised > 0);  // a 7 m spike moves every slope by more than the smaller ones
     }
     // tiles of 16 receivers, every other one dirty
     ReceiverTiles only;
     only.reset(pyr.nxr, pyr.nyr, 16, false);
     for (int t = 0; t < only.tilesX * only.tilesY; t += 2) only.dirty[static_cast<std::size_t>(t)] = 1;
     std::vector<float> restricted;
-    boundSlopeChangePerReceiverAzimuth(levels, pyr, op.phi, &only, restricted);
+    boundSlopeChangePerReceiverAzimuth(levels, pyr, op.phi, &only, 0.0f, restricted);
     REQUIRE(restricted.size() == bound.size());
     int mismatched = 0;
     for (std::size_t i = 0; i < bound.size(); ++i) {
@@ -261,7 +288,7 @@ TEST_CASE(
     CHECK(mismatched == 0);
     HeightPyramid other;
     buildHeightPyramid(terrainOf(60, 40).cview(), kCell, 2, PyramidSettings{}, other);
-    CHECK_THROWS_AS(boundSlopeChangePerReceiverAzimuth(levels, other, op.phi, nullptr, bound), InputError);
+    CHECK_THROWS_AS(boundSlopeChangePerReceiverAzimuth(levels, other, op.phi, nullptr, 0.0f, bound), InputError);
     MaxChangePyramid small;
     buildMaxChangePyramid(terrainOf(30, 30).cview(), small);
     CHECK_THROWS_AS(buildChangeLevels(small, pyr, levels), InputError);
