@@ -309,15 +309,16 @@ void measureFrame(Track& t, const gi::GiSettings& settings, float cell, float to
     const IndirectBounds ib = indirectBounds(t.now, t.last, settings.indirect.azimuths);
     t.indirectSampleBound.insert(t.indirectSampleBound.end(), ib.sampleMove.begin(), ib.sampleMove.end());
     t.indirectBound.insert(t.indirectBound.end(), ib.bound.begin(), ib.bound.end());
-    t.bound.insert(t.bound.end(), cache.drift.lastExcursion.begin(), cache.drift.lastExcursion.end());
+    t.bound.insert(t.bound.end(), cache.envBound.begin(), cache.envBound.end());
     t.vChange.insert(t.vChange.end(), v.begin(), v.end());
     t.indirectChange.insert(t.indirectChange.end(), ind.begin(), ind.end());
 }
 
 const char* kIntro =
     "Full GI frames (2x, one bounce, uniform unit sky: shade units are the tolerance's, 2 threads), consecutive "
-    "frames compared per visibility tile (32 x 32 receivers). One-frame V bound: the drift "
-    "gi/visibility_cache.h adds for the frame (environment, per azimuth, V alone). True change of the cached V: "
+    "frames compared per visibility tile (32 x 32 receivers). One-frame V bound: the bound "
+    "gi/visibility_cache.h takes over the visibility tile (environment, per azimuth, V alone) before it refines it per "
+    "receiver where it passes the tolerance. True change of the cached V: "
     "the SH ambient map at the new normals shaded with the last frame's V against the one shaded with the new V "
     "(the frame's own ambient map is the exact one, which does not read V), largest over the tile's "
     "texels. Largest radiance sample move: the largest over the indirect azimuths of the samples' moves "

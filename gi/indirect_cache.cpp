@@ -26,7 +26,7 @@ bool cacheFits(const IndirectPlanInputs& in, const IndirectCache& cache) {
            last.nx == h.nx && last.ny == h.ny && in.source[0].nx == h.nx && in.source[0].ny == h.ny &&
            cache.tiles.nxr == h.nxr && cache.tiles.nyr == h.nyr && cache.drift.fits(cache.tiles.dirty.size()) &&
            (!in.geometryTiles || (in.geometryTiles->nxr == h.nxr && in.geometryTiles->nyr == h.nyr &&
-                                  in.geometryTiles->tileSize == kVisibilityTile));
+                                  in.geometryTiles->tileSize == kIndirectTile));
 }
 
 // The last pass kept the occlusions of this grid (sub-sampling).
@@ -307,17 +307,9 @@ const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCac
         return nullptr;
     }
     boundRadianceChange(in, cache);
-    std::span<const std::uint8_t> geometry;
-    if (in.geometryTiles) {
-        // each geometry tile's dirty flag on the indirect tiles it holds
-        const ReceiverTiles& g = *in.geometryTiles;
-        cache.geometry.resize(cache.tiles.dirty.size());
-        for (int ty = 0; ty < cache.tiles.tilesY; ++ty)
-            for (int tx = 0; tx < cache.tiles.tilesX; ++tx)
-                cache.geometry[static_cast<std::size_t>(ty) * cache.tiles.tilesX + tx] =
-                    g.dirty[visibilityTileHolding(tx, ty, g.nxr)];
-        geometry = cache.geometry;
-    }
+    // the geometry tiles are the indirect tiles (cacheFits)
+    const std::span<const std::uint8_t> geometry =
+        in.geometryTiles ? std::span<const std::uint8_t>(in.geometryTiles->dirty) : std::span<const std::uint8_t>{};
     if (planAnchoredDrift(cache.radianceBound, geometry, in.tolerance, cache.drift, cache.tiles.dirty)) {
         // L_0 equals the anchor's outside anchorChanged: copy its rows
         for (std::size_t c = 0; c < 3; ++c)

@@ -42,11 +42,12 @@
 //    tolerance (else the tile re-gathers), so the factor is that largest
 //    O(x) plus the tolerance, at most 1. Without sub-sampling (every texel a
 //    receiver, no texel occlusion kept) the bound is max_j D_j.
-//  - the geometry within reach: the tiles in a visibility tile whose
-//    geometry drifted beyond the tolerance this frame
-//    (VisibilityCache::geometryTiles, the bound over every azimuth, so it
-//    covers the indirect azimuths): their casting sets have drifted beyond
-//    the tolerance in the ambient map's units.
+//  - the geometry within reach: the tiles whose geometry drifted beyond the
+//    tolerance this frame (VisibilityCache::geometryTiles, the visibility
+//    cache's tiles, which are these: the bound over every azimuth, or along
+//    the environment's when the indirect scan takes those, so it covers the
+//    indirect azimuths): their casting sets have drifted beyond the
+//    tolerance in the ambient map's units.
 // Tolerance 0 re-gathers every tile where either bound is not 0, which gives
 // the full recompute bit for bit. More than one bounce, or another strategy:
 // every receiver (no per-bounce cache).
@@ -89,6 +90,7 @@ namespace terrain::gi {
 inline constexpr int kIndirectTile = 16;
 static_assert(kVisibilityTile % kIndirectTile == 0 && kIndirectTile % ReceiverTiles::kTileAlign == 0,
               "indirect tiles split visibility tiles into whole receiver groups");
+static_assert(kIndirectTile == kCacheTile, "the visibility cache's geometry tiles are the indirect tiles");
 
 /// The visibility tile (its row-major index over nxr receivers) holding indirect tile (tx, ty).
 inline std::size_t visibilityTileHolding(int tx, int ty, int nxr) {
@@ -123,14 +125,13 @@ struct IndirectCache {
     // (shareEnvelopeStale: not yet taken since)
     std::vector<float> shareEnvelope;
     std::vector<std::uint8_t> shareEnvelopeStale;
-    ReceiverTiles tiles;                 // this frame's tiles to re-gather
-    std::vector<std::uint8_t> geometry;  // scratch: the geometry tiles' flags on these tiles
-    ReceiverTiles texels;                // this frame's tiles whose receivers' occlusion the texel passes redo
-    TexelRuns texelRuns;                 // and the texels they redo
-    std::vector<TexelRect> texelRects;   // their scratch
-    std::uint64_t geometryVersion = 0;   // GiState::geometryVersion of the last pass
-    PlanSkips skips;                     // frames that re-gather everything unplanned
-    bool hadAlbedo = false;              // the last pass's albedo channels (empty: 1)
+    ReceiverTiles tiles;                // this frame's tiles to re-gather
+    ReceiverTiles texels;               // this frame's tiles whose receivers' occlusion the texel passes redo
+    TexelRuns texelRuns;                // and the texels they redo
+    std::vector<TexelRect> texelRects;  // their scratch
+    std::uint64_t geometryVersion = 0;  // GiState::geometryVersion of the last pass
+    PlanSkips skips;                    // frames that re-gather everything unplanned
+    bool hadAlbedo = false;             // the last pass's albedo channels (empty: 1)
     std::array<Grid, 3> lastAlbedo;
 };
 

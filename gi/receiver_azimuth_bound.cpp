@@ -32,7 +32,28 @@ namespace {
 // from which on no step's slope can move by more than the floor (each sample
 // and the receiver's own height moved by at most the largest |dh|, M: 2 M
 // over the step's length).
-void buildWalks(const HeightPyramid& b, std::span<const double> phi, float largest, float floor,
+// The texels of the field step i reads (a level on the receiver grid, or the
+// raw heights in cells) that are within reach of a cell of `cells`, the box
+// of non-zero |dh|: a level texel X (at cell s X) reads the cells within
+// levelReachCells of it. A box that reaches the field's edge takes the
+// padding beyond it too (replicated edges).
+CellBox changedTexels(const HeightPyramid& b, int level, const CellBox& cells) {
+    if (cells.empty()) return CellBox::none();
+    constexpr int kFar = 1 << 28;
+    const int s = level < 0 ? 1 : b.subsample, n[2] = {level < 0 ? b.nx : b.nxr, level < 0 ? b.ny : b.nyr};
+    const double reach = level < 0 ? 0.0 : levelReachCells(b, level);
+    const int lo[2] = {cells.x0, cells.y0}, hi[2] = {cells.x1, cells.y1};
+    int out[2][2];
+    for (int a = 0; a < 2; ++a) {
+        const int first = static_cast<int>(std::ceil((lo[a] - reach) / s));
+        const int last = static_cast<int>(std::floor((hi[a] - 1 + reach) / s));
+        out[a][0] = first <= 0 ? -kFar : first;
+        out[a][1] = last >= n[a] - 1 ? kFar : last + 1;
+    }
+    return {out[0][0], out[1][0], out[0][1], out[1][1]};
+}
+
+void buildWalks(const HeightPyramid& b, std::span<const double> phi, float largest, float floor, const CellBox& built,
                 std::vector<ChangeWalk>& walks, std::vector<float>& tail) {
     const std::size_t nSteps = b.steps.size();
     walks.resize(phi.size());
@@ -48,7 +69,18 @@ void buildWalks(const HeightPyramid& b, std::span<const double> phi, float large
             x1 = std::min(x1, info.xLast);
             y0 = std::max(y0, info.yFirst);
             y1 = std::min(y1, info.yLast);
-            steps[i] = {info.step, x0, x1, y0, y1};
+            const int level = b.steps[i].level;
+            steps[i] = {info.step,
+                        x0,
+                        x1,
+                        y0,
+                        y1,
+                        level < 0 ? b.subsample : 1,
+                        info.tapX,
+                        info.tapY,
+                        info.nextX,
+                        info.nextY,
+                        changedTexels(b, level, built)};
         }
         tail[nSteps] = 0.0f;  // tail[i]: the bound of steps i and on
         for (std::size_t i = nSteps; i-- > 0;)
@@ -62,13 +94,20 @@ void buildWalks(const HeightPyramid& b, std::span<const double> phi, float large
 
 // One receiver row's span [x0, x1) along one azimuth into o (the row of
 // out): the largest bound of its walked steps, at least the tail's.
+// `ownChange`: some receiver of the span may have a height change of its own
+// (else a step whose samples all read texels of zero |dh| bound adds 0).
 template <class V>
-[[gnu::always_inline]] inline void walkSpan(const ChangeWalk& walk, const float* dh0, int Y, int x0, int x1, float* o) {
+[[gnu::always_inline]] inline void walkSpan(const ChangeWalk& walk, const float* dh0, int Y, int x0, int x1,
+                                            bool ownChange, float* o) {
     for (int X = x0; X < x1; ++X) o[X] = walk.tail;
     for (const ChangeWalk::Step& bs : walk.steps) {
         const int a = std::max(x0, bs.x0), e = std::min(x1 - 1, bs.x1);
         // the valid ranges only shrink: once empty, for good
         if (Y < bs.y0 || Y > bs.y1 || a > e) break;
+        const int tx0 = bs.k * a + bs.tapX, tx1 = bs.k * e + bs.tapX + bs.nextX + 1;
+        const int ty0 = bs.k * Y + bs.tapY, ty1 = ty0 + bs.nextY + 1;
+        const CellBox& c = bs.changed;
+        if (!ownChange && (tx1 <= c.x0 || tx0 >= c.x1 || ty1 <= c.y0 || ty0 >= c.y1)) continue;
         const ScanStep& st = bs.step;
         const float* fa = st.field + st.offA + static_cast<std::ptrdiff_t>(Y) * st.rowStep;
         const float* fb = st.field + st.offB + static_cast<std::ptrdiff_t>(Y) * st.rowStep;
@@ -85,23 +124,34 @@ template <class V>
 
 // Every azimuth's walk over the row's spans; azimuth j's bounds go to the
 // row rows + j * stride (indexed by the receiver's column).
-using WalkRow = void (*)(const std::vector<ChangeWalk>&, std::span<const ColumnSpan>, const float*, int, float*,
+// `own`: the cells of non-zero |dh| (whose receivers may have a height
+// change of their own); s the sub-sampling.
+struct RowWalk {
+    const float* dh0;  // |dh| at the row's receivers' own cells
+    int Y, s;
+    CellBox own;
+};
+using WalkRow = void (*)(const std::vector<ChangeWalk>&, std::span<const ColumnSpan>, const RowWalk&, float*,
                          std::size_t);
 
 template <class V>
 [[gnu::always_inline]] inline void walkRowWith(const std::vector<ChangeWalk>& walks, std::span<const ColumnSpan> spans,
-                                               const float* dh0, int Y, float* rows, std::size_t stride) {
+                                               const RowWalk& r, float* rows, std::size_t stride) {
+    const bool ownRow = r.s * r.Y >= r.own.y0 && r.s * r.Y < r.own.y1;
     for (std::size_t j = 0; j < walks.size(); ++j)
-        for (const ColumnSpan& span : spans) walkSpan<V>(walks[j], dh0, Y, span.x0, span.x1, rows + j * stride);
+        for (const ColumnSpan& span : spans) {
+            const bool own = ownRow && r.s * (span.x1 - 1) >= r.own.x0 && r.s * span.x0 < r.own.x1;
+            walkSpan<V>(walks[j], r.dh0, r.Y, span.x0, span.x1, own, rows + j * stride);
+        }
 }
-void walkRowSse(const std::vector<ChangeWalk>& walks, std::span<const ColumnSpan> spans, const float* dh0, int Y,
-                float* rows, std::size_t stride) {
-    walkRowWith<simd::F4>(walks, spans, dh0, Y, rows, stride);
+void walkRowSse(const std::vector<ChangeWalk>& walks, std::span<const ColumnSpan> spans, const RowWalk& r, float* rows,
+                std::size_t stride) {
+    walkRowWith<simd::F4>(walks, spans, r, rows, stride);
 }
 [[gnu::target("avx2"), gnu::flatten]] void walkRowAvx2(const std::vector<ChangeWalk>& walks,
-                                                       std::span<const ColumnSpan> spans, const float* dh0, int Y,
-                                                       float* rows, std::size_t stride) {
-    walkRowWith<simd::F8>(walks, spans, dh0, Y, rows, stride);
+                                                       std::span<const ColumnSpan> spans, const RowWalk& r, float* rows,
+                                                       std::size_t stride) {
+    walkRowWith<simd::F8>(walks, spans, r, rows, stride);
 }
 
 // The walks of `levels` over the receivers of `only`'s dirty tiles: calls
@@ -114,7 +164,7 @@ void forEachWalkedRow(ChangeLevels& levels, const HeightPyramid& pyr, std::span<
     if (!levels.valid || b.nx != pyr.nx || b.ny != pyr.ny || b.nxr != pyr.nxr || b.nyr != pyr.nyr ||
         b.steps.size() != pyr.steps.size())
         throw InputError("receiver azimuth bound: the change levels were not built for this pyramid");
-    buildWalks(b, phi, levels.largest, std::max(floor, 0.0f), levels.walks, levels.tails);
+    buildWalks(b, phi, levels.largest, std::max(floor, 0.0f), levels.built, levels.walks, levels.tails);
     const std::vector<ChangeWalk>& walks = levels.walks;
     const DirtySpans& spans = levels.spans;
     dirtySpans(only, b.nxr, b.nyr, levels.spans);
@@ -124,8 +174,8 @@ void forEachWalkedRow(ChangeLevels& levels, const HeightPyramid& pyr, std::span<
             const std::span<const ColumnSpan> rowSpans = spans.ofRow(Y);
             if (rowSpans.empty()) continue;
             // |dh| at the receivers' own cells: raw phase 0 of row s Y
-            const float* dh0 = b.rawPhaseRow(0, b.subsample * Y);
-            row(Y, rowSpans, [&](float* rows, std::size_t stride) { walkRow(walks, rowSpans, dh0, Y, rows, stride); });
+            const RowWalk r{b.rawPhaseRow(0, b.subsample * Y), Y, b.subsample, levels.built};
+            row(Y, rowSpans, [&](float* rows, std::size_t stride) { walkRow(walks, rowSpans, r, rows, stride); });
         }
     });
 }
@@ -142,27 +192,87 @@ void boundSlopeChangePerReceiverAzimuth(ChangeLevels& levels, const HeightPyrami
     });
 }
 
+namespace {
+
+// gradientBoundOfTile for a tile of one receiver, from a receiver row's
+// column maxima: its footprint's cells (offsets up to s / 2, clamped to the
+// field) dilated by one cell, a border footprint counting twice.
+struct FootprintRows {
+    int y0, y1;   // the dilated footprint's rows, clamped (inclusive)
+    bool border;  // the footprint itself reaches the first or the last row
+};
+FootprintRows footprintRows(const HeightPyramid& pyr, int Y) {
+    const int half = pyr.subsample / 2, c = pyr.subsample * Y;
+    const int y0 = std::max(c - half, 0), y1 = std::min(c + half, pyr.ny - 1);
+    return {std::max(y0 - 1, 0), std::min(y1 + 1, pyr.ny - 1), y0 == 0 || y1 == pyr.ny - 1};
+}
+
+// `columns` holds, for the cell columns the span's footprints reach, the
+// largest |dh| over the rows (filled at the span's first receiver).
+float footprintGradientBound(const MaxChangePyramid& dh, const HeightPyramid& pyr, const FootprintRows& rows, int X,
+                             const ColumnSpan& span, float* columns) {
+    const int half = pyr.subsample / 2, s = pyr.subsample;
+    const auto cellsOf = [&](int R, int& a, int& b) {
+        a = std::max(s * R - half, 0);
+        b = std::min(s * R + half, pyr.nx - 1);
+    };
+    const Grid& g = dh.levels[0];
+    if (X == span.x0) {
+        int a = 0, b = 0, c = 0, d = 0;
+        cellsOf(span.x0, a, b);
+        cellsOf(span.x1 - 1, c, d);
+        const int x0 = std::max(a - 1, 0), x1 = std::min(d + 1, pyr.nx - 1);
+        for (int x = x0; x <= x1; ++x) columns[x] = 0.0f;
+        for (int y = rows.y0; y <= rows.y1; ++y) {
+            const float* row = g.data() + static_cast<std::size_t>(y) * g.nx;
+            for (int x = x0; x <= x1; ++x) columns[x] = std::max(columns[x], row[x]);
+        }
+    }
+    int a = 0, b = 0;
+    cellsOf(X, a, b);
+    const bool border = rows.border || a == 0 || b == pyr.nx - 1;
+    float m = 0.0f;
+    for (int x = std::max(a - 1, 0); x <= std::min(b + 1, pyr.nx - 1); ++x) m = std::max(m, columns[x]);
+    return floatNotBelow((border ? 2.0 : 1.0) * m / pyr.cellSize);
+}
+
+}  // namespace
+
 void boundEnvironmentPerReceiver(ChangeLevels& levels, const MaxChangePyramid& dh, const HeightPyramid& pyr,
                                  std::span<const double> phi, float lipschitz, const ReceiverTiles* only, float floor,
-                                 std::vector<float>& out) {
+                                 std::vector<float>& out, int subsetStride, std::vector<float>* subsetOut) {
     const int nxr = pyr.nxr, m = static_cast<int>(phi.size());
-    out.assign(static_cast<std::size_t>(nxr) * pyr.nyr, 0.0f);
     if (m < 1) throw InputError("boundEnvironmentPerReceiver: at least one azimuth");
+    if (subsetOut && (subsetStride < 1 || m % subsetStride != 0))
+        throw InputError("boundEnvironmentPerReceiver: the subset's stride must divide the azimuths");
+    const std::size_t planeR = static_cast<std::size_t>(nxr) * pyr.nyr;
+    out.assign(planeR, 0.0f);
+    if (subsetOut) subsetOut->assign(planeR, 0.0f);
     if (levels.largest == 0.0f && levels.valid) return;  // no height changed
-    // per worker slot: a row's slope bounds per azimuth, then one receiver's
+    // per worker slot: a row's slope bounds per azimuth, one receiver's, and
+    // the row's largest |dh| per cell column over its footprints' rows
+    const std::size_t slopesSize = static_cast<std::size_t>(m) * (nxr + 1);
     levels.rows.resize(static_cast<std::size_t>(workerSlots()));
-    for (std::vector<float>& r : levels.rows) r.resize(static_cast<std::size_t>(m) * (nxr + 1));
+    for (std::vector<float>& r : levels.rows) r.resize(slopesSize + static_cast<std::size_t>(pyr.nx));
     forEachWalkedRow(levels, pyr, phi, only, floor, [&](int Y, std::span<const ColumnSpan> spans, auto&& walk) {
         float* slopes = levels.rows[static_cast<std::size_t>(workerSlot())].data();
         float* perAzimuth = slopes + static_cast<std::size_t>(m) * nxr;
+        float* columns = slopes + slopesSize;
         walk(slopes, static_cast<std::size_t>(nxr));
+        const FootprintRows rows = footprintRows(pyr, Y);
         for (const ColumnSpan& span : spans)
             for (int X = span.x0; X < span.x1; ++X) {
+                const std::size_t r = static_cast<std::size_t>(Y) * nxr + static_cast<std::size_t>(X);
+                const float gradient = footprintGradientBound(dh, pyr, rows, X, span, columns);
                 for (int j = 0; j < m; ++j)
                     perAzimuth[static_cast<std::size_t>(j)] =
                         lipschitz * slopes[static_cast<std::size_t>(j) * nxr + static_cast<std::size_t>(X)];
-                out[static_cast<std::size_t>(Y) * nxr + X] =
-                    ambientChangeBoundPerAzimuth(perAzimuth, m, gradientBoundOfTile(dh, pyr, 1, X, Y), 1.0f, false);
+                out[r] = ambientChangeBoundPerAzimuth(perAzimuth, m, gradient, 1.0f, false);
+                if (!subsetOut) continue;
+                // every subsetStride-th azimuth, gathered to the front
+                for (int k = 0; k < m / subsetStride; ++k)
+                    perAzimuth[static_cast<std::size_t>(k)] = perAzimuth[static_cast<std::size_t>(k * subsetStride)];
+                (*subsetOut)[r] = ambientChangeBoundPerAzimuth(perAzimuth, m / subsetStride, gradient, 1.0f, false);
             }
     });
 }

@@ -41,6 +41,10 @@ struct ChangeWalk {
     struct Step {
         ScanStep step;
         int x0 = 0, x1 = -1, y0 = 0, y1 = -1;
+        // the first tap of receiver (X, Y) at texel (k X + tapX, k Y + tapY)
+        // of its field, the second one (nextX, nextY) further (ScanStepInfo)
+        int k = 1, tapX = 0, tapY = 0, nextX = 0, nextY = 0;
+        CellBox changed;  // the field's texels whose |dh| bound may not be 0
     };
     std::vector<Step> steps;
     float tail = 0.0f;
@@ -85,9 +89,13 @@ void boundSlopeChangePerReceiverAzimuth(ChangeLevels& levels, const HeightPyrami
 /// maximum's Lipschitz factor, and the gradient bound of the receiver's own
 /// footprint (gradientBoundOfTile with tiles of one receiver, from dh: the
 /// |dh| the levels were built from). With `only`, the receivers of its
-/// dirty tiles alone; the others get 0. `floor` as above.
+/// dirty tiles alone; the others get 0. `floor` as above. With subsetOut,
+/// also the same bound over the azimuths j = 0, k, 2k, ... alone (k =
+/// subsetStride, a divisor of their count): what another scan that takes
+/// every k-th of these azimuths reads (the indirect light's).
 void boundEnvironmentPerReceiver(ChangeLevels& levels, const MaxChangePyramid& dh, const HeightPyramid& pyr,
                                  std::span<const double> phi, float lipschitz, const ReceiverTiles* only, float floor,
-                                 std::vector<float>& out);
+                                 std::vector<float>& out, int subsetStride = 0,
+                                 std::vector<float>* subsetOut = nullptr);
 
 }  // namespace terrain::gi

@@ -4,13 +4,14 @@
 #include <limits>
 
 #include "core/error.h"
+#include "gi/sh.h"
 
 namespace terrain::gi {
 
 void resetVisibilityCache(const HeightPyramid& pyr, ConstGridView heights, VisibilityCache& cache) {
-    cache.tiles.reset(pyr.nxr, pyr.nyr, kVisibilityTile, true);
-    cache.keyTiles.reset(pyr.nxr, pyr.nyr, kVisibilityTile, true);
-    cache.geometryTiles.reset(pyr.nxr, pyr.nyr, kVisibilityTile, true);
+    cache.tiles.reset(pyr.nxr, pyr.nyr, kCacheTile, true);
+    cache.keyTiles.reset(pyr.nxr, pyr.nyr, kCacheTile, true);
+    cache.geometryTiles.reset(pyr.nxr, pyr.nyr, kCacheTile, true);
     cache.drift.reset(cache.tiles.dirty.size());
     cache.keyDrift.reset(cache.tiles.dirty.size());
     cache.geometryDrift.reset(cache.tiles.dirty.size());
@@ -76,9 +77,73 @@ void geometryBoundPerTile(std::span<const float> slopeBound, std::span<const flo
         out[t] = ambientChangeBound(lipschitz * slopeBound[t], gradBound[t], 1.0f, false);
 }
 
+namespace {
+
+// Each cache tile's value of `perTile` (one per visibility tile) into out.
+void onCacheTiles(const std::vector<float>& perTile, const ReceiverTiles& tiles, std::vector<float>& out) {
+    constexpr int kPer = kVisibilityTile / kCacheTile;
+    const int visibilityX = tileCount(tiles.nxr, kVisibilityTile);
+    out.resize(tiles.dirty.size());
+    for (int ty = 0; ty < tiles.tilesY; ++ty)
+        for (int tx = 0; tx < tiles.tilesX; ++tx)
+            out[static_cast<std::size_t>(ty) * tiles.tilesX + tx] =
+                perTile[static_cast<std::size_t>(ty / kPer) * visibilityX + tx / kPer];
+}
+
+// The environment's ambient-map excursions of the cache tiles that they and
+// their drift would recompute, and the geometry's where the indirect scan
+// takes every k-th of the environment's azimuths (geometryStride k; 0:
+// not), each lowered to the largest of its receivers' own bounds where that
+// is smaller (gi/receiver_azimuth_bound.h); the others keep their
+// visibility tile's. The receivers' walks stop where no step can add more
+// than a sixteenth of the tolerance (tolerance 0: where no step sees a
+// change).
+void refinePerReceiver(const HeightPyramid& pyr, const VisibilitySettings& vis, float lipschitz, float tolerance,
+                       int geometryStride, VisibilityCache& cache) {
+    ReceiverTiles& refined = cache.refined;
+    refined.reset(pyr.nxr, pyr.nyr, kCacheTile, false);
+    bool any = false;
+    for (std::size_t t = 0; t < refined.dirty.size(); ++t) {
+        const bool env = cache.drift.fromAnchor[t] + cache.envExcursion[t] > tolerance;
+        const bool geo =
+            geometryStride > 0 && cache.geometryDrift.fromAnchor[t] + cache.geometryExcursion[t] > tolerance;
+        refined.dirty[t] = env || geo ? 1 : 0;
+        any = any || env || geo;
+    }
+    if (!any) return;
+    // the environment's scan's azimuths, as foldFullCircle takes them
+    const double dphi = 2.0 * kPi / vis.azimuths;
+    cache.azimuths.resize(static_cast<std::size_t>(vis.azimuths));
+    for (int j = 0; j < vis.azimuths; ++j) cache.azimuths[static_cast<std::size_t>(j)] = dphi * j;
+    // a uniform slope bound f on every azimuth adds kShadePerSlope lipschitz f to the ambient's
+    const float floor = tolerance / (16.0f * kShadePerSlope * lipschitz);
+    buildChangeLevels(cache.change, pyr, cache.receiverLevels);
+    boundEnvironmentPerReceiver(cache.receiverLevels, cache.change, pyr, cache.azimuths, lipschitz, &refined, floor,
+                                cache.receiverBound, geometryStride,
+                                geometryStride > 0 ? &cache.receiverGeometry : nullptr);
+    const auto largestIn = [&](const std::vector<float>& bound, int tx, int ty) {
+        float largest = 0.0f;
+        for (int Y = ty * kCacheTile; Y < std::min(pyr.nyr, (ty + 1) * kCacheTile); ++Y)
+            for (int X = tx * kCacheTile; X < std::min(pyr.nxr, (tx + 1) * kCacheTile); ++X)
+                largest = std::max(largest, bound[static_cast<std::size_t>(Y) * pyr.nxr + X]);
+        return largest;
+    };
+    for (int ty = 0; ty < refined.tilesY; ++ty)
+        for (int tx = 0; tx < refined.tilesX; ++tx) {
+            const std::size_t t = static_cast<std::size_t>(ty) * refined.tilesX + tx;
+            if (!refined.dirty[t]) continue;
+            cache.envExcursion[t] = std::min(cache.envExcursion[t], largestIn(cache.receiverBound, tx, ty));
+            if (geometryStride > 0)
+                cache.geometryExcursion[t] =
+                    std::min(cache.geometryExcursion[t], largestIn(cache.receiverGeometry, tx, ty));
+        }
+}
+
+}  // namespace
+
 void planVisibilityTiles(ConstGridView before, ConstGridView after, const HeightPyramid& pyr,
                          const VisibilitySettings& vis, const std::vector<KeyLightRegion>& keys, float tolerance,
-                         VisibilityCache& cache, CellBox sinceBefore) {
+                         VisibilityCache& cache, CellBox sinceBefore, int indirectAzimuths) {
     if (cache.tiles.nxr != pyr.nxr || cache.tiles.nyr != pyr.nyr || !cache.drift.fits(cache.tiles.dirty.size()) ||
         cache.anchorHeights.nx != after.nx || cache.anchorHeights.ny != after.ny)
         resetVisibilityCache(pyr, before, cache);
@@ -100,22 +165,28 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
     environmentBoundPerTile(cache.azimuthBound, cache.gradBound, vis.azimuths, lipschitz, cache.tileAzimuths,
                             cache.envBound);
     geometryBoundPerTile(cache.slopeBound, cache.gradBound, lipschitz, cache.geometryBound);
+    onCacheTiles(cache.envBound, cache.tiles, cache.envExcursion);
+    onCacheTiles(cache.keyBound, cache.tiles, cache.keyExcursion);
+    onCacheTiles(cache.geometryBound, cache.tiles, cache.geometryExcursion);
+    const bool subset = indirectAzimuths > 0 && vis.azimuths % indirectAzimuths == 0;
+    refinePerReceiver(pyr, vis, lipschitz, tolerance, subset ? vis.azimuths / indirectAzimuths : 0, cache);
     // one anchor for the three drifts: they vote together on moving it
     AnchorVotes votes;
-    markAnchoredDrift(cache.envBound, {}, 1.0f, tolerance, cache.drift, cache.tiles.dirty, votes);
-    markAnchoredDrift(cache.keyBound, {}, keyShadePerFraction(keys), tolerance, cache.keyDrift, cache.keyTiles.dirty,
+    markAnchoredDrift(cache.envExcursion, {}, 1.0f, tolerance, cache.drift, cache.tiles.dirty, votes);
+    markAnchoredDrift(cache.keyExcursion, {}, keyShadePerFraction(keys), tolerance, cache.keyDrift,
+                      cache.keyTiles.dirty, votes);
+    markAnchoredDrift(cache.geometryExcursion, {}, 1.0f, tolerance, cache.geometryDrift, cache.geometryTiles.dirty,
                       votes);
-    markAnchoredDrift(cache.geometryBound, {}, 1.0f, tolerance, cache.geometryDrift, cache.geometryTiles.dirty, votes);
     const bool reanchor = votes.reanchor();
-    advanceAnchoredDrift(cache.envBound, cache.tiles.dirty, reanchor, cache.drift);
-    advanceAnchoredDrift(cache.keyBound, cache.keyTiles.dirty, reanchor, cache.keyDrift);
-    advanceAnchoredDrift(cache.geometryBound, cache.geometryTiles.dirty, reanchor, cache.geometryDrift);
+    advanceAnchoredDrift(cache.envExcursion, cache.tiles.dirty, reanchor, cache.drift);
+    advanceAnchoredDrift(cache.keyExcursion, cache.keyTiles.dirty, reanchor, cache.keyDrift);
+    advanceAnchoredDrift(cache.geometryExcursion, cache.geometryTiles.dirty, reanchor, cache.geometryDrift);
     // the anchor becomes `after`, which differs from `before` within
     // sinceBefore; else it differs from `before` and from `after` (the
     // next plan's `before`, if this frame is recorded) within mayDiffer
     if (reanchor) copyGrid(after, cache.anchorHeights, differing.rows());
     cache.anchorDiffers = reanchor ? sinceBefore : mayDiffer;
-    const int all = static_cast<int>(cache.slopeBound.size());
+    const int all = static_cast<int>(cache.tiles.dirty.size());
     // the indirect light re-gathers the geometry's dirty tiles: both count
     countAfterPlan(std::min(cache.tiles.dirtyCount(), cache.geometryTiles.dirtyCount()), all, cache.skips);
 }

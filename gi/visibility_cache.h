@@ -2,7 +2,7 @@
 // Which receiver tiles must recompute their visibility after the heights
 // changed (the frame's one place for it; the scans only take the tiles).
 //
-// Per tile of kVisibilityTile x kVisibilityTile receivers the cache keeps how
+// Per tile of kCacheTile x kCacheTile receivers the cache keeps how
 // far its cached V can have drifted since it was computed, from an anchor
 // (gi/anchored_drift.h: the heights of an earlier frame): each frame with new
 // heights takes the conservative bounds (gi/change_bound.h) of the change
@@ -29,7 +29,9 @@
 // shaded through SH (the paper's settings) recomputes every tile whose bound
 // is not 0, where its order-4 product has no such bound. The geometry
 // tiles (geometryTiles) do the same with the bound over every azimuth: what
-// the indirect light's casting sets may have moved (gi/indirect_cache.h).
+// the indirect light's casting sets may have moved (gi/indirect_cache.h);
+// where the indirect scan takes every k-th of the environment's azimuths,
+// refined per receiver with the same bound over those azimuths alone.
 #include <span>
 #include <vector>
 
@@ -38,13 +40,26 @@
 #include "gi/change_bound.h"
 #include "gi/plan_skips.h"
 #include "gi/pyramid.h"
+#include "gi/receiver_azimuth_bound.h"
 #include "gi/receiver_tiles.h"
 #include "gi/visibility.h"
 
 namespace terrain::gi {
 
-/// Receivers per side of a visibility tile (a multiple of ReceiverTiles::kTileAlign).
+/// Receivers per side of a visibility tile, over which the bounds are taken
+/// (a multiple of ReceiverTiles::kTileAlign).
 inline constexpr int kVisibilityTile = 32;
+
+/// Receivers per side of the tiles whose V is kept or recomputed, each with
+/// its own drift: a quarter of a visibility tile. A tile takes its
+/// visibility tile's bound, and where that would recompute it, the largest
+/// of its receivers' own bounds (gi/receiver_azimuth_bound.h) if smaller:
+/// the box bounds cost little per tile and rule out most of the field, the
+/// receivers' bounds are precise where a change lies near (a tile's bound
+/// charges each receiver with the largest change within reach of any).
+inline constexpr int kCacheTile = 16;
+static_assert(kVisibilityTile % kCacheTile == 0 && kCacheTile % ReceiverTiles::kTileAlign == 0,
+              "cache tiles split visibility tiles into whole receiver groups");
 
 /// What a key light's cached visibility answers for: the azimuths [phi0,
 /// phi1] (radians) it reads and its window's sines (gi/lights.h,
@@ -58,20 +73,29 @@ struct KeyLightRegion {
 };
 
 struct VisibilityCache {
-    Grid anchorHeights;                        // the heights the drifts are measured from
-    CellBox anchorDiffers;                     // holds every cell where they may differ from the last plan's (all)
-    MaxChangePyramid change;                   // |dh| from the anchor to this frame
-    std::vector<float> slopeBound, gradBound;  // this frame's bounds per tile (all azimuths)
-    std::vector<float> azimuthBound;           // per tile and environment azimuth (tile-major)
-    std::vector<float> keyBound, rangeBound;   // per tile: the key lights' fraction bound; scratch: one light's slopes
-    std::vector<float> envBound, geometryBound;  // per tile: the ambient-map bound (environment, every azimuth)
-    AnchoredDrift drift, keyDrift;               // per tile: ambient-map (key: visible-fraction) change
-    AnchoredDrift geometryDrift;                 // per tile: the same over every azimuth
+    Grid anchorHeights;       // the heights the drifts are measured from
+    CellBox anchorDiffers;    // holds every cell where they may differ from the last plan's (all)
+    MaxChangePyramid change;  // |dh| from the anchor to this frame
+    // this frame's bounds per visibility tile (kVisibilityTile)
+    std::vector<float> slopeBound, gradBound;    // all azimuths
+    std::vector<float> azimuthBound;             // per tile and environment azimuth (tile-major)
+    std::vector<float> keyBound, rangeBound;     // the key lights' fraction bound; scratch: one light's slopes
+    std::vector<float> envBound, geometryBound;  // the ambient-map bound (environment, every azimuth)
     std::vector<float> tileAzimuths;             // scratch: one tile's per-azimuth slope bounds
-    ReceiverTiles tiles;                         // this frame's tiles to recompute (environment)
-    ReceiverTiles keyTiles;                      // the same for the key lights
-    ReceiverTiles geometryTiles;                 // tiles whose geometry moved beyond the tolerance along any azimuth
-    PlanSkips skips;                             // frames that recompute everything unplanned
+    // this frame's bounds per cache tile (kCacheTile): their visibility
+    // tile's, refined per receiver where those pass the tolerance
+    std::vector<float> envExcursion, keyExcursion, geometryExcursion;
+    ChangeLevels receiverLevels;          // the |dh| pyramid of the receivers' bounds
+    std::vector<double> azimuths;         // the environment's azimuths (radians) they are taken along
+    std::vector<float> receiverBound;     // per receiver: the ambient-map bound (refined tiles only)
+    std::vector<float> receiverGeometry;  // the same along the indirect scan's azimuths
+    ReceiverTiles refined;                // scratch: the cache tiles refined this frame
+    AnchoredDrift drift, keyDrift;        // per cache tile: ambient-map (key: visible-fraction) change
+    AnchoredDrift geometryDrift;          // per cache tile: the same along the indirect light's azimuths
+    ReceiverTiles tiles;                  // this frame's cache tiles to recompute (environment)
+    ReceiverTiles keyTiles;               // the same for the key lights
+    ReceiverTiles geometryTiles;          // cache tiles whose geometry moved beyond the tolerance
+    PlanSkips skips;                      // frames that recompute everything unplanned
 };
 
 /// A frame whose heights did not change but whose lights did: marks the key
@@ -113,12 +137,14 @@ void geometryBoundPerTile(std::span<const float> slopeBound, std::span<const flo
 /// whose drift exceeds `tolerance`: cache.tiles for the environment's V
 /// (`vis`: its azimuths and maximum rule), cache.keyTiles for the key lights'
 /// (one region per light; none: no key tile), cache.geometryTiles over every
-/// azimuth. `before`: the last frame's heights, the anchor when the cache
-/// starts afresh (no drift of this grid); `sinceBefore` holds every cell
-/// where `after` differs from them (every cell by default). `pyr` is the
-/// pyramid of `after`.
+/// azimuth, refined per receiver along the indirect scan's
+/// `indirectAzimuths` when those are every k-th of the environment's (0:
+/// not known). `before`: the last frame's heights, the anchor when the
+/// cache starts afresh (no drift of this grid); `sinceBefore` holds every
+/// cell where `after` differs from them (every cell by default). `pyr` is
+/// the pyramid of `after`.
 void planVisibilityTiles(ConstGridView before, ConstGridView after, const HeightPyramid& pyr,
                          const VisibilitySettings& vis, const std::vector<KeyLightRegion>& keys, float tolerance,
-                         VisibilityCache& cache, CellBox sinceBefore = {});
+                         VisibilityCache& cache, CellBox sinceBefore = {}, int indirectAzimuths = 0);
 
 }  // namespace terrain::gi

@@ -450,6 +450,7 @@ TEST_CASE("gi.change_bound: tile bounds hold for the engine's slopes and ambient
         GiSettings settings = cfg.paper ? paperGiSettings() : GiSettings{};
         settings.subsample = cfg.subsample;
         settings.indirect.bounces = 0;
+        settings.incremental = false;  // every frame's slopes the true ones
         const float lipschitz = blockingMaxLipschitz(settings.visibility.blockingMax);
         const Grid base = baseTerrain(cfg.nx, cfg.ny);
         GiState before, after;
@@ -545,6 +546,8 @@ TEST_CASE("gi.change_bound: azimuth-range bounds hold for a key light's slopes a
             GiSettings settings = cfg.paper ? paperGiSettings() : GiSettings{};
             settings.subsample = cfg.subsample;
             settings.indirect.bounces = 0;
+            settings.incremental = false;  // every frame's slopes the true ones
+        settings.incremental = false;  // every frame's slopes the true ones
             GiLighting light;
             KeyLight key;
             key.azimuthDeg = azimuths[k];

@@ -150,8 +150,15 @@ TEST_CASE("gi.frame_change: a crater recomputes the tiles within its reach, with
         MESSAGE("largest ambient difference from the full frame " << worst);
         CHECK(worst <= settings.tolerance);
         // the crater's own tile is among the recomputed ones: its floor sees the walls
-        const int r = 128 / s / kVisibilityTile;
+        const int r = 128 / s / inc.visibilityCache.tiles.tileSize;
         CHECK(inc.visibilityCache.tiles.isDirty(r, r));
+        // per receiver the bound keeps more than the visibility tiles' alone would
+        const VisibilityCache& vc = inc.visibilityCache;
+        double coarse = 0.0;
+        for (float b : vc.envBound) coarse += b > tolerance ? 1.0 : 0.0;
+        coarse /= static_cast<double>(vc.envBound.size());
+        MESSAGE("visibility tiles' bounds alone: " << 100.0 * coarse << " % of the receivers");
+        CHECK(inc.receiversRecomputed < coarse);
         if (tolerance > 0.02f) continue;
         // looseness: each tile's one-frame bound (its drift before any reset: the
         // key lights' full-circle form, the environment's per azimuth) over the

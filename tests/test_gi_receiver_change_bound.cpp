@@ -165,6 +165,7 @@ TEST_CASE("gi.receiver_azimuth_bound: bounds every receiver's slope change along
         GiSettings settings = c.paper ? paperGiSettings() : GiSettings{};
         settings.subsample = c.subsample;
         settings.indirect.bounces = 0;
+        settings.incremental = false;  // every frame's slopes the true ones
         const float lipschitz = blockingMaxLipschitz(settings.visibility.blockingMax);
         const Grid base = terrainOf(c.nx, c.ny);
         GiState before, after;
