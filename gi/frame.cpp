@@ -463,9 +463,10 @@ GeometryPlan planGeometry(ConstGridView heights, const GiLighting& lighting, con
     plan.tiled = change.heightsOnly && !st.lastInputs.heights.empty() && shouldPlanTiles(st.visibilityCache);
     if (plan.tiled) {
         VisibilityCache& cache = st.visibilityCache;
-        // the indirect scan's azimuths (indirectScanOperator)
-        const int indirectAzimuths =
-            settings.indirect.azimuths == 0 ? settings.visibility.azimuths : settings.indirect.azimuths;
+        // the indirect scan's azimuths (indirectScanOperator; none without a bounce)
+        const int indirectAzimuths = settings.indirect.bounces == 0    ? 0
+                                     : settings.indirect.azimuths == 0 ? settings.visibility.azimuths
+                                                                       : settings.indirect.azimuths;
         planVisibilityTiles(st.lastInputs.heights.cview(), heights, st.pyramid, settings.visibility,
                             keyLightRegions(lighting, settings), settings.tolerance, cache, change.heightBox,
                             indirectAzimuths);
