@@ -28,10 +28,6 @@ void buildChangeLevels(const MaxChangePyramid& dh, const HeightPyramid& pyr, Cha
 
 namespace {
 
-// Each azimuth's walk (ChangeWalk) into `walks`: its steps stop at the first
-// from which on no step's slope can move by more than the floor (each sample
-// and the receiver's own height moved by at most the largest |dh|, M: 2 M
-// over the step's length).
 // The texels of the field step i reads (a level on the receiver grid, or the
 // raw heights in cells) that are within reach of a cell of `cells`, the box
 // of non-zero |dh|: a level texel X (at cell s X) reads the cells within
@@ -53,6 +49,11 @@ CellBox changedTexels(const HeightPyramid& b, int level, const CellBox& cells) {
     return {out[0][0], out[1][0], out[0][1], out[1][1]};
 }
 
+// Each azimuth's walk (ChangeWalk) into `walks`: its steps stop at the first
+// from which on no step's slope can move by more than the floor (each sample
+// and the receiver's own height moved by at most the largest |dh|, M: 2 M
+// over the step's length); each step knows its field's texels of non-zero
+// |dh| bound (from `built`, the cells of non-zero |dh|).
 void buildWalks(const HeightPyramid& b, std::span<const double> phi, float largest, float floor, const CellBox& built,
                 std::vector<ChangeWalk>& walks, std::vector<float>& tail) {
     const std::size_t nSteps = b.steps.size();

@@ -103,28 +103,27 @@ constexpr double kRefineAtMost = 0.5;
 // not), each lowered to the largest of its receivers' own bounds where that
 // is smaller (gi/receiver_azimuth_bound.h); the others keep their
 // visibility tile's (each drift's all, when more than kRefineAtMost of the
-// tiles would be refined for it). The receivers' walks stop where no step can add more
-// than a sixteenth of the tolerance (tolerance 0: where no step sees a
-// change).
+// tiles would be refined for it). The receivers' walks stop where no step
+// can add more than a sixteenth of the tolerance (tolerance 0: where no
+// step sees a change).
 void refinePerReceiver(const HeightPyramid& pyr, const VisibilitySettings& vis, float lipschitz, float tolerance,
                        int geometryStride, VisibilityCache& cache) {
     ReceiverTiles& refined = cache.refined;
     refined.reset(pyr.nxr, pyr.nyr, kCacheTile, false);
     const std::size_t tiles = refined.dirty.size();
+    const auto envOver = [&](std::size_t t) { return cache.drift.fromAnchor[t] + cache.envExcursion[t] > tolerance; };
+    const auto geometryOver = [&](std::size_t t) {
+        return cache.geometryDrift.fromAnchor[t] + cache.geometryExcursion[t] > tolerance;
+    };
     std::size_t envCandidates = 0, geometryCandidates = 0;
     for (std::size_t t = 0; t < tiles; ++t) {
-        envCandidates += cache.drift.fromAnchor[t] + cache.envExcursion[t] > tolerance ? 1 : 0;
-        geometryCandidates += cache.geometryDrift.fromAnchor[t] + cache.geometryExcursion[t] > tolerance ? 1 : 0;
+        envCandidates += envOver(t) ? 1 : 0;
+        geometryCandidates += geometryOver(t) ? 1 : 0;
     }
     const auto worth = [&](std::size_t n) { return n > 0 && static_cast<double>(n) <= kRefineAtMost * tiles; };
     const bool env = worth(envCandidates), geometry = geometryStride > 0 && worth(geometryCandidates);
     if (!env && !geometry) return;
-    for (std::size_t t = 0; t < tiles; ++t)
-        refined.dirty[t] =
-            (env && cache.drift.fromAnchor[t] + cache.envExcursion[t] > tolerance) ||
-                    (geometry && cache.geometryDrift.fromAnchor[t] + cache.geometryExcursion[t] > tolerance)
-                ? 1
-                : 0;
+    for (std::size_t t = 0; t < tiles; ++t) refined.dirty[t] = (env && envOver(t)) || (geometry && geometryOver(t));
     // the environment's scan's azimuths, as foldFullCircle takes them
     const double dphi = 2.0 * kPi / vis.azimuths;
     cache.azimuths.resize(static_cast<std::size_t>(vis.azimuths));

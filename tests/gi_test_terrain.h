@@ -81,6 +81,14 @@ inline gi::GiSettings withBounces(gi::GiSettings s, int subsample, int bounces) 
     return s;
 }
 
+/// Full direct-light frames (no bounce, not incremental: every frame's
+/// visibility the true one), the engine's or the paper's settings.
+inline gi::GiSettings fullDirectFrames(bool paper, int subsample) {
+    gi::GiSettings s = withBounces(paper ? gi::paperGiSettings() : gi::GiSettings{}, subsample, 0);
+    s.incremental = false;
+    return s;
+}
+
 // Every output a caller reads: ambient, direct shade, indirect, total and the bounce means.
 inline bool sameOutputs(const gi::GiState& a, const gi::GiState& b) {
     bool ok = sameBits(a.shade.ambient.v, b.shade.ambient.v);

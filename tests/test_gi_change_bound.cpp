@@ -447,10 +447,7 @@ TEST_CASE("gi.change_bound: tile bounds hold for the engine's slopes and ambient
                               {61, 47, 2, 1, false}};
     double worstSlope = 0.0, worstAmbient = 0.0, worstAzimuth = 0.0, worstAzimuthAmbient = 0.0;
     for (const Config& cfg : configs) {
-        GiSettings settings = cfg.paper ? paperGiSettings() : GiSettings{};
-        settings.subsample = cfg.subsample;
-        settings.indirect.bounces = 0;
-        settings.incremental = false;  // every frame's slopes the true ones
+        const GiSettings settings = gi_test::fullDirectFrames(cfg.paper, cfg.subsample);
         const float lipschitz = blockingMaxLipschitz(settings.visibility.blockingMax);
         const Grid base = baseTerrain(cfg.nx, cfg.ny);
         GiState before, after;
@@ -543,11 +540,7 @@ TEST_CASE("gi.change_bound: azimuth-range bounds hold for a key light's slopes a
     int smallerTiles = 0;
     for (const Config& cfg : configs)
         for (int k = 0; k < 3; ++k) {
-            GiSettings settings = cfg.paper ? paperGiSettings() : GiSettings{};
-            settings.subsample = cfg.subsample;
-            settings.indirect.bounces = 0;
-            settings.incremental = false;  // every frame's slopes the true ones
-        settings.incremental = false;  // every frame's slopes the true ones
+            const GiSettings settings = gi_test::fullDirectFrames(cfg.paper, cfg.subsample);
             GiLighting light;
             KeyLight key;
             key.azimuthDeg = azimuths[k];

@@ -162,10 +162,7 @@ TEST_CASE("gi.receiver_azimuth_bound: bounds every receiver's slope change along
     };
     for (const Case c : {Case{97, 70, 1, false}, Case{120, 83, 2, false}, Case{150, 118, 4, false},
                          Case{80, 96, 1, true}, Case{300, 260, 2, false}}) {
-        GiSettings settings = c.paper ? paperGiSettings() : GiSettings{};
-        settings.subsample = c.subsample;
-        settings.indirect.bounces = 0;
-        settings.incremental = false;  // every frame's slopes the true ones
+        const GiSettings settings = gi_test::fullDirectFrames(c.paper, c.subsample);
         const float lipschitz = blockingMaxLipschitz(settings.visibility.blockingMax);
         const Grid base = terrainOf(c.nx, c.ny);
         GiState before, after;
