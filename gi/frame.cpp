@@ -20,10 +20,15 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
+// The indirect scan's azimuths: its own (IndirectSettings::azimuths) or the environment's.
+int indirectScanAzimuths(const GiSettings& settings) {
+    return settings.indirect.azimuths == 0 ? settings.visibility.azimuths : settings.indirect.azimuths;
+}
+
 // The folded wedge operator of the indirect scan: the environment's (when it
-// gives V), or one of its own azimuths (IndirectSettings::azimuths), cached.
+// gives V), or one of its own azimuths, cached.
 const FoldedWedgeOperator& indirectScanOperator(const GiSettings& settings, GiState& st) {
-    const int m = settings.indirect.azimuths == 0 ? settings.visibility.azimuths : settings.indirect.azimuths;
+    const int m = indirectScanAzimuths(settings);
     if (m == settings.visibility.azimuths && st.envOperator.shRows == kShCount) return st.envOperator;
     if (st.indirectOperatorAzimuths != m || st.indirectOperatorInterp != settings.visibility.interp) {
         st.indirectOperator = foldFullCircle(m, settings.visibility.interp);
@@ -463,10 +468,8 @@ GeometryPlan planGeometry(ConstGridView heights, const GiLighting& lighting, con
     plan.tiled = change.heightsOnly && !st.lastInputs.heights.empty() && shouldPlanTiles(st.visibilityCache);
     if (plan.tiled) {
         VisibilityCache& cache = st.visibilityCache;
-        // the indirect scan's azimuths (indirectScanOperator; none without a bounce)
-        const int indirectAzimuths = settings.indirect.bounces == 0    ? 0
-                                     : settings.indirect.azimuths == 0 ? settings.visibility.azimuths
-                                                                       : settings.indirect.azimuths;
+        // none without a bounce
+        const int indirectAzimuths = settings.indirect.bounces == 0 ? 0 : indirectScanAzimuths(settings);
         planVisibilityTiles(st.lastInputs.heights.cview(), heights, st.pyramid, settings.visibility,
                             keyLightRegions(lighting, settings), settings.tolerance, cache, change.heightBox,
                             indirectAzimuths);

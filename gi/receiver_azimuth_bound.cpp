@@ -193,52 +193,6 @@ void boundSlopeChangePerReceiverAzimuth(ChangeLevels& levels, const HeightPyrami
     });
 }
 
-namespace {
-
-// gradientBoundOfTile for a tile of one receiver, from a receiver row's
-// column maxima: its footprint's cells (offsets up to s / 2, clamped to the
-// field) dilated by one cell, a border footprint counting twice.
-struct FootprintRows {
-    int y0, y1;   // the dilated footprint's rows, clamped (inclusive)
-    bool border;  // the footprint itself reaches the first or the last row
-};
-FootprintRows footprintRows(const HeightPyramid& pyr, int Y) {
-    const int half = pyr.subsample / 2, c = pyr.subsample * Y;
-    const int y0 = std::max(c - half, 0), y1 = std::min(c + half, pyr.ny - 1);
-    return {std::max(y0 - 1, 0), std::min(y1 + 1, pyr.ny - 1), y0 == 0 || y1 == pyr.ny - 1};
-}
-
-// `columns` holds, for the cell columns the span's footprints reach, the
-// largest |dh| over the rows (filled at the span's first receiver).
-float footprintGradientBound(const MaxChangePyramid& dh, const HeightPyramid& pyr, const FootprintRows& rows, int X,
-                             const ColumnSpan& span, float* columns) {
-    const int half = pyr.subsample / 2, s = pyr.subsample;
-    const auto cellsOf = [&](int R, int& a, int& b) {
-        a = std::max(s * R - half, 0);
-        b = std::min(s * R + half, pyr.nx - 1);
-    };
-    const Grid& g = dh.levels[0];
-    if (X == span.x0) {
-        int a = 0, b = 0, c = 0, d = 0;
-        cellsOf(span.x0, a, b);
-        cellsOf(span.x1 - 1, c, d);
-        const int x0 = std::max(a - 1, 0), x1 = std::min(d + 1, pyr.nx - 1);
-        for (int x = x0; x <= x1; ++x) columns[x] = 0.0f;
-        for (int y = rows.y0; y <= rows.y1; ++y) {
-            const float* row = g.data() + static_cast<std::size_t>(y) * g.nx;
-            for (int x = x0; x <= x1; ++x) columns[x] = std::max(columns[x], row[x]);
-        }
-    }
-    int a = 0, b = 0;
-    cellsOf(X, a, b);
-    const bool border = rows.border || a == 0 || b == pyr.nx - 1;
-    float m = 0.0f;
-    for (int x = std::max(a - 1, 0); x <= std::min(b + 1, pyr.nx - 1); ++x) m = std::max(m, columns[x]);
-    return floatNotBelow((border ? 2.0 : 1.0) * m / pyr.cellSize);
-}
-
-}  // namespace
-
 void boundEnvironmentPerReceiver(ChangeLevels& levels, const MaxChangePyramid& dh, const HeightPyramid& pyr,
                                  std::span<const double> phi, float lipschitz, const ReceiverTiles* only, float floor,
                                  std::vector<float>& out, int subsetStride, std::vector<float>* subsetOut) {
@@ -250,21 +204,17 @@ void boundEnvironmentPerReceiver(ChangeLevels& levels, const MaxChangePyramid& d
     out.assign(planeR, 0.0f);
     if (subsetOut) subsetOut->assign(planeR, 0.0f);
     if (levels.largest == 0.0f && levels.valid) return;  // no height changed
-    // per worker slot: a row's slope bounds per azimuth, one receiver's, and
-    // the row's largest |dh| per cell column over its footprints' rows
-    const std::size_t slopesSize = static_cast<std::size_t>(m) * (nxr + 1);
+    // per worker slot: a row's slope bounds per azimuth, then one receiver's
     levels.rows.resize(static_cast<std::size_t>(workerSlots()));
-    for (std::vector<float>& r : levels.rows) r.resize(slopesSize + static_cast<std::size_t>(pyr.nx));
+    for (std::vector<float>& r : levels.rows) r.resize(static_cast<std::size_t>(m) * (nxr + 1));
     forEachWalkedRow(levels, pyr, phi, only, floor, [&](int Y, std::span<const ColumnSpan> spans, auto&& walk) {
         float* slopes = levels.rows[static_cast<std::size_t>(workerSlot())].data();
         float* perAzimuth = slopes + static_cast<std::size_t>(m) * nxr;
-        float* columns = slopes + slopesSize;
         walk(slopes, static_cast<std::size_t>(nxr));
-        const FootprintRows rows = footprintRows(pyr, Y);
         for (const ColumnSpan& span : spans)
             for (int X = span.x0; X < span.x1; ++X) {
                 const std::size_t r = static_cast<std::size_t>(Y) * nxr + static_cast<std::size_t>(X);
-                const float gradient = footprintGradientBound(dh, pyr, rows, X, span, columns);
+                const float gradient = gradientBoundOfTile(dh, pyr, 1, X, Y);
                 for (int j = 0; j < m; ++j)
                     perAzimuth[static_cast<std::size_t>(j)] =
                         lipschitz * slopes[static_cast<std::size_t>(j) * nxr + static_cast<std::size_t>(X)];
