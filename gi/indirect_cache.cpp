@@ -46,69 +46,89 @@ bool hasOcclusions(const IndirectPlanInputs& in) {
 // measures are well above their rounding.
 constexpr float kNoShareBelow = 1e-6f;
 
+// The sample moves a row's receivers are weighed with: per azimuth j and
+// distance group g, one value for every receiver (a tile's, D[j] and G[g])
+// or one per receiver (planes of the receiver grid, D[j nxr nyr + Y nxr + X]
+// and G likewise; boundSampleMovePerReceiver).
+struct RowMoves {
+    const float* D;
+    const float* G;
+    bool perReceiver;
+};
+
 // The largest rho_k of the receivers [x0, x1) of row Y (at most one tile's
 // width): the smaller of two weighings of each one's occlusion
 // (gi/indirect_cache.h), the azimuth bounds D_j by its shares per azimuth,
 // sum_j (O_kj / O_k) D_j, and the distance groups' bounds G_g (over every
-// azimuth) by its shares per group, sum_g (O_kg / O_k) G_g; `largest`
-// (max_j D_j) for a receiver with (next to) no occlusion. Sums of m (or 8)
-// positive float terms and a division, rounded up by 1e-5 plus one float
-// epsilon per azimuth, above their rounding for any m; a positive term w D
-// never rounds to 0 (at least the smallest float), so that tolerance 0 sees
-// every change a member may carry. L receivers per vector (a run cut by the
-// grid's edge copied into zero-padded lanes); lane-wise IEEE arithmetic, so
-// the 4- and 8-wide builds give the same bits.
+// azimuth) by its shares per group, sum_g (O_kg / O_k) G_g; its largest
+// D_j for a receiver with (next to) no occlusion, and never more. Sums of m
+// (or 8) positive float terms and a division, rounded up by 1e-5 plus one
+// float epsilon per azimuth, above their rounding for any m; a positive
+// term w D never rounds to 0 (at least the smallest float), so that
+// tolerance 0 sees every change a member may carry. L receivers per vector
+// (a run cut by the grid's edge copied into zero-padded lanes); lane-wise
+// IEEE arithmetic, so the 4- and 8-wide builds give the same bits.
 template <class V>
 [[gnu::always_inline]] inline float rowShareBoundWith(const BlockerRadianceState& b, int Y, int x0, int x1,
-                                                      const float* D, const float* G, float largest) {
+                                                      const RowMoves& moves) {
     constexpr int L = simd::kLaneCount<V>, kLaneGroups = kIndirectTile / L;
     const std::size_t m = static_cast<std::size_t>(b.azimuths), plane = static_cast<std::size_t>(b.nxr) * b.nyr;
     const std::size_t at = static_cast<std::size_t>(Y) * b.nxr + static_cast<std::size_t>(x0);
     const int n = x1 - x0, laneGroups = (n + L - 1) / L;
-    const V zero = simd::splat<V>(0.0f);
+    const V zero = simd::splat<V>(0.0f), denorm = simd::splat<V>(std::numeric_limits<float>::denorm_min());
     V azWeighed[kLaneGroups], azTotal[kLaneGroups], grWeighed[kLaneGroups], grTotal[kLaneGroups];
-    for (int q = 0; q < laneGroups; ++q) azWeighed[q] = azTotal[q] = grWeighed[q] = grTotal[q] = zero;
+    V largest[kLaneGroups];
+    for (int q = 0; q < laneGroups; ++q) azWeighed[q] = azTotal[q] = grWeighed[q] = grTotal[q] = largest[q] = zero;
     alignas(32) float lanes[kIndirectTile] = {};
-    const auto weighed = [&](const float* v, float d, V* sum, V* total, bool running) {
-        if (n % L != 0) {  // a cut run: zero-padded lanes
-            std::copy(v, v + n, lanes);
-            v = lanes;
-        }
-        const V dv = simd::splat<V>(d);
-        const V tiny = simd::splat<V>(d > 0.0f ? std::numeric_limits<float>::denorm_min() : 0.0f);
+    alignas(32) float moveLanes[kIndirectTile] = {};
+    // a plane's run of the row (zero-padded when cut)
+    const auto run = [&](const float* v, float* padded) {
+        if (n % L == 0) return v;
+        std::copy(v, v + n, padded);
+        return static_cast<const float*>(padded);
+    };
+    const auto weighed = [&](const float* occlusion, const float* move, float d, V* sum, V* total, bool running) {
+        const float* v = run(occlusion, lanes);
+        const float* dv = moves.perReceiver ? run(move, moveLanes) : nullptr;
         for (int q = 0; q < laneGroups; ++q) {
             const V x = simd::load<V>(v + L * q);
+            const V dq = dv ? simd::load<V>(dv + L * q) : simd::splat<V>(d);
             const V w = running ? x - total[q] : x;  // an azimuth's share: the running sum's step
-            sum[q] += w > zero ? simd::vmax(w * dv, tiny) : zero;
+            sum[q] += w > zero ? simd::vmax(w * dq, dq > zero ? denorm : zero) : zero;
             total[q] = running ? x : total[q] + x;
+            if (running) largest[q] = simd::vmax(largest[q], dq);
         }
     };
-    for (std::size_t j = 0; j < m; ++j)
-        weighed(b.receiverOcclusionRunning.data() + j * plane + at, D[j], azWeighed, azTotal, true);
-    for (std::size_t g = 0; g < kDistanceGroups; ++g)
-        weighed(b.receiverGroupOcclusion.data() + g * plane + at, G[g], grWeighed, grTotal, false);
-    // sum / total, positive when the sum is, or `largest` for (next to) no occlusion
-    const V big = simd::splat<V>(largest), floor = simd::splat<V>(kNoShareBelow);
-    const V denorm = simd::splat<V>(std::numeric_limits<float>::denorm_min());
-    const auto mean = [&](V sum, V total) {
-        const V ratio = sum > zero ? simd::vmax(sum / total, denorm) : zero;
-        return total > floor ? ratio : big;
+    const auto moveAt = [&](const float* planes, std::size_t i) {
+        return moves.perReceiver ? planes + i * plane + at : nullptr;
     };
+    for (std::size_t j = 0; j < m; ++j)
+        weighed(b.receiverOcclusionRunning.data() + j * plane + at, moveAt(moves.D, j),
+                moves.perReceiver ? 0.0f : moves.D[j], azWeighed, azTotal, true);
+    for (std::size_t g = 0; g < kDistanceGroups; ++g)
+        weighed(b.receiverGroupOcclusion.data() + g * plane + at, moveAt(moves.G, g),
+                moves.perReceiver ? 0.0f : moves.G[g], grWeighed, grTotal, false);
+    // sum / total, positive when the sum is, or the largest D_j for (next to) no occlusion
+    const V floor = simd::splat<V>(kNoShareBelow);
+    const V up = simd::splat<V>(1.0f + 1e-5f + static_cast<float>(m) * std::numeric_limits<float>::epsilon());
     float bound = 0.0f;
     for (int q = 0; q < laneGroups; ++q) {
-        const V rho = simd::vmin(mean(azWeighed[q], azTotal[q]), mean(grWeighed[q], grTotal[q]));
+        const auto mean = [&](V sum, V total) {
+            const V ratio = sum > zero ? simd::vmax(sum / total, denorm) : zero;
+            return total > floor ? ratio : largest[q];
+        };
+        const V rho =
+            simd::vmin(largest[q], simd::vmin(mean(azWeighed[q], azTotal[q]), mean(grWeighed[q], grTotal[q])) * up);
         for (int l = 0; l < L && L * q + l < n; ++l) bound = std::max(bound, rho[l]);
     }
-    const float up = 1.0f + 1e-5f + static_cast<float>(m) * std::numeric_limits<float>::epsilon();
-    return std::min(largest, bound * up);
+    return bound;
 }
-float rowShareBoundSse(const BlockerRadianceState& b, int Y, int x0, int x1, const float* D, const float* G,
-                       float largest) {
-    return rowShareBoundWith<simd::F4>(b, Y, x0, x1, D, G, largest);
+float rowShareBoundSse(const BlockerRadianceState& b, int Y, int x0, int x1, const RowMoves& moves) {
+    return rowShareBoundWith<simd::F4>(b, Y, x0, x1, moves);
 }
 [[gnu::target("avx2"), gnu::flatten]] float rowShareBoundAvx2(const BlockerRadianceState& b, int Y, int x0, int x1,
-                                                              const float* D, const float* G, float largest) {
-    return rowShareBoundWith<simd::F8>(b, Y, x0, x1, D, G, largest);
+                                                              const RowMoves& moves) {
+    return rowShareBoundWith<simd::F8>(b, Y, x0, x1, moves);
 }
 
 // Tile (tx, ty)'s share envelope (IndirectCache::shareEnvelope) from the
@@ -197,7 +217,7 @@ void sharedBounds(const IndirectPlanInputs& in, IndirectCache& cache) {
         float bound = 0.0f;
         const int x0 = tx * kIndirectTile, x1 = std::min(h.nxr, x0 + kIndirectTile);
         for (int Y = ty * kIndirectTile; Y < std::min(h.nyr, (ty + 1) * kIndirectTile); ++Y)
-            bound = std::max(bound, rowShareBound(*in.blocker, Y, x0, x1, D, G, largest));
+            bound = std::max(bound, rowShareBound(*in.blocker, Y, x0, x1, RowMoves{D, G, false}));
         return bound;
     };
     parallelFor(0, tilesY, 1, [&](int ty0, int ty1) {
@@ -263,6 +283,61 @@ void occlusionFactors(const IndirectPlanInputs& in, IndirectCache& cache) {
     cache.occlusionsRedone = CellBox::none();
 }
 
+// Refines the radiance bound of the tiles it would re-gather (with their
+// drift from the anchor) and the geometry does not re-gather anyway: each
+// takes the largest of its receivers' own bounds if smaller, their sample
+// moves walked on their own (boundSampleMovePerReceiver) and weighed by
+// their own shares (rowShareBound), times the tile's occlusion factor
+// (without the occlusions: each receiver's largest move). Only where at
+// most kRefineAtMost of the tiles are candidates (gi/plan_skips.h).
+void refinePerReceiver(const IndirectPlanInputs& in, IndirectCache& cache) {
+    const HeightPyramid& field = in.pyramid.fields[0];
+    ReceiverTiles& refined = cache.refined;
+    refined.reset(field.nxr, field.nyr, kIndirectTile, false);
+    const std::size_t tiles = refined.dirty.size();
+    const bool drifts = cache.drift.fits(tiles);  // else every result is at the anchor (a bound alone)
+    std::size_t candidates = 0;
+    for (std::size_t t = 0; t < tiles; ++t) {
+        const bool forced = in.geometryTiles && in.geometryTiles->dirty[t];
+        const float drift = drifts ? cache.drift.fromAnchor[t] : 0.0f;
+        refined.dirty[t] = !forced && drift + cache.radianceBound[t] > in.tolerance ? 1 : 0;
+        candidates += refined.dirty[t];
+    }
+    if (static_cast<double>(candidates) > kRefineAtMost * static_cast<double>(tiles))
+        std::fill(refined.dirty.begin(), refined.dirty.end(), 0);
+    if (refined.dirtyCount() == 0) return;
+    buildChangeLevels(cache.change, field, cache.receiverLevels);
+    boundSampleMovePerReceiver(cache.receiverLevels, field, in.phi, &refined, cache.receiverAzimuthMove,
+                               cache.receiverGroupMove);
+    const bool shares = hasOcclusions(in);
+    const std::size_t m = in.phi.size(), plane = static_cast<std::size_t>(field.nxr) * field.nyr;
+    const auto rowShareBound = simd::wideEnabled() ? rowShareBoundAvx2 : rowShareBoundSse;
+    const RowMoves moves{cache.receiverAzimuthMove.data(), cache.receiverGroupMove.data(), true};
+    // a receiver's largest move over the azimuths: its rho_k without shares
+    const auto largestMove = [&](int Y, int x0, int x1) {
+        float largest = 0.0f;
+        for (std::size_t j = 0; j < m; ++j)
+            for (int X = x0; X < x1; ++X)
+                largest =
+                    std::max(largest, cache.receiverAzimuthMove[j * plane + static_cast<std::size_t>(Y) * field.nxr +
+                                                                static_cast<std::size_t>(X)]);
+        return largest;
+    };
+    parallelFor(0, refined.tilesY, 1, [&](int ty0, int ty1) {
+        for (int ty = ty0; ty < ty1; ++ty)
+            for (int tx = 0; tx < refined.tilesX; ++tx) {
+                if (!refined.isDirty(tx, ty)) continue;
+                const int x0 = tx * kIndirectTile, x1 = std::min(field.nxr, x0 + kIndirectTile);
+                float bound = 0.0f;
+                for (int Y = ty * kIndirectTile; Y < std::min(field.nyr, (ty + 1) * kIndirectTile); ++Y)
+                    bound =
+                        std::max(bound, shares ? rowShareBound(*in.blocker, Y, x0, x1, moves) : largestMove(Y, x0, x1));
+                const std::size_t t = static_cast<std::size_t>(ty) * refined.tilesX + tx;
+                cache.radianceBound[t] = std::min(cache.radianceBound[t], cache.occlusionFactor[t] * bound);
+            }
+    });
+}
+
 }  // namespace
 
 void boundRadianceChange(const IndirectPlanInputs& in, IndirectCache& cache) {
@@ -284,6 +359,7 @@ void boundRadianceChange(const IndirectPlanInputs& in, IndirectCache& cache) {
                                 cache.azimuthBound, cache.groupBound);
     occlusionFactors(in, cache);
     sharedBounds(in, cache);
+    refinePerReceiver(in, cache);
 }
 
 bool startIndirectPlan(const IndirectPlanInputs& in, IndirectCache& cache) {

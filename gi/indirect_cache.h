@@ -42,6 +42,13 @@
 //    tolerance (else the tile re-gathers), so the factor is that largest
 //    O(x) plus the tolerance, at most 1. Without sub-sampling (every texel a
 //    receiver, no texel occlusion kept) the bound is max_j D_j.
+//    Refined per receiver: where that bound would re-gather a tile that the
+//    geometry does not, D_kj and G_kg of each receiver's own samples
+//    (gi/receiver_azimuth_bound.h, walked over the pyramid of |L_0 - L_0 at
+//    the anchor|) weighed by its own shares replace the larger tile's, if
+//    smaller: beside a local change, a tile's receivers see it along a few
+//    azimuths and at a few distances of their own, where the larger tile's
+//    bounds charge each with the nearest and largest move of any.
 //  - the geometry within reach: the tiles whose geometry drifted beyond the
 //    tolerance this frame (VisibilityCache::geometryTiles, the visibility
 //    cache's tiles, which are these: the bound over every azimuth, or along
@@ -77,6 +84,7 @@
 #include "gi/pyramid.h"
 #include "gi/radiance_pyramid.h"
 #include "gi/radiance_sample_change.h"
+#include "gi/receiver_azimuth_bound.h"
 #include "gi/receiver_tiles.h"
 #include "gi/shading.h"
 #include "gi/texel_runs.h"
@@ -118,6 +126,11 @@ struct IndirectCache {
     std::vector<float> largestOcclusion;
     CellBox occlusionsRedone;
     std::vector<float> radianceBound;  // per tile: this frame's bound from the anchor (boundRadianceChange)
+    // the receivers' own sample moves (refined tiles only): the |L_0 -
+    // anchor| pyramid they are walked on, per azimuth and per distance group
+    ChangeLevels receiverLevels;
+    std::vector<float> receiverAzimuthMove, receiverGroupMove;
+    ReceiverTiles refined;  // scratch: the tiles refined this frame
     // per tile: the largest share of a receiver's occlusion along each
     // azimuth, then in each distance group (azimuths + kDistanceGroups
     // floats, rounded up), or all -1 when some receiver has (next to) no

@@ -26,6 +26,15 @@ inline constexpr double kMostlyDirty = 0.75;
 inline constexpr int kFramesWithoutPlan = 7;
 inline constexpr int kMostFramesWithoutPlan = 31;
 
+/// A plan refines its tiles' bounds per receiver (walks over the change,
+/// gi/receiver_azimuth_bound.h) only where the tiles' own bounds leave at
+/// most this share of them to recompute: a receiver's walk costs about as
+/// much as the scan it may spare it (and the change's pyramid as a partial
+/// pyramid build), so it pays where few tiles are left. Where most are
+/// (rain-fed `erosion`, every frame), refining the visibility's tiles made
+/// the 300-frame run at 256² 108.5 % of full frames' time instead of 102 %.
+inline constexpr double kRefineAtMost = 0.5;
+
 /// The frames without a plan of one cache that plans tiles.
 struct PlanSkips {
     int left = 0;    // frames left that recompute everything unplanned

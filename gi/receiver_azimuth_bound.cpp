@@ -21,6 +21,8 @@ void buildChangeLevels(const MaxChangePyramid& dh, const HeightPyramid& pyr, Cha
     out.valid = false;  // until built
     if (!same || !redo.empty())
         buildHeightPyramid(dh.levels[0].cview(), pyr.cellSize, pyr.subsample, pyr.settings, out.bound, redo);
+    // the field's own steps (a radiance field's are the height pyramid's taus, gi/radiance_pyramid.h)
+    out.bound.steps = pyr.steps;
     out.built = nonZero;
     out.largest = maxChangeAll(dh);
     out.valid = true;
@@ -81,7 +83,8 @@ void buildWalks(const HeightPyramid& b, std::span<const double> phi, float large
                         info.tapY,
                         info.nextX,
                         info.nextY,
-                        changedTexels(b, level, built)};
+                        changedTexels(b, level, built),
+                        distanceGroup(b.steps[i].tauCells)};
         }
         tail[nSteps] = 0.0f;  // tail[i]: the bound of steps i and on
         for (std::size_t i = nSteps; i-- > 0;)
@@ -93,8 +96,24 @@ void buildWalks(const HeightPyramid& b, std::span<const double> phi, float large
     }
 }
 
+// The receivers [a, e] of row Y's span [x0, x1) that step bs reads: kStop
+// when none is inside the domain (the valid ranges only shrink: once empty,
+// for good), kSkip when its taps read no texel of non-zero |dh| bound and
+// no receiver of the span has a change of its own (`ownChange`).
+enum class StepReach { kWalk, kSkip, kStop };
+inline StepReach stepReach(const ChangeWalk::Step& bs, int Y, int x0, int x1, bool ownChange, int& a, int& e) {
+    a = std::max(x0, bs.x0);
+    e = std::min(x1 - 1, bs.x1);
+    if (Y < bs.y0 || Y > bs.y1 || a > e) return StepReach::kStop;
+    const int tx0 = bs.k * a + bs.tapX, tx1 = bs.k * e + bs.tapX + bs.nextX + 1;
+    const int ty0 = bs.k * Y + bs.tapY, ty1 = ty0 + bs.nextY + 1;
+    const CellBox& c = bs.changed;
+    const bool reads = !(tx1 <= c.x0 || tx0 >= c.x1 || ty1 <= c.y0 || ty0 >= c.y1);
+    return reads || ownChange ? StepReach::kWalk : StepReach::kSkip;
+}
+
 // One receiver row's span [x0, x1) along one azimuth into o (the row of
-// out): the largest bound of its walked steps, at least the tail's.
+// out): the largest slope bound of its walked steps, at least the tail's.
 // `ownChange`: some receiver of the span may have a height change of its own
 // (else a step whose samples all read texels of zero |dh| bound adds 0).
 template <class V>
@@ -102,13 +121,10 @@ template <class V>
                                             bool ownChange, float* o) {
     for (int X = x0; X < x1; ++X) o[X] = walk.tail;
     for (const ChangeWalk::Step& bs : walk.steps) {
-        const int a = std::max(x0, bs.x0), e = std::min(x1 - 1, bs.x1);
-        // the valid ranges only shrink: once empty, for good
-        if (Y < bs.y0 || Y > bs.y1 || a > e) break;
-        const int tx0 = bs.k * a + bs.tapX, tx1 = bs.k * e + bs.tapX + bs.nextX + 1;
-        const int ty0 = bs.k * Y + bs.tapY, ty1 = ty0 + bs.nextY + 1;
-        const CellBox& c = bs.changed;
-        if (!ownChange && (tx1 <= c.x0 || tx0 >= c.x1 || ty1 <= c.y0 || ty0 >= c.y1)) continue;
+        int a = 0, e = 0;
+        const StepReach reach = stepReach(bs, Y, x0, x1, ownChange, a, e);
+        if (reach == StepReach::kStop) break;
+        if (reach == StepReach::kSkip) continue;
         const ScanStep& st = bs.step;
         const float* fa = st.field + st.offA + static_cast<std::ptrdiff_t>(Y) * st.rowStep;
         const float* fb = st.field + st.offB + static_cast<std::ptrdiff_t>(Y) * st.rowStep;
@@ -120,6 +136,39 @@ template <class V>
             simd::store(o + X, simd::vmax(simd::load<V>(o + X), v));
         }
         for (; X <= e; ++X) o[X] = std::max(o[X], (st.w[0][0] * fa[X] + st.w[1][0] * fb[X] + dh0[X]) * st.w[2][0]);
+    }
+}
+
+// The same walk bounding the samples' own moves, w_a D[a] + w_b D[b]: their
+// largest along the azimuth into o, and in each distance group into
+// groups + g * groupStride (raised, not set: the caller starts them at 0
+// and walks every azimuth). Walked with no floor (its tail is 0).
+template <class V>
+[[gnu::always_inline]] inline void walkMoveSpan(const ChangeWalk& walk, int Y, int x0, int x1, float* o, float* groups,
+                                                std::size_t groupStride) {
+    for (int X = x0; X < x1; ++X) o[X] = 0.0f;
+    for (const ChangeWalk::Step& bs : walk.steps) {
+        int a = 0, e = 0;
+        const StepReach reach = stepReach(bs, Y, x0, x1, false, a, e);
+        if (reach == StepReach::kStop) break;
+        if (reach == StepReach::kSkip) continue;
+        const ScanStep& st = bs.step;
+        const float* fa = st.field + st.offA + static_cast<std::ptrdiff_t>(Y) * st.rowStep;
+        const float* fb = st.field + st.offB + static_cast<std::ptrdiff_t>(Y) * st.rowStep;
+        float* g = groups + static_cast<std::size_t>(bs.group) * groupStride;
+        const V wa = simd::splat<V>(st.w[0][0]), wb = simd::splat<V>(st.w[1][0]);
+        constexpr int L = simd::kLaneCount<V>;
+        int X = a;
+        for (; X + L <= e + 1; X += L) {
+            const V v = wa * simd::load<V>(fa + X) + wb * simd::load<V>(fb + X);
+            simd::store(o + X, simd::vmax(simd::load<V>(o + X), v));
+            simd::store(g + X, simd::vmax(simd::load<V>(g + X), v));
+        }
+        for (; X <= e; ++X) {
+            const float v = st.w[0][0] * fa[X] + st.w[1][0] * fb[X];
+            o[X] = std::max(o[X], v);
+            g[X] = std::max(g[X], v);
+        }
     }
 }
 
@@ -155,9 +204,35 @@ void walkRowSse(const std::vector<ChangeWalk>& walks, std::span<const ColumnSpan
     walkRowWith<simd::F8>(walks, spans, r, rows, stride);
 }
 
+// Every azimuth's sample-move walk over row Y's spans: azimuth j's largest
+// moves to rows + j * stride, distance group g's over every azimuth to
+// groups + g * stride (indexed by the receiver's column).
+using WalkMoveRow = void (*)(const std::vector<ChangeWalk>&, std::span<const ColumnSpan>, int, float*, float*,
+                             std::size_t);
+template <class V>
+[[gnu::always_inline]] inline void walkMoveRowWith(const std::vector<ChangeWalk>& walks,
+                                                   std::span<const ColumnSpan> spans, int Y, float* rows, float* groups,
+                                                   std::size_t stride) {
+    for (const ColumnSpan& span : spans)
+        for (std::size_t g = 0; g < kDistanceGroups; ++g)
+            std::fill(groups + g * stride + span.x0, groups + g * stride + span.x1, 0.0f);
+    for (std::size_t j = 0; j < walks.size(); ++j)
+        for (const ColumnSpan& span : spans)
+            walkMoveSpan<V>(walks[j], Y, span.x0, span.x1, rows + j * stride, groups, stride);
+}
+void walkMoveRowSse(const std::vector<ChangeWalk>& walks, std::span<const ColumnSpan> spans, int Y, float* rows,
+                    float* groups, std::size_t stride) {
+    walkMoveRowWith<simd::F4>(walks, spans, Y, rows, groups, stride);
+}
+[[gnu::target("avx2"), gnu::flatten]] void walkMoveRowAvx2(const std::vector<ChangeWalk>& walks,
+                                                           std::span<const ColumnSpan> spans, int Y, float* rows,
+                                                           float* groups, std::size_t stride) {
+    walkMoveRowWith<simd::F8>(walks, spans, Y, rows, groups, stride);
+}
+
 // The walks of `levels` over the receivers of `only`'s dirty tiles: calls
-// row(Y, spans, walk) for each receiver row with a span, in parallel, where
-// walk(rows, stride) writes the row's bounds per azimuth.
+// row(Y, spans, r) for each receiver row with a span, in parallel (r: what
+// the slope walks read of the row; the walks are levels.walks).
 template <class Row>
 void forEachWalkedRow(ChangeLevels& levels, const HeightPyramid& pyr, std::span<const double> phi,
                       const ReceiverTiles* only, float floor, Row&& row) {
@@ -166,17 +241,14 @@ void forEachWalkedRow(ChangeLevels& levels, const HeightPyramid& pyr, std::span<
         b.steps.size() != pyr.steps.size())
         throw InputError("receiver azimuth bound: the change levels were not built for this pyramid");
     buildWalks(b, phi, levels.largest, std::max(floor, 0.0f), levels.built, levels.walks, levels.tails);
-    const std::vector<ChangeWalk>& walks = levels.walks;
     const DirtySpans& spans = levels.spans;
     dirtySpans(only, b.nxr, b.nyr, levels.spans);
-    const WalkRow walkRow = simd::wideEnabled() ? walkRowAvx2 : walkRowSse;
     parallelForRows(RowSpan{0, b.nyr}, b.nxr * static_cast<int>(phi.size()), [&](int Y0, int Y1) {
         for (int Y = Y0; Y < Y1; ++Y) {
             const std::span<const ColumnSpan> rowSpans = spans.ofRow(Y);
             if (rowSpans.empty()) continue;
             // |dh| at the receivers' own cells: raw phase 0 of row s Y
-            const RowWalk r{b.rawPhaseRow(0, b.subsample * Y), Y, b.subsample, levels.built};
-            row(Y, rowSpans, [&](float* rows, std::size_t stride) { walkRow(walks, rowSpans, r, rows, stride); });
+            row(Y, rowSpans, RowWalk{b.rawPhaseRow(0, b.subsample * Y), Y, b.subsample, levels.built});
         }
     });
 }
@@ -188,8 +260,9 @@ void boundSlopeChangePerReceiverAzimuth(ChangeLevels& levels, const HeightPyrami
     const std::size_t planeR = static_cast<std::size_t>(pyr.nxr) * pyr.nyr;
     out.assign(phi.size() * planeR, 0.0f);
     if (levels.largest == 0.0f && levels.valid) return;  // no height changed
-    forEachWalkedRow(levels, pyr, phi, only, floor, [&](int Y, std::span<const ColumnSpan>, auto&& walk) {
-        walk(out.data() + static_cast<std::size_t>(Y) * pyr.nxr, planeR);
+    const WalkRow walkRow = simd::wideEnabled() ? walkRowAvx2 : walkRowSse;
+    forEachWalkedRow(levels, pyr, phi, only, floor, [&](int Y, std::span<const ColumnSpan> spans, const RowWalk& r) {
+        walkRow(levels.walks, spans, r, out.data() + static_cast<std::size_t>(Y) * pyr.nxr, planeR);
     });
 }
 
@@ -207,10 +280,11 @@ void boundEnvironmentPerReceiver(ChangeLevels& levels, const MaxChangePyramid& d
     // per worker slot: a row's slope bounds per azimuth, then one receiver's
     levels.rows.resize(static_cast<std::size_t>(workerSlots()));
     for (std::vector<float>& r : levels.rows) r.resize(static_cast<std::size_t>(m) * (nxr + 1));
-    forEachWalkedRow(levels, pyr, phi, only, floor, [&](int Y, std::span<const ColumnSpan> spans, auto&& walk) {
+    const WalkRow walkRow = simd::wideEnabled() ? walkRowAvx2 : walkRowSse;
+    forEachWalkedRow(levels, pyr, phi, only, floor, [&](int Y, std::span<const ColumnSpan> spans, const RowWalk& row) {
         float* slopes = levels.rows[static_cast<std::size_t>(workerSlot())].data();
         float* perAzimuth = slopes + static_cast<std::size_t>(m) * nxr;
-        walk(slopes, static_cast<std::size_t>(nxr));
+        walkRow(levels.walks, spans, row, slopes, static_cast<std::size_t>(nxr));
         for (const ColumnSpan& span : spans)
             for (int X = span.x0; X < span.x1; ++X) {
                 const std::size_t r = static_cast<std::size_t>(Y) * nxr + static_cast<std::size_t>(X);
@@ -225,6 +299,20 @@ void boundEnvironmentPerReceiver(ChangeLevels& levels, const MaxChangePyramid& d
                     perAzimuth[static_cast<std::size_t>(k)] = perAzimuth[static_cast<std::size_t>(k * subsetStride)];
                 (*subsetOut)[r] = ambientChangeBoundPerAzimuth(perAzimuth, m / subsetStride, gradient, 1.0f, false);
             }
+    });
+}
+
+void boundSampleMovePerReceiver(ChangeLevels& levels, const HeightPyramid& field, std::span<const double> phi,
+                                const ReceiverTiles* only, std::vector<float>& azimuthMove,
+                                std::vector<float>& groupMove) {
+    const std::size_t planeR = static_cast<std::size_t>(field.nxr) * field.nyr;
+    azimuthMove.resize(phi.size() * planeR);
+    groupMove.resize(static_cast<std::size_t>(kDistanceGroups) * planeR);
+    const WalkMoveRow walkRow = simd::wideEnabled() ? walkMoveRowAvx2 : walkMoveRowSse;
+    // no floor: a move does not shrink with the distance (the walks' tails are 0)
+    forEachWalkedRow(levels, field, phi, only, 0.0f, [&](int Y, std::span<const ColumnSpan> spans, const RowWalk&) {
+        const std::size_t row = static_cast<std::size_t>(Y) * field.nxr;
+        walkRow(levels.walks, spans, Y, azimuthMove.data() + row, groupMove.data() + row, planeR);
     });
 }
 

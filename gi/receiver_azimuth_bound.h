@@ -45,6 +45,7 @@ struct ChangeWalk {
         // of its field, the second one (nextX, nextY) further (ScanStepInfo)
         int k = 1, tapX = 0, tapY = 0, nextX = 0, nextY = 0;
         CellBox changed;  // the field's texels whose |dh| bound may not be 0
+        int group = 0;    // the step's distance group (gi/pyramid.h)
     };
     std::vector<Step> steps;
     float tail = 0.0f;
@@ -65,8 +66,10 @@ struct ChangeLevels {
 
 /// Builds (or redoes, over the cells whose |dh| may differ from the last
 /// build's: the old and the new box of non-zero |dh|) the |dh| pyramid of
-/// `dh` (its level 0, |dh| per cell rounded up) for the heights' pyramid
-/// `pyr`. Throws InputError when the sizes of dh and pyr differ.
+/// `dh` (its level 0, |dh| per cell rounded up) for the pyramid `pyr` of
+/// the field that changed by dh, with pyr's settings and steps: the heights',
+/// or a radiance channel's (gi/radiance_pyramid.h; below). Throws InputError
+/// when the sizes of dh and pyr differ.
 void buildChangeLevels(const MaxChangePyramid& dh, const HeightPyramid& pyr, ChangeLevels& out);
 
 /// Per receiver and azimuth phi_j (radians), a bound on |change| of its
@@ -97,5 +100,24 @@ void boundEnvironmentPerReceiver(ChangeLevels& levels, const MaxChangePyramid& d
                                  std::span<const double> phi, float lipschitz, const ReceiverTiles* only, float floor,
                                  std::vector<float>& out, int subsetStride = 0,
                                  std::vector<float>* subsetOut = nullptr);
+
+/// The same walks for a radiance field's scan (gi/radiance_pyramid.h, whose
+/// levels are plain means: the argument above holds for them): with
+/// `levels` built by buildChangeLevels from |L - L_anchor| (max over the
+/// channels) for channel 0's pyramid `field`, each step's sample moved by at
+/// most w_a D_l[a] + w_b D_l[b]. Per receiver of `only`'s dirty tiles (every
+/// receiver without), the largest move of its samples along each azimuth
+/// phi_j, azimuthMove[(j nyr + Y) nxr + X], and in each distance group
+/// (gi/pyramid.h) over every azimuth, groupMove[(g nyr + Y) nxr + X]: what
+/// gi/indirect_cache.h weighs by the receiver's shares of its occlusion.
+/// In real arithmetic, as the slopes' bound: the pyramids' own rounding
+/// (the radiance's octaves and syntheses, up to about 1e-5 of the radiance)
+/// is not counted; where a bound is 0 the samples are the anchor's bit for
+/// bit (they read no changed texel). The other receivers' entries are left as they were (the planes are
+/// sized, not cleared). Throws InputError when `levels` was not built for
+/// `field`.
+void boundSampleMovePerReceiver(ChangeLevels& levels, const HeightPyramid& field, std::span<const double> phi,
+                                const ReceiverTiles* only, std::vector<float>& azimuthMove,
+                                std::vector<float>& groupMove);
 
 }  // namespace terrain::gi

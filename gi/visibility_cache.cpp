@@ -90,13 +90,6 @@ void onCacheTiles(const std::vector<float>& perTile, const ReceiverTiles& tiles,
                 perTile[static_cast<std::size_t>(ty / kPer) * visibilityX + tx / kPer];
 }
 
-// A receiver's walk costs about as much as the visibility scan it may spare
-// it (and the |dh| pyramid as a partial height pyramid): it pays where the
-// box bounds leave a small share of the tiles to recompute. Where they leave
-// most (rain-fed `erosion`, every frame), refining them all made the
-// 300-frame run at 256² 108.5 % of full frames' time instead of 102 %.
-constexpr double kRefineAtMost = 0.5;
-
 // The environment's ambient-map excursions of the cache tiles that they and
 // their drift would recompute, and the geometry's where the indirect scan
 // takes every k-th of the environment's azimuths (geometryStride k; 0:

@@ -4,8 +4,10 @@
 // checks against the engine's slopes): never below it, equal to it where
 // every cell changed alike. gi/receiver_azimuth_bound (per azimuth, from the
 // samples' own change) against the engine's slopes before and after each
-// change.
+// change, and its radiance walks against the samples of a radiance field's
+// pyramids before and after.
 #include <algorithm>
+#include <array>
 #include <cfloat>
 #include <cmath>
 #include <random>
@@ -17,8 +19,10 @@
 #include "gi/change_bound.h"
 #include "gi/frame.h"
 #include "gi/pyramid.h"
+#include "gi/radiance_pyramid.h"
 #include "gi/receiver_azimuth_bound.h"
 #include "gi/receiver_change_bound.h"
+#include "gi/visibility.h"
 #include "tests/gi_test_terrain.h"
 
 using namespace terrain;
@@ -290,4 +294,105 @@ TEST_CASE(
     MaxChangePyramid small;
     buildMaxChangePyramid(terrainOf(30, 30).cview(), small);
     CHECK_THROWS_AS(buildChangeLevels(small, pyr, levels), InputError);
+}
+
+TEST_CASE(
+    "gi.receiver_azimuth_bound: a radiance field's sample moves bound every sample's move per receiver, azimuth and "
+    "distance group") {
+    struct Case {
+        int nx, ny, subsample;
+    };
+    for (const Case c : {Case{97, 70, 1}, Case{120, 83, 2}, Case{150, 118, 4}}) {
+        const Grid base = terrainOf(c.nx, c.ny);
+        HeightPyramid heights;
+        buildHeightPyramid(base.cview(), kCell, c.subsample, PyramidSettings{}, heights);
+        // three channels of a radiance around 0.5, each changed by a scaled copy of a height change
+        const auto radianceOf = [&](const Grid& h) {
+            std::array<Grid, 3> rgb;
+            for (std::size_t ch = 0; ch < 3; ++ch) {
+                rgb[ch] = h;
+                for (float& v : rgb[ch].v) v = 0.5f + 0.02f * static_cast<float>(ch + 1) * v;
+            }
+            return rgb;
+        };
+        const std::array<Grid, 3> before = radianceOf(base);
+        RadiancePyramid p0, p1;
+        buildRadiancePyramid(before, heights, RadiancePyramidSettings{}, p0);
+        const FoldedWedgeOperator op = foldFullCircle(8, AzimuthInterp::Linear);
+        const std::size_t m = op.phi.size();
+        ChangeLevels levels;
+        for (int kind = 0; kind < 4; ++kind) {
+            CAPTURE(c.nx);
+            CAPTURE(c.subsample);
+            CAPTURE(kind);
+            const std::array<Grid, 3> after = radianceOf(changed(base, kind));
+            buildRadiancePyramid(after, heights, RadiancePyramidSettings{}, p1);
+            MaxChangePyramid dl;
+            const std::array<ConstGridView, 3> from{before[0].cview(), before[1].cview(), before[2].cview()};
+            const std::array<ConstGridView, 3> to{after[0].cview(), after[1].cview(), after[2].cview()};
+            buildMaxChangePyramid(from, to, dl, CellBox{});
+            const HeightPyramid& field = p1.fields[0];
+            buildChangeLevels(dl, field, levels);
+            std::vector<float> azimuthMove, groupMove;
+            boundSampleMovePerReceiver(levels, field, op.phi, nullptr, azimuthMove, groupMove);
+            const std::size_t planeR = static_cast<std::size_t>(field.nxr) * field.nyr;
+            REQUIRE(azimuthMove.size() == m * planeR);
+            REQUIRE(groupMove.size() == kDistanceGroups * planeR);
+            // every sample a receiver's scan reads (its valid prefix of steps), in every channel
+            double worst = 0.0, excess = 0.0, zeroMoved = 0.0;
+            for (std::size_t j = 0; j < m; ++j) {
+                const double cs = std::cos(op.phi[j]), sn = std::sin(op.phi[j]);
+                for (int Y = 0; Y < field.nyr; ++Y)
+                    for (int X = 0; X < field.nxr; ++X) {
+                        const std::size_t r = static_cast<std::size_t>(Y) * field.nxr + static_cast<std::size_t>(X);
+                        for (int i = 0; i < static_cast<int>(field.steps.size()); ++i) {
+                            const ScanStepInfo info = scanStepInfo(field, i, cs, sn);
+                            if (X < info.xFirst || X > info.xLast || Y < info.yFirst || Y > info.yLast) break;
+                            const int g = distanceGroup(field.steps[static_cast<std::size_t>(i)].tauCells);
+                            const float bound = std::min(azimuthMove[j * planeR + r],
+                                                         groupMove[static_cast<std::size_t>(g) * planeR + r]);
+                            const std::ptrdiff_t at = static_cast<std::ptrdiff_t>(Y) * info.step.rowStep + X;
+                            for (std::size_t ch = 0; ch < 3; ++ch) {
+                                // the same step's taps in each channel's pyramid (one layout)
+                                const ScanStepInfo a = scanStepInfo(p0.fields[ch], i, cs, sn);
+                                const ScanStepInfo b = scanStepInfo(p1.fields[ch], i, cs, sn);
+                                const float sample = stepSample(b.step, at);
+                                const double move = std::fabs(static_cast<double>(sample) - stepSample(a.step, at));
+                                // in real arithmetic: the pyramids' own rounding (up to about a
+                                // hundred float epsilons of the radiance, through the octaves'
+                                // means and syntheses) is not bounded
+                                const double rounding = 256.0 * FLT_EPSILON * std::fabs(sample);
+                                excess = std::max(excess, move - (bound + rounding));
+                                // no move at all where the bound is 0
+                                if (bound == 0.0f) zeroMoved = std::max(zeroMoved, move);
+                                if (bound > 1e-4f) worst = std::max(worst, move / bound);
+                            }
+                        }
+                    }
+            }
+            CHECK(excess <= 0.0);
+            CHECK(zeroMoved == 0.0);
+            MESSAGE(c.nx << " x " << c.ny << " s=" << c.subsample << " change " << kind
+                         << ": largest sample move / its bound " << worst);
+            // the same values walked over a few tiles alone
+            ReceiverTiles only;
+            only.reset(field.nxr, field.nyr, 16, false);
+            only.dirty[0] = only.dirty[only.dirty.size() - 1] = 1;
+            std::vector<float> az = azimuthMove, gr = groupMove;
+            std::fill(az.begin(), az.end(), -1.0f);
+            std::fill(gr.begin(), gr.end(), -1.0f);
+            boundSampleMovePerReceiver(levels, field, op.phi, &only, az, gr);
+            int mismatched = 0;
+            for (std::size_t r = 0; r < planeR; ++r) {
+                const int X = static_cast<int>(r % static_cast<std::size_t>(field.nxr)) / 16;
+                const int Y = static_cast<int>(r / static_cast<std::size_t>(field.nxr)) / 16;
+                const bool walked = only.isDirty(X, Y);
+                for (std::size_t j = 0; j < m; ++j)
+                    mismatched += az[j * planeR + r] != (walked ? azimuthMove[j * planeR + r] : -1.0f) ? 1 : 0;
+                for (std::size_t g = 0; g < kDistanceGroups; ++g)
+                    mismatched += gr[g * planeR + r] != (walked ? groupMove[g * planeR + r] : -1.0f) ? 1 : 0;
+            }
+            CHECK(mismatched == 0);
+        }
+    }
 }
