@@ -135,7 +135,8 @@ void runIndirectStage(ConstGridView heights, const GiSettings& settings, const F
     st.indirect.timings.total += pyramidMs;
     st.directChanged = CellBox::none();  // the indirect light has read every change
     if (cached && only == nullptr)
-        recordIndirectSource(st.shade.rgb, st.indirect.radiance, st.pyramid, st.indirectCache);
+        recordIndirectSource(st.shade.rgb, st.indirect.radiance, st.pyramid, static_cast<int>(op.phi.size()),
+                             st.indirectCache);
     st.indirectCache.geometryVersion = st.geometryVersion;
     st.indirectRecomputed = only ? only->dirtyFraction() : 1.0;
     st.timings.indirect = msSince(t);

@@ -398,12 +398,19 @@ const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCac
 }
 
 void recordIndirectSource(const std::array<Grid, 3>& source, const RadiancePyramid& pyramid,
-                          const HeightPyramid& heights, IndirectCache& cache) {
+                          const HeightPyramid& heights, int azimuths, IndirectCache& cache) {
     cache.anchorSource = source;
     cache.levelsRecorded = !cache.levels.fits(pyramid);
     if (cache.levelsRecorded) {
         recordAnchorLevels(pyramid, cache.levels);
         buildLevelChanges(pyramid, CellBox::none(), cache.levels);
+        // the receivers' walks (refinePerReceiver): their pyramid, of no change yet, and their planes
+        const std::array<ConstGridView, 3> views{source[0].cview(), source[1].cview(), source[2].cview()};
+        buildMaxChangePyramid(views, views, cache.change);
+        buildChangeLevels(cache.change, pyramid.fields[0], cache.receiverLevels);
+        const std::size_t planeR = static_cast<std::size_t>(heights.nxr) * heights.nyr;
+        cache.receiverAzimuthMove.resize(static_cast<std::size_t>(azimuths) * planeR);
+        cache.receiverGroupMove.resize(kDistanceGroups * planeR);
     }
     cache.anchorChanged = CellBox::none();
     cache.tiles.reset(heights.nxr, heights.nyr, kIndirectTile, false);

@@ -191,14 +191,16 @@ bool startIndirectPlan(const IndirectPlanInputs& in, IndirectCache& cache);
 const ReceiverTiles* planIndirectTiles(const IndirectPlanInputs& in, IndirectCache& cache);
 
 /// After an indirect pass over `source` (its RGB radiance pyramid `pyramid`,
-/// on the receiver grid of `heights`) that gathered every receiver: `source`
-/// is the anchor the next frames compare with, the drifts start again at 0.
-/// The pyramid's levels are copied by the next plan, if any; only the first
-/// pass on a grid copies them at once, with their (zero) change, so that
-/// the cache's memory is taken then and not in the middle of a run. (A
-/// planned pass moved the anchor, if at all, in planIndirectTiles.)
+/// on the receiver grid of `heights`, with the scan's `azimuths`) that
+/// gathered every receiver: `source` is the anchor the next frames compare
+/// with, the drifts start again at 0. The pyramid's levels are copied by the
+/// next plan, if any; only the first pass on a grid copies them at once,
+/// with their (zero) change, and sizes the receivers' walks (their pyramid
+/// and planes), so that the cache's memory is taken then and not in the
+/// middle of a run. (A planned pass moved the anchor, if at all, in
+/// planIndirectTiles.)
 void recordIndirectSource(const std::array<Grid, 3>& source, const RadiancePyramid& pyramid,
-                          const HeightPyramid& heights, IndirectCache& cache);
+                          const HeightPyramid& heights, int azimuths, IndirectCache& cache);
 
 /// After an indirect pass whose texel passes redid the receivers'
 /// occlusions in the tiles `redone` (cache.texels) and the texels'
