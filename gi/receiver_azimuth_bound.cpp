@@ -16,15 +16,22 @@ void buildChangeLevels(const MaxChangePyramid& dh, const HeightPyramid& pyr, Cha
     const HeightPyramid& b = out.bound;
     const bool same = out.valid && b.nx == pyr.nx && b.ny == pyr.ny && b.subsample == pyr.subsample &&
                       b.cellSize == pyr.cellSize && b.settings == pyr.settings;
+    const ConstGridView input = dh.levels[0].cview();
     const CellBox nonZero = changedCells(dh);
+    out.largest = maxChangeAll(dh);
     const CellBox redo = same ? out.built.joined(nonZero) : CellBox{};
-    out.valid = false;  // until built
-    if (!same || !redo.empty())
-        buildHeightPyramid(dh.levels[0].cview(), pyr.cellSize, pyr.subsample, pyr.settings, out.bound, redo);
+    // nothing to redo without a change (no walk reads the pyramid then: it
+    // keeps the last one, and `built` its box) or with the last build's
+    // input again (a pit dropped, filled and dropped)
+    const bool kept = same && (nonZero.empty() || differingCellsIn(out.input.cview(), input, redo).empty());
+    if (!kept) {
+        out.valid = false;  // until built
+        buildHeightPyramid(input, pyr.cellSize, pyr.subsample, pyr.settings, out.bound, redo);
+        copyGrid(input, out.input, same ? redo.rows() : RowSpan{0, input.ny});
+        out.built = nonZero;
+    }
     // the field's own steps (a radiance field's are the height pyramid's taus, gi/radiance_pyramid.h)
     out.bound.steps = pyr.steps;
-    out.built = nonZero;
-    out.largest = maxChangeAll(dh);
     out.valid = true;
 }
 

@@ -55,9 +55,10 @@ struct ChangeWalk {
 /// and the bounds' scratch (reused: no allocation once sized).
 struct ChangeLevels {
     HeightPyramid bound;
-    CellBox built = CellBox::none();
-    float largest = 0.0f;  // max |dh|
-    bool valid = false;    // `bound` was built for the grid and settings of the last call
+    Grid input;                       // the |dh| `bound` was built from
+    CellBox built = CellBox::none();  // holds every non-zero cell of `input`
+    float largest = 0.0f;             // max |dh|
+    bool valid = false;               // `bound` was built for the grid and settings of the last call
     std::vector<ChangeWalk> walks;
     std::vector<float> tails;
     DirtySpans spans;
@@ -68,8 +69,10 @@ struct ChangeLevels {
 /// build's: the old and the new box of non-zero |dh|) the |dh| pyramid of
 /// `dh` (its level 0, |dh| per cell rounded up) for the pyramid `pyr` of
 /// the field that changed by dh, with pyr's settings and steps: the heights',
-/// or a radiance channel's (gi/radiance_pyramid.h; below). Throws InputError
-/// when the sizes of dh and pyr differ.
+/// or a radiance channel's (gi/radiance_pyramid.h; below). Nothing is redone
+/// when dh is 0 everywhere (no walk reads the pyramid then; `largest` says
+/// so) or equals the last build's input (a change undone and made again).
+/// Throws InputError when the sizes of dh and pyr differ.
 void buildChangeLevels(const MaxChangePyramid& dh, const HeightPyramid& pyr, ChangeLevels& out);
 
 /// Per receiver and azimuth phi_j (radians), a bound on |change| of its
