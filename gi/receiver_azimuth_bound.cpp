@@ -103,47 +103,48 @@ void buildWalks(const HeightPyramid& b, std::span<const double> phi, float large
     }
 }
 
-// The receivers [a, e] of row Y's span [x0, x1) that step bs reads: kStop
-// when none is inside the domain (the valid ranges only shrink: once empty,
-// for good), kSkip when its taps read no texel of non-zero |dh| bound and
-// no receiver of the span has a change of its own (`ownChange`).
-enum class StepReach { kWalk, kSkip, kStop };
-inline StepReach stepReach(const ChangeWalk::Step& bs, int Y, int x0, int x1, bool ownChange, int& a, int& e) {
-    a = std::max(x0, bs.x0);
-    e = std::min(x1 - 1, bs.x1);
-    if (Y < bs.y0 || Y > bs.y1 || a > e) return StepReach::kStop;
-    const int tx0 = bs.k * a + bs.tapX, tx1 = bs.k * e + bs.tapX + bs.nextX + 1;
-    const int ty0 = bs.k * Y + bs.tapY, ty1 = ty0 + bs.nextY + 1;
-    const CellBox& c = bs.changed;
-    const bool reads = !(tx1 <= c.x0 || tx0 >= c.x1 || ty1 <= c.y0 || ty0 >= c.y1);
-    return reads || ownChange ? StepReach::kWalk : StepReach::kSkip;
+// Calls step(bs, fa, fb, a, e) for each walked step of `walk` whose taps
+// row Y's receivers [a, e] of the span [x0, x1) read (fa, fb: the two tap
+// rows, indexed by the receiver's column): up to the first step none of
+// them is inside the domain at (the valid ranges only shrink: once empty,
+// for good), skipping the steps whose taps read no texel of non-zero |dh|
+// bound unless some receiver of the span has a change of its own
+// (`ownChange`: a step's sample then adds 0).
+template <class Step>
+[[gnu::always_inline]] inline void forEachReadingStep(const ChangeWalk& walk, int Y, int x0, int x1, bool ownChange,
+                                                      Step&& step) {
+    for (const ChangeWalk::Step& bs : walk.steps) {
+        const int a = std::max(x0, bs.x0), e = std::min(x1 - 1, bs.x1);
+        if (Y < bs.y0 || Y > bs.y1 || a > e) break;
+        const int tx0 = bs.k * a + bs.tapX, tx1 = bs.k * e + bs.tapX + bs.nextX + 1;
+        const int ty0 = bs.k * Y + bs.tapY, ty1 = ty0 + bs.nextY + 1;
+        const CellBox& c = bs.changed;
+        if (!ownChange && (tx1 <= c.x0 || tx0 >= c.x1 || ty1 <= c.y0 || ty0 >= c.y1)) continue;
+        const ScanStep& st = bs.step;
+        const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(Y) * st.rowStep;
+        step(bs, st.field + st.offA + row, st.field + st.offB + row, a, e);
+    }
 }
 
 // One receiver row's span [x0, x1) along one azimuth into o (the row of
 // out): the largest slope bound of its walked steps, at least the tail's.
-// `ownChange`: some receiver of the span may have a height change of its own
-// (else a step whose samples all read texels of zero |dh| bound adds 0).
 template <class V>
 [[gnu::always_inline]] inline void walkSpan(const ChangeWalk& walk, const float* dh0, int Y, int x0, int x1,
                                             bool ownChange, float* o) {
     for (int X = x0; X < x1; ++X) o[X] = walk.tail;
-    for (const ChangeWalk::Step& bs : walk.steps) {
-        int a = 0, e = 0;
-        const StepReach reach = stepReach(bs, Y, x0, x1, ownChange, a, e);
-        if (reach == StepReach::kStop) break;
-        if (reach == StepReach::kSkip) continue;
-        const ScanStep& st = bs.step;
-        const float* fa = st.field + st.offA + static_cast<std::ptrdiff_t>(Y) * st.rowStep;
-        const float* fb = st.field + st.offB + static_cast<std::ptrdiff_t>(Y) * st.rowStep;
-        const V wa = simd::splat<V>(st.w[0][0]), wb = simd::splat<V>(st.w[1][0]), inv = simd::splat<V>(st.w[2][0]);
-        constexpr int L = simd::kLaneCount<V>;
-        int X = a;
-        for (; X + L <= e + 1; X += L) {
-            const V v = (wa * simd::load<V>(fa + X) + wb * simd::load<V>(fb + X) + simd::load<V>(dh0 + X)) * inv;
-            simd::store(o + X, simd::vmax(simd::load<V>(o + X), v));
-        }
-        for (; X <= e; ++X) o[X] = std::max(o[X], (st.w[0][0] * fa[X] + st.w[1][0] * fb[X] + dh0[X]) * st.w[2][0]);
-    }
+    forEachReadingStep(
+        walk, Y, x0, x1, ownChange, [&](const ChangeWalk::Step& bs, const float* fa, const float* fb, int a, int e) {
+            const ScanStep& st = bs.step;
+            const V wa = simd::splat<V>(st.w[0][0]), wb = simd::splat<V>(st.w[1][0]);
+            const V inv = simd::splat<V>(st.w[2][0]);
+            constexpr int L = simd::kLaneCount<V>;
+            int X = a;
+            for (; X + L <= e + 1; X += L) {
+                const V v = (wa * simd::load<V>(fa + X) + wb * simd::load<V>(fb + X) + simd::load<V>(dh0 + X)) * inv;
+                simd::store(o + X, simd::vmax(simd::load<V>(o + X), v));
+            }
+            for (; X <= e; ++X) o[X] = std::max(o[X], (st.w[0][0] * fa[X] + st.w[1][0] * fb[X] + dh0[X]) * st.w[2][0]);
+        });
 }
 
 // The same walk bounding the samples' own moves, w_a D[a] + w_b D[b]: their
@@ -154,29 +155,24 @@ template <class V>
 [[gnu::always_inline]] inline void walkMoveSpan(const ChangeWalk& walk, int Y, int x0, int x1, float* o, float* groups,
                                                 std::size_t groupStride) {
     for (int X = x0; X < x1; ++X) o[X] = 0.0f;
-    for (const ChangeWalk::Step& bs : walk.steps) {
-        int a = 0, e = 0;
-        const StepReach reach = stepReach(bs, Y, x0, x1, false, a, e);
-        if (reach == StepReach::kStop) break;
-        if (reach == StepReach::kSkip) continue;
-        const ScanStep& st = bs.step;
-        const float* fa = st.field + st.offA + static_cast<std::ptrdiff_t>(Y) * st.rowStep;
-        const float* fb = st.field + st.offB + static_cast<std::ptrdiff_t>(Y) * st.rowStep;
-        float* g = groups + static_cast<std::size_t>(bs.group) * groupStride;
-        const V wa = simd::splat<V>(st.w[0][0]), wb = simd::splat<V>(st.w[1][0]);
-        constexpr int L = simd::kLaneCount<V>;
-        int X = a;
-        for (; X + L <= e + 1; X += L) {
-            const V v = wa * simd::load<V>(fa + X) + wb * simd::load<V>(fb + X);
-            simd::store(o + X, simd::vmax(simd::load<V>(o + X), v));
-            simd::store(g + X, simd::vmax(simd::load<V>(g + X), v));
-        }
-        for (; X <= e; ++X) {
-            const float v = st.w[0][0] * fa[X] + st.w[1][0] * fb[X];
-            o[X] = std::max(o[X], v);
-            g[X] = std::max(g[X], v);
-        }
-    }
+    forEachReadingStep(walk, Y, x0, x1, false,
+                       [&](const ChangeWalk::Step& bs, const float* fa, const float* fb, int a, int e) {
+                           const ScanStep& st = bs.step;
+                           float* g = groups + static_cast<std::size_t>(bs.group) * groupStride;
+                           const V wa = simd::splat<V>(st.w[0][0]), wb = simd::splat<V>(st.w[1][0]);
+                           constexpr int L = simd::kLaneCount<V>;
+                           int X = a;
+                           for (; X + L <= e + 1; X += L) {
+                               const V v = wa * simd::load<V>(fa + X) + wb * simd::load<V>(fb + X);
+                               simd::store(o + X, simd::vmax(simd::load<V>(o + X), v));
+                               simd::store(g + X, simd::vmax(simd::load<V>(g + X), v));
+                           }
+                           for (; X <= e; ++X) {
+                               const float v = st.w[0][0] * fa[X] + st.w[1][0] * fb[X];
+                               o[X] = std::max(o[X], v);
+                               g[X] = std::max(g[X], v);
+                           }
+                       });
 }
 
 // Every azimuth's walk over the row's spans; azimuth j's bounds go to the
