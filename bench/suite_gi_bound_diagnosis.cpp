@@ -28,7 +28,6 @@
 #include "gi/change_bound.h"
 #include "gi/frame.h"
 #include "gi/indirect_cache.h"
-#include "gi/max_octave_change.h"
 #include "gi/receiver_azimuth_bound.h"
 #include "gi/receiver_change_bound.h"
 #include "gi/visibility_cache.h"
@@ -109,15 +108,6 @@ struct Track {
     // (gi/receiver_azimuth_bound.h): alone, in runs of 16, and its cost (ms)
     std::vector<double> sampleShare, sampleRunShare, sampleMs;
     gi::ChangeLevels changeLevels;  // its |dh| pyramid, redone from frame to frame as a plan would
-    // Per octave of the height pyramid's max-decimated images, summed over
-    // their texels and the frames: the largest |dh| over the texel's block
-    // (what the bounds charge the levels' peak-keeping part), the bound of
-    // gi/max_octave_change.h, the true change of the texel; and the texels.
-    struct OctaveSums {
-        double largest = 0.0, bound = 0.0, truth = 0.0, texels = 0.0;
-    };
-    std::vector<OctaveSums> octaves;
-    gi::MaxOctaveChange octaveChange;
 };
 
 // Copies the receivers (V) or texels (indirect light) of the tiles of T x T
@@ -278,33 +268,6 @@ IndirectBounds indirectBounds(const GiState& now, const GiState& last, int azimu
     return out;
 }
 
-// This frame's max-decimated octaves against the last frame's (Track::octaves).
-void addOctaveChanges(Track& t) {
-    const std::vector<Grid>&before = t.last.pyramid.maxOctaves, &after = t.now.pyramid.maxOctaves;
-    gi::boundMaxOctaveChange(t.lastHeights.cview(), t.heights.cview(), before, after, t.octaveChange);
-    t.octaves.resize(before.size());
-    Grid largest = t.octaveChange.cells, coarser;  // per block, its largest |dh|
-    for (std::size_t o = 0; o < before.size(); ++o) {
-        const Grid& bound = t.octaveChange.bound[o];
-        coarser.ensureSize(bound.nx, bound.ny);
-        Track::OctaveSums& sum = t.octaves[o];
-        for (int y = 0; y < bound.ny; ++y)
-            for (int x = 0; x < bound.nx; ++x) {
-                float m = 0.0f;
-                for (int dy = 0; dy < 2; ++dy)
-                    for (int dx = 0; dx < 2; ++dx)
-                        m = std::max(
-                            m, largest(std::min(2 * x + dx, largest.nx - 1), std::min(2 * y + dy, largest.ny - 1)));
-                coarser(x, y) = m;
-                sum.largest += m;
-                sum.bound += bound(x, y);
-                sum.truth += std::fabs(static_cast<double>(after[o](x, y)) - before[o](x, y));
-                sum.texels += 1.0;
-            }
-        std::swap(largest, coarser);
-    }
-}
-
 void measureFrame(Track& t, const gi::GiSettings& settings, float cell, float tolerance) {
     const gi::GiLighting sky;  // uniform unit sky
     gi::runGiFrame(t.heights.cview(), cell, sky, settings, t.now);
@@ -314,7 +277,6 @@ void measureFrame(Track& t, const gi::GiSettings& settings, float cell, float to
     if (t.lastHeights.empty()) return;
     for (std::size_t i = 0; i < t.heights.v.size(); ++i)
         t.dh.push_back(std::fabs(static_cast<double>(t.heights.v[i]) - t.lastHeights.v[i]));
-    addOctaveChanges(t);
     gi::VisibilityCache cache;  // fresh, anchored at the last heights: one plan's excursion is the frame's bound
     gi::planVisibilityTiles(t.lastHeights.cview(), t.heights.cview(), t.now.pyramid, settings.visibility, {}, 1e30f,
                             cache);
@@ -378,11 +340,7 @@ const char* kIntro =
     "very samples its scan reads, gi/receiver_azimuth_bound.h, with what it costs on 2 threads: the |dh| pyramid "
     "redone over the change since the last frame, the scan over every receiver and the V bound) and the shares of the "
     "receivers an oracle with "
-    "tiles of that size recomputes, mean over the frames after the first. The third table takes the height "
-    "pyramid's max-decimated octave images (the levels' peak-keeping part, PyramidSettings::peakBlend of them): per "
-    "octave, the mean over its texels and the frames of the largest |dh| over the texel's block (what the bounds "
-    "above charge that part today), of gi/max_octave_change.h's bound (a cell far below its block's peak cannot move "
-    "the peak), and of the true change of the block's maximum.\n";
+    "tiles of that size recomputes, mean over the frames after the first.\n";
 
 // One row per quantity: its quantiles and the share of tiles (or cells) above the tolerance.
 std::string row(const std::string& what, const std::vector<double>& v, double above) {
@@ -427,22 +385,6 @@ std::string granularityTable(const Track& t) {
     return out + buf;
 }
 
-// Track::octaves as a table.
-std::string octaveTable(const Track& t) {
-    std::string out =
-        "\n| max-decimated octave (block side, cells) | mean largest \\|dh\\| over the block | mean bound of "
-        "gi/max_octave_change.h | mean true change of the block's maximum | largest / bound |\n|---|---|---|---|---|\n";
-    char buf[300];
-    for (std::size_t o = 0; o < t.octaves.size(); ++o) {
-        const Track::OctaveSums& s = t.octaves[o];
-        const double n = std::max(s.texels, 1.0);
-        std::snprintf(buf, sizeof buf, "| %zu (%d) | %.3g | %.3g | %.3g | %.1f |\n", o + 1, 2 << o, s.largest / n,
-                      s.bound / n, s.truth / n, s.bound > 0.0 ? s.largest / s.bound : 0.0);
-        out += buf;
-    }
-    return out;
-}
-
 std::string report(const Track& t, float tolerance) {
     std::vector<double> ratio;
     for (std::size_t i = 0; i < t.bound.size(); ++i)
@@ -460,7 +402,7 @@ std::string report(const Track& t, float tolerance) {
                0.0) +
            row("oracle: share of the tiles whose indirect light it recomputes, per frame (share above 0)",
                t.oracles[0].indirectShare, 0.0) +
-           granularityTable(t) + octaveTable(t);
+           granularityTable(t);
 }
 
 gi::GiSettings diagnosisSettings() {
