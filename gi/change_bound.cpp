@@ -401,10 +401,10 @@ void forEachTile(const HeightPyramid& pyr, int T, std::vector<float>& out, PerTi
 // Fills `azimuths` values per tile (tile-major) at the m samples phi_j = 2 pi
 // j / m of the full circle, tile rows in parallel: perTile(the tile's cells,
 // cos phi_j and sin phi_j of every j, out, the tile's index) writes one
-// tile's m values.
+// tile's m values; with `only`, the flagged tiles' (the others get 0).
 template <class PerTile>
 void forEachTileAndAzimuth(const MaxChangePyramid& dv, const HeightPyramid& pyr, int T, int azimuths,
-                           std::vector<float>& out, PerTile&& perTile) {
+                           std::vector<float>& out, std::span<const std::uint8_t> only, PerTile&& perTile) {
     requireSameSize(dv, pyr, T);
     if (azimuths < 1) throw InputError("change bound: at least one azimuth");
     std::vector<double> cs(static_cast<std::size_t>(azimuths)), sn(cs.size());
@@ -415,12 +415,18 @@ void forEachTileAndAzimuth(const MaxChangePyramid& dv, const HeightPyramid& pyr,
     }
     const int tilesX = tileCount(pyr.nxr, T), tilesY = tileCount(pyr.nyr, T);
     const std::size_t m = static_cast<std::size_t>(azimuths);
-    out.resize(static_cast<std::size_t>(tilesX) * static_cast<std::size_t>(tilesY) * m);
+    const std::size_t tiles = static_cast<std::size_t>(tilesX) * static_cast<std::size_t>(tilesY);
+    if (!only.empty() && only.size() != tiles) throw InputError("change bound: one flag per tile");
+    out.resize(tiles * m);
     parallelFor(0, tilesY, 1, [&](int ty0, int ty1) {
         for (int ty = ty0; ty < ty1; ++ty)
             for (int tx = 0; tx < tilesX; ++tx) {
-                float* values = out.data() + (static_cast<std::size_t>(ty) * tilesX + tx) * m;
-                perTile(tileCells(pyr, T, tx, ty), cs, sn, values, static_cast<std::size_t>(ty) * tilesX + tx);
+                const std::size_t t = static_cast<std::size_t>(ty) * tilesX + tx;
+                float* values = out.data() + t * m;
+                if (only.empty() || only[t])
+                    perTile(tileCells(pyr, T, tx, ty), cs, sn, values, t);
+                else
+                    std::fill(values, values + m, 0.0f);
             }
     });
 }
@@ -618,6 +624,20 @@ float gradientBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, 
     return floatNotBelow((border ? 2.0 : 1.0) * m / pyr.cellSize);
 }
 
+float largestReceiverGradientBound(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int tx,
+                                   int ty) {
+    const InclusiveCells c = tileCells(pyr, tileReceivers, tx, ty);
+    const int half = pyr.subsample / 2;
+    const bool inside = c.x0 - half > 0 && c.y0 - half > 0 && c.x1 + half < pyr.nx - 1 && c.y1 + half < pyr.ny - 1;
+    // inside: the receivers' boxes make up the tile's, with no one-sided differences in any
+    if (inside) return gradientBoundOfTile(dh, pyr, tileReceivers, tx, ty);
+    float largest = 0.0f;
+    const int s = pyr.subsample;
+    for (int Y = c.y0 / s; Y <= c.y1 / s; ++Y)
+        for (int X = c.x0 / s; X <= c.x1 / s; ++X) largest = std::max(largest, gradientBoundOfTile(dh, pyr, 1, X, Y));
+    return largest;
+}
+
 void boundGradientChange(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers,
                          std::vector<float>& tileBound) {
     requireSameSize(dh, pyr, tileReceivers);
@@ -641,10 +661,10 @@ float azimuthBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, i
 }
 
 void boundSlopeChangePerAzimuth(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int azimuths,
-                                std::vector<float>& tileBound) {
+                                std::vector<float>& tileBound, std::span<const std::uint8_t> only) {
     const StepTable steps = stepTable(pyr);
     const double lipschitz = heightFilterLipschitz(pyr);
-    forEachTileAndAzimuth(dh, pyr, tileReceivers, azimuths, tileBound,
+    forEachTileAndAzimuth(dh, pyr, tileReceivers, azimuths, tileBound, only,
                           [&](const InclusiveCells& c, const std::vector<double>& cs, const std::vector<double>& sn,
                               float* out, std::size_t) {
                               const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);

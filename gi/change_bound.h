@@ -246,9 +246,11 @@ float azimuthBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, i
 
 /// azimuthBoundOfTile of every tile at the m = azimuths samples phi_j = 2 pi
 /// j / m of the full circle (gi/wedge.h, foldFullCircle): tileBound[t m + j],
-/// tiles row-major as boundSlopeChange (same errors; InputError for azimuths < 1).
+/// tiles row-major as boundSlopeChange (same errors; InputError for azimuths
+/// < 1). With `only` (one flag per tile), of the flagged tiles alone: the
+/// others' values are 0.
 void boundSlopeChangePerAzimuth(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int azimuths,
-                                std::vector<float>& tileBound);
+                                std::vector<float>& tileBound, std::span<const std::uint8_t> only = {});
 
 // A key light's visibility reads only the azimuths of its region of the
 // sky, [phi0, phi1]: the sample points of every such azimuth lie in the tile's
@@ -285,6 +287,13 @@ float blockingMaxLipschitz(BlockingMax rule);
 /// Bound on |change| of each gradient component (metres per metre) over the
 /// footprint texels of tile (tx, ty).
 float gradientBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int tx, int ty);
+
+/// The largest over the receivers of tile (tx, ty) of each one's own
+/// gradientBoundOfTile (tiles of one receiver): the tile's own bound where
+/// its footprint keeps off the field's edges (the receivers' boxes then
+/// make up the tile's), else taken receiver by receiver.
+float largestReceiverGradientBound(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int tx,
+                                   int ty);
 
 /// gradientBoundOfTile of every tile (layout and errors as boundSlopeChange).
 void boundGradientChange(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers,

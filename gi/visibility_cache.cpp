@@ -25,18 +25,23 @@ bool shouldPlanTiles(VisibilityCache& cache) { return !skipsPlan(cache.skips); }
 
 namespace {
 
-// Per tile, the largest over the key lights of the bound on each one's
-// visible fraction (keyLightFractionBound; an SH-shaded light: infinite
-// where its slopes may have moved at all). 0 without key lights.
+// Per cache tile, the largest over the key lights of the bound on each
+// one's visible fraction (keyLightFractionBound; an SH-shaded light:
+// infinite where its slopes may have moved at all), into keyExcursion. 0
+// without key lights. Taken over the cache tiles themselves, not their
+// visibility tiles: a light's few azimuths see a change along a narrow
+// strip, which a larger tile's reach widens (the 51² pit's key tiles: 20
+// instead of 36).
 void boundKeyFractions(const HeightPyramid& pyr, const std::vector<KeyLightRegion>& keys, float lipschitz,
                        VisibilityCache& cache) {
-    cache.keyBound.assign(cache.slopeBound.size(), 0.0f);
+    cache.keyExcursion.assign(cache.cacheGradBound.size(), 0.0f);
     for (const KeyLightRegion& k : keys) {
-        boundSlopeChangeOverRange(cache.change, pyr, kVisibilityTile, k.phi0, k.phi1, cache.rangeBound);
-        for (std::size_t t = 0; t < cache.keyBound.size(); ++t) {
-            float f = keyLightFractionBound(lipschitz * cache.rangeBound[t], cache.gradBound[t], k.sinLow, k.sinHigh);
+        boundSlopeChangeOverRange(cache.change, pyr, kCacheTile, k.phi0, k.phi1, cache.rangeBound);
+        for (std::size_t t = 0; t < cache.keyExcursion.size(); ++t) {
+            float f =
+                keyLightFractionBound(lipschitz * cache.rangeBound[t], cache.cacheGradBound[t], k.sinLow, k.sinHigh);
             if (!k.exactCosine && f > 0.0f) f = std::numeric_limits<float>::infinity();
-            cache.keyBound[t] = std::max(cache.keyBound[t], f);
+            cache.keyExcursion[t] = std::max(cache.keyExcursion[t], f);
         }
     }
 }
@@ -56,15 +61,20 @@ bool planKeyBrightness(const std::vector<KeyLightRegion>& keys, float tolerance,
 }
 
 void environmentBoundPerTile(std::span<const float> azimuthBound, std::span<const float> gradBound, int azimuths,
-                             float lipschitz, std::vector<float>& scratch, std::vector<float>& out) {
+                             float lipschitz, std::vector<float>& scratch, std::vector<float>& out, int stride) {
     const std::size_t m = static_cast<std::size_t>(azimuths), tiles = gradBound.size();
-    if (azimuths < 1 || azimuthBound.size() != tiles * m)
-        throw InputError("environmentBoundPerTile: one slope bound per tile and azimuth, at least one azimuth");
-    scratch.resize(m);  // no allocation after the first frame of these settings
+    if (azimuths < 1 || azimuthBound.size() != tiles * m || stride < 1 || azimuths % stride != 0)
+        throw InputError(
+            "environmentBoundPerTile: one slope bound per tile and azimuth, at least one azimuth, a stride that "
+            "divides them");
+    const int taken = azimuths / stride;
+    scratch.resize(static_cast<std::size_t>(taken));  // no allocation after the first frame of these settings
     out.resize(tiles);
     for (std::size_t t = 0; t < tiles; ++t) {
-        for (std::size_t j = 0; j < m; ++j) scratch[j] = lipschitz * azimuthBound[t * m + j];
-        out[t] = ambientChangeBoundPerAzimuth(scratch.data(), azimuths, gradBound[t], 1.0f, false);
+        for (int q = 0; q < taken; ++q)
+            scratch[static_cast<std::size_t>(q)] =
+                lipschitz * azimuthBound[t * m + static_cast<std::size_t>(q * stride)];
+        out[t] = ambientChangeBoundPerAzimuth(scratch.data(), taken, gradBound[t], 1.0f, false);
     }
 }
 
@@ -90,37 +100,97 @@ void onCacheTiles(const std::vector<float>& perTile, const ReceiverTiles& tiles,
                 perTile[static_cast<std::size_t>(ty / kPer) * visibilityX + tx / kPer];
 }
 
+// Which drifts' candidates a refinement takes (env, geometry), and whether a
+// cache tile is over the tolerance for either.
+struct Candidates {
+    bool env = false, geometry = false;
+    bool over(const VisibilityCache& cache, std::size_t t, float tolerance) const {
+        return (env && cache.drift.fromAnchor[t] + cache.envExcursion[t] > tolerance) ||
+               (geometry && cache.geometryDrift.fromAnchor[t] + cache.geometryExcursion[t] > tolerance);
+    }
+};
+
+// Takes off cache.refined the candidates that recompute whatever their
+// receivers' walks find, for each drift they are a candidate for: those
+// whose receivers' own gradient bounds alone put one of them over the
+// tolerance. A receiver's bound is at least the one its gradient bound
+// gives with every slope bound 0 (each azimuth's term is the larger of the
+// two, and the sum and the rounding are monotone), and the tile's refined
+// bound is its receivers' largest. Unwalked, such a tile keeps its
+// visibility tile's bounds, which also put it over.
+void skipSurelyRecomputed(const HeightPyramid& pyr, int azimuths, float tolerance, int geometryStride,
+                          Candidates candidates, VisibilityCache& cache) {
+    ReceiverTiles& refined = cache.refined;
+    cache.tileAzimuths.assign(static_cast<std::size_t>(azimuths), 0.0f);
+    const float* zeros = cache.tileAzimuths.data();
+    for (int ty = 0; ty < refined.tilesY; ++ty)
+        for (int tx = 0; tx < refined.tilesX; ++tx) {
+            const std::size_t t = static_cast<std::size_t>(ty) * refined.tilesX + tx;
+            if (!refined.dirty[t]) continue;
+            const float g = largestReceiverGradientBound(cache.change, pyr, kCacheTile, tx, ty);
+            Candidates open = candidates;  // the drifts a walk could still keep it for
+            open.env = open.env && ambientChangeBoundPerAzimuth(zeros, azimuths, g, 1.0f, false) <= tolerance;
+            open.geometry = open.geometry && geometryStride > 0 &&
+                            ambientChangeBoundPerAzimuth(zeros, azimuths / geometryStride, g, 1.0f, false) <= tolerance;
+            refined.dirty[t] = open.over(cache, t, tolerance) ? 1 : 0;
+        }
+}
+
+// Lowers the excursions of cache.refined's tiles to the tiles' own box
+// bounds (those of their visibility tile over a smaller reach; a tile's
+// bounds hold wherever they were taken, whichever drift asked for them) and
+// keeps on it those still over the tolerance.
+void lowerToOwnTileBounds(const HeightPyramid& pyr, int azimuths, float lipschitz, float tolerance, int geometryStride,
+                          Candidates candidates, VisibilityCache& cache) {
+    ReceiverTiles& refined = cache.refined;
+    boundSlopeChangePerAzimuth(cache.change, pyr, kCacheTile, azimuths, cache.cacheAzimuthBound, refined.dirty);
+    environmentBoundPerTile(cache.cacheAzimuthBound, cache.cacheGradBound, azimuths, lipschitz, cache.tileAzimuths,
+                            cache.cacheEnvBound);
+    if (geometryStride > 0)
+        environmentBoundPerTile(cache.cacheAzimuthBound, cache.cacheGradBound, azimuths, lipschitz, cache.tileAzimuths,
+                                cache.cacheGeometryBound, geometryStride);
+    for (std::size_t t = 0; t < refined.dirty.size(); ++t) {
+        if (!refined.dirty[t]) continue;
+        cache.envExcursion[t] = std::min(cache.envExcursion[t], cache.cacheEnvBound[t]);
+        if (geometryStride > 0)
+            cache.geometryExcursion[t] = std::min(cache.geometryExcursion[t], cache.cacheGeometryBound[t]);
+        refined.dirty[t] = candidates.over(cache, t, tolerance) ? 1 : 0;
+    }
+}
+
 // The environment's ambient-map excursions of the cache tiles that they and
 // their drift would recompute, and the geometry's where the indirect scan
 // takes every k-th of the environment's azimuths (geometryStride k; 0:
-// not), each lowered to the largest of its receivers' own bounds where that
-// is smaller (gi/receiver_azimuth_bound.h); the others keep their
-// visibility tile's (each drift's all, when more than kRefineAtMost of the
-// tiles would be refined for it). The receivers' walks stop where no step
-// can add more than a sixteenth of the tolerance (tolerance 0: where no
-// step sees a change).
+// not), each lowered to the cache tile's own box bound where that is
+// smaller, and then, for those still over the tolerance and not recomputed
+// whatever their receivers' bounds, to the largest of those
+// (gi/receiver_azimuth_bound.h) where that is smaller; the others keep
+// their visibility tile's (each drift's all, when more than kRefineAtMost
+// of the tiles would be refined for it). The receivers' walks stop where no
+// step can add more than a sixteenth of the tolerance (tolerance 0: where
+// no step sees a change).
 void refinePerReceiver(const HeightPyramid& pyr, const VisibilitySettings& vis, float lipschitz, float tolerance,
                        int geometryStride, VisibilityCache& cache) {
     ReceiverTiles& refined = cache.refined;
     refined.reset(pyr.nxr, pyr.nyr, kCacheTile, false);
     const std::size_t tiles = refined.dirty.size();
-    const auto envOver = [&](std::size_t t) { return cache.drift.fromAnchor[t] + cache.envExcursion[t] > tolerance; };
-    const auto geometryOver = [&](std::size_t t) {
-        return cache.geometryDrift.fromAnchor[t] + cache.geometryExcursion[t] > tolerance;
+    const auto count = [&](Candidates c) {
+        std::size_t n = 0;
+        for (std::size_t t = 0; t < tiles; ++t) n += c.over(cache, t, tolerance) ? 1 : 0;
+        return n;
     };
-    std::size_t envCandidates = 0, geometryCandidates = 0;
-    for (std::size_t t = 0; t < tiles; ++t) {
-        envCandidates += envOver(t) ? 1 : 0;
-        geometryCandidates += geometryOver(t) ? 1 : 0;
-    }
     const auto worth = [&](std::size_t n) { return n > 0 && static_cast<double>(n) <= kRefineAtMost * tiles; };
-    const bool env = worth(envCandidates), geometry = geometryStride > 0 && worth(geometryCandidates);
-    if (!env && !geometry) return;
-    for (std::size_t t = 0; t < tiles; ++t) refined.dirty[t] = (env && envOver(t)) || (geometry && geometryOver(t));
+    const Candidates candidates{worth(count({true, false})), geometryStride > 0 && worth(count({false, true}))};
+    if (!candidates.env && !candidates.geometry) return;
+    for (std::size_t t = 0; t < tiles; ++t) refined.dirty[t] = candidates.over(cache, t, tolerance) ? 1 : 0;
+    const int m = vis.azimuths;
+    skipSurelyRecomputed(pyr, m, tolerance, geometryStride, candidates, cache);
+    lowerToOwnTileBounds(pyr, m, lipschitz, tolerance, geometryStride, candidates, cache);
+    if (refined.dirtyCount() == 0) return;
     // the environment's scan's azimuths, as foldFullCircle takes them
-    const double dphi = 2.0 * kPi / vis.azimuths;
-    cache.azimuths.resize(static_cast<std::size_t>(vis.azimuths));
-    for (int j = 0; j < vis.azimuths; ++j) cache.azimuths[static_cast<std::size_t>(j)] = dphi * j;
+    const double dphi = 2.0 * kPi / m;
+    cache.azimuths.resize(static_cast<std::size_t>(m));
+    for (int j = 0; j < m; ++j) cache.azimuths[static_cast<std::size_t>(j)] = dphi * j;
     // a uniform slope bound f on every azimuth adds kShadePerSlope lipschitz f to the ambient's
     const float floor = tolerance / (16.0f * kShadePerSlope * lipschitz);
     buildChangeLevels(cache.change, pyr, cache.receiverLevels);
@@ -160,9 +230,13 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
     const CellBox mayDiffer = cache.anchorDiffers.joined(sinceBefore).cut(after.nx, after.ny);
     const CellBox differing = differingCellsIn(cache.anchorHeights.cview(), after, mayDiffer);
     buildMaxChangePyramid(cache.anchorHeights.cview(), after, cache.change, differing);
-    boundSlopeChange(cache.change, pyr, kVisibilityTile, cache.slopeBound);
+    // the indirect scan's azimuths, when they are every k-th of the environment's
+    const bool subset = indirectAzimuths > 0 && vis.azimuths % indirectAzimuths == 0;
+    const int geometryStride = subset ? vis.azimuths / indirectAzimuths : 0;
+    if (geometryStride == 0) boundSlopeChange(cache.change, pyr, kVisibilityTile, cache.slopeBound);
     boundSlopeChangePerAzimuth(cache.change, pyr, kVisibilityTile, vis.azimuths, cache.azimuthBound);
     boundGradientChange(cache.change, pyr, kVisibilityTile, cache.gradBound);
+    boundGradientChange(cache.change, pyr, kCacheTile, cache.cacheGradBound);
     // V depends on the heights through the maximum blocking slope and, below
     // it, the tangent plane's slope along the azimuth (moving by at most
     // sqrt2 times a gradient component's bound); shading reruns at the new
@@ -171,12 +245,17 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
     boundKeyFractions(pyr, keys, lipschitz, cache);
     environmentBoundPerTile(cache.azimuthBound, cache.gradBound, vis.azimuths, lipschitz, cache.tileAzimuths,
                             cache.envBound);
-    geometryBoundPerTile(cache.slopeBound, cache.gradBound, lipschitz, cache.geometryBound);
+    // the geometry's over the indirect scan's own azimuths where known (each
+    // receiver's slope bounds along them are at most the tile's), else one
+    // slope bound over every direction
+    if (geometryStride > 0)
+        environmentBoundPerTile(cache.azimuthBound, cache.gradBound, vis.azimuths, lipschitz, cache.tileAzimuths,
+                                cache.geometryBound, geometryStride);
+    else
+        geometryBoundPerTile(cache.slopeBound, cache.gradBound, lipschitz, cache.geometryBound);
     onCacheTiles(cache.envBound, cache.tiles, cache.envExcursion);
-    onCacheTiles(cache.keyBound, cache.tiles, cache.keyExcursion);
     onCacheTiles(cache.geometryBound, cache.tiles, cache.geometryExcursion);
-    const bool subset = indirectAzimuths > 0 && vis.azimuths % indirectAzimuths == 0;
-    refinePerReceiver(pyr, vis, lipschitz, tolerance, subset ? vis.azimuths / indirectAzimuths : 0, cache);
+    refinePerReceiver(pyr, vis, lipschitz, tolerance, geometryStride, cache);
     // one anchor for the three drifts: they vote together on moving it
     AnchorVotes votes;
     markAnchoredDrift(cache.envExcursion, {}, 1.0f, tolerance, cache.drift, cache.tiles.dirty, votes);

@@ -20,18 +20,19 @@
 // their region of the sky: their tiles (keyTiles) keep a drift of their own
 // in visible fraction, the largest over the lights of each one's bound
 // (keyLightFractionBound: the slope bound over the light's azimuths,
-// boundSlopeChangeOverRange, over its window's height), and recompute when
-// it, times the sum of the lights' largest channels this frame, exceeds the
-// tolerance: the key lights' shade may then have drifted beyond it, in the
-// shade units of the lights themselves, not of a unit sky (a shadow edge
-// that moved across a texel is a change of the light's whole shade there),
-// and a light made brighter since counts at its new brightness. A key light
+// boundSlopeChangeOverRange, over its window's height, taken over each
+// cache tile itself), and recompute when it, times the sum of the lights'
+// largest channels this frame, exceeds the tolerance: the key lights' shade
+// may then have drifted beyond it, in the shade units of the lights
+// themselves, not of a unit sky (a shadow edge that moved across a texel is
+// a change of the light's whole shade there), and a light made brighter
+// since counts at its new brightness. A key light
 // shaded through SH (the paper's settings) recomputes every tile whose bound
 // is not 0, where its order-4 product has no such bound. The geometry
-// tiles (geometryTiles) do the same with the bound over every azimuth: what
-// the indirect light's casting sets may have moved (gi/indirect_cache.h);
-// where the indirect scan takes every k-th of the environment's azimuths,
-// refined per receiver with the same bound over those azimuths alone.
+// tiles (geometryTiles) do the same with the environment's bound taken over
+// the indirect scan's azimuths alone, where those are every k-th of the
+// environment's (else with one slope bound over every direction): what the
+// indirect light's casting sets may have moved (gi/indirect_cache.h).
 #include <span>
 #include <vector>
 
@@ -52,11 +53,13 @@ inline constexpr int kVisibilityTile = 32;
 
 /// Receivers per side of the tiles whose V is kept or recomputed, each with
 /// its own drift: a quarter of a visibility tile. A tile takes its
-/// visibility tile's bound, and where that would recompute it, the largest
-/// of its receivers' own bounds (gi/receiver_azimuth_bound.h) if smaller:
-/// the box bounds cost little per tile and rule out most of the field, the
-/// receivers' bounds are precise where a change lies near (a tile's bound
-/// charges each receiver with the largest change within reach of any).
+/// visibility tile's environment and geometry bounds, and where those would
+/// recompute it, the largest of its receivers' own bounds
+/// (gi/receiver_azimuth_bound.h) if smaller: the box bounds cost little per
+/// tile and rule out most of the field, the receivers' bounds are precise
+/// where a change lies near (a tile's bound charges each receiver with the
+/// largest change within reach of any). The key lights' bounds are taken
+/// over the cache tile itself.
 inline constexpr int kCacheTile = 16;
 static_assert(kVisibilityTile % kCacheTile == 0 && kCacheTile % ReceiverTiles::kTileAlign == 0,
               "cache tiles split visibility tiles into whole receiver groups");
@@ -77,14 +80,19 @@ struct VisibilityCache {
     CellBox anchorDiffers;    // holds every cell where they may differ from the last plan's (all)
     MaxChangePyramid change;  // |dh| from the anchor to this frame
     // this frame's bounds per visibility tile (kVisibilityTile)
-    std::vector<float> slopeBound, gradBound;    // all azimuths
+    std::vector<float> slopeBound, gradBound;    // all azimuths (slopeBound: only without a geometry stride)
     std::vector<float> azimuthBound;             // per tile and environment azimuth (tile-major)
-    std::vector<float> keyBound, rangeBound;     // the key lights' fraction bound; scratch: one light's slopes
-    std::vector<float> envBound, geometryBound;  // the ambient-map bound (environment, every azimuth)
+    std::vector<float> envBound, geometryBound;  // the ambient-map bound: every azimuth, the indirect scan's
     std::vector<float> tileAzimuths;             // scratch: one tile's per-azimuth slope bounds
-    // this frame's bounds per cache tile (kCacheTile): their visibility
-    // tile's, refined per receiver where those pass the tolerance
+    // this frame's bounds per cache tile (kCacheTile): the environment's and
+    // the geometry's their visibility tile's, lowered to the cache tile's own
+    // and its receivers' where those pass the tolerance; the key lights'
+    // fraction bound its own
     std::vector<float> envExcursion, keyExcursion, geometryExcursion;
+    std::vector<float> cacheGradBound;  // per cache tile: its own gradient bound
+    // scratch: one key light's slopes per cache tile; the refined cache
+    // tiles' own slope bounds per azimuth, environment and geometry bounds
+    std::vector<float> rangeBound, cacheAzimuthBound, cacheEnvBound, cacheGeometryBound;
     ChangeLevels receiverLevels;          // the |dh| pyramid of the receivers' bounds
     std::vector<double> azimuths;         // the environment's azimuths (radians) they are taken along
     std::vector<float> receiverBound;     // per receiver: the ambient-map bound (refined tiles only)
@@ -123,12 +131,15 @@ void forgetEnvironmentDrift(VisibilityCache& cache);
 /// sky) that its per-azimuth slope bounds (`azimuthBound`, tile-major, before
 /// the maximum rule's Lipschitz factor) and its gradient bound allow: what
 /// planVisibilityTiles adds to an environment tile's drift. `scratch` holds
-/// one tile's azimuths.
+/// one tile's azimuths. With a stride k, over every k-th azimuth alone (from
+/// the first; k divides `azimuths`): a geometry tile's, when the indirect
+/// scan takes every k-th of the environment's azimuths.
 void environmentBoundPerTile(std::span<const float> azimuthBound, std::span<const float> gradBound, int azimuths,
-                             float lipschitz, std::vector<float>& scratch, std::vector<float>& out);
+                             float lipschitz, std::vector<float>& scratch, std::vector<float>& out, int stride = 1);
 
 /// The same from one slope bound per tile over every azimuth (`slopeBound`):
-/// what planVisibilityTiles adds to a geometry tile's drift.
+/// what planVisibilityTiles adds to a geometry tile's drift when the indirect
+/// scan's azimuths are not every k-th of the environment's.
 void geometryBoundPerTile(std::span<const float> slopeBound, std::span<const float> gradBound, float lipschitz,
                           std::vector<float>& out);
 
@@ -136,9 +147,9 @@ void geometryBoundPerTile(std::span<const float> slopeBound, std::span<const flo
 /// `after`, adds every tile's drift from the anchor, and marks the tiles
 /// whose drift exceeds `tolerance`: cache.tiles for the environment's V
 /// (`vis`: its azimuths and maximum rule), cache.keyTiles for the key lights'
-/// (one region per light; none: no key tile), cache.geometryTiles over every
-/// azimuth, refined per receiver along the indirect scan's
-/// `indirectAzimuths` when those are every k-th of the environment's (0:
+/// (one region per light; none: no key tile), cache.geometryTiles along the
+/// indirect scan's `indirectAzimuths` when those are every k-th of the
+/// environment's (also refined per receiver), else over every direction (0:
 /// not known). `before`: the last frame's heights, the anchor when the
 /// cache starts afresh (no drift of this grid); `sinceBefore` holds every
 /// cell where `after` differs from them (every cell by default). `pyr` is

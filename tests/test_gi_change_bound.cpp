@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <span>
 #include <sstream>
 #include <vector>
 
@@ -18,6 +19,7 @@
 #include "gi/frame.h"
 #include "gi/nlp.h"
 #include "gi/sh.h"
+#include "gi/visibility_cache.h"
 #include "tests/gi_test_terrain.h"
 
 using namespace terrain;
@@ -518,6 +520,17 @@ TEST_CASE("gi.change_bound: no change gives zero bounds, a distant change a smal
     CHECK(farAz[2] == 0.0f);  // phi = 45 degrees, away from it
     CHECK(azimuthBoundOfTile(dh, pyr, 8, tileCount(90, 8) - 1, tileCount(70, 8) - 1, 1.25 * 3.14159265358979) ==
           farAz[10]);
+    // of flagged tiles alone: theirs bit for bit, the others' 0
+    std::vector<std::uint8_t> only(slope.size(), 0);
+    only.front() = only.back() = 1;
+    std::vector<float> flagged;
+    boundSlopeChangePerAzimuth(dh, pyr, 8, 16, flagged, only);
+    REQUIRE(flagged.size() == perAzimuth.size());
+    for (std::size_t i = 0; i < flagged.size(); ++i) {
+        CAPTURE(i);
+        CHECK(flagged[i] == (only[i / 16] ? perAzimuth[i] : 0.0f));
+    }
+    CHECK_THROWS_AS(boundSlopeChangePerAzimuth(dh, pyr, 8, 16, flagged, std::vector<std::uint8_t>(3, 1)), InputError);
     buildMaxChangePyramid(h.cview(), h.cview(), dh);
     boundSlopeChangePerAzimuth(dh, pyr, 8, 16, perAzimuth);
     CHECK(std::all_of(perAzimuth.begin(), perAzimuth.end(), [](float v) { return v == 0.0f; }));
@@ -670,4 +683,29 @@ TEST_CASE("gi.change_bound: a change pyramid redone over the box of differing ce
     const Grid moved = withPatch(boxes[4], 0.25f);
     buildMaxChangePyramid(anchor.cview(), moved.cview(), reused, boxes[0]);
     CHECK(maxChangeAll(reused) == 0.0f);
+}
+
+TEST_CASE("gi.change_bound: a tile's bound over every k-th azimuth is the ambient bound of those azimuths alone") {
+    constexpr int kAzimuths = 16, kTiles = 3;
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(0.0f, 0.2f);
+    std::vector<float> perAzimuth(kTiles * kAzimuths), grad(kTiles);
+    for (float& v : perAzimuth) v = u(rng);
+    for (float& v : grad) v = u(rng) / 4.0f;
+    const float lipschitz = 1.25f;
+    std::vector<float> scratch, all, every2nd, every4th;
+    environmentBoundPerTile(perAzimuth, grad, kAzimuths, lipschitz, scratch, all);
+    environmentBoundPerTile(perAzimuth, grad, kAzimuths, lipschitz, scratch, every2nd, 2);
+    environmentBoundPerTile(perAzimuth, grad, kAzimuths, lipschitz, scratch, every4th, 4);
+    REQUIRE(every2nd.size() == kTiles);
+    for (int t = 0; t < kTiles; ++t) {
+        CAPTURE(t);
+        std::vector<float> taken;
+        for (int j = 0; j < kAzimuths; j += 2) taken.push_back(lipschitz * perAzimuth[t * kAzimuths + j]);
+        CHECK(every2nd[t] == ambientChangeBoundPerAzimuth(taken.data(), kAzimuths / 2, grad[t], 1.0f, false));
+        CHECK(all[t] > 0.0f);
+        CHECK(every4th[t] > 0.0f);
+    }
+    CHECK_THROWS_AS(environmentBoundPerTile(perAzimuth, grad, kAzimuths, lipschitz, scratch, all, 3), InputError);
+    CHECK_THROWS_AS(environmentBoundPerTile(perAzimuth, grad, kAzimuths, lipschitz, scratch, all, 0), InputError);
 }
