@@ -33,6 +33,17 @@ void parallelFor(int begin, int end, int grain, Fn&& fn) {
                       [&](const tbb::blocked_range<int>& r) { fn(r.begin(), r.end()); });
 }
 
+/// fn(item) for each of `items` in parallel, each item a chunk of its own
+/// at most: for a loop over fixed blocks of which a few have work (a local
+/// change's tiles), given only those, so that the threads share them
+/// instead of one thread finding them all in its part of the range.
+template <class Fn>
+void parallelForEach(const std::vector<int>& items, Fn&& fn) {
+    parallelFor(0, static_cast<int>(items.size()), 1, [&](int i0, int i1) {
+        for (int i = i0; i < i1; ++i) fn(items[static_cast<std::size_t>(i)]);
+    });
+}
+
 /// Rows [rows.y0, rows.y1) (cut to the grid already) in parallel, with a
 /// grain that keeps chunks around 16k cells; fn(y0, y1) gets row numbers.
 template <class Fn>

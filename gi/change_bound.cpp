@@ -386,20 +386,20 @@ double azimuthBoundFrom(const MaxChangePyramid& dh, const HeightPyramid& pyr, co
     return best;
 }
 
-// Fills one value per tile, tile rows in parallel.
+// Fills one value per tile, tiles in parallel (each a chunk of its own at
+// most: a local change makes a few tiles' bounds far costlier than the
+// rest's).
 template <class PerTile>
 void forEachTile(const HeightPyramid& pyr, int T, std::vector<float>& out, PerTile&& perTile) {
     const int tilesX = tileCount(pyr.nxr, T), tilesY = tileCount(pyr.nyr, T);
     out.resize(static_cast<std::size_t>(tilesX) * static_cast<std::size_t>(tilesY));
-    parallelFor(0, tilesY, 1, [&](int ty0, int ty1) {
-        for (int ty = ty0; ty < ty1; ++ty)
-            for (int tx = 0; tx < tilesX; ++tx)
-                out[static_cast<std::size_t>(ty) * tilesX + static_cast<std::size_t>(tx)] = perTile(tx, ty);
+    parallelFor(0, tilesX * tilesY, 1, [&](int t0, int t1) {
+        for (int t = t0; t < t1; ++t) out[static_cast<std::size_t>(t)] = perTile(t % tilesX, t / tilesX);
     });
 }
 
 // Fills `azimuths` values per tile (tile-major) at the m samples phi_j = 2 pi
-// j / m of the full circle, tile rows in parallel: perTile(the tile's cells,
+// j / m of the full circle, tiles in parallel (forEachTile): perTile(the tile's cells,
 // cos phi_j and sin phi_j of every j, out, the tile's index) writes one
 // tile's m values; with `only`, the flagged tiles' (the others get 0).
 template <class PerTile>
@@ -418,16 +418,15 @@ void forEachTileAndAzimuth(const MaxChangePyramid& dv, const HeightPyramid& pyr,
     const std::size_t tiles = static_cast<std::size_t>(tilesX) * static_cast<std::size_t>(tilesY);
     if (!only.empty() && only.size() != tiles) throw InputError("change bound: one flag per tile");
     out.resize(tiles * m);
-    parallelFor(0, tilesY, 1, [&](int ty0, int ty1) {
-        for (int ty = ty0; ty < ty1; ++ty)
-            for (int tx = 0; tx < tilesX; ++tx) {
-                const std::size_t t = static_cast<std::size_t>(ty) * tilesX + tx;
-                float* values = out.data() + t * m;
-                if (only.empty() || only[t])
-                    perTile(tileCells(pyr, T, tx, ty), cs, sn, values, t);
-                else
-                    std::fill(values, values + m, 0.0f);
-            }
+    parallelFor(0, static_cast<int>(tiles), 1, [&](int t0, int t1) {
+        for (int i = t0; i < t1; ++i) {
+            const auto t = static_cast<std::size_t>(i);
+            float* values = out.data() + t * m;
+            if (only.empty() || only[t])
+                perTile(tileCells(pyr, T, i % tilesX, i / tilesX), cs, sn, values, t);
+            else
+                std::fill(values, values + m, 0.0f);
+        }
     });
 }
 

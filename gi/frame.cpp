@@ -497,8 +497,8 @@ DirectRuns directRuns(ConstGridView heights, const FrameChange& change, const Ge
         st.lastInputs.heights.ny != heights.ny)
         return {};
     const VisibilityCache& cache = st.visibilityCache;
-    changedDirectTexels(st.lastInputs.heights.cview(), heights, cache.tiles, st.keyTilesChanged, st.pyramid.subsample,
-                        st.texelRects, st.ambientRuns, st.shadingRuns, change.heightBox);
+    changedDirectTexels(st.lastInputs.heights.cview(), heights, cache.tiles, st.keyReceiversChanged,
+                        st.pyramid.subsample, st.texelRects, st.ambientRuns, st.shadingRuns, change.heightBox);
     return {&st.shadingRuns, &st.ambientRuns};
 }
 
@@ -553,7 +553,7 @@ void runDirectStages(ConstGridView heights, float cellSize, const GiLighting& li
     if (brighter) keyOnly = &st.visibilityCache.keyTiles;
     if (keyOnly) keepKeyVisibility(st.keyVisibility, *keyOnly, st.keyBefore);
     keyLightVisibility(lighting, settings, change, keyOnly, brighter, st);
-    if (keyOnly) keyTilesChanged(st.keyVisibility, *keyOnly, st.keyBefore, st.keyTilesChanged);
+    if (keyOnly) keyReceiversChanged(st.keyVisibility, *keyOnly, st.keyBefore, st.keyReceiversChanged);
     st.timings.keyVisibility = msSince(t);
     t = Clock::now();
     const DirectRuns runs = directRuns(heights, change, plan, st);

@@ -70,9 +70,7 @@ void BlockerRadianceIndirect::scan(int b) {
     scan_.buildStepTable();
     // the receivers' horizons do not change between bounces
     const bool horizons = b == 1 && in_.heights.subsample > 1;
-    parallelFor(0, scan_.blockCount(), 1, [&](int b0, int b1) {
-        for (int block = b0; block < b1; ++block) scanBlock(block, horizons);
-    });
+    scan_.forEachBlockWithWork([&](int block) { scanBlock(block, horizons); });
 }
 
 // Casting sets and the exact irradiance at one block of receiver rows
@@ -85,7 +83,6 @@ void BlockerRadianceIndirect::scanBlock(int block, bool horizons) {
         simd::wideEnabled() ? accumulateIrradianceAvx2 : accumulateIrradianceSse;
     IndirectScratch& sc = scan_.scratch();
     const RowBlock rb = scan_.rowBlock(block);
-    if (!scan_.hasWork(rb)) return;  // no dirty tile in these rows: every receiver keeps its values
     // the rows' receiver heights and gradients; E sums zeroed
     scan_.loadRows(rb, sc);
     std::fill(sc.irradiance.data(), sc.irradiance.data() + 3 * static_cast<std::size_t>(rb.rows) * pad, 0.0f);

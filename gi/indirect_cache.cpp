@@ -190,8 +190,9 @@ constexpr float kEnvelopeShareOfTolerance = 0.5f;
 // Per tile: the radiance bound, the largest rho_k over its receivers (max_j
 // D_tj without the last pass's occlusions, D and G those of the sample
 // bounds' larger tile that holds it) times its occlusion factor; from the
-// tile's share envelope where that is small enough. Tile rows in parallel
-// (each tile's value alone).
+// tile's share envelope where that is small enough. Tiles in parallel (each
+// tile's value alone), each a chunk of its own at most: those weighed
+// receiver by receiver cost far more than the rest.
 void sharedBounds(const IndirectPlanInputs& in, IndirectCache& cache) {
     const HeightPyramid& h = in.heights;
     const int tilesX = tileCount(h.nxr, kIndirectTile), tilesY = tileCount(h.nyr, kIndirectTile);
@@ -220,15 +221,15 @@ void sharedBounds(const IndirectPlanInputs& in, IndirectCache& cache) {
             bound = std::max(bound, rowShareBound(*in.blocker, Y, x0, x1, RowMoves{D, G, false}));
         return bound;
     };
-    parallelFor(0, tilesY, 1, [&](int ty0, int ty1) {
-        for (int ty = ty0; ty < ty1; ++ty)
-            for (int tx = 0; tx < tilesX; ++tx) {
-                const std::size_t t = static_cast<std::size_t>(ty) * tilesX + tx;
-                const std::size_t b = visibilityTileHolding(tx, ty, h.nxr);
-                cache.radianceBound[t] =
-                    cache.occlusionFactor[t] *
-                    tileBound(tx, ty, cache.azimuthBound.data() + b * m, cache.groupBound.data() + b * kDistanceGroups);
-            }
+    parallelFor(0, static_cast<int>(tiles), 1, [&](int t0, int t1) {
+        for (int k = t0; k < t1; ++k) {
+            const int tx = k % tilesX, ty = k / tilesX;
+            const auto t = static_cast<std::size_t>(k);
+            const std::size_t b = visibilityTileHolding(tx, ty, h.nxr);
+            cache.radianceBound[t] =
+                cache.occlusionFactor[t] *
+                tileBound(tx, ty, cache.azimuthBound.data() + b * m, cache.groupBound.data() + b * kDistanceGroups);
+        }
     });
 }
 
@@ -284,7 +285,8 @@ void occlusionFactors(const IndirectPlanInputs& in, IndirectCache& cache) {
 }
 
 // Refines the radiance bound of the tiles it would re-gather (with their
-// drift from the anchor) and the geometry does not re-gather anyway: each
+// drift from the anchor) and the geometry does not re-gather anyway, unless
+// their drift alone is past the tolerance: each
 // takes the largest of its receivers' own bounds if smaller, their sample
 // moves walked on their own (boundSampleMovePerReceiver) and weighed by
 // their own shares (rowShareBound), times the tile's occlusion factor
@@ -300,7 +302,8 @@ void refinePerReceiver(const IndirectPlanInputs& in, IndirectCache& cache) {
     for (std::size_t t = 0; t < tiles; ++t) {
         const bool forced = in.geometryTiles && in.geometryTiles->dirty[t];
         const float drift = drifts ? cache.drift.fromAnchor[t] : 0.0f;
-        refined.dirty[t] = !forced && drift + cache.radianceBound[t] > in.tolerance ? 1 : 0;
+        // a walk leaves a bound of at least 0: a drift past the tolerance re-gathers anyway
+        refined.dirty[t] = !forced && drift + cache.radianceBound[t] > in.tolerance && drift <= in.tolerance ? 1 : 0;
         candidates += refined.dirty[t];
     }
     if (static_cast<double>(candidates) > kRefineAtMost * static_cast<double>(tiles))
@@ -323,18 +326,18 @@ void refinePerReceiver(const IndirectPlanInputs& in, IndirectCache& cache) {
                                                                 static_cast<std::size_t>(X)]);
         return largest;
     };
-    parallelFor(0, refined.tilesY, 1, [&](int ty0, int ty1) {
-        for (int ty = ty0; ty < ty1; ++ty)
-            for (int tx = 0; tx < refined.tilesX; ++tx) {
-                if (!refined.isDirty(tx, ty)) continue;
-                const int x0 = tx * kIndirectTile, x1 = std::min(field.nxr, x0 + kIndirectTile);
-                float bound = 0.0f;
-                for (int Y = ty * kIndirectTile; Y < std::min(field.nyr, (ty + 1) * kIndirectTile); ++Y)
-                    bound =
-                        std::max(bound, shares ? rowShareBound(*in.blocker, Y, x0, x1, moves) : largestMove(Y, x0, x1));
-                const std::size_t t = static_cast<std::size_t>(ty) * refined.tilesX + tx;
-                cache.radianceBound[t] = std::min(cache.radianceBound[t], cache.occlusionFactor[t] * bound);
-            }
+    std::vector<int>& walked = cache.walkedTiles;
+    walked.clear();
+    for (std::size_t t = 0; t < tiles; ++t)
+        if (refined.dirty[t]) walked.push_back(static_cast<int>(t));
+    parallelForEach(walked, [&](int k) {
+        const int tx = k % refined.tilesX, ty = k / refined.tilesX;
+        const int x0 = tx * kIndirectTile, x1 = std::min(field.nxr, x0 + kIndirectTile);
+        float bound = 0.0f;
+        for (int Y = ty * kIndirectTile; Y < std::min(field.nyr, (ty + 1) * kIndirectTile); ++Y)
+            bound = std::max(bound, shares ? rowShareBound(*in.blocker, Y, x0, x1, moves) : largestMove(Y, x0, x1));
+        const auto t = static_cast<std::size_t>(k);
+        cache.radianceBound[t] = std::min(cache.radianceBound[t], cache.occlusionFactor[t] * bound);
     });
 }
 

@@ -130,7 +130,8 @@ struct IndirectCache {
     // anchor| pyramid they are walked on, per azimuth and per distance group
     ChangeLevels receiverLevels;
     std::vector<float> receiverAzimuthMove, receiverGroupMove;
-    ReceiverTiles refined;  // scratch: the tiles refined this frame
+    ReceiverTiles refined;         // scratch: the tiles refined this frame
+    std::vector<int> walkedTiles;  // scratch: their indices
     // per tile: the largest share of a receiver's occlusion along each
     // azimuth, then in each distance group (azimuths + kDistanceGroups
     // floats, rounded up), or all -1 when some receiver has (next to) no

@@ -78,6 +78,9 @@ void IndirectScan::beginFrame() {
     st_.stepsPerColumn.resize(static_cast<std::size_t>(m) * pad_);
     st_.stepsPerRow.resize(static_cast<std::size_t>(m) * nyr);
     dirtySpans(in_.only, in_.heights.nxr, nyr, st_.spans);
+    withWork_.clear();
+    for (int block = 0; block < nBlocks_; ++block)
+        if (hasWork(rowBlock(block))) withWork_.push_back(block);
 }
 
 void IndirectScan::buildPyramid(const BounceSource& source, const RadiancePyramidSettings& settings) {

@@ -13,11 +13,13 @@
 // frame of a given size and settings.
 //
 // Receiver tiles (IndirectInputs::only): rows are scanned over their dirty
-// column spans only (spans(Y)), blocks without any skipped (hasWork); each
+// column spans only (spans(Y)), blocks without any skipped
+// (forEachBlockWithWork); each
 // scanned receiver gets the bits of a full scan.
 #include <array>
 #include <cstddef>
 #include <span>
+#include <vector>
 
 #include "core/grid.h"
 #include "core/parallel.h"
@@ -57,15 +59,20 @@ public:
     /// (GlossyNlp: of IndirectState::glossy's pyramid).
     void buildStepTable();
 
-    int blockCount() const { return nBlocks_; }
+    /// fn(block) for each block with a span to scan (beginFrame finds them),
+    /// in parallel: only those are handed out, so that a few dirty tiles'
+    /// blocks are shared among the threads rather than falling to one of
+    /// them with the field's empty blocks around them.
+    template <class Fn>
+    void forEachBlockWithWork(Fn&& fn) const {
+        parallelForEach(withWork_, std::forward<Fn>(fn));
+    }
     /// The calling thread's scratch: a block keeps nothing in it once done,
     /// so each worker slot's serves every block that thread runs.
     IndirectScratch& scratch() const { return st_.blocks[static_cast<std::size_t>(workerSlot())]; }
     RowBlock rowBlock(int block) const;
     /// The receiver columns of row Y to scan (the whole row without tiles).
     std::span<const ColumnSpan> spans(int Y) const { return st_.spans.ofRow(Y); }
-    /// Whether some row of the block has a span to scan.
-    bool hasWork(const RowBlock& rb) const;
     /// The block's receiver rows (loadReceiverRow) into its scratch.
     void loadRows(const RowBlock& rb, IndirectScratch& sc) const;
     /// Azimuth j's step tables; clampNegative: GlossyNlp's members send
@@ -80,6 +87,8 @@ public:
 
 private:
     void buildGlossyStepTable();
+    /// Whether some row of the block has a span to scan.
+    bool hasWork(const RowBlock& rb) const;
 
     const IndirectInputs& in_;
     IndirectState& st_;
@@ -88,6 +97,7 @@ private:
     int pad_, nSteps_, nBlocks_;
     std::size_t tableSize_;  // azimuths x steps
     float hMax_ = 0.0f;
+    std::vector<int> withWork_;  // the blocks with a span to scan (beginFrame)
 };
 
 }  // namespace terrain::gi

@@ -150,9 +150,7 @@ void ShKernelIndirect::scan(int b) {
         if (!needsU(b)) return;
     }
     scan_.buildStepTable();
-    parallelFor(0, scan_.blockCount(), 1, [&](int b0, int b1) {
-        for (int block = b0; block < b1; ++block) scanBlock(block);
-    });
+    scan_.forEachBlockWithWork([&](int block) { scanBlock(block); });
 }
 
 // Casting sets, Eq. 12 and U through the folded wedge operator for one block
@@ -165,7 +163,6 @@ void ShKernelIndirect::scanBlock(int block) {
     void (*const accumulate)(const URowSums&) = simd::wideEnabled() ? accumulateUAvx2 : accumulateUSse;
     IndirectScratch& sc = scan_.scratch();
     const RowBlock rb = scan_.rowBlock(block);
-    if (!scan_.hasWork(rb)) return;  // no dirty tile in these rows: every receiver keeps its U
     // the rows' receiver heights and gradients; U zeroed in the spans
     scan_.loadRows(rb, sc);
     for (int r = 0; r < rb.rows; ++r)

@@ -191,33 +191,34 @@ void boundSampleChangeFromLevels(const MaxChangePyramid& raw, const RadianceLeve
                 field, i, std::cos(phi[static_cast<std::size_t>(j)]), std::sin(phi[static_cast<std::size_t>(j)]));
     for (int i = 0; i < nSteps; ++i)
         group[static_cast<std::size_t>(i)] = distanceGroup(field.steps[static_cast<std::size_t>(i)].tauCells);
-    parallelFor(0, tilesY, 1, [&](int ty0, int ty1) {
-        for (int ty = ty0; ty < ty1; ++ty)
-            for (int tx = 0; tx < tilesX; ++tx) {
-                const std::size_t t = static_cast<std::size_t>(ty) * tilesX + tx;
-                const int X0 = tx * T, Y0 = ty * T;
-                const int X1 = std::min(field.nxr, X0 + T) - 1, Y1 = std::min(field.nyr, Y0 + T) - 1;
-                for (int j = 0; j < m; ++j)
-                    for (int i = 0; i < nSteps; ++i) {
-                        const ScanStepInfo& si = info[static_cast<std::size_t>(j) * nSteps + i];
-                        const int x0 = std::max(X0, si.xFirst), x1 = std::min(X1, si.xLast);
-                        const int y0 = std::max(Y0, si.yFirst), y1 = std::min(Y1, si.yLast);
-                        if (x0 > x1 || y0 > y1) continue;
-                        float& az = tileBound[t * m + static_cast<std::size_t>(j)];
-                        float& gr = groupBound[t * kDistanceGroups +
-                                               static_cast<std::size_t>(group[static_cast<std::size_t>(i)])];
-                        // only a move above both running maxima changes either
-                        const float above = std::min(az, gr);
-                        const int level = field.steps[static_cast<std::size_t>(i)].level;
-                        const float d = level < 0 ? tapsChange(raw, field.subsample, si, x0, y0, x1, y1, above)
-                                        : level < levels.exactLevels
-                                            ? tapsChange(levels.change[static_cast<std::size_t>(level)], 1, si, x0, y0,
-                                                         x1, y1, above)
-                                            : octaveTapsChange(levels, field, level, si, x0, y0, x1, y1, above);
-                        az = std::max(az, d);
-                        gr = std::max(gr, d);
-                    }
-            }
+    // tiles in parallel, each a chunk of its own at most (those near a change cost the most)
+    parallelFor(0, tilesX * tilesY, 1, [&](int t0, int t1) {
+        for (int k = t0; k < t1; ++k) {
+            const int tx = k % tilesX, ty = k / tilesX;
+            const auto t = static_cast<std::size_t>(k);
+            const int X0 = tx * T, Y0 = ty * T;
+            const int X1 = std::min(field.nxr, X0 + T) - 1, Y1 = std::min(field.nyr, Y0 + T) - 1;
+            for (int j = 0; j < m; ++j)
+                for (int i = 0; i < nSteps; ++i) {
+                    const ScanStepInfo& si = info[static_cast<std::size_t>(j) * nSteps + i];
+                    const int x0 = std::max(X0, si.xFirst), x1 = std::min(X1, si.xLast);
+                    const int y0 = std::max(Y0, si.yFirst), y1 = std::min(Y1, si.yLast);
+                    if (x0 > x1 || y0 > y1) continue;
+                    float& az = tileBound[t * m + static_cast<std::size_t>(j)];
+                    float& gr =
+                        groupBound[t * kDistanceGroups + static_cast<std::size_t>(group[static_cast<std::size_t>(i)])];
+                    // only a move above both running maxima changes either
+                    const float above = std::min(az, gr);
+                    const int level = field.steps[static_cast<std::size_t>(i)].level;
+                    const float d =
+                        level < 0 ? tapsChange(raw, field.subsample, si, x0, y0, x1, y1, above)
+                        : level < levels.exactLevels
+                            ? tapsChange(levels.change[static_cast<std::size_t>(level)], 1, si, x0, y0, x1, y1, above)
+                            : octaveTapsChange(levels, field, level, si, x0, y0, x1, y1, above);
+                    az = std::max(az, d);
+                    gr = std::max(gr, d);
+                }
+        }
     });
 }
 

@@ -58,23 +58,35 @@ CellBox changedTexels(const HeightPyramid& b, int level, const CellBox& cells) {
     return {out[0][0], out[1][0], out[0][1], out[1][1]};
 }
 
-// Each azimuth's walk (ChangeWalk) into `walks`: its steps stop at the first
-// from which on no step's slope can move by more than the floor (each sample
-// and the receiver's own height moved by at most the largest |dh|, M: 2 M
-// over the step's length); each step knows its field's texels of non-zero
-// |dh| bound (from `built`, the cells of non-zero |dh|).
-void buildWalks(const HeightPyramid& b, std::span<const double> phi, float largest, float floor, const CellBox& built,
-                std::vector<ChangeWalk>& walks, std::vector<float>& tail) {
+// Each azimuth's walk (ChangeWalk) into levels.walks: its steps stop at the
+// first from which on no step's slope can move by more than the floor (each
+// sample and the receiver's own height moved by at most the largest |dh|,
+// M: 2 M over the step's length); each step knows its field's texels of
+// non-zero |dh| bound (from levels.built, the cells of non-zero |dh|). The
+// steps' taps are levels.stepInfo, taken again only when the pyramid's
+// layout or the azimuths differ from the last call's.
+void buildWalks(const HeightPyramid& b, std::span<const double> phi, float largest, float floor, ChangeLevels& levels) {
+    const CellBox& built = levels.built;
+    std::vector<ChangeWalk>& walks = levels.walks;
+    std::vector<float>& tail = levels.tails;
     const std::size_t nSteps = b.steps.size();
     walks.resize(phi.size());
     tail.resize(nSteps + 1);
+    StepTableKey key = stepTableKey(b, std::vector<double>(phi.begin(), phi.end()), 0);
+    if (!(key == levels.stepsKey)) {
+        levels.stepInfo.resize(phi.size() * nSteps);
+        for (std::size_t j = 0; j < phi.size(); ++j)
+            for (std::size_t i = 0; i < nSteps; ++i)
+                levels.stepInfo[j * nSteps + i] =
+                    scanStepInfo(b, static_cast<int>(i), std::cos(phi[j]), std::sin(phi[j]));
+        levels.stepsKey = std::move(key);
+    }
     for (std::size_t j = 0; j < phi.size(); ++j) {
-        const double c = std::cos(phi[j]), sn = std::sin(phi[j]);
         std::vector<ChangeWalk::Step>& steps = walks[j].steps;
         steps.resize(nSteps);
         int x0 = 0, x1 = b.nxr - 1, y0 = 0, y1 = b.nyr - 1;
         for (std::size_t i = 0; i < nSteps; ++i) {
-            const ScanStepInfo info = scanStepInfo(b, static_cast<int>(i), c, sn);
+            const ScanStepInfo& info = levels.stepInfo[j * nSteps + i];
             x0 = std::max(x0, info.xFirst);
             x1 = std::min(x1, info.xLast);
             y0 = std::max(y0, info.yFirst);
@@ -243,16 +255,14 @@ void forEachWalkedRow(ChangeLevels& levels, const HeightPyramid& pyr, std::span<
     if (!levels.valid || b.nx != pyr.nx || b.ny != pyr.ny || b.nxr != pyr.nxr || b.nyr != pyr.nyr ||
         b.steps.size() != pyr.steps.size())
         throw InputError("receiver azimuth bound: the change levels were not built for this pyramid");
-    buildWalks(b, phi, levels.largest, std::max(floor, 0.0f), levels.built, levels.walks, levels.tails);
+    buildWalks(b, phi, levels.largest, std::max(floor, 0.0f), levels);
     const DirtySpans& spans = levels.spans;
     dirtySpans(only, b.nxr, b.nyr, levels.spans);
-    parallelForRows(RowSpan{0, b.nyr}, b.nxr * static_cast<int>(phi.size()), [&](int Y0, int Y1) {
-        for (int Y = Y0; Y < Y1; ++Y) {
-            const std::span<const ColumnSpan> rowSpans = spans.ofRow(Y);
-            if (rowSpans.empty()) continue;
-            // |dh| at the receivers' own cells: raw phase 0 of row s Y
-            row(Y, rowSpans, RowWalk{b.rawPhaseRow(0, b.subsample * Y), Y, b.subsample, levels.built});
-        }
+    // only the rows with a span are handed out (a local change's few tiles)
+    rowsWithSpans(spans, b.nyr, levels.walkedRows);
+    parallelForEach(levels.walkedRows, [&](int Y) {
+        // |dh| at the receivers' own cells: raw phase 0 of row s Y
+        row(Y, spans.ofRow(Y), RowWalk{b.rawPhaseRow(0, b.subsample * Y), Y, b.subsample, levels.built});
     });
 }
 

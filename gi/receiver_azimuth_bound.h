@@ -61,7 +61,12 @@ struct ChangeLevels {
     bool valid = false;               // `bound` was built for the grid and settings of the last call
     std::vector<ChangeWalk> walks;
     std::vector<float> tails;
+    // each azimuth's steps' taps (azimuth-major), kept while the pyramid's
+    // layout and the azimuths are the same (a function of those alone)
+    StepTableKey stepsKey;
+    std::vector<ScanStepInfo> stepInfo;
     DirtySpans spans;
+    std::vector<int> walkedRows;           // the receiver rows with a span to walk
     std::vector<std::vector<float>> rows;  // per worker slot: one receiver row's bounds per azimuth
 };
 

@@ -24,6 +24,7 @@
 // so a local change that a low key light looks across redoes the shade of a
 // strip of tiles but the ambient of a few.
 #include <array>
+#include <span>
 #include <vector>
 
 #include "core/grid.h"
@@ -36,24 +37,31 @@ namespace terrain::gi {
 /// The cells within this many of a texel that its direct light reads.
 inline int shadingReach(int subsample) { return subsample + subsample / 2 + 1; }
 
+/// Receivers [x0, x1) of receiver row y.
+struct ReceiverRun {
+    int y = 0, x0 = 0, x1 = 0;
+};
+
 /// The texels whose exact ambient (`ambient`) and whose direct light
 /// (`shading`) must be redone after the heights went from `before` to
-/// `after` (same size) and the visibility of the dirty tiles of `env` and
-/// `keys` (on the receiver grid of `subsample`, one layout) was recomputed:
-/// the texels that read a receiver of a dirty tile (the ambient: of `env`
-/// alone) and those of the texel tiles within shadingReach of a changed
-/// height (appendTexelsToRedo; `differing` holds every height that may
-/// differ, every cell by default). `rects` is scratch. Throws InputError
-/// when the sizes differ.
-void changedDirectTexels(ConstGridView before, ConstGridView after, const ReceiverTiles& env, const ReceiverTiles& keys,
-                         int subsample, std::vector<TexelRect>& rects, TexelRuns& ambient, TexelRuns& shading,
-                         CellBox differing = {});
+/// `after` (same size), the visibility of the dirty tiles of `env` (on the
+/// receiver grid of `subsample`) was recomputed and that of the receivers
+/// of `keys` changed: the texels that read a receiver of a dirty tile or
+/// (the shading alone) of `keys`, and those of the texel tiles within
+/// shadingReach of a changed height (appendTexelsToRedo; `differing` holds
+/// every height that may differ, every cell by default). `rects` is
+/// scratch. Throws InputError when the sizes differ.
+void changedDirectTexels(ConstGridView before, ConstGridView after, const ReceiverTiles& env,
+                         std::span<const ReceiverRun> keys, int subsample, std::vector<TexelRect>& rects,
+                         TexelRuns& ambient, TexelRuns& shading, CellBox differing = {});
 
 // A key light's tile is recomputed when its bound allows a change, which
 // is often none at all (a local change beside a light's region of the sky
-// moves its far, filtered samples, not whether the window is visible):
-// the key tiles whose visibility the scan left bit for bit as it was need
-// no shading, and a texel that reads only their receivers keeps its light.
+// moves its far, filtered samples, not whether the window is visible), and
+// within a tile whose shadows did move, most receivers' visibility is
+// often what it was (a shadow's edge crosses a few of them): the receivers
+// whose visibility the scan left bit for bit as it was need no shading,
+// and a texel that reads only such receivers keeps its light.
 
 /// The key lights' visibility (every light's planes) of the receivers of
 /// the dirty tiles of `tiles`, kept before a scan recomputes them.
@@ -65,10 +73,12 @@ struct KeyVisibilityBefore {
 /// Keeps the key lights' visibility of the dirty tiles of `tiles` (in `out`).
 void keepKeyVisibility(const std::vector<VisibilityField>& keys, const ReceiverTiles& tiles, KeyVisibilityBefore& out);
 
-/// `changed`: the dirty tiles of `tiles` where some light's visibility
-/// differs (bits) from `before`, kept of the same tiles; every dirty tile
-/// when the lights or their fields' layout differ from the kept ones.
-void keyTilesChanged(const std::vector<VisibilityField>& keys, const ReceiverTiles& tiles,
-                     const KeyVisibilityBefore& before, ReceiverTiles& changed);
+/// `changed`: per receiver row of each dirty tile of `tiles`, the run from
+/// its first to its last receiver where some light's visibility differs
+/// (bits) from `before`, kept of the same tiles (none where none differs);
+/// every receiver of the dirty tiles when the lights or their fields'
+/// layout differ from the kept ones.
+void keyReceiversChanged(const std::vector<VisibilityField>& keys, const ReceiverTiles& tiles,
+                         const KeyVisibilityBefore& before, std::vector<ReceiverRun>& changed);
 
 }  // namespace terrain::gi

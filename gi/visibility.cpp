@@ -797,18 +797,29 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
     // ---- schedule: fixed row blocks in parallel, rows serially within a block,
     // every azimuth of a row before the next row (the row's h0 / tau table is
     // built once for all azimuths).
-    parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
-        for (int block = b0; block < b1; ++block) {
-            VisibilityScratch& sc = state.blocks[static_cast<std::size_t>(block)];
-            const int yBegin = static_cast<int>(static_cast<long long>(nyr) * block / nBlocks);
-            const int yEnd = static_cast<int>(static_cast<long long>(nyr) * (block + 1) / nBlocks);
-            for (int Y = yBegin; Y < yEnd; ++Y) {
-                // rows without a dirty span (receiver tiles) are skipped
-                const std::span<const ColumnSpan> spans = state.spans.ofRow(Y);
-                if (spans.empty()) continue;
-                loadReceiverRow(rows, Y, sc);
-                visibilityOfRow(rows, Y, spans, sc);
+    // (receiver tiles: only the blocks with a dirty span are handed out, and
+    // their rows without one are skipped)
+    const auto blockRows = [&](int block) {
+        return RowSpan{static_cast<int>(static_cast<long long>(nyr) * block / nBlocks),
+                       static_cast<int>(static_cast<long long>(nyr) * (block + 1) / nBlocks)};
+    };
+    state.busyBlocks.clear();
+    for (int block = 0; block < nBlocks; ++block) {
+        const RowSpan r = blockRows(block);
+        for (int Y = r.y0; Y < r.y1; ++Y)
+            if (!state.spans.ofRow(Y).empty()) {
+                state.busyBlocks.push_back(block);
+                break;
             }
+    }
+    parallelForEach(state.busyBlocks, [&](int block) {
+        VisibilityScratch& sc = state.blocks[static_cast<std::size_t>(block)];
+        const RowSpan r = blockRows(block);
+        for (int Y = r.y0; Y < r.y1; ++Y) {
+            const std::span<const ColumnSpan> spans = state.spans.ofRow(Y);
+            if (spans.empty()) continue;
+            loadReceiverRow(rows, Y, sc);
+            visibilityOfRow(rows, Y, spans, sc);
         }
     });
 }

@@ -199,7 +199,8 @@ struct VisibilityState {
     // them holds reuses it
     static constexpr std::size_t kKeptTables = 4;
     std::vector<StepTables> tables;
-    DirtySpans spans;  // the receiver columns to compute, per row
+    DirtySpans spans;             // the receiver columns to compute, per row
+    std::vector<int> busyBlocks;  // the row blocks with a row to compute
 };
 
 /// One step of the scan table as computeVisibility builds it (exposed for

@@ -112,12 +112,15 @@ struct Candidates {
 
 // Takes off cache.refined the candidates that recompute whatever their
 // receivers' walks find, for each drift they are a candidate for: those
-// whose receivers' own gradient bounds alone put one of them over the
-// tolerance. A receiver's bound is at least the one its gradient bound
-// gives with every slope bound 0 (each azimuth's term is the larger of the
-// two, and the sum and the rounding are monotone), and the tile's refined
-// bound is its receivers' largest. Unwalked, such a tile keeps its
-// visibility tile's bounds, which also put it over.
+// whose drift from the anchor plus their receivers' own gradient bounds
+// alone put one of them over the tolerance (a tile recomputed since the
+// anchor whose drift is past it already, among them). A receiver's bound is
+// at least the one its gradient bound gives with every slope bound 0 (each
+// azimuth's term is the larger of the two, and the sum and the rounding
+// are monotone), the tile's refined bound is its receivers' largest and
+// never above its present one, and the sum with the drift is monotone in
+// it. Unwalked, such a tile keeps its visibility tile's bounds, which also
+// put it over.
 void skipSurelyRecomputed(const HeightPyramid& pyr, int azimuths, float tolerance, int geometryStride,
                           Candidates candidates, VisibilityCache& cache) {
     ReceiverTiles& refined = cache.refined;
@@ -128,10 +131,16 @@ void skipSurelyRecomputed(const HeightPyramid& pyr, int azimuths, float toleranc
             const std::size_t t = static_cast<std::size_t>(ty) * refined.tilesX + tx;
             if (!refined.dirty[t]) continue;
             const float g = largestReceiverGradientBound(cache.change, pyr, kCacheTile, tx, ty);
+            // whether the least a walk can leave, with the drift, keeps the tile
+            const auto keepable = [&](float drift, float excursion, int taken) {
+                const float least = std::min(excursion, ambientChangeBoundPerAzimuth(zeros, taken, g, 1.0f, false));
+                return drift + least <= tolerance;
+            };
             Candidates open = candidates;  // the drifts a walk could still keep it for
-            open.env = open.env && ambientChangeBoundPerAzimuth(zeros, azimuths, g, 1.0f, false) <= tolerance;
-            open.geometry = open.geometry && geometryStride > 0 &&
-                            ambientChangeBoundPerAzimuth(zeros, azimuths / geometryStride, g, 1.0f, false) <= tolerance;
+            open.env = open.env && keepable(cache.drift.fromAnchor[t], cache.envExcursion[t], azimuths);
+            open.geometry =
+                open.geometry && geometryStride > 0 &&
+                keepable(cache.geometryDrift.fromAnchor[t], cache.geometryExcursion[t], azimuths / geometryStride);
             refined.dirty[t] = open.over(cache, t, tolerance) ? 1 : 0;
         }
 }
@@ -185,6 +194,7 @@ void refinePerReceiver(const HeightPyramid& pyr, const VisibilitySettings& vis, 
     for (std::size_t t = 0; t < tiles; ++t) refined.dirty[t] = candidates.over(cache, t, tolerance) ? 1 : 0;
     const int m = vis.azimuths;
     skipSurelyRecomputed(pyr, m, tolerance, geometryStride, candidates, cache);
+    if (refined.dirtyCount() == 0) return;
     lowerToOwnTileBounds(pyr, m, lipschitz, tolerance, geometryStride, candidates, cache);
     if (refined.dirtyCount() == 0) return;
     // the environment's scan's azimuths, as foldFullCircle takes them

@@ -57,16 +57,17 @@ std::string summary(const TexelRuns& r) {
 }  // namespace
 
 TEST_CASE(
-    "gi.shading_tiles: the texels within reach of changed heights, and those reading the dirty tiles' receivers") {
+    "gi.shading_tiles: the texels within reach of changed heights, those reading the dirty tiles' receivers and the "
+    "key lights' changed receivers") {
     // 40 x 70 texels at 2x: 20 x 35 receivers, tiles of 16: 2 x 3 tiles,
     // texel columns 0..31 and 32..39, rows 0..31, 32..63 and 64..69; reach 4
     const Grid before = bumpy(40, 70);
-    ReceiverTiles env, keys;
+    ReceiverTiles env;
+    std::vector<ReceiverRun> keys;
     TexelRuns ambient, shading;
     std::vector<TexelRect> rects;
     const int s = 2;
     env.reset(20, 35, 16, false);
-    keys.reset(20, 35, 16, false);
     CHECK(shadingReach(s) == 4);
     const auto redo = [&](const Grid& after) {
         changedDirectTexels(before.cview(), after.cview(), env, keys, s, rects, ambient, shading);
@@ -83,12 +84,19 @@ TEST_CASE(
     after(39, 69) = -0.0f == before(39, 69) ? 1.0f : -0.0f;  // a bit changed in the last texel
     redo(after);
     CHECK(summary(shading) == "64-70:32-40");
-    // a dirty key-light tile (1, 1), receivers 16..19 x 16..31: the texels
-    // that read them, from the last texels of the receivers before (15)
-    keys.setDirty(1, 1);
+    // one key-light receiver changed, (5, 20): the texels whose lower
+    // receiver is it or the one before, 8..11 x 38..41
+    keys = {{20, 5, 6}};
+    redo(before);
+    CHECK(summary(shading) == "38-42:8-12");
+    CHECK(summary(ambient).empty());  // the ambient reads no key light
+    // key-light receivers 16..19 x 16..31 (tile (1, 1)): the texels that read
+    // them, from the last texels of the receivers before (15)
+    keys.clear();
+    for (int y = 16; y < 32; ++y) keys.push_back({y, 16, 20});
     redo(before);
     CHECK(summary(shading) == "30-64:30-40");
-    CHECK(summary(ambient).empty());  // the ambient reads no key light
+    CHECK(summary(ambient).empty());
     CHECK(texelCount(shading) == 34 * 10);
     // with a changed height as well: the ambient redoes the height's tiles,
     // the shading those and the key tile's readers
@@ -103,6 +111,9 @@ TEST_CASE(
     CHECK(summary(shading) == "0-30:0-32 30-64:0-40 64-70:0-32");
     env.setDirty(0, 2, false);
     CHECK_THROWS_AS(changedDirectTexels(bumpy(40, 69).cview(), before.cview(), env, keys, s, rects, ambient, shading),
+                    InputError);
+    const std::vector<ReceiverRun> outside{{35, 0, 1}};  // a receiver row past the grid
+    CHECK_THROWS_AS(changedDirectTexels(before.cview(), before.cview(), env, outside, s, rects, ambient, shading),
                     InputError);
 }
 
@@ -156,6 +167,12 @@ bool ambientAsEveryTexelWould(const GiState& st, const GiSettings& settings, Con
     return same;
 }
 
+int changedReceivers(const std::vector<ReceiverRun>& runs) {
+    int n = 0;
+    for (const ReceiverRun& r : runs) n += r.x1 - r.x0;
+    return n;
+}
+
 bool sameRgb(const std::array<Grid, 3>& a, const std::array<Grid, 3>& b) {
     bool same = true;
     for (std::size_t c = 0; c < 3; ++c) same = same && gi_test::sameBits(a[c].v, b[c].v);
@@ -203,9 +220,12 @@ TEST_CASE("gi.shading_tiles: local height changes shade some tiles, the rest is 
                     const TexelRuns& t = states[0].shadingRuns;
                     const long long texels = static_cast<long long>(surfaces[f].nx) * surfaces[f].ny;
                     if (f > 0) kept += texels - texelCount(t);
-                    // the key tiles whose visibility the scan left as it was are not shaded
-                    const int keyTiles = states[0].visibilityCache.keyTiles.dirtyCount();
-                    if (f > 0) keySame += keyTiles - states[0].keyTilesChanged.dirtyCount();
+                    // the key receivers whose visibility the scan left as it was are not shaded
+                    const ReceiverTiles& keyPlan = states[0].visibilityCache.keyTiles;
+                    const int keyTiles = keyPlan.dirtyCount();  // whole tiles: 256 or 128 receivers a side
+                    if (f > 0)
+                        keySame += keyTiles * keyPlan.tileSize * keyPlan.tileSize -
+                                   changedReceivers(states[0].keyReceiversChanged);
                     // the ambient redoes no texel the shading keeps
                     if (f > 0 && keyTiles > 0) {
                         const TexelRuns& a = states[0].ambientRuns;
