@@ -44,6 +44,22 @@ void parallelForEach(const std::vector<int>& items, Fn&& fn) {
     });
 }
 
+/// The blocks of [0, nBlocks) holding a row for which hasRow(y) is true,
+/// block b being the rows rowsOf(b) (a RowSpan), in order, into out: the
+/// items a pass over fixed row blocks hands to parallelForEach.
+template <class RowsOf, class HasRow>
+void blocksWithRows(int nBlocks, RowsOf&& rowsOf, HasRow&& hasRow, std::vector<int>& out) {
+    out.clear();
+    for (int b = 0; b < nBlocks; ++b) {
+        const RowSpan r = rowsOf(b);
+        for (int y = r.y0; y < r.y1; ++y)
+            if (hasRow(y)) {
+                out.push_back(b);
+                break;
+            }
+    }
+}
+
 /// Rows [rows.y0, rows.y1) (cut to the grid already) in parallel, with a
 /// grain that keeps chunks around 16k cells; fn(y0, y1) gets row numbers.
 template <class Fn>

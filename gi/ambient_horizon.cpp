@@ -304,22 +304,25 @@ void ambientFromHorizons(const AmbientInputs& in, const AmbientOutputs& out, Amb
     const AmbientJob job{
         in,   nx, ny, nxr, nyr, m, rowFloats, scratch.rows.data(), scratch.columns.data(), scratch.nearSteps.data(),
         runs, out};
-    // a row keeps nothing in the scratch but the window, which a block starts afresh
-    parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
+    // a row keeps nothing in the scratch but the window, which a block
+    // starts afresh; only the blocks with runs are handed out
+    const auto blockRows = [&](int block) {
+        return RowSpan{static_cast<int>(static_cast<long long>(ny) * block / nBlocks),
+                       static_cast<int>(static_cast<long long>(ny) * (block + 1) / nBlocks)};
+    };
+    blocksWithRuns(runs, nBlocks, blockRows, scratch.busyBlocks);
+    parallelForEach(scratch.busyBlocks, [&](int block) {
         float* buffers = job.scratch + static_cast<std::size_t>(workerSlot()) * slotFloats;
-        for (int block = b0; block < b1; ++block) {
-            const int yBegin = static_cast<int>(static_cast<long long>(ny) * block / nBlocks);
-            const int yEnd = static_cast<int>(static_cast<long long>(ny) * (block + 1) / nBlocks);
-            const ColumnSpan read =
-                receiverColumnsRead(runs, yBegin, yEnd, nxr, [&](int x) { return job.columns[x].i0; });
-            RaisedWindow window{buffers + kRowsPerSlot * static_cast<std::size_t>(rowFloats), nxr, read};
-            const ColumnSpan wholeRow{0, nx};
-            for (int y = yBegin; y < yEnd; ++y) {
-                const Runs rowRuns = runsOfRow(runs, y, wholeRow);
-                if (rowRuns.empty()) continue;
-                if (s > 1) window.cover(job, y);
-                ambientRow(job, y, rowRuns, buffers, window);
-            }
+        const RowSpan rows = blockRows(block);
+        const ColumnSpan read =
+            receiverColumnsRead(runs, rows.y0, rows.y1, nxr, [&](int x) { return job.columns[x].i0; });
+        RaisedWindow window{buffers + kRowsPerSlot * static_cast<std::size_t>(rowFloats), nxr, read};
+        const ColumnSpan wholeRow{0, nx};
+        for (int y = rows.y0; y < rows.y1; ++y) {
+            const Runs rowRuns = runsOfRow(runs, y, wholeRow);
+            if (rowRuns.empty()) continue;
+            if (s > 1) window.cover(job, y);
+            ambientRow(job, y, rowRuns, buffers, window);
         }
     });
 }

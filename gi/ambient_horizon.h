@@ -61,6 +61,7 @@ struct AmbientScratch {
     std::vector<float> rows;               // per worker slot: row buffers and the raised receiver rows
     std::vector<ReceiverLerp> columns;     // per texel column: the receivers it lies between
     std::vector<NearFieldStep> nearSteps;  // azimuths x subsample
+    std::vector<int> busyBlocks;           // the row blocks with texels to do
 };
 
 /// Adds the light of a sky of constant radiance `radiance` (RGB) to a

@@ -212,31 +212,32 @@ void occlusionAtTexels(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
     const int nBlocks = (ny + kRowsPerBlock - 1) / kRowsPerBlock;
     const std::size_t perBlock = static_cast<std::size_t>(5) * pad;  // gx, gy, far, sum, receivers' row
     st.scratch.resize(perBlock * nBlocks);
-    parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
-        for (int block = b0; block < b1; ++block) {
-            const RowScratch r = RowScratch::at(st.scratch.data() + perBlock * block, pad);
-            float* recv = r.sum + pad;
-            for (int y = block * kRowsPerBlock; y < std::min(ny, (block + 1) * kRowsPerBlock); ++y) {
-                const ReceiverLerp ry = receiverLerp(y, s, nyr);
-                const std::span<const ColumnSpan> runs = st.texelRuns.ofRow(y);
-                if (runs.empty()) continue;
-                const PointRow pts{y, 1, nx, pad, st.heights.data() + (y + B) * stride + B, stride, nTaps};
-                const auto fillFar = [&](int j, float* far, int a, int e) {
-                    const float* fs = st.farSlope.data() + static_cast<std::size_t>(j) * nxr * nyr;
-                    const float* f0 = fs + static_cast<std::size_t>(ry.i0) * nxr;
-                    const float* f1 = fs + static_cast<std::size_t>(ry.i1) * nxr;
-                    const ColumnSpan read = receiversReadBy(st.cols[static_cast<std::size_t>(a)].i0,
-                                                            st.cols[static_cast<std::size_t>(e - 1)].i0, nxr);
-                    for (int X = read.x0; X < read.x1; ++X) recv[X] = f0[X] + ry.f * (f1[X] - f0[X]);
-                    for (int x = a; x < e; ++x) {
-                        const ReceiverLerp& rx = st.cols[static_cast<std::size_t>(x)];
-                        far[x] = recv[rx.i0] + rx.f * (recv[rx.i1] - recv[rx.i0]);
-                    }
-                };
-                occlusionOfRow(gradX, gradY, pts, runs, r, st.taps.data(), st.cosPhi.data(), st.sinPhi.data(), pass.m,
-                               pass.scale, pass.azimuth, fillFar,
-                               st.occlusion.data() + static_cast<std::size_t>(y) * nx);
-            }
+    const auto blockRows = [&](int block) {
+        return RowSpan{block * kRowsPerBlock, std::min(ny, (block + 1) * kRowsPerBlock)};
+    };
+    blocksWithRuns(&st.texelRuns, nBlocks, blockRows, st.busyBlocks);
+    parallelForEach(st.busyBlocks, [&](int block) {
+        const RowScratch r = RowScratch::at(st.scratch.data() + perBlock * block, pad);
+        float* recv = r.sum + pad;
+        for (int y = block * kRowsPerBlock; y < std::min(ny, (block + 1) * kRowsPerBlock); ++y) {
+            const ReceiverLerp ry = receiverLerp(y, s, nyr);
+            const std::span<const ColumnSpan> runs = st.texelRuns.ofRow(y);
+            if (runs.empty()) continue;
+            const PointRow pts{y, 1, nx, pad, st.heights.data() + (y + B) * stride + B, stride, nTaps};
+            const auto fillFar = [&](int j, float* far, int a, int e) {
+                const float* fs = st.farSlope.data() + static_cast<std::size_t>(j) * nxr * nyr;
+                const float* f0 = fs + static_cast<std::size_t>(ry.i0) * nxr;
+                const float* f1 = fs + static_cast<std::size_t>(ry.i1) * nxr;
+                const ColumnSpan read = receiversReadBy(st.cols[static_cast<std::size_t>(a)].i0,
+                                                        st.cols[static_cast<std::size_t>(e - 1)].i0, nxr);
+                for (int X = read.x0; X < read.x1; ++X) recv[X] = f0[X] + ry.f * (f1[X] - f0[X]);
+                for (int x = a; x < e; ++x) {
+                    const ReceiverLerp& rx = st.cols[static_cast<std::size_t>(x)];
+                    far[x] = recv[rx.i0] + rx.f * (recv[rx.i1] - recv[rx.i0]);
+                }
+            };
+            occlusionOfRow(gradX, gradY, pts, runs, r, st.taps.data(), st.cosPhi.data(), st.sinPhi.data(), pass.m,
+                           pass.scale, pass.azimuth, fillFar, st.occlusion.data() + static_cast<std::size_t>(y) * nx);
         }
     });
 }
@@ -252,24 +253,27 @@ void occlusionAtReceivers(const HeightPyramid& pyr, ConstGridView gradX, ConstGr
     const int nBlocksR = (nyr + kRowsPerBlock - 1) / kRowsPerBlock;
     const std::size_t perBlockR = static_cast<std::size_t>(4) * padR;  // gx, gy, far, sum
     if (st.scratch.size() < perBlockR * nBlocksR) st.scratch.resize(perBlockR * nBlocksR);
-    parallelFor(0, nBlocksR, 1, [&](int b0, int b1) {
-        for (int block = b0; block < b1; ++block) {
-            const RowScratch r = RowScratch::at(st.scratch.data() + perBlockR * block, padR);
-            for (int Y = block * kRowsPerBlock; Y < std::min(nyr, (block + 1) * kRowsPerBlock); ++Y) {
-                const std::span<const ColumnSpan> runs = st.receiverRuns.ofRow(Y);
-                if (runs.empty()) continue;
-                const PointRow pts{std::min(s * Y, ny - 1), s, nxr, padR, nullptr, 0, 0};
-                const auto fillFar = [&](int j, float* far, int a, int e) {
-                    const float* fs = st.farSlope.data() + static_cast<std::size_t>(j) * nxr * nyr +
-                                      static_cast<std::size_t>(Y) * nxr;
-                    std::copy(fs + a, fs + std::max(a, e), far + a);
-                };
-                occlusionOfRow(gradX, gradY, pts, runs, r, nullptr, st.cosPhi.data(), st.sinPhi.data(), pass.m,
-                               pass.scale, pass.azimuth, fillFar,
-                               st.receiverOcclusion.data() + static_cast<std::size_t>(Y) * nxr,
-                               st.receiverOcclusionRunning.data() + static_cast<std::size_t>(Y) * nxr,
-                               static_cast<std::size_t>(nxr) * nyr);
-            }
+    blocksWithRows(
+        nBlocksR,
+        [&](int block) {
+            return RowSpan{block * kRowsPerBlock, std::min(nyr, (block + 1) * kRowsPerBlock)};
+        },
+        [&](int Y) { return !st.receiverRuns.ofRow(Y).empty(); }, st.busyBlocks);
+    parallelForEach(st.busyBlocks, [&](int block) {
+        const RowScratch r = RowScratch::at(st.scratch.data() + perBlockR * block, padR);
+        for (int Y = block * kRowsPerBlock; Y < std::min(nyr, (block + 1) * kRowsPerBlock); ++Y) {
+            const std::span<const ColumnSpan> runs = st.receiverRuns.ofRow(Y);
+            if (runs.empty()) continue;
+            const PointRow pts{std::min(s * Y, ny - 1), s, nxr, padR, nullptr, 0, 0};
+            const auto fillFar = [&](int j, float* far, int a, int e) {
+                const float* fs =
+                    st.farSlope.data() + static_cast<std::size_t>(j) * nxr * nyr + static_cast<std::size_t>(Y) * nxr;
+                std::copy(fs + a, fs + std::max(a, e), far + a);
+            };
+            occlusionOfRow(gradX, gradY, pts, runs, r, nullptr, st.cosPhi.data(), st.sinPhi.data(), pass.m, pass.scale,
+                           pass.azimuth, fillFar, st.receiverOcclusion.data() + static_cast<std::size_t>(Y) * nxr,
+                           st.receiverOcclusionRunning.data() + static_cast<std::size_t>(Y) * nxr,
+                           static_cast<std::size_t>(nxr) * nyr);
         }
     });
 }
@@ -390,14 +394,18 @@ void shadeBlockerRadiance(BlockerRadianceState& st, const AlbedoMap* albedo, con
     const int nBlocks = (ny + kRowsPerBlock - 1) / kRowsPerBlock;
     const std::size_t perBlock = static_cast<std::size_t>(4) * nxr;  // O, E x 3 of a row, between receiver rows
     if (st.scratch.size() < perBlock * nBlocks) st.scratch.resize(perBlock * nBlocks);
-    parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
-        for (int block = b0; block < b1; ++block) {
-            float* oRow = st.scratch.data() + perBlock * block;
-            float* const eRow[3] = {oRow + nxr, oRow + 2 * nxr, oRow + 3 * nxr};
-            for (int y = block * kRowsPerBlock; y < std::min(ny, (block + 1) * kRowsPerBlock); ++y)
-                for (const ColumnSpan& run : st.texelRuns.ofRow(y))
-                    shadeTexelRun(st, alb, y, run.x0, run.x1, oRow, eRow, rgb);
-        }
+    blocksWithRuns(
+        &st.texelRuns, nBlocks,
+        [&](int block) {
+            return RowSpan{block * kRowsPerBlock, std::min(ny, (block + 1) * kRowsPerBlock)};
+        },
+        st.busyBlocks);
+    parallelForEach(st.busyBlocks, [&](int block) {
+        float* oRow = st.scratch.data() + perBlock * block;
+        float* const eRow[3] = {oRow + nxr, oRow + 2 * nxr, oRow + 3 * nxr};
+        for (int y = block * kRowsPerBlock; y < std::min(ny, (block + 1) * kRowsPerBlock); ++y)
+            for (const ColumnSpan& run : st.texelRuns.ofRow(y))
+                shadeTexelRun(st, alb, y, run.x0, run.x1, oRow, eRow, rgb);
     });
 }
 

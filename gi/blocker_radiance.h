@@ -75,6 +75,7 @@ struct BlockerRadianceState {
     std::vector<float> receiverGroupOcclusion;
     std::array<std::vector<float>, 3> receiverShade;  // E / pi at the receivers, per channel
     std::vector<float> scratch;                       // per block of rows: padded row buffers
+    std::vector<int> busyBlocks;                      // the blocks of rows with runs (scratch)
     std::vector<NearTap> taps;                        // azimuths x near samples
     std::vector<float> cosPhi, sinPhi;
     std::vector<ReceiverLerp> cols;  // per full-resolution column: the receivers it reads

@@ -729,10 +729,16 @@ void shadeTexels(ConstGridView gradX, ConstGridView gradY, int s, const Visibili
     // ---- schedule: fixed row blocks; a row keeps nothing in the scratch, so
     // each thread's slot of it serves every block it runs ----------------------
     const BlockSchedule schedule{gradX, gradY, lights, lightCount, runs, nBlocks, nPlanes, window, phong};
-    parallelFor(0, nBlocks, 1, [&](int b0, int b1) {
-        const auto slot = static_cast<std::size_t>(workerSlot());
-        for (int block = b0; block < b1; ++block) shadeBlock(schedule, phongJob, block, slot);
-    });
+    // only the blocks with runs are handed out
+    blocksWithRuns(
+        runs, nBlocks,
+        [&](int block) {
+            const RowBlock r = rowBlock(gradX.ny, nBlocks, block);
+            return RowSpan{r.begin, r.end};
+        },
+        out.busyBlocks);
+    parallelForEach(out.busyBlocks,
+                    [&](int block) { shadeBlock(schedule, phongJob, block, static_cast<std::size_t>(workerSlot())); });
 }
 
 }  // namespace terrain::gi

@@ -208,6 +208,7 @@ struct ShadeMaps {
     std::vector<BlockTerm> incidentTerms;    // per block of output coefficients
     std::vector<int> incidentTermStart;      // blocks + 1
     std::vector<float> rowScratch;           // per worker slot: interpolated SH planes of one row
+    std::vector<int> busyBlocks;             // the row blocks with texels to shade
     std::vector<std::uint8_t> receiverRows;  // per receiver row: its incident radiance is updated (restricted rows)
 };
 

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "core/grid.h"
+#include "core/parallel.h"
 #include "gi/receiver_tiles.h"
 
 namespace terrain::gi {
@@ -56,6 +57,17 @@ void texelRunsOfRects(std::span<const TexelRect> rects, int nx, int ny, TexelRun
 
 /// Texels in the runs.
 long long texelCount(const TexelRuns& runs);
+
+/// The blocks of [0, nBlocks) holding a row with a run, block b being the
+/// rows rowsOf(b) (a RowSpan), in order, into out (every block with a row
+/// when `runs` is null): a pass over fixed row blocks hands out only these
+/// (parallelForEach), so that a local change's few blocks are shared among
+/// the threads.
+template <class RowsOf>
+void blocksWithRuns(const TexelRuns* runs, int nBlocks, RowsOf&& rowsOf, std::vector<int>& out) {
+    blocksWithRows(
+        nBlocks, rowsOf, [&](int y) { return !runs || runs->hasRow(y); }, out);
+}
 
 /// Row y's runs, or `whole` (a caller's run [0, nx)) when there are no runs
 /// (null: every texel).

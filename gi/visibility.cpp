@@ -803,15 +803,8 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
         return RowSpan{static_cast<int>(static_cast<long long>(nyr) * block / nBlocks),
                        static_cast<int>(static_cast<long long>(nyr) * (block + 1) / nBlocks)};
     };
-    state.busyBlocks.clear();
-    for (int block = 0; block < nBlocks; ++block) {
-        const RowSpan r = blockRows(block);
-        for (int Y = r.y0; Y < r.y1; ++Y)
-            if (!state.spans.ofRow(Y).empty()) {
-                state.busyBlocks.push_back(block);
-                break;
-            }
-    }
+    blocksWithRows(
+        nBlocks, blockRows, [&](int Y) { return !state.spans.ofRow(Y).empty(); }, state.busyBlocks);
     parallelForEach(state.busyBlocks, [&](int block) {
         VisibilityScratch& sc = state.blocks[static_cast<std::size_t>(block)];
         const RowSpan r = blockRows(block);
