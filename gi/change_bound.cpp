@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -399,12 +400,14 @@ void forEachTile(const HeightPyramid& pyr, int T, std::vector<float>& out, PerTi
 }
 
 // Fills `azimuths` values per tile (tile-major) at the m samples phi_j = 2 pi
-// j / m of the full circle, tiles in parallel (forEachTile): perTile(the tile's cells,
-// cos phi_j and sin phi_j of every j, out, the tile's index) writes one
-// tile's m values; with `only`, the flagged tiles' (the others get 0).
-template <class PerTile>
+// j / m of the full circle: start(the tile's cells) once per tile, then
+// value(its start, the tile's cells, cos phi_j, sin phi_j) for each
+// azimuth, the (tile, azimuth) pairs in parallel, each a chunk of its own at
+// most (beside a local change one tile's azimuths cost far more than most
+// tiles'); with `only`, the flagged tiles' (the others get 0).
+template <class Start, class Value>
 void forEachTileAndAzimuth(const MaxChangePyramid& dv, const HeightPyramid& pyr, int T, int azimuths,
-                           std::vector<float>& out, std::span<const std::uint8_t> only, PerTile&& perTile) {
+                           std::vector<float>& out, std::span<const std::uint8_t> only, Start&& start, Value&& value) {
     requireSameSize(dv, pyr, T);
     if (azimuths < 1) throw InputError("change bound: at least one azimuth");
     std::vector<double> cs(static_cast<std::size_t>(azimuths)), sn(cs.size());
@@ -414,18 +417,23 @@ void forEachTileAndAzimuth(const MaxChangePyramid& dv, const HeightPyramid& pyr,
         sn[static_cast<std::size_t>(j)] = std::sin(phi);
     }
     const int tilesX = tileCount(pyr.nxr, T), tilesY = tileCount(pyr.nyr, T);
-    const std::size_t m = static_cast<std::size_t>(azimuths);
-    const std::size_t tiles = static_cast<std::size_t>(tilesX) * static_cast<std::size_t>(tilesY);
-    if (!only.empty() && only.size() != tiles) throw InputError("change bound: one flag per tile");
-    out.resize(tiles * m);
-    parallelFor(0, static_cast<int>(tiles), 1, [&](int t0, int t1) {
-        for (int i = t0; i < t1; ++i) {
-            const auto t = static_cast<std::size_t>(i);
-            float* values = out.data() + t * m;
-            if (only.empty() || only[t])
-                perTile(tileCells(pyr, T, i % tilesX, i / tilesX), cs, sn, values, t);
-            else
-                std::fill(values, values + m, 0.0f);
+    const int tiles = tilesX * tilesY;
+    if (!only.empty() && only.size() != static_cast<std::size_t>(tiles))
+        throw InputError("change bound: one flag per tile");
+    const auto flagged = [&](int t) { return only.empty() || only[static_cast<std::size_t>(t)]; };
+    const auto cells = [&](int t) { return tileCells(pyr, T, t % tilesX, t / tilesX); };
+    std::vector<std::invoke_result_t<Start&, const InclusiveCells&>> starts(static_cast<std::size_t>(tiles));
+    parallelFor(0, tiles, 1, [&](int t0, int t1) {
+        for (int t = t0; t < t1; ++t)
+            if (flagged(t)) starts[static_cast<std::size_t>(t)] = start(cells(t));
+    });
+    out.resize(static_cast<std::size_t>(tiles) * cs.size());
+    parallelFor(0, tiles * azimuths, 1, [&](int k0, int k1) {
+        for (int k = k0; k < k1; ++k) {
+            const int t = k / azimuths;
+            const auto j = static_cast<std::size_t>(k % azimuths);
+            out[static_cast<std::size_t>(k)] =
+                flagged(t) ? value(starts[static_cast<std::size_t>(t)], cells(t), cs[j], sn[j]) : 0.0f;
         }
     });
 }
@@ -663,15 +671,20 @@ void boundSlopeChangePerAzimuth(const MaxChangePyramid& dh, const HeightPyramid&
                                 std::vector<float>& tileBound, std::span<const std::uint8_t> only) {
     const StepTable steps = stepTable(pyr);
     const double lipschitz = heightFilterLipschitz(pyr);
-    forEachTileAndAzimuth(dh, pyr, tileReceivers, azimuths, tileBound, only,
-                          [&](const InclusiveCells& c, const std::vector<double>& cs, const std::vector<double>& sn,
-                              float* out, std::size_t) {
-                              const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
-                              const int first = firstBusyStep(dh, pyr, c, m0);
-                              for (std::size_t j = 0; j < cs.size(); ++j)
-                                  out[j] = floatNotBelow(azimuthBoundFrom(dh, pyr, steps, c, m0, first,
-                                                                          oneDirection(cs[j], sn[j]), lipschitz));
-                          });
+    // per tile: the largest change among its own cells, and the first step that may see one
+    struct TileStart {
+        double m0 = 0.0;
+        int first = 0;
+    };
+    forEachTileAndAzimuth(
+        dh, pyr, tileReceivers, azimuths, tileBound, only,
+        [&](const InclusiveCells& c) {
+            const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
+            return TileStart{m0, firstBusyStep(dh, pyr, c, m0)};
+        },
+        [&](const TileStart& t, const InclusiveCells& c, double cs, double sn) {
+            return floatNotBelow(azimuthBoundFrom(dh, pyr, steps, c, t.m0, t.first, oneDirection(cs, sn), lipschitz));
+        });
 }
 
 float ambientChangeBoundPerAzimuth(const float* slopeBound, int azimuths, float gradientBound, float maxSkyRadiance,

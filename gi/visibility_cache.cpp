@@ -278,10 +278,12 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
     advanceAnchoredDrift(cache.keyExcursion, cache.keyTiles.dirty, reanchor, cache.keyDrift);
     advanceAnchoredDrift(cache.geometryExcursion, cache.geometryTiles.dirty, reanchor, cache.geometryDrift);
     // the anchor becomes `after`, which differs from `before` within
-    // sinceBefore; else it differs from `before` and from `after` (the
-    // next plan's `before`, if this frame is recorded) within mayDiffer
+    // sinceBefore; else it differs from `after` (the next plan's `before`,
+    // if this frame is recorded) within `differing`, and from `before`
+    // within that and sinceBefore (where `after` differs from `before`):
+    // the next plan compares only those cells, not the whole field again
     if (reanchor) copyGrid(after, cache.anchorHeights, differing.rows());
-    cache.anchorDiffers = reanchor ? sinceBefore : mayDiffer;
+    cache.anchorDiffers = reanchor ? sinceBefore : differing.joined(sinceBefore);
     const int all = static_cast<int>(cache.tiles.dirty.size());
     // the indirect light re-gathers the geometry's dirty tiles: both count
     countAfterPlan(std::min(cache.tiles.dirtyCount(), cache.geometryTiles.dirtyCount()), all, cache.skips);
