@@ -18,6 +18,9 @@ constexpr int kRowsPerBlock = 8;
 constexpr int kLanePad = 8;           // rows padded to the widest lane group
 constexpr float kOutside = -1.0e30f;  // height outside the domain: a sample there blocks nothing
 
+// The rows of block b of n rows in blocks of kRowsPerBlock.
+RowSpan rowsOfBlock(int b, int n) { return {b * kRowsPerBlock, std::min(n, (b + 1) * kRowsPerBlock)}; }
+
 inline int padLanes(int n) { return (n + kLanePad - 1) / kLanePad * kLanePad; }
 
 // One row of texels: inputs and the occlusion sum.
@@ -212,14 +215,13 @@ void occlusionAtTexels(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
     const int nBlocks = (ny + kRowsPerBlock - 1) / kRowsPerBlock;
     const std::size_t perBlock = static_cast<std::size_t>(5) * pad;  // gx, gy, far, sum, receivers' row
     st.scratch.resize(perBlock * nBlocks);
-    const auto blockRows = [&](int block) {
-        return RowSpan{block * kRowsPerBlock, std::min(ny, (block + 1) * kRowsPerBlock)};
-    };
-    blocksWithRuns(&st.texelRuns, nBlocks, blockRows, st.busyBlocks);
+    blocksWithRuns(
+        &st.texelRuns, nBlocks, [&](int block) { return rowsOfBlock(block, ny); }, st.busyBlocks);
     parallelForEach(st.busyBlocks, [&](int block) {
         const RowScratch r = RowScratch::at(st.scratch.data() + perBlock * block, pad);
         float* recv = r.sum + pad;
-        for (int y = block * kRowsPerBlock; y < std::min(ny, (block + 1) * kRowsPerBlock); ++y) {
+        const RowSpan rows = rowsOfBlock(block, ny);
+        for (int y = rows.y0; y < rows.y1; ++y) {
             const ReceiverLerp ry = receiverLerp(y, s, nyr);
             const std::span<const ColumnSpan> runs = st.texelRuns.ofRow(y);
             if (runs.empty()) continue;
@@ -254,14 +256,12 @@ void occlusionAtReceivers(const HeightPyramid& pyr, ConstGridView gradX, ConstGr
     const std::size_t perBlockR = static_cast<std::size_t>(4) * padR;  // gx, gy, far, sum
     if (st.scratch.size() < perBlockR * nBlocksR) st.scratch.resize(perBlockR * nBlocksR);
     blocksWithRows(
-        nBlocksR,
-        [&](int block) {
-            return RowSpan{block * kRowsPerBlock, std::min(nyr, (block + 1) * kRowsPerBlock)};
-        },
+        nBlocksR, [&](int block) { return rowsOfBlock(block, nyr); },
         [&](int Y) { return !st.receiverRuns.ofRow(Y).empty(); }, st.busyBlocks);
     parallelForEach(st.busyBlocks, [&](int block) {
         const RowScratch r = RowScratch::at(st.scratch.data() + perBlockR * block, padR);
-        for (int Y = block * kRowsPerBlock; Y < std::min(nyr, (block + 1) * kRowsPerBlock); ++Y) {
+        const RowSpan rows = rowsOfBlock(block, nyr);
+        for (int Y = rows.y0; Y < rows.y1; ++Y) {
             const std::span<const ColumnSpan> runs = st.receiverRuns.ofRow(Y);
             if (runs.empty()) continue;
             const PointRow pts{std::min(s * Y, ny - 1), s, nxr, padR, nullptr, 0, 0};
@@ -395,15 +395,12 @@ void shadeBlockerRadiance(BlockerRadianceState& st, const AlbedoMap* albedo, con
     const std::size_t perBlock = static_cast<std::size_t>(4) * nxr;  // O, E x 3 of a row, between receiver rows
     if (st.scratch.size() < perBlock * nBlocks) st.scratch.resize(perBlock * nBlocks);
     blocksWithRuns(
-        &st.texelRuns, nBlocks,
-        [&](int block) {
-            return RowSpan{block * kRowsPerBlock, std::min(ny, (block + 1) * kRowsPerBlock)};
-        },
-        st.busyBlocks);
+        &st.texelRuns, nBlocks, [&](int block) { return rowsOfBlock(block, ny); }, st.busyBlocks);
     parallelForEach(st.busyBlocks, [&](int block) {
         float* oRow = st.scratch.data() + perBlock * block;
         float* const eRow[3] = {oRow + nxr, oRow + 2 * nxr, oRow + 3 * nxr};
-        for (int y = block * kRowsPerBlock; y < std::min(ny, (block + 1) * kRowsPerBlock); ++y)
+        const RowSpan rows = rowsOfBlock(block, ny);
+        for (int y = rows.y0; y < rows.y1; ++y)
             for (const ColumnSpan& run : st.texelRuns.ofRow(y))
                 shadeTexelRun(st, alb, y, run.x0, run.x1, oRow, eRow, rgb);
     });

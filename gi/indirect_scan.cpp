@@ -78,9 +78,13 @@ void IndirectScan::beginFrame() {
     st_.stepsPerColumn.resize(static_cast<std::size_t>(m) * pad_);
     st_.stepsPerRow.resize(static_cast<std::size_t>(m) * nyr);
     dirtySpans(in_.only, in_.heights.nxr, nyr, st_.spans);
-    withWork_.clear();
-    for (int block = 0; block < nBlocks_; ++block)
-        if (hasWork(rowBlock(block))) withWork_.push_back(block);
+    blocksWithRows(
+        nBlocks_,
+        [&](int block) {
+            const RowBlock rb = rowBlock(block);
+            return RowSpan{rb.yBegin, rb.yBegin + rb.rows};
+        },
+        [&](int Y) { return !spans(Y).empty(); }, st_.blocksWithWork);
 }
 
 void IndirectScan::buildPyramid(const BounceSource& source, const RadiancePyramidSettings& settings) {
@@ -120,12 +124,6 @@ void IndirectScan::buildGlossyStepTable() {
 RowBlock IndirectScan::rowBlock(int block) const {
     const int yBegin = block * kRowsPerBlock;
     return {yBegin, std::min(kRowsPerBlock, in_.heights.nyr - yBegin)};
-}
-
-bool IndirectScan::hasWork(const RowBlock& rb) const {
-    for (int r = 0; r < rb.rows; ++r)
-        if (!spans(rb.yBegin + r).empty()) return true;
-    return false;
 }
 
 void IndirectScan::loadRows(const RowBlock& rb, IndirectScratch& sc) const {

@@ -65,7 +65,7 @@ public:
     /// them with the field's empty blocks around them.
     template <class Fn>
     void forEachBlockWithWork(Fn&& fn) const {
-        parallelForEach(withWork_, std::forward<Fn>(fn));
+        parallelForEach(st_.blocksWithWork, std::forward<Fn>(fn));
     }
     /// The calling thread's scratch: a block keeps nothing in it once done,
     /// so each worker slot's serves every block that thread runs.
@@ -87,8 +87,6 @@ public:
 
 private:
     void buildGlossyStepTable();
-    /// Whether some row of the block has a span to scan.
-    bool hasWork(const RowBlock& rb) const;
 
     const IndirectInputs& in_;
     IndirectState& st_;
@@ -97,7 +95,6 @@ private:
     int pad_, nSteps_, nBlocks_;
     std::size_t tableSize_;  // azimuths x steps
     float hMax_ = 0.0f;
-    std::vector<int> withWork_;  // the blocks with a span to scan (beginFrame)
 };
 
 }  // namespace terrain::gi

@@ -52,6 +52,7 @@ struct IndirectState {
     std::vector<StepTableKey> radianceTableKey;
     std::vector<std::uint8_t> distanceGroups;  // per step (gi/pyramid.h, distanceGroup)
     DirtySpans spans;                          // the receiver columns to scan, per row
+    std::vector<int> blocksWithWork;           // the row blocks with a span to scan
     std::vector<float> topOfRows;              // per block of raw-phase rows: its highest height (fieldTopHeight)
     std::uint64_t topOfBuild = 0;              // the height pyramid build topOfRows holds (0: none)
     std::vector<IndirectScratch> blocks;       // per worker slot (IndirectScan::scratch)

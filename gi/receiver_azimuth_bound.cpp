@@ -259,7 +259,12 @@ void forEachWalkedRow(ChangeLevels& levels, const HeightPyramid& pyr, std::span<
     const DirtySpans& spans = levels.spans;
     dirtySpans(only, b.nxr, b.nyr, levels.spans);
     // only the rows with a span are handed out (a local change's few tiles)
-    rowsWithSpans(spans, b.nyr, levels.walkedRows);
+    blocksWithRows(
+        b.nyr,
+        [](int Y) {
+            return RowSpan{Y, Y + 1};
+        },
+        [&](int Y) { return !spans.ofRow(Y).empty(); }, levels.walkedRows);
     parallelForEach(levels.walkedRows, [&](int Y) {
         // |dh| at the receivers' own cells: raw phase 0 of row s Y
         row(Y, spans.ofRow(Y), RowWalk{b.rawPhaseRow(0, b.subsample * Y), Y, b.subsample, levels.built});

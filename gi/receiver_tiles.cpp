@@ -77,10 +77,4 @@ void dirtySpans(const ReceiverTiles* only, int nxr, int nyr, DirtySpans& out) {
     }
 }
 
-void rowsWithSpans(const DirtySpans& spans, int nyr, std::vector<int>& rows) {
-    rows.clear();
-    for (int Y = 0; Y < nyr; ++Y)
-        if (!spans.ofRow(Y).empty()) rows.push_back(Y);
-}
-
 }  // namespace terrain::gi

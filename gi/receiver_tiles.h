@@ -78,8 +78,4 @@ struct DirtySpans {
 /// tilesX x tilesY.
 void dirtySpans(const ReceiverTiles* only, int nxr, int nyr, DirtySpans& out);
 
-/// The receiver rows of [0, nyr) with a span of `spans`, in order, into
-/// rows (its buffer reused).
-void rowsWithSpans(const DirtySpans& spans, int nyr, std::vector<int>& rows);
-
 }  // namespace terrain::gi
