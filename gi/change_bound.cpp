@@ -153,7 +153,7 @@ struct StepExtent {
     double tauMin, tauMax, reach;
 };
 
-double octaveReach(int o) { return o == 0 ? 0.0 : 2.5 * std::ldexp(1.0, o) - 0.5; }
+double octaveReach(int o) { return o == 0 ? 0.0 : 2.5 * octaveScale(o) - 0.5; }
 
 double stepReach(const HeightPyramid& pyr, int i) {
     const int level = pyr.steps[static_cast<std::size_t>(i)].level;
@@ -299,7 +299,7 @@ struct AxisWeights {
     std::vector<int> lastStart;               // per octave: first cell of the last block
     std::vector<std::vector<double>> suffix;  // per octave: max weight from cell lastStart + k on
     double maxOver(int o, int a0, int a1) const {
-        const double inside = std::ldexp(1.0, -o);
+        const double inside = 1.0 / octaveScale(o);
         const int start = lastStart[static_cast<std::size_t>(o)];
         const bool edgeTexel = a0 < (1 << o) || a1 >= start;
         const double tap = edgeTexel ? 1.0 : kTapWeight;

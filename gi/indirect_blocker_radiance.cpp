@@ -7,6 +7,7 @@
 #include "core/parallel.h"
 #include "core/simd.h"
 #include "gi/blocker_radiance.h"
+#include "gi/indirect_scan_tables.h"
 
 namespace terrain::gi {
 
@@ -85,11 +86,20 @@ void BlockerRadianceIndirect::scanBlock(int block, bool horizons) {
     const RowBlock rb = scan_.rowBlock(block);
     // the rows' receiver heights and gradients; E sums zeroed
     scan_.loadRows(rb, sc);
-    std::fill(sc.irradiance.data(), sc.irradiance.data() + 3 * static_cast<std::size_t>(rb.rows) * pad, 0.0f);
-    // with the horizons, each distance group's occlusion (the indirect cache's weights)
-    if (horizons)
-        for (int r = 0; r < rb.rows; ++r)
-            std::fill_n(sc.groupOccludersOf(r), static_cast<std::size_t>(kDistanceGroups) * pad, 0.0f);
+    // E sums and, with the horizons, each distance group's occlusion (the
+    // indirect cache's weights) zeroed over the lanes the scan writes: the
+    // rows' spans, each to its padded end (a local change's few tiles)
+    for (int r = 0; r < rb.rows; ++r)
+        for (const ColumnSpan& span : scan_.spans(rb.yBegin + r)) {
+            const int x0 = span.x0, x1 = indirectRowPad(span.x1);
+            for (int c = 0; c < 3; ++c)
+                std::fill(sc.irradiance.data() + (3 * static_cast<std::size_t>(r) + c) * pad + x0,
+                          sc.irradiance.data() + (3 * static_cast<std::size_t>(r) + c) * pad + x1, 0.0f);
+            if (!horizons) continue;
+            for (int g = 0; g < kDistanceGroups; ++g)
+                std::fill(sc.groupOccludersOf(r) + static_cast<std::size_t>(g) * pad + x0,
+                          sc.groupOccludersOf(r) + static_cast<std::size_t>(g) * pad + x1, 0.0f);
+        }
     for (int j = 0; j < in_.op.azimuths; ++j) {
         const AzimuthSteps az = scan_.azimuth(j, false, horizons);
         scan_.castRows(az, j, rb, sc);

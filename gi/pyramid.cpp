@@ -119,7 +119,7 @@ RowSpan receiversReading(const int* taps, int receivers, int t0, int t1) {
 // is centred at (k + 0.5) 2^o - 0.5. Its B-spline taps are floor(u) - 1 ..
 // floor(u) + 2.
 double synthesisCoordinate(int X, int subsample, int octave) {
-    return (subsample * X + 0.5) / std::ldexp(1.0, octave) - 0.5;
+    return (subsample * X + 0.5) / octaveScale(octave) - 0.5;
 }
 
 // Taps of the B-spline synthesis of octave o at the receivers.
@@ -293,7 +293,10 @@ CellBox synthesisePass(ConstGridView src, int o, int pass, float blend, const Ce
     const RowSpan rows = receiversReading(iy, nyr, changed.y0, changed.y1);
     if (cols.y0 >= cols.y1 || rows.y0 >= rows.y1) return CellBox::none();
     const int X0 = cols.y0, X1 = cols.y1;
-    p.rowTmp.resize(static_cast<std::size_t>(src.ny) * nxr);
+    // never shrunk: the octaves' passes alternate sizes, and growing back
+    // would zero the buffer every build (its rows are written before read)
+    const std::size_t tmpSize = static_cast<std::size_t>(src.ny) * nxr;
+    if (p.rowTmp.size() < tmpSize) p.rowTmp.resize(tmpSize);
     float* tmp = p.rowTmp.data();
     // the rows of B_o those receiver rows read (taps nondecreasing)
     const RowSpan tmpRows{iy[4 * rows.y0], iy[4 * (rows.y1 - 1) + 3] + 1};

@@ -28,6 +28,7 @@
 // also be max-decimated; levels then blend mean and max syntheses, which
 // counters the filtered pyramid's lowering of distant peaks.
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -154,6 +155,12 @@ struct LevelOctaves {
     float q = 0.0f;
 };
 LevelOctaves levelOctaves(const HeightPyramid& pyramid, int level);
+
+/// 2^o, the cells across a texel of octave o: exact, as std::ldexp(1, o),
+/// without its library call (the change bounds ask it per box they read).
+inline double octaveScale(int o) {
+    return o >= 0 && o < 63 ? static_cast<double>(std::uint64_t{1} << o) : std::ldexp(1.0, o);
+}
 
 /// The texels [y0, y1) of octave o's image B_o (o >= 1; `size` texels along
 /// the axis) that the B-spline synthesis at the receivers [r0, r1] of that

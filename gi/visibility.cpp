@@ -546,27 +546,31 @@ struct VisibilityRows {
     void (*rowBatch)(const RowBatch&);  // rowBatchSse or rowBatchAvx2
 };
 
-// h0 and the height gradients of receiver row Y into the block's scratch
-// (padding lanes: 0), and the footprint box rows, padded the same way.
-void loadReceiverRow(const VisibilityRows& r, int Y, VisibilityScratch& sc) {
+// h0 and the height gradients of the receivers of row Y's spans into the
+// block's scratch, each span up to its padded end (padding lanes: 0), and
+// the footprint box rows, padded the same way. Only the spans' columns: a
+// local change's rows read a few tiles of the row.
+void loadReceiverRow(const VisibilityRows& r, int Y, std::span<const ColumnSpan> spans, VisibilityScratch& sc) {
     const int nxr = r.pyr.nxr, s = r.pyr.subsample, nxrPad = r.nxrPad;
     const float* hRow = r.pyr.rawPhaseRow(0, s * Y);
-    for (int X = 0; X < nxrPad; ++X) {
-        const bool in = X < nxr;
-        sc.gradX[static_cast<std::size_t>(X)] = in ? r.gradX(s * X, s * Y) : 0.0f;
-        sc.gradY[static_cast<std::size_t>(X)] = in ? r.gradY(s * X, s * Y) : 0.0f;
-    }
-    for (int X = 0; X < nxrPad; ++X) sc.h0[static_cast<std::size_t>(X)] = X < nxr ? hRow[X] : 0.0f;
-    if (r.box) {
-        const FootprintBox* box = r.box;
-        const std::size_t at = static_cast<std::size_t>(Y) * nxr;
-        float* loX = sc.gradX.data() + nxrPad;
-        float* loY = sc.gradY.data() + nxrPad;
-        std::copy(box->loX.begin() + at, box->loX.begin() + at + nxr, loX);
-        std::copy(box->hiX.begin() + at, box->hiX.begin() + at + nxr, loX + nxrPad);
-        std::copy(box->loY.begin() + at, box->loY.begin() + at + nxr, loY);
-        std::copy(box->hiY.begin() + at, box->hiY.begin() + at + nxr, loY + nxrPad);
-        for (int X = nxr; X < nxrPad; ++X) loX[X] = loX[nxrPad + X] = loY[X] = loY[nxrPad + X] = 0.0f;
+    const FootprintBox* box = r.box;
+    const std::size_t at = static_cast<std::size_t>(Y) * nxr;
+    float* loX = sc.gradX.data() + nxrPad;
+    float* loY = sc.gradY.data() + nxrPad;
+    for (const ColumnSpan& span : spans) {
+        const int end = std::min(spanEnd(span), nxrPad);
+        for (int X = span.x0; X < end; ++X) {
+            const bool in = X < nxr;
+            sc.gradX[static_cast<std::size_t>(X)] = in ? r.gradX(s * X, s * Y) : 0.0f;
+            sc.gradY[static_cast<std::size_t>(X)] = in ? r.gradY(s * X, s * Y) : 0.0f;
+            sc.h0[static_cast<std::size_t>(X)] = in ? hRow[X] : 0.0f;
+            if (!box) continue;
+            const std::size_t i = at + static_cast<std::size_t>(std::min(X, nxr - 1));
+            loX[X] = in ? box->loX[i] : 0.0f;
+            loX[nxrPad + X] = in ? box->hiX[i] : 0.0f;
+            loY[X] = in ? box->loY[i] : 0.0f;
+            loY[nxrPad + X] = in ? box->hiY[i] : 0.0f;
+        }
     }
 }
 
@@ -811,7 +815,7 @@ void computeVisibility(const HeightPyramid& pyr, ConstGridView gradX, ConstGridV
         for (int Y = r.y0; Y < r.y1; ++Y) {
             const std::span<const ColumnSpan> spans = state.spans.ofRow(Y);
             if (spans.empty()) continue;
-            loadReceiverRow(rows, Y, sc);
+            loadReceiverRow(rows, Y, spans, sc);
             visibilityOfRow(rows, Y, spans, sc);
         }
     });
