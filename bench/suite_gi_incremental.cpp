@@ -69,10 +69,15 @@ struct CaseResult {
     Difference diff;
     StageMs stages;
     double changedArea = -1.0;  // the sweep's share of the cells changed, (0, 1]; -1 for the other cases
+    // a crater or pit: the median over the frames that drop it, and over
+    // those that fill it, of each frame's incremental ms over its full ms
+    // (-1 for the other cases): a new change and an undone one cost apart
+    double droppedRatio = -1.0, filledRatio = -1.0;
 };
 
-// Frames of a crater or pit case: six events (the pit dropped or filled) after the first.
-constexpr int kEventFrames = 7;
+// Frames of a crater or pit case: twelve events after the first, the pit
+// dropped on odd frames and filled on even ones.
+constexpr int kEventFrames = 13;
 
 // A frame's surface and lights; returns false when the sequence is over.
 using NextFrame = std::function<bool(int frame, Grid& surface, gi::GiLighting& light)>;
@@ -99,6 +104,7 @@ public:
         const gi::GiTimings& t = incState_.timings;
         incMs_.push_back(t.total);
         fullMs_.push_back(fullState_.timings.total);
+        frameRatio_.push_back(t.total / std::max(1e-9, fullState_.timings.total));
         stages_[0].push_back(t.gradient + t.pyramid);
         stages_[1].push_back(t.visibility);
         stages_[2].push_back(t.keyVisibility);
@@ -119,6 +125,13 @@ public:
         r.stages = {median(stages_[0]), median(stages_[1]), median(stages_[2]), median(stages_[3]), median(stages_[4])};
         return r;
     }
+    /// The median ratio of the measured frames of this parity (frame 1: odd).
+    double medianRatioOfFrames(int parity) const {
+        std::vector<double> v;
+        for (std::size_t i = 0; i < frameRatio_.size(); ++i)
+            if (static_cast<int>((i + 1) % 2) == parity) v.push_back(frameRatio_[i]);
+        return v.empty() ? -1.0 : median(v);
+    }
     double sumIncremental() const { return sum(incMs_); }
     double sumFull() const { return sum(fullMs_); }
 
@@ -131,7 +144,7 @@ private:
     gi::GiSettings inc_, full_;
     gi::GiState incState_, fullState_;
     bool first_ = true;
-    std::vector<double> incMs_, fullMs_;
+    std::vector<double> incMs_, fullMs_, frameRatio_;
     std::array<std::vector<double>, 5> stages_;
     double visibility_ = 0.0, indirect_ = 0.0;
     Difference diff_;
@@ -144,17 +157,26 @@ void printCase(const CaseResult& r) {
         r.name.c_str(), r.size, static_cast<double>(r.tolerance), r.fullMs, r.incrementalMs,
         100.0 * r.incrementalMs / r.fullMs, 100.0 * r.visibility, 100.0 * r.indirect, r.diff.rms, r.diff.maxRel,
         r.stages.geometry, r.stages.visibility, r.stages.keys, r.stages.shading, r.stages.indirect);
+    if (r.droppedRatio >= 0.0)
+        std::printf("%-28s frames that drop it %5.1f %%, that fill it %5.1f %% (median per-frame ratios)\n", "",
+                    100.0 * r.droppedRatio, 100.0 * r.filledRatio);
     std::fflush(stdout);
 }
 
-CaseResult runCase(const std::string& name, int size, float cell, float tolerance, int frames, const NextFrame& next) {
+// events: a crater or pit case (droppedRatio, filledRatio).
+CaseResult runCase(const std::string& name, int size, float cell, float tolerance, int frames, const NextFrame& next,
+                   bool events = false) {
     PairedRun run(tolerance);
     Grid surface;
     gi::GiLighting light;
     withThreads(2, [&] {
         for (int f = 0; f < frames && next(f, surface, light); ++f) run.frame(surface, cell, light);
     });
-    const CaseResult r = run.result(name, size);
+    CaseResult r = run.result(name, size);
+    if (events) {
+        r.droppedRatio = run.medianRatioOfFrames(1);
+        r.filledRatio = run.medianRatioOfFrames(0);
+    }
     printCase(r);
     return r;
 }
@@ -238,7 +260,7 @@ std::vector<CaseResult> runCases(const IncrementalOptions& o, const Grid& dem, f
                     return true;
                 }));
         if (o.wanted("dem, 16x16 crater"))
-            rows.push_back(runCase("dem, 16x16 crater", 512, cell, tol, kEventFrames, demWithPit(dem, 16)));
+            rows.push_back(runCase("dem, 16x16 crater", 512, cell, tol, kEventFrames, demWithPit(dem, 16), true));
     }
     return rows;
 }
@@ -250,8 +272,8 @@ std::vector<CaseResult> runSweep(const IncrementalOptions& o, const Grid& dem, f
     for (float tol : o.tolerances)
         for (int side : {5, 16, 51, 102, 229, 512}) {
             if (!o.wanted("dem, " + std::to_string(side) + "² pit")) continue;
-            rows.push_back(
-                runCase("dem, " + std::to_string(side) + "² pit", 512, cell, tol, kEventFrames, demWithPit(dem, side)));
+            rows.push_back(runCase("dem, " + std::to_string(side) + "² pit", 512, cell, tol, kEventFrames,
+                                   demWithPit(dem, side), true));
             rows.back().changedArea = static_cast<double>(side) * side / (512.0 * 512.0);
         }
     return rows;
@@ -311,8 +333,9 @@ float chooseTolerance(const std::vector<LongRun>& runs, const std::vector<CaseRe
     return best;
 }
 
-std::string caseRow(const CaseResult& r) {
-    char buf[400];
+// events: with the sweep's column of the frames that drop and fill the pit.
+std::string caseRow(const CaseResult& r, bool events = false) {
+    char buf[480];
     std::snprintf(buf, sizeof buf,
                   "| %s | %d² | %g | %.2f | %.2f | %.1f %% | %.1f %% | %.1f %% | %.2e | %.2e | %.1f / %.1f / %.1f / "
                   "%.1f / %.1f |\n",
@@ -320,13 +343,24 @@ std::string caseRow(const CaseResult& r) {
                   100.0 * r.incrementalMs / r.fullMs, 100.0 * r.visibility, 100.0 * r.indirect, r.diff.rms,
                   r.diff.maxRel, r.stages.geometry, r.stages.visibility, r.stages.keys, r.stages.shading,
                   r.stages.indirect);
-    return buf;
+    std::string row = buf;
+    if (events) {
+        std::snprintf(buf, sizeof buf, " %.1f / %.1f %% |\n", 100.0 * r.droppedRatio, 100.0 * r.filledRatio);
+        row.pop_back();  // the newline
+        row += buf;
+    }
+    return row;
 }
 
 const char* kCaseHeader =
     "| case | size | tolerance | full ms | incremental ms | ratio | V recomputed | indirect re-gathered | rel. RMS | "
     "max | incremental stages ms: geometry / V / key V / shading / indirect |\n"
     "|---|---|---|---|---|---|---|---|---|---|---|\n";
+const char* kSweepHeader =
+    "| case | size | tolerance | full ms | incremental ms | ratio | V recomputed | indirect re-gathered | rel. RMS | "
+    "max | incremental stages ms: geometry / V / key V / shading / indirect | ratio, frames that drop / fill the "
+    "pit |\n"
+    "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
 
 void writeReport(const std::vector<CaseResult>& rows, const std::vector<CaseResult>& sweep,
                  const std::vector<LongRun>& longRuns, const IncrementalOptions& o, const BenchContext& ctx) {
@@ -345,8 +379,9 @@ void writeReport(const std::vector<CaseResult>& rows, const std::vector<CaseResu
        << "the full result, and largest |difference| over the mean, every texel and channel.\n\n"
        << kCaseHeader;
     csv << "case,size,tolerance,full_ms,incremental_ms,v_recomputed,indirect_recomputed,rel_rms,max_rel,"
-           "changed_area\n";
-    // The case names hold commas: quoted. changed_area is empty outside the sweep.
+           "changed_area,dropped_ratio,filled_ratio\n";
+    // The case names hold commas: quoted. changed_area is empty outside the
+    // sweep, the dropped and filled ratios outside the crater and the pits.
     const auto csvRow = [&](const CaseResult& r) {
         char buf[360];
         std::snprintf(buf, sizeof buf, "\"%s\",%d,%g,%.3f,%.3f,%.4f,%.4f,%.3e,%.3e,", r.name.c_str(), r.size,
@@ -357,6 +392,13 @@ void writeReport(const std::vector<CaseResult>& rows, const std::vector<CaseResu
             std::snprintf(buf, sizeof buf, "%.6g", r.changedArea);
             csv << buf;
         }
+        csv << ',';
+        if (r.droppedRatio >= 0.0) {
+            std::snprintf(buf, sizeof buf, "%.4f,%.4f", r.droppedRatio, r.filledRatio);
+            csv << buf;
+        } else {
+            csv << ',';
+        }
         csv << '\n';
     };
     for (const CaseResult& r : rows) {
@@ -366,9 +408,12 @@ void writeReport(const std::vector<CaseResult>& rows, const std::vector<CaseResu
     md << "\n## Cost against the changed area\n\nSquares of growing side lowered by 30 m at the centre of the 512² "
        << "DEM, dropped and filled on alternate frames.\n\n![GI cost against the changed "
           "area](gi_incremental_cost.png)\n\n"
-       << kCaseHeader;
+       << "Last column: the median, over the frames that drop the pit and over those that fill it, of each "
+          "frame's incremental time over its full one (a new change, and one undone, which returns to the "
+          "anchor's inputs).\n\n"
+       << kSweepHeader;
     for (const CaseResult& r : sweep) {
-        md << caseRow(r);
+        md << caseRow(r, true);
         csvRow(r);
     }
     if (!longRuns.empty()) {
