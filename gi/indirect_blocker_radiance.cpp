@@ -84,7 +84,7 @@ void BlockerRadianceIndirect::scanBlock(int block, bool horizons) {
         simd::wideEnabled() ? accumulateIrradianceAvx2 : accumulateIrradianceSse;
     IndirectScratch& sc = scan_.scratch();
     const RowBlock rb = scan_.rowBlock(block);
-    // the rows' receiver heights and gradients; E sums zeroed
+    // the rows' receiver heights and gradients
     scan_.loadRows(rb, sc);
     // E sums and, with the horizons, each distance group's occlusion (the
     // indirect cache's weights) zeroed over the lanes the scan writes: the
