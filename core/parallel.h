@@ -13,6 +13,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 #include <tbb/task_arena.h>
 
 #include "core/grid.h"
@@ -31,6 +32,14 @@ void parallelFor(int begin, int end, int grain, Fn&& fn) {
     }
     tbb::parallel_for(tbb::blocked_range<int>(begin, end, grain),
                       [&](const tbb::blocked_range<int>& r) { fn(r.begin(), r.end()); });
+}
+
+/// a() and b() side by side: two independent passes whose own loops are
+/// parallel but short (a local change's plans), so that neither thread waits
+/// at the end of one for the other's last chunk. They must write disjoint data.
+template <class A, class B>
+void parallelInvoke(A&& a, B&& b) {
+    tbb::parallel_invoke(std::forward<A>(a), std::forward<B>(b));
 }
 
 /// fn(item) for each of `items` in parallel, each item a chunk of its own

@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "core/error.h"
+#include "core/parallel.h"
 #include "gi/sh.h"
 
 namespace terrain::gi {
@@ -243,16 +244,21 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
     // the indirect scan's azimuths, when they are every k-th of the environment's
     const bool subset = indirectAzimuths > 0 && vis.azimuths % indirectAzimuths == 0;
     const int geometryStride = subset ? vis.azimuths / indirectAzimuths : 0;
-    if (geometryStride == 0) boundSlopeChange(cache.change, pyr, kVisibilityTile, cache.slopeBound);
-    boundSlopeChangePerAzimuth(cache.change, pyr, kVisibilityTile, vis.azimuths, cache.azimuthBound);
-    boundGradientChange(cache.change, pyr, kVisibilityTile, cache.gradBound);
-    boundGradientChange(cache.change, pyr, kCacheTile, cache.cacheGradBound);
     // V depends on the heights through the maximum blocking slope and, below
     // it, the tangent plane's slope along the azimuth (moving by at most
     // sqrt2 times a gradient component's bound); shading reruns at the new
     // normals every frame, so only V's own change counts.
     const float lipschitz = blockingMaxLipschitz(vis.blockingMax);
-    boundKeyFractions(pyr, keys, lipschitz, cache);
+    parallelInvoke(
+        [&] {  // the slope bounds of the visibility tiles
+            if (geometryStride == 0) boundSlopeChange(cache.change, pyr, kVisibilityTile, cache.slopeBound);
+            boundSlopeChangePerAzimuth(cache.change, pyr, kVisibilityTile, vis.azimuths, cache.azimuthBound);
+        },
+        [&] {  // the gradient bounds, and the key lights' (which read the cache tiles')
+            boundGradientChange(cache.change, pyr, kVisibilityTile, cache.gradBound);
+            boundGradientChange(cache.change, pyr, kCacheTile, cache.cacheGradBound);
+            boundKeyFractions(pyr, keys, lipschitz, cache);
+        });
     environmentBoundPerTile(cache.azimuthBound, cache.gradBound, vis.azimuths, lipschitz, cache.tileAzimuths,
                             cache.envBound);
     // the geometry's over the indirect scan's own azimuths where known (each
