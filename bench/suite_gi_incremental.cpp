@@ -335,32 +335,35 @@ float chooseTolerance(const std::vector<LongRun>& runs, const std::vector<CaseRe
 
 // events: with the sweep's column of the frames that drop and fill the pit.
 std::string caseRow(const CaseResult& r, bool events = false) {
-    char buf[480];
+    char buf[400];
     std::snprintf(buf, sizeof buf,
                   "| %s | %d² | %g | %.2f | %.2f | %.1f %% | %.1f %% | %.1f %% | %.2e | %.2e | %.1f / %.1f / %.1f / "
-                  "%.1f / %.1f |\n",
+                  "%.1f / %.1f |",
                   r.name.c_str(), r.size, static_cast<double>(r.tolerance), r.fullMs, r.incrementalMs,
                   100.0 * r.incrementalMs / r.fullMs, 100.0 * r.visibility, 100.0 * r.indirect, r.diff.rms,
                   r.diff.maxRel, r.stages.geometry, r.stages.visibility, r.stages.keys, r.stages.shading,
                   r.stages.indirect);
     std::string row = buf;
     if (events) {
-        std::snprintf(buf, sizeof buf, " %.1f / %.1f %% |\n", 100.0 * r.droppedRatio, 100.0 * r.filledRatio);
-        row.pop_back();  // the newline
+        std::snprintf(buf, sizeof buf, " %.1f / %.1f %% |", 100.0 * r.droppedRatio, 100.0 * r.filledRatio);
         row += buf;
     }
-    return row;
+    return row + '\n';
 }
 
-const char* kCaseHeader =
-    "| case | size | tolerance | full ms | incremental ms | ratio | V recomputed | indirect re-gathered | rel. RMS | "
-    "max | incremental stages ms: geometry / V / key V / shading / indirect |\n"
-    "|---|---|---|---|---|---|---|---|---|---|---|\n";
-const char* kSweepHeader =
-    "| case | size | tolerance | full ms | incremental ms | ratio | V recomputed | indirect re-gathered | rel. RMS | "
-    "max | incremental stages ms: geometry / V / key V / shading / indirect | ratio, frames that drop / fill the "
-    "pit |\n"
-    "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+// The cases' table header; events: with the sweep's last column.
+std::string caseHeader(bool events = false) {
+    std::string names =
+        "| case | size | tolerance | full ms | incremental ms | ratio | V recomputed | indirect re-gathered | rel. RMS "
+        "| "
+        "max | incremental stages ms: geometry / V / key V / shading / indirect |";
+    std::string rule = "|---|---|---|---|---|---|---|---|---|---|---|";
+    if (events) {
+        names += " ratio, frames that drop / fill the pit |";
+        rule += "---|";
+    }
+    return names + '\n' + rule + '\n';
+}
 
 void writeReport(const std::vector<CaseResult>& rows, const std::vector<CaseResult>& sweep,
                  const std::vector<LongRun>& longRuns, const IncrementalOptions& o, const BenchContext& ctx) {
@@ -377,7 +380,7 @@ void writeReport(const std::vector<CaseResult>& rows, const std::vector<CaseResu
        << "(V) and whose indirect light were recomputed, mean over the measured frames. Difference of the "
        << "incremental total (direct + indirect) from the full one, worst frame: RMS of the difference over RMS of "
        << "the full result, and largest |difference| over the mean, every texel and channel.\n\n"
-       << kCaseHeader;
+       << caseHeader();
     csv << "case,size,tolerance,full_ms,incremental_ms,v_recomputed,indirect_recomputed,rel_rms,max_rel,"
            "changed_area,dropped_ratio,filled_ratio\n";
     // The case names hold commas: quoted. changed_area is empty outside the
@@ -411,7 +414,7 @@ void writeReport(const std::vector<CaseResult>& rows, const std::vector<CaseResu
        << "Last column: the median, over the frames that drop the pit and over those that fill it, of each "
           "frame's incremental time over its full one (a new change, and one undone, which returns to the "
           "anchor's inputs).\n\n"
-       << kSweepHeader;
+       << caseHeader(true);
     for (const CaseResult& r : sweep) {
         md << caseRow(r, true);
         csvRow(r);

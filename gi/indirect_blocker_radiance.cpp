@@ -91,14 +91,14 @@ void BlockerRadianceIndirect::scanBlock(int block, bool horizons) {
     // rows' spans, each to its padded end (a local change's few tiles)
     for (int r = 0; r < rb.rows; ++r)
         for (const ColumnSpan& span : scan_.spans(rb.yBegin + r)) {
-            const int x0 = span.x0, x1 = indirectRowPad(span.x1);
-            for (int c = 0; c < 3; ++c)
-                std::fill(sc.irradiance.data() + (3 * static_cast<std::size_t>(r) + c) * pad + x0,
-                          sc.irradiance.data() + (3 * static_cast<std::size_t>(r) + c) * pad + x1, 0.0f);
-            if (!horizons) continue;
-            for (int g = 0; g < kDistanceGroups; ++g)
-                std::fill(sc.groupOccludersOf(r) + static_cast<std::size_t>(g) * pad + x0,
-                          sc.groupOccludersOf(r) + static_cast<std::size_t>(g) * pad + x1, 0.0f);
+            // planes of pad floats from `first`, each zeroed over the span's lanes
+            const auto zero = [&](float* first, int planes) {
+                for (int p = 0; p < planes; ++p)
+                    std::fill(first + static_cast<std::size_t>(p) * pad + span.x0,
+                              first + static_cast<std::size_t>(p) * pad + indirectRowPad(span.x1), 0.0f);
+            };
+            zero(sc.irradiance.data() + 3 * static_cast<std::size_t>(r) * pad, 3);
+            if (horizons) zero(sc.groupOccludersOf(r), kDistanceGroups);
         }
     for (int j = 0; j < in_.op.azimuths; ++j) {
         const AzimuthSteps az = scan_.azimuth(j, false, horizons);

@@ -557,21 +557,23 @@ void loadReceiverRow(const VisibilityRows& r, int Y, std::span<const ColumnSpan>
     const std::size_t at = static_cast<std::size_t>(Y) * nxr;
     float* loX = sc.gradX.data() + nxrPad;
     float* loY = sc.gradY.data() + nxrPad;
-    for (const ColumnSpan& span : spans) {
-        const int end = std::min(spanEnd(span), nxrPad);
-        for (int X = span.x0; X < end; ++X) {
-            const bool in = X < nxr;
-            sc.gradX[static_cast<std::size_t>(X)] = in ? r.gradX(s * X, s * Y) : 0.0f;
-            sc.gradY[static_cast<std::size_t>(X)] = in ? r.gradY(s * X, s * Y) : 0.0f;
-            sc.h0[static_cast<std::size_t>(X)] = in ? hRow[X] : 0.0f;
+    for (const ColumnSpan& span : spans)
+        for (int X = span.x0; X < std::min(spanEnd(span), nxrPad); ++X) {
+            const auto x = static_cast<std::size_t>(X);
+            if (X >= nxr) {  // a padding lane
+                sc.gradX[x] = sc.gradY[x] = sc.h0[x] = 0.0f;
+                if (box) loX[X] = loX[nxrPad + X] = loY[X] = loY[nxrPad + X] = 0.0f;
+                continue;
+            }
+            sc.gradX[x] = r.gradX(s * X, s * Y);
+            sc.gradY[x] = r.gradY(s * X, s * Y);
+            sc.h0[x] = hRow[X];
             if (!box) continue;
-            const std::size_t i = at + static_cast<std::size_t>(std::min(X, nxr - 1));
-            loX[X] = in ? box->loX[i] : 0.0f;
-            loX[nxrPad + X] = in ? box->hiX[i] : 0.0f;
-            loY[X] = in ? box->loY[i] : 0.0f;
-            loY[nxrPad + X] = in ? box->hiY[i] : 0.0f;
+            loX[X] = box->loX[at + x];
+            loX[nxrPad + X] = box->hiX[at + x];
+            loY[X] = box->loY[at + x];
+            loY[nxrPad + X] = box->hiY[at + x];
         }
-    }
 }
 
 // V of the receivers of row Y's spans (loaded by loadReceiverRow): every
