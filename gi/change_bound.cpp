@@ -712,13 +712,17 @@ float rangeBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, int
 }
 
 void boundSlopeChangeOverRange(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, double phi0,
-                               double phi1, std::vector<float>& tileBound) {
+                               double phi1, std::vector<float>& tileBound, std::span<const std::uint8_t> only) {
     requireSameSize(dh, pyr, tileReceivers);
     if (!(phi0 <= phi1)) throw InputError("change bound: an azimuth range needs phi0 <= phi1");
+    const int tilesX = tileCount(pyr.nxr, tileReceivers);
+    if (!only.empty() && only.size() != static_cast<std::size_t>(tilesX) * tileCount(pyr.nyr, tileReceivers))
+        throw InputError("change bound: one flag per tile");
     const StepTable steps = stepTable(pyr);
     const double lipschitz = heightFilterLipschitz(pyr);
     const Directions dir = directionsOver(phi0, phi1);
     forEachTile(pyr, tileReceivers, tileBound, [&](int tx, int ty) {
+        if (!only.empty() && !only[static_cast<std::size_t>(ty) * tilesX + tx]) return 0.0f;
         const InclusiveCells c = tileCells(pyr, tileReceivers, tx, ty);
         const double m0 = maxChangeInBox(dh, c.x0, c.y0, c.x1, c.y1);
         return floatNotBelow(azimuthBoundFrom(dh, pyr, steps, c, m0, firstBusyStep(dh, pyr, c, m0), dir, lipschitz));

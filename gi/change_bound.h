@@ -266,9 +266,10 @@ float rangeBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, int
                        double phi0, double phi1);
 
 /// rangeBoundOfTile of every tile, row-major as boundSlopeChange (same
-/// errors; InputError when phi0 > phi1).
+/// errors; InputError when phi0 > phi1). With `only` (one flag per tile), of
+/// the flagged tiles alone: the others' values are 0.
 void boundSlopeChangeOverRange(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, double phi0,
-                               double phi1, std::vector<float>& tileBound);
+                               double phi1, std::vector<float>& tileBound, std::span<const std::uint8_t> only = {});
 
 /// How much the maximum blocking slope can move per unit of the per-step
 /// bound: 1 for the sample maximum, 20 / 16 for Eq. 16's midpoints.

@@ -26,33 +26,58 @@ bool shouldPlanTiles(VisibilityCache& cache) { return !skipsPlan(cache.skips); }
 
 namespace {
 
-// Per cache tile, the largest over the key lights of the bound on each
-// one's visible fraction (keyLightFractionBound; an SH-shaded light:
-// infinite where its slopes may have moved at all), into keyExcursion. 0
-// without key lights. Taken over the cache tiles themselves, not their
-// visibility tiles: a light's few azimuths see a change along a narrow
-// strip, which a larger tile's reach widens (the 51² pit's key tiles: 20
-// instead of 36).
-void boundKeyFractions(const HeightPyramid& pyr, const std::vector<KeyLightRegion>& keys, float lipschitz,
-                       VisibilityCache& cache) {
-    cache.keyExcursion.assign(cache.cacheGradBound.size(), 0.0f);
-    for (const KeyLightRegion& k : keys) {
-        boundSlopeChangeOverRange(cache.change, pyr, kCacheTile, k.phi0, k.phi1, cache.rangeBound);
-        for (std::size_t t = 0; t < cache.keyExcursion.size(); ++t) {
-            float f =
-                keyLightFractionBound(lipschitz * cache.rangeBound[t], cache.cacheGradBound[t], k.sinLow, k.sinHigh);
-            if (!k.exactCosine && f > 0.0f) f = std::numeric_limits<float>::infinity();
-            cache.keyExcursion[t] = std::max(cache.keyExcursion[t], f);
-        }
-    }
-}
-
 // The key lights' shade per unit of visible fraction: the sum of their
 // largest channels (a texel's key shade is sum_k rgb_k f_k max(0, N . l_k)).
 float keyShadePerFraction(const std::vector<KeyLightRegion>& keys) {
     double sum = 0.0;
     for (const KeyLightRegion& k : keys) sum += k.maxRgb;  // >= 0 (validateKeyLight)
     return static_cast<float>(sum);
+}
+
+// Each cache tile's value of `perTile` (one per visibility tile) into out.
+void onCacheTiles(const std::vector<float>& perTile, const ReceiverTiles& tiles, std::vector<float>& out) {
+    constexpr int kPer = kVisibilityTile / kCacheTile;
+    const int visibilityX = tileCount(tiles.nxr, kVisibilityTile);
+    out.resize(tiles.dirty.size());
+    for (int ty = 0; ty < tiles.tilesY; ++ty)
+        for (int tx = 0; tx < tiles.tilesX; ++tx)
+            out[static_cast<std::size_t>(ty) * tiles.tilesX + tx] =
+                perTile[static_cast<std::size_t>(ty / kPer) * visibilityX + tx / kPer];
+}
+
+// Per cache tile, the largest over the key lights of the bound on each
+// one's visible fraction (keyLightFractionBound; an SH-shaded light:
+// infinite where its slopes may have moved at all), into keyExcursion. 0
+// without key lights. Each light's comes from its visibility tile's coarse
+// slope bound (cache.slopeBound) where that keeps the tile's key drift
+// within kCoarseBoundShare of the tolerance, else from the bound over the
+// light's own azimuths, taken over the cache tile itself, not its
+// visibility tile: a light's few azimuths see a change along a narrow
+// strip, which a larger tile's reach widens (the 51² pit's key tiles: 20
+// instead of 36).
+void boundKeyFractions(const HeightPyramid& pyr, const std::vector<KeyLightRegion>& keys, float lipschitz,
+                       float tolerance, VisibilityCache& cache) {
+    const std::size_t tiles = cache.cacheGradBound.size();
+    cache.keyExcursion.assign(tiles, 0.0f);
+    if (keys.empty()) return;
+    const float shade = keyShadePerFraction(keys);
+    const auto fraction = [&](const KeyLightRegion& k, float slope, std::size_t t) {
+        const float f = keyLightFractionBound(lipschitz * slope, cache.cacheGradBound[t], k.sinLow, k.sinHigh);
+        return !k.exactCosine && f > 0.0f ? std::numeric_limits<float>::infinity() : f;
+    };
+    onCacheTiles(cache.slopeBound, cache.keyTiles, cache.cacheSlope);
+    cache.overRange.resize(tiles);
+    for (const KeyLightRegion& k : keys) {
+        for (std::size_t t = 0; t < tiles; ++t)
+            cache.overRange[t] = (cache.keyDrift.fromAnchor[t] + fraction(k, cache.cacheSlope[t], t)) * shade >
+                                 kCoarseBoundShare * tolerance;
+        boundSlopeChangeOverRange(cache.change, pyr, kCacheTile, k.phi0, k.phi1, cache.rangeBound, cache.overRange);
+        for (std::size_t t = 0; t < tiles; ++t) {
+            const float slope = cache.overRange[t] ? cache.rangeBound[t] : cache.cacheSlope[t];
+            const float f = fraction(k, slope, t);
+            cache.keyExcursion[t] = std::max(cache.keyExcursion[t], f);
+        }
+    }
 }
 
 }  // namespace
@@ -90,15 +115,36 @@ void geometryBoundPerTile(std::span<const float> slopeBound, std::span<const flo
 
 namespace {
 
-// Each cache tile's value of `perTile` (one per visibility tile) into out.
-void onCacheTiles(const std::vector<float>& perTile, const ReceiverTiles& tiles, std::vector<float>& out) {
+// Flags in cache.perAzimuth the visibility tiles with a cache tile whose
+// drift from the anchor (the environment's, and the geometry's when that is
+// taken per azimuth too), counted with the coarse bound (cache.coarseBound),
+// would pass kCoarseBoundShare of the tolerance.
+void markPerAzimuthTiles(float tolerance, bool geometryPerAzimuth, VisibilityCache& cache) {
     constexpr int kPer = kVisibilityTile / kCacheTile;
+    const ReceiverTiles& tiles = cache.tiles;
     const int visibilityX = tileCount(tiles.nxr, kVisibilityTile);
-    out.resize(tiles.dirty.size());
+    const float share = kCoarseBoundShare * tolerance;
+    cache.perAzimuth.assign(cache.coarseBound.size(), 0);
     for (int ty = 0; ty < tiles.tilesY; ++ty)
-        for (int tx = 0; tx < tiles.tilesX; ++tx)
-            out[static_cast<std::size_t>(ty) * tiles.tilesX + tx] =
-                perTile[static_cast<std::size_t>(ty / kPer) * visibilityX + tx / kPer];
+        for (int tx = 0; tx < tiles.tilesX; ++tx) {
+            const std::size_t t = static_cast<std::size_t>(ty) * tiles.tilesX + tx;
+            const std::size_t v = static_cast<std::size_t>(ty / kPer) * visibilityX + tx / kPer;
+            const float coarse = cache.coarseBound[v];
+            if (cache.drift.fromAnchor[t] + coarse > share ||
+                (geometryPerAzimuth && cache.geometryDrift.fromAnchor[t] + coarse > share))
+                cache.perAzimuth[v] = 1;
+        }
+}
+
+// The visibility tiles not taken per azimuth keep their coarse bound as
+// their environment's and geometry's bounds (its slope bound holds along
+// every azimuth).
+void keepCoarseBounds(VisibilityCache& cache) {
+    for (std::size_t v = 0; v < cache.perAzimuth.size(); ++v)
+        if (!cache.perAzimuth[v]) {
+            cache.envBound[v] = cache.coarseBound[v];
+            cache.geometryBound[v] = cache.coarseBound[v];
+        }
 }
 
 // Which drifts' candidates a refinement takes (env, geometry), and whether a
@@ -249,16 +295,22 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
     // sqrt2 times a gradient component's bound); shading reruns at the new
     // normals every frame, so only V's own change counts.
     const float lipschitz = blockingMaxLipschitz(vis.blockingMax);
+    // the coarse bounds first: one slope bound over every direction per
+    // visibility tile, and the gradient bounds
+    parallelInvoke([&] { boundSlopeChange(cache.change, pyr, kVisibilityTile, cache.slopeBound); },
+                   [&] {
+                       boundGradientChange(cache.change, pyr, kVisibilityTile, cache.gradBound);
+                       boundGradientChange(cache.change, pyr, kCacheTile, cache.cacheGradBound);
+                   });
+    geometryBoundPerTile(cache.slopeBound, cache.gradBound, lipschitz, cache.coarseBound);
+    markPerAzimuthTiles(tolerance, geometryStride > 0, cache);
+    // then the finer ones where the coarse ones would take more than their share of the tolerance
     parallelInvoke(
-        [&] {  // the slope bounds of the visibility tiles
-            if (geometryStride == 0) boundSlopeChange(cache.change, pyr, kVisibilityTile, cache.slopeBound);
-            boundSlopeChangePerAzimuth(cache.change, pyr, kVisibilityTile, vis.azimuths, cache.azimuthBound);
+        [&] {
+            boundSlopeChangePerAzimuth(cache.change, pyr, kVisibilityTile, vis.azimuths, cache.azimuthBound,
+                                       cache.perAzimuth);
         },
-        [&] {  // the gradient bounds, and the key lights' (which read the cache tiles')
-            boundGradientChange(cache.change, pyr, kVisibilityTile, cache.gradBound);
-            boundGradientChange(cache.change, pyr, kCacheTile, cache.cacheGradBound);
-            boundKeyFractions(pyr, keys, lipschitz, cache);
-        });
+        [&] { boundKeyFractions(pyr, keys, lipschitz, tolerance, cache); });
     environmentBoundPerTile(cache.azimuthBound, cache.gradBound, vis.azimuths, lipschitz, cache.tileAzimuths,
                             cache.envBound);
     // the geometry's over the indirect scan's own azimuths where known (each
@@ -268,7 +320,8 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
         environmentBoundPerTile(cache.azimuthBound, cache.gradBound, vis.azimuths, lipschitz, cache.tileAzimuths,
                                 cache.geometryBound, geometryStride);
     else
-        geometryBoundPerTile(cache.slopeBound, cache.gradBound, lipschitz, cache.geometryBound);
+        cache.geometryBound = cache.coarseBound;
+    keepCoarseBounds(cache);
     onCacheTiles(cache.envBound, cache.tiles, cache.envExcursion);
     onCacheTiles(cache.geometryBound, cache.tiles, cache.geometryExcursion);
     refinePerReceiver(pyr, vis, lipschitz, tolerance, geometryStride, cache);

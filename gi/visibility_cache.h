@@ -33,6 +33,7 @@
 // the indirect scan's azimuths alone, where those are every k-th of the
 // environment's (else with one slope bound over every direction): what the
 // indirect light's casting sets may have moved (gi/indirect_cache.h).
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -64,6 +65,16 @@ inline constexpr int kCacheTile = 16;
 static_assert(kVisibilityTile % kCacheTile == 0 && kCacheTile % ReceiverTiles::kTileAlign == 0,
               "cache tiles split visibility tiles into whole receiver groups");
 
+/// The share of the tolerance up to which a tile's drift may be counted with
+/// its coarse bounds alone: one slope bound over every direction per
+/// visibility tile (a few box queries per step) in place of one per azimuth
+/// or over a key light's azimuths (a query per azimuth or sweep and step).
+/// The coarse bound holds along every azimuth as the finer ones do, only
+/// more loosely: it lets a tile's drift grow faster, by at most this share of
+/// the tolerance from the anchor, while far from a local change most tiles
+/// stay under it and the finer bounds cost most of the plan.
+inline constexpr float kCoarseBoundShare = 0.25f;
+
 /// What a key light's cached visibility answers for: the azimuths [phi0,
 /// phi1] (radians) it reads and its window's sines (gi/lights.h,
 /// keyLightExtent); with its largest channel this frame and whether it is
@@ -80,8 +91,10 @@ struct VisibilityCache {
     CellBox anchorDiffers;    // holds every cell where they may differ from the last plan's (all)
     MaxChangePyramid change;  // |dh| from the anchor to this frame
     // this frame's bounds per visibility tile (kVisibilityTile)
-    std::vector<float> slopeBound, gradBound;    // all azimuths (slopeBound: only without a geometry stride)
-    std::vector<float> azimuthBound;             // per tile and environment azimuth (tile-major)
+    std::vector<float> slopeBound, gradBound;    // all azimuths
+    std::vector<float> coarseBound;              // the ambient-map bound from slopeBound (any azimuths)
+    std::vector<std::uint8_t> perAzimuth;        // the tiles whose bounds are taken per azimuth too
+    std::vector<float> azimuthBound;             // per tile and environment azimuth (tile-major; those tiles')
     std::vector<float> envBound, geometryBound;  // the ambient-map bound: every azimuth, the indirect scan's
     std::vector<float> tileAzimuths;             // scratch: one tile's per-azimuth slope bounds
     // this frame's bounds per cache tile (kCacheTile): the environment's and
@@ -93,6 +106,8 @@ struct VisibilityCache {
     // scratch: one key light's slopes per cache tile; the refined cache
     // tiles' own slope bounds per azimuth, environment and geometry bounds
     std::vector<float> rangeBound, cacheAzimuthBound, cacheEnvBound, cacheGeometryBound;
+    std::vector<float> cacheSlope;        // scratch: each cache tile's visibility tile's slopeBound
+    std::vector<std::uint8_t> overRange;  // scratch: the cache tiles a key light's range bound is taken for
     ChangeLevels receiverLevels;          // the |dh| pyramid of the receivers' bounds
     std::vector<double> azimuths;         // the environment's azimuths (radians) they are taken along
     std::vector<float> receiverBound;     // per receiver: the ambient-map bound (refined tiles only)

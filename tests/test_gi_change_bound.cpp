@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <random>
 #include <span>
@@ -622,6 +623,13 @@ TEST_CASE("gi.change_bound: azimuth-range bounds hold for a key light's slopes a
                     smallerTiles += range[t] < all[t];
                 }
                 CHECK(rangeBoundOfTile(dh, p, cfg.tile, 1, 1, ext.phiStart, ext.phiEnd) == range[tilesX + 1]);
+                // with flags, the flagged tiles' bounds alone (every other tile here), the others 0
+                std::vector<std::uint8_t> only(range.size());
+                for (std::size_t t = 0; t < only.size(); ++t) only[t] = t % 2 == 0 ? 1 : 0;
+                std::vector<float> flagged;
+                boundSlopeChangeOverRange(dh, p, cfg.tile, ext.phiStart, ext.phiEnd, flagged, only);
+                REQUIRE(flagged.size() == range.size());
+                for (std::size_t t = 0; t < range.size(); ++t) CHECK(flagged[t] == (only[t] ? range[t] : 0.0f));
             }
         }
     MESSAGE("key-light slopes: worst change / range bound "
@@ -641,6 +649,8 @@ TEST_CASE("gi.change_bound: azimuth-range bounds hold for a key light's slopes a
     runGiFrame(flat.cview(), kCell, GiLighting{}, GiSettings{}, st);
     std::vector<float> range;
     CHECK_THROWS_AS(boundSlopeChangeOverRange(dh, st.pyramid, 8, 1.0, 0.5, range), InputError);
+    const std::vector<std::uint8_t> tooFew(1, 1);  // one flag for several tiles
+    CHECK_THROWS_AS(boundSlopeChangeOverRange(dh, st.pyramid, 8, 0.5, 1.0, range, tooFew), InputError);
 }
 
 TEST_CASE("gi.change_bound: a change pyramid redone over the box of differing cells is a whole build's") {

@@ -170,7 +170,8 @@ TEST_CASE("gi.frame_change: a crater recomputes the tiles within its reach, with
         std::vector<double> fullCircle, perAzimuth;
         std::vector<float> az(static_cast<std::size_t>(m));
         for (std::size_t t = 0; t < change.size(); ++t) {
-            if (change[t] <= 1e-7) continue;
+            // the tiles whose bounds were taken per azimuth (the others' coarse bound was enough)
+            if (change[t] <= 1e-7 || !cache.perAzimuth[t]) continue;
             for (int j = 0; j < m; ++j)
                 az[static_cast<std::size_t>(j)] = lipschitz * cache.azimuthBound[t * m + static_cast<std::size_t>(j)];
             const double g = std::sqrt(2.0) * cache.gradBound[t];
@@ -182,6 +183,56 @@ TEST_CASE("gi.frame_change: a crater recomputes the tiles within its reach, with
                                                                    << medianOf(fullCircle) << ", per azimuth "
                                                                    << medianOf(perAzimuth));
     }
+}
+
+TEST_CASE("gi.frame_change: a plan takes per-azimuth bounds only where the coarse ones pass their share") {
+    // a crater in a field of 8 x 8 visibility tiles at 2x, sun and sky and a
+    // key light: the tiles near it need the finer bounds, the far ones not
+    const Grid h = bumpy(512, 512);
+    Grid crater = h;
+    for (int y = 248; y < 264; ++y)
+        for (int x = 248; x < 264; ++x) crater(x, y) -= 6.0f;
+    GiSettings settings = withBounces(GiSettings{}, 2, 0);
+    settings.tolerance = 0.05f;
+    const float share = kCoarseBoundShare * settings.tolerance;
+    GiState inc;
+    runGiFrame(h.cview(), 10.0f, sunSkyAndKey(), settings, inc);
+    runGiFrame(crater.cview(), 10.0f, sunSkyAndKey(), settings, inc);
+    const VisibilityCache& cache = inc.visibilityCache;
+    REQUIRE(cache.perAzimuth.size() == cache.coarseBound.size());
+    int fine = 0, coarse = 0;
+    for (std::size_t v = 0; v < cache.coarseBound.size(); ++v) {
+        INFO("visibility tile " << v << ", coarse bound " << cache.coarseBound[v]);
+        // the first planned frame: every drift from the anchor was 0
+        if (cache.perAzimuth[v]) {
+            ++fine;
+            CHECK(cache.coarseBound[v] > share);
+            CHECK(cache.envBound[v] <= cache.coarseBound[v]);  // finer, and not looser here
+        } else {
+            ++coarse;
+            CHECK(cache.coarseBound[v] <= share);
+            CHECK(cache.envBound[v] == cache.coarseBound[v]);
+            CHECK(cache.geometryBound[v] == cache.coarseBound[v]);
+        }
+    }
+    MESSAGE(fine << " visibility tiles bounded per azimuth, " << coarse << " by their coarse bound");
+    CHECK(fine > 0);
+    CHECK(coarse > 0);
+    // the key light's fraction: its range bound where the coarse one would
+    // take more than the share, which it never does elsewhere
+    const KeyLight key = sunSkyAndKey().keys[0];
+    const float keyShade = std::max({key.rgb[0], key.rgb[1], key.rgb[2]});
+    for (std::size_t t = 0; t < cache.keyExcursion.size(); ++t)
+        if (!cache.overRange[t]) CHECK(cache.keyExcursion[t] * keyShade <= share);
+    // and the frame stays within the tolerance of a full one
+    GiSettings off = settings;
+    off.incremental = false;
+    GiState full;
+    runGiFrame(crater.cview(), 10.0f, sunSkyAndKey(), off, full);
+    double worst = 0.0;
+    for (std::size_t i = 0; i < full.shade.ambient.v.size(); ++i)
+        worst = std::max(worst, std::fabs(static_cast<double>(inc.shade.ambient.v[i]) - full.shade.ambient.v[i]));
+    CHECK(worst <= settings.tolerance);
 }
 
 namespace {
