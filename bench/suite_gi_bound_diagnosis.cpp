@@ -281,11 +281,14 @@ void measureFrame(Track& t, const gi::GiSettings& settings, float cell, float to
     gi::planVisibilityTiles(t.lastHeights.cview(), t.heights.cview(), t.now.pyramid, settings.visibility, {}, 1e30f,
                             cache);
     const int nxr = t.now.pyramid.nxr, nyr = t.now.pyramid.nyr;
+    // the per-azimuth bound of every visibility tile (the plan takes it only
+    // where the coarse one would use much of the tolerance)
+    const std::vector<float> tileBound =
+        environmentBounds(cache.change, t.now.pyramid, settings.visibility, gi::kVisibilityTile);
     for (std::size_t g = 0; g < kGranularities.size(); ++g) {
         const int T = kGranularities[g];
-        // the engine's tiles: the plan above has this frame's bound already
         const std::vector<float> bound = T == gi::kVisibilityTile
-                                             ? cache.envBound
+                                             ? tileBound
                                              : environmentBounds(cache.change, t.now.pyramid, settings.visibility, T);
         t.boundShare[g].push_back(shareAbove(bound, T, 1, nxr, nyr, tolerance));
         if (T != 1) continue;
@@ -309,16 +312,17 @@ void measureFrame(Track& t, const gi::GiSettings& settings, float cell, float to
     const IndirectBounds ib = indirectBounds(t.now, t.last, settings.indirect.azimuths);
     t.indirectSampleBound.insert(t.indirectSampleBound.end(), ib.sampleMove.begin(), ib.sampleMove.end());
     t.indirectBound.insert(t.indirectBound.end(), ib.bound.begin(), ib.bound.end());
-    t.bound.insert(t.bound.end(), cache.envBound.begin(), cache.envBound.end());
+    t.bound.insert(t.bound.end(), tileBound.begin(), tileBound.end());
     t.vChange.insert(t.vChange.end(), v.begin(), v.end());
     t.indirectChange.insert(t.indirectChange.end(), ind.begin(), ind.end());
 }
 
 const char* kIntro =
     "Full GI frames (2x, one bounce, uniform unit sky: shade units are the tolerance's, 2 threads), consecutive "
-    "frames compared per visibility tile (32 x 32 receivers). One-frame V bound: the bound "
-    "gi/visibility_cache.h takes over the visibility tile (environment, per azimuth, V alone) before it refines it per "
-    "receiver where it passes the tolerance. True change of the cached V: "
+    "frames compared per visibility tile (32 x 32 receivers). One-frame V bound: the per-azimuth bound "
+    "gi/visibility_cache.h takes over the visibility tile (environment, V alone; where its coarse bound over every "
+    "direction would take more than a quarter of the tolerance) before it refines it per receiver where it passes "
+    "the tolerance. True change of the cached V: "
     "the SH ambient map at the new normals shaded with the last frame's V against the one shaded with the new V "
     "(the frame's own ambient map is the exact one, which does not read V), largest over the tile's "
     "texels. Largest radiance sample move: the largest over the indirect azimuths of the samples' moves "
