@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <type_traits>
+#include <utility>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -629,6 +630,36 @@ float gradientBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, 
     const bool border = x0 == 0 || y0 == 0 || x1 == pyr.nx - 1 || y1 == pyr.ny - 1;  // one-sided differences
     const double m = maxChangeInBox(dh, x0 - 1, y0 - 1, x1 + 1, y1 + 1);
     return floatNotBelow((border ? 2.0 : 1.0) * m / pyr.cellSize);
+}
+
+void receiverGradientBounds(const MaxChangePyramid& dh, const HeightPyramid& pyr, int Y, int X0, int X1, float* out,
+                            std::vector<float>& columnMax) {
+    if (X0 >= X1) return;
+    const int s = pyr.subsample, half = s / 2, nx = pyr.nx, ny = pyr.ny;
+    // gradientBoundOfTile's footprint of receiver (X, Y), clamped, and the
+    // same dilated by one cell (clamped again, as maxChangeInBox clamps)
+    const auto footprint = [&](int c, int n) { return std::pair{std::max(c - half, 0), std::min(c + half, n - 1)}; };
+    const auto [fy0, fy1] = footprint(s * Y, ny);
+    const int ry0 = std::max(fy0 - 1, 0), ry1 = std::min(fy1 + 1, ny - 1);
+    const int cx0 = std::max(footprint(s * X0, nx).first - 1, 0);
+    const int cx1 = std::min(footprint(s * (X1 - 1), nx).second + 1, nx - 1);
+    // each column's largest |dh| over the dilated rows, then each receiver's over its columns
+    const Grid& level0 = dh.levels[0];
+    columnMax.assign(static_cast<std::size_t>(cx1 - cx0 + 1), 0.0f);
+    for (int y = ry0; y <= ry1; ++y) {
+        const float* row = level0.data() + static_cast<std::size_t>(y) * level0.nx;
+        for (int x = cx0; x <= cx1; ++x)
+            columnMax[static_cast<std::size_t>(x - cx0)] =
+                std::max(columnMax[static_cast<std::size_t>(x - cx0)], row[x]);
+    }
+    for (int X = X0; X < X1; ++X) {
+        const auto [fx0, fx1] = footprint(s * X, nx);
+        const bool border = fx0 == 0 || fy0 == 0 || fx1 == nx - 1 || fy1 == ny - 1;  // one-sided differences
+        float m = 0.0f;
+        for (int x = std::max(fx0 - 1, 0); x <= std::min(fx1 + 1, nx - 1); ++x)
+            m = std::max(m, columnMax[static_cast<std::size_t>(x - cx0)]);
+        out[X] = floatNotBelow((border ? 2.0 : 1.0) * static_cast<double>(m) / pyr.cellSize);
+    }
 }
 
 float largestReceiverGradientBound(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int tx,

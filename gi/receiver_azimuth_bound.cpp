@@ -295,18 +295,24 @@ void boundEnvironmentPerReceiver(ChangeLevels& levels, const MaxChangePyramid& d
     out.assign(planeR, 0.0f);
     if (subsetOut) subsetOut->assign(planeR, 0.0f);
     if (levels.largest == 0.0f && levels.valid) return;  // no height changed
-    // per worker slot: a row's slope bounds per azimuth, then one receiver's
-    levels.rows.resize(static_cast<std::size_t>(workerSlots()));
-    for (std::vector<float>& r : levels.rows) r.resize(static_cast<std::size_t>(m) * (nxr + 1));
+    // per worker slot: a row's slope bounds per azimuth, then one receiver's,
+    // then the row's gradient bounds; and the gradients' column scratch
+    const std::size_t slots = static_cast<std::size_t>(workerSlots());
+    levels.rows.resize(slots);
+    levels.columns.resize(slots);
+    for (std::vector<float>& r : levels.rows) r.resize(static_cast<std::size_t>(m) * (nxr + 1) + nxr);
     const WalkRow walkRow = simd::wideEnabled() ? walkRowAvx2 : walkRowSse;
     forEachWalkedRow(levels, pyr, phi, only, floor, [&](int Y, std::span<const ColumnSpan> spans, const RowWalk& row) {
-        float* slopes = levels.rows[static_cast<std::size_t>(workerSlot())].data();
+        const std::size_t slot = static_cast<std::size_t>(workerSlot());
+        float* slopes = levels.rows[slot].data();
         float* perAzimuth = slopes + static_cast<std::size_t>(m) * nxr;
+        float* gradients = perAzimuth + m;
         walkRow(levels.walks, spans, row, slopes, static_cast<std::size_t>(nxr));
-        for (const ColumnSpan& span : spans)
+        for (const ColumnSpan& span : spans) {
+            receiverGradientBounds(dh, pyr, Y, span.x0, span.x1, gradients, levels.columns[slot]);
             for (int X = span.x0; X < span.x1; ++X) {
                 const std::size_t r = static_cast<std::size_t>(Y) * nxr + static_cast<std::size_t>(X);
-                const float gradient = gradientBoundOfTile(dh, pyr, 1, X, Y);
+                const float gradient = gradients[X];
                 for (int j = 0; j < m; ++j)
                     perAzimuth[static_cast<std::size_t>(j)] =
                         lipschitz * slopes[static_cast<std::size_t>(j) * nxr + static_cast<std::size_t>(X)];
@@ -317,6 +323,7 @@ void boundEnvironmentPerReceiver(ChangeLevels& levels, const MaxChangePyramid& d
                     perAzimuth[static_cast<std::size_t>(k)] = perAzimuth[static_cast<std::size_t>(k * subsetStride)];
                 (*subsetOut)[r] = ambientChangeBoundPerAzimuth(perAzimuth, m / subsetStride, gradient, 1.0f, false);
             }
+        }
     });
 }
 

@@ -66,8 +66,9 @@ struct ChangeLevels {
     StepTableKey stepsKey;
     std::vector<ScanStepInfo> stepInfo;
     DirtySpans spans;
-    std::vector<int> walkedRows;           // the receiver rows with a span to walk
-    std::vector<std::vector<float>> rows;  // per worker slot: one receiver row's bounds per azimuth
+    std::vector<int> walkedRows;              // the receiver rows with a span to walk
+    std::vector<std::vector<float>> rows;     // per worker slot: one receiver row's bounds per azimuth
+    std::vector<std::vector<float>> columns;  // per worker slot: the row's gradient bounds' column maxima
 };
 
 /// Builds (or redoes, over the cells whose |dh| may differ from the last

@@ -11,6 +11,7 @@
 #include <cfloat>
 #include <cmath>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include <doctest/doctest.h>
@@ -218,6 +219,18 @@ TEST_CASE("gi.receiver_azimuth_bound: bounds every receiver's slope change along
                                                                     gradientBoundOfTile(dh, pyr, 1, X, Y), 1.0f, false);
             }
             CHECK(differing == 0);
+            // the row-wise gradient bounds are the one-receiver tiles' (a whole row and a span inside it)
+            std::vector<float> gradients(static_cast<std::size_t>(pyr.nxr)), scratch;
+            int gradientsDiffering = 0;
+            for (int Y = 0; Y < pyr.nyr; ++Y)
+                for (const auto& [X0, X1] : {std::pair{0, pyr.nxr}, std::pair{3, pyr.nxr - 2}}) {
+                    std::fill(gradients.begin(), gradients.end(), -1.0f);
+                    receiverGradientBounds(dh, pyr, Y, X0, X1, gradients.data(), scratch);
+                    for (int X = 0; X < pyr.nxr; ++X)
+                        gradientsDiffering += gradients[static_cast<std::size_t>(X)] !=
+                                              (X >= X0 && X < X1 ? gradientBoundOfTile(dh, pyr, 1, X, Y) : -1.0f);
+                }
+            CHECK(gradientsDiffering == 0);
             std::sort(toTiles.begin(), toTiles.end());
             if (!toTiles.empty())
                 MESSAGE(c.nx << " x " << c.ny << " s=" << c.subsample << " change " << kind
