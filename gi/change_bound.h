@@ -289,7 +289,6 @@ float blockingMaxLipschitz(BlockingMax rule);
 /// footprint texels of tile (tx, ty).
 float gradientBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int tx, int ty);
 
-/// The largest over the receivers of tile (tx, ty) of each one's own
 /// gradientBoundOfTile with tiles of one receiver for the receivers [X0, X1)
 /// of row Y, into out[X] (the same values: the largest |dh| over each
 /// receiver's dilated footprint, read from |dh| itself row by row instead
@@ -297,6 +296,7 @@ float gradientBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, 
 void receiverGradientBounds(const MaxChangePyramid& dh, const HeightPyramid& pyr, int Y, int X0, int X1, float* out,
                             std::vector<float>& columnMax);
 
+/// The largest over the receivers of tile (tx, ty) of each one's own
 /// gradientBoundOfTile (tiles of one receiver): the tile's own bound where
 /// its footprint keeps off the field's edges (the receivers' boxes then
 /// make up the tile's), else taken receiver by receiver.

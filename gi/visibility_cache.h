@@ -33,6 +33,10 @@
 // the indirect scan's azimuths alone, where those are every k-th of the
 // environment's (else with one slope bound over every direction): what the
 // indirect light's casting sets may have moved (gi/indirect_cache.h).
+// Each bound is first taken coarsely, with one slope bound over every
+// direction per visibility tile, and per azimuth (or over a key light's
+// azimuths) only where the coarse one would take a tile past
+// kCoarseBoundShare of the tolerance.
 #include <cstdint>
 #include <span>
 #include <vector>
