@@ -354,9 +354,8 @@ std::string caseRow(const CaseResult& r, bool events = false) {
 // The cases' table header; events: with the sweep's last column.
 std::string caseHeader(bool events = false) {
     std::string names =
-        "| case | size | tolerance | full ms | incremental ms | ratio | V recomputed | indirect re-gathered | rel. RMS "
-        "| "
-        "max | incremental stages ms: geometry / V / key V / shading / indirect |";
+        "| case | size | tolerance | full ms | incremental ms | ratio | V recomputed | indirect re-gathered | "
+        "rel. RMS | max | incremental stages ms: geometry / V / key V / shading / indirect |";
     std::string rule = "|---|---|---|---|---|---|---|---|---|---|---|";
     if (events) {
         names += " ratio, frames that drop / fill the pit |";

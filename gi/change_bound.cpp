@@ -4,7 +4,6 @@
 #include <cmath>
 #include <limits>
 #include <type_traits>
-#include <utility>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -622,27 +621,46 @@ std::vector<StepSquare> stepSquares(const HeightPyramid& pyr) {
 
 float blockingMaxLipschitz(BlockingMax rule) { return rule == BlockingMax::Samples ? 1.0f : 20.0f / 16.0f; }
 
+namespace {
+
+// Along one axis, the cells [first, last] of the footprint texels of the
+// receivers whose own cells span [lo, hi] (offsets up to half = s / 2
+// cells, clamped to the n cells), and whether it reaches an edge, where the
+// gradient is a one-sided difference.
+struct FootprintSpan {
+    int first, last;
+    bool edge;
+};
+FootprintSpan footprintSpan(int lo, int hi, int half, int n) {
+    const int first = std::max(lo - half, 0), last = std::min(hi + half, n - 1);
+    return {first, last, first == 0 || last == n - 1};
+}
+
+// The gradient bound from m, the largest |dh| over the footprint dilated by one cell.
+float gradientBoundFrom(double m, bool edge, float cellSize) {
+    return floatNotBelow((edge ? 2.0 : 1.0) * m / cellSize);
+}
+
+}  // namespace
+
 float gradientBoundOfTile(const MaxChangePyramid& dh, const HeightPyramid& pyr, int tileReceivers, int tx, int ty) {
     const InclusiveCells c = tileCells(pyr, tileReceivers, tx, ty);
     const int half = pyr.subsample / 2;
-    const int x0 = std::max(c.x0 - half, 0), y0 = std::max(c.y0 - half, 0);
-    const int x1 = std::min(c.x1 + half, pyr.nx - 1), y1 = std::min(c.y1 + half, pyr.ny - 1);
-    const bool border = x0 == 0 || y0 == 0 || x1 == pyr.nx - 1 || y1 == pyr.ny - 1;  // one-sided differences
-    const double m = maxChangeInBox(dh, x0 - 1, y0 - 1, x1 + 1, y1 + 1);
-    return floatNotBelow((border ? 2.0 : 1.0) * m / pyr.cellSize);
+    const FootprintSpan fx = footprintSpan(c.x0, c.x1, half, pyr.nx), fy = footprintSpan(c.y0, c.y1, half, pyr.ny);
+    const double m = maxChangeInBox(dh, fx.first - 1, fy.first - 1, fx.last + 1, fy.last + 1);
+    return gradientBoundFrom(m, fx.edge || fy.edge, pyr.cellSize);
 }
 
 void receiverGradientBounds(const MaxChangePyramid& dh, const HeightPyramid& pyr, int Y, int X0, int X1, float* out,
                             std::vector<float>& columnMax) {
     if (X0 >= X1) return;
     const int s = pyr.subsample, half = s / 2, nx = pyr.nx, ny = pyr.ny;
-    // gradientBoundOfTile's footprint of receiver (X, Y), clamped, and the
-    // same dilated by one cell (clamped again, as maxChangeInBox clamps)
-    const auto footprint = [&](int c, int n) { return std::pair{std::max(c - half, 0), std::min(c + half, n - 1)}; };
-    const auto [fy0, fy1] = footprint(s * Y, ny);
-    const int ry0 = std::max(fy0 - 1, 0), ry1 = std::min(fy1 + 1, ny - 1);
-    const int cx0 = std::max(footprint(s * X0, nx).first - 1, 0);
-    const int cx1 = std::min(footprint(s * (X1 - 1), nx).second + 1, nx - 1);
+    // gradientBoundOfTile's footprints of the row's receivers, dilated by one
+    // cell and clamped (as maxChangeInBox clamps)
+    const FootprintSpan fy = footprintSpan(s * Y, s * Y, half, ny);
+    const int ry0 = std::max(fy.first - 1, 0), ry1 = std::min(fy.last + 1, ny - 1);
+    const int cx0 = std::max(footprintSpan(s * X0, s * X0, half, nx).first - 1, 0);
+    const int cx1 = std::min(footprintSpan(s * (X1 - 1), s * (X1 - 1), half, nx).last + 1, nx - 1);
     // each column's largest |dh| over the dilated rows, then each receiver's over its columns
     const Grid& level0 = dh.levels[0];
     columnMax.assign(static_cast<std::size_t>(cx1 - cx0 + 1), 0.0f);
@@ -653,12 +671,11 @@ void receiverGradientBounds(const MaxChangePyramid& dh, const HeightPyramid& pyr
                 std::max(columnMax[static_cast<std::size_t>(x - cx0)], row[x]);
     }
     for (int X = X0; X < X1; ++X) {
-        const auto [fx0, fx1] = footprint(s * X, nx);
-        const bool border = fx0 == 0 || fy0 == 0 || fx1 == nx - 1 || fy1 == ny - 1;  // one-sided differences
+        const FootprintSpan fx = footprintSpan(s * X, s * X, half, nx);
         float m = 0.0f;
-        for (int x = std::max(fx0 - 1, 0); x <= std::min(fx1 + 1, nx - 1); ++x)
+        for (int x = std::max(fx.first - 1, 0); x <= std::min(fx.last + 1, nx - 1); ++x)
             m = std::max(m, columnMax[static_cast<std::size_t>(x - cx0)]);
-        out[X] = floatNotBelow((border ? 2.0 : 1.0) * static_cast<double>(m) / pyr.cellSize);
+        out[X] = gradientBoundFrom(m, fx.edge || fy.edge, pyr.cellSize);
     }
 }
 

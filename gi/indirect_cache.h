@@ -100,13 +100,6 @@ static_assert(kVisibilityTile % kIndirectTile == 0 && kIndirectTile % ReceiverTi
               "indirect tiles split visibility tiles into whole receiver groups");
 static_assert(kIndirectTile == kCacheTile, "the visibility cache's geometry tiles are the indirect tiles");
 
-/// The visibility tile (its row-major index over nxr receivers) holding indirect tile (tx, ty).
-inline std::size_t visibilityTileHolding(int tx, int ty, int nxr) {
-    constexpr int kPer = kVisibilityTile / kIndirectTile;
-    return static_cast<std::size_t>(ty / kPer) * static_cast<std::size_t>(tileCount(nxr, kVisibilityTile)) +
-           static_cast<std::size_t>(tx / kPer);
-}
-
 struct IndirectCache {
     bool valid = false;                // the fields below describe the cached indirect result
     std::array<Grid, 3> anchorSource;  // L_0 at the anchor (gi/anchored_drift.h)

@@ -36,13 +36,10 @@ float keyShadePerFraction(const std::vector<KeyLightRegion>& keys) {
 
 // Each cache tile's value of `perTile` (one per visibility tile) into out.
 void onCacheTiles(const std::vector<float>& perTile, const ReceiverTiles& tiles, std::vector<float>& out) {
-    constexpr int kPer = kVisibilityTile / kCacheTile;
-    const int visibilityX = tileCount(tiles.nxr, kVisibilityTile);
     out.resize(tiles.dirty.size());
     for (int ty = 0; ty < tiles.tilesY; ++ty)
         for (int tx = 0; tx < tiles.tilesX; ++tx)
-            out[static_cast<std::size_t>(ty) * tiles.tilesX + tx] =
-                perTile[static_cast<std::size_t>(ty / kPer) * visibilityX + tx / kPer];
+            out[static_cast<std::size_t>(ty) * tiles.tilesX + tx] = perTile[visibilityTileHolding(tx, ty, tiles.nxr)];
 }
 
 // Per cache tile, the largest over the key lights of the bound on each
@@ -120,15 +117,13 @@ namespace {
 // taken per azimuth too), counted with the coarse bound (cache.coarseBound),
 // would pass kCoarseBoundShare of the tolerance.
 void markPerAzimuthTiles(float tolerance, bool geometryPerAzimuth, VisibilityCache& cache) {
-    constexpr int kPer = kVisibilityTile / kCacheTile;
     const ReceiverTiles& tiles = cache.tiles;
-    const int visibilityX = tileCount(tiles.nxr, kVisibilityTile);
     const float share = kCoarseBoundShare * tolerance;
     cache.perAzimuth.assign(cache.coarseBound.size(), 0);
     for (int ty = 0; ty < tiles.tilesY; ++ty)
         for (int tx = 0; tx < tiles.tilesX; ++tx) {
             const std::size_t t = static_cast<std::size_t>(ty) * tiles.tilesX + tx;
-            const std::size_t v = static_cast<std::size_t>(ty / kPer) * visibilityX + tx / kPer;
+            const std::size_t v = visibilityTileHolding(tx, ty, tiles.nxr);
             const float coarse = cache.coarseBound[v];
             if (cache.drift.fromAnchor[t] + coarse > share ||
                 (geometryPerAzimuth && cache.geometryDrift.fromAnchor[t] + coarse > share))

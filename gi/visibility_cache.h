@@ -69,6 +69,14 @@ inline constexpr int kCacheTile = 16;
 static_assert(kVisibilityTile % kCacheTile == 0 && kCacheTile % ReceiverTiles::kTileAlign == 0,
               "cache tiles split visibility tiles into whole receiver groups");
 
+/// The visibility tile (its row-major index over nxr receivers) holding
+/// cache tile (tx, ty) (an indirect tile too: gi/indirect_cache.h).
+inline std::size_t visibilityTileHolding(int tx, int ty, int nxr) {
+    constexpr int kPer = kVisibilityTile / kCacheTile;
+    return static_cast<std::size_t>(ty / kPer) * static_cast<std::size_t>(tileCount(nxr, kVisibilityTile)) +
+           static_cast<std::size_t>(tx / kPer);
+}
+
 /// The share of the tolerance up to which a tile's drift may be counted with
 /// its coarse bounds alone: one slope bound over every direction per
 /// visibility tile (a few box queries per step) in place of one per azimuth
