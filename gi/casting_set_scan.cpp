@@ -38,6 +38,10 @@ struct StepTaps {
     V back[2];   // -(cos phi, sin phi)
     bool clamp;  // members send max(0, u)
     int group;   // Irradiance: the step's distance group (-1: none summed)
+    // Irradiance, Nlp: the samples the block reads next (as nextPlanes):
+    // the two height taps and each channel's first radiance tap
+    const float *nextA, *nextB;
+    const float* nextR[3];
 };
 
 template <class V, CastingMoments K>
@@ -67,6 +71,13 @@ template <class V, CastingMoments K>
         return tp;
     }
     tp.group = az.distanceGroups ? az.distanceGroups[i] : -1;
+    const ScanStep& ns = az.heights[nextI];
+    tp.nextA = ns.field + (nextY * ns.rowStep + ns.offA);
+    tp.nextB = ns.field + (nextY * ns.rowStep + ns.offB);
+    for (int c = 0; c < 3; ++c) {
+        const ScanStep& nr = az.radiance[c][nextI];
+        tp.nextR[c] = nr.field + (nextY * nr.rowStep + nr.offA);
+    }
     for (int c = 0; c < 3; ++c) {
         const ScanStep& rs = az.radiance[c][i];
         const std::ptrdiff_t ro = Y * rs.rowStep;
@@ -241,6 +252,17 @@ struct CastingRow {
     [[gnu::always_inline]] bool stepGroup(const StepTaps<V>& tp, I iv, V hMax, int X0) {
         I stp;
         std::memcpy(&stp, steps + X0, sizeof stp);
+        if constexpr (K != CastingMoments::GlossyNlp) {
+            // once per 64-byte line of the row, the lines the block reads
+            // next at this column: a local change's spans are a tile or two
+            // wide, too short a stream for the hardware's prefetchers, and
+            // each step's reads came cold (README, "Incremental frames")
+            if ((X0 & 15) == 0) {
+                __builtin_prefetch(tp.nextA + X0);
+                __builtin_prefetch(tp.nextB + X0);
+                for (int c = 0; c < 3; ++c) __builtin_prefetch(tp.nextR[c] + X0);
+            }
+        }
         const V h0 = load<V>(in->h0 + X0);
         const V t =
             (((tp.wa * load<V>(tp.a + X0) + tp.wb * load<V>(tp.b + X0)) - h0) - load<V>(in->margin + X0)) * tp.inv;
