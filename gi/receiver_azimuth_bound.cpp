@@ -1,7 +1,9 @@
 #include "gi/receiver_azimuth_bound.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -115,142 +117,179 @@ void buildWalks(const HeightPyramid& b, std::span<const double> phi, float large
     }
 }
 
-// Calls step(bs, fa, fb, a, e) for each walked step of `walk` whose taps
-// row Y's receivers [a, e] of the span [x0, x1) read (fa, fb: the two tap
-// rows, indexed by the receiver's column): up to the first step none of
-// them is inside the domain at (the valid ranges only shrink: once empty,
-// for good), skipping the steps whose taps read no texel of non-zero |dh|
-// bound unless some receiver of the span has a change of its own
-// (`ownChange`: a step's sample then adds 0).
+// A block of consecutive receiver rows Y0 .. Y0 + rows - 1 that share their
+// spans: the walks take its rows together, step by step (each step's taps
+// of consecutive rows lie in consecutive rows of its field, so the lines
+// one row reads are followed by their neighbours while the prefetchers see
+// the stride; a row at a time, every step read a new field cold). `dh0`:
+// |dh| at each row's receivers' own cells; `own`: the cells of non-zero
+// |dh| (whose receivers may have a height change of their own).
+constexpr int kWalkRows = 8;
+struct WalkBlock {
+    int Y0, rows, s;
+    std::array<const float*, kWalkRows> dh0;
+    CellBox own;
+    // bit r: row Y0 + r's receivers in [x0, x1) may have a change of their own
+    std::uint32_t ownRows(int x0, int x1) const {
+        std::uint32_t bits = 0;
+        const bool columns = s * (x1 - 1) >= own.x0 && s * x0 < own.x1;
+        for (int r = 0; r < rows && columns; ++r)
+            if (s * (Y0 + r) >= own.y0 && s * (Y0 + r) < own.y1) bits |= 1u << r;
+        return bits;
+    }
+};
+
+// Calls step(r, bs, fa, fb, a, e) for each walked step of `walk` and each
+// row Y0 + r of the block whose taps that row's receivers [a, e] of the
+// span [x0, x1) read (fa, fb: the two tap rows, indexed by the receiver's
+// column): up to the first step none of them is inside the domain at (the
+// valid ranges only shrink: once out, for good), skipping the steps whose
+// taps read no texel of non-zero |dh| bound unless the row's receivers have
+// a change of their own (bit r of `ownRows`: a step's sample then adds 0).
 template <class Step>
-[[gnu::always_inline]] inline void forEachReadingStep(const ChangeWalk& walk, int Y, int x0, int x1, bool ownChange,
-                                                      Step&& step) {
+[[gnu::always_inline]] inline void forEachReadingStep(const ChangeWalk& walk, int Y0, int rows, int x0, int x1,
+                                                      std::uint32_t ownRows, Step&& step) {
     for (const ChangeWalk::Step& bs : walk.steps) {
         const int a = std::max(x0, bs.x0), e = std::min(x1 - 1, bs.x1);
-        if (Y < bs.y0 || Y > bs.y1 || a > e) break;
+        const int r0 = std::max(Y0, bs.y0) - Y0, r1 = std::min(Y0 + rows - 1, bs.y1) - Y0;
+        if (a > e || r0 > r1) break;
         const int tx0 = bs.k * a + bs.tapX, tx1 = bs.k * e + bs.tapX + bs.nextX + 1;
-        const int ty0 = bs.k * Y + bs.tapY, ty1 = ty0 + bs.nextY + 1;
         const CellBox& c = bs.changed;
-        if (!ownChange && (tx1 <= c.x0 || tx0 >= c.x1 || ty1 <= c.y0 || ty0 >= c.y1)) continue;
+        const bool columns = tx1 > c.x0 && tx0 < c.x1;
+        if (!columns && ownRows == 0) continue;
         const ScanStep& st = bs.step;
-        const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(Y) * st.rowStep;
-        step(bs, st.field + st.offA + row, st.field + st.offB + row, a, e);
+        for (int r = r0; r <= r1; ++r) {
+            const int Y = Y0 + r;
+            const int ty0 = bs.k * Y + bs.tapY, ty1 = ty0 + bs.nextY + 1;
+            if (!((ownRows >> r) & 1u) && (!columns || ty1 <= c.y0 || ty0 >= c.y1)) continue;
+            const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(Y) * st.rowStep;
+            step(r, bs, st.field + st.offA + row, st.field + st.offB + row, a, e);
+        }
     }
 }
 
-// One receiver row's span [x0, x1) along one azimuth into o (the row of
-// out): the largest slope bound of its walked steps, at least the tail's.
+// The block's span [x0, x1) along one azimuth into the rows o + r * stride:
+// each receiver's largest slope bound of its walked steps, at least the
+// tail's.
 template <class V>
-[[gnu::always_inline]] inline void walkSpan(const ChangeWalk& walk, const float* dh0, int Y, int x0, int x1,
-                                            bool ownChange, float* o) {
-    for (int X = x0; X < x1; ++X) o[X] = walk.tail;
+[[gnu::always_inline]] inline void walkSpan(const ChangeWalk& walk, const WalkBlock& block, int x0, int x1, float* o,
+                                            std::size_t stride) {
+    for (int r = 0; r < block.rows; ++r)
+        for (int X = x0; X < x1; ++X) o[static_cast<std::size_t>(r) * stride + X] = walk.tail;
     forEachReadingStep(
-        walk, Y, x0, x1, ownChange, [&](const ChangeWalk::Step& bs, const float* fa, const float* fb, int a, int e) {
+        walk, block.Y0, block.rows, x0, x1, block.ownRows(x0, x1),
+        [&](int r, const ChangeWalk::Step& bs, const float* fa, const float* fb, int a, int e) {
             const ScanStep& st = bs.step;
+            const float* dh0 = block.dh0[static_cast<std::size_t>(r)];
+            float* out = o + static_cast<std::size_t>(r) * stride;
             const V wa = simd::splat<V>(st.w[0][0]), wb = simd::splat<V>(st.w[1][0]);
             const V inv = simd::splat<V>(st.w[2][0]);
             constexpr int L = simd::kLaneCount<V>;
             int X = a;
             for (; X + L <= e + 1; X += L) {
                 const V v = (wa * simd::load<V>(fa + X) + wb * simd::load<V>(fb + X) + simd::load<V>(dh0 + X)) * inv;
-                simd::store(o + X, simd::vmax(simd::load<V>(o + X), v));
+                simd::store(out + X, simd::vmax(simd::load<V>(out + X), v));
             }
-            for (; X <= e; ++X) o[X] = std::max(o[X], (st.w[0][0] * fa[X] + st.w[1][0] * fb[X] + dh0[X]) * st.w[2][0]);
+            for (; X <= e; ++X)
+                out[X] = std::max(out[X], (st.w[0][0] * fa[X] + st.w[1][0] * fb[X] + dh0[X]) * st.w[2][0]);
         });
 }
 
 // The same walk bounding the samples' own moves, w_a D[a] + w_b D[b]: their
-// largest along the azimuth into o, and in each distance group into
-// groups + g * groupStride (raised, not set: the caller starts them at 0
-// and walks every azimuth). Walked with no floor (its tail is 0).
+// largest along the azimuth into the rows o + r * stride, and in each
+// distance group into groups + g * groupStride + r * stride (raised, not
+// set: the caller starts them at 0 and walks every azimuth). Walked with no
+// floor (its tail is 0).
 template <class V>
-[[gnu::always_inline]] inline void walkMoveSpan(const ChangeWalk& walk, int Y, int x0, int x1, float* o, float* groups,
-                                                std::size_t groupStride) {
-    for (int X = x0; X < x1; ++X) o[X] = 0.0f;
-    forEachReadingStep(walk, Y, x0, x1, false,
-                       [&](const ChangeWalk::Step& bs, const float* fa, const float* fb, int a, int e) {
+[[gnu::always_inline]] inline void walkMoveSpan(const ChangeWalk& walk, const WalkBlock& block, int x0, int x1,
+                                                float* o, float* groups, std::size_t stride, std::size_t groupStride) {
+    for (int r = 0; r < block.rows; ++r)
+        for (int X = x0; X < x1; ++X) o[static_cast<std::size_t>(r) * stride + X] = 0.0f;
+    forEachReadingStep(walk, block.Y0, block.rows, x0, x1, 0u,
+                       [&](int r, const ChangeWalk::Step& bs, const float* fa, const float* fb, int a, int e) {
                            const ScanStep& st = bs.step;
-                           float* g = groups + static_cast<std::size_t>(bs.group) * groupStride;
+                           float* out = o + static_cast<std::size_t>(r) * stride;
+                           float* g = groups + static_cast<std::size_t>(bs.group) * groupStride +
+                                      static_cast<std::size_t>(r) * stride;
                            const V wa = simd::splat<V>(st.w[0][0]), wb = simd::splat<V>(st.w[1][0]);
                            constexpr int L = simd::kLaneCount<V>;
                            int X = a;
                            for (; X + L <= e + 1; X += L) {
                                const V v = wa * simd::load<V>(fa + X) + wb * simd::load<V>(fb + X);
-                               simd::store(o + X, simd::vmax(simd::load<V>(o + X), v));
+                               simd::store(out + X, simd::vmax(simd::load<V>(out + X), v));
                                simd::store(g + X, simd::vmax(simd::load<V>(g + X), v));
                            }
                            for (; X <= e; ++X) {
                                const float v = st.w[0][0] * fa[X] + st.w[1][0] * fb[X];
-                               o[X] = std::max(o[X], v);
+                               out[X] = std::max(out[X], v);
                                g[X] = std::max(g[X], v);
                            }
                        });
 }
 
-// Every azimuth's walk over the row's spans; azimuth j's bounds go to the
-// row rows + j * stride (indexed by the receiver's column).
-// `own`: the cells of non-zero |dh| (whose receivers may have a height
-// change of their own); s the sub-sampling.
-struct RowWalk {
-    const float* dh0;  // |dh| at the row's receivers' own cells
-    int Y, s;
-    CellBox own;
-};
-using WalkRow = void (*)(const std::vector<ChangeWalk>&, std::span<const ColumnSpan>, const RowWalk&, float*,
-                         std::size_t);
+// Every azimuth's walk over the block's spans; azimuth j's bounds of row
+// Y0 + r go to rows + j * azimuthStride + r * rowStride (indexed by the
+// receiver's column).
+using WalkRows = void (*)(const std::vector<ChangeWalk>&, std::span<const ColumnSpan>, const WalkBlock&, float*,
+                          std::size_t, std::size_t);
 
 template <class V>
-[[gnu::always_inline]] inline void walkRowWith(const std::vector<ChangeWalk>& walks, std::span<const ColumnSpan> spans,
-                                               const RowWalk& r, float* rows, std::size_t stride) {
-    const bool ownRow = r.s * r.Y >= r.own.y0 && r.s * r.Y < r.own.y1;
-    for (std::size_t j = 0; j < walks.size(); ++j)
-        for (const ColumnSpan& span : spans) {
-            const bool own = ownRow && r.s * (span.x1 - 1) >= r.own.x0 && r.s * span.x0 < r.own.x1;
-            walkSpan<V>(walks[j], r.dh0, r.Y, span.x0, span.x1, own, rows + j * stride);
-        }
-}
-void walkRowSse(const std::vector<ChangeWalk>& walks, std::span<const ColumnSpan> spans, const RowWalk& r, float* rows,
-                std::size_t stride) {
-    walkRowWith<simd::F4>(walks, spans, r, rows, stride);
-}
-[[gnu::target("avx2"), gnu::flatten]] void walkRowAvx2(const std::vector<ChangeWalk>& walks,
-                                                       std::span<const ColumnSpan> spans, const RowWalk& r, float* rows,
-                                                       std::size_t stride) {
-    walkRowWith<simd::F8>(walks, spans, r, rows, stride);
-}
-
-// Every azimuth's sample-move walk over row Y's spans: azimuth j's largest
-// moves to rows + j * stride, distance group g's over every azimuth to
-// groups + g * stride (indexed by the receiver's column).
-using WalkMoveRow = void (*)(const std::vector<ChangeWalk>&, std::span<const ColumnSpan>, int, float*, float*,
-                             std::size_t);
-template <class V>
-[[gnu::always_inline]] inline void walkMoveRowWith(const std::vector<ChangeWalk>& walks,
-                                                   std::span<const ColumnSpan> spans, int Y, float* rows, float* groups,
-                                                   std::size_t stride) {
-    for (const ColumnSpan& span : spans)
-        for (std::size_t g = 0; g < kDistanceGroups; ++g)
-            std::fill(groups + g * stride + span.x0, groups + g * stride + span.x1, 0.0f);
+[[gnu::always_inline]] inline void walkRowsWith(const std::vector<ChangeWalk>& walks, std::span<const ColumnSpan> spans,
+                                                const WalkBlock& block, float* rows, std::size_t azimuthStride,
+                                                std::size_t rowStride) {
     for (std::size_t j = 0; j < walks.size(); ++j)
         for (const ColumnSpan& span : spans)
-            walkMoveSpan<V>(walks[j], Y, span.x0, span.x1, rows + j * stride, groups, stride);
+            walkSpan<V>(walks[j], block, span.x0, span.x1, rows + j * azimuthStride, rowStride);
 }
-void walkMoveRowSse(const std::vector<ChangeWalk>& walks, std::span<const ColumnSpan> spans, int Y, float* rows,
-                    float* groups, std::size_t stride) {
-    walkMoveRowWith<simd::F4>(walks, spans, Y, rows, groups, stride);
+void walkRowsSse(const std::vector<ChangeWalk>& walks, std::span<const ColumnSpan> spans, const WalkBlock& block,
+                 float* rows, std::size_t azimuthStride, std::size_t rowStride) {
+    walkRowsWith<simd::F4>(walks, spans, block, rows, azimuthStride, rowStride);
 }
-[[gnu::target("avx2"), gnu::flatten]] void walkMoveRowAvx2(const std::vector<ChangeWalk>& walks,
-                                                           std::span<const ColumnSpan> spans, int Y, float* rows,
-                                                           float* groups, std::size_t stride) {
-    walkMoveRowWith<simd::F8>(walks, spans, Y, rows, groups, stride);
+[[gnu::target("avx2"), gnu::flatten]] void walkRowsAvx2(const std::vector<ChangeWalk>& walks,
+                                                        std::span<const ColumnSpan> spans, const WalkBlock& block,
+                                                        float* rows, std::size_t azimuthStride, std::size_t rowStride) {
+    walkRowsWith<simd::F8>(walks, spans, block, rows, azimuthStride, rowStride);
+}
+
+// Every azimuth's sample-move walk over the block's spans: azimuth j's
+// largest moves of row Y0 + r to rows + j * plane + r * rowStride, distance
+// group g's over every azimuth to groups + g * plane + r * rowStride
+// (indexed by the receiver's column).
+using WalkMoveRows = void (*)(const std::vector<ChangeWalk>&, std::span<const ColumnSpan>, const WalkBlock&, float*,
+                              float*, std::size_t, std::size_t);
+template <class V>
+[[gnu::always_inline]] inline void walkMoveRowsWith(const std::vector<ChangeWalk>& walks,
+                                                    std::span<const ColumnSpan> spans, const WalkBlock& block,
+                                                    float* rows, float* groups, std::size_t plane,
+                                                    std::size_t rowStride) {
+    for (const ColumnSpan& span : spans)
+        for (std::size_t g = 0; g < kDistanceGroups; ++g)
+            for (int r = 0; r < block.rows; ++r) {
+                float* row = groups + g * plane + static_cast<std::size_t>(r) * rowStride;
+                std::fill(row + span.x0, row + span.x1, 0.0f);
+            }
+    for (std::size_t j = 0; j < walks.size(); ++j)
+        for (const ColumnSpan& span : spans)
+            walkMoveSpan<V>(walks[j], block, span.x0, span.x1, rows + j * plane, groups, rowStride, plane);
+}
+void walkMoveRowsSse(const std::vector<ChangeWalk>& walks, std::span<const ColumnSpan> spans, const WalkBlock& block,
+                     float* rows, float* groups, std::size_t plane, std::size_t rowStride) {
+    walkMoveRowsWith<simd::F4>(walks, spans, block, rows, groups, plane, rowStride);
+}
+[[gnu::target("avx2"), gnu::flatten]] void walkMoveRowsAvx2(const std::vector<ChangeWalk>& walks,
+                                                            std::span<const ColumnSpan> spans, const WalkBlock& block,
+                                                            float* rows, float* groups, std::size_t plane,
+                                                            std::size_t rowStride) {
+    walkMoveRowsWith<simd::F8>(walks, spans, block, rows, groups, plane, rowStride);
 }
 
 // The walks of `levels` over the receivers of `only`'s dirty tiles: calls
-// row(Y, spans, r) for each receiver row with a span, in parallel (r: what
-// the slope walks read of the row; the walks are levels.walks).
-template <class Row>
-void forEachWalkedRow(ChangeLevels& levels, const HeightPyramid& pyr, std::span<const double> phi,
-                      const ReceiverTiles* only, float floor, Row&& row) {
+// block(spans, b) for each block of consecutive receiver rows with the same
+// spans (at most kWalkRows, b: what the slope walks read of its rows), in
+// parallel (the walks are levels.walks).
+template <class Block>
+void forEachWalkedBlock(ChangeLevels& levels, const HeightPyramid& pyr, std::span<const double> phi,
+                        const ReceiverTiles* only, float floor, Block&& block) {
     const HeightPyramid& b = levels.bound;
     if (!levels.valid || b.nx != pyr.nx || b.ny != pyr.ny || b.nxr != pyr.nxr || b.nyr != pyr.nyr ||
         b.steps.size() != pyr.steps.size())
@@ -258,19 +297,33 @@ void forEachWalkedRow(ChangeLevels& levels, const HeightPyramid& pyr, std::span<
     buildWalks(b, phi, levels.largest, std::max(floor, 0.0f), levels);
     const DirtySpans& spans = levels.spans;
     dirtySpans(only, b.nxr, b.nyr, levels.spans);
-    // only the rows with a span are handed out (a local change's few tiles)
-    blocksWithRows(
-        b.nyr,
-        [](int Y) {
-            return RowSpan{Y, Y + 1};
-        },
-        [&](int Y) { return !spans.ofRow(Y).empty(); }, levels.walkedRows);
-    parallelForEach(levels.walkedRows, [&](int Y) {
-        // |dh| at the receivers' own cells: raw phase 0 of row s Y
-        row(Y, spans.ofRow(Y), RowWalk{b.rawPhaseRow(0, b.subsample * Y), Y, b.subsample, levels.built});
+    // blocks of rows with a span, each cut where the spans differ (a tile
+    // row's rows share theirs)
+    const auto sameSpans = [&](int Y, int Z) {
+        return std::ranges::equal(spans.ofRow(Y), spans.ofRow(Z), [](const ColumnSpan& p, const ColumnSpan& q) {
+            return p.x0 == q.x0 && p.x1 == q.x1;
+        });
+    };
+    std::vector<int>& blocks = levels.walkedBlocks;  // first row, rows: pairs
+    blocks.clear();
+    for (int Y = 0; Y < b.nyr;) {
+        const int start = Y++;
+        if (spans.ofRow(start).empty()) continue;
+        while (Y < b.nyr && Y - start < kWalkRows && sameSpans(start, Y)) ++Y;
+        blocks.push_back(start);
+        blocks.push_back(Y - start);
+    }
+    parallelFor(0, static_cast<int>(blocks.size() / 2), 1, [&](int k0, int k1) {
+        for (int k = k0; k < k1; ++k) {
+            const int Y0 = blocks[2 * static_cast<std::size_t>(k)];
+            WalkBlock wb{Y0, blocks[2 * static_cast<std::size_t>(k) + 1], b.subsample, {}, levels.built};
+            // |dh| at the receivers' own cells: raw phase 0 of row s Y
+            for (int r = 0; r < wb.rows; ++r)
+                wb.dh0[static_cast<std::size_t>(r)] = b.rawPhaseRow(0, b.subsample * (Y0 + r));
+            block(spans.ofRow(Y0), wb);
+        }
     });
 }
-
 }  // namespace
 
 void boundSlopeChangePerReceiverAzimuth(ChangeLevels& levels, const HeightPyramid& pyr, std::span<const double> phi,
@@ -278,9 +331,10 @@ void boundSlopeChangePerReceiverAzimuth(ChangeLevels& levels, const HeightPyrami
     const std::size_t planeR = static_cast<std::size_t>(pyr.nxr) * pyr.nyr;
     out.assign(phi.size() * planeR, 0.0f);
     if (levels.largest == 0.0f && levels.valid) return;  // no height changed
-    const WalkRow walkRow = simd::wideEnabled() ? walkRowAvx2 : walkRowSse;
-    forEachWalkedRow(levels, pyr, phi, only, floor, [&](int Y, std::span<const ColumnSpan> spans, const RowWalk& r) {
-        walkRow(levels.walks, spans, r, out.data() + static_cast<std::size_t>(Y) * pyr.nxr, planeR);
+    const WalkRows walkRows = simd::wideEnabled() ? walkRowsAvx2 : walkRowsSse;
+    forEachWalkedBlock(levels, pyr, phi, only, floor, [&](std::span<const ColumnSpan> spans, const WalkBlock& block) {
+        walkRows(levels.walks, spans, block, out.data() + static_cast<std::size_t>(block.Y0) * pyr.nxr, planeR,
+                 static_cast<std::size_t>(pyr.nxr));
     });
 }
 
@@ -295,33 +349,39 @@ void boundEnvironmentPerReceiver(ChangeLevels& levels, const MaxChangePyramid& d
     out.assign(planeR, 0.0f);
     if (subsetOut) subsetOut->assign(planeR, 0.0f);
     if (levels.largest == 0.0f && levels.valid) return;  // no height changed
-    // per worker slot: a row's slope bounds per azimuth, then one receiver's,
-    // then the row's gradient bounds; and the gradients' column scratch
+    // per worker slot: a block's slope bounds per row and azimuth, then one
+    // receiver's, then a row's gradient bounds; and the gradients' column scratch
     const std::size_t slots = static_cast<std::size_t>(workerSlots());
+    const std::size_t rowStride = static_cast<std::size_t>(m) * nxr;
     levels.rows.resize(slots);
     levels.columns.resize(slots);
-    for (std::vector<float>& r : levels.rows) r.resize(static_cast<std::size_t>(m) * (nxr + 1) + nxr);
-    const WalkRow walkRow = simd::wideEnabled() ? walkRowAvx2 : walkRowSse;
-    forEachWalkedRow(levels, pyr, phi, only, floor, [&](int Y, std::span<const ColumnSpan> spans, const RowWalk& row) {
+    for (std::vector<float>& r : levels.rows) r.resize(kWalkRows * rowStride + m + nxr);
+    const WalkRows walkRows = simd::wideEnabled() ? walkRowsAvx2 : walkRowsSse;
+    forEachWalkedBlock(levels, pyr, phi, only, floor, [&](std::span<const ColumnSpan> spans, const WalkBlock& block) {
         const std::size_t slot = static_cast<std::size_t>(workerSlot());
         float* slopes = levels.rows[slot].data();
-        float* perAzimuth = slopes + static_cast<std::size_t>(m) * nxr;
+        float* perAzimuth = slopes + kWalkRows * rowStride;
         float* gradients = perAzimuth + m;
-        walkRow(levels.walks, spans, row, slopes, static_cast<std::size_t>(nxr));
-        for (const ColumnSpan& span : spans) {
-            receiverGradientBounds(dh, pyr, Y, span.x0, span.x1, gradients, levels.columns[slot]);
-            for (int X = span.x0; X < span.x1; ++X) {
-                const std::size_t r = static_cast<std::size_t>(Y) * nxr + static_cast<std::size_t>(X);
-                const float gradient = gradients[X];
-                for (int j = 0; j < m; ++j)
-                    perAzimuth[static_cast<std::size_t>(j)] =
-                        lipschitz * slopes[static_cast<std::size_t>(j) * nxr + static_cast<std::size_t>(X)];
-                out[r] = ambientChangeBoundPerAzimuth(perAzimuth, m, gradient, 1.0f, false);
-                if (!subsetOut) continue;
-                // every subsetStride-th azimuth, gathered to the front
-                for (int k = 0; k < m / subsetStride; ++k)
-                    perAzimuth[static_cast<std::size_t>(k)] = perAzimuth[static_cast<std::size_t>(k * subsetStride)];
-                (*subsetOut)[r] = ambientChangeBoundPerAzimuth(perAzimuth, m / subsetStride, gradient, 1.0f, false);
+        walkRows(levels.walks, spans, block, slopes, static_cast<std::size_t>(nxr), rowStride);
+        for (int rb = 0; rb < block.rows; ++rb) {
+            const int Y = block.Y0 + rb;
+            const float* rowSlopes = slopes + static_cast<std::size_t>(rb) * rowStride;
+            for (const ColumnSpan& span : spans) {
+                receiverGradientBounds(dh, pyr, Y, span.x0, span.x1, gradients, levels.columns[slot]);
+                for (int X = span.x0; X < span.x1; ++X) {
+                    const std::size_t r = static_cast<std::size_t>(Y) * nxr + static_cast<std::size_t>(X);
+                    const float gradient = gradients[X];
+                    for (int j = 0; j < m; ++j)
+                        perAzimuth[static_cast<std::size_t>(j)] =
+                            lipschitz * rowSlopes[static_cast<std::size_t>(j) * nxr + static_cast<std::size_t>(X)];
+                    out[r] = ambientChangeBoundPerAzimuth(perAzimuth, m, gradient, 1.0f, false);
+                    if (!subsetOut) continue;
+                    // every subsetStride-th azimuth, gathered to the front
+                    for (int k = 0; k < m / subsetStride; ++k)
+                        perAzimuth[static_cast<std::size_t>(k)] =
+                            perAzimuth[static_cast<std::size_t>(k * subsetStride)];
+                    (*subsetOut)[r] = ambientChangeBoundPerAzimuth(perAzimuth, m / subsetStride, gradient, 1.0f, false);
+                }
             }
         }
     });
@@ -333,11 +393,12 @@ void boundSampleMovePerReceiver(ChangeLevels& levels, const HeightPyramid& field
     const std::size_t planeR = static_cast<std::size_t>(field.nxr) * field.nyr;
     azimuthMove.resize(phi.size() * planeR);
     groupMove.resize(static_cast<std::size_t>(kDistanceGroups) * planeR);
-    const WalkMoveRow walkRow = simd::wideEnabled() ? walkMoveRowAvx2 : walkMoveRowSse;
+    const WalkMoveRows walkRows = simd::wideEnabled() ? walkMoveRowsAvx2 : walkMoveRowsSse;
     // no floor: a move does not shrink with the distance (the walks' tails are 0)
-    forEachWalkedRow(levels, field, phi, only, 0.0f, [&](int Y, std::span<const ColumnSpan> spans, const RowWalk&) {
-        const std::size_t row = static_cast<std::size_t>(Y) * field.nxr;
-        walkRow(levels.walks, spans, Y, azimuthMove.data() + row, groupMove.data() + row, planeR);
+    forEachWalkedBlock(levels, field, phi, only, 0.0f, [&](std::span<const ColumnSpan> spans, const WalkBlock& block) {
+        const std::size_t row = static_cast<std::size_t>(block.Y0) * field.nxr;
+        walkRows(levels.walks, spans, block, azimuthMove.data() + row, groupMove.data() + row, planeR,
+                 static_cast<std::size_t>(field.nxr));
     });
 }
 

@@ -66,8 +66,8 @@ struct ChangeLevels {
     StepTableKey stepsKey;
     std::vector<ScanStepInfo> stepInfo;
     DirtySpans spans;
-    std::vector<int> walkedRows;              // the receiver rows with a span to walk
-    std::vector<std::vector<float>> rows;     // per worker slot: one receiver row's bounds per azimuth
+    std::vector<int> walkedBlocks;            // the blocks of receiver rows to walk: first row, rows
+    std::vector<std::vector<float>> rows;     // per worker slot: a block's bounds per row and azimuth
     std::vector<std::vector<float>> columns;  // per worker slot: the row's gradient bounds' column maxima
 };
 
