@@ -293,11 +293,12 @@ CellBox synthesisePass(ConstGridView src, int o, int pass, float blend, const Ce
     const RowSpan rows = receiversReading(iy, nyr, changed.y0, changed.y1);
     if (cols.y0 >= cols.y1 || rows.y0 >= rows.y1) return CellBox::none();
     const int X0 = cols.y0, X1 = cols.y1;
-    // never shrunk: the octaves' passes alternate sizes, and growing back
-    // would zero the buffer every build (its rows are written before read)
+    // each octave's own (the octaves are synthesised side by side); sized
+    // once per grid, its rows written before they are read
+    std::vector<float>& rowTmp = p.rowTmp[static_cast<std::size_t>(o)];
     const std::size_t tmpSize = static_cast<std::size_t>(src.ny) * nxr;
-    if (p.rowTmp.size() < tmpSize) p.rowTmp.resize(tmpSize);
-    float* tmp = p.rowTmp.data();
+    if (rowTmp.size() < tmpSize) rowTmp.resize(tmpSize);
+    float* tmp = rowTmp.data();
     // the rows of B_o those receiver rows read (taps nondecreasing)
     const RowSpan tmpRows{iy[4 * rows.y0], iy[4 * (rows.y1 - 1) + 3] + 1};
     parallelForRows(tmpRows, X1 - X0, [&](int y0, int y1) {
@@ -342,23 +343,29 @@ std::vector<CellBox> synthesiseOctaves(ConstGridView heights, const std::vector<
     p.levels.resize(static_cast<std::size_t>(nLevels));
     p.synth.resize(static_cast<std::size_t>(std::max(0, nOctaves - octavesInLevels(nLevels, kv))));
     p.taps.resize(static_cast<std::size_t>(nOctaves));
+    p.rowTmp.resize(static_cast<std::size_t>(nOctaves));
+    for (int o = 0; o < nOctaves; ++o) octaveField(p, o).resize(nxr, nyr);
     std::vector<CellBox> receivers(static_cast<std::size_t>(nOctaves));
-    for (int o = 0; o < nOctaves; ++o) {
-        PaddedField& out = octaveField(p, o);
-        out.resize(nxr, nyr);
-        const CellBox& box = changed[static_cast<std::size_t>(o)];
-        if (o == 0) {
-            receiverHeights(heights, p.subsample, box.rows(), out);
-            receivers[0] = receiversIn(box, p.subsample, nxr, nyr);
-            continue;
+    // the octaves side by side: each reads its own B_o and writes its own
+    // field, taps and scratch (a local change's boxes are too small for
+    // their row loops to split)
+    parallelFor(0, nOctaves, 1, [&](int o0, int o1) {
+        for (int o = o0; o < o1; ++o) {
+            PaddedField& out = octaveField(p, o);
+            const CellBox& box = changed[static_cast<std::size_t>(o)];
+            if (o == 0) {
+                receiverHeights(heights, p.subsample, box.rows(), out);
+                receivers[0] = receiversIn(box, p.subsample, nxr, nyr);
+                continue;
+            }
+            for (int pass = 0; pass < (withMax ? 2 : 1); ++pass) {
+                ConstGridView src = (pass == 0 ? p.meanOctaves : p.maxOctaves)[static_cast<std::size_t>(o - 1)].cview();
+                const float blend = withMax ? (pass == 0 ? 1.0f - p.settings.peakBlend : p.settings.peakBlend) : 1.0f;
+                receivers[static_cast<std::size_t>(o)] = synthesisePass(src, o, pass, blend, box, p, out);
+            }
+            out.padEdges(receivers[static_cast<std::size_t>(o)]);
         }
-        for (int pass = 0; pass < (withMax ? 2 : 1); ++pass) {
-            ConstGridView src = (pass == 0 ? p.meanOctaves : p.maxOctaves)[static_cast<std::size_t>(o - 1)].cview();
-            const float blend = withMax ? (pass == 0 ? 1.0f - p.settings.peakBlend : p.settings.peakBlend) : 1.0f;
-            receivers[static_cast<std::size_t>(o)] = synthesisePass(src, o, pass, blend, box, p, out);
-        }
-        out.padEdges(receivers[static_cast<std::size_t>(o)]);
-    }
+    });
     return receivers;
 }
 
@@ -366,32 +373,34 @@ std::vector<CellBox> synthesiseOctaves(ConstGridView heights, const std::vector<
 // Levels past the last octave repeat it. Only the receivers of the two
 // octaves' boxes (`receivers`); the padding then replicates the edges, as
 // the blend of the octaves' replicated edges would.
+void blendLevel(int l, int nOctaves, int kv, const std::vector<CellBox>& receivers, HeightPyramid& p) {
+    const LevelOctaves lo = levelOctaves(p, l);
+    const int o = lo.octave, ob = std::min(o + 1, nOctaves - 1);
+    if (l == o * kv) return;  // the octave itself, synthesised in place
+    PaddedField& lev = p.levels[static_cast<std::size_t>(l)];
+    const PaddedField& a = octaveSynthesis(p, o);
+    const PaddedField& b = octaveSynthesis(p, ob);
+    const float wa = 1.0f - lo.q, wb = lo.q;
+    const CellBox box =
+        receivers[static_cast<std::size_t>(o)].joined(receivers[static_cast<std::size_t>(ob)]).cut(p.nxr, p.nyr);
+    if (box.empty()) return;
+    parallelForRows(box.rows(), box.x1 - box.x0, [&](int y0, int y1) {
+        for (int Y = y0; Y < y1; ++Y) {
+            const float* ra = a.row(Y);
+            const float* rb = b.row(Y);
+            float* d = lev.row(Y);
+            for (int X = box.x0; X < box.x1; ++X) d[X] = wa * ra[X] + wb * rb[X];
+        }
+    });
+    lev.padEdges(box);
+}
+
+// Every level, side by side (each writes its own field alone).
 void blendLevels(int nLevels, int nOctaves, int kv, const std::vector<CellBox>& receivers, HeightPyramid& p) {
-    const int nxr = p.nxr, nyr = p.nyr;
-    for (int l = 0; l < nLevels; ++l) {
-        const LevelOctaves lo = levelOctaves(p, l);
-        const int o = lo.octave;
-        const float q = lo.q;
-        if (l == o * kv) continue;  // the octave itself, synthesised in place
-        PaddedField& lev = p.levels[static_cast<std::size_t>(l)];
-        lev.resize(nxr, nyr);
-        const PaddedField& a = octaveSynthesis(p, o);
-        const PaddedField& b = octaveSynthesis(p, std::min(o + 1, nOctaves - 1));
-        const float wa = 1.0f - q, wb = q;
-        const int ob = std::min(o + 1, nOctaves - 1);
-        const CellBox box =
-            receivers[static_cast<std::size_t>(o)].joined(receivers[static_cast<std::size_t>(ob)]).cut(nxr, nyr);
-        if (box.empty()) continue;
-        parallelForRows(box.rows(), box.x1 - box.x0, [&](int y0, int y1) {
-            for (int Y = y0; Y < y1; ++Y) {
-                const float* ra = a.row(Y);
-                const float* rb = b.row(Y);
-                float* d = lev.row(Y);
-                for (int X = box.x0; X < box.x1; ++X) d[X] = wa * ra[X] + wb * rb[X];
-            }
-        });
-        lev.padEdges(box);
-    }
+    for (int l = 0; l < nLevels; ++l) p.levels[static_cast<std::size_t>(l)].resize(p.nxr, p.nyr);
+    parallelFor(0, nLevels, 1, [&](int l0, int l1) {
+        for (int l = l0; l < l1; ++l) blendLevel(l, nOctaves, kv, receivers, p);
+    });
 }
 
 }  // namespace

@@ -110,12 +110,12 @@ struct HeightPyramid {
     // it redid: a copy of build `basedOn`'s raw heights needs only those.
     std::uint64_t buildId = 0, basedOn = 0;
     RowSpan rawRowsRedone;
-    std::vector<Grid> meanOctaves;    // B_1, B_2, ... (B_0 is the input)
-    std::vector<Grid> maxOctaves;     // same, max-decimated (only when peakBlend > 0)
-    int octaves = 0;                  // octaves synthesised, S_0 .. S_(octaves - 1)
-    std::vector<PaddedField> levels;  // f_l at the receiver grid, spacing s; level o k_v is S_o
-    std::vector<PaddedField> synth;   // S_o of the octaves above the last level (octaveSynthesis)
-    std::vector<float> rowTmp;        // scratch of the separable synthesis
+    std::vector<Grid> meanOctaves;           // B_1, B_2, ... (B_0 is the input)
+    std::vector<Grid> maxOctaves;            // same, max-decimated (only when peakBlend > 0)
+    int octaves = 0;                         // octaves synthesised, S_0 .. S_(octaves - 1)
+    std::vector<PaddedField> levels;         // f_l at the receiver grid, spacing s; level o k_v is S_o
+    std::vector<PaddedField> synth;          // S_o of the octaves above the last level (octaveSynthesis)
+    std::vector<std::vector<float>> rowTmp;  // per octave: scratch of the separable synthesis
     // Each octave's synthesis taps (4 indices into B_o and 4 weights per
     // receiver column, then per receiver row), a function of the grids
     // alone: kept while they are the same.
