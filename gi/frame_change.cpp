@@ -1,10 +1,34 @@
 #include "gi/frame_change.h"
 
 #include <algorithm>
+#include <array>
 #include <cstring>
+
+#include "core/parallel.h"
 
 namespace terrain::gi {
 namespace {
+
+// differingCells (core/grid.h), its search for the first and the last
+// differing row split over row chunks side by side: every frame compares
+// the whole field, where a local change leaves most rows the same.
+CellBox differingHeights(ConstGridView a, ConstGridView b) {
+    constexpr int kChunks = 16;
+    std::array<RowSpan, kChunks> differing;  // per chunk: its first and one past its last differing row
+    parallelFor(0, kChunks, 1, [&](int c0, int c1) {
+        for (int c = c0; c < c1; ++c) {
+            int y0 = b.ny * c / kChunks, y1 = b.ny * (c + 1) / kChunks;
+            while (y0 < y1 && sameRow(a, b, y0)) ++y0;
+            while (y1 > y0 && sameRow(a, b, y1 - 1)) --y1;
+            differing[static_cast<std::size_t>(c)] = {y0, y1};
+        }
+    });
+    RowSpan rows{b.ny, 0};
+    for (const RowSpan& r : differing)
+        if (r.y0 < r.y1) rows = {std::min(rows.y0, r.y0), std::max(rows.y1, r.y1)};
+    if (rows.y0 >= rows.y1) return CellBox::none();
+    return differingCellsIn(a, b, {0, rows.y0, b.nx, rows.y1});
+}
 
 bool sameGrid(const Grid& a, ConstGridView b) {
     if (a.nx != b.nx || a.ny != b.ny) return false;
@@ -47,7 +71,7 @@ FrameChange compareFrameInputs(const FrameInputs& last, ConstGridView heights, f
     if (!last.valid) return everythingChanged(nKeys);
     FrameChange c;
     const bool sameSize = last.heights.nx == heights.nx && last.heights.ny == heights.ny;
-    if (sameSize) c.newHeights = differingCells(last.heights.cview(), heights);
+    if (sameSize) c.newHeights = differingHeights(last.heights.cview(), heights);
     const bool sameFrame = sameSize && cellSize == last.cellSize && settings == last.settings;
     if (sameFrame) {
         c.heightBox = c.newHeights;
