@@ -256,7 +256,7 @@ struct CastingRow {
             // once per 64-byte line of the row, the lines the block reads
             // next at this column: a local change's spans are a tile or two
             // wide, too short a stream for the hardware's prefetchers, and
-            // each step's reads came cold (README, "Incremental frames")
+            // each step's reads came cold (README, "Cold reads and an idle thread")
             if ((X0 & 15) == 0) {
                 __builtin_prefetch(tp.nextA + X0);
                 __builtin_prefetch(tp.nextB + X0);
