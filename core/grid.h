@@ -178,13 +178,20 @@ inline bool sameRow(ConstGridView a, ConstGridView b, int y) {
     return std::memcmp(a.row(y), b.row(y), sizeof(float) * b.nx) == 0;
 }
 
+/// The rows of `rows` (cut to the views) from the first to the last that
+/// differ; empty (y0 == y1) when none does.
+inline RowSpan differingRows(ConstGridView a, ConstGridView b, RowSpan rows) {
+    rows = rows.cut(b.ny);
+    while (rows.y0 < rows.y1 && sameRow(a, b, rows.y0)) ++rows.y0;
+    while (rows.y1 > rows.y0 && sameRow(a, b, rows.y1 - 1)) --rows.y1;
+    return rows;
+}
+
 /// The box from the first to the last row of `a` and `b` (the same size)
 /// that differ, and in those rows from the first to the last differing
 /// column; empty when no cell differs. Bits are compared, so -0 and 0 differ.
 inline CellBox differingCells(ConstGridView a, ConstGridView b) {
-    int y0 = 0, y1 = b.ny;
-    while (y0 < y1 && sameRow(a, b, y0)) ++y0;
-    while (y1 > y0 && sameRow(a, b, y1 - 1)) --y1;
+    const auto [y0, y1] = differingRows(a, b, RowSpan{0, b.ny});
     if (y0 == y1) return CellBox::none();
     const auto same = [&](int x, int y) { return std::memcmp(a.row(y) + x, b.row(y) + x, sizeof(float)) == 0; };
     int x0 = b.nx, x1 = 0;

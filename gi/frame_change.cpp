@@ -16,12 +16,9 @@ CellBox differingHeights(ConstGridView a, ConstGridView b) {
     constexpr int kChunks = 16;
     std::array<RowSpan, kChunks> differing;  // per chunk: its first and one past its last differing row
     parallelFor(0, kChunks, 1, [&](int c0, int c1) {
-        for (int c = c0; c < c1; ++c) {
-            int y0 = b.ny * c / kChunks, y1 = b.ny * (c + 1) / kChunks;
-            while (y0 < y1 && sameRow(a, b, y0)) ++y0;
-            while (y1 > y0 && sameRow(a, b, y1 - 1)) --y1;
-            differing[static_cast<std::size_t>(c)] = {y0, y1};
-        }
+        for (int c = c0; c < c1; ++c)
+            differing[static_cast<std::size_t>(c)] =
+                differingRows(a, b, RowSpan{b.ny * c / kChunks, b.ny * (c + 1) / kChunks});
     });
     RowSpan rows{b.ny, 0};
     for (const RowSpan& r : differing)

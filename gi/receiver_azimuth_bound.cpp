@@ -299,28 +299,22 @@ void forEachWalkedBlock(ChangeLevels& levels, const HeightPyramid& pyr, std::spa
     dirtySpans(only, b.nxr, b.nyr, levels.spans);
     // blocks of rows with a span, each cut where the spans differ (a tile
     // row's rows share theirs)
-    const auto sameSpans = [&](int Y, int Z) {
-        return std::ranges::equal(spans.ofRow(Y), spans.ofRow(Z), [](const ColumnSpan& p, const ColumnSpan& q) {
-            return p.x0 == q.x0 && p.x1 == q.x1;
-        });
-    };
-    std::vector<int>& blocks = levels.walkedBlocks;  // first row, rows: pairs
+    std::vector<RowSpan>& blocks = levels.walkedBlocks;
     blocks.clear();
     for (int Y = 0; Y < b.nyr;) {
         const int start = Y++;
         if (spans.ofRow(start).empty()) continue;
-        while (Y < b.nyr && Y - start < kWalkRows && sameSpans(start, Y)) ++Y;
-        blocks.push_back(start);
-        blocks.push_back(Y - start);
+        while (Y < b.nyr && Y - start < kWalkRows && std::ranges::equal(spans.ofRow(start), spans.ofRow(Y))) ++Y;
+        blocks.push_back({start, Y});
     }
-    parallelFor(0, static_cast<int>(blocks.size() / 2), 1, [&](int k0, int k1) {
+    parallelFor(0, static_cast<int>(blocks.size()), 1, [&](int k0, int k1) {
         for (int k = k0; k < k1; ++k) {
-            const int Y0 = blocks[2 * static_cast<std::size_t>(k)];
-            WalkBlock wb{Y0, blocks[2 * static_cast<std::size_t>(k) + 1], b.subsample, {}, levels.built};
+            const RowSpan rows = blocks[static_cast<std::size_t>(k)];
+            WalkBlock wb{rows.y0, rows.y1 - rows.y0, b.subsample, {}, levels.built};
             // |dh| at the receivers' own cells: raw phase 0 of row s Y
             for (int r = 0; r < wb.rows; ++r)
-                wb.dh0[static_cast<std::size_t>(r)] = b.rawPhaseRow(0, b.subsample * (Y0 + r));
-            block(spans.ofRow(Y0), wb);
+                wb.dh0[static_cast<std::size_t>(r)] = b.rawPhaseRow(0, b.subsample * (rows.y0 + r));
+            block(spans.ofRow(rows.y0), wb);
         }
     });
 }

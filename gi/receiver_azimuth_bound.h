@@ -66,7 +66,7 @@ struct ChangeLevels {
     StepTableKey stepsKey;
     std::vector<ScanStepInfo> stepInfo;
     DirtySpans spans;
-    std::vector<int> walkedBlocks;            // the blocks of receiver rows to walk: first row, rows
+    std::vector<RowSpan> walkedBlocks;        // the blocks of receiver rows to walk
     std::vector<std::vector<float>> rows;     // per worker slot: a block's bounds per row and azimuth
     std::vector<std::vector<float>> columns;  // per worker slot: the row's gradient bounds' column maxima
 };

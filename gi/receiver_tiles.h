@@ -55,6 +55,7 @@ struct ReceiverTiles {
 /// A run [x0, x1) of receiver columns in one receiver row.
 struct ColumnSpan {
     int x0 = 0, x1 = 0;
+    bool operator==(const ColumnSpan&) const = default;
 };
 
 /// The dirty column spans of every tile row (receiver row Y belongs to tile
