@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "core/prefetch.h"
 
 namespace terrain::gi {
 
@@ -507,6 +508,12 @@ void buildMaxChangePyramid(std::span<const ConstGridView> before, std::span<cons
     const int x0 = region.x0, x1 = region.x1;
     const auto raiseToChange = simd::wideEnabled() ? raiseToChangeAvx2 : raiseToChangeSse;
     parallelForRows(region.rows(), x1 - x0, [&](int y0, int y1) {
+        // the chunk's rows of every field first: a local change's are short (core/prefetch.h)
+        for (int y = y0; y < y1; ++y)
+            for (std::size_t c = 0; c < before.size(); ++c) {
+                prefetchRow(before[c].row(y), x0, x1);
+                prefetchRow(after[c].row(y), x0, x1);
+            }
         for (int y = y0; y < y1; ++y) {
             float* out = base.data() + static_cast<std::size_t>(y) * base.nx;
             std::fill(out + x0, out + x1, 0.0f);
