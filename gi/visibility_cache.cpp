@@ -9,7 +9,30 @@
 
 namespace terrain::gi {
 
+namespace {
+
+// The plans' change pyramid and the receivers' walks' |dh| pyramid and
+// planes, built once per grid and settings (of no change) when the cache is
+// reset for them: built by the first plan that refines, in the middle of a
+// run, they took their memory then, and faulting its pages in made that
+// one frame cost about a full frame's time.
+void sizeChangeScratch(const HeightPyramid& pyr, ConstGridView heights, VisibilityCache& cache) {
+    const HeightPyramid& b = cache.receiverLevels.bound;
+    const bool sized = cache.change.nx == heights.nx && cache.change.ny == heights.ny && cache.receiverLevels.valid &&
+                       b.nx == pyr.nx && b.ny == pyr.ny && b.subsample == pyr.subsample && b.cellSize == pyr.cellSize &&
+                       b.settings == pyr.settings;
+    if (sized) return;
+    buildMaxChangePyramid(heights, heights, cache.change, CellBox{});
+    buildChangeLevels(cache.change, pyr, cache.receiverLevels);
+    const std::size_t planeR = static_cast<std::size_t>(pyr.nxr) * pyr.nyr;
+    cache.receiverBound.resize(planeR);
+    cache.receiverGeometry.resize(planeR);
+}
+
+}  // namespace
+
 void resetVisibilityCache(const HeightPyramid& pyr, ConstGridView heights, VisibilityCache& cache) {
+    sizeChangeScratch(pyr, heights, cache);
     cache.tiles.reset(pyr.nxr, pyr.nyr, kCacheTile, true);
     cache.keyTiles.reset(pyr.nxr, pyr.nyr, kCacheTile, true);
     cache.geometryTiles.reset(pyr.nxr, pyr.nyr, kCacheTile, true);
