@@ -3,9 +3,10 @@
 // share of receivers whose visibility and whose indirect light were
 // recomputed, and the difference of the incremental result from the full
 // one: animated erosion and waves, the static Mont Blanc DEM, the DEM under a
-// sun moving 1 degree per frame, a crater dropped into it; a sweep of local
-// changes of growing area; and long animated runs at several tolerances,
-// from which the default tolerance is chosen. Writes gi_incremental.md and
+// sun moving 1 degree per frame, a crater dropped into it, pits added one a
+// frame and never filled; a sweep of local changes of growing area; and long
+// animated runs at several tolerances, from which the default tolerance is
+// chosen. Writes gi_incremental.md and
 // .csv, and gi_incremental_cost.png / .svg (bench/plots/gi_incremental_cost.py:
 // the sweep's cost against its changed area).
 #include <algorithm>
@@ -231,6 +232,25 @@ NextFrame demWithPit(const Grid& dem, int side) {
     };
 }
 
+// The DEM with a square pit of side `side` cells lowered by 30 m at one more
+// place each frame, none filled: frame f holds pits 1 .. f, at the places
+// of a 4 x 4 grid 128 cells apart (from the 512² crop's corner), so every
+// frame after the first brings a new change that stays (a stricter local
+// change than a pit dropped and filled, whose every other frame returns to
+// the anchor's heights).
+NextFrame demWithPitsAdded(const Grid& dem, int side) {
+    return [&dem, side](int f, Grid& s, gi::GiLighting& l) {
+        s = dem;
+        for (int k = 0; k < f; ++k) {
+            const int x0 = 64 + 128 * (k % 4) - side / 2, y0 = 64 + 128 * ((k / 4) % 4) - side / 2;
+            for (int y = std::max(0, y0); y < std::min(dem.ny, y0 + side); ++y)
+                for (int x = std::max(0, x0); x < std::min(dem.nx, x0 + side); ++x) s(x, y) -= 30.0f;
+        }
+        l = sunAndSky(135.0f);
+        return true;
+    };
+}
+
 std::vector<CaseResult> runCases(const IncrementalOptions& o, const Grid& dem, float cell) {
     std::vector<CaseResult> rows;
     for (float tol : o.tolerances) {
@@ -261,6 +281,8 @@ std::vector<CaseResult> runCases(const IncrementalOptions& o, const Grid& dem, f
                 }));
         if (o.wanted("dem, 16x16 crater"))
             rows.push_back(runCase("dem, 16x16 crater", 512, cell, tol, kEventFrames, demWithPit(dem, 16), true));
+        if (o.wanted("dem, 51² pits added"))
+            rows.push_back(runCase("dem, 51² pits added", 512, cell, tol, kEventFrames, demWithPitsAdded(dem, 51)));
     }
     return rows;
 }
@@ -374,7 +396,8 @@ void writeReport(const std::vector<CaseResult>& rows, const std::vector<CaseResu
        << "bounce, sun-and-sky plus one key light, 2 threads. Times: median GI ms per frame over the frames after "
        << "the first (" << o.frames << " frames; erosion 1024²: " << std::max(3, o.frames / 3)
        << "; a crater or pit: " << kEventFrames
-       << ", dropped on odd frames and filled on even ones). Animated scenes at their pacing (erosion "
+       << ", dropped on odd frames and filled on even ones; pits added: " << kEventFrames
+       << ", one more 51² pit each frame at a new place, none filled). Animated scenes at their pacing (erosion "
        << "60 ticks per frame, waves 0.25 s). Shares recomputed: of the receivers, whose environment visibility "
        << "(V) and whose indirect light were recomputed, mean over the measured frames. Difference of the "
        << "incremental total (direct + indirect) from the full one, worst frame: RMS of the difference over RMS of "
