@@ -6,9 +6,9 @@
 // sun moving 1 degree per frame, a crater dropped into it, pits added one a
 // frame and never filled; a sweep of local changes of growing area; and long
 // animated runs at several tolerances, from which the default tolerance is
-// chosen. Writes gi_incremental.md and
-// .csv, and gi_incremental_cost.png / .svg (bench/plots/gi_incremental_cost.py:
-// the sweep's cost against its changed area).
+// chosen. Writes gi_incremental.md and .csv, and gi_incremental_cost.png /
+// .svg (bench/plots/gi_incremental_cost.py: the sweep's cost against its
+// changed area).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
