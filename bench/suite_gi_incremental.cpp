@@ -218,15 +218,18 @@ NextFrame animated(const char* scene, int size, std::shared_ptr<Simulation>& sim
     };
 }
 
+// Lowers the square of side `side` cells from (x0, y0) (cut to the grid) by 30 m.
+void lowerSquare(Grid& s, int x0, int y0, int side) {
+    for (int y = std::max(0, y0); y < std::min(s.ny, y0 + side); ++y)
+        for (int x = std::max(0, x0); x < std::min(s.nx, x0 + side); ++x) s(x, y) -= 30.0f;
+}
+
 // The DEM with a square of side `side` cells at its centre lowered by 30 m
 // on odd frames: every frame after the first drops or fills the pit.
 NextFrame demWithPit(const Grid& dem, int side) {
     return [&dem, side](int f, Grid& s, gi::GiLighting& l) {
         s = dem;
-        const int x0 = (dem.nx - side) / 2, y0 = (dem.ny - side) / 2;
-        if (f % 2 == 1)
-            for (int y = y0; y < y0 + side; ++y)
-                for (int x = x0; x < x0 + side; ++x) s(x, y) -= 30.0f;
+        if (f % 2 == 1) lowerSquare(s, (dem.nx - side) / 2, (dem.ny - side) / 2, side);
         l = sunAndSky(135.0f);
         return true;
     };
@@ -241,11 +244,8 @@ NextFrame demWithPit(const Grid& dem, int side) {
 NextFrame demWithPitsAdded(const Grid& dem, int side) {
     return [&dem, side](int f, Grid& s, gi::GiLighting& l) {
         s = dem;
-        for (int k = 0; k < f; ++k) {
-            const int x0 = 64 + 128 * (k % 4) - side / 2, y0 = 64 + 128 * ((k / 4) % 4) - side / 2;
-            for (int y = std::max(0, y0); y < std::min(dem.ny, y0 + side); ++y)
-                for (int x = std::max(0, x0); x < std::min(dem.nx, x0 + side); ++x) s(x, y) -= 30.0f;
-        }
+        for (int k = 0; k < f; ++k)
+            lowerSquare(s, 64 + 128 * (k % 4) - side / 2, 64 + 128 * ((k / 4) % 4) - side / 2, side);
         l = sunAndSky(135.0f);
         return true;
     };

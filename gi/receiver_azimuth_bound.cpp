@@ -12,12 +12,16 @@
 
 namespace terrain::gi {
 
+bool changeLevelsFit(const ChangeLevels& levels, const HeightPyramid& pyr) {
+    const HeightPyramid& b = levels.bound;
+    return levels.valid && b.nx == pyr.nx && b.ny == pyr.ny && b.subsample == pyr.subsample &&
+           b.cellSize == pyr.cellSize && b.settings == pyr.settings;
+}
+
 void buildChangeLevels(const MaxChangePyramid& dh, const HeightPyramid& pyr, ChangeLevels& out) {
     if (dh.levels.empty() || dh.nx != pyr.nx || dh.ny != pyr.ny)
         throw InputError("change levels: the height change and the pyramid differ in size");
-    const HeightPyramid& b = out.bound;
-    const bool same = out.valid && b.nx == pyr.nx && b.ny == pyr.ny && b.subsample == pyr.subsample &&
-                      b.cellSize == pyr.cellSize && b.settings == pyr.settings;
+    const bool same = changeLevelsFit(out, pyr);
     const ConstGridView input = dh.levels[0].cview();
     const CellBox nonZero = changedCells(dh);
     out.largest = maxChangeAll(dh);

@@ -81,6 +81,10 @@ struct ChangeLevels {
 /// Throws InputError when the sizes of dh and pyr differ.
 void buildChangeLevels(const MaxChangePyramid& dh, const HeightPyramid& pyr, ChangeLevels& out);
 
+/// Whether `levels` holds a |dh| pyramid built for pyr's grid and settings
+/// (a build for pyr then redoes only the cells its change reaches).
+bool changeLevelsFit(const ChangeLevels& levels, const HeightPyramid& pyr);
+
 /// Per receiver and azimuth phi_j (radians), a bound on |change| of its
 /// maximum blocking slope's samples along phi_j (metres per metre; the
 /// maximum's own rule multiplies it by blockingMaxLipschitz), azimuth-major:

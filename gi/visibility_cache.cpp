@@ -17,11 +17,8 @@ namespace {
 // run, they took their memory then, and faulting its pages in made that
 // one frame cost about a full frame's time.
 void sizeChangeScratch(const HeightPyramid& pyr, ConstGridView heights, VisibilityCache& cache) {
-    const HeightPyramid& b = cache.receiverLevels.bound;
-    const bool sized = cache.change.nx == heights.nx && cache.change.ny == heights.ny && cache.receiverLevels.valid &&
-                       b.nx == pyr.nx && b.ny == pyr.ny && b.subsample == pyr.subsample && b.cellSize == pyr.cellSize &&
-                       b.settings == pyr.settings;
-    if (sized) return;
+    if (cache.change.nx == heights.nx && cache.change.ny == heights.ny && changeLevelsFit(cache.receiverLevels, pyr))
+        return;
     buildMaxChangePyramid(heights, heights, cache.change, CellBox{});
     buildChangeLevels(cache.change, pyr, cache.receiverLevels);
     const std::size_t planeR = static_cast<std::size_t>(pyr.nxr) * pyr.nyr;
