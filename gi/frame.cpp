@@ -389,15 +389,6 @@ void exactAmbient(ConstGridView heights, float cellSize, const GiSettings& setti
     sh.skyParts = withSkyParts;
 }
 
-// The box of the texels of `box` whose light differs from `before` (copies
-// of that box's light, taken before the shading redid it); empty when none.
-CellBox changedLight(const std::array<Grid, 3>& before, const std::array<Grid, 3>& now, CellBox box) {
-    CellBox out = CellBox::none();
-    for (int c = 0; c < 3; ++c)
-        out = out.joined(differingCells(before[c].cview(), subView(now[c].cview(), box)).shifted(box.x0, box.y0));
-    return out;
-}
-
 // Direct light at every texel: the lighting's SH product matrices once per
 // frame, then the shading (Section 7); key lights through the SH clamped
 // cosine, or with the exact cosine (GiSettings::keyLightExactCosine). With
@@ -423,9 +414,10 @@ void directShading(const GiLighting& lighting, const GiSettings& settings, const
     // The indirect light re-reads the texels whose light changed, which can
     // be far fewer than those redone (a key light's tile recomputed to the
     // same visible fractions): its pyramids and bounds cost by their box.
-    const CellBox redone = runs ? boundingBox(*runs) : CellBox{};
+    // The runs' texels are copied before and compared after, which costs
+    // their count, not their bounding box (changes at several places).
     if (runs)
-        for (int c = 0; c < 3; ++c) copyGrid(subView(st.shade.rgb[c].cview(), redone), st.shadeBefore[c]);
+        for (int c = 0; c < 3; ++c) copyRuns(st.shade.rgb[c].cview(), *runs, st.shadeBefore[c]);
     shadeTexels(st.gradX.cview(), st.gradY.cview(), settings.subsample, st.envVisibility, st.shadingLights.data(),
                 static_cast<int>(st.shadingLights.size()), albedo, settings.shading, st.shade, shAmbient, runs);
     if (sky.exactSky)
@@ -437,7 +429,9 @@ void directShading(const GiLighting& lighting, const GiSettings& settings, const
         for (std::size_t k = 0; k < nKeys; ++k)
             addKeyLightExactCosine(lighting.keys[k], st.keyVisibility[k], settings.subsample, st.gradX.cview(),
                                    st.gradY.cview(), albedo, st.shade.rgb, runs);
-    st.directChanged = st.directChanged.joined(runs ? changedLight(st.shadeBefore, st.shade.rgb, redone) : CellBox{});
+    if (!runs) st.directChanged = CellBox{};  // every texel
+    for (int c = 0; c < 3 && runs; ++c)
+        st.directChanged = st.directChanged.joined(differingInRuns(st.shadeBefore[c], st.shade.rgb[c].cview(), *runs));
 }
 
 // Which receivers' visibility the frame recomputes, planned before any stage

@@ -67,11 +67,11 @@ struct GiState {
     bool directStale = false, indirectStale = false;
     TexelRuns shadingRuns;  // this frame's texels whose direct light was redone (gi/shading_tiles.h)
     CellBox directChanged;  // texels of shade.rgb that may differ from what the indirect light last read (all)
-    std::array<Grid, 3> shadeBefore;  // scratch: the light of the texels a restricted shading redoes, before it
-    TexelRuns ambientRuns;            // of those, the texels whose exact ambient was redone
-    KeyVisibilityBefore keyBefore;    // scratch: the key tiles' visibility before this frame's scan
-    std::vector<ReceiverRun> keyReceiversChanged;  // the key receivers whose visibility this frame's scan changed
-    std::vector<TexelRect> texelRects;             // their scratch
+    std::array<std::vector<float>, 3> shadeBefore;  // scratch: the redone texels' light before the shading (copyRuns)
+    TexelRuns ambientRuns;                          // of those, the texels whose exact ambient was redone
+    KeyVisibilityBefore keyBefore;                  // scratch: the key tiles' visibility before this frame's scan
+    std::vector<ReceiverRun> keyReceiversChanged;   // the key receivers whose visibility this frame's scan changed
+    std::vector<TexelRect> texelRects;              // their scratch
     double receiversRecomputed = 0.0;   // fraction of the receivers whose environment V the last frame recomputed
     int keyVisibilitiesRecomputed = 0;  // key lights whose V the last frame recomputed
     int framesSinceRefresh = 0;         // incremental frames since the last full one (GiSettings::refreshEvery)

@@ -119,6 +119,31 @@ CellBox boundingBox(const TexelRuns& runs) {
     return box;
 }
 
+void copyRuns(ConstGridView grid, const TexelRuns& runs, std::vector<float>& out) {
+    out.resize(static_cast<std::size_t>(texelCount(runs)));
+    float* to = out.data();
+    for (int y = 0; y < runs.ny; ++y)
+        for (const ColumnSpan& r : runs.ofRow(y)) to = std::copy(grid.row(y) + r.x0, grid.row(y) + r.x1, to);
+}
+
+CellBox differingInRuns(const std::vector<float>& before, ConstGridView grid, const TexelRuns& runs) {
+    if (before.size() != static_cast<std::size_t>(texelCount(runs)))
+        throw InputError("differingInRuns: the copy is not of these runs");
+    CellBox box = CellBox::none();
+    const float* was = before.data();
+    for (int y = 0; y < runs.ny; ++y)
+        for (const ColumnSpan& r : runs.ofRow(y)) {
+            const float* now = grid.row(y);
+            const auto same = [&](int x) { return std::memcmp(now + x, was + (x - r.x0), sizeof(float)) == 0; };
+            int first = r.x0, last = r.x1;
+            while (first < last && same(first)) ++first;
+            while (last > first && same(last - 1)) --last;
+            if (first < last) box = box.joined({first, y, last, y + 1});
+            was += r.x1 - r.x0;
+        }
+    return box;
+}
+
 void texelRunsOfRects(std::span<const TexelRect> rects, int nx, int ny, TexelRuns& out) {
     out.ny = ny;
     out.first.assign(static_cast<std::size_t>(ny) + 1, 0);

@@ -58,6 +58,16 @@ void texelRunsOfRects(std::span<const TexelRect> rects, int nx, int ny, TexelRun
 /// Texels in the runs.
 long long texelCount(const TexelRuns& runs);
 
+/// The values of `grid` at the runs' texels, run after run, into out (for
+/// differingInRuns after a restricted pass).
+void copyRuns(ConstGridView grid, const TexelRuns& runs, std::vector<float>& out);
+
+/// The smallest box of the runs' texels where `grid` differs bit for bit
+/// from `before` (copyRuns of the same runs); empty when none does. A pass
+/// restricted to the runs costs this by its texels, not by their bounding
+/// box (changes at several places far apart).
+CellBox differingInRuns(const std::vector<float>& before, ConstGridView grid, const TexelRuns& runs);
+
 /// The blocks of [0, nBlocks) holding a row with a run, block b being the
 /// rows rowsOf(b) (a RowSpan), in order, into out (every block with a row
 /// when `runs` is null): a pass over fixed row blocks hands out only these

@@ -140,6 +140,34 @@ TEST_CASE("gi.shading_tiles: the runs of rectangles are merged per row and cut t
     CHECK(boundingBox(r).empty());
 }
 
+TEST_CASE(
+    "gi.shading_tiles: a copy of the runs finds the box of the texels that changed in them, whatever lies between") {
+    // two runs far apart: the changes inside them, not their bounding box
+    TexelRuns r;
+    texelRunsOfRects(std::vector<TexelRect>{{1, 1, 4, 3}, {20, 6, 23, 8}}, 25, 10, r);
+    Grid g(25, 10);
+    for (std::size_t i = 0; i < g.v.size(); ++i) g.v[i] = static_cast<float>(i);
+    std::vector<float> before;
+    copyRuns(g.cview(), r, before);
+    CHECK(before.size() == static_cast<std::size_t>(texelCount(r)));
+    CHECK(before.front() == g(1, 1));
+    CHECK(before.back() == g(22, 7));
+    // unchanged, and changed outside the runs only: nothing found
+    CHECK(differingInRuns(before, g.cview(), r).empty());
+    g(10, 5) = -1.0f;
+    CHECK(differingInRuns(before, g.cview(), r).empty());
+    // one texel in each run: the box from one to the other
+    g(2, 2) = 0.5f;
+    const CellBox one = differingInRuns(before, g.cview(), r);
+    CHECK((one.x0 == 2 && one.y0 == 2 && one.x1 == 3 && one.y1 == 3));
+    g(21, 6) = 0.25f;
+    const CellBox both = differingInRuns(before, g.cview(), r);
+    CHECK((both.x0 == 2 && both.y0 == 2 && both.x1 == 22 && both.y1 == 7));
+    // a copy of other runs is refused
+    texelRunsOfRects(std::vector<TexelRect>{{1, 1, 4, 3}}, 25, 10, r);
+    CHECK_THROWS_AS(differingInRuns(before, g.cview(), r), InputError);
+}
+
 namespace {
 
 // The direct light of the state's current inputs (cached or new V, the
