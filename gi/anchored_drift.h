@@ -27,6 +27,21 @@
 // geometry moved) does not move the anchor. The choice depends on the
 // bounds alone, so it is deterministic; tolerance 0 recomputes every tile
 // whose drift is not 0, so the results are those of full recomputes.
+//
+// A second path, where the caller takes it: the drift S_t from the last
+// planned frame's inputs (sinceInputs) plus this frame's bound L_t from
+// those inputs to its own. A change that stays (a pit dropped and left)
+// counts twice from the anchor in the tiles it recomputed (A_t = E_t, and
+// E_t again), so without it each new change elsewhere would move the
+// anchor, and every move adds each far change's small bound to every kept
+// tile (the plain sum); with it such a tile keeps its result while the
+// changes since the last frame stay small near it, the drift being the
+// smaller of A_t + E_t and S_t + L_t, and a tile that path could have kept
+// (L_t taken) does not move the anchor. The anchor then moves when a tile
+// without it (S_t past the tolerance: the changes since it was recomputed
+// added up) is recomputed while moving away. A terrain that moves
+// everywhere (waves) then moves its anchor less often and leans on the sum
+// of the per-frame bounds (README, "A change that stays").
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -60,16 +75,25 @@ struct AnchorVotes {
 };
 
 /// Marks dirty[t] (1: recompute) where forced[t] (empty: none) or where the
-/// drift (A_t + excursion[t]) x scale exceeds `tolerance`, and adds the
-/// tiles' votes.
-void markAnchoredDrift(std::span<const float> excursion, std::span<const std::uint8_t> forced, float scale,
-                       float tolerance, const AnchoredDrift& drift, std::span<std::uint8_t> dirty, AnchorVotes& votes);
+/// drift times `scale` exceeds `tolerance`, and adds the tiles' votes. The
+/// drift is A_t + excursion[t], or with `sinceLast` (empty: not known) the smaller of
+/// that and S_t + sinceLast[t]: the drift from the last planned frame's
+/// inputs (sinceInputs) plus this frame's bound from those inputs to its own
+/// (infinite where not taken). Both bound how far the tile's result is
+/// from this frame's; the second keeps a tile recomputed since the anchor
+/// for a change that stays (a pit dropped and left) while other changes
+/// come, where measured from the anchor the change it was recomputed for
+/// counts twice (A_t and E_t) and the anchor would move every frame.
+void markAnchoredDrift(std::span<const float> excursion, std::span<const float> sinceLast,
+                       std::span<const std::uint8_t> forced, float scale, float tolerance, const AnchoredDrift& drift,
+                       std::span<std::uint8_t> dirty, AnchorVotes& votes);
 
 /// After the marks: a recomputed tile's result is this frame's (A_t = E_t,
-/// or 0 when the anchor moves here); a kept tile's drift from a new anchor
-/// is A_t + E_t.
-void advanceAnchoredDrift(std::span<const float> excursion, std::span<const std::uint8_t> dirty, bool reanchor,
-                          AnchoredDrift& drift);
+/// or 0 when the anchor moves here); a kept tile's drift from this frame's
+/// inputs is the smaller of A_t + E_t and S_t + sinceLast[t] (the first
+/// alone without sinceLast), and from a new anchor the same.
+void advanceAnchoredDrift(std::span<const float> excursion, std::span<const float> sinceLast,
+                          std::span<const std::uint8_t> dirty, bool reanchor, AnchoredDrift& drift);
 
 /// Both for a drift with an anchor of its own (scale 1). Returns whether the
 /// anchor moves to this frame's inputs: the caller then records them.

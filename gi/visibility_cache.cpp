@@ -20,6 +20,7 @@ void sizeChangeScratch(const HeightPyramid& pyr, ConstGridView heights, Visibili
     if (cache.change.nx == heights.nx && cache.change.ny == heights.ny && changeLevelsFit(cache.receiverLevels, pyr))
         return;
     buildMaxChangePyramid(heights, heights, cache.change, CellBox{});
+    buildMaxChangePyramid(heights, heights, cache.lastChange, CellBox{});
     buildChangeLevels(cache.change, pyr, cache.receiverLevels);
     const std::size_t planeR = static_cast<std::size_t>(pyr.nxr) * pyr.nyr;
     cache.receiverBound.resize(planeR);
@@ -132,6 +133,21 @@ void geometryBoundPerTile(std::span<const float> slopeBound, std::span<const flo
 
 namespace {
 
+// Per visibility tile, the environment's bound from its per-azimuth slope
+// bounds and gradient bound, and the geometry's over the indirect scan's
+// own azimuths where those are every geometryStride-th of the
+// environment's (each receiver's slope bounds along them are at most the
+// tile's), else `coarse` (one slope bound over every direction).
+void environmentAndGeometryBounds(const std::vector<float>& azimuthBound, const std::vector<float>& gradBound,
+                                  const std::vector<float>& coarse, int azimuths, float lipschitz, int geometryStride,
+                                  std::vector<float>& scratch, std::vector<float>& env, std::vector<float>& geometry) {
+    environmentBoundPerTile(azimuthBound, gradBound, azimuths, lipschitz, scratch, env);
+    if (geometryStride > 0)
+        environmentBoundPerTile(azimuthBound, gradBound, azimuths, lipschitz, scratch, geometry, geometryStride);
+    else
+        geometry = coarse;
+}
+
 // Flags in cache.perAzimuth the visibility tiles with a cache tile whose
 // drift from the anchor (the environment's, and the geometry's when that is
 // taken per azimuth too), counted with the coarse bound (cache.coarseBound),
@@ -167,8 +183,14 @@ void keepCoarseBounds(VisibilityCache& cache) {
 struct Candidates {
     bool env = false, geometry = false;
     bool over(const VisibilityCache& cache, std::size_t t, float tolerance) const {
-        return (env && cache.drift.fromAnchor[t] + cache.envExcursion[t] > tolerance) ||
-               (geometry && cache.geometryDrift.fromAnchor[t] + cache.geometryExcursion[t] > tolerance);
+        return (env && driftOver(cache.drift, cache.envExcursion, cache.envSinceLast, t, tolerance)) ||
+               (geometry &&
+                driftOver(cache.geometryDrift, cache.geometryExcursion, cache.geometrySinceLast, t, tolerance));
+    }
+    // over the tolerance from the anchor, and from the last planned frame's inputs
+    static bool driftOver(const AnchoredDrift& d, const std::vector<float>& excursion,
+                          const std::vector<float>& sinceLast, std::size_t t, float tolerance) {
+        return d.fromAnchor[t] + excursion[t] > tolerance && d.sinceInputs[t] + sinceLast[t] > tolerance;
     }
 };
 
@@ -288,6 +310,127 @@ void refinePerReceiver(const HeightPyramid& pyr, const VisibilitySettings& vis, 
         }
 }
 
+// The drifts' second path (gi/anchored_drift.h), its tiles: the cache tiles
+// whose drift from the anchor passes the tolerance (their coarse or
+// visibility-tile bounds, before any walk) while their drift from the last
+// planned frame's heights does not, into cache.sinceLastTiles. False when
+// there are none.
+bool markSinceLastTiles(const std::vector<KeyLightRegion>& keys, float tolerance, VisibilityCache& cache) {
+    const std::size_t tiles = cache.tiles.dirty.size();
+    const float keyScale = keyShadePerFraction(keys);
+    const auto open = [&](const AnchoredDrift& d, const std::vector<float>& e, float scale, std::size_t t) {
+        return (d.fromAnchor[t] + e[t]) * scale > tolerance && d.sinceInputs[t] * scale <= tolerance;
+    };
+    cache.sinceLastTiles.assign(tiles, 0);
+    bool any = false;
+    for (std::size_t t = 0; t < tiles; ++t) {
+        const bool o = open(cache.drift, cache.envExcursion, 1.0f, t) ||
+                       open(cache.keyDrift, cache.keyExcursion, keyScale, t) ||
+                       open(cache.geometryDrift, cache.geometryExcursion, 1.0f, t);
+        cache.sinceLastTiles[t] = o ? 1 : 0;
+        any = any || o;
+    }
+    return any;
+}
+
+// The second path's environment and geometry bounds of its tiles, from
+// cache.lastChange: the coarse one (a slope bound over every direction per
+// visibility tile, which holds along any azimuths), and per azimuth where
+// the coarse one would take a tile's drift past kCoarseBoundShare of the
+// tolerance (as the anchor's path does: the drift from the last frame's
+// heights adds these bounds up frame after frame).
+void environmentSinceLast(const HeightPyramid& pyr, const VisibilitySettings& vis, float lipschitz, float tolerance,
+                          int geometryStride, VisibilityCache& cache) {
+    const ReceiverTiles& ct = cache.tiles;
+    boundSlopeChange(cache.lastChange, pyr, kVisibilityTile, cache.lastSlope);
+    boundGradientChange(cache.lastChange, pyr, kVisibilityTile, cache.lastGrad);
+    geometryBoundPerTile(cache.lastSlope, cache.lastGrad, lipschitz, cache.lastCoarse);
+    const float share = kCoarseBoundShare * tolerance;
+    cache.sinceLastVisibilityTiles.assign(cache.lastCoarse.size(), 0);
+    const auto forEachOpen = [&](auto&& f) {
+        for (int ty = 0; ty < ct.tilesY; ++ty)
+            for (int tx = 0; tx < ct.tilesX; ++tx) {
+                const std::size_t t = static_cast<std::size_t>(ty) * ct.tilesX + tx;
+                if (cache.sinceLastTiles[t]) f(t, visibilityTileHolding(tx, ty, ct.nxr));
+            }
+    };
+    forEachOpen([&](std::size_t t, std::size_t v) {
+        const float coarse = cache.lastCoarse[v];
+        if (cache.drift.sinceInputs[t] + coarse > share || cache.geometryDrift.sinceInputs[t] + coarse > share)
+            cache.sinceLastVisibilityTiles[v] = 1;
+    });
+    boundSlopeChangePerAzimuth(cache.lastChange, pyr, kVisibilityTile, vis.azimuths, cache.lastAzimuthBound,
+                               cache.sinceLastVisibilityTiles);
+    environmentAndGeometryBounds(cache.lastAzimuthBound, cache.lastGrad, cache.lastCoarse, vis.azimuths, lipschitz,
+                                 geometryStride, cache.tileAzimuths, cache.lastEnv, cache.lastGeometry);
+    forEachOpen([&](std::size_t t, std::size_t v) {
+        const bool perAzimuth = cache.sinceLastVisibilityTiles[v] != 0;
+        const float coarse = cache.lastCoarse[v];
+        cache.envSinceLast[t] = perAzimuth ? std::min(coarse, cache.lastEnv[v]) : coarse;
+        cache.geometrySinceLast[t] = perAzimuth ? std::min(coarse, cache.lastGeometry[v]) : coarse;
+    });
+}
+
+// The second path's key-light fractions of its tiles, from
+// cache.lastChange: the largest over the lights, each from its visibility
+// tile's coarse slope bound (cache.lastSlope) where that keeps the tile's
+// key drift within kCoarseBoundShare of the tolerance, else from the slope bound over the
+// light's azimuths over the cache tile itself.
+void keySinceLast(const HeightPyramid& pyr, const std::vector<KeyLightRegion>& keys, float lipschitz, float tolerance,
+                  VisibilityCache& cache) {
+    const std::size_t tiles = cache.sinceLastTiles.size();
+    const float inf = std::numeric_limits<float>::infinity();
+    const float scale = keyShadePerFraction(keys);
+    boundGradientChange(cache.lastChange, pyr, kCacheTile, cache.lastCacheGrad);
+    onCacheTiles(cache.lastSlope, cache.tiles, cache.cacheSlope);
+    const auto fraction = [&](const KeyLightRegion& k, float slope, std::size_t t) {
+        const float f = keyLightFractionBound(lipschitz * slope, cache.lastCacheGrad[t], k.sinLow, k.sinHigh);
+        return !k.exactCosine && f > 0.0f ? inf : f;
+    };
+    for (std::size_t t = 0; t < tiles; ++t)
+        if (cache.sinceLastTiles[t]) cache.keySinceLast[t] = 0.0f;
+    cache.overRange.resize(tiles);
+    for (const KeyLightRegion& k : keys) {
+        for (std::size_t t = 0; t < tiles; ++t)
+            cache.overRange[t] = cache.sinceLastTiles[t] &&
+                                 (cache.keyDrift.sinceInputs[t] + fraction(k, cache.cacheSlope[t], t)) * scale >
+                                     kCoarseBoundShare * tolerance;
+        boundSlopeChangeOverRange(cache.lastChange, pyr, kCacheTile, k.phi0, k.phi1, cache.rangeBound, cache.overRange);
+        for (std::size_t t = 0; t < tiles; ++t) {
+            if (!cache.sinceLastTiles[t]) continue;
+            const float slope = cache.overRange[t] ? cache.rangeBound[t] : cache.cacheSlope[t];
+            cache.keySinceLast[t] = std::max(cache.keySinceLast[t], fraction(k, slope, t));
+        }
+    }
+}
+
+// The drifts' second path (gi/anchored_drift.h): per cache tile, the bounds
+// of the change from the last planned frame's heights `before` to `after`
+// (cache.lastChange, over the cells sinceBefore holds) into envSinceLast,
+// keySinceLast and geometrySinceLast, for the tiles markSinceLastTiles
+// marks; infinite elsewhere. Taken as the anchor's are, without receivers'
+// walks: a change since the last frame lies at a new place, mostly far
+// from the tiles a change that stayed recomputed. `differing` holds every
+// cell where `after` differs from the anchor's heights.
+void boundSinceLastFrame(ConstGridView before, ConstGridView after, const HeightPyramid& pyr,
+                         const VisibilitySettings& vis, const std::vector<KeyLightRegion>& keys, float lipschitz,
+                         float tolerance, int geometryStride, CellBox sinceBefore, CellBox differing,
+                         VisibilityCache& cache) {
+    const std::size_t tiles = cache.tiles.dirty.size();
+    const float inf = std::numeric_limits<float>::infinity();
+    cache.envSinceLast.assign(tiles, inf);
+    cache.keySinceLast.assign(tiles, inf);
+    cache.geometrySinceLast.assign(tiles, inf);
+    // none when `after` is back at the anchor's heights (a change undone: the
+    // anchor's path says all), or `before` was at them (the paths are one)
+    if (!markSinceLastTiles(keys, tolerance, cache) || differing.empty() ||
+        differingCellsIn(cache.anchorHeights.cview(), before, cache.anchorDiffers).empty())
+        return;
+    buildMaxChangePyramid(before, after, cache.lastChange, sinceBefore);
+    environmentSinceLast(pyr, vis, lipschitz, tolerance, geometryStride, cache);
+    keySinceLast(pyr, keys, lipschitz, tolerance, cache);
+}
+
 }  // namespace
 
 void planVisibilityTiles(ConstGridView before, ConstGridView after, const HeightPyramid& pyr,
@@ -326,31 +469,27 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
                                        cache.perAzimuth);
         },
         [&] { boundKeyFractions(pyr, keys, lipschitz, tolerance, cache); });
-    environmentBoundPerTile(cache.azimuthBound, cache.gradBound, vis.azimuths, lipschitz, cache.tileAzimuths,
-                            cache.envBound);
-    // the geometry's over the indirect scan's own azimuths where known (each
-    // receiver's slope bounds along them are at most the tile's), else one
-    // slope bound over every direction
-    if (geometryStride > 0)
-        environmentBoundPerTile(cache.azimuthBound, cache.gradBound, vis.azimuths, lipschitz, cache.tileAzimuths,
-                                cache.geometryBound, geometryStride);
-    else
-        cache.geometryBound = cache.coarseBound;
+    environmentAndGeometryBounds(cache.azimuthBound, cache.gradBound, cache.coarseBound, vis.azimuths, lipschitz,
+                                 geometryStride, cache.tileAzimuths, cache.envBound, cache.geometryBound);
     keepCoarseBounds(cache);
     onCacheTiles(cache.envBound, cache.tiles, cache.envExcursion);
     onCacheTiles(cache.geometryBound, cache.tiles, cache.geometryExcursion);
+    boundSinceLastFrame(before, after, pyr, vis, keys, lipschitz, tolerance, geometryStride, sinceBefore, differing,
+                        cache);
     refinePerReceiver(pyr, vis, lipschitz, tolerance, geometryStride, cache);
     // one anchor for the three drifts: they vote together on moving it
     AnchorVotes votes;
-    markAnchoredDrift(cache.envExcursion, {}, 1.0f, tolerance, cache.drift, cache.tiles.dirty, votes);
-    markAnchoredDrift(cache.keyExcursion, {}, keyShadePerFraction(keys), tolerance, cache.keyDrift,
-                      cache.keyTiles.dirty, votes);
-    markAnchoredDrift(cache.geometryExcursion, {}, 1.0f, tolerance, cache.geometryDrift, cache.geometryTiles.dirty,
+    markAnchoredDrift(cache.envExcursion, cache.envSinceLast, {}, 1.0f, tolerance, cache.drift, cache.tiles.dirty,
                       votes);
+    markAnchoredDrift(cache.keyExcursion, cache.keySinceLast, {}, keyShadePerFraction(keys), tolerance, cache.keyDrift,
+                      cache.keyTiles.dirty, votes);
+    markAnchoredDrift(cache.geometryExcursion, cache.geometrySinceLast, {}, 1.0f, tolerance, cache.geometryDrift,
+                      cache.geometryTiles.dirty, votes);
     const bool reanchor = votes.reanchor();
-    advanceAnchoredDrift(cache.envExcursion, cache.tiles.dirty, reanchor, cache.drift);
-    advanceAnchoredDrift(cache.keyExcursion, cache.keyTiles.dirty, reanchor, cache.keyDrift);
-    advanceAnchoredDrift(cache.geometryExcursion, cache.geometryTiles.dirty, reanchor, cache.geometryDrift);
+    advanceAnchoredDrift(cache.envExcursion, cache.envSinceLast, cache.tiles.dirty, reanchor, cache.drift);
+    advanceAnchoredDrift(cache.keyExcursion, cache.keySinceLast, cache.keyTiles.dirty, reanchor, cache.keyDrift);
+    advanceAnchoredDrift(cache.geometryExcursion, cache.geometrySinceLast, cache.geometryTiles.dirty, reanchor,
+                         cache.geometryDrift);
     // the anchor becomes `after`, which differs from `before` within
     // sinceBefore; else it differs from `after` (the next plan's `before`,
     // if this frame is recorded) within `differing`, and from `before`

@@ -14,7 +14,11 @@
 // every tile whose inputs may have changed at all, which reproduces a full
 // recompute bit for bit. The drift bounds the accumulated change (triangle
 // inequality), so slow changes over many frames are caught too, and a
-// change that comes and goes is not counted again each time.
+// change that comes and goes is not counted again each time. A tile the
+// anchor's drift would recompute is kept when its drift from the last
+// frame's heights, plus the bound of the change since them, stays within
+// the tolerance (the second path): a change that stays is then paid for
+// once.
 //
 // Key lights sample their own azimuths, between the environment's, within
 // their region of the sky: their tiles (keyTiles) keep a drift of their own
@@ -125,12 +129,21 @@ struct VisibilityCache {
     std::vector<float> receiverBound;     // per receiver: the ambient-map bound (refined tiles only)
     std::vector<float> receiverGeometry;  // the same along the indirect scan's azimuths
     ReceiverTiles refined;                // scratch: the cache tiles refined this frame
-    AnchoredDrift drift, keyDrift;        // per cache tile: ambient-map (key: visible-fraction) change
-    AnchoredDrift geometryDrift;          // per cache tile: the same along the indirect light's azimuths
-    ReceiverTiles tiles;                  // this frame's cache tiles to recompute (environment)
-    ReceiverTiles keyTiles;               // the same for the key lights
-    ReceiverTiles geometryTiles;          // cache tiles whose geometry moved beyond the tolerance
-    PlanSkips skips;                      // frames that recompute everything unplanned
+    // the drifts' second path (gi/anchored_drift.h): |dh| from the last
+    // planned frame's heights to this frame's, and per cache tile the
+    // bounds of that change (infinite where not taken: the tiles that the
+    // anchor's bounds keep, or whose drift from those heights is past the
+    // tolerance already); per visibility tile, scratch
+    MaxChangePyramid lastChange;
+    std::vector<float> envSinceLast, keySinceLast, geometrySinceLast;
+    std::vector<std::uint8_t> sinceLastTiles, sinceLastVisibilityTiles;
+    std::vector<float> lastSlope, lastGrad, lastCoarse, lastCacheGrad, lastAzimuthBound, lastEnv, lastGeometry;
+    AnchoredDrift drift, keyDrift;  // per cache tile: ambient-map (key: visible-fraction) change
+    AnchoredDrift geometryDrift;    // per cache tile: the same along the indirect light's azimuths
+    ReceiverTiles tiles;            // this frame's cache tiles to recompute (environment)
+    ReceiverTiles keyTiles;         // the same for the key lights
+    ReceiverTiles geometryTiles;    // cache tiles whose geometry moved beyond the tolerance
+    PlanSkips skips;                // frames that recompute everything unplanned
 };
 
 /// A frame whose heights did not change but whose lights did: marks the key
