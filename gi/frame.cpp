@@ -429,8 +429,11 @@ void directShading(const GiLighting& lighting, const GiSettings& settings, const
         for (std::size_t k = 0; k < nKeys; ++k)
             addKeyLightExactCosine(lighting.keys[k], st.keyVisibility[k], settings.subsample, st.gradX.cview(),
                                    st.gradY.cview(), albedo, st.shade.rgb, runs);
-    if (!runs) st.directChanged = CellBox{};  // every texel
-    for (int c = 0; c < 3 && runs; ++c)
+    if (!runs) {
+        st.directChanged = CellBox{};  // every texel
+        return;
+    }
+    for (int c = 0; c < 3; ++c)
         st.directChanged = st.directChanged.joined(differingInRuns(st.shadeBefore[c], st.shade.rgb[c].cview(), *runs));
 }
 

@@ -39,6 +39,7 @@ void resetVisibilityCache(const HeightPyramid& pyr, ConstGridView heights, Visib
     cache.geometryDrift.reset(cache.tiles.dirty.size());
     copyGrid(heights, cache.anchorHeights);
     cache.anchorDiffers = CellBox{};  // the next plan compares every cell once
+    cache.anchorIsLastPlan = true;
 }
 
 void forgetEnvironmentDrift(VisibilityCache& cache) { cache.drift.recomputedAll(); }
@@ -65,35 +66,41 @@ void onCacheTiles(const std::vector<float>& perTile, const ReceiverTiles& tiles,
 
 // Per cache tile, the largest over the key lights of the bound on each
 // one's visible fraction (keyLightFractionBound; an SH-shaded light:
-// infinite where its slopes may have moved at all), into keyExcursion. 0
-// without key lights. Each light's comes from its visibility tile's coarse
-// slope bound (cache.slopeBound) where that keeps the tile's key drift
-// within kCoarseBoundShare of the tolerance, else from the bound over the
-// light's own azimuths, taken over the cache tile itself, not its
-// visibility tile: a light's few azimuths see a change along a narrow
-// strip, which a larger tile's reach widens (the 51² pit's key tiles: 20
-// instead of 36).
+// infinite where its slopes may have moved at all) under the change
+// `change`, into out: for the tiles `only` flags (null: every tile; the
+// others keep their value), 0 without key lights. Each light's comes from
+// its visibility tile's coarse slope bound (slopeBound) where that keeps the
+// tile's key drift (driftSoFar plus it) within kCoarseBoundShare of the
+// tolerance, else from the bound over the light's own azimuths, taken over
+// the cache tile itself, not its visibility tile: a light's few azimuths see
+// a change along a narrow strip, which a larger tile's reach widens (the 51²
+// pit's key tiles: 20 instead of 36). gradBound: per cache tile.
 void boundKeyFractions(const HeightPyramid& pyr, const std::vector<KeyLightRegion>& keys, float lipschitz,
-                       float tolerance, VisibilityCache& cache) {
-    const std::size_t tiles = cache.cacheGradBound.size();
-    cache.keyExcursion.assign(tiles, 0.0f);
+                       float tolerance, const MaxChangePyramid& change, const std::vector<float>& slopeBound,
+                       const std::vector<float>& gradBound, const std::vector<float>& driftSoFar,
+                       const std::vector<std::uint8_t>* only, VisibilityCache& cache, std::vector<float>& out) {
+    const std::size_t tiles = gradBound.size();
+    const auto taken = [&](std::size_t t) { return !only || (*only)[t] != 0; };
+    out.resize(tiles);
+    for (std::size_t t = 0; t < tiles; ++t)
+        if (taken(t)) out[t] = 0.0f;
     if (keys.empty()) return;
     const float shade = keyShadePerFraction(keys);
     const auto fraction = [&](const KeyLightRegion& k, float slope, std::size_t t) {
-        const float f = keyLightFractionBound(lipschitz * slope, cache.cacheGradBound[t], k.sinLow, k.sinHigh);
+        const float f = keyLightFractionBound(lipschitz * slope, gradBound[t], k.sinLow, k.sinHigh);
         return !k.exactCosine && f > 0.0f ? std::numeric_limits<float>::infinity() : f;
     };
-    onCacheTiles(cache.slopeBound, cache.keyTiles, cache.cacheSlope);
+    onCacheTiles(slopeBound, cache.keyTiles, cache.cacheSlope);
     cache.overRange.resize(tiles);
     for (const KeyLightRegion& k : keys) {
         for (std::size_t t = 0; t < tiles; ++t)
-            cache.overRange[t] = (cache.keyDrift.fromAnchor[t] + fraction(k, cache.cacheSlope[t], t)) * shade >
-                                 kCoarseBoundShare * tolerance;
-        boundSlopeChangeOverRange(cache.change, pyr, kCacheTile, k.phi0, k.phi1, cache.rangeBound, cache.overRange);
+            cache.overRange[t] = taken(t) && (driftSoFar[t] + fraction(k, cache.cacheSlope[t], t)) * shade >
+                                                 kCoarseBoundShare * tolerance;
+        boundSlopeChangeOverRange(change, pyr, kCacheTile, k.phi0, k.phi1, cache.rangeBound, cache.overRange);
         for (std::size_t t = 0; t < tiles; ++t) {
+            if (!taken(t)) continue;
             const float slope = cache.overRange[t] ? cache.rangeBound[t] : cache.cacheSlope[t];
-            const float f = fraction(k, slope, t);
-            cache.keyExcursion[t] = std::max(cache.keyExcursion[t], f);
+            out[t] = std::max(out[t], fraction(k, slope, t));
         }
     }
 }
@@ -148,33 +155,36 @@ void environmentAndGeometryBounds(const std::vector<float>& azimuthBound, const 
         geometry = coarse;
 }
 
-// Flags in cache.perAzimuth the visibility tiles with a cache tile whose
-// drift from the anchor (the environment's, and the geometry's when that is
-// taken per azimuth too), counted with the coarse bound (cache.coarseBound),
-// would pass kCoarseBoundShare of the tolerance.
-void markPerAzimuthTiles(float tolerance, bool geometryPerAzimuth, VisibilityCache& cache) {
-    const ReceiverTiles& tiles = cache.tiles;
+// Flags in `perAzimuth` the visibility tiles with a cache tile (of those
+// `only` flags; null: every one) whose drift so far (the environment's,
+// and the geometry's when that is taken per azimuth too: non-null) plus its
+// visibility tile's coarse bound would pass kCoarseBoundShare of the
+// tolerance.
+void markPerAzimuthTiles(const ReceiverTiles& tiles, const std::vector<float>& coarse,
+                         const std::vector<float>& envDrift, const std::vector<float>* geometryDrift,
+                         const std::vector<std::uint8_t>* only, float tolerance,
+                         std::vector<std::uint8_t>& perAzimuth) {
     const float share = kCoarseBoundShare * tolerance;
-    cache.perAzimuth.assign(cache.coarseBound.size(), 0);
+    perAzimuth.assign(coarse.size(), 0);
     for (int ty = 0; ty < tiles.tilesY; ++ty)
         for (int tx = 0; tx < tiles.tilesX; ++tx) {
             const std::size_t t = static_cast<std::size_t>(ty) * tiles.tilesX + tx;
+            if (only && !(*only)[t]) continue;
             const std::size_t v = visibilityTileHolding(tx, ty, tiles.nxr);
-            const float coarse = cache.coarseBound[v];
-            if (cache.drift.fromAnchor[t] + coarse > share ||
-                (geometryPerAzimuth && cache.geometryDrift.fromAnchor[t] + coarse > share))
-                cache.perAzimuth[v] = 1;
+            if (envDrift[t] + coarse[v] > share || (geometryDrift && (*geometryDrift)[t] + coarse[v] > share))
+                perAzimuth[v] = 1;
         }
 }
 
 // The visibility tiles not taken per azimuth keep their coarse bound as
 // their environment's and geometry's bounds (its slope bound holds along
 // every azimuth).
-void keepCoarseBounds(VisibilityCache& cache) {
-    for (std::size_t v = 0; v < cache.perAzimuth.size(); ++v)
-        if (!cache.perAzimuth[v]) {
-            cache.envBound[v] = cache.coarseBound[v];
-            cache.geometryBound[v] = cache.coarseBound[v];
+void keepCoarseBounds(const std::vector<std::uint8_t>& perAzimuth, const std::vector<float>& coarse,
+                      std::vector<float>& env, std::vector<float>& geometry) {
+    for (std::size_t v = 0; v < perAzimuth.size(); ++v)
+        if (!perAzimuth[v]) {
+            env[v] = coarse[v];
+            geometry[v] = coarse[v];
         }
 }
 
@@ -341,67 +351,26 @@ bool markSinceLastTiles(const std::vector<KeyLightRegion>& keys, float tolerance
 // heights adds these bounds up frame after frame).
 void environmentSinceLast(const HeightPyramid& pyr, const VisibilitySettings& vis, float lipschitz, float tolerance,
                           int geometryStride, VisibilityCache& cache) {
-    const ReceiverTiles& ct = cache.tiles;
     boundSlopeChange(cache.lastChange, pyr, kVisibilityTile, cache.lastSlope);
     boundGradientChange(cache.lastChange, pyr, kVisibilityTile, cache.lastGrad);
     geometryBoundPerTile(cache.lastSlope, cache.lastGrad, lipschitz, cache.lastCoarse);
-    const float share = kCoarseBoundShare * tolerance;
-    cache.sinceLastVisibilityTiles.assign(cache.lastCoarse.size(), 0);
-    const auto forEachOpen = [&](auto&& f) {
-        for (int ty = 0; ty < ct.tilesY; ++ty)
-            for (int tx = 0; tx < ct.tilesX; ++tx) {
-                const std::size_t t = static_cast<std::size_t>(ty) * ct.tilesX + tx;
-                if (cache.sinceLastTiles[t]) f(t, visibilityTileHolding(tx, ty, ct.nxr));
-            }
-    };
-    forEachOpen([&](std::size_t t, std::size_t v) {
-        const float coarse = cache.lastCoarse[v];
-        if (cache.drift.sinceInputs[t] + coarse > share || cache.geometryDrift.sinceInputs[t] + coarse > share)
-            cache.sinceLastVisibilityTiles[v] = 1;
-    });
+    markPerAzimuthTiles(cache.tiles, cache.lastCoarse, cache.drift.sinceInputs,
+                        geometryStride > 0 ? &cache.geometryDrift.sinceInputs : nullptr, &cache.sinceLastTiles,
+                        tolerance, cache.sinceLastVisibilityTiles);
     boundSlopeChangePerAzimuth(cache.lastChange, pyr, kVisibilityTile, vis.azimuths, cache.lastAzimuthBound,
                                cache.sinceLastVisibilityTiles);
     environmentAndGeometryBounds(cache.lastAzimuthBound, cache.lastGrad, cache.lastCoarse, vis.azimuths, lipschitz,
                                  geometryStride, cache.tileAzimuths, cache.lastEnv, cache.lastGeometry);
-    forEachOpen([&](std::size_t t, std::size_t v) {
-        const bool perAzimuth = cache.sinceLastVisibilityTiles[v] != 0;
-        const float coarse = cache.lastCoarse[v];
-        cache.envSinceLast[t] = perAzimuth ? std::min(coarse, cache.lastEnv[v]) : coarse;
-        cache.geometrySinceLast[t] = perAzimuth ? std::min(coarse, cache.lastGeometry[v]) : coarse;
-    });
-}
-
-// The second path's key-light fractions of its tiles, from
-// cache.lastChange: the largest over the lights, each from its visibility
-// tile's coarse slope bound (cache.lastSlope) where that keeps the tile's
-// key drift within kCoarseBoundShare of the tolerance, else from the slope bound over the
-// light's azimuths over the cache tile itself.
-void keySinceLast(const HeightPyramid& pyr, const std::vector<KeyLightRegion>& keys, float lipschitz, float tolerance,
-                  VisibilityCache& cache) {
-    const std::size_t tiles = cache.sinceLastTiles.size();
-    const float inf = std::numeric_limits<float>::infinity();
-    const float scale = keyShadePerFraction(keys);
-    boundGradientChange(cache.lastChange, pyr, kCacheTile, cache.lastCacheGrad);
-    onCacheTiles(cache.lastSlope, cache.tiles, cache.cacheSlope);
-    const auto fraction = [&](const KeyLightRegion& k, float slope, std::size_t t) {
-        const float f = keyLightFractionBound(lipschitz * slope, cache.lastCacheGrad[t], k.sinLow, k.sinHigh);
-        return !k.exactCosine && f > 0.0f ? inf : f;
-    };
-    for (std::size_t t = 0; t < tiles; ++t)
-        if (cache.sinceLastTiles[t]) cache.keySinceLast[t] = 0.0f;
-    cache.overRange.resize(tiles);
-    for (const KeyLightRegion& k : keys) {
-        for (std::size_t t = 0; t < tiles; ++t)
-            cache.overRange[t] = cache.sinceLastTiles[t] &&
-                                 (cache.keyDrift.sinceInputs[t] + fraction(k, cache.cacheSlope[t], t)) * scale >
-                                     kCoarseBoundShare * tolerance;
-        boundSlopeChangeOverRange(cache.lastChange, pyr, kCacheTile, k.phi0, k.phi1, cache.rangeBound, cache.overRange);
-        for (std::size_t t = 0; t < tiles; ++t) {
+    keepCoarseBounds(cache.sinceLastVisibilityTiles, cache.lastCoarse, cache.lastEnv, cache.lastGeometry);
+    const ReceiverTiles& ct = cache.tiles;
+    for (int ty = 0; ty < ct.tilesY; ++ty)
+        for (int tx = 0; tx < ct.tilesX; ++tx) {
+            const std::size_t t = static_cast<std::size_t>(ty) * ct.tilesX + tx;
             if (!cache.sinceLastTiles[t]) continue;
-            const float slope = cache.overRange[t] ? cache.rangeBound[t] : cache.cacheSlope[t];
-            cache.keySinceLast[t] = std::max(cache.keySinceLast[t], fraction(k, slope, t));
+            const std::size_t v = visibilityTileHolding(tx, ty, ct.nxr);
+            cache.envSinceLast[t] = std::min(cache.lastCoarse[v], cache.lastEnv[v]);
+            cache.geometrySinceLast[t] = std::min(cache.lastCoarse[v], cache.lastGeometry[v]);
         }
-    }
 }
 
 // The drifts' second path (gi/anchored_drift.h): per cache tile, the bounds
@@ -422,13 +391,14 @@ void boundSinceLastFrame(ConstGridView before, ConstGridView after, const Height
     cache.keySinceLast.assign(tiles, inf);
     cache.geometrySinceLast.assign(tiles, inf);
     // none when `after` is back at the anchor's heights (a change undone: the
-    // anchor's path says all), or `before` was at them (the paths are one)
-    if (!markSinceLastTiles(keys, tolerance, cache) || differing.empty() ||
-        differingCellsIn(cache.anchorHeights.cview(), before, cache.anchorDiffers).empty())
-        return;
+    // anchor's path says all), or `before` (the last plan's) was at them:
+    // the paths are one
+    if (!markSinceLastTiles(keys, tolerance, cache) || differing.empty() || cache.anchorIsLastPlan) return;
     buildMaxChangePyramid(before, after, cache.lastChange, sinceBefore);
     environmentSinceLast(pyr, vis, lipschitz, tolerance, geometryStride, cache);
-    keySinceLast(pyr, keys, lipschitz, tolerance, cache);
+    boundGradientChange(cache.lastChange, pyr, kCacheTile, cache.lastCacheGrad);
+    boundKeyFractions(pyr, keys, lipschitz, tolerance, cache.lastChange, cache.lastSlope, cache.lastCacheGrad,
+                      cache.keyDrift.sinceInputs, &cache.sinceLastTiles, cache, cache.keySinceLast);
 }
 
 }  // namespace
@@ -461,17 +431,22 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
                        boundGradientChange(cache.change, pyr, kCacheTile, cache.cacheGradBound);
                    });
     geometryBoundPerTile(cache.slopeBound, cache.gradBound, lipschitz, cache.coarseBound);
-    markPerAzimuthTiles(tolerance, geometryStride > 0, cache);
+    markPerAzimuthTiles(cache.tiles, cache.coarseBound, cache.drift.fromAnchor,
+                        geometryStride > 0 ? &cache.geometryDrift.fromAnchor : nullptr, nullptr, tolerance,
+                        cache.perAzimuth);
     // then the finer ones where the coarse ones would take more than their share of the tolerance
     parallelInvoke(
         [&] {
             boundSlopeChangePerAzimuth(cache.change, pyr, kVisibilityTile, vis.azimuths, cache.azimuthBound,
                                        cache.perAzimuth);
         },
-        [&] { boundKeyFractions(pyr, keys, lipschitz, tolerance, cache); });
+        [&] {
+            boundKeyFractions(pyr, keys, lipschitz, tolerance, cache.change, cache.slopeBound, cache.cacheGradBound,
+                              cache.keyDrift.fromAnchor, nullptr, cache, cache.keyExcursion);
+        });
     environmentAndGeometryBounds(cache.azimuthBound, cache.gradBound, cache.coarseBound, vis.azimuths, lipschitz,
                                  geometryStride, cache.tileAzimuths, cache.envBound, cache.geometryBound);
-    keepCoarseBounds(cache);
+    keepCoarseBounds(cache.perAzimuth, cache.coarseBound, cache.envBound, cache.geometryBound);
     onCacheTiles(cache.envBound, cache.tiles, cache.envExcursion);
     onCacheTiles(cache.geometryBound, cache.tiles, cache.geometryExcursion);
     boundSinceLastFrame(before, after, pyr, vis, keys, lipschitz, tolerance, geometryStride, sinceBefore, differing,
@@ -497,6 +472,7 @@ void planVisibilityTiles(ConstGridView before, ConstGridView after, const Height
     // the next plan compares only those cells, not the whole field again
     if (reanchor) copyGrid(after, cache.anchorHeights, differing.rows());
     cache.anchorDiffers = reanchor ? sinceBefore : differing.joined(sinceBefore);
+    cache.anchorIsLastPlan = reanchor || differing.empty();
     const int all = static_cast<int>(cache.tiles.dirty.size());
     // the indirect light re-gathers the geometry's dirty tiles: both count
     countAfterPlan(std::min(cache.tiles.dirtyCount(), cache.geometryTiles.dirtyCount()), all, cache.skips);

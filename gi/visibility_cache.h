@@ -103,9 +103,10 @@ struct KeyLightRegion {
 };
 
 struct VisibilityCache {
-    Grid anchorHeights;       // the heights the drifts are measured from
-    CellBox anchorDiffers;    // holds every cell where they may differ from the last plan's (all)
-    MaxChangePyramid change;  // |dh| from the anchor to this frame
+    Grid anchorHeights;            // the heights the drifts are measured from
+    CellBox anchorDiffers;         // holds every cell where they may differ from the last plan's (all)
+    bool anchorIsLastPlan = true;  // they are the last plan's (its `after`, or reset to them)
+    MaxChangePyramid change;       // |dh| from the anchor to this frame
     // this frame's bounds per visibility tile (kVisibilityTile)
     std::vector<float> slopeBound, gradBound;    // all azimuths
     std::vector<float> coarseBound;              // the ambient-map bound from slopeBound (any azimuths)
