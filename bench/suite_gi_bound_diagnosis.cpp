@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/horizon_aware_bound.h"
 #include "bench/suites.h"
 #include "core/parallel.h"
 #include "gi/change_bound.h"
@@ -108,6 +109,23 @@ struct Track {
     // (gi/receiver_azimuth_bound.h): alone, in runs of 16, and its cost (ms)
     std::vector<double> sampleShare, sampleRunShare, sampleMs;
     gi::ChangeLevels changeLevels;  // its |dh| pyramid, redone from frame to frame as a plan would
+    // bench/horizon_aware_bound.h's three bounds (plain, ideal, top two), per
+    // frame the share of the receivers above the tolerance: alone, in runs of
+    // 16, in tiles of 16 x 16 and of 32 x 32 receivers
+    std::array<std::array<std::vector<double>, 4>, HorizonAwareBounds::kVariants> horizonShare;
+    std::vector<double> idealBound;  // per 32 x 32 tile, the ideal exact-tangent bound's largest
+    // The same bounds from the heights of frame anchorFrame (an anchor kept while
+    // the frames go on) against the true change of its V, per frame: the
+    // shares of the 32 x 32 and 16 x 16 tiles above the tolerance
+    struct FromAnchor {
+        double engine32 = 0, truth32 = 0, truth16 = 0;
+        std::array<double, HorizonAwareBounds::kVariants> bound32{}, bound16{};
+    };
+    std::vector<FromAnchor> fromAnchor;
+    int frame = 0, anchorFrame = 0;  // this frame's number; the anchor's (the frames before it settle the scene)
+    GiState anchor;
+    Grid anchorHeights;
+    gi::ChangeLevels anchorLevels;
 };
 
 // Copies the receivers (V) or texels (indirect light) of the tiles of T x T
@@ -268,12 +286,66 @@ IndirectBounds indirectBounds(const GiState& now, const GiState& last, int azimu
     return out;
 }
 
+// Per variant of bench/horizon_aware_bound.h (plain, ideal, top two), the
+// share of the receivers above the tolerance alone, in runs of 16 and in
+// tiles of 16 x 16 and 32 x 32 receivers.
+using HorizonShares = std::array<std::array<double, 4>, HorizonAwareBounds::kVariants>;
+HorizonShares horizonShares(const HorizonAwareBounds& b, int nxr, int nyr, float tolerance) {
+    HorizonShares out{};
+    for (std::size_t v = 0; v < out.size(); ++v) {
+        const std::vector<float>& r = b.bound[v];
+        out[v] = {
+            shareAbove(r, 1, 1, nxr, nyr, tolerance),
+            shareAbove(r, 1, gi::ReceiverTiles::kTileAlign, nxr, nyr, tolerance),
+            shareAbove(tileMaxima(r, nxr, nyr, 16), 16, 1, nxr, nyr, tolerance),
+            shareAbove(tileMaxima(r, nxr, nyr, gi::kVisibilityTile), gi::kVisibilityTile, 1, nxr, nyr, tolerance)};
+    }
+    return out;
+}
+
+// The frame against the anchor frame's V (bench/horizon_aware_bound.h with
+// that frame's heights as the anchor).
+void measureFromAnchor(Track& t, const gi::GiSettings& settings, float tolerance, const gi::ShadeMaps& fresh) {
+    gi::VisibilityCache cache;
+    gi::planVisibilityTiles(t.anchorHeights.cview(), t.heights.cview(), t.now.pyramid, settings.visibility, {}, 1e30f,
+                            cache);
+    const gi::FoldedWedgeOperator op = gi::foldFullCircle(settings.visibility.azimuths, settings.visibility.interp);
+    gi::buildChangeLevels(cache.change, t.now.pyramid, t.anchorLevels);
+    std::vector<float> tileSlopes;
+    gi::boundSlopeChangePerAzimuth(cache.change, t.now.pyramid, gi::kVisibilityTile, settings.visibility.azimuths,
+                                   tileSlopes);
+    const int nxr = t.now.pyramid.nxr, nyr = t.now.pyramid.nyr, s = settings.subsample;
+    const HorizonAwareBounds b =
+        horizonAwareBounds(t.anchor.pyramid, t.anchor.footprint, t.now.footprint, t.anchorLevels, cache.change, op.phi,
+                           gi::blockingMaxLipschitz(settings.visibility.blockingMax), tileSlopes, gi::kVisibilityTile);
+    gi::ShadeMaps cached;
+    ambientOfV(t.now, t.anchor.envVisibility, settings, cached);
+    Track::FromAnchor f;
+    const auto toFloat = [](const std::vector<double>& v) { return std::vector<float>(v.begin(), v.end()); };
+    const int T32 = gi::kVisibilityTile;
+    f.truth32 =
+        shareAbove(toFloat(perTile({&cached.ambient}, {&fresh.ambient}, t.now, s, T32)), T32, 1, nxr, nyr, tolerance);
+    f.truth16 =
+        shareAbove(toFloat(perTile({&cached.ambient}, {&fresh.ambient}, t.now, s, 16)), 16, 1, nxr, nyr, tolerance);
+    f.engine32 = shareAbove(environmentBounds(cache.change, t.now.pyramid, settings.visibility, T32), T32, 1, nxr, nyr,
+                            tolerance);
+    for (std::size_t v = 0; v < f.bound32.size(); ++v) {
+        f.bound32[v] = shareAbove(tileMaxima(b.bound[v], nxr, nyr, T32), T32, 1, nxr, nyr, tolerance);
+        f.bound16[v] = shareAbove(tileMaxima(b.bound[v], nxr, nyr, 16), 16, 1, nxr, nyr, tolerance);
+    }
+    t.fromAnchor.push_back(f);
+}
+
 void measureFrame(Track& t, const gi::GiSettings& settings, float cell, float tolerance) {
     const gi::GiLighting sky;  // uniform unit sky
     gi::runGiFrame(t.heights.cview(), cell, sky, settings, t.now);
     gi::ShadeMaps fresh;
     ambientOfV(t.now, t.now.envVisibility, settings, fresh);
     oracleFrame(t, settings, tolerance, fresh);
+    if (t.frame++ == t.anchorFrame) {
+        t.anchor = t.now;
+        t.anchorHeights = t.heights;
+    }
     if (t.lastHeights.empty()) return;
     for (std::size_t i = 0; i < t.heights.v.size(); ++i)
         t.dh.push_back(std::fabs(static_cast<double>(t.heights.v[i]) - t.lastHeights.v[i]));
@@ -301,7 +373,21 @@ void measureFrame(Track& t, const gi::GiSettings& settings, float cell, float to
         t.sampleShare.push_back(shareAbove(samples, 1, 1, nxr, nyr, tolerance));
         t.sampleRunShare.push_back(shareAbove(samples, 1, gi::ReceiverTiles::kTileAlign, nxr, nyr, tolerance));
         t.sampleMs.push_back(ms);
+        const gi::FoldedWedgeOperator op = gi::foldFullCircle(settings.visibility.azimuths, settings.visibility.interp);
+        std::vector<float> tileSlopes;
+        gi::boundSlopeChangePerAzimuth(cache.change, t.now.pyramid, gi::kVisibilityTile, settings.visibility.azimuths,
+                                       tileSlopes);
+        const HorizonAwareBounds hb = horizonAwareBounds(
+            t.last.pyramid, t.last.footprint, t.now.footprint, t.changeLevels, cache.change, op.phi,
+            gi::blockingMaxLipschitz(settings.visibility.blockingMax), tileSlopes, gi::kVisibilityTile);
+        const HorizonShares shares = horizonShares(hb, nxr, nyr, tolerance);
+        for (std::size_t v = 0; v < shares.size(); ++v)
+            for (std::size_t k = 0; k < 4; ++k) t.horizonShare[v][k].push_back(shares[v][k]);
+        const std::vector<float> ideal =
+            tileMaxima(hb.bound[HorizonAwareBounds::IdealExactTangent], nxr, nyr, gi::kVisibilityTile);
+        t.idealBound.insert(t.idealBound.end(), ideal.begin(), ideal.end());
     }
+    if (t.frame > t.anchorFrame + 1) measureFromAnchor(t, settings, tolerance, fresh);
     gi::ShadeMaps cached;
     ambientOfV(t.now, t.last.envVisibility, settings, cached);
     const int s = settings.subsample;
@@ -344,7 +430,11 @@ const char* kIntro =
     "very samples its scan reads, gi/receiver_azimuth_bound.h, with what it costs on 2 threads: the |dh| pyramid "
     "redone over the change since the last frame, the scan over every receiver and the V bound) and the shares of the "
     "receivers an oracle with "
-    "tiles of that size recomputes, mean over the frames after the first.\n";
+    "tiles of that size recomputes, mean over the frames after the first. The third table takes the per-receiver "
+    "bound apart (bench/horizon_aware_bound.h): the same samples' change, then bounds that know each receiver's "
+    "horizon (the maximum blocking slope) and its footprint's tangent plane at the last frame, and with the new "
+    "frame's tangent planes; the fourth keeps one frame's V (the anchor) while the frames go on and counts the tiles "
+    "whose true change, and whose bounds from the anchor, pass the tolerance.\n";
 
 // One row per quantity: its quantiles and the share of tiles (or cells) above the tolerance.
 std::string row(const std::string& what, const std::vector<double>& v, double above) {
@@ -358,6 +448,48 @@ double mean(const std::vector<double>& v) {
     double sum = 0.0;
     for (double x : v) sum += x;
     return v.empty() ? 0.0 : sum / static_cast<double>(v.size());
+}
+
+// bench/horizon_aware_bound.h's bounds: one frame's, and from the anchor frame on.
+std::string horizonTables(const Track& t) {
+    std::string out =
+        "\n| one-frame V bound per receiver (bench/horizon_aware_bound.h), share of the receivers above the tolerance "
+        "| alone | in runs of 16 | in tiles of 16 x 16 | in tiles of 32 x 32 |\n|---|---|---|---|---|\n";
+    for (std::size_t v = 0; v < t.horizonShare.size(); ++v) {
+        char buf[300];
+        std::snprintf(buf, sizeof buf, "| %s | %.2f %% | %.2f %% | %.2f %% | %.2f %% |\n",
+                      HorizonAwareBounds::kNames[v], 100.0 * mean(t.horizonShare[v][0]),
+                      100.0 * mean(t.horizonShare[v][1]), 100.0 * mean(t.horizonShare[v][2]),
+                      100.0 * mean(t.horizonShare[v][3]));
+        out += buf;
+    }
+    char intro[300];
+    std::snprintf(intro, sizeof intro,
+                  "\nFrom frame %d's V on (an anchor kept while the frames go on; the frames before it let the scene "
+                  "settle), the share of the tiles above the tolerance: ",
+                  t.anchorFrame);
+    out += intro;
+    out +=
+        "its true change, the engine's tile bound, and the tile maxima of the bounds above (in their order).\n\n"
+        "| frames since the anchor | tiles 32²: true change | engine's bound | bounds above | tiles 16²: true change | "
+        "bounds above |\n|---|---|---|---|---|---|\n";
+    const auto list = [](const auto& shares) {
+        std::string s;
+        for (double x : shares) {
+            char b[32];
+            std::snprintf(b, sizeof b, "%s%.1f", s.empty() ? "" : " / ", 100.0 * x);
+            s += b;
+        }
+        return s + " %";
+    };
+    for (std::size_t n = 0; n < t.fromAnchor.size(); ++n) {
+        const Track::FromAnchor& f = t.fromAnchor[n];
+        char buf[400];
+        std::snprintf(buf, sizeof buf, "| %zu | %.1f %% | %.1f %% | %s | %.1f %% | %s |\n", n + 1, 100 * f.truth32,
+                      100 * f.engine32, list(f.bound32).c_str(), 100 * f.truth16, list(f.bound16).c_str());
+        out += buf;
+    }
+    return out;
 }
 
 // Per granularity, the mean share per frame of the receivers the one-frame
@@ -386,19 +518,25 @@ std::string granularityTable(const Track& t) {
     out += buf;
     std::snprintf(buf, sizeof buf, "| the same, in the scans' runs of %d along a row | %.2f %% | | |\n",
                   gi::ReceiverTiles::kTileAlign, 100.0 * mean(t.sampleRunShare));
-    return out + buf;
+    return out + buf + horizonTables(t);
 }
 
 std::string report(const Track& t, float tolerance) {
     std::vector<double> ratio;
     for (std::size_t i = 0; i < t.bound.size(); ++i)
         if (t.vChange[i] > 0.0) ratio.push_back(t.bound[i] / t.vChange[i]);
+    std::vector<double> idealRatio;
+    for (std::size_t i = 0; i < t.idealBound.size() && i < t.vChange.size(); ++i)
+        if (t.vChange[i] > 0.0) idealRatio.push_back(t.idealBound[i] / t.vChange[i]);
     return "\n### " + t.name +
            "\n\n| quantity | p10 | median | p90 | max | share above the tolerance |\n|---|---|---|---|---|---|\n" +
            row("\\|dh\\| per cell (m; share above 1 cm)", t.dh, 0.01) +
            row("per tile: one-frame bound on the cached V's ambient change", t.bound, tolerance) +
            row("per tile: true change of the cached V's ambient", t.vChange, tolerance) +
            row("per tile: V bound / true change (share above 1)", ratio, 1.0) +
+           row("per tile: the ideal exact-tangent bound (bench/horizon_aware_bound.h), one frame", t.idealBound,
+               tolerance) +
+           row("per tile: the same / true change", idealRatio, 1.0) +
            row("per tile: largest radiance sample move of the indirect scan", t.indirectSampleBound, tolerance) +
            row("per tile: one-frame radiance bound of the indirect light", t.indirectBound, tolerance) +
            row("per tile: true change of the indirect light", t.indirectChange, tolerance) +
@@ -421,6 +559,7 @@ gi::GiSettings diagnosisSettings() {
 void runTracks(const std::vector<Track*>& tracks, float cell, int frames, float tolerance,
                const std::function<void(int frame)>& nextSurfaces) {
     const gi::GiSettings settings = diagnosisSettings();
+    for (Track* t : tracks) t->anchorFrame = frames / 2;
     withThreads(2, [&] {
         for (int f = 0; f <= frames; ++f) {
             nextSurfaces(f);
