@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -58,6 +59,51 @@ float lowestTangentSlope(const gi::FootprintBox& b, std::size_t r, double c, dou
     return static_cast<float>((c >= 0.0 ? b.loX[r] : b.hiX[r]) * c + (sn >= 0.0 ? b.loY[r] : b.hiY[r]) * sn);
 }
 
+// The unit normals of the texels whose V blends receiver (X, Y)'s: those
+// within s - 1 cells of its cell (Fig. 7), from the heights' gradients.
+struct Normal {
+    double x, y, z;
+};
+void texelNormals(ConstGridView gx, ConstGridView gy, int s, int X, int Y, std::vector<Normal>& out) {
+    out.clear();
+    for (int y = std::max(0, s * Y - (s - 1)); y <= std::min(gx.ny - 1, s * Y + (s - 1)); ++y)
+        for (int x = std::max(0, s * X - (s - 1)); x <= std::min(gx.nx - 1, s * X + (s - 1)); ++x) {
+            const double a = gx(x, y), b = gy(x, y), n = std::sqrt(1.0 + a * a + b * b);
+            out.push_back({-a / n, -b / n, 1.0 / n});
+        }
+}
+
+double sinOfSlope(double t) { return t / std::sqrt(1.0 + t * t); }
+
+// The ambient change bound of gi/change_bound.h with the elevation weight:
+// (2 pi / m) sum_j W_j dU_j, sigma_j (tan) moving within [lo_j, hi_j]; dU_j
+// the largest move of sin(sigma_j) over the band, W_j the largest |g| over
+// it, the normals, and azimuths across the support of sample j's hat
+// (sampled at its ends, middle and quarter points).
+double weightedAmbientBound(const ElevationWeight& weight, const std::vector<Normal>& normals,
+                            std::span<const double> phi, const float* sigma, const float* lo, const float* hi) {
+    const int m = static_cast<int>(phi.size());
+    const double step = 2.0 * std::numbers::pi / m;
+    double sum = 0.0;
+    for (int j = 0; j < m; ++j) {
+        const double u = sinOfSlope(sigma[j]), u0 = sinOfSlope(lo[j]), u1 = sinOfSlope(hi[j]);
+        const double du = std::max(u1 - u, u - u0);
+        if (!(du > 0.0)) continue;
+        double w = 0.0;
+        for (int d = -2; d <= 2; ++d) {
+            const double p = phi[static_cast<std::size_t>(j)] + 0.5 * d * step, c = std::cos(p), sn = std::sin(p);
+            for (const Normal& n : normals) w = std::max(w, weight.largest(n.z, n.x * c + n.y * sn, u0, u1));
+        }
+        sum += w * du;
+    }
+    return step * sum;
+}
+
+const ElevationWeight& elevationWeight() {
+    static const ElevationWeight w;
+    return w;
+}
+
 // The slope bounds of receiver (X, Y) along one azimuth's steps, and its
 // anchor horizon H (-infinity without a step inside the domain).
 struct SlopeBounds {
@@ -101,7 +147,8 @@ SlopeBounds receiverSlopeBounds(const std::vector<StepPair>& steps, int X, int Y
 HorizonAwareBounds horizonAwareBounds(const gi::HeightPyramid& anchor, const gi::FootprintBox& box,
                                       const gi::FootprintBox& newBox, const gi::ChangeLevels& levels,
                                       const gi::MaxChangePyramid& dh, std::span<const double> phi, float lipschitz,
-                                      const std::vector<float>& tileSlopeBound, int tile) {
+                                      const std::vector<float>& tileSlopeBound, int tile, ConstGridView gradX,
+                                      ConstGridView gradY) {
     const gi::HeightPyramid& change = levels.bound;
     if (!levels.valid || change.nxr != anchor.nxr || change.nyr != anchor.nyr ||
         change.steps.size() != anchor.steps.size() || box.nxr != anchor.nxr || box.nyr != anchor.nyr ||
@@ -120,6 +167,10 @@ HorizonAwareBounds horizonAwareBounds(const gi::HeightPyramid& anchor, const gi:
     parallelFor(0, nyr, 4, [&](int Y0, int Y1) {
         constexpr int kV = HorizonAwareBounds::kVariants;
         std::vector<float> gradients(static_cast<std::size_t>(nxr)), columns, perAzimuth(kV * m);
+        // the weighted variants' sigma and their bounds (Ideal, TopTwo, Plain, exact tangent)
+        constexpr int kWeighted = 3;
+        std::vector<float> sigma(m), lo(kWeighted * m), hi(kWeighted * m);
+        std::vector<Normal> normals;
         for (int Y = Y0; Y < Y1; ++Y) {
             gi::receiverGradientBounds(dh, anchor, Y, 0, nxr, gradients.data(), columns);
             const float* h0 = anchor.rawPhaseRow(0, s * Y);
@@ -140,24 +191,71 @@ HorizonAwareBounds horizonAwareBounds(const gi::HeightPyramid& anchor, const gi:
                         sigmaMove(b.horizon, lipschitz * b.ideal, T, dT);
                     perAzimuth[HorizonAwareBounds::TopTwoTangent * m + k] =
                         sigmaMove(b.horizon, lipschitz * b.topTwo, T, dT);
-                    perAzimuth[HorizonAwareBounds::IdealExactTangent * m + k] =
-                        sigmaMoveExactTangent(b.horizon, lipschitz * b.ideal, T, newT);
-                    perAzimuth[HorizonAwareBounds::TopTwoExactTangent * m + k] =
-                        sigmaMoveExactTangent(b.horizon, lipschitz * b.topTwo, T, newT);
-                    perAzimuth[HorizonAwareBounds::PlainExactTangent * m + k] =
-                        sigmaMoveExactTangent(b.horizon, lipschitz * b.plain, T, newT);
+                    const float moves[kWeighted] = {sigmaMoveExactTangent(b.horizon, lipschitz * b.ideal, T, newT),
+                                                    sigmaMoveExactTangent(b.horizon, lipschitz * b.topTwo, T, newT),
+                                                    sigmaMoveExactTangent(b.horizon, lipschitz * b.plain, T, newT)};
+                    perAzimuth[HorizonAwareBounds::IdealExactTangent * m + k] = moves[0];
+                    perAzimuth[HorizonAwareBounds::TopTwoExactTangent * m + k] = moves[1];
+                    perAzimuth[HorizonAwareBounds::PlainExactTangent * m + k] = moves[2];
+                    sigma[k] = std::max(b.horizon, T);
+                    for (int w = 0; w < kWeighted; ++w) {
+                        lo[static_cast<std::size_t>(w * m) + k] = sigma[k] - moves[w];
+                        hi[static_cast<std::size_t>(w * m) + k] = sigma[k] + moves[w];
+                    }
                     const std::size_t t = static_cast<std::size_t>(Y / tile) * gi::tileCount(nxr, tile) +
                                           static_cast<std::size_t>(X / tile);
                     perAzimuth[HorizonAwareBounds::TileExactTangent * m + k] =
                         sigmaMoveExactTangent(b.horizon, lipschitz * tileSlopeBound[t * m + k], T, newT);
                 }
-                for (int v = 0; v < kV; ++v) {
+                for (int v = 0; v < HorizonAwareBounds::IdealExactTangentWeighted; ++v) {
                     const bool tangentAware = v >= HorizonAwareBounds::IdealTangent;  // dT or T' counted already
                     out.bound[v][r] = gi::ambientChangeBoundPerAzimuth(perAzimuth.data() + v * m, m,
                                                                        tangentAware ? 0.0f : g, 1.0f, false);
                 }
+                texelNormals(gradX, gradY, s, X, Y, normals);
+                for (int w = 0; w < kWeighted; ++w)
+                    out.bound[HorizonAwareBounds::IdealExactTangentWeighted + w][r] =
+                        static_cast<float>(weightedAmbientBound(elevationWeight(), normals, phi, sigma.data(),
+                                                                lo.data() + w * m, hi.data() + w * m));
             }
         }
+    });
+    return out;
+}
+
+TrueSigmaBounds trueSigmaMoveBound(const gi::VisibilityField& last, const gi::FootprintBox& lastBox,
+                                   const gi::VisibilityField& now, const gi::FootprintBox& newBox,
+                                   std::span<const double> phi, ConstGridView gradX, ConstGridView gradY,
+                                   int subsample) {
+    const int nxr = now.nxr, nyr = now.nyr, m = static_cast<int>(phi.size());
+    const std::size_t plane = static_cast<std::size_t>(nxr) * nyr;
+    if (last.nxr != nxr || last.nyr != nyr || last.maxSlope.size() != plane * m || now.maxSlope.size() != plane * m ||
+        lastBox.loX.size() != plane || newBox.loX.size() != plane)
+        throw InputError("true sigma move: the frames' visibility fields and boxes differ in size");
+    TrueSigmaBounds out{std::vector<float>(plane, 0.0f), std::vector<float>(plane, 0.0f)};
+    parallelFor(0, nyr, 8, [&](int Y0, int Y1) {
+        std::vector<float> move(m), sigma(m), lo(m), hi(m);
+        std::vector<Normal> normals;
+        for (int Y = Y0; Y < Y1; ++Y)
+            for (int X = 0; X < nxr; ++X) {
+                const std::size_t r = static_cast<std::size_t>(Y) * nxr + X;
+                for (int j = 0; j < m; ++j) {
+                    const double c = std::cos(phi[static_cast<std::size_t>(j)]);
+                    const double sn = std::sin(phi[static_cast<std::size_t>(j)]);
+                    const std::size_t at = static_cast<std::size_t>(j) * plane + r;
+                    const std::size_t k = static_cast<std::size_t>(j);
+                    const float before = std::max(last.maxSlope[at], lowestTangentSlope(lastBox, r, c, sn));
+                    const float after = std::max(now.maxSlope[at], lowestTangentSlope(newBox, r, c, sn));
+                    move[k] = std::fabs(after - before);
+                    sigma[k] = before;
+                    lo[k] = std::min(before, after);
+                    hi[k] = std::max(before, after);
+                }
+                out.frames[r] = gi::ambientChangeBoundPerAzimuth(move.data(), m, 0.0f, 1.0f, false);
+                texelNormals(gradX, gradY, subsample, X, Y, normals);
+                out.weighted[r] = static_cast<float>(
+                    weightedAmbientBound(elevationWeight(), normals, phi, sigma.data(), lo.data(), hi.data()));
+            }
     });
     return out;
 }

@@ -30,11 +30,17 @@
 // hand when a frame plans (its gradients come first), so T' itself may
 // replace the bound dT: |sigma' - sigma| <= the larger of |max(H + dH, T')
 // - sigma| and |max(H - dH, T') - sigma| (exact tangent).
+// The exact tangent is also paired with the plain dH = max_i D_i and with
+// the visibility tile's per-azimuth slope bound (gi/change_bound.h): forms
+// that need the anchor's horizons (which a V keeps, VisibilityField::
+// maxSlope) and tangent planes but not its every slope.
 // All of them hold in real arithmetic (float rounding is not counted: this
 // is a measurement, not a bound the engine relies on).
 #include <span>
 #include <vector>
 
+#include "bench/elevation_weight.h"
+#include "core/grid.h"
 #include "gi/change_bound.h"
 #include "gi/pyramid.h"
 #include "gi/receiver_azimuth_bound.h"
@@ -42,8 +48,10 @@
 namespace terrain::bench {
 
 /// Per receiver (row-major), the environment V's ambient change bound
-/// (gi::ambientChangeBoundPerAzimuth over the azimuths phi, with each
-/// receiver's own gradient bound) from three per-azimuth slope bounds.
+/// (gi::ambientChangeBoundPerAzimuth over the azimuths phi) from each
+/// variant's per-azimuth bounds: with each receiver's own gradient bound for
+/// the first three, whose slope bounds leave the tangent planes out; the
+/// others count them already (dT or T').
 struct HorizonAwareBounds {
     enum Variant {
         Plain,
@@ -55,6 +63,9 @@ struct HorizonAwareBounds {
         TopTwoExactTangent,
         PlainExactTangent,
         TileExactTangent,
+        IdealExactTangentWeighted,
+        TopTwoExactTangentWeighted,
+        PlainExactTangentWeighted,
         kVariants
     };
     static constexpr const char* kNames[kVariants] = {
@@ -67,6 +78,9 @@ struct HorizonAwareBounds {
         "top two, exact tangent",
         "samples' own change, exact tangent",
         "the visibility tile's slope bound per azimuth (gi/change_bound.h), exact tangent",
+        "ideal, exact tangent, elevation weight (bench/elevation_weight.h, an estimate)",
+        "top two, exact tangent, elevation weight (an estimate)",
+        "samples' own change, exact tangent, elevation weight (an estimate)",
     };
     std::vector<float> bound[kVariants];
 };
@@ -77,11 +91,29 @@ struct HorizonAwareBounds {
 /// `levels`: the |dh| pyramid (gi::buildChangeLevels) of `dh`, the change
 /// from the anchor's heights to the new ones; phi: the V's azimuths;
 /// tileSlopeBound: gi::boundSlopeChangePerAzimuth over tiles of `tile`
-/// receivers for the same change and azimuths.
+/// receivers for the same change and azimuths; gradX, gradY: the new
+/// heights' gradients (the texels' normals the weighted variant shades at).
 HorizonAwareBounds horizonAwareBounds(const gi::HeightPyramid& anchor, const gi::FootprintBox& box,
                                       const gi::FootprintBox& newBox, const gi::ChangeLevels& levels,
                                       const gi::MaxChangePyramid& dh, std::span<const double> phi, float lipschitz,
-                                      const std::vector<float>& tileSlopeBound, int tile);
+                                      const std::vector<float>& tileSlopeBound, int tile, ConstGridView gradX,
+                                      ConstGridView gradY);
+
+/// Per receiver (row-major), what the conversion makes of the true moves:
+/// each azimuth's sigma to sigma' (in slope, tan) from the two frames'
+/// maximum blocking slopes (VisibilityField::maxSlope, planes in the order
+/// of phi) and footprint boxes, through gi::ambientChangeBoundPerAzimuth
+/// (`frames`) and through the elevation weight at the new normals
+/// (`weighted`). Where the first is far above the true change of the
+/// ambient, the slack is the conversion (one weight for every elevation and
+/// normal), not the bound on the slopes.
+struct TrueSigmaBounds {
+    std::vector<float> frames, weighted;
+};
+TrueSigmaBounds trueSigmaMoveBound(const gi::VisibilityField& last, const gi::FootprintBox& lastBox,
+                                   const gi::VisibilityField& now, const gi::FootprintBox& newBox,
+                                   std::span<const double> phi, ConstGridView gradX, ConstGridView gradY,
+                                   int subsample);
 
 /// The largest bound over each tile of T x T receivers (row-major tiles).
 std::vector<float> tileMaxima(const std::vector<float>& perReceiver, int nxr, int nyr, int T);

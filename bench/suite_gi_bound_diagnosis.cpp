@@ -109,11 +109,13 @@ struct Track {
     // (gi/receiver_azimuth_bound.h): alone, in runs of 16, and its cost (ms)
     std::vector<double> sampleShare, sampleRunShare, sampleMs;
     gi::ChangeLevels changeLevels;  // its |dh| pyramid, redone from frame to frame as a plan would
-    // bench/horizon_aware_bound.h's three bounds (plain, ideal, top two), per
-    // frame the share of the receivers above the tolerance: alone, in runs of
-    // 16, in tiles of 16 x 16 and of 32 x 32 receivers
+    // per variant of bench/horizon_aware_bound.h's bounds, per frame the
+    // share of the receivers above the tolerance: alone, in runs of 16, in
+    // tiles of 16 x 16 and of 32 x 32 receivers
     std::array<std::array<std::vector<double>, 4>, HorizonAwareBounds::kVariants> horizonShare;
     std::vector<double> idealBound;  // per 32 x 32 tile, the ideal exact-tangent bound's largest
+    std::vector<double> trueSigma;   // per 32 x 32 tile, the true sigma moves through the conversion
+    std::vector<double> trueSigmaWeighted, idealWeighted;  // the same and the ideal bound, with the elevation weight
     // The same bounds from the heights of frame anchorFrame (an anchor kept while
     // the frames go on) against the true change of its V, per frame: the
     // shares of the 32 x 32 and 16 x 16 tiles above the tolerance
@@ -286,9 +288,9 @@ IndirectBounds indirectBounds(const GiState& now, const GiState& last, int azimu
     return out;
 }
 
-// Per variant of bench/horizon_aware_bound.h (plain, ideal, top two), the
-// share of the receivers above the tolerance alone, in runs of 16 and in
-// tiles of 16 x 16 and 32 x 32 receivers.
+// Per variant of bench/horizon_aware_bound.h's bounds, the share of the
+// receivers above the tolerance alone, in runs of 16 and in tiles of 16 x 16
+// and 32 x 32 receivers.
 using HorizonShares = std::array<std::array<double, 4>, HorizonAwareBounds::kVariants>;
 HorizonShares horizonShares(const HorizonAwareBounds& b, int nxr, int nyr, float tolerance) {
     HorizonShares out{};
@@ -317,7 +319,8 @@ void measureFromAnchor(Track& t, const gi::GiSettings& settings, float tolerance
     const int nxr = t.now.pyramid.nxr, nyr = t.now.pyramid.nyr, s = settings.subsample;
     const HorizonAwareBounds b =
         horizonAwareBounds(t.anchor.pyramid, t.anchor.footprint, t.now.footprint, t.anchorLevels, cache.change, op.phi,
-                           gi::blockingMaxLipschitz(settings.visibility.blockingMax), tileSlopes, gi::kVisibilityTile);
+                           gi::blockingMaxLipschitz(settings.visibility.blockingMax), tileSlopes, gi::kVisibilityTile,
+                           t.now.gradX.cview(), t.now.gradY.cview());
     gi::ShadeMaps cached;
     ambientOfV(t.now, t.anchor.envVisibility, settings, cached);
     Track::FromAnchor f;
@@ -377,15 +380,26 @@ void measureFrame(Track& t, const gi::GiSettings& settings, float cell, float to
         std::vector<float> tileSlopes;
         gi::boundSlopeChangePerAzimuth(cache.change, t.now.pyramid, gi::kVisibilityTile, settings.visibility.azimuths,
                                        tileSlopes);
-        const HorizonAwareBounds hb = horizonAwareBounds(
-            t.last.pyramid, t.last.footprint, t.now.footprint, t.changeLevels, cache.change, op.phi,
-            gi::blockingMaxLipschitz(settings.visibility.blockingMax), tileSlopes, gi::kVisibilityTile);
+        const HorizonAwareBounds hb =
+            horizonAwareBounds(t.last.pyramid, t.last.footprint, t.now.footprint, t.changeLevels, cache.change, op.phi,
+                               gi::blockingMaxLipschitz(settings.visibility.blockingMax), tileSlopes,
+                               gi::kVisibilityTile, t.now.gradX.cview(), t.now.gradY.cview());
         const HorizonShares shares = horizonShares(hb, nxr, nyr, tolerance);
         for (std::size_t v = 0; v < shares.size(); ++v)
             for (std::size_t k = 0; k < 4; ++k) t.horizonShare[v][k].push_back(shares[v][k]);
         const std::vector<float> ideal =
             tileMaxima(hb.bound[HorizonAwareBounds::IdealExactTangent], nxr, nyr, gi::kVisibilityTile);
         t.idealBound.insert(t.idealBound.end(), ideal.begin(), ideal.end());
+        const TrueSigmaBounds ts =
+            trueSigmaMoveBound(t.last.envVisibility, t.last.footprint, t.now.envVisibility, t.now.footprint, op.phi,
+                               t.now.gradX.cview(), t.now.gradY.cview(), settings.subsample);
+        const std::vector<float> sigma = tileMaxima(ts.frames, nxr, nyr, gi::kVisibilityTile);
+        const std::vector<float> sigmaWeighted = tileMaxima(ts.weighted, nxr, nyr, gi::kVisibilityTile);
+        const std::vector<float> idealWeighted =
+            tileMaxima(hb.bound[HorizonAwareBounds::IdealExactTangentWeighted], nxr, nyr, gi::kVisibilityTile);
+        t.trueSigma.insert(t.trueSigma.end(), sigma.begin(), sigma.end());
+        t.trueSigmaWeighted.insert(t.trueSigmaWeighted.end(), sigmaWeighted.begin(), sigmaWeighted.end());
+        t.idealWeighted.insert(t.idealWeighted.end(), idealWeighted.begin(), idealWeighted.end());
     }
     if (t.frame > t.anchorFrame + 1) measureFromAnchor(t, settings, tolerance, fresh);
     gi::ShadeMaps cached;
@@ -430,7 +444,11 @@ const char* kIntro =
     "very samples its scan reads, gi/receiver_azimuth_bound.h, with what it costs on 2 threads: the |dh| pyramid "
     "redone over the change since the last frame, the scan over every receiver and the V bound) and the shares of the "
     "receivers an oracle with "
-    "tiles of that size recomputes, mean over the frames after the first. The third table takes the per-receiver "
+    "tiles of that size recomputes, mean over the frames after the first. The rows after the V bound's ratio set the "
+    "tightest bound of the third table (ideal, exact tangent) and the true moves of each azimuth's sigma from the two "
+    "frames' horizons and tangent planes, through the same weight per unit of slope, and both through the elevation "
+    "weight of bench/elevation_weight.h (an estimate, not a bound), against the true change. The third table takes "
+    "the per-receiver "
     "bound apart (bench/horizon_aware_bound.h): the same samples' change, then bounds that know each receiver's "
     "horizon (the maximum blocking slope) and its footprint's tangent plane at the last frame, and with the new "
     "frame's tangent planes; the fourth keeps one frame's V (the anchor) while the frames go on and counts the tiles "
@@ -528,6 +546,15 @@ std::string report(const Track& t, float tolerance) {
     std::vector<double> idealRatio;
     for (std::size_t i = 0; i < t.idealBound.size() && i < t.vChange.size(); ++i)
         if (t.vChange[i] > 0.0) idealRatio.push_back(t.idealBound[i] / t.vChange[i]);
+    const auto ratioTo = [&](const std::vector<double>& bound) {
+        std::vector<double> r;
+        for (std::size_t i = 0; i < bound.size() && i < t.vChange.size(); ++i)
+            if (t.vChange[i] > 0.0) r.push_back(bound[i] / t.vChange[i]);
+        return r;
+    };
+    std::vector<double> sigmaRatio;
+    for (std::size_t i = 0; i < t.trueSigma.size() && i < t.vChange.size(); ++i)
+        if (t.vChange[i] > 0.0) sigmaRatio.push_back(t.trueSigma[i] / t.vChange[i]);
     return "\n### " + t.name +
            "\n\n| quantity | p10 | median | p90 | max | share above the tolerance |\n|---|---|---|---|---|---|\n" +
            row("\\|dh\\| per cell (m; share above 1 cm)", t.dh, 0.01) +
@@ -537,6 +564,14 @@ std::string report(const Track& t, float tolerance) {
            row("per tile: the ideal exact-tangent bound (bench/horizon_aware_bound.h), one frame", t.idealBound,
                tolerance) +
            row("per tile: the same / true change", idealRatio, 1.0) +
+           row("per tile: the true moves of sigma through the same conversion (bench/horizon_aware_bound.h)",
+               t.trueSigma, tolerance) +
+           row("per tile: the same / true change", sigmaRatio, 1.0) +
+           row("per tile: the true moves of sigma, elevation weight (bench/elevation_weight.h, an estimate)",
+               t.trueSigmaWeighted, tolerance) +
+           row("per tile: the same / true change", ratioTo(t.trueSigmaWeighted), 1.0) +
+           row("per tile: the ideal exact-tangent bound, elevation weight (an estimate)", t.idealWeighted, tolerance) +
+           row("per tile: the same / true change", ratioTo(t.idealWeighted), 1.0) +
            row("per tile: largest radiance sample move of the indirect scan", t.indirectSampleBound, tolerance) +
            row("per tile: one-frame radiance bound of the indirect light", t.indirectBound, tolerance) +
            row("per tile: true change of the indirect light", t.indirectChange, tolerance) +
