@@ -266,7 +266,9 @@ std::vector<float> tileMaxima(const std::vector<float>& perReceiver, int nxr, in
     for (int Y = 0; Y < nyr; ++Y)
         for (int X = 0; X < nxr; ++X) {
             float& t = out[static_cast<std::size_t>(Y / T) * tilesX + X / T];
-            t = std::max(t, perReceiver[static_cast<std::size_t>(Y) * nxr + X]);
+            for (int y = std::max(0, Y - 1); y <= std::min(nyr - 1, Y + 1); ++y)
+                for (int x = std::max(0, X - 1); x <= std::min(nxr - 1, X + 1); ++x)
+                    t = std::max(t, perReceiver[static_cast<std::size_t>(y) * nxr + x]);
         }
     return out;
 }

@@ -115,7 +115,11 @@ TrueSigmaBounds trueSigmaMoveBound(const gi::VisibilityField& last, const gi::Fo
                                    std::span<const double> phi, ConstGridView gradX, ConstGridView gradY,
                                    int subsample);
 
-/// The largest bound over each tile of T x T receivers (row-major tiles).
+/// The largest bound over each tile of T x T receivers (row-major tiles)
+/// and their neighbours one receiver on: a texel between receivers blends
+/// their V (Fig. 7), so a tile's texels may move with a neighbouring tile's
+/// receivers (the frames' bound takes the largest of the tiles those
+/// receivers belong to).
 std::vector<float> tileMaxima(const std::vector<float>& perReceiver, int nxr, int nyr, int T);
 
 }  // namespace terrain::bench
