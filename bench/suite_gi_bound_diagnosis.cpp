@@ -194,10 +194,14 @@ void oracleFrame(Track& t, const gi::GiSettings& settings, float tolerance, cons
 }
 
 // One frame's environment V bound per tile of T x T receivers (what
-// gi/visibility_cache.h adds to a tile's drift), from the height change `dh`.
+// gi/visibility_cache.h adds to a tile's drift), from the height change `dh`;
+// with azimuthsOut, also the per-azimuth slope bounds it comes from
+// (gi::boundSlopeChangePerAzimuth).
 std::vector<float> environmentBounds(const gi::MaxChangePyramid& dh, const gi::HeightPyramid& pyr,
-                                     const gi::VisibilitySettings& vis, int T) {
-    std::vector<float> azimuths, gradients, scratch, bound;
+                                     const gi::VisibilitySettings& vis, int T,
+                                     std::vector<float>* azimuthsOut = nullptr) {
+    std::vector<float> own, gradients, scratch, bound;
+    std::vector<float>& azimuths = azimuthsOut ? *azimuthsOut : own;
     gi::boundSlopeChangePerAzimuth(dh, pyr, T, vis.azimuths, azimuths);
     gi::boundGradientChange(dh, pyr, T, gradients);
     gi::environmentBoundPerTile(azimuths, gradients, vis.azimuths, gi::blockingMaxLipschitz(vis.blockingMax), scratch,
@@ -313,10 +317,10 @@ void measureFromAnchor(Track& t, const gi::GiSettings& settings, float tolerance
                             cache);
     const gi::FoldedWedgeOperator op = gi::foldFullCircle(settings.visibility.azimuths, settings.visibility.interp);
     gi::buildChangeLevels(cache.change, t.now.pyramid, t.anchorLevels);
+    const int nxr = t.now.pyramid.nxr, nyr = t.now.pyramid.nyr, s = settings.subsample, T32 = gi::kVisibilityTile;
     std::vector<float> tileSlopes;
-    gi::boundSlopeChangePerAzimuth(cache.change, t.now.pyramid, gi::kVisibilityTile, settings.visibility.azimuths,
-                                   tileSlopes);
-    const int nxr = t.now.pyramid.nxr, nyr = t.now.pyramid.nyr, s = settings.subsample;
+    const std::vector<float> engine =
+        environmentBounds(cache.change, t.now.pyramid, settings.visibility, T32, &tileSlopes);
     const HorizonAwareBounds b =
         horizonAwareBounds(t.anchor.pyramid, t.anchor.footprint, t.now.footprint, t.anchorLevels, cache.change, op.phi,
                            gi::blockingMaxLipschitz(settings.visibility.blockingMax), tileSlopes, gi::kVisibilityTile,
@@ -325,18 +329,44 @@ void measureFromAnchor(Track& t, const gi::GiSettings& settings, float tolerance
     ambientOfV(t.now, t.anchor.envVisibility, settings, cached);
     Track::FromAnchor f;
     const auto toFloat = [](const std::vector<double>& v) { return std::vector<float>(v.begin(), v.end()); };
-    const int T32 = gi::kVisibilityTile;
     f.truth32 =
         shareAbove(toFloat(perTile({&cached.ambient}, {&fresh.ambient}, t.now, s, T32)), T32, 1, nxr, nyr, tolerance);
     f.truth16 =
         shareAbove(toFloat(perTile({&cached.ambient}, {&fresh.ambient}, t.now, s, 16)), 16, 1, nxr, nyr, tolerance);
-    f.engine32 = shareAbove(environmentBounds(cache.change, t.now.pyramid, settings.visibility, T32), T32, 1, nxr, nyr,
-                            tolerance);
+    f.engine32 = shareAbove(engine, T32, 1, nxr, nyr, tolerance);
     for (std::size_t v = 0; v < f.bound32.size(); ++v) {
         f.bound32[v] = shareAbove(tileMaxima(b.bound[v], nxr, nyr, T32), T32, 1, nxr, nyr, tolerance);
         f.bound16[v] = shareAbove(tileMaxima(b.bound[v], nxr, nyr, 16), 16, 1, nxr, nyr, tolerance);
     }
     t.fromAnchor.push_back(f);
+}
+
+// One frame's bench/horizon_aware_bound.h bounds from the last frame's
+// heights (dh: the change since them, whose |dh| pyramid sampleBounds built
+// in t.changeLevels; tileSlopes: its visibility tiles' per-azimuth slope
+// bounds), and the true moves of sigma through both weights.
+void measureHorizonAware(Track& t, const gi::GiSettings& settings, const gi::MaxChangePyramid& dh,
+                         const std::vector<float>& tileSlopes, float tolerance) {
+    const int nxr = t.now.pyramid.nxr, nyr = t.now.pyramid.nyr, T32 = gi::kVisibilityTile;
+    const gi::FoldedWedgeOperator op = gi::foldFullCircle(settings.visibility.azimuths, settings.visibility.interp);
+    const HorizonAwareBounds hb =
+        horizonAwareBounds(t.last.pyramid, t.last.footprint, t.now.footprint, t.changeLevels, dh, op.phi,
+                           gi::blockingMaxLipschitz(settings.visibility.blockingMax), tileSlopes, T32,
+                           t.now.gradX.cview(), t.now.gradY.cview());
+    const HorizonShares shares = horizonShares(hb, nxr, nyr, tolerance);
+    for (std::size_t v = 0; v < shares.size(); ++v)
+        for (std::size_t k = 0; k < 4; ++k) t.horizonShare[v][k].push_back(shares[v][k]);
+    const TrueSigmaBounds ts =
+        trueSigmaMoveBound(t.last.envVisibility, t.last.footprint, t.now.envVisibility, t.now.footprint, op.phi,
+                           t.now.gradX.cview(), t.now.gradY.cview(), settings.subsample);
+    const auto addTiles = [&](const std::vector<float>& perReceiver, std::vector<double>& to) {
+        const std::vector<float> tiles = tileMaxima(perReceiver, nxr, nyr, T32);
+        to.insert(to.end(), tiles.begin(), tiles.end());
+    };
+    addTiles(hb.bound[HorizonAwareBounds::IdealExactTangent], t.idealBound);
+    addTiles(ts.frames, t.trueSigma);
+    addTiles(ts.weighted, t.trueSigmaWeighted);
+    addTiles(hb.bound[HorizonAwareBounds::IdealExactTangentWeighted], t.idealWeighted);
 }
 
 void measureFrame(Track& t, const gi::GiSettings& settings, float cell, float tolerance) {
@@ -358,8 +388,9 @@ void measureFrame(Track& t, const gi::GiSettings& settings, float cell, float to
     const int nxr = t.now.pyramid.nxr, nyr = t.now.pyramid.nyr;
     // the per-azimuth bound of every visibility tile (the plan takes it only
     // where the coarse one would use much of the tolerance)
+    std::vector<float> tileSlopes;
     const std::vector<float> tileBound =
-        environmentBounds(cache.change, t.now.pyramid, settings.visibility, gi::kVisibilityTile);
+        environmentBounds(cache.change, t.now.pyramid, settings.visibility, gi::kVisibilityTile, &tileSlopes);
     for (std::size_t g = 0; g < kGranularities.size(); ++g) {
         const int T = kGranularities[g];
         const std::vector<float> bound = T == gi::kVisibilityTile
@@ -376,31 +407,8 @@ void measureFrame(Track& t, const gi::GiSettings& settings, float cell, float to
         t.sampleShare.push_back(shareAbove(samples, 1, 1, nxr, nyr, tolerance));
         t.sampleRunShare.push_back(shareAbove(samples, 1, gi::ReceiverTiles::kTileAlign, nxr, nyr, tolerance));
         t.sampleMs.push_back(ms);
-        const gi::FoldedWedgeOperator op = gi::foldFullCircle(settings.visibility.azimuths, settings.visibility.interp);
-        std::vector<float> tileSlopes;
-        gi::boundSlopeChangePerAzimuth(cache.change, t.now.pyramid, gi::kVisibilityTile, settings.visibility.azimuths,
-                                       tileSlopes);
-        const HorizonAwareBounds hb =
-            horizonAwareBounds(t.last.pyramid, t.last.footprint, t.now.footprint, t.changeLevels, cache.change, op.phi,
-                               gi::blockingMaxLipschitz(settings.visibility.blockingMax), tileSlopes,
-                               gi::kVisibilityTile, t.now.gradX.cview(), t.now.gradY.cview());
-        const HorizonShares shares = horizonShares(hb, nxr, nyr, tolerance);
-        for (std::size_t v = 0; v < shares.size(); ++v)
-            for (std::size_t k = 0; k < 4; ++k) t.horizonShare[v][k].push_back(shares[v][k]);
-        const std::vector<float> ideal =
-            tileMaxima(hb.bound[HorizonAwareBounds::IdealExactTangent], nxr, nyr, gi::kVisibilityTile);
-        t.idealBound.insert(t.idealBound.end(), ideal.begin(), ideal.end());
-        const TrueSigmaBounds ts =
-            trueSigmaMoveBound(t.last.envVisibility, t.last.footprint, t.now.envVisibility, t.now.footprint, op.phi,
-                               t.now.gradX.cview(), t.now.gradY.cview(), settings.subsample);
-        const std::vector<float> sigma = tileMaxima(ts.frames, nxr, nyr, gi::kVisibilityTile);
-        const std::vector<float> sigmaWeighted = tileMaxima(ts.weighted, nxr, nyr, gi::kVisibilityTile);
-        const std::vector<float> idealWeighted =
-            tileMaxima(hb.bound[HorizonAwareBounds::IdealExactTangentWeighted], nxr, nyr, gi::kVisibilityTile);
-        t.trueSigma.insert(t.trueSigma.end(), sigma.begin(), sigma.end());
-        t.trueSigmaWeighted.insert(t.trueSigmaWeighted.end(), sigmaWeighted.begin(), sigmaWeighted.end());
-        t.idealWeighted.insert(t.idealWeighted.end(), idealWeighted.begin(), idealWeighted.end());
     }
+    measureHorizonAware(t, settings, cache.change, tileSlopes, tolerance);
     if (t.frame > t.anchorFrame + 1) measureFromAnchor(t, settings, tolerance, fresh);
     gi::ShadeMaps cached;
     ambientOfV(t.now, t.last.envVisibility, settings, cached);
@@ -540,33 +548,25 @@ std::string granularityTable(const Track& t) {
 }
 
 std::string report(const Track& t, float tolerance) {
-    std::vector<double> ratio;
-    for (std::size_t i = 0; i < t.bound.size(); ++i)
-        if (t.vChange[i] > 0.0) ratio.push_back(t.bound[i] / t.vChange[i]);
-    std::vector<double> idealRatio;
-    for (std::size_t i = 0; i < t.idealBound.size() && i < t.vChange.size(); ++i)
-        if (t.vChange[i] > 0.0) idealRatio.push_back(t.idealBound[i] / t.vChange[i]);
+    // per tile, a bound over the true change where that is not 0
     const auto ratioTo = [&](const std::vector<double>& bound) {
         std::vector<double> r;
         for (std::size_t i = 0; i < bound.size() && i < t.vChange.size(); ++i)
             if (t.vChange[i] > 0.0) r.push_back(bound[i] / t.vChange[i]);
         return r;
     };
-    std::vector<double> sigmaRatio;
-    for (std::size_t i = 0; i < t.trueSigma.size() && i < t.vChange.size(); ++i)
-        if (t.vChange[i] > 0.0) sigmaRatio.push_back(t.trueSigma[i] / t.vChange[i]);
     return "\n### " + t.name +
            "\n\n| quantity | p10 | median | p90 | max | share above the tolerance |\n|---|---|---|---|---|---|\n" +
            row("\\|dh\\| per cell (m; share above 1 cm)", t.dh, 0.01) +
            row("per tile: one-frame bound on the cached V's ambient change", t.bound, tolerance) +
            row("per tile: true change of the cached V's ambient", t.vChange, tolerance) +
-           row("per tile: V bound / true change (share above 1)", ratio, 1.0) +
+           row("per tile: V bound / true change (share above 1)", ratioTo(t.bound), 1.0) +
            row("per tile: the ideal exact-tangent bound (bench/horizon_aware_bound.h), one frame", t.idealBound,
                tolerance) +
-           row("per tile: the same / true change", idealRatio, 1.0) +
+           row("per tile: the same / true change", ratioTo(t.idealBound), 1.0) +
            row("per tile: the true moves of sigma through the same conversion (bench/horizon_aware_bound.h)",
                t.trueSigma, tolerance) +
-           row("per tile: the same / true change", sigmaRatio, 1.0) +
+           row("per tile: the same / true change", ratioTo(t.trueSigma), 1.0) +
            row("per tile: the true moves of sigma, elevation weight (bench/elevation_weight.h, an estimate)",
                t.trueSigmaWeighted, tolerance) +
            row("per tile: the same / true change", ratioTo(t.trueSigmaWeighted), 1.0) +

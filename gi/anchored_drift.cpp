@@ -15,20 +15,18 @@ void AnchoredDrift::reset(std::size_t tiles) {
 
 namespace {
 
-// How far tile t's result can be from this frame's: from the anchor, and
-// from the last planned frame's inputs where sinceLast is known.
-float driftNow(const AnchoredDrift& drift, std::span<const float> excursion, std::span<const float> sinceLast,
-               std::size_t t) {
-    const float fromAnchor = drift.fromAnchor[t] + excursion[t];
-    return sinceLast.empty() ? fromAnchor : std::min(fromAnchor, drift.sinceInputs[t] + sinceLast[t]);
-}
-
 void requireLayout(const AnchoredDrift& drift, std::size_t n, std::size_t dirty, std::span<const float> sinceLast) {
     if (!drift.fits(n) || dirty != n || (!sinceLast.empty() && sinceLast.size() != n))
         throw InputError("anchored drift: tiles of another layout");
 }
 
 }  // namespace
+
+float driftNow(const AnchoredDrift& drift, std::span<const float> excursion, std::span<const float> sinceLast,
+               std::size_t t) {
+    const float fromAnchor = drift.fromAnchor[t] + excursion[t];
+    return sinceLast.empty() ? fromAnchor : std::min(fromAnchor, drift.sinceInputs[t] + sinceLast[t]);
+}
 
 void markAnchoredDrift(std::span<const float> excursion, std::span<const float> sinceLast,
                        std::span<const std::uint8_t> forced, float scale, float tolerance, const AnchoredDrift& drift,

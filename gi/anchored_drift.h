@@ -74,6 +74,12 @@ struct AnchorVotes {
     bool reanchor() const { return movingAway || (recomputedMoved && !keptMoved); }
 };
 
+/// How far tile t's result can be from this frame's: A_t + excursion[t],
+/// or with `sinceLast` (empty: not known) the smaller of that and S_t +
+/// sinceLast[t] (below).
+float driftNow(const AnchoredDrift& drift, std::span<const float> excursion, std::span<const float> sinceLast,
+               std::size_t t);
+
 /// Marks dirty[t] (1: recompute) where forced[t] (empty: none) or where the
 /// drift times `scale` exceeds `tolerance`, and adds the tiles' votes. The
 /// drift is A_t + excursion[t], or with `sinceLast` (empty: not known) the smaller of

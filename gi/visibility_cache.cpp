@@ -193,14 +193,9 @@ void keepCoarseBounds(const std::vector<std::uint8_t>& perAzimuth, const std::ve
 struct Candidates {
     bool env = false, geometry = false;
     bool over(const VisibilityCache& cache, std::size_t t, float tolerance) const {
-        return (env && driftOver(cache.drift, cache.envExcursion, cache.envSinceLast, t, tolerance)) ||
+        return (env && driftNow(cache.drift, cache.envExcursion, cache.envSinceLast, t) > tolerance) ||
                (geometry &&
-                driftOver(cache.geometryDrift, cache.geometryExcursion, cache.geometrySinceLast, t, tolerance));
-    }
-    // over the tolerance from the anchor, and from the last planned frame's inputs
-    static bool driftOver(const AnchoredDrift& d, const std::vector<float>& excursion,
-                          const std::vector<float>& sinceLast, std::size_t t, float tolerance) {
-        return d.fromAnchor[t] + excursion[t] > tolerance && d.sinceInputs[t] + sinceLast[t] > tolerance;
+                driftNow(cache.geometryDrift, cache.geometryExcursion, cache.geometrySinceLast, t) > tolerance);
     }
 };
 
