@@ -25,12 +25,17 @@ void buildChangeLevels(const MaxChangePyramid& dh, const HeightPyramid& pyr, Cha
     const ConstGridView input = dh.levels[0].cview();
     const CellBox nonZero = changedCells(dh);
     out.largest = maxChangeAll(dh);
-    const CellBox redo = same ? out.built.joined(nonZero) : CellBox{};
-    // nothing to redo without a change (no walk reads the pyramid then: it
-    // keeps the last one, and `built` its box) or with the last build's
-    // input again (a pit dropped, filled and dropped)
-    const bool kept = same && (nonZero.empty() || differingCellsIn(out.input.cview(), input, redo).empty());
-    if (!kept) {
+    // the input can differ from the last build's only where either is
+    // non-zero; the pyramid is redone where it does: nothing without a
+    // change (no walk reads the pyramid then: it keeps the last one, and
+    // `built` its box) or with the last build's input again (a pit dropped,
+    // filled and dropped), one pit's reach when a change adds a pit to
+    // those already since the anchor
+    const CellBox redo = same
+                             ? (nonZero.empty() ? CellBox::none()
+                                                : differingCellsIn(out.input.cview(), input, out.built.joined(nonZero)))
+                             : CellBox{};
+    if (!same || !redo.empty()) {
         out.valid = false;  // until built
         buildHeightPyramid(input, pyr.cellSize, pyr.subsample, pyr.settings, out.bound, redo);
         copyGrid(input, out.input, same ? redo.rows() : RowSpan{0, input.ny});

@@ -256,12 +256,22 @@ TEST_CASE(
     boundSlopeChangePerReceiverAzimuth(levels, pyr, op.phi, nullptr, 0.0f, bound);
     CHECK(std::all_of(bound.begin(), bound.end(), [](float v) { return v == 0.0f; }));
     // a bump, no change, the bump again, a spike elsewhere, no change, the
-    // spike again: a build with a change redoes the last one's box and its
-    // own, one without a change or with the last one's again redoes nothing
-    // (-1: no change), and the bounds are always a whole build's
-    for (int kind : {0, -1, 0, 2, -1, 2}) {
+    // spike again, the spikes and a pit beside them (a change added to one
+    // that stays): a build redoes the cells where its |dh| differs from the
+    // last one's, none without a change or with the last one's again (-1:
+    // no change; 4: kind 2 and the pit), and the bounds are always a whole
+    // build's
+    const auto heightsOf = [&](int kind) {
+        if (kind < 0) return base;
+        Grid h = changed(base, kind == 4 ? 2 : kind);
+        if (kind == 4)
+            for (int y = 60; y < 70; ++y)
+                for (int x = 90; x < 100; ++x) h(x, y) -= 5.0f;
+        return h;
+    };
+    for (int kind : {0, -1, 0, 2, -1, 2, 4, 2}) {
         CAPTURE(kind);
-        const Grid h = kind < 0 ? base : changed(base, kind);
+        const Grid h = heightsOf(kind);
         buildMaxChangePyramid(base.cview(), h.cview(), dh);
         buildChangeLevels(dh, pyr, levels);
         whole = {};
