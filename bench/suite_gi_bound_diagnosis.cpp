@@ -28,6 +28,7 @@
 #include "core/parallel.h"
 #include "gi/change_bound.h"
 #include "gi/frame.h"
+#include "gi/indirect.h"
 #include "gi/indirect_cache.h"
 #include "gi/receiver_azimuth_bound.h"
 #include "gi/receiver_change_bound.h"
@@ -87,6 +88,9 @@ struct Track {
     GiState now, last;
     Grid heights, lastHeights;
     std::vector<double> bound, vChange, indirectSampleBound, indirectBound, indirectChange, dh;
+    // the indirect light's true change from the geometry alone and from the
+    // sources alone (indirectOfLastSources), and its geometry bound (geometryBounds)
+    std::vector<double> indirectGeometryChange, indirectSourceChange, indirectGeometryBound;
     // An oracle that knows the true results, per granularity
     // (kGranularities): per tile it keeps its cached V and indirect light
     // until they are more than the tolerance from the truth. The share of
@@ -292,6 +296,49 @@ IndirectBounds indirectBounds(const GiState& now, const GiState& last, int azimu
     return out;
 }
 
+// The one-bounce indirect light of this frame's geometry lit by the last
+// frame's direct light, with the frame's own settings: from the last
+// frame's indirect light to it only the geometry moved, from it to this
+// frame's only the sources (the direct light it reflects).
+std::array<Grid, 3> indirectOfLastSources(const GiState& now, const GiState& last, const gi::GiSettings& settings) {
+    const int azimuths = settings.indirect.azimuths == 0 ? settings.visibility.azimuths : settings.indirect.azimuths;
+    const gi::FoldedWedgeOperator op = gi::foldFullCircle(azimuths, settings.visibility.interp);
+    const gi::IndirectInputs in{.heights = now.pyramid,
+                                .gradX = now.gradX.cview(),
+                                .gradY = now.gradY.cview(),
+                                .op = op,
+                                .envVisibility = now.envVisibility,
+                                .direct = last.shade.rgb,
+                                .directShade = &last.shade,
+                                .albedo = nullptr,
+                                .shading = settings.shading};
+    gi::IndirectState state;
+    gi::computeIndirect(in, settings.indirect, state);
+    return state.indirect;
+}
+
+// Per visibility tile, the bound the plan (gi/visibility_cache.h) puts on
+// the geometry's change of the indirect light: V's bound over the indirect
+// scan's azimuths where they are every k-th of the environment's (from the
+// tiles' per-azimuth slope bounds `azimuthBound`), else over every direction.
+std::vector<float> geometryBounds(const gi::MaxChangePyramid& dh, const gi::HeightPyramid& pyr,
+                                  const gi::GiSettings& settings, const std::vector<float>& azimuthBound) {
+    const gi::VisibilitySettings& vis = settings.visibility;
+    const int indirect = settings.indirect.azimuths == 0 ? vis.azimuths : settings.indirect.azimuths;
+    const float lipschitz = gi::blockingMaxLipschitz(vis.blockingMax);
+    std::vector<float> gradients, scratch, bound;
+    gi::boundGradientChange(dh, pyr, gi::kVisibilityTile, gradients);
+    if (vis.azimuths % indirect == 0) {
+        gi::environmentBoundPerTile(azimuthBound, gradients, vis.azimuths, lipschitz, scratch, bound,
+                                    vis.azimuths / indirect);
+    } else {
+        std::vector<float> slopes;
+        gi::boundSlopeChange(dh, pyr, gi::kVisibilityTile, slopes);
+        gi::geometryBoundPerTile(slopes, gradients, lipschitz, bound);
+    }
+    return bound;
+}
+
 // Per variant of bench/horizon_aware_bound.h's bounds, the share of the
 // receivers above the tolerance alone, in runs of 16 and in tiles of 16 x 16
 // and 32 x 32 receivers.
@@ -418,6 +465,17 @@ void measureFrame(Track& t, const gi::GiSettings& settings, float cell, float to
         perTile({&t.last.indirect.indirect[0], &t.last.indirect.indirect[1], &t.last.indirect.indirect[2]},
                 {&t.now.indirect.indirect[0], &t.now.indirect.indirect[1], &t.now.indirect.indirect[2]}, t.now, s);
     const IndirectBounds ib = indirectBounds(t.now, t.last, settings.indirect.azimuths);
+    const std::array<Grid, 3> mixed = indirectOfLastSources(t.now, t.last, settings);
+    const std::vector<double> geometry =
+        perTile({&t.last.indirect.indirect[0], &t.last.indirect.indirect[1], &t.last.indirect.indirect[2]},
+                {&mixed[0], &mixed[1], &mixed[2]}, t.now, s);
+    const std::vector<double> sources =
+        perTile({&mixed[0], &mixed[1], &mixed[2]},
+                {&t.now.indirect.indirect[0], &t.now.indirect.indirect[1], &t.now.indirect.indirect[2]}, t.now, s);
+    const std::vector<float> geometryBound = geometryBounds(cache.change, t.now.pyramid, settings, tileSlopes);
+    t.indirectGeometryChange.insert(t.indirectGeometryChange.end(), geometry.begin(), geometry.end());
+    t.indirectSourceChange.insert(t.indirectSourceChange.end(), sources.begin(), sources.end());
+    t.indirectGeometryBound.insert(t.indirectGeometryBound.end(), geometryBound.begin(), geometryBound.end());
     t.indirectSampleBound.insert(t.indirectSampleBound.end(), ib.sampleMove.begin(), ib.sampleMove.end());
     t.indirectBound.insert(t.indirectBound.end(), ib.bound.begin(), ib.bound.end());
     t.bound.insert(t.bound.end(), tileBound.begin(), tileBound.end());
@@ -440,7 +498,11 @@ const char* kIntro =
     "group, times the occlusion factor; the largest over the indirect tiles of 16 x 16 receivers the tile holds); "
     "the true change of the indirect light is that of the whole frame (sources and "
     "geometry), largest over the tile's texels and "
-    "channels. Quantiles over every tile of every frame after the first. The oracle knows the true results: per "
+    "channels, then split in two through the indirect light of this frame's geometry lit by the last frame's "
+    "direct light: from the last frame's indirect light to that one only the geometry moved, from that one to this "
+    "frame's only the sources; the plan's geometry bound of the indirect light is V's one-frame bound over the "
+    "indirect scan's azimuths (gi/visibility_cache.h re-gathers a tile whose geometry drift passes the tolerance). "
+    "Quantiles over every tile of every frame after the first. The oracle knows the true results: per "
     "tile it keeps its cached V (or indirect light) until the tile's texels are more than the tolerance from the "
     "truth, then takes the truth; the share of tiles it recomputes per frame is about the least any conservative "
     "bound can recompute. The second table of each case compares granularities: per frame, the share of the "
@@ -548,11 +610,12 @@ std::string granularityTable(const Track& t) {
 }
 
 std::string report(const Track& t, float tolerance) {
-    // per tile, a bound over the true change where that is not 0
-    const auto ratioTo = [&](const std::vector<double>& bound) {
+    // per tile, a bound over a true change (V's by default) where that is not 0
+    const auto ratioTo = [&](const std::vector<double>& bound, const std::vector<double>* truth = nullptr) {
+        const std::vector<double>& change = truth ? *truth : t.vChange;
         std::vector<double> r;
-        for (std::size_t i = 0; i < bound.size() && i < t.vChange.size(); ++i)
-            if (t.vChange[i] > 0.0) r.push_back(bound[i] / t.vChange[i]);
+        for (std::size_t i = 0; i < bound.size() && i < change.size(); ++i)
+            if (change[i] > 0.0) r.push_back(bound[i] / change[i]);
         return r;
     };
     return "\n### " + t.name +
@@ -575,6 +638,13 @@ std::string report(const Track& t, float tolerance) {
            row("per tile: largest radiance sample move of the indirect scan", t.indirectSampleBound, tolerance) +
            row("per tile: one-frame radiance bound of the indirect light", t.indirectBound, tolerance) +
            row("per tile: true change of the indirect light", t.indirectChange, tolerance) +
+           row("per tile: the same, from the sources alone (the direct light it reflects)", t.indirectSourceChange,
+               tolerance) +
+           row("per tile: the same, from the geometry alone", t.indirectGeometryChange, tolerance) +
+           row("per tile: the plan's geometry bound of the indirect light (V's over its azimuths)",
+               t.indirectGeometryBound, tolerance) +
+           row("per tile: the same / the true change from the geometry",
+               ratioTo(t.indirectGeometryBound, &t.indirectGeometryChange), 1.0) +
            row("oracle: share of the tiles whose V it recomputes, per frame (share above 0)", t.oracles[0].vShare,
                0.0) +
            row("oracle: share of the tiles whose indirect light it recomputes, per frame (share above 0)",
