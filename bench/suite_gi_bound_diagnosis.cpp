@@ -92,14 +92,14 @@ struct Track {
     // sources alone (indirectOfLastSources), and its geometry bound (geometryBounds)
     std::vector<double> indirectGeometryChange, indirectSourceChange, indirectGeometryBound;
     // An oracle that knows the true results, per granularity
-    // (kGranularities): per tile it keeps its cached V and indirect light
-    // until they are more than the tolerance from the truth. The share of
-    // receivers it recomputes per frame is what any conservative bound on
-    // tiles of that size recomputes at least.
+    // (kGranularities): per tile it keeps its cached V, direct shade and
+    // indirect light until they are more than the tolerance from the truth.
+    // The share of receivers it recomputes per frame is what any
+    // conservative bound on tiles of that size recomputes at least.
     struct Oracle {
         gi::VisibilityField v;
-        std::array<Grid, 3> indirect;
-        std::vector<double> vShare, indirectShare;
+        std::array<Grid, 3> shade, indirect;
+        std::vector<double> vShare, shadeShare, indirectShare;
     };
     std::array<Oracle, kGranularities.size()> oracles;
     // per granularity, per frame: the share of the receivers whose tile's
@@ -134,11 +134,12 @@ struct Track {
     gi::ChangeLevels anchorLevels;
 };
 
-// Copies the receivers (V) or texels (indirect light) of the tiles of T x T
-// receivers whose deviation exceeds the tolerance from the truth into the
-// oracle's cache; returns the share of the receivers they hold.
+// Copies the receivers (V) or texels (`texels` from `truth`: the direct
+// shade or the indirect light) of the tiles of T x T receivers whose
+// deviation exceeds the tolerance from the truth into the oracle's cache;
+// returns the share of the receivers they hold.
 double refreshTiles(const std::vector<double>& deviation, float tolerance, const GiState& now, int s, int T,
-                    gi::VisibilityField* v, std::array<Grid, 3>* indirect) {
+                    gi::VisibilityField* v, std::array<Grid, 3>* texels, const std::array<Grid, 3>* truth = nullptr) {
     const int tilesX = gi::tileCount(now.pyramid.nxr, T);
     double dirty = 0.0;
     for (std::size_t t = 0; t < deviation.size(); ++t) {
@@ -152,13 +153,13 @@ double refreshTiles(const std::vector<double>& deviation, float tolerance, const
                     for (int k = 0; k < 16; ++k)
                         v->plane(k)[static_cast<std::size_t>(Y) * v->nxr + X] =
                             now.envVisibility.plane(k)[static_cast<std::size_t>(Y) * v->nxr + X];
-                if (!indirect) continue;
+                if (!texels) continue;
                 // the texels that map to this receiver (the last ones take the edge)
                 const int xEnd = X + 1 == now.pyramid.nxr ? now.gradX.nx : s * X + s;
                 const int yEnd = Y + 1 == now.pyramid.nyr ? now.gradX.ny : s * Y + s;
                 for (std::size_t c = 0; c < 3; ++c)
                     for (int y = s * Y; y < yEnd; ++y)
-                        for (int x = s * X; x < xEnd; ++x) (*indirect)[c](x, y) = now.indirect.indirect[c](x, y);
+                        for (int x = s * X; x < xEnd; ++x) (*texels)[c](x, y) = (*truth)[c](x, y);
             }
     }
     return dirty / (static_cast<double>(now.pyramid.nxr) * now.pyramid.nyr);
@@ -183,6 +184,7 @@ void oracleFrame(Track& t, const gi::GiSettings& settings, float tolerance, cons
         const int T = kGranularities[g];
         if (o.v.sh.empty()) {
             o.v = t.now.envVisibility;
+            o.shade = t.now.shade.rgb;
             o.indirect = t.now.indirect.indirect;
             continue;
         }
@@ -193,7 +195,12 @@ void oracleFrame(Track& t, const gi::GiSettings& settings, float tolerance, cons
         const std::vector<double> ind = perTile(
             {&o.indirect[0], &o.indirect[1], &o.indirect[2]},
             {&t.now.indirect.indirect[0], &t.now.indirect.indirect[1], &t.now.indirect.indirect[2]}, t.now, s, T);
-        o.indirectShare.push_back(refreshTiles(ind, tolerance, t.now, s, T, nullptr, &o.indirect));
+        o.indirectShare.push_back(
+            refreshTiles(ind, tolerance, t.now, s, T, nullptr, &o.indirect, &t.now.indirect.indirect));
+        const std::vector<double> shade =
+            perTile({&o.shade[0], &o.shade[1], &o.shade[2]},
+                    {&t.now.shade.rgb[0], &t.now.shade.rgb[1], &t.now.shade.rgb[2]}, t.now, s, T);
+        o.shadeShare.push_back(refreshTiles(shade, tolerance, t.now, s, T, nullptr, &o.shade, &t.now.shade.rgb));
     }
 }
 
@@ -503,7 +510,8 @@ const char* kIntro =
     "frame's only the sources; the plan's geometry bound of the indirect light is V's one-frame bound over the "
     "indirect scan's azimuths (gi/visibility_cache.h re-gathers a tile whose geometry drift passes the tolerance). "
     "Quantiles over every tile of every frame after the first. The oracle knows the true results: per "
-    "tile it keeps its cached V (or indirect light) until the tile's texels are more than the tolerance from the "
+    "tile it keeps its cached V (or direct shade, or indirect light) until the tile's texels are more than the "
+    "tolerance from the "
     "truth, then takes the truth; the share of tiles it recomputes per frame is about the least any conservative "
     "bound can recompute. The second table of each case compares granularities: per frame, the share of the "
     "receivers whose tile's one-frame V bound passes the tolerance (the same bound taken over tiles of that many "
@@ -584,27 +592,27 @@ std::string horizonTables(const Track& t) {
 // V bound marks and of those the oracle recomputes.
 std::string granularityTable(const Track& t) {
     std::string out =
-        "\n| tiles (receivers) | one-frame V bound above the tolerance | oracle: V recomputed | oracle: indirect light "
-        "recomputed |\n|---|---|---|---|\n";
+        "\n| tiles (receivers) | one-frame V bound above the tolerance | oracle: V recomputed | oracle: direct shade "
+        "recomputed | oracle: indirect light recomputed |\n|---|---|---|---|---|\n";
     for (std::size_t g = 0; g < kGranularities.size(); ++g) {
         char buf[200];
-        std::snprintf(buf, sizeof buf, "| %d x %d | %.2f %% | %.2f %% | %.2f %% |\n", kGranularities[g],
+        std::snprintf(buf, sizeof buf, "| %d x %d | %.2f %% | %.2f %% | %.2f %% | %.2f %% |\n", kGranularities[g],
                       kGranularities[g], 100.0 * mean(t.boundShare[g]), 100.0 * mean(t.oracles[g].vShare),
-                      100.0 * mean(t.oracles[g].indirectShare));
+                      100.0 * mean(t.oracles[g].shadeShare), 100.0 * mean(t.oracles[g].indirectShare));
         out += buf;
     }
     char buf[200];
-    std::snprintf(buf, sizeof buf, "| 1 x 1, in the scans' runs of %d along a row | %.2f %% | | |\n",
+    std::snprintf(buf, sizeof buf, "| 1 x 1, in the scans' runs of %d along a row | %.2f %% | | | |\n",
                   gi::ReceiverTiles::kTileAlign, 100.0 * mean(t.laneRunShare));
     out += buf;
-    std::snprintf(buf, sizeof buf, "| 1 x 1, one slope bound for every azimuth (max filters) | %.2f %% | | |\n",
+    std::snprintf(buf, sizeof buf, "| 1 x 1, one slope bound for every azimuth (max filters) | %.2f %% | | | |\n",
                   100.0 * mean(t.isotropicShare));
     out += buf;
     std::snprintf(buf, sizeof buf,
-                  "| 1 x 1, per azimuth from the samples' own change (%.1f ms per frame, median) | %.2f %% | | |\n",
+                  "| 1 x 1, per azimuth from the samples' own change (%.1f ms per frame, median) | %.2f %% | | | |\n",
                   quantile(t.sampleMs, 0.5), 100.0 * mean(t.sampleShare));
     out += buf;
-    std::snprintf(buf, sizeof buf, "| the same, in the scans' runs of %d along a row | %.2f %% | | |\n",
+    std::snprintf(buf, sizeof buf, "| the same, in the scans' runs of %d along a row | %.2f %% | | | |\n",
                   gi::ReceiverTiles::kTileAlign, 100.0 * mean(t.sampleRunShare));
     return out + buf + horizonTables(t);
 }
@@ -647,6 +655,8 @@ std::string report(const Track& t, float tolerance) {
                ratioTo(t.indirectGeometryBound, &t.indirectGeometryChange), 1.0) +
            row("oracle: share of the tiles whose V it recomputes, per frame (share above 0)", t.oracles[0].vShare,
                0.0) +
+           row("oracle: share of the tiles whose direct shade it recomputes, per frame (share above 0)",
+               t.oracles[0].shadeShare, 0.0) +
            row("oracle: share of the tiles whose indirect light it recomputes, per frame (share above 0)",
                t.oracles[0].indirectShare, 0.0) +
            granularityTable(t);
