@@ -308,8 +308,8 @@ IndirectBounds indirectBounds(const GiState& now, const GiState& last, int azimu
 // frame's indirect light to it only the geometry moved, from it to this
 // frame's only the sources (the direct light it reflects).
 std::array<Grid, 3> indirectOfLastSources(const GiState& now, const GiState& last, const gi::GiSettings& settings) {
-    const int azimuths = settings.indirect.azimuths == 0 ? settings.visibility.azimuths : settings.indirect.azimuths;
-    const gi::FoldedWedgeOperator op = gi::foldFullCircle(azimuths, settings.visibility.interp);
+    const gi::FoldedWedgeOperator op =
+        gi::foldFullCircle(gi::indirectScanAzimuths(settings), settings.visibility.interp);
     const gi::IndirectInputs in{.heights = now.pyramid,
                                 .gradX = now.gradX.cview(),
                                 .gradY = now.gradY.cview(),
@@ -331,7 +331,7 @@ std::array<Grid, 3> indirectOfLastSources(const GiState& now, const GiState& las
 std::vector<float> geometryBounds(const gi::MaxChangePyramid& dh, const gi::HeightPyramid& pyr,
                                   const gi::GiSettings& settings, const std::vector<float>& azimuthBound) {
     const gi::VisibilitySettings& vis = settings.visibility;
-    const int indirect = settings.indirect.azimuths == 0 ? vis.azimuths : settings.indirect.azimuths;
+    const int indirect = gi::indirectScanAzimuths(settings);
     const float lipschitz = gi::blockingMaxLipschitz(vis.blockingMax);
     std::vector<float> gradients, scratch, bound;
     gi::boundGradientChange(dh, pyr, gi::kVisibilityTile, gradients);
@@ -471,7 +471,7 @@ void measureFrame(Track& t, const gi::GiSettings& settings, float cell, float to
     const std::vector<double> ind =
         perTile({&t.last.indirect.indirect[0], &t.last.indirect.indirect[1], &t.last.indirect.indirect[2]},
                 {&t.now.indirect.indirect[0], &t.now.indirect.indirect[1], &t.now.indirect.indirect[2]}, t.now, s);
-    const IndirectBounds ib = indirectBounds(t.now, t.last, settings.indirect.azimuths);
+    const IndirectBounds ib = indirectBounds(t.now, t.last, gi::indirectScanAzimuths(settings));
     const std::array<Grid, 3> mixed = indirectOfLastSources(t.now, t.last, settings);
     const std::vector<double> geometry =
         perTile({&t.last.indirect.indirect[0], &t.last.indirect.indirect[1], &t.last.indirect.indirect[2]},

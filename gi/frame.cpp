@@ -20,11 +20,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
-// The indirect scan's azimuths: its own (IndirectSettings::azimuths) or the environment's.
-int indirectScanAzimuths(const GiSettings& settings) {
-    return settings.indirect.azimuths == 0 ? settings.visibility.azimuths : settings.indirect.azimuths;
-}
-
 // The folded wedge operator of the indirect scan: the environment's (when it
 // gives V), or one of its own azimuths, cached.
 const FoldedWedgeOperator& indirectScanOperator(const GiSettings& settings, GiState& st) {

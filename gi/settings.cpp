@@ -45,4 +45,8 @@ void validateGiSettings(const GiSettings& s) {
     validateIndirectSettings(s.indirect);
 }
 
+int indirectScanAzimuths(const GiSettings& s) {
+    return s.indirect.azimuths == 0 ? s.visibility.azimuths : s.indirect.azimuths;
+}
+
 }  // namespace terrain::gi

@@ -69,4 +69,8 @@ GiSettings paperGiSettings();
 /// Throws InputError naming the first setting outside its range.
 void validateGiSettings(const GiSettings& s);
 
+/// The indirect scan's azimuths: its own (IndirectSettings::azimuths) or,
+/// for 0, the environment's.
+int indirectScanAzimuths(const GiSettings& s);
+
 }  // namespace terrain::gi
