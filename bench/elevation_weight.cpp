@@ -2,19 +2,32 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 
 #include "gi/sh.h"
 
 namespace terrain::bench {
 namespace {
 
-// The clamped cosine's bands 0..2 over pi (gi/change_bound.h).
-double bandLimitedCosine(double x) { return (15.0 * x * x + 16.0 * x + 3.0) / (32.0 * std::numbers::pi); }
+// The Legendre polynomials P_0..P_3 at z.
+std::array<double, 4> legendreP(double z) {
+    return {1.0, z, 0.5 * (3.0 * z * z - 1.0), 0.5 * (5.0 * z * z * z - 3.0 * z)};
+}
+
+// The clamped cosine's bands 0..2 over pi at x = N . w, from its zonal
+// coefficients: sum_l z_l sqrt((2l + 1) / (4 pi)) P_l(x) / pi.
+double bandLimitedCosine(double x) {
+    const double* zh = gi::lambertZonal();
+    const std::array<double, 4> p = legendreP(x);
+    double k = 0.0;
+    for (int l = 0; l < 3; ++l)
+        k += zh[l] * std::sqrt((2.0 * l + 1.0) / (4.0 * gi::kPi)) * p[static_cast<std::size_t>(l)];
+    return k / gi::kPi;
+}
 
 // g(z) = sum_n c_n P_n(z), n = 0..3.
 double legendreSum(const std::array<double, 4>& c, double z) {
-    return c[0] + c[1] * z + c[2] * 0.5 * (3.0 * z * z - 1.0) + c[3] * 0.5 * (5.0 * z * z * z - 3.0 * z);
+    const std::array<double, 4> p = legendreP(z);
+    return c[0] * p[0] + c[1] * p[1] + c[2] * p[2] + c[3] * p[3];
 }
 
 }  // namespace
@@ -30,8 +43,9 @@ ElevationWeight::ElevationWeight() {
             std::array<double, 4> c{};
             for (int i = 0; i < kNodes; ++i) {
                 const double z = zs[i], f = bandLimitedCosine(nz * z + h * std::sqrt(1.0 - z * z));
-                const double p[4] = {1.0, z, 0.5 * (3.0 * z * z - 1.0), 0.5 * (5.0 * z * z * z - 3.0 * z)};
-                for (int n = 0; n < 4; ++n) c[static_cast<std::size_t>(n)] += ws[i] * f * p[n] * (2.0 * n + 1.0) / 2.0;
+                const std::array<double, 4> p = legendreP(z);
+                for (std::size_t n = 0; n < 4; ++n)
+                    c[n] += ws[i] * f * p[n] * (2.0 * static_cast<double>(n) + 1.0) / 2.0;
             }
             table_[static_cast<std::size_t>(a) * kH + b] = c;
         }

@@ -75,28 +75,46 @@ void texelNormals(ConstGridView gx, ConstGridView gy, int s, int X, int Y, std::
 
 double sinOfSlope(double t) { return t / std::sqrt(1.0 + t * t); }
 
+// The directions across the support of each azimuth sample's hat: its
+// ends, middle and quarter points (kHatPoints per sample, sample-major),
+// taken once per call of the bounds below rather than per receiver.
+constexpr int kHatPoints = 5;
+struct HatDirections {
+    std::vector<double> cosPhi, sinPhi;
+};
+HatDirections hatDirections(std::span<const double> phi) {
+    const double step = 2.0 * std::numbers::pi / static_cast<double>(phi.size());
+    HatDirections out;
+    for (const double p0 : phi)
+        for (int d = -(kHatPoints / 2); d <= kHatPoints / 2; ++d) {
+            const double p = p0 + 0.5 * d * step;
+            out.cosPhi.push_back(std::cos(p));
+            out.sinPhi.push_back(std::sin(p));
+        }
+    return out;
+}
+
 // The ambient change bound of gi/change_bound.h with the elevation weight:
 // (2 pi / m) sum_j W_j dU_j, sigma_j (tan) moving within [lo_j, hi_j]; dU_j
 // the largest move of sin(sigma_j) over the band, W_j the largest |g| over
-// it, the normals, and azimuths across the support of sample j's hat
-// (sampled at its ends, middle and quarter points).
-double weightedAmbientBound(const ElevationWeight& weight, const std::vector<Normal>& normals,
-                            std::span<const double> phi, const float* sigma, const float* lo, const float* hi) {
-    const int m = static_cast<int>(phi.size());
-    const double step = 2.0 * std::numbers::pi / m;
+// it, the normals, and the directions of sample j's hat.
+double weightedAmbientBound(const ElevationWeight& weight, const std::vector<Normal>& normals, const HatDirections& hat,
+                            const float* sigma, const float* lo, const float* hi) {
+    const int m = static_cast<int>(hat.cosPhi.size()) / kHatPoints;
     double sum = 0.0;
     for (int j = 0; j < m; ++j) {
         const double u = sinOfSlope(sigma[j]), u0 = sinOfSlope(lo[j]), u1 = sinOfSlope(hi[j]);
         const double du = std::max(u1 - u, u - u0);
         if (!(du > 0.0)) continue;
         double w = 0.0;
-        for (int d = -2; d <= 2; ++d) {
-            const double p = phi[static_cast<std::size_t>(j)] + 0.5 * d * step, c = std::cos(p), sn = std::sin(p);
+        for (int d = 0; d < kHatPoints; ++d) {
+            const std::size_t k = static_cast<std::size_t>(j * kHatPoints + d);
+            const double c = hat.cosPhi[k], sn = hat.sinPhi[k];
             for (const Normal& n : normals) w = std::max(w, weight.largest(n.z, n.x * c + n.y * sn, u0, u1));
         }
         sum += w * du;
     }
-    return step * sum;
+    return 2.0 * std::numbers::pi / m * sum;
 }
 
 const ElevationWeight& elevationWeight() {
@@ -164,6 +182,7 @@ HorizonAwareBounds horizonAwareBounds(const gi::HeightPyramid& anchor, const gi:
         c[j] = std::cos(phi[j]);
         sn[j] = std::sin(phi[j]);
     }
+    const HatDirections hat = hatDirections(phi);
     parallelFor(0, nyr, 4, [&](int Y0, int Y1) {
         constexpr int kV = HorizonAwareBounds::kVariants;
         std::vector<float> gradients(static_cast<std::size_t>(nxr)), columns, perAzimuth(kV * m);
@@ -215,7 +234,7 @@ HorizonAwareBounds horizonAwareBounds(const gi::HeightPyramid& anchor, const gi:
                 texelNormals(gradX, gradY, s, X, Y, normals);
                 for (int w = 0; w < kWeighted; ++w)
                     out.bound[HorizonAwareBounds::IdealExactTangentWeighted + w][r] =
-                        static_cast<float>(weightedAmbientBound(elevationWeight(), normals, phi, sigma.data(),
+                        static_cast<float>(weightedAmbientBound(elevationWeight(), normals, hat, sigma.data(),
                                                                 lo.data() + w * m, hi.data() + w * m));
             }
         }
@@ -233,6 +252,12 @@ TrueSigmaBounds trueSigmaMoveBound(const gi::VisibilityField& last, const gi::Fo
         lastBox.loX.size() != plane || newBox.loX.size() != plane)
         throw InputError("true sigma move: the frames' visibility fields and boxes differ in size");
     TrueSigmaBounds out{std::vector<float>(plane, 0.0f), std::vector<float>(plane, 0.0f)};
+    const HatDirections hat = hatDirections(phi);
+    std::vector<double> cosPhi, sinPhi;
+    for (const double p : phi) {
+        cosPhi.push_back(std::cos(p));
+        sinPhi.push_back(std::sin(p));
+    }
     parallelFor(0, nyr, 8, [&](int Y0, int Y1) {
         std::vector<float> move(m), sigma(m), lo(m), hi(m);
         std::vector<Normal> normals;
@@ -240,10 +265,8 @@ TrueSigmaBounds trueSigmaMoveBound(const gi::VisibilityField& last, const gi::Fo
             for (int X = 0; X < nxr; ++X) {
                 const std::size_t r = static_cast<std::size_t>(Y) * nxr + X;
                 for (int j = 0; j < m; ++j) {
-                    const double c = std::cos(phi[static_cast<std::size_t>(j)]);
-                    const double sn = std::sin(phi[static_cast<std::size_t>(j)]);
-                    const std::size_t at = static_cast<std::size_t>(j) * plane + r;
-                    const std::size_t k = static_cast<std::size_t>(j);
+                    const std::size_t k = static_cast<std::size_t>(j), at = k * plane + r;
+                    const double c = cosPhi[k], sn = sinPhi[k];
                     const float before = std::max(last.maxSlope[at], lowestTangentSlope(lastBox, r, c, sn));
                     const float after = std::max(now.maxSlope[at], lowestTangentSlope(newBox, r, c, sn));
                     move[k] = std::fabs(after - before);
@@ -254,7 +277,7 @@ TrueSigmaBounds trueSigmaMoveBound(const gi::VisibilityField& last, const gi::Fo
                 out.frames[r] = gi::ambientChangeBoundPerAzimuth(move.data(), m, 0.0f, 1.0f, false);
                 texelNormals(gradX, gradY, subsample, X, Y, normals);
                 out.weighted[r] = static_cast<float>(
-                    weightedAmbientBound(elevationWeight(), normals, phi, sigma.data(), lo.data(), hi.data()));
+                    weightedAmbientBound(elevationWeight(), normals, hat, sigma.data(), lo.data(), hi.data()));
             }
     });
     return out;

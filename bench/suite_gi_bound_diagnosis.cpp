@@ -82,6 +82,12 @@ std::vector<double> perTile(const std::vector<const Grid*>& a, const std::vector
     return out;
 }
 
+// The same over the three channels of two colour fields (a direct shade or an indirect light).
+std::vector<double> perTile(const std::array<Grid, 3>& a, const std::array<Grid, 3>& b, const GiState& st, int s,
+                            int T = gi::kVisibilityTile) {
+    return perTile({&a[0], &a[1], &a[2]}, {&b[0], &b[1], &b[2]}, st, s, T);
+}
+
 // One surface sequence (lit or ground only): its GI state and the last frame's.
 struct Track {
     std::string name;
@@ -139,7 +145,7 @@ struct Track {
 // deviation exceeds the tolerance from the truth into the oracle's cache;
 // returns the share of the receivers they hold.
 double refreshTiles(const std::vector<double>& deviation, float tolerance, const GiState& now, int s, int T,
-                    gi::VisibilityField* v, std::array<Grid, 3>* texels, const std::array<Grid, 3>* truth = nullptr) {
+                    gi::VisibilityField* v, std::array<Grid, 3>* texels, const std::array<Grid, 3>* truth) {
     const int tilesX = gi::tileCount(now.pyramid.nxr, T);
     double dirty = 0.0;
     for (std::size_t t = 0; t < deviation.size(); ++t) {
@@ -191,28 +197,27 @@ void oracleFrame(Track& t, const gi::GiSettings& settings, float tolerance, cons
         gi::ShadeMaps cached;
         ambientOfV(t.now, o.v, settings, cached);
         const std::vector<double> v = perTile({&cached.ambient}, {&fresh.ambient}, t.now, s, T);
-        o.vShare.push_back(refreshTiles(v, tolerance, t.now, s, T, &o.v, nullptr));
-        const std::vector<double> ind = perTile(
-            {&o.indirect[0], &o.indirect[1], &o.indirect[2]},
-            {&t.now.indirect.indirect[0], &t.now.indirect.indirect[1], &t.now.indirect.indirect[2]}, t.now, s, T);
+        o.vShare.push_back(refreshTiles(v, tolerance, t.now, s, T, &o.v, nullptr, nullptr));
+        const std::vector<double> ind = perTile(o.indirect, t.now.indirect.indirect, t.now, s, T);
         o.indirectShare.push_back(
             refreshTiles(ind, tolerance, t.now, s, T, nullptr, &o.indirect, &t.now.indirect.indirect));
-        const std::vector<double> shade =
-            perTile({&o.shade[0], &o.shade[1], &o.shade[2]},
-                    {&t.now.shade.rgb[0], &t.now.shade.rgb[1], &t.now.shade.rgb[2]}, t.now, s, T);
+        const std::vector<double> shade = perTile(o.shade, t.now.shade.rgb, t.now, s, T);
         o.shadeShare.push_back(refreshTiles(shade, tolerance, t.now, s, T, nullptr, &o.shade, &t.now.shade.rgb));
     }
 }
 
 // One frame's environment V bound per tile of T x T receivers (what
 // gi/visibility_cache.h adds to a tile's drift), from the height change `dh`;
-// with azimuthsOut, also the per-azimuth slope bounds it comes from
-// (gi::boundSlopeChangePerAzimuth).
+// with azimuthsOut and gradientsOut, also the per-azimuth slope bounds and
+// the gradient bounds it comes from (gi::boundSlopeChangePerAzimuth,
+// gi::boundGradientChange).
 std::vector<float> environmentBounds(const gi::MaxChangePyramid& dh, const gi::HeightPyramid& pyr,
                                      const gi::VisibilitySettings& vis, int T,
-                                     std::vector<float>* azimuthsOut = nullptr) {
-    std::vector<float> own, gradients, scratch, bound;
-    std::vector<float>& azimuths = azimuthsOut ? *azimuthsOut : own;
+                                     std::vector<float>* azimuthsOut = nullptr,
+                                     std::vector<float>* gradientsOut = nullptr) {
+    std::vector<float> ownAzimuths, ownGradients, scratch, bound;
+    std::vector<float>& azimuths = azimuthsOut ? *azimuthsOut : ownAzimuths;
+    std::vector<float>& gradients = gradientsOut ? *gradientsOut : ownGradients;
     gi::boundSlopeChangePerAzimuth(dh, pyr, T, vis.azimuths, azimuths);
     gi::boundGradientChange(dh, pyr, T, gradients);
     gi::environmentBoundPerTile(azimuths, gradients, vis.azimuths, gi::blockingMaxLipschitz(vis.blockingMax), scratch,
@@ -327,14 +332,15 @@ std::array<Grid, 3> indirectOfLastSources(const GiState& now, const GiState& las
 // Per visibility tile, the bound the plan (gi/visibility_cache.h) puts on
 // the geometry's change of the indirect light: V's bound over the indirect
 // scan's azimuths where they are every k-th of the environment's (from the
-// tiles' per-azimuth slope bounds `azimuthBound`), else over every direction.
+// tiles' per-azimuth slope bounds `azimuthBound` and gradient bounds
+// `gradients`, environmentBounds'), else over every direction.
 std::vector<float> geometryBounds(const gi::MaxChangePyramid& dh, const gi::HeightPyramid& pyr,
-                                  const gi::GiSettings& settings, const std::vector<float>& azimuthBound) {
+                                  const gi::GiSettings& settings, const std::vector<float>& azimuthBound,
+                                  const std::vector<float>& gradients) {
     const gi::VisibilitySettings& vis = settings.visibility;
     const int indirect = gi::indirectScanAzimuths(settings);
     const float lipschitz = gi::blockingMaxLipschitz(vis.blockingMax);
-    std::vector<float> gradients, scratch, bound;
-    gi::boundGradientChange(dh, pyr, gi::kVisibilityTile, gradients);
+    std::vector<float> scratch, bound;
     if (vis.azimuths % indirect == 0) {
         gi::environmentBoundPerTile(azimuthBound, gradients, vis.azimuths, lipschitz, scratch, bound,
                                     vis.azimuths / indirect);
@@ -442,9 +448,9 @@ void measureFrame(Track& t, const gi::GiSettings& settings, float cell, float to
     const int nxr = t.now.pyramid.nxr, nyr = t.now.pyramid.nyr;
     // the per-azimuth bound of every visibility tile (the plan takes it only
     // where the coarse one would use much of the tolerance)
-    std::vector<float> tileSlopes;
-    const std::vector<float> tileBound =
-        environmentBounds(cache.change, t.now.pyramid, settings.visibility, gi::kVisibilityTile, &tileSlopes);
+    std::vector<float> tileSlopes, tileGradients;
+    const std::vector<float> tileBound = environmentBounds(cache.change, t.now.pyramid, settings.visibility,
+                                                           gi::kVisibilityTile, &tileSlopes, &tileGradients);
     for (std::size_t g = 0; g < kGranularities.size(); ++g) {
         const int T = kGranularities[g];
         const std::vector<float> bound = T == gi::kVisibilityTile
@@ -468,18 +474,13 @@ void measureFrame(Track& t, const gi::GiSettings& settings, float cell, float to
     ambientOfV(t.now, t.last.envVisibility, settings, cached);
     const int s = settings.subsample;
     const std::vector<double> v = perTile({&cached.ambient}, {&fresh.ambient}, t.now, s);
-    const std::vector<double> ind =
-        perTile({&t.last.indirect.indirect[0], &t.last.indirect.indirect[1], &t.last.indirect.indirect[2]},
-                {&t.now.indirect.indirect[0], &t.now.indirect.indirect[1], &t.now.indirect.indirect[2]}, t.now, s);
+    const std::vector<double> ind = perTile(t.last.indirect.indirect, t.now.indirect.indirect, t.now, s);
     const IndirectBounds ib = indirectBounds(t.now, t.last, gi::indirectScanAzimuths(settings));
     const std::array<Grid, 3> mixed = indirectOfLastSources(t.now, t.last, settings);
-    const std::vector<double> geometry =
-        perTile({&t.last.indirect.indirect[0], &t.last.indirect.indirect[1], &t.last.indirect.indirect[2]},
-                {&mixed[0], &mixed[1], &mixed[2]}, t.now, s);
-    const std::vector<double> sources =
-        perTile({&mixed[0], &mixed[1], &mixed[2]},
-                {&t.now.indirect.indirect[0], &t.now.indirect.indirect[1], &t.now.indirect.indirect[2]}, t.now, s);
-    const std::vector<float> geometryBound = geometryBounds(cache.change, t.now.pyramid, settings, tileSlopes);
+    const std::vector<double> geometry = perTile(t.last.indirect.indirect, mixed, t.now, s);
+    const std::vector<double> sources = perTile(mixed, t.now.indirect.indirect, t.now, s);
+    const std::vector<float> geometryBound =
+        geometryBounds(cache.change, t.now.pyramid, settings, tileSlopes, tileGradients);
     t.indirectGeometryChange.insert(t.indirectGeometryChange.end(), geometry.begin(), geometry.end());
     t.indirectSourceChange.insert(t.indirectSourceChange.end(), sources.begin(), sources.end());
     t.indirectGeometryBound.insert(t.indirectGeometryBound.end(), geometryBound.begin(), geometryBound.end());
